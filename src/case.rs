@@ -1,0 +1,500 @@
+//! Case files: TOML → serde structs (`deny_unknown_fields`) → one validated, typed [`Case`].
+//!
+//! Numbers may be written as TOML numbers or as strings holding an expression of the case's
+//! `[constants]` (e.g. `radius_m = "L/40"`); load components are expressions of the reference
+//! arc length `s` [m], time `t` [s] and the constants (see `src/expr.rs`). Solvers never see
+//! TOML: they receive the [`Case`] built here.
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use serde::Deserialize;
+
+use crate::expr::Expr;
+use crate::loads::Loads;
+use crate::material::{CrossSection, Material, RodProperties};
+use crate::mesh::{Mesh, QuadratureScheme};
+
+/// Errors at the case-file boundary. Every variant names the file; `Invalid` names the key.
+#[derive(Debug, thiserror::Error)]
+pub enum CaseError {
+    #[error("cannot read case file {path}: {source}")]
+    Io { path: PathBuf, source: std::io::Error },
+    #[error("{path}: {message}")]
+    Syntax { path: PathBuf, message: String },
+    #[error("{path}: key `{key}`: {reason}")]
+    Invalid { path: PathBuf, key: String, reason: String },
+}
+
+// ---------------------------------------------------------------- raw (serde) layer
+
+#[derive(Debug, Deserialize, Clone)]
+#[serde(untagged)]
+enum Scalar {
+    Number(f64),
+    Text(String),
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawCase {
+    description: String,
+    #[serde(default)]
+    constants: BTreeMap<String, Scalar>,
+    rod: RawRod,
+    material: RawMaterial,
+    cross_section: RawSection,
+    #[serde(default)]
+    loads: RawLoads,
+    solver: RawSolver,
+    time: Option<RawTime>,
+    compare: RawCompare,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawRod {
+    length_m: Scalar,
+    elements: usize,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawMaterial {
+    young_modulus_pa: Scalar,
+    shear_modulus_pa: Scalar,
+    density_kg_m3: Option<Scalar>,
+    shear_correction: Scalar,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields, tag = "shape", rename_all = "snake_case")]
+enum RawSection {
+    Circle { radius_m: Scalar },
+    Rectangle { width_m: Scalar, height_m: Scalar },
+}
+
+#[derive(Debug, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct RawLoads {
+    force_n_per_m: Option<[Scalar; 3]>,
+    torque_nm_per_m: Option<[Scalar; 3]>,
+    end_force_n: Option<[Scalar; 3]>,
+    end_torque_nm: Option<[Scalar; 3]>,
+}
+
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+enum RawAnalysis {
+    Static,
+    Dynamic,
+}
+
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+enum RawMethod {
+    FixedPoint,
+    Newton,
+}
+
+#[derive(Debug, Deserialize, Clone, Copy)]
+#[serde(rename_all = "snake_case")]
+enum RawQuadrature {
+    Selective,
+    Full,
+    Reduced,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawSolver {
+    analysis: RawAnalysis,
+    #[serde(default = "default_method")]
+    method: RawMethod,
+    #[serde(default = "default_quadrature")]
+    quadrature: RawQuadrature,
+    relaxation: Option<f64>,
+    tolerance: f64,
+    max_iterations: usize,
+}
+fn default_method() -> RawMethod {
+    RawMethod::FixedPoint
+}
+fn default_quadrature() -> RawQuadrature {
+    RawQuadrature::Selective
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawTime {
+    end_s: Scalar,
+    steps: usize,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawCompare {
+    displacement_rel: f64,
+    angles_rel: f64,
+    metric_rel: f64,
+    #[serde(default)]
+    metric_abs: f64,
+    #[serde(default)]
+    iterations_abs: f64,
+}
+
+// ---------------------------------------------------------------- validated layer
+
+/// Static nonlinear solver (D5).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum StaticMethod {
+    /// The paper's relaxed fixed point (§4, Remark 10) with relaxation w ∈ (0, 1].
+    FixedPoint { relaxation: f64 },
+    /// Newton with the exact Jacobian (Rust engine only).
+    Newton,
+}
+
+/// What is solved.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Analysis {
+    Static { method: StaticMethod, tolerance: f64, max_iterations: usize },
+    /// Appendix A time stepping (D6), Newton per step.
+    Dynamic { end_time_s: f64, steps: usize, tolerance: f64, max_iterations: usize },
+}
+
+/// Rust–FreeFEM comparison tolerances (D8).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CompareTolerances {
+    /// max node-wise |Δ(x − x0)| / max |x − x0|
+    pub displacement_rel: f64,
+    /// max node-wise |Δα| / max |α|
+    pub angles_rel: f64,
+    /// scalar metrics: |Δ| ≤ metric_rel·|rust| + metric_abs
+    pub metric_rel: f64,
+    pub metric_abs: f64,
+    /// allowed difference of iteration counts
+    pub iterations_abs: f64,
+}
+
+/// A validated case.
+#[derive(Clone, Debug)]
+pub struct Case {
+    pub name: String,
+    pub description: String,
+    pub source: Option<PathBuf>,
+    pub constants: BTreeMap<String, f64>,
+    pub mesh: Mesh,
+    pub material: Material,
+    pub section: CrossSection,
+    pub props: RodProperties,
+    pub quadrature: QuadratureScheme,
+    pub loads: Loads,
+    pub analysis: Analysis,
+    pub compare: CompareTolerances,
+}
+
+impl Case {
+    /// Read and validate a case file.
+    pub fn from_file(path: &Path) -> Result<Case, CaseError> {
+        let text = std::fs::read_to_string(path).map_err(|source| CaseError::Io { path: path.to_path_buf(), source })?;
+        let name = path.file_stem().and_then(|s| s.to_str()).unwrap_or("case").to_string();
+        let mut case = Case::from_toml(&text, &name, path)?;
+        case.source = Some(path.to_path_buf());
+        Ok(case)
+    }
+
+    /// Parse and validate TOML text; `path` is only used in messages.
+    pub fn from_toml(text: &str, name: &str, path: &Path) -> Result<Case, CaseError> {
+        let raw: RawCase = toml::from_str(text).map_err(|e| CaseError::Syntax { path: path.to_path_buf(), message: e.to_string() })?;
+        Validator { path }.case(raw, name)
+    }
+
+    /// Is this a dynamic case?
+    pub fn is_dynamic(&self) -> bool {
+        matches!(self.analysis, Analysis::Dynamic { .. })
+    }
+}
+
+struct Validator<'a> {
+    path: &'a Path,
+}
+
+impl Validator<'_> {
+    fn err(&self, key: &str, reason: impl Into<String>) -> CaseError {
+        CaseError::Invalid { path: self.path.to_path_buf(), key: key.to_string(), reason: reason.into() }
+    }
+
+    fn scalar(&self, key: &str, v: &Scalar, constants: &BTreeMap<String, f64>) -> Result<f64, CaseError> {
+        let x = match v {
+            Scalar::Number(x) => *x,
+            Scalar::Text(s) => crate::expr::eval_const(s, constants).map_err(|e| self.err(key, e.to_string()))?,
+        };
+        if !x.is_finite() {
+            return Err(self.err(key, format!("value is not finite ({x})")));
+        }
+        Ok(x)
+    }
+
+    fn positive(&self, key: &str, v: &Scalar, constants: &BTreeMap<String, f64>) -> Result<f64, CaseError> {
+        let x = self.scalar(key, v, constants)?;
+        if x <= 0.0 {
+            return Err(self.err(key, format!("must be > 0, got {x}")));
+        }
+        Ok(x)
+    }
+
+    fn expr(&self, key: &str, v: &Scalar, allowed: &[&str], constants: &BTreeMap<String, f64>) -> Result<Expr, CaseError> {
+        let text = match v {
+            Scalar::Number(x) => format!("{x:e}"),
+            Scalar::Text(s) => s.clone(),
+        };
+        let e = Expr::parse(&text).map_err(|e| self.err(key, format!("cannot parse `{text}`: {e}")))?;
+        for var in e.variables() {
+            if !allowed.contains(&var.as_str()) && !constants.contains_key(&var) {
+                return Err(self.err(key, format!("unknown name `{var}` in `{text}` (allowed: {}, or a [constants] entry)", allowed.join(", "))));
+            }
+        }
+        Ok(e)
+    }
+
+    fn vector(&self, key: &str, v: &Option<[Scalar; 3]>, allowed: &[&str], constants: &BTreeMap<String, f64>) -> Result<[Expr; 3], CaseError> {
+        let zero = Scalar::Number(0.0);
+        let items = v.clone().unwrap_or([zero.clone(), zero.clone(), zero]);
+        let mut out = Vec::with_capacity(3);
+        for (i, item) in items.iter().enumerate() {
+            out.push(self.expr(&format!("{key}[{i}]"), item, allowed, constants)?);
+        }
+        Ok([out[0].clone(), out[1].clone(), out[2].clone()])
+    }
+
+    fn case(&self, raw: RawCase, name: &str) -> Result<Case, CaseError> {
+        // Constants are evaluated in order of appearance-independent dependency: allow each to use
+        // earlier (alphabetically resolved) ones by iterating until no progress.
+        let mut constants = BTreeMap::new();
+        let mut pending: Vec<(String, Scalar)> = raw.constants.into_iter().collect();
+        for (k, _) in &pending {
+            if matches!(k.as_str(), "s" | "t" | "pi") || Expr::parse(k).map(|e| e.variables().len() != 1).unwrap_or(true) {
+                return Err(self.err(&format!("constants.{k}"), "not a valid constant name (identifier other than s, t, pi)"));
+            }
+        }
+        while !pending.is_empty() {
+            let before = pending.len();
+            let mut rest = Vec::new();
+            for (k, v) in pending {
+                match self.scalar(&format!("constants.{k}"), &v, &constants) {
+                    Ok(x) => {
+                        constants.insert(k, x);
+                    }
+                    Err(e) => rest.push((k, v, e)),
+                }
+            }
+            if rest.len() == before {
+                return Err(rest.into_iter().next().map(|(_, _, e)| e).expect("non-empty"));
+            }
+            pending = rest.into_iter().map(|(k, v, _)| (k, v)).collect();
+        }
+        let c = &constants;
+
+        let length = self.positive("rod.length_m", &raw.rod.length_m, c)?;
+        if raw.rod.elements < 2 {
+            return Err(self.err("rod.elements", format!("need at least 2 elements, got {}", raw.rod.elements)));
+        }
+        let mesh = Mesh::new(length, raw.rod.elements);
+
+        let analysis_kind = raw.solver.analysis;
+        let density = match (&raw.material.density_kg_m3, analysis_kind) {
+            (Some(d), _) => self.positive("material.density_kg_m3", d, c)?,
+            (None, RawAnalysis::Static) => 1.0,
+            (None, RawAnalysis::Dynamic) => return Err(self.err("material.density_kg_m3", "required for a dynamic analysis")),
+        };
+        let material = Material {
+            young_modulus_pa: self.positive("material.young_modulus_pa", &raw.material.young_modulus_pa, c)?,
+            shear_modulus_pa: self.positive("material.shear_modulus_pa", &raw.material.shear_modulus_pa, c)?,
+            density_kg_m3: density,
+            shear_correction: self.positive("material.shear_correction", &raw.material.shear_correction, c)?,
+        };
+        let section = match &raw.cross_section {
+            RawSection::Circle { radius_m } => CrossSection::Circle { radius_m: self.positive("cross_section.radius_m", radius_m, c)? },
+            RawSection::Rectangle { width_m, height_m } => CrossSection::Rectangle {
+                width_m: self.positive("cross_section.width_m", width_m, c)?,
+                height_m: self.positive("cross_section.height_m", height_m, c)?,
+            },
+        };
+        let props = RodProperties::new(&material, &section);
+
+        let vars: &[&str] = match analysis_kind {
+            RawAnalysis::Static => &["s"],
+            RawAnalysis::Dynamic => &["s", "t"],
+        };
+        let end_vars: &[&str] = match analysis_kind {
+            RawAnalysis::Static => &[],
+            RawAnalysis::Dynamic => &["t"],
+        };
+        let loads = Loads::new(
+            self.vector("loads.force_n_per_m", &raw.loads.force_n_per_m, vars, c)?,
+            self.vector("loads.torque_nm_per_m", &raw.loads.torque_nm_per_m, vars, c)?,
+            self.vector("loads.end_force_n", &raw.loads.end_force_n, end_vars, c)?,
+            self.vector("loads.end_torque_nm", &raw.loads.end_torque_nm, end_vars, c)?,
+            c,
+        )
+        .map_err(|e| self.err("loads", e.to_string()))?;
+
+        let s = &raw.solver;
+        if !(s.tolerance > 0.0 && s.tolerance < 1.0) {
+            return Err(self.err("solver.tolerance", format!("must lie in (0, 1), got {}", s.tolerance)));
+        }
+        if s.max_iterations == 0 {
+            return Err(self.err("solver.max_iterations", "must be ≥ 1"));
+        }
+        let analysis = match analysis_kind {
+            RawAnalysis::Static => {
+                if raw.time.is_some() {
+                    return Err(self.err("time", "only allowed when solver.analysis = \"dynamic\""));
+                }
+                let method = match s.method {
+                    RawMethod::FixedPoint => {
+                        let w = s.relaxation.ok_or_else(|| self.err("solver.relaxation", "required by method = \"fixed_point\""))?;
+                        if !(w > 0.0 && w <= 1.0) {
+                            return Err(self.err("solver.relaxation", format!("must lie in (0, 1], got {w}")));
+                        }
+                        StaticMethod::FixedPoint { relaxation: w }
+                    }
+                    RawMethod::Newton => StaticMethod::Newton,
+                };
+                Analysis::Static { method, tolerance: s.tolerance, max_iterations: s.max_iterations }
+            }
+            RawAnalysis::Dynamic => {
+                if s.method != RawMethod::Newton {
+                    return Err(self.err("solver.method", "a dynamic analysis is solved by \"newton\" per step (D6)"));
+                }
+                if s.relaxation.is_some() {
+                    return Err(self.err("solver.relaxation", "not used by a dynamic analysis"));
+                }
+                let t = raw.time.as_ref().ok_or_else(|| self.err("time", "required when solver.analysis = \"dynamic\""))?;
+                if t.steps == 0 {
+                    return Err(self.err("time.steps", "must be ≥ 1"));
+                }
+                Analysis::Dynamic {
+                    end_time_s: self.positive("time.end_s", &t.end_s, c)?,
+                    steps: t.steps,
+                    tolerance: s.tolerance,
+                    max_iterations: s.max_iterations,
+                }
+            }
+        };
+        let quadrature = match s.quadrature {
+            RawQuadrature::Selective => QuadratureScheme::Selective,
+            RawQuadrature::Full => QuadratureScheme::Full,
+            RawQuadrature::Reduced => QuadratureScheme::Reduced,
+        };
+        let rc = &raw.compare;
+        for (k, v) in [("compare.displacement_rel", rc.displacement_rel), ("compare.angles_rel", rc.angles_rel), ("compare.metric_rel", rc.metric_rel)] {
+            if !(v > 0.0 && v.is_finite()) {
+                return Err(self.err(k, format!("must be > 0, got {v}")));
+            }
+        }
+        for (k, v) in [("compare.metric_abs", rc.metric_abs), ("compare.iterations_abs", rc.iterations_abs)] {
+            if !(v >= 0.0 && v.is_finite()) {
+                return Err(self.err(k, format!("must be ≥ 0, got {v}")));
+            }
+        }
+        Ok(Case {
+            name: name.to_string(),
+            description: raw.description,
+            source: None,
+            constants,
+            mesh,
+            material,
+            section,
+            props,
+            quadrature,
+            loads,
+            analysis,
+            compare: CompareTolerances {
+                displacement_rel: rc.displacement_rel,
+                angles_rel: rc.angles_rel,
+                metric_rel: rc.metric_rel,
+                metric_abs: rc.metric_abs,
+                iterations_abs: rc.iterations_abs,
+            },
+        })
+    }
+}
+
+/// All `*.toml` files of a directory, sorted by name.
+pub fn case_files(dir: &Path) -> std::io::Result<Vec<PathBuf>> {
+    let mut v: Vec<PathBuf> = std::fs::read_dir(dir)?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().map(|x| x == "toml").unwrap_or(false))
+        .collect();
+    v.sort();
+    Ok(v)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const GOOD: &str = r#"
+description = "test"
+[constants]
+F = 1e-8
+L0 = 1e-3
+[rod]
+length_m = "L0"
+elements = 10
+[material]
+young_modulus_pa = 1.1e5
+shear_modulus_pa = 5e4
+shear_correction = "4/3"
+[cross_section]
+shape = "circle"
+radius_m = "L0/40"
+[loads]
+end_force_n = [0, "-F", 0]
+[solver]
+analysis = "static"
+relaxation = 0.5
+tolerance = 1e-10
+max_iterations = 100
+[compare]
+displacement_rel = 1e-6
+angles_rel = 1e-6
+metric_rel = 1e-6
+"#;
+
+    fn parse(text: &str) -> Result<Case, CaseError> {
+        Case::from_toml(text, "t", Path::new("t.toml"))
+    }
+
+    #[test]
+    fn good_case_parses() {
+        let c = parse(GOOD).unwrap();
+        assert_eq!(c.mesh.elements, 10);
+        assert!((c.mesh.length_m - 1e-3).abs() < 1e-18);
+        assert!((c.material.shear_correction - 4.0 / 3.0).abs() < 1e-15);
+        assert!(matches!(c.analysis, Analysis::Static { method: StaticMethod::FixedPoint { relaxation }, .. } if relaxation == 0.5));
+    }
+
+    fn expect_key(text: &str, key: &str) {
+        match parse(text) {
+            Err(CaseError::Invalid { key: k, .. }) => assert_eq!(k, key),
+            other => panic!("expected invalid {key}, got {other:?}"),
+        }
+    }
+
+    #[test]
+    fn bad_values_name_the_key() {
+        expect_key(&GOOD.replace("elements = 10", "elements = 1"), "rod.elements");
+        expect_key(&GOOD.replace("young_modulus_pa = 1.1e5", "young_modulus_pa = -1"), "material.young_modulus_pa");
+        expect_key(&GOOD.replace("\"-F\"", "\"-G*s\""), "loads.end_force_n[1]");
+        expect_key(&GOOD.replace("relaxation = 0.5", "relaxation = 1.5"), "solver.relaxation");
+        expect_key(&GOOD.replace("radius_m = \"L0/40\"", "radius_m = \"L0/(\""), "cross_section.radius_m");
+        expect_key(&GOOD.replace("analysis = \"static\"", "analysis = \"dynamic\""), "material.density_kg_m3");
+    }
+
+    #[test]
+    fn unknown_keys_are_rejected() {
+        let e = parse(&GOOD.replace("elements = 10", "elements = 10\nelement = 3")).unwrap_err();
+        assert!(e.to_string().contains("unknown field `element`"), "{e}");
+    }
+}

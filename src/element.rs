@@ -1,0 +1,328 @@
+//! Pure P1 element kernels (no global state): residuals and tangents of one two-node element.
+//!
+//! Local unknowns are ordered `[x_a, α_a, x_b, α_b]` (12 values). Shape functions on the
+//! element `[s0, s0 + h]`: `N = (1 − ξ, ξ)`, `∂s N = (−1/h, 1/h)`.
+//!
+//! Integrands (see `docs/decisions.md`, D3–D6):
+//!
+//! ```text
+//!   stretch–shear:  ∂sδx · n − δα · (∂s x × n),   n = Qᵀ K (Q ∂s x − e3)        eqs. (13), (40)
+//!   bending:        ∂sδα · m,                      m = Qᵀ J A ∂s α               eqs. (15), (28), (40)
+//!   momentum:       δx · ρA ẋ + δα · Qᵀ I A α̇                                  eqs. (7), (27), (40)
+//!   loads:          δx · f + δα · l                                             eq. (40)
+//! ```
+#![allow(non_snake_case)]
+use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
+
+use crate::material::RodProperties;
+use crate::mesh::{QuadratureScheme, Rule};
+use crate::rotation::{a_matrix, a_matrix_derivatives, rotation, rotation_derivatives, skew};
+
+/// Local element vector (12 entries).
+pub type LocalVec = SVector<f64, 12>;
+/// Local element matrix (12 × 12).
+pub type LocalMat = SMatrix<f64, 12, 12>;
+
+const X: [usize; 2] = [0, 6];
+const ALPHA: [usize; 2] = [3, 9];
+
+/// Fields interpolated at one point of an element.
+#[derive(Clone, Copy, Debug)]
+pub struct PointState {
+    /// shape function values `N_a` at the point
+    pub n: [f64; 2],
+    /// shape function derivatives `∂s N_a` [1/m]
+    pub dn: [f64; 2],
+    pub x: Vector3<f64>,
+    pub dx: Vector3<f64>,
+    pub alpha: Vector3<f64>,
+    pub dalpha: Vector3<f64>,
+}
+
+/// Interpolate the local unknowns `u` at `ξ ∈ [0, 1]` of an element of size `h` [m].
+pub fn interpolate(u: &LocalVec, h: f64, xi: f64) -> PointState {
+    let n = [1.0 - xi, xi];
+    let dn = [-1.0 / h, 1.0 / h];
+    let node = |k: usize, off: usize| Vector3::new(u[k * 6 + off], u[k * 6 + off + 1], u[k * 6 + off + 2]);
+    let (xa, xb, aa, ab) = (node(0, 0), node(1, 0), node(0, 3), node(1, 3));
+    PointState {
+        n,
+        dn,
+        x: xa * n[0] + xb * n[1],
+        dx: xa * dn[0] + xb * dn[1],
+        alpha: aa * n[0] + ab * n[1],
+        dalpha: aa * dn[0] + ab * dn[1],
+    }
+}
+
+fn add_vec(r: &mut LocalVec, off: usize, v: &Vector3<f64>) {
+    for i in 0..3 {
+        r[off + i] += v[i];
+    }
+}
+fn add_mat(t: &mut LocalMat, ro: usize, co: usize, m: &Matrix3<f64>) {
+    for i in 0..3 {
+        for j in 0..3 {
+            t[(ro + i, co + j)] += m[(i, j)];
+        }
+    }
+}
+fn columns(c: [Vector3<f64>; 3]) -> Matrix3<f64> {
+    Matrix3::from_columns(&c)
+}
+
+/// Internal force `G(u)` of one element (D3, with the quadrature split of D4) and, if asked,
+/// its exact tangent `∂G/∂u`.
+pub fn internal_force(
+    props: &RodProperties,
+    scheme: QuadratureScheme,
+    h: f64,
+    u: &LocalVec,
+    mut tangent: Option<&mut LocalMat>,
+) -> LocalVec {
+    let K = Matrix3::from_diagonal(&props.shear_stretch_n);
+    let J = Matrix3::from_diagonal(&props.bend_twist_nm2);
+    let mut r = LocalVec::zeros();
+    for_each_point(&scheme.stretch_shear(), h, u, |p, wh| {
+        let Q = rotation(&p.alpha);
+        let e = Q * p.dx - Vector3::z();
+        let n = Q.transpose() * K * e;
+        let c = p.dx.cross(&n);
+        for a in 0..2 {
+            add_vec(&mut r, X[a], &(n * (wh * p.dn[a])));
+            add_vec(&mut r, ALPHA[a], &(c * (-wh * p.n[a])));
+        }
+        if let Some(t) = tangent.as_deref_mut() {
+            let dQ = rotation_derivatives(&p.alpha);
+            let dn_dx = Q.transpose() * K * Q;
+            let dn_da = columns([0, 1, 2].map(|j| dQ[j].transpose() * K * e + Q.transpose() * K * dQ[j] * p.dx));
+            let dc_dx = -skew(&n) + skew(&p.dx) * dn_dx;
+            let dc_da = skew(&p.dx) * dn_da;
+            for a in 0..2 {
+                for b in 0..2 {
+                    add_mat(t, X[a], X[b], &(dn_dx * (wh * p.dn[a] * p.dn[b])));
+                    add_mat(t, X[a], ALPHA[b], &(dn_da * (wh * p.dn[a] * p.n[b])));
+                    add_mat(t, ALPHA[a], X[b], &(dc_dx * (-wh * p.n[a] * p.dn[b])));
+                    add_mat(t, ALPHA[a], ALPHA[b], &(dc_da * (-wh * p.n[a] * p.n[b])));
+                }
+            }
+        }
+    });
+    for_each_point(&scheme.bending(), h, u, |p, wh| {
+        let Q = rotation(&p.alpha);
+        let A = a_matrix(&p.alpha);
+        let m = Q.transpose() * J * A * p.dalpha;
+        for a in 0..2 {
+            add_vec(&mut r, ALPHA[a], &(m * (wh * p.dn[a])));
+        }
+        if let Some(t) = tangent.as_deref_mut() {
+            let dQ = rotation_derivatives(&p.alpha);
+            let dA = a_matrix_derivatives(&p.alpha);
+            let dm_dda = Q.transpose() * J * A;
+            let dm_da = columns([0, 1, 2].map(|j| (dQ[j].transpose() * J * A + Q.transpose() * J * dA[j]) * p.dalpha));
+            for a in 0..2 {
+                for b in 0..2 {
+                    let blk = dm_dda * (wh * p.dn[a] * p.dn[b]) + dm_da * (wh * p.dn[a] * p.n[b]);
+                    add_mat(t, ALPHA[a], ALPHA[b], &blk);
+                }
+            }
+        }
+    });
+    r
+}
+
+/// The frozen-coefficient linear operator of the paper's fixed point (§4, D5) on one element:
+/// returns `(L, b)` with `L(u_k) û = b(u_k)` (loads excluded from `b`), where `Q_k, A_k, B_k,
+/// q3_k` come from the iterate `u_k`. At a fixed point `L u − b = G(u)`.
+pub fn frozen_operator(props: &RodProperties, scheme: QuadratureScheme, h: f64, uk: &LocalVec) -> (LocalMat, LocalVec) {
+    let K = Matrix3::from_diagonal(&props.shear_stretch_n);
+    let J = Matrix3::from_diagonal(&props.bend_twist_nm2);
+    let k33 = props.shear_stretch_n[2];
+    let mut l = LocalMat::zeros();
+    let mut b = LocalVec::zeros();
+    for_each_point(&scheme.stretch_shear(), h, uk, |p, wh| {
+        let Q = rotation(&p.alpha);
+        let S = Q.transpose() * K * Q;
+        let q3: Vector3<f64> = Q.row(2).transpose();
+        let Bk = skew(&p.dx);
+        for a in 0..2 {
+            add_vec(&mut b, X[a], &(q3 * (wh * p.dn[a] * k33)));
+            add_vec(&mut b, ALPHA[a], &(Bk * q3 * (-wh * p.n[a] * k33)));
+            for c in 0..2 {
+                add_mat(&mut l, X[a], X[c], &(S * (wh * p.dn[a] * p.dn[c])));
+                add_mat(&mut l, ALPHA[a], X[c], &(Bk * S * (-wh * p.n[a] * p.dn[c])));
+            }
+        }
+    });
+    for_each_point(&scheme.bending(), h, uk, |p, wh| {
+        let Q = rotation(&p.alpha);
+        let A = a_matrix(&p.alpha);
+        let C = Q.transpose() * J * A;
+        for a in 0..2 {
+            for c in 0..2 {
+                add_mat(&mut l, ALPHA[a], ALPHA[c], &(C * (wh * p.dn[a] * p.dn[c])));
+            }
+        }
+    });
+    (l, b)
+}
+
+/// Momentum functional `P(u, u̇)` of one element (D6, 2-point Gauss) and optionally its
+/// derivatives with respect to `u` and `u̇`.
+pub fn momentum(
+    props: &RodProperties,
+    scheme: QuadratureScheme,
+    h: f64,
+    u: &LocalVec,
+    udot: &LocalVec,
+    mut d_u: Option<&mut LocalMat>,
+    mut d_udot: Option<&mut LocalMat>,
+) -> LocalVec {
+    let I = Matrix3::from_diagonal(&props.rotary_inertia_kg_m);
+    let rho_a = props.mass_per_length_kg_m;
+    let mut r = LocalVec::zeros();
+    let rule = scheme.loads();
+    for (xi, w) in rule.points.iter().zip(rule.weights) {
+        let p = interpolate(u, h, *xi);
+        let v = interpolate(udot, h, *xi);
+        let wh = w * h;
+        let Q = rotation(&p.alpha);
+        let A = a_matrix(&p.alpha);
+        let H = Q.transpose() * I * A;
+        let px = v.x * rho_a;
+        let pa = H * v.alpha;
+        for a in 0..2 {
+            add_vec(&mut r, X[a], &(px * (wh * p.n[a])));
+            add_vec(&mut r, ALPHA[a], &(pa * (wh * p.n[a])));
+        }
+        if let Some(t) = d_udot.as_deref_mut() {
+            for a in 0..2 {
+                for b in 0..2 {
+                    let nn = wh * p.n[a] * p.n[b];
+                    add_mat(t, X[a], X[b], &(Matrix3::identity() * (rho_a * nn)));
+                    add_mat(t, ALPHA[a], ALPHA[b], &(H * nn));
+                }
+            }
+        }
+        if let Some(t) = d_u.as_deref_mut() {
+            let dQ = rotation_derivatives(&p.alpha);
+            let dA = a_matrix_derivatives(&p.alpha);
+            let dp_da = columns([0, 1, 2].map(|j| (dQ[j].transpose() * I * A + Q.transpose() * I * dA[j]) * v.alpha));
+            for a in 0..2 {
+                for b in 0..2 {
+                    add_mat(t, ALPHA[a], ALPHA[b], &(dp_da * (wh * p.n[a] * p.n[b])));
+                }
+            }
+        }
+    }
+    r
+}
+
+/// Distributed loads of one element starting at `s0` [m]: `∫ N_a f`, `∫ N_a l` with the load
+/// rule of D4; `field(s, out_f, out_l)` fills the global force [N/m] and torque [N m/m] at `s`.
+pub fn distributed_load(scheme: QuadratureScheme, h: f64, s0: f64, field: &mut dyn FnMut(f64) -> (Vector3<f64>, Vector3<f64>)) -> LocalVec {
+    let mut r = LocalVec::zeros();
+    let rule = scheme.loads();
+    for (xi, w) in rule.points.iter().zip(rule.weights) {
+        let (f, l) = field(s0 + xi * h);
+        let n = [1.0 - xi, *xi];
+        for a in 0..2 {
+            add_vec(&mut r, X[a], &(f * (w * h * n[a])));
+            add_vec(&mut r, ALPHA[a], &(l * (w * h * n[a])));
+        }
+    }
+    r
+}
+
+fn for_each_point(rule: &Rule, h: f64, u: &LocalVec, mut f: impl FnMut(&PointState, f64)) {
+    for (xi, w) in rule.points.iter().zip(rule.weights) {
+        let p = interpolate(u, h, *xi);
+        f(&p, w * h);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::material::{CrossSection, Material, RodProperties};
+
+    fn props() -> RodProperties {
+        let mat = Material { young_modulus_pa: 7.1e10, shear_modulus_pa: 2.69e10, density_kg_m3: 2.73e3, shear_correction: 0.833 };
+        RodProperties::new(&mat, &CrossSection::Rectangle { width_m: 0.06, height_m: 0.04 })
+    }
+
+    fn state() -> LocalVec {
+        let h = 0.1;
+        LocalVec::from_column_slice(&[0.01, -0.02, 0.0, 0.3, -0.5, 0.2, 0.03, 0.01, h * 1.01, 0.45, -0.35, 0.4])
+    }
+
+    fn fd_check(f: &dyn Fn(&LocalVec) -> LocalVec, t: &LocalMat, u: &LocalVec) {
+        let eps = 1e-7;
+        let scale = t.amax();
+        for j in 0..12 {
+            let mut up = *u;
+            up[j] += eps;
+            let mut um = *u;
+            um[j] -= eps;
+            let col = (f(&up) - f(&um)) / (2.0 * eps);
+            let err = (col - t.column(j)).amax();
+            assert!(err < 1e-6 * scale, "column {j}: fd error {err:e}, scale {scale:e}");
+        }
+    }
+
+    #[test]
+    fn internal_force_tangent_matches_fd() {
+        let p = props();
+        for scheme in [QuadratureScheme::Selective, QuadratureScheme::Full, QuadratureScheme::Reduced] {
+            let u = state();
+            let mut t = LocalMat::zeros();
+            internal_force(&p, scheme, 0.1, &u, Some(&mut t));
+            fd_check(&|v| internal_force(&p, scheme, 0.1, v, None), &t, &u);
+        }
+    }
+
+    #[test]
+    fn momentum_derivatives_match_fd() {
+        let p = props();
+        let u = state();
+        let udot = LocalVec::from_fn(|i, _| 0.1 * (i as f64 + 1.0).sin());
+        let mut du = LocalMat::zeros();
+        let mut dv = LocalMat::zeros();
+        momentum(&p, QuadratureScheme::Selective, 0.1, &u, &udot, Some(&mut du), Some(&mut dv));
+        fd_check(&|v| momentum(&p, QuadratureScheme::Selective, 0.1, v, &udot, None, None), &du, &u);
+        fd_check(&|w| momentum(&p, QuadratureScheme::Selective, 0.1, &u, w, None, None), &dv, &udot);
+    }
+
+    #[test]
+    fn frozen_operator_is_consistent_with_the_residual() {
+        // L(u) u − b(u) = G(u): the fixed point of §4 solves the discrete equations of D3.
+        let p = props();
+        for scheme in [QuadratureScheme::Selective, QuadratureScheme::Full] {
+            let u = state();
+            let (l, b) = frozen_operator(&p, scheme, 0.1, &u);
+            let g = internal_force(&p, scheme, 0.1, &u, None);
+            assert!((l * u - b - g).amax() < 1e-9 * g.amax());
+        }
+    }
+
+    #[test]
+    fn rigid_motions_cost_nothing() {
+        // Stress-free state: straight along e3 with α = 0, translated → zero internal force.
+        let p = props();
+        let h = 0.1;
+        let u = LocalVec::from_column_slice(&[1.0, 2.0, 3.0, 0.0, 0.0, 0.0, 1.0, 2.0, 3.0 + h, 0.0, 0.0, 0.0]);
+        let g = internal_force(&p, QuadratureScheme::Selective, h, &u, None);
+        assert!(g.amax() < 1e-6, "{g}");
+        // Rigid rotation: x' = d3(α) with constant α → also stress free.
+        let a = Vector3::new(0.3, 0.4, -0.2);
+        let d3 = crate::rotation::d3(&a);
+        let mut u = LocalVec::zeros();
+        for k in 0..3 {
+            u[6 + k] = h * d3[k];
+            u[3 + k] = a[k];
+            u[9 + k] = a[k];
+        }
+        let g = internal_force(&p, QuadratureScheme::Full, h, &u, None);
+        assert!(g.amax() < 1e-6, "{g}");
+    }
+}

@@ -1,0 +1,63 @@
+//! External loads of eq. (40): distributed force `f(s,t)` [N/m] and torque `l(s,t)` [N m/m]
+//! (global frame), and dead end loads at `s = L`: force [N] and torque [N m]. Components are
+//! expressions compiled once; evaluation does no string lookups.
+use std::collections::BTreeMap;
+
+use nalgebra::Vector3;
+
+use crate::expr::{Compiled, Expr, ExprError};
+
+/// Slot layout of compiled load expressions: `s`, `t`, then the constants in name order.
+const FIXED: [&str; 2] = ["s", "t"];
+
+/// Parsed and compiled load expressions of a case.
+#[derive(Clone, Debug)]
+pub struct Loads {
+    /// Source expressions, kept for the FreeFEM include file: force, torque, end force, end torque.
+    pub exprs: [[Expr; 3]; 4],
+    compiled: Vec<Compiled>,
+    /// slot values: s, t, constants...
+    slots: Vec<f64>,
+}
+
+impl Loads {
+    pub fn new(force: [Expr; 3], torque: [Expr; 3], end_force: [Expr; 3], end_torque: [Expr; 3], constants: &BTreeMap<String, f64>) -> Result<Self, ExprError> {
+        let names: Vec<&str> = FIXED.iter().copied().chain(constants.keys().map(|k| k.as_str())).collect();
+        let exprs = [force, torque, end_force, end_torque];
+        let mut compiled = Vec::with_capacity(12);
+        for group in &exprs {
+            for e in group {
+                compiled.push(e.compile(&names)?);
+            }
+        }
+        let slots = [0.0, 0.0].into_iter().chain(constants.values().copied()).collect();
+        Ok(Loads { exprs, compiled, slots })
+    }
+
+    fn eval3(&self, group: usize, s: f64, t: f64) -> Vector3<f64> {
+        let mut slots = self.slots.clone();
+        slots[0] = s;
+        slots[1] = t;
+        Vector3::new(
+            self.compiled[3 * group].eval(&slots),
+            self.compiled[3 * group + 1].eval(&slots),
+            self.compiled[3 * group + 2].eval(&slots),
+        )
+    }
+
+    /// Distributed force [N/m] and torque [N m/m] at `(s, t)`.
+    pub fn distributed(&self, s: f64, t: f64) -> (Vector3<f64>, Vector3<f64>) {
+        (self.eval3(0, s, t), self.eval3(1, s, t))
+    }
+
+    /// End force [N] and end torque [N m] at time `t`.
+    pub fn end(&self, t: f64) -> (Vector3<f64>, Vector3<f64>) {
+        (self.eval3(2, 0.0, t), self.eval3(3, 0.0, t))
+    }
+
+    /// True when all distributed components are the literal zero (skip their quadrature).
+    pub fn has_distributed(&self) -> bool {
+        let zero = |e: &Expr| e.variables().is_empty() && e.eval(&|_| None).map(|v| v == 0.0).unwrap_or(false);
+        self.exprs[0].iter().chain(self.exprs[1].iter()).any(|e| !zero(e))
+    }
+}

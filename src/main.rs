@@ -1,0 +1,190 @@
+//! `cosserat` command-line interface (thin: parsing, progress and printing only).
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use anyhow::{Context, Result};
+use clap::{Parser, Subcommand};
+use indicatif::{ProgressBar, ProgressStyle};
+
+use cosserat::case::{case_files, Case};
+use cosserat::metrics::{all_metrics, compare};
+use cosserat::output::write_run;
+use cosserat::run::{run, Engine, RunResult};
+use cosserat::solve::modes::modal_model;
+use cosserat::solve::Problem;
+
+/// Forward Cosserat rods after Wang et al. (Comput. Mech. 71, 2023), in Rust and FreeFEM.
+#[derive(Parser, Debug)]
+#[command(name = "cosserat", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Run a case and write fields (CSV), metrics.json and plot.svg.
+    Run {
+        /// Case file (TOML), e.g. cases/timoshenko_10pct.toml
+        case: PathBuf,
+        /// Which engine to run
+        #[arg(long, value_enum, default_value_t = Engine::Rust)]
+        engine: Engine,
+        /// Output directory [default: out/<case name>/<engine>]
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Do not show a progress bar
+        #[arg(long)]
+        quiet: bool,
+    },
+    /// Run both engines and compare their metrics; exit status 1 if any row fails.
+    Compare {
+        /// Case file (TOML)
+        case: PathBuf,
+        /// Directory for both engines' outputs [default: out/<case name>]
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
+    /// List the cases of a directory with their descriptions.
+    List {
+        /// Directory holding *.toml case files
+        #[arg(default_value = "cases")]
+        dir: PathBuf,
+    },
+    /// Natural frequencies of the rod linearised about its rest state (clamped at s = 0).
+    Modes {
+        /// Case file (TOML); loads and time settings are ignored
+        case: PathBuf,
+        /// How many modes to print
+        #[arg(long, default_value_t = 10)]
+        count: usize,
+    },
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match dispatch(cli) {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::from(1)
+        }
+    }
+}
+
+fn dispatch(cli: Cli) -> Result<ExitCode> {
+    match cli.command {
+        Command::Run { case, engine, out, quiet } => cmd_run(&case, engine, out, quiet),
+        Command::Compare { case, out } => cmd_compare(&case, out),
+        Command::List { dir } => cmd_list(&dir),
+        Command::Modes { case, count } => cmd_modes(&case, count),
+    }
+}
+
+fn load(path: &Path) -> Result<Case> {
+    Ok(Case::from_file(path)?)
+}
+
+fn progress_bar(quiet: bool, label: &str) -> ProgressBar {
+    if quiet {
+        return ProgressBar::hidden();
+    }
+    let pb = ProgressBar::new(0);
+    pb.set_style(ProgressStyle::with_template("{prefix} [{bar:40}] {pos}/{len} {per_sec} eta {eta}").unwrap_or_else(|_| ProgressStyle::default_bar()).progress_chars("=> "));
+    pb.set_prefix(label.to_string());
+    pb
+}
+
+fn run_engine(case: &Case, engine: Engine, dir: &Path, quiet: bool) -> Result<RunResult> {
+    let pb = progress_bar(quiet || engine == Engine::Freefem, &format!("{} [{engine}]", case.name));
+    if engine == Engine::Freefem && !quiet {
+        eprintln!("{} [freefem]: running FreeFEM in {}", case.name, dir.display());
+    }
+    let result = run(case, engine, &dir.join("freefem_work"), |done, total| {
+        pb.set_length(total as u64);
+        pb.set_position(done as u64);
+    });
+    pb.finish_and_clear();
+    Ok(result.with_context(|| format!("case {}", case.name))?)
+}
+
+fn cmd_run(path: &Path, engine: Engine, out: Option<PathBuf>, quiet: bool) -> Result<ExitCode> {
+    let case = load(path)?;
+    let dir = out.unwrap_or_else(|| PathBuf::from("out").join(&case.name).join(engine.to_string()));
+    let r = run_engine(&case, engine, &dir, quiet)?;
+    let m = all_metrics(&case, &r);
+    let written = write_run(&case, &r, &m, &dir)?;
+    let tip = r.nodes.x.last().copied().unwrap_or_default();
+    println!(
+        "{} [{engine}]: tip = ({:.6e}, {:.6e}, {:.6e}) m, {} iterations, {:.3} s; wrote {} files to {}",
+        case.name,
+        tip[0],
+        tip[1],
+        tip[2],
+        r.stats.iterations,
+        r.stats.wall_time_s,
+        written.len(),
+        dir.display()
+    );
+    Ok(ExitCode::SUCCESS)
+}
+
+fn cmd_compare(path: &Path, out: Option<PathBuf>) -> Result<ExitCode> {
+    let case = load(path)?;
+    let dir = out.unwrap_or_else(|| PathBuf::from("out").join(&case.name));
+    let rust = run_engine(&case, Engine::Rust, &dir.join("rust"), false)?;
+    write_run(&case, &rust, &all_metrics(&case, &rust), &dir.join("rust"))?;
+    let ff = run_engine(&case, Engine::Freefem, &dir.join("freefem"), false)?;
+    write_run(&case, &ff, &all_metrics(&case, &ff), &dir.join("freefem"))?;
+    let rows = compare(&case, &rust, &ff);
+    println!("{:<34} {:>15} {:>15} {:>11} {:>11}  result", "metric", "rust", "freefem", "|diff|", "tolerance");
+    let mut failed = 0;
+    for r in &rows {
+        let verdict = if r.passed() { "PASS" } else { "FAIL" };
+        failed += usize::from(!r.passed());
+        println!("{:<34} {:>15.8e} {:>15.8e} {:>11.3e} {:>11.3e}  {verdict}", r.name, r.rust, r.freefem, r.difference, r.tolerance);
+    }
+    println!(
+        "wall time: rust {:.3} s, freefem {:.3} s (ratio freefem/rust {:.1})",
+        rust.stats.wall_time_s,
+        ff.stats.wall_time_s,
+        ff.stats.wall_time_s / rust.stats.wall_time_s
+    );
+    Ok(if failed == 0 { ExitCode::SUCCESS } else { ExitCode::from(1) })
+}
+
+fn cmd_list(dir: &Path) -> Result<ExitCode> {
+    let files = case_files(dir).with_context(|| format!("cannot list {}", dir.display()))?;
+    if files.is_empty() {
+        anyhow::bail!("no *.toml case files in {}", dir.display());
+    }
+    for f in files {
+        match Case::from_file(&f) {
+            Ok(c) => println!("{:<24} {}", c.name, c.description),
+            Err(e) => println!("{:<24} INVALID: {e}", f.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default()),
+        }
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn cmd_modes(path: &Path, count: usize) -> Result<ExitCode> {
+    let case = load(path)?;
+    let model = modal_model(&Problem::from_case(&case))?;
+    println!("{}: natural frequencies of the linearised rod (clamped at s = 0, {} elements)", case.name, case.mesh.elements);
+    println!("{:>4} {:>16} {:>14}", "mode", "omega_rad_per_s", "f_hz");
+    for (i, w) in model.omegas.iter().take(count).enumerate() {
+        println!("{:>4} {:>16.6} {:>14.6}", i + 1, w, w / (2.0 * std::f64::consts::PI));
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::CommandFactory;
+
+    #[test]
+    fn cli_is_consistent() {
+        Cli::command().debug_assert();
+    }
+}

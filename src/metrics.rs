@@ -1,0 +1,113 @@
+//! Metrics of a run (one function for both engines) and the Rust–FreeFEM comparison (D8).
+use std::collections::BTreeMap;
+
+use crate::case::{Case, CompareTolerances};
+use crate::run::RunResult;
+
+/// Flat map metric name → value (`metrics.json`). Names carry SI units.
+pub type Metrics = BTreeMap<String, f64>;
+
+/// Physical metrics compared between engines.
+pub fn physical_metrics(case: &Case, r: &RunResult) -> Metrics {
+    let mut m = Metrics::new();
+    let last = r.nodes.x.len() - 1;
+    let (x, a) = (r.nodes.x[last], r.nodes.alpha[last]);
+    let _ = case;
+    for (k, name) in ["x", "y", "z"].iter().enumerate() {
+        m.insert(format!("tip_{name}_m"), x[k]);
+    }
+    for (k, name) in ["alpha", "beta", "gamma"].iter().enumerate() {
+        m.insert(format!("tip_{name}_rad"), a[k]);
+    }
+    if !r.tip.is_empty() {
+        let max_abs = |k: usize| r.tip.iter().fold(0.0_f64, |acc, t| acc.max(t.position_m[k].abs()));
+        m.insert("tip_max_abs_x_m".into(), max_abs(0));
+        m.insert("tip_max_abs_y_m".into(), max_abs(1));
+        let max_abs_a = |k: usize| r.tip.iter().fold(0.0_f64, |acc, t| acc.max(t.angles_rad[k].abs()));
+        m.insert("tip_max_abs_beta_rad".into(), max_abs_a(1));
+        m.insert("tip_max_abs_gamma_rad".into(), max_abs_a(2));
+    }
+    m
+}
+
+/// All metrics written to `metrics.json`: physical ones plus solver statistics.
+pub fn all_metrics(case: &Case, r: &RunResult) -> Metrics {
+    let mut m = physical_metrics(case, r);
+    m.insert("iterations".into(), r.stats.iterations as f64);
+    if let Some(v) = r.stats.last_change {
+        m.insert("last_change".into(), v);
+    }
+    if let Some(v) = r.stats.residual {
+        m.insert("relative_residual".into(), v);
+    }
+    if let Some(v) = r.stats.max_newton_iterations {
+        m.insert("max_newton_iterations".into(), v as f64);
+    }
+    m.insert("wall_time_s".into(), r.stats.wall_time_s);
+    m
+}
+
+/// One row of `cosserat compare`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ComparisonRow {
+    pub name: String,
+    pub rust: f64,
+    pub freefem: f64,
+    pub difference: f64,
+    pub tolerance: f64,
+}
+
+impl ComparisonRow {
+    pub fn passed(&self) -> bool {
+        self.difference <= self.tolerance
+    }
+}
+
+/// `max_i |a_i − b_i| / max_i |a_i|` over 3-vectors (D8); 0 when both are identically zero.
+pub fn max_relative_difference(a: &[nalgebra::Vector3<f64>], b: &[nalgebra::Vector3<f64>]) -> f64 {
+    let scale = a.iter().fold(0.0_f64, |m, v| m.max(v.amax()));
+    let diff = a.iter().zip(b).fold(0.0_f64, |m, (u, v)| m.max((u - v).amax()));
+    if diff == 0.0 {
+        0.0
+    } else if scale == 0.0 {
+        f64::INFINITY
+    } else {
+        diff / scale
+    }
+}
+
+/// Rows comparing a Rust and a FreeFEM run of the same case.
+pub fn compare(case: &Case, rust: &RunResult, ff: &RunResult) -> Vec<ComparisonRow> {
+    let tol: &CompareTolerances = &case.compare;
+    let mut rows = Vec::new();
+    let nodes_match = rust.nodes.s.len() == ff.nodes.s.len();
+    let field = |name: &str, value: f64, tolerance: f64| ComparisonRow { name: name.into(), rust: 0.0, freefem: 0.0, difference: value, tolerance };
+    if nodes_match {
+        rows.push(field(
+            "nodewise_rel_diff_displacement",
+            max_relative_difference(&rust.nodes.displacement(), &ff.nodes.displacement()),
+            tol.displacement_rel,
+        ));
+        rows.push(field("nodewise_rel_diff_angles", max_relative_difference(&rust.nodes.alpha, &ff.nodes.alpha), tol.angles_rel));
+    } else {
+        rows.push(field("node_count", f64::INFINITY, 0.0));
+    }
+    let (mr, mf) = (physical_metrics(case, rust), physical_metrics(case, ff));
+    for (name, &a) in &mr {
+        let b = mf.get(name).copied().unwrap_or(f64::NAN);
+        let d = (a - b).abs();
+        rows.push(ComparisonRow { name: name.clone(), rust: a, freefem: b, difference: if d.is_nan() { f64::INFINITY } else { d }, tolerance: tol.metric_rel * a.abs() + tol.metric_abs });
+    }
+    if rust.tip.len() == ff.tip.len() && !rust.tip.is_empty() {
+        let a: Vec<_> = rust.tip.iter().map(|t| t.position_m).collect();
+        let b: Vec<_> = ff.tip.iter().map(|t| t.position_m).collect();
+        let a0: Vec<_> = a.iter().map(|p| p - a[0]).collect();
+        let b0: Vec<_> = b.iter().map(|p| p - b[0]).collect();
+        rows.push(field("tip_history_rel_diff", max_relative_difference(&a0, &b0), tol.displacement_rel));
+    }
+    if rust.history.len() + ff.history.len() > 0 {
+        let (a, b) = (rust.stats.iterations as f64, ff.stats.iterations as f64);
+        rows.push(ComparisonRow { name: "iterations".into(), rust: a, freefem: b, difference: (a - b).abs(), tolerance: tol.iterations_abs });
+    }
+    rows
+}

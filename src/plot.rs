@@ -1,0 +1,517 @@
+//! Thin helpers over plotters' SVG backend: line plots (optionally log
+//! axes) and grids of sub-plots. Files are written atomically (temporary
+//! file in the target directory, then rename).
+
+use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use std::io::Write;
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+use thiserror::Error;
+
+/// Size of a single plot in pixels (width, height).
+pub const PLOT_SIZE: (u32, u32) = (900, 600);
+/// Fractional margin added on each side of the data range.
+pub const RANGE_MARGIN: f64 = 0.05;
+
+/// One curve: `y[i]` against `x[i]`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Series {
+    /// Legend entry.
+    pub label: String,
+    /// Abscissae (any unit; same length as `y`).
+    pub x: Vec<f64>,
+    /// Ordinates.
+    pub y: Vec<f64>,
+}
+
+/// A 2-D line chart. Non-finite points (and non-positive values on a log
+/// axis) are skipped; lines break at skipped points.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct LinePlot {
+    /// Caption above the chart.
+    pub title: String,
+    /// x-axis description (include the unit, e.g. `"s [m]"`).
+    pub x_label: String,
+    /// y-axis description (include the unit).
+    pub y_label: String,
+    /// Curves, drawn in order with distinct colours.
+    pub series: Vec<Series>,
+    /// Logarithmic x axis.
+    pub log_x: bool,
+    /// Logarithmic y axis.
+    pub log_y: bool,
+}
+
+/// Errors from the plotting helpers.
+#[derive(Debug, Error)]
+pub enum PlotError {
+    /// The plot has no series at all.
+    #[error("plot '{title}' has no series")]
+    NoSeries { title: String },
+    /// A series with zero points.
+    #[error("series '{series}' of plot '{title}' is empty")]
+    EmptySeries { title: String, series: String },
+    /// `x` and `y` lengths differ.
+    #[error("series '{series}' of plot '{title}' has {x_len} x values but {y_len} y values")]
+    LengthMismatch {
+        title: String,
+        series: String,
+        x_len: usize,
+        y_len: usize,
+    },
+    /// Every point is non-finite (or non-positive on a log axis).
+    #[error("plot '{title}' has no plottable point (log_x = {log_x}, log_y = {log_y}; non-finite and, on log axes, non-positive values are dropped)")]
+    NoPlottablePoints {
+        title: String,
+        log_x: bool,
+        log_y: bool,
+    },
+    /// `write_panels_svg` called with no panels or zero columns.
+    #[error("invalid panel grid: {panels} panel(s) in {cols} column(s)")]
+    InvalidGrid { panels: usize, cols: usize },
+    /// Drawing failed inside plotters.
+    #[error("drawing plot '{title}' failed: {detail}")]
+    Draw { title: String, detail: String },
+    /// Creating, writing or renaming the output file failed.
+    #[error("cannot write '{}': {source}", path.display())]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+}
+
+fn draw_err(title: &str, e: impl std::fmt::Display) -> PlotError {
+    PlotError::Draw {
+        title: title.to_string(),
+        detail: e.to_string(),
+    }
+}
+
+fn keep(v: f64, log: bool) -> bool {
+    v.is_finite() && (!log || v > 0.0)
+}
+
+/// Validates `plot` and returns the padded (x, y) ranges.
+fn ranges(plot: &LinePlot) -> Result<(Range<f64>, Range<f64>), PlotError> {
+    if plot.series.is_empty() {
+        return Err(PlotError::NoSeries {
+            title: plot.title.clone(),
+        });
+    }
+    let (mut x0, mut x1, mut y0, mut y1) = (
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+    );
+    for s in &plot.series {
+        if s.x.len() != s.y.len() {
+            return Err(PlotError::LengthMismatch {
+                title: plot.title.clone(),
+                series: s.label.clone(),
+                x_len: s.x.len(),
+                y_len: s.y.len(),
+            });
+        }
+        if s.x.is_empty() {
+            return Err(PlotError::EmptySeries {
+                title: plot.title.clone(),
+                series: s.label.clone(),
+            });
+        }
+        for (&x, &y) in s.x.iter().zip(&s.y) {
+            if keep(x, plot.log_x) && keep(y, plot.log_y) {
+                (x0, x1, y0, y1) = (x0.min(x), x1.max(x), y0.min(y), y1.max(y));
+            }
+        }
+    }
+    if x0 > x1 {
+        return Err(PlotError::NoPlottablePoints {
+            title: plot.title.clone(),
+            log_x: plot.log_x,
+            log_y: plot.log_y,
+        });
+    }
+    Ok((pad(x0, x1, plot.log_x), pad(y0, y1, plot.log_y)))
+}
+
+/// Adds a margin (multiplicative on log axes); widens a zero-width range.
+fn pad(lo: f64, hi: f64, log: bool) -> Range<f64> {
+    if log {
+        let (a, b) = (lo.log10(), hi.log10());
+        let m = if b > a { RANGE_MARGIN * (b - a) } else { 0.5 };
+        return 10f64.powf(a - m)..10f64.powf(b + m);
+    }
+    if hi > lo {
+        let m = RANGE_MARGIN * (hi - lo);
+        (lo - m)..(hi + m)
+    } else {
+        let m = if lo == 0.0 { 1.0 } else { 0.1 * lo.abs() };
+        (lo - m)..(hi + m)
+    }
+}
+
+/// Draws one plot into `area` with the given coordinate specs.
+fn draw_with<DB, X, Y>(
+    area: &DrawingArea<DB, Shift>,
+    plot: &LinePlot,
+    xs: X,
+    ys: Y,
+) -> Result<(), PlotError>
+where
+    DB: DrawingBackend,
+    X: AsRangedCoord<Value = f64>,
+    Y: AsRangedCoord<Value = f64>,
+    X::CoordDescType: ValueFormatter<f64>,
+    Y::CoordDescType: ValueFormatter<f64>,
+{
+    let t = plot.title.as_str();
+    let mut chart = ChartBuilder::on(area)
+        .caption(t, ("sans-serif", 22))
+        .margin(12)
+        .x_label_area_size(45)
+        .y_label_area_size(75)
+        .build_cartesian_2d(xs, ys)
+        .map_err(|e| draw_err(t, e))?;
+    chart
+        .configure_mesh()
+        .x_desc(plot.x_label.as_str())
+        .y_desc(plot.y_label.as_str())
+        .x_label_formatter(&|v| format_tick(*v))
+        .y_label_formatter(&|v| format_tick(*v))
+        .draw()
+        .map_err(|e| draw_err(t, e))?;
+    for (i, s) in plot.series.iter().enumerate() {
+        let color = Palette99::pick(i).to_rgba();
+        // Split into runs of plottable points so lines break at gaps.
+        let mut runs: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
+        for (&x, &y) in s.x.iter().zip(&s.y) {
+            if keep(x, plot.log_x) && keep(y, plot.log_y) {
+                if let Some(r) = runs.last_mut() {
+                    r.push((x, y));
+                }
+            } else if runs.last().is_some_and(|r| !r.is_empty()) {
+                runs.push(Vec::new());
+            }
+        }
+        let mut labelled = false;
+        for run in runs.into_iter().filter(|r| !r.is_empty()) {
+            let style = ShapeStyle::from(color).stroke_width(2);
+            let drawn = chart
+                .draw_series(LineSeries::new(run, style))
+                .map_err(|e| draw_err(t, e))?;
+            if !labelled {
+                drawn
+                    .label(s.label.as_str())
+                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+                labelled = true;
+            }
+        }
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .draw()
+        .map_err(|e| draw_err(t, e))?;
+    Ok(())
+}
+
+/// Compact tick labels: plain decimals for moderate magnitudes, else `1.5e-3`.
+fn format_tick(v: f64) -> String {
+    let a = v.abs();
+    if a == 0.0 {
+        "0".to_string()
+    } else if (1e-3..1e4).contains(&a) {
+        let s = format!("{v:.4}");
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        let s = format!("{v:.2e}");
+        match s.split_once('e') {
+            Some((m, e)) => format!("{}e{e}", m.trim_end_matches('0').trim_end_matches('.')),
+            None => s,
+        }
+    }
+}
+
+fn draw_plot<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    plot: &LinePlot,
+) -> Result<(), PlotError> {
+    let (xr, yr) = ranges(plot)?;
+    match (plot.log_x, plot.log_y) {
+        (false, false) => draw_with(area, plot, xr, yr),
+        (true, false) => draw_with(area, plot, xr.log_scale(), yr),
+        (false, true) => draw_with(area, plot, xr, yr.log_scale()),
+        (true, true) => draw_with(area, plot, xr.log_scale(), yr.log_scale()),
+    }
+}
+
+static TMP_COUNTER: AtomicU64 = AtomicU64::new(0);
+
+/// Writes `contents` to `path` via a temporary sibling file and a rename.
+fn write_atomic(path: &Path, contents: &str) -> Result<(), PlotError> {
+    let io = |source| PlotError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let name = path.file_name().ok_or_else(|| {
+        io(std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            "path has no file name",
+        ))
+    })?;
+    let n = TMP_COUNTER.fetch_add(1, Ordering::Relaxed);
+    let tmp = path.with_file_name(format!(
+        ".{}.{}.{n}.tmp",
+        name.to_string_lossy(),
+        std::process::id()
+    ));
+    let result = std::fs::File::create(&tmp)
+        .and_then(|mut f| {
+            f.write_all(contents.as_bytes())?;
+            f.sync_all()
+        })
+        .and_then(|_| std::fs::rename(&tmp, path));
+    if let Err(e) = result {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(io(e));
+    }
+    Ok(())
+}
+
+/// Renders `draw` into an in-memory SVG of `size` pixels.
+fn render(
+    size: (u32, u32),
+    title: &str,
+    draw: impl FnOnce(&DrawingArea<SVGBackend, Shift>) -> Result<(), PlotError>,
+) -> Result<String, PlotError> {
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| draw_err(title, e))?;
+        draw(&root)?;
+        root.present().map_err(|e| draw_err(title, e))?;
+    }
+    Ok(svg)
+}
+
+/// Writes `plot` as a 900×600 SVG at `path` (with legend, axis labels and
+/// auto ranges padded by [`RANGE_MARGIN`]). Nothing is left at `path` if
+/// it fails.
+pub fn write_svg(plot: &LinePlot, path: &Path) -> Result<(), PlotError> {
+    ranges(plot)?; // validate before rendering
+    let svg = render(PLOT_SIZE, &plot.title, |root| draw_plot(root, plot))?;
+    write_atomic(path, &svg)
+}
+
+/// Writes `panels` as a grid with `cols` columns (rows as needed) into one
+/// SVG at `path`; each panel is 900×600 scaled to fit a width of at most
+/// 1800 px. Errors if any panel is invalid, `panels` is empty or `cols` is 0.
+pub fn write_panels_svg(panels: &[LinePlot], cols: usize, path: &Path) -> Result<(), PlotError> {
+    if panels.is_empty() || cols == 0 {
+        return Err(PlotError::InvalidGrid {
+            panels: panels.len(),
+            cols,
+        });
+    }
+    for p in panels {
+        ranges(p)?;
+    }
+    let cols = cols.min(panels.len());
+    let rows = panels.len().div_ceil(cols);
+    let (pw, ph) = if cols <= 2 {
+        PLOT_SIZE
+    } else {
+        (1800 / cols as u32, 1200 / cols as u32)
+    };
+    let size = (pw * cols as u32, ph * rows as u32);
+    let title = panels.first().map_or("", |p| p.title.as_str());
+    let svg = render(size, title, |root| {
+        for (area, plot) in root.split_evenly((rows, cols)).iter().zip(panels) {
+            draw_plot(area, plot)?;
+        }
+        Ok(())
+    })?;
+    write_atomic(path, &svg)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tmp(name: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("cosserat-plot-{}-{name}", std::process::id()));
+        let _ = std::fs::create_dir_all(&dir);
+        dir.join(format!("{name}.svg"))
+    }
+
+    fn series(label: &str, f: impl Fn(f64) -> f64) -> Series {
+        let x: Vec<f64> = (0..50).map(|i| i as f64 * 0.1).collect();
+        Series {
+            label: label.into(),
+            y: x.iter().map(|&v| f(v)).collect(),
+            x,
+        }
+    }
+
+    fn plot(series: Vec<Series>) -> LinePlot {
+        LinePlot {
+            title: "Tip deflection".into(),
+            x_label: "time [s]".into(),
+            y_label: "y(L) [m]".into(),
+            series,
+            ..Default::default()
+        }
+    }
+
+    fn no_tmp_left(path: &Path) -> bool {
+        let dir = path.parent().expect("dir");
+        std::fs::read_dir(dir).expect("read_dir").all(|e| {
+            !e.expect("entry")
+                .file_name()
+                .to_string_lossy()
+                .ends_with(".tmp")
+        })
+    }
+
+    #[test]
+    fn writes_svg_with_labels() {
+        let path = tmp("basic");
+        let mut s2 = series("constant", |_| 3.0);
+        s2.y[7] = f64::NAN;
+        s2.x[8] = f64::INFINITY;
+        write_svg(&plot(vec![series("rust", |x| x.sin()), s2]), &path).unwrap();
+        let svg = std::fs::read_to_string(&path).unwrap();
+        for text in [
+            "Tip deflection",
+            "time [s]",
+            "y(L) [m]",
+            "rust",
+            "constant",
+            "width=\"900\"",
+            "height=\"600\"",
+        ] {
+            assert!(svg.contains(text), "missing {text}");
+        }
+        assert!(no_tmp_left(&path));
+        // Only a constant series: zero range must still work.
+        write_svg(&plot(vec![series("flat", |_| 0.0)]), &path).unwrap();
+        let _ = std::fs::remove_dir_all(path.parent().expect("dir"));
+    }
+
+    #[test]
+    fn log_axes() {
+        let path = tmp("log");
+        let mut p = plot(vec![
+            series("err", |x| 10f64.powf(-x)),
+            series("with zero", |x| x),
+        ]);
+        p.log_y = true;
+        p.log_x = true; // x = 0 is dropped
+        write_svg(&p, &path).unwrap();
+        let svg = std::fs::read_to_string(&path).unwrap();
+        assert!(svg.contains("err") && svg.contains("with zero"));
+        let all_negative = LinePlot {
+            log_y: true,
+            ..plot(vec![series("neg", |x| -1.0 - x)])
+        };
+        assert!(matches!(
+            write_svg(&all_negative, &path.with_file_name("neg.svg")),
+            Err(PlotError::NoPlottablePoints { log_y: true, .. })
+        ));
+        let _ = std::fs::remove_dir_all(path.parent().expect("dir"));
+    }
+
+    #[test]
+    fn bad_input_errors() {
+        let path = tmp("bad");
+        let empty = plot(vec![Series {
+            label: "nothing".into(),
+            x: vec![],
+            y: vec![],
+        }]);
+        let e = write_svg(&empty, &path).unwrap_err();
+        assert!(matches!(e, PlotError::EmptySeries { .. }));
+        assert!(
+            e.to_string().contains("'nothing'") && e.to_string().contains("empty"),
+            "{e}"
+        );
+        assert!(matches!(
+            write_svg(&plot(vec![]), &path),
+            Err(PlotError::NoSeries { .. })
+        ));
+        let mismatch = plot(vec![Series {
+            label: "m".into(),
+            x: vec![1.0, 2.0],
+            y: vec![1.0],
+        }]);
+        assert!(matches!(
+            write_svg(&mismatch, &path),
+            Err(PlotError::LengthMismatch {
+                x_len: 2,
+                y_len: 1,
+                ..
+            })
+        ));
+        assert!(!path.exists());
+        assert!(matches!(
+            write_panels_svg(&[], 2, &path),
+            Err(PlotError::InvalidGrid { .. })
+        ));
+        assert!(matches!(
+            write_panels_svg(&[plot(vec![series("a", |x| x)])], 0, &path),
+            Err(PlotError::InvalidGrid { .. })
+        ));
+        // Unwritable destination: an Io error naming the path, no temp file left.
+        let missing = std::env::temp_dir()
+            .join(format!("cosserat-plot-{}-no-such-dir", std::process::id()))
+            .join("x.svg");
+        let e = write_svg(&plot(vec![series("a", |x| x)]), &missing).unwrap_err();
+        assert!(
+            matches!(e, PlotError::Io { .. }) && e.to_string().contains("no-such-dir"),
+            "{e}"
+        );
+        let _ = std::fs::remove_dir_all(path.parent().expect("dir"));
+    }
+
+    #[test]
+    fn tick_format() {
+        assert_eq!(format_tick(1e-5), "1e-5");
+        assert_eq!(format_tick(-2.5e6), "-2.5e6");
+        assert_eq!(format_tick(0.25), "0.25");
+        assert_eq!(format_tick(0.0), "0");
+        assert_eq!(format_tick(3.0), "3");
+    }
+
+    #[test]
+    fn panels_grid() {
+        let path = tmp("panels");
+        let names = ["position", "kappa_1", "kappa_2", "kappa_3"];
+        let panels: Vec<LinePlot> = names
+            .iter()
+            .enumerate()
+            .map(|(i, n)| LinePlot {
+                title: n.to_string(),
+                x_label: "s [m]".into(),
+                y_label: format!("{n} [1/m]"),
+                series: vec![
+                    series(&format!("rust {n}"), move |x| (x * i as f64).cos()),
+                    series("freefem", |x| x),
+                ],
+                ..Default::default()
+            })
+            .collect();
+        write_panels_svg(&panels, 2, &path).unwrap();
+        let svg = std::fs::read_to_string(&path).unwrap();
+        for n in names {
+            assert!(svg.contains(n) && svg.contains(&format!("rust {n}")), "{n}");
+        }
+        assert!(svg.contains("width=\"1800\"") && svg.contains("height=\"1200\""));
+        assert!(no_tmp_left(&path));
+        let _ = std::fs::remove_dir_all(path.parent().expect("dir"));
+    }
+}

@@ -1,0 +1,105 @@
+//! Time stepping of eq. (40) with inertia: Appendix A, eqs. (66)–(69), in momentum form (D6).
+//!
+//! ```text
+//!   u̇_n = (2/Δt)(u_n − u_{n−1}) − u̇_{n−1}                                   (69)
+//!   R_n(u_n) = [P(u_n, u̇_n) − P(u_{n−1}, u̇_{n−1})]/Δt
+//!              + G((u_n + u_{n−1})/2) − ½ [F(t_n) + F(t_{n−1})] = 0           (68)
+//!   ∂R_n/∂u_n = (1/Δt) ∂P/∂u + (2/Δt²) ∂P/∂u̇ + ½ ∂G/∂u
+//! ```
+//! solved by Newton from the predictor `u_{n−1} + Δt u̇_{n−1}`. The printed (71)/(72) are not
+//! used (errata: (Δt²/2) F_n and M_{n−2}; see PAPER-NOTES and `docs/decisions.md`).
+use nalgebra::{DVector, Vector3};
+
+use super::{node_values, Problem, SolveError};
+use crate::assembly::{LinearSolver, Pattern};
+
+/// Time-stepping parameters.
+#[derive(Clone, Copy, Debug)]
+pub struct DynamicParams {
+    pub end_time_s: f64,
+    pub steps: usize,
+    pub newton_tolerance: f64,
+    pub newton_max_iterations: usize,
+}
+
+/// Tip state at one time level.
+#[derive(Clone, Copy, Debug)]
+pub struct TipRecord {
+    pub time_s: f64,
+    pub position_m: Vector3<f64>,
+    pub angles_rad: Vector3<f64>,
+    pub newton_iterations: usize,
+}
+
+/// Result of a time integration.
+#[derive(Clone, Debug)]
+pub struct DynamicSolution {
+    /// final state
+    pub u: DVector<f64>,
+    pub tip: Vec<TipRecord>,
+    pub total_newton_iterations: usize,
+    pub max_newton_iterations: usize,
+}
+
+/// Integrate from the reference configuration at rest.
+pub fn solve(problem: &Problem, params: &DynamicParams, mut progress: impl FnMut(usize, usize)) -> Result<DynamicSolution, SolveError> {
+    let pattern = Pattern::new(&problem.mesh);
+    let solver = LinearSolver::new(&pattern)?;
+    let fixed = problem.clamped_dofs();
+    let dt = params.end_time_s / params.steps as f64;
+    let last = problem.mesh.nodes() - 1;
+
+    let mut u_prev = problem.reference_state();
+    let mut v_prev = DVector::zeros(u_prev.len());
+    let mut p_prev = problem.momentum(&u_prev, &v_prev, None);
+    let mut f_prev = problem.external_force(0.0);
+    let mut values = vec![0.0; pattern.nnz()];
+    let record = |t: f64, u: &DVector<f64>, it: usize| {
+        let (x, a) = node_values(u, last);
+        TipRecord { time_s: t, position_m: x, angles_rad: a, newton_iterations: it }
+    };
+    let mut tip = vec![record(0.0, &u_prev, 0)];
+    let (mut total, mut max_it) = (0, 0);
+
+    for n in 1..=params.steps {
+        let t = n as f64 * dt;
+        let f_n = problem.external_force(t);
+        let f_avg = (&f_n + &f_prev) * 0.5;
+        let mut u = &u_prev + &v_prev * dt;
+        let mut converged = None;
+        let mut increment = f64::NAN;
+        for it in 1..=params.newton_max_iterations {
+            let v = (&u - &u_prev) * (2.0 / dt) - &v_prev;
+            let u_mid = (&u + &u_prev) * 0.5;
+            values.iter_mut().for_each(|x| *x = 0.0);
+            let p = problem.momentum(&u, &v, Some((&pattern, &mut values, 1.0 / dt, 2.0 / (dt * dt))));
+            let g = problem.internal_force(&u_mid, Some((&pattern, &mut values, 0.5)));
+            let mut r = (p - &p_prev) / dt + g - &f_avg;
+            for &d in &fixed {
+                r[d] = 0.0;
+            }
+            pattern.set_identity_rows(&mut values, &fixed);
+            let du = solver.solve(&values, &(-r))?;
+            u += &du;
+            increment = problem.increment_measure(&du);
+            if !increment.is_finite() {
+                return Err(SolveError::NonFinite { step: Some(n), iteration: it });
+            }
+            if increment <= params.newton_tolerance {
+                converged = Some(it);
+                break;
+            }
+        }
+        let it = converged.ok_or(SolveError::NewtonNotConverged { step: Some(n), iterations: params.newton_max_iterations, increment })?;
+        total += it;
+        max_it = max_it.max(it);
+        let v = (&u - &u_prev) * (2.0 / dt) - &v_prev;
+        p_prev = problem.momentum(&u, &v, None);
+        f_prev = f_n;
+        tip.push(record(t, &u, it));
+        u_prev = u;
+        v_prev = v;
+        progress(n, params.steps);
+    }
+    Ok(DynamicSolution { u: u_prev, tip, total_newton_iterations: total, max_newton_iterations: max_it })
+}

@@ -1,0 +1,164 @@
+//! Solvers. Each stage has its own file: [`statics`] (the paper's relaxed fixed point of §4 and
+//! Newton), [`dynamics`] (Appendix A time stepping, D6), [`modes`] (linearised natural
+//! frequencies about the rest state). All of them assemble through [`Problem`], which owns the
+//! one element loop of the crate.
+pub mod dynamics;
+pub mod modes;
+pub mod statics;
+
+use nalgebra::{DVector, Vector3};
+
+use crate::assembly::{assemble_vector, gather, LinearError, Pattern};
+use crate::case::Case;
+use crate::element::{distributed_load, internal_force, momentum, LocalMat};
+use crate::loads::Loads;
+use crate::material::RodProperties;
+use crate::mesh::{Dof, Mesh, QuadratureScheme};
+
+/// Errors of the solvers; each variant carries the numbers needed to act on it.
+#[derive(Debug, thiserror::Error)]
+pub enum SolveError {
+    #[error("fixed point did not converge after {iterations} iterations (last relative change {rel_change:e})")]
+    FixedPointNotConverged { iterations: usize, rel_change: f64 },
+    #[error("Newton did not converge after {iterations} iterations (last increment {increment:e}){}", step_text(*.step))]
+    NewtonNotConverged { step: Option<usize>, iterations: usize, increment: f64 },
+    #[error("non-finite value in iteration {iteration}{}", step_text(*.step))]
+    NonFinite { step: Option<usize>, iteration: usize },
+    #[error(transparent)]
+    Linear(#[from] LinearError),
+}
+
+fn step_text(step: Option<usize>) -> String {
+    step.map(|s| format!(" at time step {s}")).unwrap_or_default()
+}
+
+/// The discrete forward problem: mesh, coefficients, quadrature and loads.
+#[derive(Clone, Copy)]
+pub struct Problem<'a> {
+    pub mesh: Mesh,
+    pub props: RodProperties,
+    pub scheme: QuadratureScheme,
+    pub loads: &'a Loads,
+}
+
+impl<'a> Problem<'a> {
+    pub fn from_case(case: &'a Case) -> Self {
+        Problem { mesh: case.mesh, props: case.props, scheme: case.quadrature, loads: &case.loads }
+    }
+
+    /// Reference configuration: straight along e3, `x0(s) = (0, 0, s)`, `α = 0` (D1).
+    pub fn reference_state(&self) -> DVector<f64> {
+        let mut u = DVector::zeros(self.mesh.ndofs());
+        for i in 0..self.mesh.nodes() {
+            u[self.mesh.dof(i, Dof::Z)] = self.mesh.node_s(i);
+        }
+        u
+    }
+
+    /// Unknowns fixed by the clamp at s = 0 (D3): all six of node 0.
+    pub fn clamped_dofs(&self) -> Vec<usize> {
+        (0..6).collect()
+    }
+
+    /// External load vector `F(t)` of D3 (distributed + end loads).
+    pub fn external_force(&self, t: f64) -> DVector<f64> {
+        let h = self.mesh.h();
+        let mut f = if self.loads.has_distributed() {
+            assemble_vector(&self.mesh, |_, s0| distributed_load(self.scheme, h, s0, &mut |s| self.loads.distributed(s, t)))
+        } else {
+            DVector::zeros(self.mesh.ndofs())
+        };
+        let (fe, le) = self.loads.end(t);
+        let last = self.mesh.nodes() - 1;
+        for k in 0..3 {
+            f[self.mesh.dof(last, Dof::X) + k] += fe[k];
+            f[self.mesh.dof(last, Dof::Alpha) + k] += le[k];
+        }
+        f
+    }
+
+    /// Internal force `G(u)`; with `tangent = Some((pattern, values, scale))` also adds
+    /// `scale · ∂G/∂u` into `values`.
+    pub fn internal_force(&self, u: &DVector<f64>, mut tangent: Option<(&Pattern, &mut [f64], f64)>) -> DVector<f64> {
+        let h = self.mesh.h();
+        let mut local_t = LocalMat::zeros();
+        assemble_vector(&self.mesh, |e, _| {
+            let ue = gather(u, e);
+            match tangent.as_mut() {
+                Some((pattern, values, scale)) => {
+                    local_t.fill(0.0);
+                    let r = internal_force(&self.props, self.scheme, h, &ue, Some(&mut local_t));
+                    local_t *= *scale;
+                    pattern.scatter_mat(values, e, &local_t);
+                    r
+                }
+                None => internal_force(&self.props, self.scheme, h, &ue, None),
+            }
+        })
+    }
+
+    /// Momentum `P(u, u̇)` of D6; optionally adds `scale_u · ∂P/∂u + scale_v · ∂P/∂u̇`.
+    pub fn momentum(&self, u: &DVector<f64>, udot: &DVector<f64>, mut tangent: Option<(&Pattern, &mut [f64], f64, f64)>) -> DVector<f64> {
+        let h = self.mesh.h();
+        let (mut du, mut dv) = (LocalMat::zeros(), LocalMat::zeros());
+        assemble_vector(&self.mesh, |e, _| {
+            let (ue, ve) = (gather(u, e), gather(udot, e));
+            match tangent.as_mut() {
+                Some((pattern, values, su, sv)) => {
+                    du.fill(0.0);
+                    dv.fill(0.0);
+                    let r = momentum(&self.props, self.scheme, h, &ue, &ve, Some(&mut du), Some(&mut dv));
+                    let local = du * *su + dv * *sv;
+                    pattern.scatter_mat(values, e, &local);
+                    r
+                }
+                None => momentum(&self.props, self.scheme, h, &ue, &ve, None, None),
+            }
+        })
+    }
+
+    /// Infinity norm over the unknowns that are not clamped.
+    pub fn free_norm_inf(&self, r: &DVector<f64>) -> f64 {
+        let fixed = self.clamped_dofs();
+        r.iter().enumerate().filter(|(i, _)| !fixed.contains(i)).fold(0.0, |m, (_, v)| m.max(v.abs()))
+    }
+
+    /// Newton increment measure of D5/D6: `max(‖δx‖∞ / L, ‖δα‖∞)`.
+    pub fn increment_measure(&self, du: &DVector<f64>) -> f64 {
+        let (dx, da) = split_norms_inf(du);
+        (dx / self.mesh.length_m).max(da)
+    }
+}
+
+/// `(‖x‖∞, ‖α‖∞)` of a nodal vector.
+pub fn split_norms_inf(u: &DVector<f64>) -> (f64, f64) {
+    let mut nx: f64 = 0.0;
+    let mut na: f64 = 0.0;
+    for (i, v) in u.iter().enumerate() {
+        if i % 6 < 3 {
+            nx = nx.max(v.abs());
+        } else {
+            na = na.max(v.abs());
+        }
+    }
+    (nx, na)
+}
+
+/// `(‖x‖₂, ‖α‖₂)` of a nodal vector.
+pub fn split_norms_2(u: &DVector<f64>) -> (f64, f64) {
+    let mut nx = 0.0;
+    let mut na = 0.0;
+    for (i, v) in u.iter().enumerate() {
+        if i % 6 < 3 {
+            nx += v * v;
+        } else {
+            na += v * v;
+        }
+    }
+    (f64::sqrt(nx), f64::sqrt(na))
+}
+
+/// Node `i` position and angles of a nodal vector.
+pub fn node_values(u: &DVector<f64>, i: usize) -> (Vector3<f64>, Vector3<f64>) {
+    (Vector3::new(u[6 * i], u[6 * i + 1], u[6 * i + 2]), Vector3::new(u[6 * i + 3], u[6 * i + 4], u[6 * i + 5]))
+}

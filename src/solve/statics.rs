@@ -1,0 +1,133 @@
+//! Static forward solve of the primal equation (52) with `j = 1` and no inertia (D5).
+//!
+//! * `FixedPoint` — the paper's scheme (§4, Remark 10): freeze `Q_k, A_k, B_k, q3_k` at the
+//!   iterate, solve the linear problem for `û`, relax `u_{k+1} = w û + (1 − w) u_k`, stop when
+//!   `max(‖Δx‖₂/‖x‖₂, ‖Δα‖₂/‖α‖₂) ≤ tol`. FreeFEM runs exactly this iteration.
+//! * `Newton` — exact Jacobian of the residual of D3, stop when `max(‖δx‖∞/L, ‖δα‖∞) ≤ tol`.
+//!
+//! A fixed point of the first is a zero of the residual the second drives to zero, so both
+//! converge to the same discrete solution (checked in `tests/forward.rs`).
+//!
+//! ## References
+//! 1. Wang et al., Comput. Mech. 71 (2023), §4, eqs. (52), (61), Remark 10.
+use nalgebra::DVector;
+
+use super::{split_norms_2, Problem, SolveError};
+use crate::assembly::{gather, LinearSolver, Pattern};
+use crate::element::frozen_operator;
+
+/// Static solver parameters.
+#[derive(Clone, Copy, Debug)]
+pub struct StaticParams {
+    pub method: Method,
+    pub tolerance: f64,
+    pub max_iterations: usize,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Method {
+    FixedPoint { relaxation: f64 },
+    Newton,
+}
+
+/// One row of the iteration history.
+#[derive(Clone, Copy, Debug)]
+pub struct IterationRecord {
+    pub iteration: usize,
+    /// fixed point: relative change; Newton: increment measure
+    pub change: f64,
+}
+
+/// Result of a converged static solve.
+#[derive(Clone, Debug)]
+pub struct StaticSolution {
+    pub u: DVector<f64>,
+    pub iterations: usize,
+    pub last_change: f64,
+    /// `‖R(u)‖∞ / ‖F‖∞` over the free unknowns (D5)
+    pub residual: f64,
+    pub history: Vec<IterationRecord>,
+}
+
+/// Solve the static problem from the reference configuration.
+pub fn solve(problem: &Problem, params: &StaticParams, mut progress: impl FnMut(&IterationRecord)) -> Result<StaticSolution, SolveError> {
+    let pattern = Pattern::new(&problem.mesh);
+    let solver = LinearSolver::new(&pattern)?;
+    let fixed = problem.clamped_dofs();
+    let reference = problem.reference_state();
+    let f_ext = problem.external_force(0.0);
+    let mut u = reference.clone();
+    let mut values = vec![0.0; pattern.nnz()];
+    let mut history = Vec::new();
+    let h = problem.mesh.h();
+    for k in 1..=params.max_iterations {
+        values.iter_mut().for_each(|v| *v = 0.0);
+        let change = match params.method {
+            Method::FixedPoint { relaxation } => {
+                let mut b = f_ext.clone();
+                for e in 0..problem.mesh.elements {
+                    let (l, bl) = frozen_operator(&problem.props, problem.scheme, h, &gather(&u, e));
+                    pattern.scatter_mat(&mut values, e, &l);
+                    for i in 0..12 {
+                        b[6 * e + i] += bl[i];
+                    }
+                }
+                for &d in &fixed {
+                    b[d] = reference[d];
+                }
+                pattern.set_identity_rows(&mut values, &fixed);
+                let u_hat = solver.solve(&values, &b)?;
+                let u_new = &u_hat * relaxation + &u * (1.0 - relaxation);
+                let change = relative_change(&u_new, &u);
+                u = u_new;
+                change
+            }
+            Method::Newton => {
+                let g = problem.internal_force(&u, Some((&pattern, &mut values, 1.0)));
+                let mut r = g - &f_ext;
+                for &d in &fixed {
+                    r[d] = u[d] - reference[d];
+                }
+                pattern.set_identity_rows(&mut values, &fixed);
+                let du = solver.solve(&values, &(-r))?;
+                u += &du;
+                problem.increment_measure(&du)
+            }
+        };
+        if !change.is_finite() || u.iter().any(|v| !v.is_finite()) {
+            return Err(SolveError::NonFinite { step: None, iteration: k });
+        }
+        let rec = IterationRecord { iteration: k, change };
+        progress(&rec);
+        history.push(rec);
+        if change <= params.tolerance {
+            let residual = relative_residual(problem, &u, &f_ext);
+            return Ok(StaticSolution { u, iterations: k, last_change: change, residual, history });
+        }
+    }
+    let last = history.last().map(|r| r.change).unwrap_or(f64::NAN);
+    match params.method {
+        Method::FixedPoint { .. } => Err(SolveError::FixedPointNotConverged { iterations: params.max_iterations, rel_change: last }),
+        Method::Newton => Err(SolveError::NewtonNotConverged { step: None, iterations: params.max_iterations, increment: last }),
+    }
+}
+
+/// `max(‖Δx‖₂/‖x‖₂, ‖Δα‖₂/‖α‖₂)` with 0/0 = 0 (D5).
+pub fn relative_change(new: &DVector<f64>, old: &DVector<f64>) -> f64 {
+    let (dx, da) = split_norms_2(&(new - old));
+    let (nx, na) = split_norms_2(new);
+    let ratio = |d: f64, n: f64| if d == 0.0 { 0.0 } else { d / n };
+    ratio(dx, nx).max(ratio(da, na))
+}
+
+/// `‖G(u) − F‖∞ / ‖F‖∞` over free unknowns.
+pub fn relative_residual(problem: &Problem, u: &DVector<f64>, f_ext: &DVector<f64>) -> f64 {
+    let r = problem.internal_force(u, None) - f_ext;
+    let scale = problem.free_norm_inf(f_ext);
+    let rn = problem.free_norm_inf(&r);
+    if scale > 0.0 {
+        rn / scale
+    } else {
+        rn
+    }
+}
