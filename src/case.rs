@@ -208,6 +208,17 @@ impl Case {
         Validator { path }.case(raw, name)
     }
 
+    /// The same dynamic case cut to its first `steps` time steps (same Δt): the short but real
+    /// subset that `cargo test` runs through FreeFEM. Static cases are returned unchanged.
+    pub fn time_prefix(&self, steps: usize) -> Case {
+        let mut c = self.clone();
+        if let Analysis::Dynamic { end_time_s, steps: n, tolerance, max_iterations } = self.analysis {
+            let k = steps.min(n).max(1);
+            c.analysis = Analysis::Dynamic { end_time_s: end_time_s * k as f64 / n as f64, steps: k, tolerance, max_iterations };
+        }
+        c
+    }
+
     /// Is this a dynamic case?
     pub fn is_dynamic(&self) -> bool {
         matches!(self.analysis, Analysis::Dynamic { .. })

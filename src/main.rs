@@ -142,7 +142,8 @@ fn cmd_compare(path: &Path, out: Option<PathBuf>) -> Result<ExitCode> {
     for r in &rows {
         let verdict = if r.passed() { "PASS" } else { "FAIL" };
         failed += usize::from(!r.passed());
-        println!("{:<34} {:>15.8e} {:>15.8e} {:>11.3e} {:>11.3e}  {verdict}", r.name, r.rust, r.freefem, r.difference, r.tolerance);
+        let v = |x: Option<f64>| x.map(|x| format!("{x:.8e}")).unwrap_or_else(|| "-".into());
+        println!("{:<34} {:>15} {:>15} {:>11.3e} {:>11.3e}  {verdict}", r.name, v(r.rust), v(r.freefem), r.difference, r.tolerance);
     }
     println!(
         "wall time: rust {:.3} s, freefem {:.3} s (ratio freefem/rust {:.1})",

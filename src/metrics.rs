@@ -1,18 +1,17 @@
 //! Metrics of a run (one function for both engines) and the Rust–FreeFEM comparison (D8).
 use std::collections::BTreeMap;
 
-use crate::case::{Case, CompareTolerances};
+use crate::case::{Analysis, Case, CompareTolerances, StaticMethod};
 use crate::run::RunResult;
 
 /// Flat map metric name → value (`metrics.json`). Names carry SI units.
 pub type Metrics = BTreeMap<String, f64>;
 
 /// Physical metrics compared between engines.
-pub fn physical_metrics(case: &Case, r: &RunResult) -> Metrics {
+pub fn physical_metrics(_case: &Case, r: &RunResult) -> Metrics {
     let mut m = Metrics::new();
     let last = r.nodes.x.len() - 1;
     let (x, a) = (r.nodes.x[last], r.nodes.alpha[last]);
-    let _ = case;
     for (k, name) in ["x", "y", "z"].iter().enumerate() {
         m.insert(format!("tip_{name}_m"), x[k]);
     }
@@ -51,8 +50,9 @@ pub fn all_metrics(case: &Case, r: &RunResult) -> Metrics {
 #[derive(Clone, Debug, PartialEq)]
 pub struct ComparisonRow {
     pub name: String,
-    pub rust: f64,
-    pub freefem: f64,
+    /// metric values; `None` for rows that compare whole fields
+    pub rust: Option<f64>,
+    pub freefem: Option<f64>,
     pub difference: f64,
     pub tolerance: f64,
 }
@@ -81,7 +81,7 @@ pub fn compare(case: &Case, rust: &RunResult, ff: &RunResult) -> Vec<ComparisonR
     let tol: &CompareTolerances = &case.compare;
     let mut rows = Vec::new();
     let nodes_match = rust.nodes.s.len() == ff.nodes.s.len();
-    let field = |name: &str, value: f64, tolerance: f64| ComparisonRow { name: name.into(), rust: 0.0, freefem: 0.0, difference: value, tolerance };
+    let field = |name: &str, value: f64, tolerance: f64| ComparisonRow { name: name.into(), rust: None, freefem: None, difference: value, tolerance };
     if nodes_match {
         rows.push(field(
             "nodewise_rel_diff_displacement",
@@ -96,7 +96,7 @@ pub fn compare(case: &Case, rust: &RunResult, ff: &RunResult) -> Vec<ComparisonR
     for (name, &a) in &mr {
         let b = mf.get(name).copied().unwrap_or(f64::NAN);
         let d = (a - b).abs();
-        rows.push(ComparisonRow { name: name.clone(), rust: a, freefem: b, difference: if d.is_nan() { f64::INFINITY } else { d }, tolerance: tol.metric_rel * a.abs() + tol.metric_abs });
+        rows.push(ComparisonRow { name: name.clone(), rust: Some(a), freefem: Some(b), difference: if d.is_nan() { f64::INFINITY } else { d }, tolerance: tol.metric_rel * a.abs() + tol.metric_abs });
     }
     if rust.tip.len() == ff.tip.len() && !rust.tip.is_empty() {
         let a: Vec<_> = rust.tip.iter().map(|t| t.position_m).collect();
@@ -105,9 +105,10 @@ pub fn compare(case: &Case, rust: &RunResult, ff: &RunResult) -> Vec<ComparisonR
         let b0: Vec<_> = b.iter().map(|p| p - b[0]).collect();
         rows.push(field("tip_history_rel_diff", max_relative_difference(&a0, &b0), tol.displacement_rel));
     }
-    if rust.history.len() + ff.history.len() > 0 {
+    // Both engines run the identical fixed point (D5), so their iteration counts are compared.
+    if matches!(case.analysis, Analysis::Static { method: StaticMethod::FixedPoint { .. }, .. }) {
         let (a, b) = (rust.stats.iterations as f64, ff.stats.iterations as f64);
-        rows.push(ComparisonRow { name: "iterations".into(), rust: a, freefem: b, difference: (a - b).abs(), tolerance: tol.iterations_abs });
+        rows.push(ComparisonRow { name: "iterations".into(), rust: Some(a), freefem: Some(b), difference: (a - b).abs(), tolerance: tol.iterations_abs });
     }
     rows
 }

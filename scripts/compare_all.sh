@@ -1,0 +1,15 @@
+#!/usr/bin/env bash
+# The main job: every case of cases/ through both engines, full length (the dynamic cantilever
+# takes ~4-5 minutes in FreeFEM), writing out/<case>/{rust,freefem}/ and a comparison table
+# per case. Exit status 1 if any comparison fails.
+set -uo pipefail
+cd "$(dirname "$0")/.."
+cargo build --release -q || exit 1
+bin=target/release/cosserat
+status=0
+for c in cases/*.toml; do
+  name=$(basename "$c" .toml)
+  echo "== $name"
+  $bin compare "$c" --out "out/$name" | tee "out/$name.compare.txt" || status=1
+done
+exit $status

@@ -1,0 +1,16 @@
+#!/usr/bin/env bash
+# Install what the project needs on a fresh Debian machine: FreeFEM (Debian packages) and,
+# if absent, a Rust toolchain from Debian. Idempotent; run as root (or with sudo available).
+set -euo pipefail
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+need=()
+command -v FreeFem++ >/dev/null 2>&1 || need+=(freefem++ libfreefem++)
+command -v cargo >/dev/null 2>&1 || need+=(cargo rustc)
+if [ ${#need[@]} -gt 0 ]; then
+  echo "installing: ${need[*]}"
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq "${need[@]}" >/dev/null
+fi
+FreeFem++ -nw -v 0 /dev/null >/dev/null 2>&1 || true
+echo "FreeFEM: $(command -v FreeFem++)  cargo: $(cargo --version)"

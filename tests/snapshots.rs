@@ -1,0 +1,31 @@
+//! Regression snapshots of each case's metrics (Rust engine, full case), rounded to stated
+//! significant digits so they are stable across machines. The physics behind the numbers is
+//! asserted independently in `tests/forward.rs`; these guard against silent drift.
+mod common;
+
+use std::collections::BTreeMap;
+
+use common::sig;
+use cosserat::case::{case_files, Case};
+use cosserat::metrics::all_metrics;
+use cosserat::run::run_rust;
+
+/// Significant digits kept for physical metrics.
+const DIGITS: i32 = 7;
+
+#[test]
+fn case_metrics_snapshots() {
+    for f in case_files(&common::cases_dir()).expect("cases dir") {
+        let case = Case::from_file(&f).unwrap_or_else(|e| panic!("{e}"));
+        let r = run_rust(&case, |_, _| {}).unwrap_or_else(|e| panic!("{}: {e}", case.name));
+        let m: BTreeMap<String, f64> = all_metrics(&case, &r)
+            .into_iter()
+            .filter(|(k, _)| !matches!(k.as_str(), "wall_time_s" | "last_change" | "relative_residual"))
+            .map(|(k, v)| {
+                let v = if k.contains("iterations") { v } else { sig(v, DIGITS) };
+                (k, v)
+            })
+            .collect();
+        insta::assert_yaml_snapshot!(case.name.clone(), m);
+    }
+}
