@@ -48,6 +48,14 @@ struct RawCase {
     solver: RawSolver,
     time: Option<RawTime>,
     compare: RawCompare,
+    reference: Option<RawReference>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields, tag = "kind", rename_all = "snake_case")]
+enum RawReference {
+    /// Planar cantilever clamped at s = 0 under a dead end force of magnitude `force_n` along −e2.
+    TipLoadedCantilever { force_n: Scalar },
 }
 
 #[derive(Debug, Deserialize)]
@@ -175,6 +183,14 @@ pub struct CompareTolerances {
     pub iterations_abs: f64,
 }
 
+/// Independent theory a case is checked against (metrics `*_rel_error` in `metrics.json`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Reference {
+    /// Eq. (63), the Kirchhoff elastica and the planar Reissner rod for a dead end force of
+    /// magnitude `force_n` [N] along −e2 (see `src/theory.rs`).
+    TipLoadedCantilever { force_n: f64 },
+}
+
 /// A validated case.
 #[derive(Clone, Debug)]
 pub struct Case {
@@ -190,6 +206,7 @@ pub struct Case {
     pub loads: Loads,
     pub analysis: Analysis,
     pub compare: CompareTolerances,
+    pub reference: Option<Reference>,
 }
 
 impl Case {
@@ -408,7 +425,17 @@ impl Validator<'_> {
                 return Err(self.err(k, format!("must be ≥ 0, got {v}")));
             }
         }
+        let reference = match &raw.reference {
+            None => None,
+            Some(RawReference::TipLoadedCantilever { force_n }) => {
+                if analysis_kind != RawAnalysis::Static {
+                    return Err(self.err("reference.kind", "\"tip_loaded_cantilever\" needs a static analysis"));
+                }
+                Some(Reference::TipLoadedCantilever { force_n: self.positive("reference.force_n", force_n, c)? })
+            }
+        };
         Ok(Case {
+            reference,
             name: name.to_string(),
             description: raw.description,
             source: None,

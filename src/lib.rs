@@ -48,3 +48,4 @@ pub mod reference;
 pub mod rotation;
 pub mod run;
 pub mod solve;
+pub mod theory;

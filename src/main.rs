@@ -112,7 +112,7 @@ fn cmd_run(path: &Path, engine: Engine, out: Option<PathBuf>, quiet: bool) -> Re
     let case = load(path)?;
     let dir = out.unwrap_or_else(|| PathBuf::from("out").join(&case.name).join(engine.to_string()));
     let r = run_engine(&case, engine, &dir, quiet)?;
-    let m = all_metrics(&case, &r);
+    let m = all_metrics(&case, &r)?;
     let written = write_run(&case, &r, &m, &dir)?;
     let tip = r.nodes.x.last().copied().unwrap_or_default();
     println!(
@@ -133,9 +133,9 @@ fn cmd_compare(path: &Path, out: Option<PathBuf>) -> Result<ExitCode> {
     let case = load(path)?;
     let dir = out.unwrap_or_else(|| PathBuf::from("out").join(&case.name));
     let rust = run_engine(&case, Engine::Rust, &dir.join("rust"), false)?;
-    write_run(&case, &rust, &all_metrics(&case, &rust), &dir.join("rust"))?;
+    write_run(&case, &rust, &all_metrics(&case, &rust)?, &dir.join("rust"))?;
     let ff = run_engine(&case, Engine::Freefem, &dir.join("freefem"), false)?;
-    write_run(&case, &ff, &all_metrics(&case, &ff), &dir.join("freefem"))?;
+    write_run(&case, &ff, &all_metrics(&case, &ff)?, &dir.join("freefem"))?;
     let rows = compare(&case, &rust, &ff);
     println!("{:<34} {:>15} {:>15} {:>11} {:>11}  result", "metric", "rust", "freefem", "|diff|", "tolerance");
     let mut failed = 0;

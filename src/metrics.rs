@@ -29,9 +29,11 @@ pub fn physical_metrics(_case: &Case, r: &RunResult) -> Metrics {
     m
 }
 
-/// All metrics written to `metrics.json`: physical ones plus solver statistics.
-pub fn all_metrics(case: &Case, r: &RunResult) -> Metrics {
+/// All metrics written to `metrics.json`: physical ones, errors against the case's
+/// `[reference]` theory, and solver statistics.
+pub fn all_metrics(case: &Case, r: &RunResult) -> Result<Metrics, crate::reference::ReferenceError> {
     let mut m = physical_metrics(case, r);
+    crate::theory::add_reference_metrics(case, r, &mut m)?;
     m.insert("iterations".into(), r.stats.iterations as f64);
     if let Some(v) = r.stats.last_change {
         m.insert("last_change".into(), v);
@@ -43,7 +45,7 @@ pub fn all_metrics(case: &Case, r: &RunResult) -> Metrics {
         m.insert("max_newton_iterations".into(), v as f64);
     }
     m.insert("wall_time_s".into(), r.stats.wall_time_s);
-    m
+    Ok(m)
 }
 
 /// One row of `cosserat compare`.
