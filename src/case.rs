@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use serde::Deserialize;
 
 use crate::expr::Expr;
-use crate::loads::Loads;
+use crate::loads::{LoadFrame, Loads};
 use crate::material::{CrossSection, Material, RodProperties};
 use crate::mesh::{Mesh, QuadratureScheme};
 
@@ -84,10 +84,23 @@ enum RawSection {
 #[derive(Debug, Deserialize, Default)]
 #[serde(deny_unknown_fields)]
 struct RawLoads {
+    #[serde(default = "default_frame")]
+    frame: RawFrame,
     force_n_per_m: Option<[Scalar; 3]>,
     torque_nm_per_m: Option<[Scalar; 3]>,
     end_force_n: Option<[Scalar; 3]>,
     end_torque_nm: Option<[Scalar; 3]>,
+}
+
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default)]
+#[serde(rename_all = "snake_case")]
+enum RawFrame {
+    #[default]
+    Global,
+    Local,
+}
+fn default_frame() -> RawFrame {
+    RawFrame::Global
 }
 
 #[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
@@ -123,6 +136,11 @@ struct RawSolver {
     relaxation: Option<f64>,
     tolerance: f64,
     max_iterations: usize,
+    #[serde(default = "one")]
+    continuation_steps: usize,
+}
+fn one() -> usize {
+    1
 }
 fn default_method() -> RawMethod {
     RawMethod::FixedPoint
@@ -164,7 +182,8 @@ pub enum StaticMethod {
 /// What is solved.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Analysis {
-    Static { method: StaticMethod, tolerance: f64, max_iterations: usize },
+    /// `continuation_steps` ≥ 1: all loads ramped by k/steps, each step solved from the last.
+    Static { method: StaticMethod, tolerance: f64, max_iterations: usize, continuation_steps: usize },
     /// Appendix A time stepping (D6), Newton per step.
     Dynamic { end_time_s: f64, steps: usize, tolerance: f64, max_iterations: usize },
 }
@@ -357,7 +376,12 @@ impl Validator<'_> {
             RawAnalysis::Static => &[],
             RawAnalysis::Dynamic => &["t"],
         };
+        let frame = match raw.loads.frame {
+            RawFrame::Global => LoadFrame::Global,
+            RawFrame::Local => LoadFrame::Local,
+        };
         let loads = Loads::new(
+            frame,
             self.vector("loads.force_n_per_m", &raw.loads.force_n_per_m, vars, c)?,
             self.vector("loads.torque_nm_per_m", &raw.loads.torque_nm_per_m, vars, c)?,
             self.vector("loads.end_force_n", &raw.loads.end_force_n, end_vars, c)?,
@@ -388,7 +412,10 @@ impl Validator<'_> {
                     }
                     RawMethod::Newton => StaticMethod::Newton,
                 };
-                Analysis::Static { method, tolerance: s.tolerance, max_iterations: s.max_iterations }
+                if s.continuation_steps == 0 {
+                    return Err(self.err("solver.continuation_steps", "must be ≥ 1"));
+                }
+                Analysis::Static { method, tolerance: s.tolerance, max_iterations: s.max_iterations, continuation_steps: s.continuation_steps }
             }
             RawAnalysis::Dynamic => {
                 if s.method != RawMethod::Newton {
@@ -396,6 +423,9 @@ impl Validator<'_> {
                 }
                 if s.relaxation.is_some() {
                     return Err(self.err("solver.relaxation", "not used by a dynamic analysis"));
+                }
+                if s.continuation_steps != 1 {
+                    return Err(self.err("solver.continuation_steps", "only for a static analysis"));
                 }
                 let t = raw.time.as_ref().ok_or_else(|| self.err("time", "required when solver.analysis = \"dynamic\""))?;
                 if t.steps == 0 {

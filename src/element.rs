@@ -234,6 +234,41 @@ pub fn distributed_load(scheme: QuadratureScheme, h: f64, s0: f64, field: &mut d
     r
 }
 
+/// Follower (local-frame) distributed loads of one element: `∫ N_a Qᵀ(α) fˡ`, `∫ N_a Qᵀ(α) lˡ`
+/// (eq. 4: `vᵍ = Qᵀ vˡ`), load rule of D4, and optionally their derivative with respect to the
+/// local unknowns `∂/∂u` added into `tangent`.
+pub fn follower_load(
+    scheme: QuadratureScheme,
+    h: f64,
+    s0: f64,
+    u: &LocalVec,
+    field: &mut dyn FnMut(f64) -> (Vector3<f64>, Vector3<f64>),
+    mut tangent: Option<&mut LocalMat>,
+) -> LocalVec {
+    let mut r = LocalVec::zeros();
+    for_each_point(&scheme.loads(), h, u, |p, wh| {
+        let xi = p.n[1];
+        let (fl, ll) = field(s0 + xi * h);
+        let Qt = rotation(&p.alpha).transpose();
+        for a in 0..2 {
+            add_vec(&mut r, X[a], &(Qt * fl * (wh * p.n[a])));
+            add_vec(&mut r, ALPHA[a], &(Qt * ll * (wh * p.n[a])));
+        }
+        if let Some(t) = tangent.as_deref_mut() {
+            let dQ = rotation_derivatives(&p.alpha);
+            let df = columns([0, 1, 2].map(|j| dQ[j].transpose() * fl));
+            let dl = columns([0, 1, 2].map(|j| dQ[j].transpose() * ll));
+            for a in 0..2 {
+                for b in 0..2 {
+                    add_mat(t, X[a], ALPHA[b], &(df * (wh * p.n[a] * p.n[b])));
+                    add_mat(t, ALPHA[a], ALPHA[b], &(dl * (wh * p.n[a] * p.n[b])));
+                }
+            }
+        }
+    });
+    r
+}
+
 fn for_each_point(rule: &Rule, h: f64, u: &LocalVec, mut f: impl FnMut(&PointState, f64)) {
     for (xi, w) in rule.points.iter().zip(rule.weights) {
         let p = interpolate(u, h, *xi);
@@ -291,6 +326,23 @@ mod tests {
         momentum(&p, QuadratureScheme::Selective, 0.1, &u, &udot, Some(&mut du), Some(&mut dv));
         fd_check(&|v| momentum(&p, QuadratureScheme::Selective, 0.1, v, &udot, None, None), &du, &u);
         fd_check(&|w| momentum(&p, QuadratureScheme::Selective, 0.1, &u, w, None, None), &dv, &udot);
+    }
+
+    #[test]
+    fn follower_load_tangent_matches_fd() {
+        let u = state();
+        let field = |s: f64| (Vector3::new(0.3 * s, -1.0 - s, 0.2), Vector3::new(0.01, 0.02 * s, -0.03));
+        let mut t = LocalMat::zeros();
+        follower_load(QuadratureScheme::Selective, 0.1, 0.2, &u, &mut field.clone(), Some(&mut t));
+        fd_check(&|v| follower_load(QuadratureScheme::Selective, 0.1, 0.2, v, &mut field.clone(), None), &t, &u);
+        // At α = 0 a follower load is the global load.
+        let mut z = u;
+        for k in [3, 4, 5, 9, 10, 11] {
+            z[k] = 0.0;
+        }
+        let a = follower_load(QuadratureScheme::Selective, 0.1, 0.2, &z, &mut field.clone(), None);
+        let b = distributed_load(QuadratureScheme::Selective, 0.1, 0.2, &mut field.clone());
+        assert!((a - b).amax() < 1e-15);
     }
 
     #[test]

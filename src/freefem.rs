@@ -9,6 +9,7 @@ use std::process::Command;
 use nalgebra::Vector3;
 
 use crate::case::{Analysis, Case, StaticMethod};
+use crate::loads::LoadFrame;
 use crate::mesh::QuadratureScheme;
 use crate::run::{Engine, NodalState, RunResult, SolverStats};
 use crate::solve::dynamics::TipRecord;
@@ -92,13 +93,15 @@ pub fn include_file(case: &Case) -> String {
             let _ = writeln!(o, "macro {prefix}{}{args} ({}) //", k + 1, case.loads.exprs[g][k].to_freefem(&rename));
         }
     }
-    let (dynamic, method, relax, tol, maxit, tend, steps) = match case.analysis {
-        Analysis::Static { method, tolerance, max_iterations } => match method {
-            StaticMethod::FixedPoint { relaxation } => (0, 0, relaxation, tolerance, max_iterations, 0.0, 0),
-            StaticMethod::Newton => (0, 1, 1.0, tolerance, max_iterations, 0.0, 0),
+    let (dynamic, method, relax, tol, maxit, tend, steps, cont) = match case.analysis {
+        Analysis::Static { method, tolerance, max_iterations, continuation_steps } => match method {
+            StaticMethod::FixedPoint { relaxation } => (0, 0, relaxation, tolerance, max_iterations, 0.0, 0, continuation_steps),
+            StaticMethod::Newton => (0, 1, 1.0, tolerance, max_iterations, 0.0, 0, continuation_steps),
         },
-        Analysis::Dynamic { end_time_s, steps, tolerance, max_iterations } => (1, 1, 1.0, tolerance, max_iterations, end_time_s, steps),
+        Analysis::Dynamic { end_time_s, steps, tolerance, max_iterations } => (1, 1, 1.0, tolerance, max_iterations, end_time_s, steps, 1),
     };
+    let local = i32::from(case.loads.frame == LoadFrame::Local);
+    let _ = writeln!(o, "int localLoads = {local}; // distributed loads in the local frame (f^g = Q^T f^l)\nint contSteps = {cont};");
     let _ = writeln!(o, "int isDynamic = {dynamic};\nint method = {method};\nreal relax = {};\nreal tol = {};\nint maxit = {maxit};", num(relax), num(tol));
     let _ = writeln!(o, "real Tend = {};\nint nsteps = {steps};\nreal newtonTol = {};\nint newtonMaxit = {maxit};", num(tend), num(tol));
     o
@@ -191,7 +194,9 @@ fn read_outputs(case: &Case, dir: &Path) -> Result<RunResult, FreeFemError> {
         }
     } else {
         for r in read_table(&dir.join("ff_history.csv"), &["iteration", "rel_change"])? {
-            history.push(IterationRecord { iteration: r[0] as usize, change: r[1] });
+            let iteration = r[0] as usize;
+            let step = history.last().map(|h: &IterationRecord| if iteration <= h.iteration { h.step + 1 } else { h.step }).unwrap_or(1);
+            history.push(IterationRecord { step, iteration, change: r[1] });
         }
     }
     Ok(RunResult { engine: Engine::Freefem, nodes, history, tip, stats })

@@ -10,9 +10,20 @@ use crate::expr::{Compiled, Expr, ExprError};
 /// Slot layout of compiled load expressions: `s`, `t`, then the constants in name order.
 const FIXED: [&str; 2] = ["s", "t"];
 
+/// Frame of the distributed load components (end loads are always global dead loads).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LoadFrame {
+    /// components along e1, e2, e3
+    Global,
+    /// components along d1, d2, d3 (follower load, `fᵍ = Qᵀ fˡ`, eqs. 4, 64, 65)
+    Local,
+}
+
 /// Parsed and compiled load expressions of a case.
 #[derive(Clone, Debug)]
 pub struct Loads {
+    /// frame of the distributed components
+    pub frame: LoadFrame,
     /// Source expressions, kept for the FreeFEM include file: force, torque, end force, end torque.
     pub exprs: [[Expr; 3]; 4],
     compiled: Vec<Compiled>,
@@ -21,7 +32,7 @@ pub struct Loads {
 }
 
 impl Loads {
-    pub fn new(force: [Expr; 3], torque: [Expr; 3], end_force: [Expr; 3], end_torque: [Expr; 3], constants: &BTreeMap<String, f64>) -> Result<Self, ExprError> {
+    pub fn new(frame: LoadFrame, force: [Expr; 3], torque: [Expr; 3], end_force: [Expr; 3], end_torque: [Expr; 3], constants: &BTreeMap<String, f64>) -> Result<Self, ExprError> {
         let names: Vec<&str> = FIXED.iter().copied().chain(constants.keys().map(|k| k.as_str())).collect();
         let exprs = [force, torque, end_force, end_torque];
         let mut compiled = Vec::with_capacity(12);
@@ -31,7 +42,7 @@ impl Loads {
             }
         }
         let slots = [0.0, 0.0].into_iter().chain(constants.values().copied()).collect();
-        Ok(Loads { exprs, compiled, slots })
+        Ok(Loads { frame, exprs, compiled, slots })
     }
 
     fn eval3(&self, group: usize, s: f64, t: f64) -> Vector3<f64> {

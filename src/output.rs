@@ -77,7 +77,7 @@ pub fn write_run(case: &Case, r: &RunResult, metrics: &Metrics, dir: &Path) -> R
         csv_text(&["s_mid_m", "kappa1_per_m", "kappa2_per_m", "kappa3_per_m"], kappa.iter().map(|(s, k)| vec![*s, k[0], k[1], k[2]])).into_bytes(),
     )?;
     if !r.history.is_empty() {
-        put("history.csv", csv_text(&["iteration", "change"], r.history.iter().map(|h| vec![h.iteration as f64, h.change])).into_bytes())?;
+        put("history.csv", csv_text(&["continuation_step", "iteration", "change"], r.history.iter().map(|h| vec![h.step as f64, h.iteration as f64, h.change])).into_bytes())?;
     }
     if !r.tip.is_empty() {
         let rows = r.tip.iter().map(|t| {

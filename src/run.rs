@@ -79,9 +79,9 @@ pub struct RunResult {
 /// Errors of running a case.
 #[derive(Debug, thiserror::Error)]
 pub enum RunError {
-    #[error("rust engine: {0}")]
+    #[error("rust engine")]
     Solve(#[from] SolveError),
-    #[error("freefem engine: {0}")]
+    #[error("freefem engine")]
     FreeFem(#[from] FreeFemError),
 }
 
@@ -90,12 +90,12 @@ pub fn run_rust(case: &Case, mut progress: impl FnMut(usize, usize)) -> Result<R
     let problem = Problem::from_case(case);
     let start = Instant::now();
     match case.analysis {
-        Analysis::Static { method, tolerance, max_iterations } => {
+        Analysis::Static { method, tolerance, max_iterations, continuation_steps } => {
             let method = match method {
                 StaticMethod::FixedPoint { relaxation } => Method::FixedPoint { relaxation },
                 StaticMethod::Newton => Method::Newton,
             };
-            let params = StaticParams { method, tolerance, max_iterations };
+            let params = StaticParams { method, tolerance, max_iterations, continuation_steps };
             let sol = statics::solve(&problem, &params, |r| progress(r.iteration, max_iterations))?;
             Ok(RunResult {
                 engine: Engine::Rust,

@@ -14,7 +14,7 @@ use nalgebra::DVector;
 
 fn static_tip(case: &Case, method: Method, tol: f64) -> (f64, f64, usize) {
     let p = Problem::from_case(case);
-    let sol = statics::solve(&p, &StaticParams { method, tolerance: tol, max_iterations: 500 }, |_| {}).expect("static solve");
+    let sol = statics::solve(&p, &StaticParams { method, tolerance: tol, max_iterations: 500, continuation_steps: 1 }, |_| {}).expect("static solve");
     let last = case.mesh.nodes() - 1;
     (sol.u[6 * last + 1], sol.u[6 * last + 2], sol.iterations)
 }
@@ -194,4 +194,45 @@ fn modes_against_euler_bernoulli() {
         eprintln!("EB limit mode {}: {:.4} vs {:.4} (rel {e:.1e})", k + 1, w[k], reference[k]);
         assert!(e < 1e-3, "mode {k}: {e}");
     }
+}
+
+/// Eq. (64) follower load: the rod curls past 90°; an independent re-implementation (PAPER-NOTES)
+/// found tip ≈ (0, −5.77e-4, −2.36e-4) m and β down to ≈ −2.84 rad with the relaxed fixed point.
+/// Newton with load continuation reaches the same discrete solution.
+#[test]
+fn follower_load_eq64_large_bend() {
+    let text = case_text("follower_bend_64");
+    let c = case_from(&text, "f64");
+    let p = Problem::from_case(&c);
+    let fp = statics::solve(&p, &StaticParams { method: Method::FixedPoint { relaxation: 0.5 }, tolerance: 1e-9, max_iterations: 2000, continuation_steps: 1 }, |_| {}).expect("fixed point");
+    let nt = statics::solve(&p, &StaticParams { method: Method::Newton, tolerance: 1e-12, max_iterations: 30, continuation_steps: 5 }, |_| {}).expect("newton");
+    let last = c.mesh.nodes() - 1;
+    let (y, z) = (fp.u[6 * last + 1], fp.u[6 * last + 2]);
+    let min_beta = (0..c.mesh.nodes()).map(|i| fp.u[6 * i + 4]).fold(f64::INFINITY, f64::min);
+    eprintln!("eq. 64: tip ({:.4e}, {y:.4e}, {z:.4e}) m, min beta {min_beta:.4}, fixed point {} iterations, Newton {} over 5 steps", fp.u[6 * last], fp.iterations, nt.iterations);
+    assert!(fp.u[6 * last].abs() < 1e-15);
+    assert!((y / -5.77e-4 - 1.0).abs() < 1e-3 && (z / -2.36e-4 - 1.0).abs() < 3e-3);
+    assert!((min_beta + 2.84).abs() < 0.01);
+    // Fixed point stopped at a relative change of 1e-9 (D10): positions agree to ~1e-12 m,
+    // angles to ~2e-9 rad.
+    let (dx, da) = cosserat::solve::split_norms_inf(&(&fp.u - &nt.u));
+    assert!(dx < 1e-9 * c.mesh.length_m && da < 1e-8, "fixed point vs Newton: {dx:e} m, {da:e} rad");
+    assert!(nt.residual < 1e-8 && fp.residual < 1e-3, "{} {}", nt.residual, fp.residual);
+}
+
+/// Eq. (65): the relaxed fixed point stalls at full load (PAPER-NOTES); Newton with 10
+/// continuation steps converges in a handful of iterations per step to a fully 3D shape.
+#[test]
+fn follower_load_eq65_needs_newton() {
+    let c = case_from(&case_text("follower_bend_twist_65"), "f65");
+    let p = Problem::from_case(&c);
+    let nt = statics::solve(&p, &StaticParams { method: Method::Newton, tolerance: 1e-12, max_iterations: 30, continuation_steps: 10 }, |_| {}).expect("newton");
+    let per_step_max = (1..=10).map(|s| nt.history.iter().filter(|h| h.step == s).count()).max().unwrap_or(0);
+    let last = c.mesh.nodes() - 1;
+    eprintln!("eq. 65: Newton {} iterations (max {per_step_max} per step), residual {:.1e}, tip ({:.4e}, {:.4e}, {:.4e})", nt.iterations, nt.residual, nt.u[6 * last], nt.u[6 * last + 1], nt.u[6 * last + 2]);
+    assert!(per_step_max <= 10, "{per_step_max}");
+    assert!(nt.residual < 1e-8);
+    assert!(nt.u[6 * last].abs() > 1e-4, "fully 3D: tip x {}", nt.u[6 * last]);
+    let fp = statics::solve(&p, &StaticParams { method: Method::FixedPoint { relaxation: 0.5 }, tolerance: 1e-9, max_iterations: 500, continuation_steps: 1 }, |_| {});
+    assert!(matches!(fp, Err(cosserat::solve::SolveError::FixedPointNotConverged { .. })), "the printed fixed point stalls at full load");
 }

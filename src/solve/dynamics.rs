@@ -52,7 +52,7 @@ pub fn solve(problem: &Problem, params: &DynamicParams, mut progress: impl FnMut
     let mut u_prev = problem.reference_state();
     let mut v_prev = DVector::zeros(u_prev.len());
     let mut p_prev = problem.momentum(&u_prev, &v_prev, None);
-    let mut f_prev = problem.external_force(0.0);
+    let mut f_prev = problem.loads_at(&u_prev, 0.0, None);
     let mut values = vec![0.0; pattern.nnz()];
     let record = |t: f64, u: &DVector<f64>, it: usize| {
         let (x, a) = node_values(u, last);
@@ -63,8 +63,6 @@ pub fn solve(problem: &Problem, params: &DynamicParams, mut progress: impl FnMut
 
     for n in 1..=params.steps {
         let t = n as f64 * dt;
-        let f_n = problem.external_force(t);
-        let f_avg = (&f_n + &f_prev) * 0.5;
         let mut u = &u_prev + &v_prev * dt;
         let mut converged = None;
         let mut increment = f64::NAN;
@@ -74,7 +72,9 @@ pub fn solve(problem: &Problem, params: &DynamicParams, mut progress: impl FnMut
             values.iter_mut().for_each(|x| *x = 0.0);
             let p = problem.momentum(&u, &v, Some((&pattern, &mut values, 1.0 / dt, 2.0 / (dt * dt))));
             let g = problem.internal_force(&u_mid, Some((&pattern, &mut values, 0.5)));
-            let mut r = (p - &p_prev) / dt + g - &f_avg;
+            // ½[F(t_n, u_n) + F(t_{n−1}, u_{n−1})]: only the first half depends on u_n.
+            let f_n = problem.loads_at(&u, t, Some((&pattern, &mut values, -0.5)));
+            let mut r = (p - &p_prev) / dt + g - (f_n + &f_prev) * 0.5;
             for &d in &fixed {
                 r[d] = 0.0;
             }
@@ -95,7 +95,7 @@ pub fn solve(problem: &Problem, params: &DynamicParams, mut progress: impl FnMut
         max_it = max_it.max(it);
         let v = (&u - &u_prev) * (2.0 / dt) - &v_prev;
         p_prev = problem.momentum(&u, &v, None);
-        f_prev = f_n;
+        f_prev = problem.loads_at(&u, t, None);
         tip.push(record(t, &u, it));
         u_prev = u;
         v_prev = v;

@@ -10,17 +10,18 @@ use nalgebra::{DVector, Vector3};
 
 use crate::assembly::{assemble_vector, gather, LinearError, Pattern};
 use crate::case::Case;
-use crate::element::{distributed_load, internal_force, momentum, LocalMat};
-use crate::loads::Loads;
+use crate::element::{distributed_load, follower_load, internal_force, momentum, LocalMat};
+use crate::loads::{LoadFrame, Loads};
 use crate::material::RodProperties;
 use crate::mesh::{Dof, Mesh, QuadratureScheme};
 
 /// Errors of the solvers; each variant carries the numbers needed to act on it.
 #[derive(Debug, thiserror::Error)]
 pub enum SolveError {
-    #[error("fixed point did not converge after {iterations} iterations (last relative change {rel_change:e})")]
-    FixedPointNotConverged { iterations: usize, rel_change: f64 },
+    #[error("fixed point did not converge after {iterations} iterations in continuation step {step} (last relative change {rel_change:e})")]
+    FixedPointNotConverged { step: usize, iterations: usize, rel_change: f64 },
     #[error("Newton did not converge after {iterations} iterations (last increment {increment:e}){}", step_text(*.step))]
+    /// `step`: time step (dynamic) or continuation step (static)
     NewtonNotConverged { step: Option<usize>, iterations: usize, increment: f64 },
     #[error("non-finite value in iteration {iteration}{}", step_text(*.step))]
     NonFinite { step: Option<usize>, iteration: usize },
@@ -39,11 +40,13 @@ pub struct Problem<'a> {
     pub props: RodProperties,
     pub scheme: QuadratureScheme,
     pub loads: &'a Loads,
+    /// factor applied to every load (load continuation), 1 by default
+    pub load_factor: f64,
 }
 
 impl<'a> Problem<'a> {
     pub fn from_case(case: &'a Case) -> Self {
-        Problem { mesh: case.mesh, props: case.props, scheme: case.quadrature, loads: &case.loads }
+        Problem { mesh: case.mesh, props: case.props, scheme: case.quadrature, loads: &case.loads, load_factor: 1.0 }
     }
 
     /// Reference configuration: straight along e3, `x0(s) = (0, 0, s)`, `α = 0` (D1).
@@ -60,15 +63,42 @@ impl<'a> Problem<'a> {
         (0..6).collect()
     }
 
-    /// External load vector `F(t)` of D3 (distributed + end loads).
+    /// External load vector `F(t)` of D3 (distributed + end loads) for global-frame loads;
+    /// follower loads are evaluated in the reference configuration (use [`Problem::loads_at`]).
     pub fn external_force(&self, t: f64) -> DVector<f64> {
+        self.loads_at(&self.reference_state(), t, None)
+    }
+
+    /// External load vector `F(u, t)` of D3; follower (local-frame) distributed loads depend on
+    /// `u` through `Qᵀ(α)`, and `tangent = Some((pattern, values, scale))` then adds
+    /// `scale · ∂F/∂u` into `values`. Scaled by `load_factor`.
+    pub fn loads_at(&self, u: &DVector<f64>, t: f64, mut tangent: Option<(&Pattern, &mut [f64], f64)>) -> DVector<f64> {
         let h = self.mesh.h();
-        let mut f = if self.loads.has_distributed() {
-            assemble_vector(&self.mesh, |_, s0| distributed_load(self.scheme, h, s0, &mut |s| self.loads.distributed(s, t)))
-        } else {
-            DVector::zeros(self.mesh.ndofs())
+        let lf = self.load_factor;
+        let mut field = |s: f64| {
+            let (f, l) = self.loads.distributed(s, t);
+            (f * lf, l * lf)
+        };
+        let mut local_t = LocalMat::zeros();
+        let mut f = match (self.loads.has_distributed(), self.loads.frame) {
+            (false, _) => DVector::zeros(self.mesh.ndofs()),
+            (true, LoadFrame::Global) => assemble_vector(&self.mesh, |_, s0| distributed_load(self.scheme, h, s0, &mut field)),
+            (true, LoadFrame::Local) => assemble_vector(&self.mesh, |e, s0| {
+                let ue = gather(u, e);
+                match tangent.as_mut() {
+                    Some((pattern, values, scale)) => {
+                        local_t.fill(0.0);
+                        let r = follower_load(self.scheme, h, s0, &ue, &mut field, Some(&mut local_t));
+                        local_t *= *scale;
+                        pattern.scatter_mat(values, e, &local_t);
+                        r
+                    }
+                    None => follower_load(self.scheme, h, s0, &ue, &mut field, None),
+                }
+            }),
         };
         let (fe, le) = self.loads.end(t);
+        let (fe, le) = (fe * lf, le * lf);
         let last = self.mesh.nodes() - 1;
         for k in 0..3 {
             f[self.mesh.dof(last, Dof::X) + k] += fe[k];

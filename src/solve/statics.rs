@@ -22,6 +22,8 @@ pub struct StaticParams {
     pub method: Method,
     pub tolerance: f64,
     pub max_iterations: usize,
+    /// loads ramped by k/steps, k = 1..=steps, each step started from the previous solution
+    pub continuation_steps: usize,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -33,6 +35,9 @@ pub enum Method {
 /// One row of the iteration history.
 #[derive(Clone, Copy, Debug)]
 pub struct IterationRecord {
+    /// continuation step (1-based)
+    pub step: usize,
+    /// iteration within the step (1-based)
     pub iteration: usize,
     /// fixed point: relative change; Newton: increment measure
     pub change: f64,
@@ -42,6 +47,7 @@ pub struct IterationRecord {
 #[derive(Clone, Debug)]
 pub struct StaticSolution {
     pub u: DVector<f64>,
+    /// total iterations over all continuation steps
     pub iterations: usize,
     pub last_change: f64,
     /// `‖R(u)‖∞ / ‖F‖∞` over the free unknowns (D5)
@@ -49,22 +55,46 @@ pub struct StaticSolution {
     pub history: Vec<IterationRecord>,
 }
 
-/// Solve the static problem from the reference configuration.
+/// Solve the static problem from the reference configuration, with load continuation.
 pub fn solve(problem: &Problem, params: &StaticParams, mut progress: impl FnMut(&IterationRecord)) -> Result<StaticSolution, SolveError> {
     let pattern = Pattern::new(&problem.mesh);
     let solver = LinearSolver::new(&pattern)?;
+    let steps = params.continuation_steps.max(1);
+    let mut u = problem.reference_state();
+    let mut history = Vec::new();
+    let mut last_change = f64::NAN;
+    for step in 1..=steps {
+        let p = Problem { load_factor: problem.load_factor * step as f64 / steps as f64, ..*problem };
+        let (u_new, change) = solve_step(&p, params, &pattern, &solver, u, step, &mut history, &mut progress)?;
+        u = u_new;
+        last_change = change;
+    }
+    let residual = relative_residual(problem, &u);
+    Ok(StaticSolution { iterations: history.len(), u, last_change, residual, history })
+}
+
+/// One continuation step: iterate from `u` to the stopping rule of D5.
+#[allow(clippy::too_many_arguments)]
+fn solve_step(
+    problem: &Problem,
+    params: &StaticParams,
+    pattern: &Pattern,
+    solver: &LinearSolver,
+    mut u: DVector<f64>,
+    step: usize,
+    history: &mut Vec<IterationRecord>,
+    progress: &mut impl FnMut(&IterationRecord),
+) -> Result<(DVector<f64>, f64), SolveError> {
     let fixed = problem.clamped_dofs();
     let reference = problem.reference_state();
-    let f_ext = problem.external_force(0.0);
-    let mut u = reference.clone();
     let mut values = vec![0.0; pattern.nnz()];
-    let mut history = Vec::new();
     let h = problem.mesh.h();
+    let mut last = f64::NAN;
     for k in 1..=params.max_iterations {
         values.iter_mut().for_each(|v| *v = 0.0);
         let change = match params.method {
             Method::FixedPoint { relaxation } => {
-                let mut b = f_ext.clone();
+                let mut b = problem.loads_at(&u, 0.0, None);
                 for e in 0..problem.mesh.elements {
                     let (l, bl) = frozen_operator(&problem.props, problem.scheme, h, &gather(&u, e));
                     pattern.scatter_mat(&mut values, e, &l);
@@ -83,8 +113,8 @@ pub fn solve(problem: &Problem, params: &StaticParams, mut progress: impl FnMut(
                 change
             }
             Method::Newton => {
-                let g = problem.internal_force(&u, Some((&pattern, &mut values, 1.0)));
-                let mut r = g - &f_ext;
+                let g = problem.internal_force(&u, Some((pattern, &mut values, 1.0)));
+                let mut r = g - problem.loads_at(&u, 0.0, Some((pattern, &mut values, -1.0)));
                 for &d in &fixed {
                     r[d] = u[d] - reference[d];
                 }
@@ -95,20 +125,19 @@ pub fn solve(problem: &Problem, params: &StaticParams, mut progress: impl FnMut(
             }
         };
         if !change.is_finite() || u.iter().any(|v| !v.is_finite()) {
-            return Err(SolveError::NonFinite { step: None, iteration: k });
+            return Err(SolveError::NonFinite { step: Some(step), iteration: k });
         }
-        let rec = IterationRecord { iteration: k, change };
+        let rec = IterationRecord { step, iteration: k, change };
         progress(&rec);
         history.push(rec);
+        last = change;
         if change <= params.tolerance {
-            let residual = relative_residual(problem, &u, &f_ext);
-            return Ok(StaticSolution { u, iterations: k, last_change: change, residual, history });
+            return Ok((u, change));
         }
     }
-    let last = history.last().map(|r| r.change).unwrap_or(f64::NAN);
     match params.method {
-        Method::FixedPoint { .. } => Err(SolveError::FixedPointNotConverged { iterations: params.max_iterations, rel_change: last }),
-        Method::Newton => Err(SolveError::NewtonNotConverged { step: None, iterations: params.max_iterations, increment: last }),
+        Method::FixedPoint { .. } => Err(SolveError::FixedPointNotConverged { step, iterations: params.max_iterations, rel_change: last }),
+        Method::Newton => Err(SolveError::NewtonNotConverged { step: Some(step), iterations: params.max_iterations, increment: last }),
     }
 }
 
@@ -120,10 +149,11 @@ pub fn relative_change(new: &DVector<f64>, old: &DVector<f64>) -> f64 {
     ratio(dx, nx).max(ratio(da, na))
 }
 
-/// `‖G(u) − F‖∞ / ‖F‖∞` over free unknowns.
-pub fn relative_residual(problem: &Problem, u: &DVector<f64>, f_ext: &DVector<f64>) -> f64 {
-    let r = problem.internal_force(u, None) - f_ext;
-    let scale = problem.free_norm_inf(f_ext);
+/// `‖G(u) − F(u)‖∞ / ‖F(u)‖∞` over free unknowns.
+pub fn relative_residual(problem: &Problem, u: &DVector<f64>) -> f64 {
+    let f_ext = problem.loads_at(u, 0.0, None);
+    let r = problem.internal_force(u, None) - &f_ext;
+    let scale = problem.free_norm_inf(&f_ext);
     let rn = problem.free_norm_inf(&r);
     if scale > 0.0 {
         rn / scale
