@@ -213,10 +213,11 @@ fn follower_load_eq64_large_bend() {
     assert!(fp.u[6 * last].abs() < 1e-15);
     assert!((y / -5.77e-4 - 1.0).abs() < 1e-3 && (z / -2.36e-4 - 1.0).abs() < 3e-3);
     assert!((min_beta + 2.84).abs() < 0.01);
-    // Fixed point stopped at a relative change of 1e-9 (D10): positions agree to ~1e-12 m,
+    // Fixed point stopped at a relative change of 1e-9 (D10), i.e. an error of a few 1e-9
+    // relative; measured: positions agree to 1.0e-12 m,
     // angles to ~2e-9 rad.
     let (dx, da) = cosserat::solve::split_norms_inf(&(&fp.u - &nt.u));
-    assert!(dx < 1e-9 * c.mesh.length_m && da < 1e-8, "fixed point vs Newton: {dx:e} m, {da:e} rad");
+    assert!(dx < 1e-8 * c.mesh.length_m && da < 1e-8, "fixed point vs Newton: {dx:e} m, {da:e} rad");
     assert!(nt.residual < 1e-8 && fp.residual < 1e-3, "{} {}", nt.residual, fp.residual);
 }
 
