@@ -12,6 +12,7 @@ use nalgebra::DVector;
 use crate::element::{LocalMat, LocalVec};
 use crate::mesh::{Mesh, DOFS_PER_ELEMENT};
 
+
 /// Errors of the linear algebra layer.
 #[derive(Debug, thiserror::Error)]
 pub enum LinearError {
@@ -43,28 +44,36 @@ pub fn assemble_vector(mesh: &Mesh, mut kernel: impl FnMut(usize, f64) -> LocalV
     r
 }
 
-/// CSC sparsity pattern of the block-tridiagonal system matrix with, per element, the
-/// position of each of its 144 local entries in the value array.
+/// CSC sparsity pattern of the block-tridiagonal system matrix (`block` unknowns per node,
+/// 6 for the forward problem, 12 for the inverse) with, per element, the position of each of
+/// its `(2 block)²` local entries in the value array.
 pub struct Pattern {
     ndofs: usize,
+    block: usize,
     col_ptr: Vec<usize>,
     row_idx: Vec<usize>,
-    /// value index of local entry (i, j) of element e: `slots[e][12 i + j]`
-    slots: Vec<[usize; DOFS_PER_ELEMENT * DOFS_PER_ELEMENT]>,
+    /// value index of local entry (i, j) of element e: `slots[e * n² + n i + j]`, n = 2 block
+    slots: Vec<usize>,
     diag: Vec<usize>,
 }
 
 impl Pattern {
+    /// Pattern of the forward problem (6 unknowns per node).
     pub fn new(mesh: &Mesh) -> Self {
-        let n = mesh.ndofs();
+        Self::with_block(mesh, 6)
+    }
+
+    /// Pattern for `block` unknowns per node, element `e` owning `[block e, block (e + 2))`.
+    pub fn with_block(mesh: &Mesh, block: usize) -> Self {
+        let n = mesh.nodes() * block;
         // Column j couples with rows of the nodes of every element containing node(j).
         let mut col_ptr = Vec::with_capacity(n + 1);
         let mut row_idx = Vec::new();
         col_ptr.push(0);
         for j in 0..n {
-            let node = j / 6;
-            let lo = node.saturating_sub(1) * 6;
-            let hi = ((node + 2).min(mesh.nodes())) * 6;
+            let node = j / block;
+            let lo = node.saturating_sub(1) * block;
+            let hi = ((node + 2).min(mesh.nodes())) * block;
             row_idx.extend(lo..hi);
             col_ptr.push(row_idx.len());
         }
@@ -73,18 +82,17 @@ impl Pattern {
             let first = row_idx[range.start];
             range.start + (i - first)
         };
-        let mut slots = Vec::with_capacity(mesh.elements);
+        let ne = 2 * block;
+        let mut slots = Vec::with_capacity(mesh.elements * ne * ne);
         for e in 0..mesh.elements {
-            let mut s = [0usize; DOFS_PER_ELEMENT * DOFS_PER_ELEMENT];
-            for i in 0..DOFS_PER_ELEMENT {
-                for j in 0..DOFS_PER_ELEMENT {
-                    s[DOFS_PER_ELEMENT * i + j] = find(6 * e + i, 6 * e + j);
+            for i in 0..ne {
+                for j in 0..ne {
+                    slots.push(find(block * e + i, block * e + j));
                 }
             }
-            slots.push(s);
         }
         let diag = (0..n).map(|j| find(j, j)).collect();
-        Pattern { ndofs: n, col_ptr, row_idx, slots, diag }
+        Pattern { ndofs: n, block, col_ptr, row_idx, slots, diag }
     }
 
     pub fn nnz(&self) -> usize {
@@ -93,10 +101,16 @@ impl Pattern {
 
     /// Add a local matrix of element `e` into the values.
     pub fn scatter_mat(&self, values: &mut [f64], e: usize, local: &LocalMat) {
-        let s = &self.slots[e];
-        for i in 0..DOFS_PER_ELEMENT {
-            for j in 0..DOFS_PER_ELEMENT {
-                values[s[DOFS_PER_ELEMENT * i + j]] += local[(i, j)];
+        self.scatter_local(values, e, local);
+    }
+
+    /// Add a local `(2 block)²` matrix of element `e` into the values.
+    pub fn scatter_local<const N: usize>(&self, values: &mut [f64], e: usize, local: &nalgebra::SMatrix<f64, N, N>) {
+        assert_eq!(N, 2 * self.block, "local matrix size must be twice the block size");
+        let s = &self.slots[e * N * N..(e + 1) * N * N];
+        for i in 0..N {
+            for j in 0..N {
+                values[s[N * i + j]] += local[(i, j)];
             }
         }
     }
@@ -131,6 +145,9 @@ impl Pattern {
     }
 }
 
+/// Passes of Ruiz equilibration.
+const RUIZ_PASSES: usize = 5;
+
 /// Sparse LU with the symbolic analysis done once per pattern.
 pub struct LinearSolver {
     symbolic_matrix: SymbolicSparseColMat<usize>,
@@ -142,6 +159,39 @@ impl LinearSolver {
         let symbolic_matrix = pattern.symbolic();
         let symbolic_lu = SymbolicLu::try_new(symbolic_matrix.as_ref()).map_err(|e| LinearError::Factorisation(format!("{e:?}")))?;
         Ok(LinearSolver { symbolic_matrix, symbolic_lu })
+    }
+
+    /// Solve `M x = b` after Ruiz equilibration (`docs/inverse.md`, I6): five passes of
+    /// row/column max-norm scaling `A ← diag(1/√r) A diag(1/√c)`, then `x = D_c y`.
+    pub fn solve_equilibrated(&self, values: &[f64], b: &DVector<f64>) -> Result<DVector<f64>, LinearError> {
+        let n = b.len();
+        let col_ptr = self.symbolic_matrix.col_ptr();
+        let row_idx = self.symbolic_matrix.row_idx();
+        let mut a = values.to_vec();
+        let (mut dr, mut dc) = (vec![1.0; n], vec![1.0; n]);
+        for _ in 0..RUIZ_PASSES {
+            let (mut r, mut c) = (vec![0.0_f64; n], vec![0.0_f64; n]);
+            for j in 0..n {
+                for k in col_ptr[j]..col_ptr[j + 1] {
+                    let v = a[k].abs();
+                    r[row_idx[k]] = r[row_idx[k]].max(v);
+                    c[j] = c[j].max(v);
+                }
+            }
+            let inv_sqrt = |v: f64| if v > 0.0 { 1.0 / v.sqrt() } else { 1.0 };
+            for j in 0..n {
+                for k in col_ptr[j]..col_ptr[j + 1] {
+                    a[k] *= inv_sqrt(r[row_idx[k]]) * inv_sqrt(c[j]);
+                }
+            }
+            for i in 0..n {
+                dr[i] *= inv_sqrt(r[i]);
+                dc[i] *= inv_sqrt(c[i]);
+            }
+        }
+        let rhs = DVector::from_fn(n, |i, _| b[i] * dr[i]);
+        let y = self.solve(&a, &rhs)?;
+        Ok(DVector::from_fn(n, |i, _| y[i] * dc[i]))
     }
 
     /// Solve `M x = b` for the matrix with the pattern's structure and the given values.
@@ -178,6 +228,9 @@ mod tests {
         let solver = LinearSolver::new(&p).unwrap();
         let x = solver.solve(&vals, &b).unwrap();
         assert!((&dense * &x - &b).amax() < 1e-12);
+        // Equilibration does not change the solution of a well-conditioned system.
+        let xe = solver.solve_equilibrated(&vals, &b).unwrap();
+        assert!((&xe - &x).amax() < 1e-12);
         // Identity rows.
         p.set_identity_rows(&mut vals, &[0, 5]);
         let x = solver.solve(&vals, &b).unwrap();

@@ -3,6 +3,7 @@
 //! frequencies about the rest state). All of them assemble through [`Problem`], which owns the
 //! one element loop of the crate.
 pub mod dynamics;
+pub mod inverse;
 pub mod modes;
 pub mod statics;
 

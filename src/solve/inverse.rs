@@ -1,0 +1,326 @@
+//! Inverse problem of one frame: Problem 1 (41)–(43) solved by the monolithic fixed point of
+//! Problem 2, eq. (61), with the corrections and readings of `docs/inverse.md` (I1–I6).
+//!
+//! ```text
+//!   ⎡ H_k   L_kᵀ ⎤ ⎡u⎤   ⎡h_k⎤     u = (x, α) state, û = (x̂, α̂) adjoint,
+//!   ⎣ L_k   −C   ⎦ ⎣û⎦ = ⎣b_k⎦     f = x̂/λf, l = α̂/λl (eq. 54)
+//! ```
+//! `L_k`, `b_k`: the frozen operator of the forward fixed point (D5). `H_k`: the objective's
+//! second-order terms with `d3` linearised as in (60) and the corrected sign of the λd term.
+//! `C`: control mass matrices `(1/λf) M`, `(1/λl) M`. State relaxed with w (Remark 10).
+//!
+//! ## References
+//! 1. Wang et al., Comput. Mech. 71 (2023), §3–4, eqs. (41), (52)–(61), Remark 6, Remark 10.
+#![allow(non_snake_case)]
+use nalgebra::{DVector, Matrix3, SMatrix, SVector, Vector3};
+
+use super::{split_norms_2, Problem, SolveError};
+use crate::assembly::{LinearSolver, Pattern};
+use crate::element::{frozen_operator, interpolate, LocalVec};
+use crate::mesh::GAUSS2;
+use crate::rotation::{a_matrix, d3, rotation_derivatives};
+
+/// Unknowns per node of the KKT system: `[x, α, x̂, α̂]`.
+pub const BLOCK: usize = 12;
+type KktMat = SMatrix<f64, 24, 24>;
+type KktVec = SVector<f64, 24>;
+
+/// Regularisation weights of eq. (41) and the iteration settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct InverseParams {
+    /// λg [1/m³·…]: weight of the tracking term
+    pub lambda_g: f64,
+    pub lambda_f: f64,
+    pub lambda_l: f64,
+    pub lambda_d: f64,
+    /// Λκ diagonal
+    pub lambda_kappa: Vector3<f64>,
+    /// Λω diagonal (applied from the second frame on)
+    pub lambda_omega: Vector3<f64>,
+    /// frame interval Δt [s]
+    pub dt: f64,
+    /// first frame: α(0) = 0 on the first angle and no Λω term (Remark 6)
+    pub first_frame: bool,
+    pub relaxation: f64,
+    pub tolerance: f64,
+    pub max_iterations: usize,
+}
+
+/// Per-iteration record (`docs/inverse.md`): relative change of (x, α) (D5),
+/// ‖x − x_g‖/‖x_g‖ and ‖∂s x − d3‖ (L² norms) at the relaxed iterate.
+#[derive(Clone, Copy, Debug)]
+pub struct InverseRecord {
+    pub iteration: usize,
+    pub rel_change: f64,
+    pub x_err_rel: f64,
+    pub tangent_misfit: f64,
+}
+
+/// Converged frame.
+#[derive(Clone, Debug)]
+pub struct InverseSolution {
+    /// state `(x, α)`, 6 per node
+    pub u: DVector<f64>,
+    /// adjoint `(x̂, α̂)`, 6 per node (last solve)
+    pub adjoint: DVector<f64>,
+    pub history: Vec<InverseRecord>,
+}
+
+/// Map a forward local index (`[x_a, α_a, x_b, α_b]`) to the KKT local index; `hat` selects
+/// the adjoint copy.
+fn kkt(i: usize, hat: bool) -> usize {
+    BLOCK * (i / 6) + i % 6 + if hat { 6 } else { 0 }
+}
+
+/// `∂d3/∂α = [0 | d_β | d_γ]` (eqs. 56–58).
+fn d3_jacobian(alpha: &Vector3<f64>) -> Matrix3<f64> {
+    let dq = rotation_derivatives(alpha);
+    Matrix3::from_columns(&[dq[0].row(2).transpose(), dq[1].row(2).transpose(), dq[2].row(2).transpose()])
+}
+
+/// Local KKT matrix and right-hand side of one element (I4).
+fn element_system(problem: &Problem, p: &InverseParams, uk: &LocalVec, xg: [Vector3<f64>; 2], alpha_prev: [Vector3<f64>; 2]) -> (KktMat, KktVec) {
+    let h = problem.mesh.h();
+    let mut m = KktMat::zeros();
+    let mut r = KktVec::zeros();
+    // Frozen operator: primal rows (hat test) × state columns, and its transpose.
+    let (l, b) = frozen_operator(&problem.props, problem.scheme, h, uk);
+    for i in 0..12 {
+        r[kkt(i, true)] += b[i];
+        for j in 0..12 {
+            m[(kkt(i, true), kkt(j, false))] += l[(i, j)];
+            m[(kkt(j, false), kkt(i, true))] += l[(i, j)];
+        }
+    }
+    let add3 = |m: &mut KktMat, ro: usize, co: usize, blk: &Matrix3<f64>| {
+        for i in 0..3 {
+            for j in 0..3 {
+                m[(ro + i, co + j)] += blk[(i, j)];
+            }
+        }
+    };
+    let (X, AL, XH, ALH) = ([0, 12], [3, 15], [6, 18], [9, 21]);
+    let omega_on = !p.first_frame && p.lambda_omega.amax() > 0.0;
+    // Mass-type terms (load rule): tracking, control costs, Λω.
+    for (xi, w) in GAUSS2.points.iter().zip(GAUSS2.weights) {
+        let q = interpolate(uk, h, *xi);
+        let n = q.n;
+        let wh = w * h;
+        let xg_q = xg[0] * n[0] + xg[1] * n[1];
+        let ap_q = alpha_prev[0] * n[0] + alpha_prev[1] * n[1];
+        let W = if omega_on {
+            let A = a_matrix(&q.alpha);
+            A.transpose() * Matrix3::from_diagonal(&p.lambda_omega) * A / (p.dt * p.dt)
+        } else {
+            Matrix3::zeros()
+        };
+        for a in 0..2 {
+            for i in 0..3 {
+                r[X[a] + i] += wh * n[a] * p.lambda_g * xg_q[i];
+            }
+            let wa = W * ap_q * (wh * n[a]);
+            for i in 0..3 {
+                r[AL[a] + i] += wa[i];
+            }
+            for c in 0..2 {
+                let nn = wh * n[a] * n[c];
+                add3(&mut m, X[a], X[c], &(Matrix3::identity() * (p.lambda_g * nn)));
+                add3(&mut m, XH[a], XH[c], &(Matrix3::identity() * (-nn / p.lambda_f)));
+                add3(&mut m, ALH[a], ALH[c], &(Matrix3::identity() * (-nn / p.lambda_l)));
+                add3(&mut m, AL[a], AL[c], &(W * nn));
+            }
+        }
+    }
+    // λd term (stretch–shear rule): λd ∫ (∂sδx − D δα)·(∂s x − D α − d3^k + D α_k).
+    let rule = problem.scheme.stretch_shear();
+    for (xi, w) in rule.points.iter().zip(rule.weights) {
+        let q = interpolate(uk, h, *xi);
+        let wh = w * h * p.lambda_d;
+        let D = d3_jacobian(&q.alpha);
+        let c = d3(&q.alpha) - D * q.alpha;
+        for a in 0..2 {
+            let ta = [Matrix3::identity() * q.dn[a], -D * q.n[a]]; // test operator blocks (x, α)
+            for i in 0..3 {
+                r[X[a] + i] += wh * (ta[0].transpose() * c)[i];
+                r[AL[a] + i] += wh * (ta[1].transpose() * c)[i];
+            }
+            for cc in 0..2 {
+                let tc = [Matrix3::identity() * q.dn[cc], -D * q.n[cc]];
+                for (ra, ro) in [(0, X[a]), (1, AL[a])] {
+                    for (ca, co) in [(0, X[cc]), (1, AL[cc])] {
+                        add3(&mut m, ro, co, &(ta[ra].transpose() * tc[ca] * wh));
+                    }
+                }
+            }
+        }
+    }
+    // Λκ term (bending rule): ∫ ∂sδα · Aᵀ Λκ A ∂sα.
+    if p.lambda_kappa.amax() > 0.0 {
+        let rule = problem.scheme.bending();
+        for (xi, w) in rule.points.iter().zip(rule.weights) {
+            let q = interpolate(uk, h, *xi);
+            let A = a_matrix(&q.alpha);
+            let Kk = A.transpose() * Matrix3::from_diagonal(&p.lambda_kappa) * A * (w * h);
+            for a in 0..2 {
+                for c in 0..2 {
+                    add3(&mut m, AL[a], AL[c], &(Kk * (q.dn[a] * q.dn[c])));
+                }
+            }
+        }
+    }
+    (m, r)
+}
+
+/// Solve one frame from the initial state `u0` (6 per node). `x_g`: data positions per node;
+/// `alpha_prev`: previous frame's angles per node (unused at the first frame).
+pub fn solve_frame(
+    problem: &Problem,
+    p: &InverseParams,
+    x_g: &[Vector3<f64>],
+    alpha_prev: &[Vector3<f64>],
+    u0: &DVector<f64>,
+    mut progress: impl FnMut(&InverseRecord),
+) -> Result<InverseSolution, SolveError> {
+    let mesh = problem.mesh;
+    let nodes = mesh.nodes();
+    let pattern = Pattern::with_block(&mesh, BLOCK);
+    let solver = LinearSolver::new(&pattern)?;
+    let last = nodes - 1;
+    // Dirichlet unknowns of I5 with their values.
+    let mut fixed: Vec<(usize, f64)> = Vec::new();
+    for node in [0, last] {
+        for k in 0..3 {
+            fixed.push((BLOCK * node + k, x_g[node][k]));
+        }
+        for k in 6..12 {
+            fixed.push((BLOCK * node + k, 0.0));
+        }
+    }
+    if p.first_frame {
+        fixed.push((3, 0.0));
+    }
+    let rows: Vec<usize> = fixed.iter().map(|f| f.0).collect();
+    let mut u = u0.clone();
+    let mut values = vec![0.0; pattern.nnz()];
+    let mut history = Vec::new();
+    let mut adjoint = DVector::zeros(6 * nodes);
+    for k in 1..=p.max_iterations {
+        values.iter_mut().for_each(|v| *v = 0.0);
+        let mut rhs = DVector::zeros(BLOCK * nodes);
+        for e in 0..mesh.elements {
+            let uk = LocalVec::from_column_slice(&u.as_slice()[6 * e..6 * e + 12]);
+            let (m, r) = element_system(problem, p, &uk, [x_g[e], x_g[e + 1]], [alpha_prev[e], alpha_prev[e + 1]]);
+            pattern.scatter_local(&mut values, e, &m);
+            for i in 0..24 {
+                rhs[BLOCK * e + i] += r[i];
+            }
+        }
+        for &(d, v) in &fixed {
+            rhs[d] = v;
+        }
+        pattern.set_identity_rows(&mut values, &rows);
+        let sol = solver.solve_equilibrated(&values, &rhs)?;
+        let mut u_new = DVector::zeros(6 * nodes);
+        for node in 0..nodes {
+            for c in 0..6 {
+                u_new[6 * node + c] = sol[BLOCK * node + c];
+                adjoint[6 * node + c] = sol[BLOCK * node + 6 + c];
+            }
+        }
+        let u_next = &u_new * p.relaxation + &u * (1.0 - p.relaxation);
+        let (dx, da) = split_norms_2(&(&u_next - &u));
+        let (nx, na) = split_norms_2(&u_next);
+        let ratio = |d: f64, n: f64| if d == 0.0 { 0.0 } else { d / n };
+        let rel_change = ratio(dx, nx).max(ratio(da, na));
+        u = u_next;
+        if !rel_change.is_finite() || u.iter().any(|v| !v.is_finite()) {
+            return Err(SolveError::NonFinite { step: None, iteration: k });
+        }
+        let (x_err_rel, tangent_misfit) = fit_measures(problem, &u, x_g);
+        let rec = InverseRecord { iteration: k, rel_change, x_err_rel, tangent_misfit };
+        progress(&rec);
+        history.push(rec);
+        if rel_change <= p.tolerance {
+            return Ok(InverseSolution { u, adjoint, history });
+        }
+    }
+    Err(SolveError::FixedPointNotConverged { step: 1, iterations: p.max_iterations, rel_change: history.last().map(|h| h.rel_change).unwrap_or(f64::NAN) })
+}
+
+/// `(‖x − x_g‖/‖x_g‖, ‖∂s x − d3‖)` with the integration rules of I2.
+pub fn fit_measures(problem: &Problem, u: &DVector<f64>, x_g: &[Vector3<f64>]) -> (f64, f64) {
+    let h = problem.mesh.h();
+    let (mut e2, mut g2, mut t2) = (0.0, 0.0, 0.0);
+    let rule = problem.scheme.stretch_shear();
+    for e in 0..problem.mesh.elements {
+        let ue = LocalVec::from_column_slice(&u.as_slice()[6 * e..6 * e + 12]);
+        for (xi, w) in GAUSS2.points.iter().zip(GAUSS2.weights) {
+            let q = interpolate(&ue, h, *xi);
+            let xg = x_g[e] * q.n[0] + x_g[e + 1] * q.n[1];
+            e2 += w * h * (q.x - xg).norm_squared();
+            g2 += w * h * xg.norm_squared();
+        }
+        for (xi, w) in rule.points.iter().zip(rule.weights) {
+            let q = interpolate(&ue, h, *xi);
+            t2 += w * h * (q.dx - d3(&q.alpha)).norm_squared();
+        }
+    }
+    ((e2 / g2).sqrt(), t2.sqrt())
+}
+
+/// Element-midpoint curvature `κˡ = A(α_mid) ∂sα` [1/m] of a nodal state (eq. 28).
+pub fn element_curvatures(problem: &Problem, u: &DVector<f64>) -> Vec<Vector3<f64>> {
+    let h = problem.mesh.h();
+    (0..problem.mesh.elements)
+        .map(|e| {
+            let q = interpolate(&LocalVec::from_column_slice(&u.as_slice()[6 * e..6 * e + 12]), h, 0.5);
+            crate::rotation::curvature(&q.alpha, &q.dalpha)
+        })
+        .collect()
+}
+
+/// `‖κ − κ_f‖/‖κ_f‖` over element midpoints, skipping `skip` elements at each end.
+pub fn curvature_error(problem: &Problem, u: &DVector<f64>, truth: &DVector<f64>, skip: usize) -> f64 {
+    let (k, kf) = (element_curvatures(problem, u), element_curvatures(problem, truth));
+    let n = k.len();
+    let range = skip.min(n / 2)..n - skip.min(n / 2);
+    let num: f64 = range.clone().map(|e| (k[e] - kf[e]).norm_squared()).sum();
+    let den: f64 = range.map(|e| kf[e].norm_squared()).sum();
+    (num / den).sqrt()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::case::Case;
+
+    /// With the corrected sign of the λd term (I3) the element KKT matrix is symmetric; the
+    /// printed sign would make the α–α block λd DᵀD negative and break the symmetry.
+    #[test]
+    fn element_kkt_matrix_is_symmetric() {
+        let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/cases/follower_bend_64.toml")).expect("case");
+        let case = Case::from_toml(&text, "c", std::path::Path::new("c")).expect("case");
+        let problem = Problem::from_case(&case);
+        let h = case.mesh.h();
+        let uk = LocalVec::from_column_slice(&[0.0, 1e-6, 0.0, 0.1, -0.4, 0.2, 2e-7, 3e-6, h, 0.15, -0.5, 0.25]);
+        let p = InverseParams {
+            lambda_g: 1e9, lambda_f: 1.0, lambda_l: 1e-10, lambda_d: 1e-6,
+            lambda_kappa: Vector3::new(0.0, 1e-12, 1e-10), lambda_omega: Vector3::new(1e-3, 0.0, 1e-2), dt: 0.04,
+            first_frame: false, relaxation: 0.5, tolerance: 1e-6, max_iterations: 1,
+        };
+        let (m, _) = element_system(&problem, &p, &uk, [Vector3::zeros(), Vector3::new(0.0, 0.0, h)], [Vector3::zeros(); 2]);
+        let asym = (m - m.transpose()).amax() / m.amax();
+        assert!(asym < 1e-14, "asymmetry {asym:e}");
+        // The λd block alone is positive semi-definite.
+        let p_d = InverseParams { lambda_g: 0.0, lambda_kappa: Vector3::zeros(), lambda_omega: Vector3::zeros(), ..p };
+        let (m_d, _) = element_system(&problem, &p_d, &uk, [Vector3::zeros(); 2], [Vector3::zeros(); 2]);
+        let mut state = nalgebra::DMatrix::zeros(12, 12);
+        for i in 0..12 {
+            for j in 0..12 {
+                state[(i, j)] = m_d[(kkt(i, false), kkt(j, false))];
+            }
+        }
+        let eig = nalgebra::SymmetricEigen::new(state.clone());
+        assert!(eig.eigenvalues.min() > -1e-12 * state.amax(), "{}", eig.eigenvalues.min());
+    }
+}
