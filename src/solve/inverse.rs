@@ -185,36 +185,14 @@ pub fn solve_frame(
     let nodes = mesh.nodes();
     let pattern = Pattern::with_block(&mesh, BLOCK);
     let solver = LinearSolver::new(&pattern)?;
-    let last = nodes - 1;
-    // Dirichlet unknowns of I5 with their values.
-    let mut fixed: Vec<(usize, f64)> = Vec::new();
-    for node in [0, last] {
-        for k in 0..3 {
-            fixed.push((BLOCK * node + k, x_g[node][k]));
-        }
-        for k in 6..12 {
-            fixed.push((BLOCK * node + k, 0.0));
-        }
-    }
-    if p.first_frame {
-        fixed.push((3, 0.0));
-    }
+    let fixed = dirichlet(p, x_g);
     let rows: Vec<usize> = fixed.iter().map(|f| f.0).collect();
     let mut u = u0.clone();
     let mut values = vec![0.0; pattern.nnz()];
     let mut history = Vec::new();
     let mut adjoint = DVector::zeros(6 * nodes);
     for k in 1..=p.max_iterations {
-        values.iter_mut().for_each(|v| *v = 0.0);
-        let mut rhs = DVector::zeros(BLOCK * nodes);
-        for e in 0..mesh.elements {
-            let uk = LocalVec::from_column_slice(&u.as_slice()[6 * e..6 * e + 12]);
-            let (m, r) = element_system(problem, p, &uk, [x_g[e], x_g[e + 1]], [alpha_prev[e], alpha_prev[e + 1]]);
-            pattern.scatter_local(&mut values, e, &m);
-            for i in 0..24 {
-                rhs[BLOCK * e + i] += r[i];
-            }
-        }
+        let mut rhs = assemble_kkt(problem, p, &pattern, &mut values, &u, x_g, alpha_prev);
         for &(d, v) in &fixed {
             rhs[d] = v;
         }
@@ -245,6 +223,49 @@ pub fn solve_frame(
         }
     }
     Err(SolveError::FixedPointNotConverged { step: 1, iterations: p.max_iterations, rel_change: history.last().map(|h| h.rel_change).unwrap_or(f64::NAN) })
+}
+
+/// Dirichlet unknowns of I5 in KKT numbering with their values: `x = x_g` and `x̂ = α̂ = 0`
+/// at both ends, and at the first frame `α(0) = 0` (first angle only).
+pub fn dirichlet(p: &InverseParams, x_g: &[Vector3<f64>]) -> Vec<(usize, f64)> {
+    let last = x_g.len() - 1;
+    let mut fixed = Vec::new();
+    for node in [0, last] {
+        for k in 0..3 {
+            fixed.push((BLOCK * node + k, x_g[node][k]));
+        }
+        for k in 6..12 {
+            fixed.push((BLOCK * node + k, 0.0));
+        }
+    }
+    if p.first_frame {
+        fixed.push((3, 0.0));
+    }
+    fixed
+}
+
+/// Assemble the KKT matrix (into `values`, zeroed first) and right-hand side of I4 with the
+/// coefficients frozen at the state `u` (6 per node); boundary conditions not applied.
+pub fn assemble_kkt(
+    problem: &Problem,
+    p: &InverseParams,
+    pattern: &Pattern,
+    values: &mut [f64],
+    u: &DVector<f64>,
+    x_g: &[Vector3<f64>],
+    alpha_prev: &[Vector3<f64>],
+) -> DVector<f64> {
+    values.iter_mut().for_each(|v| *v = 0.0);
+    let mut rhs = DVector::zeros(BLOCK * problem.mesh.nodes());
+    for e in 0..problem.mesh.elements {
+        let uk = LocalVec::from_column_slice(&u.as_slice()[6 * e..6 * e + 12]);
+        let (m, r) = element_system(problem, p, &uk, [x_g[e], x_g[e + 1]], [alpha_prev[e], alpha_prev[e + 1]]);
+        pattern.scatter_local(values, e, &m);
+        for i in 0..24 {
+            rhs[BLOCK * e + i] += r[i];
+        }
+    }
+    rhs
 }
 
 /// `(‖x − x_g‖/‖x_g‖, ‖∂s x − d3‖)` with the integration rules of I2.
