@@ -13,6 +13,10 @@ use cosserat::metrics::compare;
 use cosserat::run::{run, run_rust, Engine};
 
 const FREEFEM_DYNAMIC_STEPS: usize = 40;
+/// Bound on the dynamic prefix, stricter than a case's full-run tolerance: over 40 steps the
+/// amplification of round-off by the dynamics is still small (measured agreement 1.1e-8 for
+/// the displacement, 4.1e-8 for the angles), so the 1e-6 is asserted here.
+const PREFIX_REL: f64 = 1e-6;
 
 fn freefem_required() -> bool {
     if std::env::var_os("COSSERAT_SKIP_FREEFEM").is_some() {
@@ -35,7 +39,13 @@ fn every_case_agrees_between_rust_and_freefem() {
     let mut failures = Vec::new();
     for f in files {
         let case = Case::from_file(&f).unwrap_or_else(|e| panic!("{e}"));
-        let case = case.time_prefix(FREEFEM_DYNAMIC_STEPS);
+        let dynamic = case.is_dynamic();
+        let mut case = case.time_prefix(FREEFEM_DYNAMIC_STEPS);
+        if dynamic {
+            case.compare.displacement_rel = case.compare.displacement_rel.min(PREFIX_REL);
+            case.compare.angles_rel = case.compare.angles_rel.min(PREFIX_REL);
+            case.compare.metric_rel = case.compare.metric_rel.min(PREFIX_REL);
+        }
         let dir = tempfile::tempdir().expect("tempdir");
         let rust = run_rust(&case, |_, _| {}).unwrap_or_else(|e| panic!("{}: {e}", case.name));
         let ff = run(&case, Engine::Freefem, dir.path(), |_, _| {}).unwrap_or_else(|e| panic!("{}: {e}", case.name));

@@ -10,21 +10,27 @@ use cosserat::case::{case_files, Case};
 use cosserat::metrics::all_metrics;
 use cosserat::run::run_rust;
 
-/// Significant digits kept for physical metrics.
+/// Significant digits kept for physical metrics of static cases (deterministic to ~1e-10).
 const DIGITS: i32 = 7;
+/// Dynamic histories amplify round-off ~1e9-fold over 1000 steps (docs/decisions.md, D12):
+/// another CPU's SIMD path can move the final tip by ~1e-5 relative, so keep 4 digits.
+const DYNAMIC_DIGITS: i32 = 4;
 
 #[test]
 fn case_metrics_snapshots() {
     for f in case_files(&common::cases_dir()).expect("cases dir") {
         let case = Case::from_file(&f).unwrap_or_else(|e| panic!("{e}"));
         let r = run_rust(&case, |_, _| {}).unwrap_or_else(|e| panic!("{}: {e}", case.name));
+        let digits = if case.is_dynamic() { DYNAMIC_DIGITS } else { DIGITS };
         let m: BTreeMap<String, f64> = all_metrics(&case, &r)
             .expect("reference metrics")
             .into_iter()
             .filter(|(k, _)| !matches!(k.as_str(), "wall_time_s" | "last_change" | "relative_residual"))
+            // Total Newton count of a dynamic run depends on increments near the threshold.
+            .filter(|(k, _)| !(case.is_dynamic() && k == "iterations"))
             .map(|(k, v)| {
                 // Errors against theory are differences of nearly equal numbers: keep 3 digits.
-                let v = if k.contains("iterations") { v } else if k.ends_with("rel_error") { sig(v, 3) } else { sig(v, DIGITS) };
+                let v = if k.contains("iterations") { v } else if k.ends_with("rel_error") { sig(v, 3) } else { sig(v, digits) };
                 (k, v)
             })
             .collect();
