@@ -8,7 +8,7 @@ use crate::run::RunResult;
 pub type Metrics = BTreeMap<String, f64>;
 
 /// Physical metrics compared between engines.
-pub fn physical_metrics(_case: &Case, r: &RunResult) -> Metrics {
+pub fn physical_metrics(r: &RunResult) -> Metrics {
     let mut m = Metrics::new();
     let last = r.nodes.x.len() - 1;
     let (x, a) = (r.nodes.x[last], r.nodes.alpha[last]);
@@ -32,7 +32,7 @@ pub fn physical_metrics(_case: &Case, r: &RunResult) -> Metrics {
 /// All metrics written to `metrics.json`: physical ones, errors against the case's
 /// `[reference]` theory, and solver statistics.
 pub fn all_metrics(case: &Case, r: &RunResult) -> Result<Metrics, crate::reference::ReferenceError> {
-    let mut m = physical_metrics(case, r);
+    let mut m = physical_metrics(r);
     crate::theory::add_reference_metrics(case, r, &mut m)?;
     m.insert("iterations".into(), r.stats.iterations as f64);
     if let Some(v) = r.stats.last_change {
@@ -94,7 +94,7 @@ pub fn compare(case: &Case, rust: &RunResult, ff: &RunResult) -> Vec<ComparisonR
     } else {
         rows.push(field("node_count", f64::INFINITY, 0.0));
     }
-    let (mr, mf) = (physical_metrics(case, rust), physical_metrics(case, ff));
+    let (mr, mf) = (physical_metrics(rust), physical_metrics(ff));
     for (name, &a) in &mr {
         let b = mf.get(name).copied().unwrap_or(f64::NAN);
         let d = (a - b).abs();
