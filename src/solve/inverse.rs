@@ -14,7 +14,8 @@
 #![allow(non_snake_case)]
 use nalgebra::{DVector, Matrix3, SMatrix, SVector, Vector3};
 
-use super::{split_norms_2, Problem, SolveError};
+use super::statics::relative_change;
+use super::{Problem, SolveError};
 use crate::assembly::{LinearSolver, Pattern};
 use crate::element::{frozen_operator, interpolate, LocalVec};
 use crate::mesh::GAUSS2;
@@ -206,10 +207,7 @@ pub fn solve_frame(
             }
         }
         let u_next = &u_new * p.relaxation + &u * (1.0 - p.relaxation);
-        let (dx, da) = split_norms_2(&(&u_next - &u));
-        let (nx, na) = split_norms_2(&u_next);
-        let ratio = |d: f64, n: f64| if d == 0.0 { 0.0 } else { d / n };
-        let rel_change = ratio(dx, nx).max(ratio(da, na));
+        let rel_change = relative_change(&u_next, &u);
         u = u_next;
         if !rel_change.is_finite() || u.iter().any(|v| !v.is_finite()) {
             return Err(SolveError::NonFinite { step: None, iteration: k });
