@@ -11,7 +11,7 @@ use nalgebra::{DVector, Vector3};
 
 use crate::assembly::{assemble_vector, gather, LinearError, Pattern};
 use crate::case::Case;
-use crate::element::{distributed_load, follower_load, internal_force, momentum, LocalMat};
+use crate::element::{distributed_load, follower_load, internal_force, momentum, LocalMat, LocalVec};
 use crate::loads::{LoadFrame, Loads};
 use crate::material::RodProperties;
 use crate::mesh::{Dof, Mesh, QuadratureScheme};
@@ -73,30 +73,17 @@ impl<'a> Problem<'a> {
     /// External load vector `F(u, t)` of D3; follower (local-frame) distributed loads depend on
     /// `u` through `Qᵀ(α)`, and `tangent = Some((pattern, values, scale))` then adds
     /// `scale · ∂F/∂u` into `values`. Scaled by `load_factor`.
-    pub fn loads_at(&self, u: &DVector<f64>, t: f64, mut tangent: Option<(&Pattern, &mut [f64], f64)>) -> DVector<f64> {
+    pub fn loads_at(&self, u: &DVector<f64>, t: f64, tangent: Option<(&Pattern, &mut [f64], f64)>) -> DVector<f64> {
         let h = self.mesh.h();
         let lf = self.load_factor;
         let mut field = |s: f64| {
             let (f, l) = self.loads.distributed(s, t);
             (f * lf, l * lf)
         };
-        let mut local_t = LocalMat::zeros();
         let mut f = match (self.loads.has_distributed(), self.loads.frame) {
             (false, _) => DVector::zeros(self.mesh.ndofs()),
             (true, LoadFrame::Global) => assemble_vector(&self.mesh, |_, s0| distributed_load(self.scheme, h, s0, &mut field)),
-            (true, LoadFrame::Local) => assemble_vector(&self.mesh, |e, s0| {
-                let ue = gather(u, e);
-                match tangent.as_mut() {
-                    Some((pattern, values, scale)) => {
-                        local_t.fill(0.0);
-                        let r = follower_load(self.scheme, h, s0, &ue, &mut field, Some(&mut local_t));
-                        local_t *= *scale;
-                        pattern.scatter_mat(values, e, &local_t);
-                        r
-                    }
-                    None => follower_load(self.scheme, h, s0, &ue, &mut field, None),
-                }
-            }),
+            (true, LoadFrame::Local) => self.assemble_with_tangent(tangent, |e, s0, t| follower_load(self.scheme, h, s0, &gather(u, e), &mut field, t)),
         };
         let (fe, le) = self.loads.end(t);
         let (fe, le) = (fe * lf, le * lf);
@@ -110,41 +97,49 @@ impl<'a> Problem<'a> {
 
     /// Internal force `G(u)`; with `tangent = Some((pattern, values, scale))` also adds
     /// `scale · ∂G/∂u` into `values`.
-    pub fn internal_force(&self, u: &DVector<f64>, mut tangent: Option<(&Pattern, &mut [f64], f64)>) -> DVector<f64> {
+    pub fn internal_force(&self, u: &DVector<f64>, tangent: Option<(&Pattern, &mut [f64], f64)>) -> DVector<f64> {
         let h = self.mesh.h();
-        let mut local_t = LocalMat::zeros();
-        assemble_vector(&self.mesh, |e, _| {
-            let ue = gather(u, e);
-            match tangent.as_mut() {
-                Some((pattern, values, scale)) => {
-                    local_t.fill(0.0);
-                    let r = internal_force(&self.props, self.scheme, h, &ue, Some(&mut local_t));
-                    local_t *= *scale;
-                    pattern.scatter_mat(values, e, &local_t);
-                    r
-                }
-                None => internal_force(&self.props, self.scheme, h, &ue, None),
-            }
-        })
+        self.assemble_with_tangent(tangent, |e, _, t| internal_force(&self.props, self.scheme, h, &gather(u, e), t))
     }
 
     /// Momentum `P(u, u̇)` of D6; optionally adds `scale_u · ∂P/∂u + scale_v · ∂P/∂u̇`.
-    pub fn momentum(&self, u: &DVector<f64>, udot: &DVector<f64>, mut tangent: Option<(&Pattern, &mut [f64], f64, f64)>) -> DVector<f64> {
+    pub fn momentum(&self, u: &DVector<f64>, udot: &DVector<f64>, tangent: Option<(&Pattern, &mut [f64], f64, f64)>) -> DVector<f64> {
         let h = self.mesh.h();
-        let (mut du, mut dv) = (LocalMat::zeros(), LocalMat::zeros());
-        assemble_vector(&self.mesh, |e, _| {
+        // One tangent out of two scaled kernel tangents: `su ∂P/∂u + sv ∂P/∂u̇`.
+        let (su, sv) = tangent.as_ref().map(|t| (t.2, t.3)).unwrap_or((0.0, 0.0));
+        let mut dv = LocalMat::zeros();
+        self.assemble_with_tangent(tangent.map(|(p, v, _, _)| (p, v, 1.0)), |e, _, t| {
             let (ue, ve) = (gather(u, e), gather(udot, e));
-            match tangent.as_mut() {
-                Some((pattern, values, su, sv)) => {
-                    du.fill(0.0);
+            match t {
+                Some(du) => {
                     dv.fill(0.0);
-                    let r = momentum(&self.props, self.scheme, h, &ue, &ve, Some(&mut du), Some(&mut dv));
-                    let local = du * *su + dv * *sv;
-                    pattern.scatter_mat(values, e, &local);
+                    let r = momentum(&self.props, self.scheme, h, &ue, &ve, Some(du), Some(&mut dv));
+                    *du = *du * su + dv * sv;
                     r
                 }
                 None => momentum(&self.props, self.scheme, h, &ue, &ve, None, None),
             }
+        })
+    }
+
+    /// The one gather → kernel → scatter loop with an optional tangent: `kernel(e, s0, t)`
+    /// returns the element vector and, when `t` is given, fills the element tangent (zeroed
+    /// before the call), which is added as `scale · t` into `values`.
+    fn assemble_with_tangent(
+        &self,
+        mut tangent: Option<(&Pattern, &mut [f64], f64)>,
+        mut kernel: impl FnMut(usize, f64, Option<&mut LocalMat>) -> LocalVec,
+    ) -> DVector<f64> {
+        let mut local_t = LocalMat::zeros();
+        assemble_vector(&self.mesh, |e, s0| match tangent.as_mut() {
+            Some((pattern, values, scale)) => {
+                local_t.fill(0.0);
+                let r = kernel(e, s0, Some(&mut local_t));
+                local_t *= *scale;
+                pattern.scatter_mat(values, e, &local_t);
+                r
+            }
+            None => kernel(e, s0, None),
         })
     }
 
