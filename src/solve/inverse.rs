@@ -40,21 +40,57 @@ pub struct InverseParams {
     pub lambda_omega: Vector3<f64>,
     /// frame interval Δt [s]
     pub dt: f64,
-    /// first frame: α(0) = 0 on the first angle and no Λω term (Remark 6)
+    /// first frame: α(0) = `alpha0` on the first angle and no Λω term (Remark 6)
     pub first_frame: bool,
+    /// Dirichlet value of the first angle α at s = 0 on the first frame [rad]; 0 in Remark 6,
+    /// the rotation angle about e3 when the data are rotated rigidly about e3 (invariance).
+    pub alpha0: f64,
+    /// frame index, used in error messages only
+    pub frame: usize,
     pub relaxation: f64,
     pub tolerance: f64,
     pub max_iterations: usize,
 }
 
 /// Per-iteration record (`docs/inverse.md`): relative change of (x, α) (D5),
-/// ‖x − x_g‖/‖x_g‖ and ‖∂s x − d3‖ (L² norms) at the relaxed iterate.
+/// ‖x − x_g‖/‖x_g‖ and ‖∂s x − d3‖ [L² norm, m^½] at the relaxed iterate, and the terms of
+/// the objective (41) at that iterate with the controls of the last solve.
 #[derive(Clone, Copy, Debug)]
 pub struct InverseRecord {
     pub iteration: usize,
     pub rel_change: f64,
     pub x_err_rel: f64,
     pub tangent_misfit: f64,
+    pub objective: ObjectiveTerms,
+}
+
+/// The six terms of the objective (41), each with its weight and the ½, with the
+/// integration rules of I2.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ObjectiveTerms {
+    /// λg/2 ∫|x − x_g|²
+    pub tracking: f64,
+    /// λf/2 ∫|f|², f = x̂/λf (eq. 54)
+    pub force: f64,
+    /// λl/2 ∫|l|², l = α̂/λl (eq. 54)
+    pub torque: f64,
+    /// λd/2 ∫|∂s x − d3|²
+    pub shear: f64,
+    /// ½ ∫ κᵀ Λκ κ, κ = A ∂sα (eq. 28)
+    pub bending: f64,
+    /// ½ ∫ ωᵀ Λω ω, ω = A (α − α_{n−1})/Δt (eq. 27, backward difference; 0 on the first frame)
+    pub angular: f64,
+}
+
+impl ObjectiveTerms {
+    pub fn total(&self) -> f64 {
+        self.tracking + self.force + self.torque + self.shear + self.bending + self.angular
+    }
+    /// Names in CSV order, with units (J = the objective's unit).
+    pub const NAMES: [&'static str; 7] = ["j_tracking", "j_force", "j_torque", "j_shear", "j_bending", "j_angular", "j_total"];
+    pub fn values(&self) -> [f64; 7] {
+        [self.tracking, self.force, self.torque, self.shear, self.bending, self.angular, self.total()]
+    }
 }
 
 /// Converged frame.
@@ -209,18 +245,19 @@ pub fn solve_frame(
         let u_next = &u_new * p.relaxation + &u * (1.0 - p.relaxation);
         let rel_change = relative_change(&u_next, &u);
         u = u_next;
-        if !rel_change.is_finite() || u.iter().any(|v| !v.is_finite()) {
-            return Err(SolveError::NonFinite { step: None, iteration: k });
+        if !rel_change.is_finite() || u.iter().chain(adjoint.iter()).any(|v| !v.is_finite()) {
+            return Err(SolveError::InverseNonFinite { frame: p.frame, iteration: k });
         }
         let (x_err_rel, tangent_misfit) = fit_measures(problem, &u, x_g);
-        let rec = InverseRecord { iteration: k, rel_change, x_err_rel, tangent_misfit };
+        let objective = objective_terms(problem, p, &u, &adjoint, x_g, alpha_prev);
+        let rec = InverseRecord { iteration: k, rel_change, x_err_rel, tangent_misfit, objective };
         progress(&rec);
         history.push(rec);
         if rel_change <= p.tolerance {
             return Ok(InverseSolution { u, adjoint, history });
         }
     }
-    Err(SolveError::FixedPointNotConverged { step: 1, iterations: p.max_iterations, rel_change: history.last().map(|h| h.rel_change).unwrap_or(f64::NAN) })
+    Err(SolveError::InverseNotConverged { frame: p.frame, iterations: p.max_iterations, rel_change: history.last().map(|h| h.rel_change).unwrap_or(f64::NAN) })
 }
 
 /// Dirichlet unknowns of I5 in KKT numbering with their values: `x = x_g` and `x̂ = α̂ = 0`
@@ -237,7 +274,7 @@ pub fn dirichlet(p: &InverseParams, x_g: &[Vector3<f64>]) -> Vec<(usize, f64)> {
         }
     }
     if p.first_frame {
-        fixed.push((3, 0.0));
+        fixed.push((3, p.alpha0));
     }
     fixed
 }
@@ -287,6 +324,42 @@ pub fn fit_measures(problem: &Problem, u: &DVector<f64>, x_g: &[Vector3<f64>]) -
     ((e2 / g2).sqrt(), t2.sqrt())
 }
 
+/// The terms of the objective (41) at the state `u` with the adjoint `adjoint` (6 per node
+/// each), integrated with the rules of I2.
+pub fn objective_terms(problem: &Problem, p: &InverseParams, u: &DVector<f64>, adjoint: &DVector<f64>, x_g: &[Vector3<f64>], alpha_prev: &[Vector3<f64>]) -> ObjectiveTerms {
+    let h = problem.mesh.h();
+    let mut t = ObjectiveTerms::default();
+    let omega_on = !p.first_frame;
+    for e in 0..problem.mesh.elements {
+        let ue = LocalVec::from_column_slice(&u.as_slice()[6 * e..6 * e + 12]);
+        let ae = LocalVec::from_column_slice(&adjoint.as_slice()[6 * e..6 * e + 12]);
+        for (xi, w) in GAUSS2.points.iter().zip(GAUSS2.weights) {
+            let q = interpolate(&ue, h, *xi);
+            let qa = interpolate(&ae, h, *xi);
+            let wh = 0.5 * w * h;
+            let xg = x_g[e] * q.n[0] + x_g[e + 1] * q.n[1];
+            t.tracking += wh * p.lambda_g * (q.x - xg).norm_squared();
+            t.force += wh * qa.x.norm_squared() / p.lambda_f;
+            t.torque += wh * qa.alpha.norm_squared() / p.lambda_l;
+            if omega_on {
+                let ap = alpha_prev[e] * q.n[0] + alpha_prev[e + 1] * q.n[1];
+                let om = a_matrix(&q.alpha) * (q.alpha - ap) / p.dt;
+                t.angular += wh * om.component_mul(&om).dot(&p.lambda_omega);
+            }
+        }
+        for (xi, w) in problem.scheme.stretch_shear().points.iter().zip(problem.scheme.stretch_shear().weights) {
+            let q = interpolate(&ue, h, *xi);
+            t.shear += 0.5 * w * h * p.lambda_d * (q.dx - d3(&q.alpha)).norm_squared();
+        }
+        for (xi, w) in problem.scheme.bending().points.iter().zip(problem.scheme.bending().weights) {
+            let q = interpolate(&ue, h, *xi);
+            let k = crate::rotation::curvature(&q.alpha, &q.dalpha);
+            t.bending += 0.5 * w * h * k.component_mul(&k).dot(&p.lambda_kappa);
+        }
+    }
+    t
+}
+
 /// Element-midpoint curvature `κˡ = A(α_mid) ∂sα` [1/m] of a nodal state (eq. 28).
 pub fn element_curvatures(problem: &Problem, u: &DVector<f64>) -> Vec<Vector3<f64>> {
     let h = problem.mesh.h();
@@ -325,7 +398,7 @@ mod tests {
         let p = InverseParams {
             lambda_g: 1e9, lambda_f: 1.0, lambda_l: 1e-10, lambda_d: 1e-6,
             lambda_kappa: Vector3::new(0.0, 1e-12, 1e-10), lambda_omega: Vector3::new(1e-3, 0.0, 1e-2), dt: 0.04,
-            first_frame: false, relaxation: 0.5, tolerance: 1e-6, max_iterations: 1,
+            first_frame: false, alpha0: 0.0, frame: 0, relaxation: 0.5, tolerance: 1e-6, max_iterations: 1,
         };
         let (m, _) = element_system(&problem, &p, &uk, [Vector3::zeros(), Vector3::new(0.0, 0.0, h)], [Vector3::zeros(); 2]);
         let asym = (m - m.transpose()).amax() / m.amax();

@@ -26,6 +26,12 @@ pub enum SolveError {
     NewtonNotConverged { step: Option<usize>, iterations: usize, increment: f64 },
     #[error("non-finite value in iteration {iteration}{}", step_text(*.step))]
     NonFinite { step: Option<usize>, iteration: usize },
+    #[error("inverse fixed point of frame {frame} did not converge after {iterations} iterations (last relative change of (x, α) {rel_change:e})")]
+    InverseNotConverged { frame: usize, iterations: usize, rel_change: f64 },
+    #[error("inverse Newton of frame {frame} did not converge after {iterations} iterations (last residual ‖R‖/‖R₀‖ {residual:e})")]
+    InverseNewtonNotConverged { frame: usize, iterations: usize, residual: f64 },
+    #[error("non-finite value in iteration {iteration} of inverse frame {frame}")]
+    InverseNonFinite { frame: usize, iteration: usize },
     #[error(transparent)]
     Linear(#[from] LinearError),
 }
