@@ -4,6 +4,7 @@
 //! one element loop of the crate.
 pub mod dynamics;
 pub mod inverse;
+pub mod inverse_newton;
 pub mod modes;
 pub mod statics;
 
