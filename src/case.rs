@@ -49,6 +49,37 @@ struct RawCase {
     time: Option<RawTime>,
     compare: RawCompare,
     reference: Option<RawReference>,
+    /// inverse cases: the forward solve that generates the data from `[loads]`
+    data: Option<RawData>,
+    /// inverse cases: the weights of eq. (41)
+    inverse: Option<RawInverse>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawData {
+    #[serde(default = "default_method")]
+    method: RawMethod,
+    relaxation: Option<f64>,
+    tolerance: f64,
+    max_iterations: usize,
+    #[serde(default = "one")]
+    continuation_steps: usize,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawInverse {
+    lambda_g: Scalar,
+    lambda_f: Scalar,
+    lambda_l: Scalar,
+    lambda_d: Scalar,
+    lambda_kappa: [Scalar; 3],
+    #[serde(default)]
+    lambda_omega: Option<[Scalar; 3]>,
+    frame_interval_s: Option<Scalar>,
+    #[serde(default)]
+    alpha0_rad: Option<Scalar>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -108,6 +139,7 @@ fn default_frame() -> RawFrame {
 enum RawAnalysis {
     Static,
     Dynamic,
+    Inverse,
 }
 
 #[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
@@ -166,6 +198,7 @@ struct RawCompare {
     metric_abs: f64,
     #[serde(default)]
     iterations_abs: f64,
+    adjoint_rel: Option<f64>,
 }
 
 // ---------------------------------------------------------------- validated layer
@@ -179,6 +212,52 @@ pub enum StaticMethod {
     Newton,
 }
 
+/// Nonlinear solver of the inverse problem of one frame (`docs/inverse.md`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum InverseMethod {
+    /// The paper's scheme (eq. 61, Remark 10), relaxation w ∈ (0, 1]; FreeFEM mirrors it.
+    FixedPoint { relaxation: f64 },
+    /// Newton on the same discrete equations (Rust engine only, I8).
+    Newton,
+}
+
+/// Regularisation weights of eq. (41).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct InverseWeights {
+    pub lambda_g: f64,
+    pub lambda_f: f64,
+    pub lambda_l: f64,
+    pub lambda_d: f64,
+    /// Λκ diagonal
+    pub lambda_kappa: [f64; 3],
+    /// Λω diagonal (frames after the first only, Remark 6)
+    pub lambda_omega: [f64; 3],
+}
+
+/// Static forward solve that generates the data of an inverse case from its `[loads]` (I7).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DataSolve {
+    pub method: StaticMethod,
+    pub tolerance: f64,
+    pub max_iterations: usize,
+    pub continuation_steps: usize,
+}
+
+/// An inverse analysis of one frame (Problem 2, eq. 61).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct InverseSettings {
+    pub method: InverseMethod,
+    /// stopping rule: relative change of (x, α) (D5) ≤ tolerance
+    pub tolerance: f64,
+    pub max_iterations: usize,
+    pub weights: InverseWeights,
+    /// Δt between frames [s] (Λω term)
+    pub frame_interval_s: f64,
+    /// Dirichlet value of the first angle at s = 0 [rad] (Remark 6: 0)
+    pub alpha0_rad: f64,
+    pub data: DataSolve,
+}
+
 /// What is solved.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Analysis {
@@ -186,6 +265,8 @@ pub enum Analysis {
     Static { method: StaticMethod, tolerance: f64, max_iterations: usize, continuation_steps: usize },
     /// Appendix A time stepping (D6), Newton per step.
     Dynamic { end_time_s: f64, steps: usize, tolerance: f64, max_iterations: usize },
+    /// Recover α, f, l from the centreline of a forward solution of the case's `[loads]`.
+    Inverse(InverseSettings),
 }
 
 /// Rust–FreeFEM comparison tolerances (D8).
@@ -200,6 +281,8 @@ pub struct CompareTolerances {
     pub metric_abs: f64,
     /// allowed difference of iteration counts
     pub iterations_abs: f64,
+    /// inverse cases: max node-wise |Δ(x̂, α̂)| / max |(x̂, α̂)| (per field)
+    pub adjoint_rel: f64,
 }
 
 /// Independent theory a case is checked against (metrics `*_rel_error` in `metrics.json`).
@@ -259,13 +342,54 @@ impl Case {
     pub fn is_dynamic(&self) -> bool {
         matches!(self.analysis, Analysis::Dynamic { .. })
     }
+
+    /// The settings of an inverse case.
+    pub fn inverse(&self) -> Option<&InverseSettings> {
+        match &self.analysis {
+            Analysis::Inverse(s) => Some(s),
+            _ => None,
+        }
+    }
+
+    /// The static forward case that generates an inverse case's data (same rod and loads).
+    pub fn data_case(&self) -> Option<Case> {
+        let inv = self.inverse()?;
+        let d = inv.data;
+        let mut c = self.clone();
+        c.analysis = Analysis::Static { method: d.method, tolerance: d.tolerance, max_iterations: d.max_iterations, continuation_steps: d.continuation_steps };
+        Some(c)
+    }
 }
 
 struct Validator<'a> {
     path: &'a Path,
 }
 
+fn rc_adjoint_missing(rc: &RawCompare) -> bool {
+    rc.adjoint_rel.is_none()
+}
+
 impl Validator<'_> {
+    /// `method` (+ `relaxation`) of a static solve in table `table`.
+    fn static_method(&self, table: &str, method: RawMethod, relaxation: Option<f64>) -> Result<StaticMethod, CaseError> {
+        match method {
+            RawMethod::FixedPoint => {
+                let key = format!("{table}.relaxation");
+                let w = relaxation.ok_or_else(|| self.err(&key, "required by method = \"fixed_point\""))?;
+                if !(w > 0.0 && w <= 1.0) {
+                    return Err(self.err(&key, format!("must lie in (0, 1], got {w}")));
+                }
+                Ok(StaticMethod::FixedPoint { relaxation: w })
+            }
+            RawMethod::Newton => {
+                if relaxation.is_some() {
+                    return Err(self.err(&format!("{table}.relaxation"), "not used by method = \"newton\""));
+                }
+                Ok(StaticMethod::Newton)
+            }
+        }
+    }
+
     fn err(&self, key: &str, reason: impl Into<String>) -> CaseError {
         CaseError::Invalid { path: self.path.to_path_buf(), key: key.to_string(), reason: reason.into() }
     }
@@ -350,7 +474,7 @@ impl Validator<'_> {
         let analysis_kind = raw.solver.analysis;
         let density = match (&raw.material.density_kg_m3, analysis_kind) {
             (Some(d), _) => self.positive("material.density_kg_m3", d, c)?,
-            (None, RawAnalysis::Static) => 1.0,
+            (None, RawAnalysis::Static | RawAnalysis::Inverse) => 1.0,
             (None, RawAnalysis::Dynamic) => return Err(self.err("material.density_kg_m3", "required for a dynamic analysis")),
         };
         let material = Material {
@@ -369,11 +493,11 @@ impl Validator<'_> {
         let props = RodProperties::new(&material, &section);
 
         let vars: &[&str] = match analysis_kind {
-            RawAnalysis::Static => &["s"],
+            RawAnalysis::Static | RawAnalysis::Inverse => &["s"],
             RawAnalysis::Dynamic => &["s", "t"],
         };
         let end_vars: &[&str] = match analysis_kind {
-            RawAnalysis::Static => &[],
+            RawAnalysis::Static | RawAnalysis::Inverse => &[],
             RawAnalysis::Dynamic => &["t"],
         };
         let frame = match raw.loads.frame {
@@ -397,25 +521,84 @@ impl Validator<'_> {
         if s.max_iterations == 0 {
             return Err(self.err("solver.max_iterations", "must be ≥ 1"));
         }
+        if analysis_kind != RawAnalysis::Inverse {
+            if raw.data.is_some() {
+                return Err(self.err("data", "only allowed when solver.analysis = \"inverse\""));
+            }
+            if raw.inverse.is_some() {
+                return Err(self.err("inverse", "only allowed when solver.analysis = \"inverse\""));
+            }
+        }
+        if analysis_kind != RawAnalysis::Dynamic && raw.time.is_some() {
+            return Err(self.err("time", "only allowed when solver.analysis = \"dynamic\""));
+        }
         let analysis = match analysis_kind {
             RawAnalysis::Static => {
-                if raw.time.is_some() {
-                    return Err(self.err("time", "only allowed when solver.analysis = \"dynamic\""));
-                }
-                let method = match s.method {
-                    RawMethod::FixedPoint => {
-                        let w = s.relaxation.ok_or_else(|| self.err("solver.relaxation", "required by method = \"fixed_point\""))?;
-                        if !(w > 0.0 && w <= 1.0) {
-                            return Err(self.err("solver.relaxation", format!("must lie in (0, 1], got {w}")));
-                        }
-                        StaticMethod::FixedPoint { relaxation: w }
-                    }
-                    RawMethod::Newton => StaticMethod::Newton,
-                };
+                let method = self.static_method("solver", s.method, s.relaxation)?;
                 if s.continuation_steps == 0 {
                     return Err(self.err("solver.continuation_steps", "must be ≥ 1"));
                 }
                 Analysis::Static { method, tolerance: s.tolerance, max_iterations: s.max_iterations, continuation_steps: s.continuation_steps }
+            }
+            RawAnalysis::Inverse => {
+                let method = match self.static_method("solver", s.method, s.relaxation)? {
+                    StaticMethod::FixedPoint { relaxation } => InverseMethod::FixedPoint { relaxation },
+                    StaticMethod::Newton => InverseMethod::Newton,
+                };
+                if s.continuation_steps != 1 {
+                    return Err(self.err("solver.continuation_steps", "not used by an inverse analysis"));
+                }
+                let d = raw.data.as_ref().ok_or_else(|| self.err("data", "required when solver.analysis = \"inverse\" (the forward solve generating the centreline data)"))?;
+                if !(d.tolerance > 0.0 && d.tolerance < 1.0) {
+                    return Err(self.err("data.tolerance", format!("must lie in (0, 1), got {}", d.tolerance)));
+                }
+                if d.max_iterations == 0 || d.continuation_steps == 0 {
+                    return Err(self.err("data.max_iterations", "max_iterations and continuation_steps must be ≥ 1"));
+                }
+                let data = DataSolve { method: self.static_method("data", d.method, d.relaxation)?, tolerance: d.tolerance, max_iterations: d.max_iterations, continuation_steps: d.continuation_steps };
+                let inv = raw.inverse.as_ref().ok_or_else(|| self.err("inverse", "required when solver.analysis = \"inverse\" (the weights of eq. 41)"))?;
+                let nonneg = |key: &str, v: &Scalar| -> Result<f64, CaseError> {
+                    let x = self.scalar(key, v, c)?;
+                    if x < 0.0 {
+                        return Err(self.err(key, format!("must be ≥ 0, got {x}")));
+                    }
+                    Ok(x)
+                };
+                let diag = |key: &str, v: &Option<[Scalar; 3]>| -> Result<[f64; 3], CaseError> {
+                    match v {
+                        None => Ok([0.0; 3]),
+                        Some(items) => {
+                            let mut out = [0.0; 3];
+                            for (i, item) in items.iter().enumerate() {
+                                out[i] = nonneg(&format!("{key}[{i}]"), item)?;
+                            }
+                            Ok(out)
+                        }
+                    }
+                };
+                let weights = InverseWeights {
+                    lambda_g: self.positive("inverse.lambda_g", &inv.lambda_g, c)?,
+                    lambda_f: self.positive("inverse.lambda_f", &inv.lambda_f, c)?,
+                    lambda_l: self.positive("inverse.lambda_l", &inv.lambda_l, c)?,
+                    lambda_d: nonneg("inverse.lambda_d", &inv.lambda_d)?,
+                    lambda_kappa: diag("inverse.lambda_kappa", &Some(inv.lambda_kappa.clone()))?,
+                    lambda_omega: diag("inverse.lambda_omega", &inv.lambda_omega)?,
+                };
+                let frame_interval_s = match &inv.frame_interval_s {
+                    Some(v) => self.positive("inverse.frame_interval_s", v, c)?,
+                    None if weights.lambda_omega.iter().any(|&w| w > 0.0) => {
+                        return Err(self.err("inverse.frame_interval_s", "required when lambda_omega is non-zero"));
+                    }
+                    None => 1.0,
+                };
+                let alpha0_rad = match &inv.alpha0_rad {
+                    Some(v) => self.scalar("inverse.alpha0_rad", v, c)?,
+                    None => 0.0,
+                };
+                if rc_adjoint_missing(&raw.compare) {
+                    return Err(self.err("compare.adjoint_rel", "required for an inverse case (tolerance on the adjoint x̂, α̂)"));
+                }
+                Analysis::Inverse(InverseSettings { method, tolerance: s.tolerance, max_iterations: s.max_iterations, weights, frame_interval_s, alpha0_rad, data })
             }
             RawAnalysis::Dynamic => {
                 if s.method != RawMethod::Newton {
@@ -448,6 +631,11 @@ impl Validator<'_> {
         for (k, v) in [("compare.displacement_rel", rc.displacement_rel), ("compare.angles_rel", rc.angles_rel), ("compare.metric_rel", rc.metric_rel)] {
             if !(v > 0.0 && v.is_finite()) {
                 return Err(self.err(k, format!("must be > 0, got {v}")));
+            }
+        }
+        if let Some(v) = rc.adjoint_rel {
+            if !(v > 0.0 && v.is_finite()) {
+                return Err(self.err("compare.adjoint_rel", format!("must be > 0, got {v}")));
             }
         }
         for (k, v) in [("compare.metric_abs", rc.metric_abs), ("compare.iterations_abs", rc.iterations_abs)] {
@@ -483,6 +671,7 @@ impl Validator<'_> {
                 metric_rel: rc.metric_rel,
                 metric_abs: rc.metric_abs,
                 iterations_abs: rc.iterations_abs,
+                adjoint_rel: rc.adjoint_rel.unwrap_or(f64::INFINITY),
             },
         })
     }

@@ -8,10 +8,11 @@ use std::process::Command;
 
 use nalgebra::Vector3;
 
-use crate::case::{Analysis, Case, StaticMethod};
+use crate::case::{Analysis, Case, InverseMethod, StaticMethod};
 use crate::loads::LoadFrame;
 use crate::mesh::QuadratureScheme;
-use crate::run::{Engine, NodalState, RunResult, SolverStats};
+use crate::run::{Engine, InverseOutput, NodalState, RunResult, SolverStats};
+use crate::solve::inverse::{InverseRecord, ObjectiveTerms};
 use crate::solve::dynamics::TipRecord;
 use crate::solve::statics::IterationRecord;
 
@@ -33,6 +34,8 @@ pub enum FreeFemError {
     Io { path: PathBuf, source: std::io::Error },
     #[error("FreeFEM failed (exit status {status}) in {workdir}:\n{output}")]
     Failed { status: i32, workdir: PathBuf, output: String },
+    #[error("{0}")]
+    Unsupported(&'static str),
     #[error("cannot read FreeFEM output {path}: {reason}")]
     BadOutput { path: PathBuf, reason: String },
 }
@@ -99,19 +102,105 @@ pub fn include_file(case: &Case) -> String {
             StaticMethod::Newton => (0, 1, 1.0, tolerance, max_iterations, 0.0, 0, continuation_steps),
         },
         Analysis::Dynamic { end_time_s, steps, tolerance, max_iterations } => (1, 1, 1.0, tolerance, max_iterations, end_time_s, steps, 1),
+        Analysis::Inverse(inv) => {
+            let relax = match inv.method {
+                InverseMethod::FixedPoint { relaxation } => relaxation,
+                InverseMethod::Newton => 1.0,
+            };
+            (0, 0, relax, inv.tolerance, inv.max_iterations, 0.0, 0, 1)
+        }
     };
     let local = i32::from(case.loads.frame == LoadFrame::Local);
     let _ = writeln!(o, "int localLoads = {local}; // distributed loads in the local frame (f^g = Q^T f^l)\nint contSteps = {cont};");
     let _ = writeln!(o, "int isDynamic = {dynamic};\nint method = {method};\nreal relax = {};\nreal tol = {};\nint maxit = {maxit};", num(relax), num(tol));
     let _ = writeln!(o, "real Tend = {};\nint nsteps = {steps};\nreal newtonTol = {};\nint newtonMaxit = {maxit};", num(tend), num(tol));
+    if let Analysis::Inverse(inv) = &case.analysis {
+        let w = &inv.weights;
+        let _ = writeln!(o, "// inverse problem (docs/inverse.md): weights of eq. (41), first frame");
+        let _ = writeln!(o, "real lambdaG = {}, lambdaF = {}, lambdaL = {}, lambdaD = {};", num(w.lambda_g), num(w.lambda_f), num(w.lambda_l), num(w.lambda_d));
+        let _ = writeln!(o, "real LamK1 = {}, LamK2 = {}, LamK3 = {};", num(w.lambda_kappa[0]), num(w.lambda_kappa[1]), num(w.lambda_kappa[2]));
+        let _ = writeln!(o, "real LamW1 = {}, LamW2 = {}, LamW3 = {};", num(w.lambda_omega[0]), num(w.lambda_omega[1]), num(w.lambda_omega[2]));
+        let _ = writeln!(o, "real dt = {};\nint firstFrame = 1;\nreal alpha0 = {};", num(inv.frame_interval_s), num(inv.alpha0_rad));
+    }
     o
+}
+
+/// Run `freefem/inverse.edp` on an inverse case with the data file `data_path` (copied into
+/// `workdir` as `data.csv` unless it is already there). `data` is the parsed content of that file.
+pub fn run_inverse(case: &Case, data: NodalState, data_path: &Path, workdir: &Path) -> Result<RunResult, FreeFemError> {
+    let inv = case.inverse().ok_or_else(|| FreeFemError::BadOutput { path: data_path.to_path_buf(), reason: format!("case `{}` is not an inverse case", case.name) })?;
+    if inv.method == InverseMethod::Newton {
+        return Err(FreeFemError::Unsupported("the FreeFEM engine mirrors the paper's fixed point only (solver.method = \"fixed_point\")"));
+    }
+    let io = |path: &Path| {
+        let path = path.to_path_buf();
+        move |source| FreeFemError::Io { path, source }
+    };
+    std::fs::create_dir_all(workdir).map_err(io(workdir))?;
+    let target = workdir.join("data.csv");
+    let same = std::fs::canonicalize(data_path).ok().zip(std::fs::canonicalize(&target).ok()).map(|(a, b)| a == b).unwrap_or(false);
+    if !same {
+        std::fs::copy(data_path, &target).map_err(io(&target))?;
+    }
+    execute(case, workdir, "inverse.edp", &["ff_inverse_nodes.csv", "ff_inverse_history.csv", "ff_info.csv"])?;
+    let nodes_path = workdir.join("ff_inverse_nodes.csv");
+    let mut header = vec!["s_m", "x_m", "y_m", "z_m", "alpha_rad", "beta_rad", "gamma_rad"];
+    header.extend(["xhat_1", "xhat_2", "xhat_3", "ahat_1", "ahat_2", "ahat_3"]);
+    let rows = read_table(&nodes_path, &header)?;
+    if rows.len() != case.mesh.nodes() {
+        return Err(FreeFemError::BadOutput { path: nodes_path, reason: format!("{} rows, expected {}", rows.len(), case.mesh.nodes()) });
+    }
+    let v3 = |r: &Vec<f64>, k: usize| Vector3::new(r[k], r[k + 1], r[k + 2]);
+    let nodes = NodalState { s: rows.iter().map(|r| r[0]).collect(), x: rows.iter().map(|r| v3(r, 1)).collect(), alpha: rows.iter().map(|r| v3(r, 4)).collect() };
+    let mut hist_header = vec!["iteration", "rel_change", "x_err_rel", "tangent_misfit"];
+    hist_header.extend(ObjectiveTerms::NAMES);
+    let history = read_table(&workdir.join("ff_inverse_history.csv"), &hist_header)?
+        .into_iter()
+        .map(|r| InverseRecord {
+            iteration: r[0] as usize,
+            rel_change: r[1],
+            x_err_rel: r[2],
+            tangent_misfit: r[3],
+            objective: ObjectiveTerms { tracking: r[4], force: r[5], torque: r[6], shear: r[7], bending: r[8], angular: r[9] },
+        })
+        .collect();
+    let info = read_info(&workdir.join("ff_info.csv"))?;
+    let stats = SolverStats {
+        iterations: info.get("iterations").copied().unwrap_or(0.0) as usize,
+        last_change: info.get("rel_change").copied(),
+        residual: None,
+        max_newton_iterations: None,
+        wall_time_s: info.get("wall_time_s").copied().unwrap_or(f64::NAN),
+    };
+    let w = inv.weights;
+    Ok(RunResult {
+        engine: Engine::Freefem,
+        nodes,
+        history: Vec::new(),
+        tip: Vec::new(),
+        stats,
+        inverse: Some(InverseOutput {
+            data,
+            xhat: rows.iter().map(|r| v3(r, 7)).collect(),
+            ahat: rows.iter().map(|r| v3(r, 10)).collect(),
+            history,
+            lambda_f: w.lambda_f,
+            lambda_l: w.lambda_l,
+        }),
+    })
 }
 
 /// Run the FreeFEM engine on `case` inside `workdir` (created if needed).
 pub fn run(case: &Case, workdir: &Path) -> Result<RunResult, FreeFemError> {
+    execute(case, workdir, "forward.edp", &["ff_nodes.csv", "ff_info.csv", "ff_history.csv", "ff_tip.csv"])?;
+    read_outputs(case, workdir)
+}
+
+/// Write `case.idp` into `workdir`, remove stale `outputs`, run `script` headless there.
+fn execute(case: &Case, workdir: &Path, script: &str, outputs: &[&str]) -> Result<(), FreeFemError> {
     let exe = find_executable()?;
     let scripts = script_dir();
-    let script = scripts.join("forward.edp");
+    let script = scripts.join(script);
     if !script.is_file() {
         return Err(FreeFemError::MissingScripts(scripts));
     }
@@ -122,7 +211,7 @@ pub fn run(case: &Case, workdir: &Path) -> Result<RunResult, FreeFemError> {
     std::fs::create_dir_all(workdir).map_err(io(workdir))?;
     let include = workdir.join("case.idp");
     std::fs::write(&include, include_file(case)).map_err(io(&include))?;
-    for stale in ["ff_nodes.csv", "ff_info.csv", "ff_history.csv", "ff_tip.csv"] {
+    for stale in outputs {
         let _ = std::fs::remove_file(workdir.join(stale));
     }
     let mut cmd = Command::new(exe);
@@ -135,7 +224,20 @@ pub fn run(case: &Case, workdir: &Path) -> Result<RunResult, FreeFemError> {
     if !out.status.success() {
         return Err(FreeFemError::Failed { status: out.status.code().unwrap_or(-1), workdir: workdir.to_path_buf(), output: text });
     }
-    read_outputs(case, workdir)
+    Ok(())
+}
+
+fn read_info(info_path: &Path) -> Result<BTreeMap<String, f64>, FreeFemError> {
+    let bad = |reason: String| FreeFemError::BadOutput { path: info_path.to_path_buf(), reason };
+    let mut info = BTreeMap::new();
+    let mut rdr = csv::ReaderBuilder::new().trim(csv::Trim::All).from_path(info_path).map_err(|e| bad(e.to_string()))?;
+    for rec in rdr.records() {
+        let rec = rec.map_err(|e| bad(e.to_string()))?;
+        if let (Some(k), Some(v)) = (rec.get(0), rec.get(1).and_then(|v| v.parse::<f64>().ok())) {
+            info.insert(k.to_string(), v);
+        }
+    }
+    Ok(info)
 }
 
 fn read_table(path: &Path, expected: &[&str]) -> Result<Vec<Vec<f64>>, FreeFemError> {
@@ -169,15 +271,7 @@ fn read_outputs(case: &Case, dir: &Path) -> Result<RunResult, FreeFemError> {
         x: rows.iter().map(|r| Vector3::new(r[1], r[2], r[3])).collect(),
         alpha: rows.iter().map(|r| Vector3::new(r[4], r[5], r[6])).collect(),
     };
-    let info_path = dir.join("ff_info.csv");
-    let mut info = BTreeMap::new();
-    let mut rdr = csv::ReaderBuilder::new().trim(csv::Trim::All).from_path(&info_path).map_err(|e| FreeFemError::BadOutput { path: info_path.clone(), reason: e.to_string() })?;
-    for rec in rdr.records() {
-        let rec = rec.map_err(|e| FreeFemError::BadOutput { path: info_path.clone(), reason: e.to_string() })?;
-        if let (Some(k), Some(v)) = (rec.get(0), rec.get(1).and_then(|v| v.parse::<f64>().ok())) {
-            info.insert(k.to_string(), v);
-        }
-    }
+    let info = read_info(&dir.join("ff_info.csv"))?;
     let get = |k: &str| info.get(k).copied();
     let stats = SolverStats {
         iterations: get("iterations").unwrap_or(0.0) as usize,
@@ -199,5 +293,5 @@ fn read_outputs(case: &Case, dir: &Path) -> Result<RunResult, FreeFemError> {
             history.push(IterationRecord { step, iteration, change: r[1] });
         }
     }
-    Ok(RunResult { engine: Engine::Freefem, nodes, history, tip, stats })
+    Ok(RunResult { engine: Engine::Freefem, nodes, history, tip, stats, inverse: None })
 }

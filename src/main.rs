@@ -9,7 +9,8 @@ use indicatif::{ProgressBar, ProgressStyle};
 use cosserat::case::{case_files, Case};
 use cosserat::metrics::{all_metrics, compare};
 use cosserat::output::write_run;
-use cosserat::run::{run, Engine, RunResult};
+use cosserat::data::write_data;
+use cosserat::run::{generate_data, run_inverse_on, Engine, RunResult};
 use cosserat::solve::modes::modal_model;
 use cosserat::solve::Problem;
 
@@ -95,15 +96,32 @@ fn progress_bar(quiet: bool, label: &str) -> ProgressBar {
     pb
 }
 
-fn run_engine(case: &Case, engine: Engine, dir: &Path, quiet: bool) -> Result<RunResult> {
+/// For an inverse case: generate its data with the Rust forward engine into `dir/data.csv`
+/// (I7), the file every engine's inverse run then reads.
+fn prepare_data(case: &Case, dir: &Path) -> Result<Option<PathBuf>> {
+    if case.inverse().is_none() {
+        return Ok(None);
+    }
+    let path = dir.join("data.csv");
+    let data = generate_data(case).with_context(|| format!("case {}: generating the forward data", case.name))?;
+    write_data(&path, &data)?;
+    Ok(Some(path))
+}
+
+fn run_engine(case: &Case, engine: Engine, dir: &Path, data: Option<&Path>, quiet: bool) -> Result<RunResult> {
     let pb = progress_bar(quiet || engine == Engine::Freefem, &format!("{} [{engine}]", case.name));
     if engine == Engine::Freefem && !quiet {
         eprintln!("{} [freefem]: running FreeFEM in {}", case.name, dir.display());
     }
-    let result = run(case, engine, &dir.join("freefem_work"), |done, total| {
+    let progress = |done: usize, total: usize| {
         pb.set_length(total as u64);
         pb.set_position(done as u64);
-    });
+    };
+    let work = dir.join("freefem_work");
+    let result = match data {
+        Some(path) => run_inverse_on(case, engine, path, &work, progress),
+        None => cosserat::run::run(case, engine, &work, progress),
+    };
     pb.finish_and_clear();
     Ok(result.with_context(|| format!("case {}", case.name))?)
 }
@@ -111,7 +129,8 @@ fn run_engine(case: &Case, engine: Engine, dir: &Path, quiet: bool) -> Result<Ru
 fn cmd_run(path: &Path, engine: Engine, out: Option<PathBuf>, quiet: bool) -> Result<ExitCode> {
     let case = load(path)?;
     let dir = out.unwrap_or_else(|| PathBuf::from("out").join(&case.name).join(engine.to_string()));
-    let r = run_engine(&case, engine, &dir, quiet)?;
+    let data = prepare_data(&case, &dir)?;
+    let r = run_engine(&case, engine, &dir, data.as_deref(), quiet)?;
     let m = all_metrics(&case, &r)?;
     let written = write_run(&case, &r, &m, &dir)?;
     let tip = r.nodes.x.last().copied().unwrap_or_default();
@@ -132,9 +151,10 @@ fn cmd_run(path: &Path, engine: Engine, out: Option<PathBuf>, quiet: bool) -> Re
 fn cmd_compare(path: &Path, out: Option<PathBuf>) -> Result<ExitCode> {
     let case = load(path)?;
     let dir = out.unwrap_or_else(|| PathBuf::from("out").join(&case.name));
-    let rust = run_engine(&case, Engine::Rust, &dir.join("rust"), false)?;
+    let data = prepare_data(&case, &dir)?;
+    let rust = run_engine(&case, Engine::Rust, &dir.join("rust"), data.as_deref(), false)?;
     write_run(&case, &rust, &all_metrics(&case, &rust)?, &dir.join("rust"))?;
-    let ff = run_engine(&case, Engine::Freefem, &dir.join("freefem"), false)?;
+    let ff = run_engine(&case, Engine::Freefem, &dir.join("freefem"), data.as_deref(), false)?;
     write_run(&case, &ff, &all_metrics(&case, &ff)?, &dir.join("freefem"))?;
     let rows = compare(&case, &rust, &ff);
     println!("{:<34} {:>15} {:>15} {:>11} {:>11}  result", "metric", "rust", "freefem", "|diff|", "tolerance");

@@ -3,6 +3,7 @@ use std::collections::BTreeMap;
 
 use crate::case::{Analysis, Case, CompareTolerances, StaticMethod};
 use crate::run::RunResult;
+use crate::solve::inverse::{relative_error, ObjectiveTerms};
 
 /// Flat map metric name → value (`metrics.json`). Names carry SI units.
 pub type Metrics = BTreeMap<String, f64>;
@@ -29,10 +30,42 @@ pub fn physical_metrics(r: &RunResult) -> Metrics {
     m
 }
 
+/// Edge elements left out of the "inner" curvature error: the ends carry the boundary layer of
+/// the natural condition m = 0 (46) that the data do not satisfy exactly.
+pub const INNER_SKIP_ELEMENTS: usize = 5;
+
+/// Metrics of an inverse run (empty for forward runs): the recovery errors of §5.2 and the
+/// terms of the objective (41) at the last iterate.
+///
+/// - `x_err_rel`: ‖x − x_g‖/‖x_g‖ (L², two-point rule, I2)
+/// - `kappa_err_rel`, `kappa_err_rel_inner`: discrete ℓ² relative error of the element-midpoint
+///   curvature κˡ = A ∂sα (eq. 28) against the forward data's, all elements / without
+///   [`INNER_SKIP_ELEMENTS`] at each end
+/// - `tangent_misfit_m05`: ‖∂s x − d3‖ [m^½]
+/// - `force_l2_n_per_m05`, `torque_l2_n_m05`: ‖f‖, ‖l‖ (L², from the objective terms)
+pub fn inverse_metrics(r: &RunResult) -> Metrics {
+    let mut m = Metrics::new();
+    let Some(inv) = &r.inverse else { return m };
+    let Some(last) = inv.history.last() else { return m };
+    m.insert("x_err_rel".into(), last.x_err_rel);
+    m.insert("tangent_misfit_m05".into(), last.tangent_misfit);
+    let k: Vec<_> = r.nodes.element_curvature().into_iter().map(|(_, k)| k).collect();
+    let kf: Vec<_> = inv.data.element_curvature().into_iter().map(|(_, k)| k).collect();
+    m.insert("kappa_err_rel".into(), relative_error(&k, &kf, 0));
+    m.insert("kappa_err_rel_inner".into(), relative_error(&k, &kf, INNER_SKIP_ELEMENTS));
+    for (name, v) in ObjectiveTerms::NAMES.iter().zip(last.objective.values()) {
+        m.insert(format!("{name}"), v);
+    }
+    m.insert("force_l2_n_per_m05".into(), (2.0 * last.objective.force / inv.lambda_f).sqrt());
+    m.insert("torque_l2_n_m05".into(), (2.0 * last.objective.torque / inv.lambda_l).sqrt());
+    m
+}
+
 /// All metrics written to `metrics.json`: physical ones, errors against the case's
 /// `[reference]` theory, and solver statistics.
 pub fn all_metrics(case: &Case, r: &RunResult) -> Result<Metrics, crate::reference::ReferenceError> {
     let mut m = physical_metrics(r);
+    m.extend(inverse_metrics(r));
     crate::theory::add_reference_metrics(case, r, &mut m)?;
     m.insert("iterations".into(), r.stats.iterations as f64);
     if let Some(v) = r.stats.last_change {
@@ -107,8 +140,21 @@ pub fn compare(case: &Case, rust: &RunResult, ff: &RunResult) -> Vec<ComparisonR
         let b0: Vec<_> = b.iter().map(|p| p - b[0]).collect();
         rows.push(field("tip_history_rel_diff", max_relative_difference(&a0, &b0), tol.displacement_rel));
     }
+    if let (Some(a), Some(b)) = (&rust.inverse, &ff.inverse) {
+        if nodes_match {
+            rows.push(field("nodewise_rel_diff_xhat", max_relative_difference(&a.xhat, &b.xhat), tol.adjoint_rel));
+            rows.push(field("nodewise_rel_diff_ahat", max_relative_difference(&a.ahat, &b.ahat), tol.adjoint_rel));
+        }
+        // Recovery errors (κ amplifies angle differences by ~1/h), compared relatively.
+        let (ma, mb) = (inverse_metrics(rust), inverse_metrics(ff));
+        for name in ["x_err_rel", "kappa_err_rel", "kappa_err_rel_inner"] {
+            let (x, y) = (ma.get(name).copied().unwrap_or(f64::NAN), mb.get(name).copied().unwrap_or(f64::NAN));
+            let d = (x - y).abs();
+            rows.push(ComparisonRow { name: name.into(), rust: Some(x), freefem: Some(y), difference: if d.is_nan() { f64::INFINITY } else { d }, tolerance: tol.metric_rel * x.abs() });
+        }
+    }
     // Both engines run the identical fixed point (D5), so their iteration counts are compared.
-    if matches!(case.analysis, Analysis::Static { method: StaticMethod::FixedPoint { .. }, .. }) {
+    if matches!(case.analysis, Analysis::Static { method: StaticMethod::FixedPoint { .. }, .. } | Analysis::Inverse(_)) {
         let (a, b) = (rust.stats.iterations as f64, ff.stats.iterations as f64);
         rows.push(ComparisonRow { name: "iterations".into(), rust: Some(a), freefem: Some(b), difference: (a - b).abs(), tolerance: tol.iterations_abs });
     }

@@ -4,9 +4,12 @@ use std::time::Instant;
 
 use nalgebra::{DVector, Vector3};
 
-use crate::case::{Analysis, Case, StaticMethod};
+use crate::case::{Analysis, Case, InverseMethod, InverseSettings, StaticMethod};
+use crate::data::{read_data, write_data, DataError};
 use crate::freefem::{self, FreeFemError};
 use crate::solve::dynamics::{self, DynamicParams, TipRecord};
+use crate::solve::inverse::{self, InverseParams, InverseRecord};
+use crate::solve::inverse_newton;
 use crate::solve::statics::{self, IterationRecord, Method, StaticParams};
 use crate::solve::{node_values, Problem, SolveError};
 
@@ -43,6 +46,26 @@ impl NodalState {
         let (x, alpha) = (0..n).map(|i| node_values(u, i)).unzip();
         NodalState { s: (0..n).map(|i| case.mesh.node_s(i)).collect(), x, alpha }
     }
+    /// Element-midpoint curvature `κˡ = A(α) ∂s α` [1/m] with the midpoint arc length [m] (eq. 28).
+    pub fn element_curvature(&self) -> Vec<(f64, Vector3<f64>)> {
+        (0..self.s.len().saturating_sub(1))
+            .map(|e| {
+                let h = self.s[e + 1] - self.s[e];
+                let mid = (self.alpha[e] + self.alpha[e + 1]) * 0.5;
+                ((self.s[e] + self.s[e + 1]) * 0.5, crate::rotation::curvature(&mid, &((self.alpha[e + 1] - self.alpha[e]) / h)))
+            })
+            .collect()
+    }
+    /// Directors `d1, d2, d3` per node (rows of Q, eq. 2).
+    pub fn directors(&self) -> Vec<[Vector3<f64>; 3]> {
+        self.alpha
+            .iter()
+            .map(|a| {
+                let q = crate::rotation::rotation(a);
+                [q.row(0).transpose(), q.row(1).transpose(), q.row(2).transpose()]
+            })
+            .collect()
+    }
     /// Displacement from the reference configuration `(0, 0, s)` [m].
     pub fn displacement(&self) -> Vec<Vector3<f64>> {
         self.x.iter().zip(&self.s).map(|(x, s)| x - Vector3::new(0.0, 0.0, *s)).collect()
@@ -68,12 +91,41 @@ pub struct SolverStats {
 #[derive(Clone, Debug)]
 pub struct RunResult {
     pub engine: Engine,
+    /// final state; for an inverse case the recovered `(x, α)`
     pub nodes: NodalState,
     /// static iteration history
     pub history: Vec<IterationRecord>,
     /// dynamic tip history (including t = 0)
     pub tip: Vec<TipRecord>,
     pub stats: SolverStats,
+    /// inverse cases: data, adjoint (controls) and per-iteration history
+    pub inverse: Option<InverseOutput>,
+}
+
+/// What an inverse run adds to its [`RunResult`].
+#[derive(Clone, Debug)]
+pub struct InverseOutput {
+    /// the data read from `data.csv` (x_g and the forward angles α_f, I7)
+    pub data: NodalState,
+    /// adjoint x̂ per node; the force control is f = x̂/λf [N/m] (eq. 54)
+    pub xhat: Vec<Vector3<f64>>,
+    /// adjoint α̂ per node; the torque control is l = α̂/λl [N] (eq. 54)
+    pub ahat: Vec<Vector3<f64>>,
+    /// one record per iteration (relative change, fit measures, objective terms of (41))
+    pub history: Vec<InverseRecord>,
+    pub lambda_f: f64,
+    pub lambda_l: f64,
+}
+
+impl InverseOutput {
+    /// Force control f = x̂/λf per node [N/m].
+    pub fn force(&self) -> Vec<Vector3<f64>> {
+        self.xhat.iter().map(|v| v / self.lambda_f).collect()
+    }
+    /// Torque control l = α̂/λl per node [N·m/m].
+    pub fn torque(&self) -> Vec<Vector3<f64>> {
+        self.ahat.iter().map(|v| v / self.lambda_l).collect()
+    }
 }
 
 /// Errors of running a case.
@@ -83,13 +135,77 @@ pub enum RunError {
     Solve(#[from] SolveError),
     #[error("freefem engine")]
     FreeFem(#[from] FreeFemError),
+    #[error("inverse data")]
+    Data(#[from] DataError),
+}
+
+/// The solver parameters of the first (only) frame of an inverse case.
+pub fn inverse_params(settings: &InverseSettings) -> InverseParams {
+    let w = &settings.weights;
+    InverseParams {
+        lambda_g: w.lambda_g,
+        lambda_f: w.lambda_f,
+        lambda_l: w.lambda_l,
+        lambda_d: w.lambda_d,
+        lambda_kappa: Vector3::from(w.lambda_kappa),
+        lambda_omega: Vector3::from(w.lambda_omega),
+        dt: settings.frame_interval_s,
+        first_frame: true,
+        alpha0: settings.alpha0_rad,
+        frame: 0,
+        relaxation: match settings.method {
+            InverseMethod::FixedPoint { relaxation } => relaxation,
+            InverseMethod::Newton => 1.0,
+        },
+        tolerance: settings.tolerance,
+        max_iterations: settings.max_iterations,
+    }
+}
+
+/// Generate the data of an inverse case: the Rust forward engine on [`Case::data_case`].
+pub fn generate_data(case: &Case) -> Result<NodalState, RunError> {
+    let data_case = case.data_case().ok_or_else(|| SolveError::NotInverse(case.name.clone()))?;
+    Ok(run_rust(&data_case, |_, _| {})?.nodes)
+}
+
+/// Solve the inverse case `case` in the Rust engine on the given data.
+pub fn run_rust_inverse(case: &Case, data: &NodalState, mut progress: impl FnMut(usize, usize)) -> Result<RunResult, RunError> {
+    let settings = case.inverse().ok_or_else(|| SolveError::NotInverse(case.name.clone()))?;
+    let problem = Problem::from_case(case);
+    let params = inverse_params(settings);
+    let n = case.mesh.nodes();
+    let prev = vec![Vector3::zeros(); n];
+    let start = Instant::now();
+    let report = |r: &InverseRecord| progress(r.iteration, params.max_iterations);
+    let sol = match settings.method {
+        InverseMethod::FixedPoint { .. } => inverse::solve_frame(&problem, &params, &data.x, &prev, &problem.reference_state(), report)?,
+        InverseMethod::Newton => inverse_newton::solve_frame_newton(&problem, &params, &data.x, &prev, &problem.reference_state(), report)?,
+    };
+    let wall_time_s = start.elapsed().as_secs_f64();
+    let last = sol.history.last().map(|h| h.rel_change);
+    let (xhat, ahat) = (0..n).map(|i| node_values(&sol.adjoint, i)).unzip();
+    Ok(RunResult {
+        engine: Engine::Rust,
+        nodes: NodalState::from_vector(case, &sol.u),
+        history: Vec::new(),
+        tip: Vec::new(),
+        stats: SolverStats { iterations: sol.history.len(), last_change: last, residual: None, max_newton_iterations: None, wall_time_s },
+        inverse: Some(InverseOutput { data: data.clone(), xhat, ahat, history: sol.history, lambda_f: params.lambda_f, lambda_l: params.lambda_l }),
+    })
 }
 
 /// Run `case` in the Rust engine. `progress(done, total)` is called per step/iteration.
+///
+/// An inverse case generates its data in memory (identical to what `data.csv` holds, since the
+/// file round-trips `f64` exactly); [`run`] goes through the file.
 pub fn run_rust(case: &Case, mut progress: impl FnMut(usize, usize)) -> Result<RunResult, RunError> {
     let problem = Problem::from_case(case);
     let start = Instant::now();
     match case.analysis {
+        Analysis::Inverse(_) => {
+            let data = generate_data(case)?;
+            run_rust_inverse(case, &data, progress)
+        }
         Analysis::Static { method, tolerance, max_iterations, continuation_steps } => {
             let method = match method {
                 StaticMethod::FixedPoint { relaxation } => Method::FixedPoint { relaxation },
@@ -109,6 +225,7 @@ pub fn run_rust(case: &Case, mut progress: impl FnMut(usize, usize)) -> Result<R
                     max_newton_iterations: None,
                     wall_time_s: start.elapsed().as_secs_f64(),
                 },
+                inverse: None,
             })
         }
         Analysis::Dynamic { end_time_s, steps, tolerance, max_iterations } => {
@@ -126,15 +243,32 @@ pub fn run_rust(case: &Case, mut progress: impl FnMut(usize, usize)) -> Result<R
                     max_newton_iterations: Some(sol.max_newton_iterations),
                     wall_time_s: start.elapsed().as_secs_f64(),
                 },
+                inverse: None,
             })
         }
     }
 }
 
-/// Run `case` in the chosen engine; FreeFEM works in `workdir`.
+/// Run `case` in the chosen engine; FreeFEM works in `workdir`. An inverse case first writes
+/// its data to `workdir/data.csv` (Rust forward engine) and then runs on that file.
 pub fn run(case: &Case, engine: Engine, workdir: &Path, progress: impl FnMut(usize, usize)) -> Result<RunResult, RunError> {
+    if case.inverse().is_some() {
+        let path = workdir.join("data.csv");
+        write_data(&path, &generate_data(case)?)?;
+        return run_inverse_on(case, engine, &path, workdir, progress);
+    }
     match engine {
         Engine::Rust => run_rust(case, progress),
         Engine::Freefem => Ok(freefem::run(case, workdir)?),
+    }
+}
+
+/// Run an inverse case in the chosen engine on the data file `data_path` (I7); FreeFEM works in
+/// `workdir`. Both engines read the same file.
+pub fn run_inverse_on(case: &Case, engine: Engine, data_path: &Path, workdir: &Path, progress: impl FnMut(usize, usize)) -> Result<RunResult, RunError> {
+    let data = read_data(data_path, &case.mesh)?;
+    match engine {
+        Engine::Rust => run_rust_inverse(case, &data, progress),
+        Engine::Freefem => Ok(freefem::run_inverse(case, data, data_path, workdir)?),
     }
 }

@@ -1,7 +1,8 @@
 //! Every case in `cases/` through both engines: the Rust engine and the FreeFEM reference
 //! (`freefem/forward.edp`) must agree within the tolerances stated in the case file (D8).
 //! Dynamic cases run their first `FREEFEM_DYNAMIC_STEPS` time steps here (FreeFEM needs ~0.26 s
-//! per step); `scripts/compare_all.sh` runs the full histories.
+//! per step); `scripts/compare_all.sh` runs the full histories. Inverse cases run in full
+//! (FreeFEM ~0.13 s per iteration: ~47 s for `inverse_bend`, ~18 s for `inverse_bend_twist`).
 //!
 //! FreeFEM must be installed (`apt-get install -y freefem++ libfreefem++`). For local work
 //! without it, `COSSERAT_SKIP_FREEFEM=1` skips this file; CI never sets it.
@@ -10,7 +11,8 @@ mod common;
 use cosserat::case::{case_files, Case};
 use cosserat::freefem::{find_executable, INSTALL_HINT};
 use cosserat::metrics::compare;
-use cosserat::run::{run, run_rust, Engine};
+use cosserat::data::write_data;
+use cosserat::run::{generate_data, run, run_inverse_on, run_rust, Engine};
 
 const FREEFEM_DYNAMIC_STEPS: usize = 40;
 /// Bound on the dynamic prefix, stricter than a case's full-run tolerance: over 40 steps the
@@ -47,8 +49,17 @@ fn every_case_agrees_between_rust_and_freefem() {
             case.compare.metric_rel = case.compare.metric_rel.min(PREFIX_REL);
         }
         let dir = tempfile::tempdir().expect("tempdir");
-        let rust = run_rust(&case, |_, _| {}).unwrap_or_else(|e| panic!("{}: {e}", case.name));
-        let ff = run(&case, Engine::Freefem, dir.path(), |_, _| {}).unwrap_or_else(|e| panic!("{}: {e}", case.name));
+        let (rust, ff) = if case.inverse().is_some() {
+            // Inverse cases: both engines read the same data file (I7) and run the same fixed
+            // point; the comparison includes the iteration count.
+            let data = dir.path().join("data.csv");
+            write_data(&data, &generate_data(&case).unwrap_or_else(|e| panic!("{}: {e}", case.name))).expect("data.csv");
+            let on = |engine| run_inverse_on(&case, engine, &data, dir.path(), |_, _| {}).unwrap_or_else(|e| panic!("{} [{engine}]: {e}", case.name));
+            (on(Engine::Rust), on(Engine::Freefem))
+        } else {
+            let rust = run_rust(&case, |_, _| {}).unwrap_or_else(|e| panic!("{}: {e}", case.name));
+            (rust, run(&case, Engine::Freefem, dir.path(), |_, _| {}).unwrap_or_else(|e| panic!("{}: {e}", case.name)))
+        };
         eprintln!("{}: rust {:.3} s, freefem {:.3} s (ratio {:.0})", case.name, rust.stats.wall_time_s, ff.stats.wall_time_s, ff.stats.wall_time_s / rust.stats.wall_time_s);
         for row in compare(&case, &rust, &ff) {
             eprintln!("  {:<32} |diff| {:.3e}  tol {:.3e}  {}", row.name, row.difference, row.tolerance, if row.passed() { "PASS" } else { "FAIL" });

@@ -373,11 +373,16 @@ pub fn element_curvatures(problem: &Problem, u: &DVector<f64>) -> Vec<Vector3<f6
 
 /// `‖κ − κ_f‖/‖κ_f‖` over element midpoints, skipping `skip` elements at each end.
 pub fn curvature_error(problem: &Problem, u: &DVector<f64>, truth: &DVector<f64>, skip: usize) -> f64 {
-    let (k, kf) = (element_curvatures(problem, u), element_curvatures(problem, truth));
-    let n = k.len();
+    relative_error(&element_curvatures(problem, u), &element_curvatures(problem, truth), skip)
+}
+
+/// Discrete relative ℓ² error `‖a − b‖/‖b‖` of two equally long lists of 3-vectors, skipping
+/// `skip` entries at each end (at most half of them).
+pub fn relative_error(a: &[Vector3<f64>], b: &[Vector3<f64>], skip: usize) -> f64 {
+    let n = a.len().min(b.len());
     let range = skip.min(n / 2)..n - skip.min(n / 2);
-    let num: f64 = range.clone().map(|e| (k[e] - kf[e]).norm_squared()).sum();
-    let den: f64 = range.map(|e| kf[e].norm_squared()).sum();
+    let num: f64 = range.clone().map(|e| (a[e] - b[e]).norm_squared()).sum();
+    let den: f64 = range.map(|e| b[e].norm_squared()).sum();
     (num / den).sqrt()
 }
 

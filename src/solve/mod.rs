@@ -33,6 +33,10 @@ pub enum SolveError {
     InverseNewtonNotConverged { frame: usize, iterations: usize, residual: f64 },
     #[error("non-finite value in iteration {iteration} of inverse frame {frame}")]
     InverseNonFinite { frame: usize, iteration: usize },
+    #[error("{0}")]
+    Unsupported(&'static str),
+    #[error("case `{0}` is not an inverse case")]
+    NotInverse(String),
     #[error(transparent)]
     Linear(#[from] LinearError),
 }
