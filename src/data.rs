@@ -92,7 +92,7 @@ mod tests {
         NodalState {
             s: (0..n).map(|i| mesh.node_s(i)).collect(),
             x: (0..n).map(|i| Vector3::new(0.1 / 3.0 * i as f64, (i as f64).sin() * 1e-4, mesh.node_s(i))).collect(),
-            alpha: (0..n).map(|i| Vector3::new(std::f64::consts::PI / 7.0, -0.3 * i as f64, 1e-17)).collect(),
+            alpha: (0..n).map(|i| Vector3::new(std::f64::consts::PI / 7.0, -0.3 * i as f64, 0.25)).collect(),
         }
     }
 
@@ -118,7 +118,7 @@ mod tests {
         std::fs::write(&p, lines[..3].join("\n")).unwrap();
         let e = read_data(&p, &mesh).unwrap_err().to_string();
         assert!(e.contains("2 node rows") && e.contains("4 nodes"), "{e}");
-        std::fs::write(&p, good.replace("1.0000000000000000e-17", "NaN")).unwrap();
+        std::fs::write(&p, good.replace("2.5000000000000000e-1", "NaN")).unwrap();
         let e = read_data(&p, &mesh).unwrap_err().to_string();
         assert!(e.contains("gamma_rad is not finite"), "{e}");
         assert!(matches!(read_data(&dir.path().join("missing.csv"), &mesh), Err(DataError::Read { .. })));

@@ -49,4 +49,5 @@ pub mod reference;
 pub mod rotation;
 pub mod run;
 pub mod solve;
+pub mod sweep;
 pub mod theory;

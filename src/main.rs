@@ -46,6 +46,30 @@ enum Command {
         #[arg(long)]
         out: Option<PathBuf>,
     },
+    /// Run a case for every point of a parameter grid (in parallel) and summarise.
+    ///
+    /// Writes one folder per run (the files of `run`), `summary.csv` (one row per run: the swept
+    /// values, status, iterations, recovery errors, objective, wall time, error message) and
+    /// `convergence.svg` (log-log histories, one curve per run; Figs. 9-11 of the paper).
+    /// Exit status 1 if any run failed (after writing everything).
+    Sweep {
+        /// Case file (TOML)
+        case: PathBuf,
+        /// Parameter and values, e.g. `--set lambda_l=1e-20,1e-10,1,1e3`; repeat for a
+        /// cartesian product. Inverse cases: lambda_g, lambda_f, lambda_l, lambda_d,
+        /// lambda_kappa1..3, lambda_omega1..3, relaxation, tolerance, max_iterations, elements
+        #[arg(long = "set", value_name = "KEY=V1,V2,...", required = true)]
+        set: Vec<String>,
+        /// Output directory [default: out/<case name>/sweep]
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Parallel runs [default: number of cores]
+        #[arg(long)]
+        jobs: Option<usize>,
+        /// Do not show a progress bar
+        #[arg(long)]
+        quiet: bool,
+    },
     /// List the cases of a directory with their descriptions.
     List {
         /// Directory holding *.toml case files
@@ -77,6 +101,7 @@ fn dispatch(cli: Cli) -> Result<ExitCode> {
     match cli.command {
         Command::Run { case, engine, out, quiet } => cmd_run(&case, engine, out, quiet),
         Command::Compare { case, out } => cmd_compare(&case, out),
+        Command::Sweep { case, set, out, jobs, quiet } => cmd_sweep(&case, &set, out, jobs, quiet),
         Command::List { dir } => cmd_list(&dir),
         Command::Modes { case, count } => cmd_modes(&case, count),
     }
@@ -171,6 +196,57 @@ fn cmd_compare(path: &Path, out: Option<PathBuf>) -> Result<ExitCode> {
         ff.stats.wall_time_s,
         ff.stats.wall_time_s / rust.stats.wall_time_s
     );
+    Ok(if failed == 0 { ExitCode::SUCCESS } else { ExitCode::from(1) })
+}
+
+/// One run of a sweep in the Rust engine, writing its folder; the error text on failure.
+fn sweep_run(case: &Case, dir: &Path) -> std::result::Result<(cosserat::metrics::Metrics, RunResult), String> {
+    let inner = || -> Result<(cosserat::metrics::Metrics, RunResult)> {
+        let data = prepare_data(case, dir)?;
+        let r = run_engine(case, Engine::Rust, dir, data.as_deref(), true)?;
+        let m = all_metrics(case, &r)?;
+        write_run(case, &r, &m, dir)?;
+        Ok((m, r))
+    };
+    inner().map_err(|e| format!("{e:#}"))
+}
+
+fn cmd_sweep(path: &Path, set: &[String], out: Option<PathBuf>, jobs: Option<usize>, quiet: bool) -> Result<ExitCode> {
+    use cosserat::sweep::{parse_set, product, summary_csv, SummaryRow};
+    use rayon::prelude::*;
+    let case = load(path)?;
+    let params = set.iter().map(|s| parse_set(s)).collect::<Result<Vec<_>, _>>()?;
+    let points = product(&case, &params)?;
+    let dir = out.unwrap_or_else(|| PathBuf::from("out").join(&case.name).join("sweep"));
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(jobs.unwrap_or(0)).build().context("thread pool")?;
+    let pb = progress_bar(quiet, &format!("{} sweep", case.name));
+    pb.set_length(points.len() as u64);
+    let results: Vec<_> = pool.install(|| {
+        points
+            .par_iter()
+            .map(|(point, c)| {
+                let r = sweep_run(c, &dir.join(&c.name));
+                pb.inc(1);
+                (point.clone(), c.name.clone(), r)
+            })
+            .collect()
+    });
+    pb.finish_and_clear();
+    let keys: Vec<String> = params.iter().map(|p| p.key.clone()).collect();
+    let rows: Vec<SummaryRow> = results.iter().map(|(point, _, r)| SummaryRow { point: point.clone(), outcome: r.as_ref().map(|(m, _)| m.clone()).map_err(Clone::clone) }).collect();
+    let summary = dir.join("summary.csv");
+    cosserat::output::write_atomic(&summary, summary_csv(&keys, &rows)?.as_bytes())?;
+    let ok: Vec<(&String, &RunResult)> = results.iter().filter_map(|(_, name, r)| r.as_ref().ok().map(|(_, run)| (name, run))).collect();
+    if !ok.is_empty() {
+        cosserat::output::write_convergence_plot(&ok, &dir.join("convergence.svg"))?;
+    }
+    let failed = rows.iter().filter(|r| r.outcome.is_err()).count();
+    println!("{}: {} runs, {} failed; wrote {} and one folder per run to {}", case.name, rows.len(), failed, summary.display(), dir.display());
+    for (_, name, r) in &results {
+        if let Err(e) = r {
+            eprintln!("  {name}: FAILED: {e}");
+        }
+    }
     Ok(if failed == 0 { ExitCode::SUCCESS } else { ExitCode::from(1) })
 }
 

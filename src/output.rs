@@ -191,3 +191,31 @@ fn inverse_panels(case: &Case, r: &RunResult, inv: &InverseOutput) -> Vec<LinePl
         plot("convergence of the fixed point".into(), "iteration", "value", hist, true),
     ]
 }
+
+/// Convergence histories of several runs in one figure (Figs. 9–11 style, log-log): for inverse
+/// runs ‖x − x_g‖/‖x_g‖ and the relative change per iteration, for static runs the change.
+pub fn write_convergence_plot(runs: &[(&String, &RunResult)], path: &Path) -> Result<(), OutputError> {
+    let plot = |title: &str, yl: &str, series: Vec<Series>| LinePlot { title: title.into(), x_label: "iteration".into(), y_label: yl.into(), series, log_x: true, log_y: true };
+    let mut xerr = Vec::new();
+    let mut change = Vec::new();
+    for (name, r) in runs {
+        if let Some(inv) = &r.inverse {
+            let it: Vec<f64> = inv.history.iter().map(|h| h.iteration as f64).collect();
+            xerr.push(Series { label: name.to_string(), x: it.clone(), y: inv.history.iter().map(|h| h.x_err_rel).collect() });
+            change.push(Series { label: name.to_string(), x: it, y: inv.history.iter().map(|h| h.rel_change).collect() });
+        } else if !r.history.is_empty() {
+            change.push(Series { label: name.to_string(), x: (1..=r.history.len()).map(|k| k as f64).collect(), y: r.history.iter().map(|h| h.change).collect() });
+        }
+    }
+    let mut panels = Vec::new();
+    if !xerr.is_empty() {
+        panels.push(plot("|x - x_g| / |x_g|", "relative error", xerr));
+    }
+    if !change.is_empty() {
+        panels.push(plot("relative change of (x, alpha)", "relative change", change));
+    }
+    if panels.is_empty() {
+        return Ok(());
+    }
+    write_panels_svg(&panels, 2, path).map_err(|e| OutputError::Plot { path: path.to_path_buf(), reason: e.to_string() })
+}

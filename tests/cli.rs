@@ -73,3 +73,59 @@ fn compare_runs_both_engines() {
         .stdout(predicate::str::contains("nodewise_rel_diff_displacement").and(predicate::str::contains("PASS")).and(predicate::str::contains("FAIL").not()));
     assert!(dir.path().join("freefem/metrics.json").is_file() && dir.path().join("rust/metrics.json").is_file());
 }
+
+#[test]
+fn inverse_run_writes_frame_controls_history_and_plot() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    cosserat().args(["run", "cases/inverse_bend_twist.toml", "--quiet", "--out"]).arg(dir.path()).assert().success();
+    let nodes = std::fs::read_to_string(dir.path().join("inverse_nodes.csv")).expect("inverse_nodes.csv");
+    let header = nodes.lines().next().expect("header");
+    for col in ["alpha_rad", "d1_x", "d3_z", "f_x_n_per_m", "l_z_nm_per_m", "data_x_m"] {
+        assert!(header.split(',').any(|c| c == col), "{col} missing in {header}");
+    }
+    assert_eq!(nodes.lines().count(), 102);
+    // Directors are orthonormal: check d1·d3 = 0 and |d2| = 1 on every row.
+    let cols: Vec<&str> = header.split(',').collect();
+    let at = |row: &[f64], name: &str| row[cols.iter().position(|c| *c == name).expect("column")];
+    for line in nodes.lines().skip(1) {
+        let row: Vec<f64> = line.split(',').map(|v| v.parse().expect("number")).collect();
+        let dot13 = at(&row, "d1_x") * at(&row, "d3_x") + at(&row, "d1_y") * at(&row, "d3_y") + at(&row, "d1_z") * at(&row, "d3_z");
+        let n2 = at(&row, "d2_x").powi(2) + at(&row, "d2_y").powi(2) + at(&row, "d2_z").powi(2);
+        assert!(dot13.abs() < 1e-14 && (n2 - 1.0).abs() < 1e-14);
+    }
+    let hist = std::fs::read_to_string(dir.path().join("inverse_history.csv")).expect("history");
+    assert!(hist.starts_with("iteration,rel_change,x_err_rel,tangent_misfit_m05,j_tracking,j_force,j_torque,j_shear,j_bending,j_angular,j_total\n"));
+    assert!(dir.path().join("data.csv").is_file() && dir.path().join("inverse_curvature.csv").is_file());
+    let m: std::collections::BTreeMap<String, f64> = serde_json::from_str(&std::fs::read_to_string(dir.path().join("metrics.json")).expect("metrics")).expect("json");
+    assert!(m["x_err_rel"] < 2e-5 && m["kappa_err_rel_inner"] < 1e-2, "{m:?}");
+    assert_eq!(m["iterations"] as usize + 1, hist.lines().count());
+    assert!(std::fs::read_to_string(dir.path().join("plot.svg")).expect("svg").contains("recovered torque"));
+}
+
+#[test]
+fn sweep_writes_one_folder_per_run_a_summary_and_a_convergence_plot() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    cosserat()
+        .args(["sweep", "cases/inverse_bend_twist.toml", "--quiet", "--set", "lambda_l=1e-6,1", "--set", "tolerance=1e-3", "--out"])
+        .arg(dir.path())
+        .assert()
+        .success()
+        .stdout(predicate::str::contains("2 runs, 0 failed"));
+    let summary = std::fs::read_to_string(dir.path().join("summary.csv")).expect("summary");
+    let lines: Vec<&str> = summary.lines().collect();
+    assert!(lines[0].starts_with("lambda_l,tolerance,status,iterations,x_err_rel"), "{}", lines[0]);
+    assert_eq!(lines.len(), 3);
+    assert!(lines[1].starts_with("1e-6,1e-3,ok,") && lines[2].starts_with("1e0,1e-3,ok,"), "{summary}");
+    assert!(dir.path().join("lambda_l=1e-6_tolerance=1e-3/inverse_history.csv").is_file());
+    assert!(std::fs::read_to_string(dir.path().join("convergence.svg")).expect("svg").contains("<svg"));
+    // A run that hits its iteration limit is a failed row naming frame, iteration and change.
+    cosserat()
+        .args(["sweep", "cases/inverse_bend_twist.toml", "--quiet", "--set", "max_iterations=3", "--out"])
+        .arg(dir.path().join("fail"))
+        .assert()
+        .code(1)
+        .stderr(predicate::str::contains("frame 0 did not converge after 3 iterations"));
+    let summary = std::fs::read_to_string(dir.path().join("fail/summary.csv")).expect("summary");
+    assert!(summary.lines().nth(1).expect("row").starts_with("3e0,failed,"), "{summary}");
+    cosserat().args(["sweep", "cases/inverse_bend_twist.toml", "--set", "lambda_q=1"]).assert().code(1).stderr(predicate::str::contains("unknown parameter"));
+}
