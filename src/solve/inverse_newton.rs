@@ -16,8 +16,8 @@
 //! (an adjoint that also varies Q, A, B) is a different problem and is not used.
 //!
 //! Steps are damped by backtracking on the equilibrated residual norm `‖D_r R‖₂` (D_r: Ruiz
-//! row factors of the first Jacobian, I6). Stop after a full step with
-//! `relative_change(x, α) ≤ tol` (D5).
+//! row factors of the first Jacobian, I6). Stop when the full Newton step has
+//! `relative_change(x, α) ≤ tol` (D5); that step is taken without line search.
 //!
 //! ## References
 //! 1. Wang et al., Comput. Mech. 71 (2023), §3–4, eqs. (52)–(61), Remark 8, Remark 10.
@@ -212,12 +212,15 @@ pub fn solve_frame_newton(
             phi0 = phi;
         }
         let delta = solver.solve_equilibrated(&values, &(-&r))?;
+        // A full step whose relative change is within the tolerance is taken without the
+        // line search: the merit is then at its round-off floor and cannot decrease reliably.
+        let full = relative_change(&part(&(&big + &delta), false), &part(&big, false)) <= p.tolerance;
         let mut t = 1.0;
         let (mut trial, mut phi_t);
         loop {
             trial = &big + &delta * t;
             phi_t = merit(&assemble_newton(problem, p, &pattern, &mut scratch, &trial, x_g, alpha_prev));
-            if phi_t <= (1.0 - ARMIJO * t) * phi || t <= MIN_STEP {
+            if full || phi_t <= (1.0 - ARMIJO * t) * phi || t <= MIN_STEP {
                 break;
             }
             t *= 0.5;
@@ -235,7 +238,7 @@ pub fn solve_frame_newton(
         let rec = InverseRecord { iteration: k, rel_change, x_err_rel, tangent_misfit, objective, residual: Some(last) };
         progress(&rec);
         history.push(rec);
-        if t == 1.0 && rel_change <= p.tolerance {
+        if full {
             return Ok(InverseSolution { u, adjoint, history });
         }
     }
