@@ -164,7 +164,16 @@ impl LinearSolver {
     /// Solve `M x = b` after Ruiz equilibration (`docs/inverse.md`, I6): five passes of
     /// row/column max-norm scaling `A ← diag(1/√r) A diag(1/√c)`, then `x = D_c y`.
     pub fn solve_equilibrated(&self, values: &[f64], b: &DVector<f64>) -> Result<DVector<f64>, LinearError> {
-        let n = b.len();
+        let (a, dr, dc) = self.equilibrate(values);
+        let rhs = DVector::from_fn(b.len(), |i, _| b[i] * dr[i]);
+        let y = self.solve(&a, &rhs)?;
+        Ok(DVector::from_fn(b.len(), |i, _| y[i] * dc[i]))
+    }
+
+    /// Ruiz equilibration of I6: returns `(D_r A D_c, D_r, D_c)` (values, row and column
+    /// factors) after five passes of row/column max-norm scaling.
+    pub fn equilibrate(&self, values: &[f64]) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+        let n = self.symbolic_matrix.ncols();
         let col_ptr = self.symbolic_matrix.col_ptr();
         let row_idx = self.symbolic_matrix.row_idx();
         let mut a = values.to_vec();
@@ -189,9 +198,7 @@ impl LinearSolver {
                 dc[i] *= inv_sqrt(c[i]);
             }
         }
-        let rhs = DVector::from_fn(n, |i, _| b[i] * dr[i]);
-        let y = self.solve(&a, &rhs)?;
-        Ok(DVector::from_fn(n, |i, _| y[i] * dc[i]))
+        (a, dr, dc)
     }
 
     /// Solve `M x = b` for the matrix with the pattern's structure and the given values.

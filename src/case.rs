@@ -170,6 +170,8 @@ struct RawSolver {
     max_iterations: usize,
     #[serde(default = "one")]
     continuation_steps: usize,
+    /// inverse Newton: the fixed point runs until this relative change before Newton starts
+    warm_start_tolerance: Option<f64>,
 }
 fn one() -> usize {
     1
@@ -217,8 +219,9 @@ pub enum StaticMethod {
 pub enum InverseMethod {
     /// The paper's scheme (eq. 61, Remark 10), relaxation w ∈ (0, 1]; FreeFEM mirrors it.
     FixedPoint { relaxation: f64 },
-    /// Newton on the same discrete equations (Rust engine only, I8).
-    Newton,
+    /// Newton on the same discrete equations (Rust engine only, I8), started from the fixed
+    /// point (relaxation `relaxation`) run until its relative change is ≤ `warm_start_tolerance`.
+    Newton { relaxation: f64, warm_start_tolerance: f64 },
 }
 
 /// Regularisation weights of eq. (41).
@@ -533,6 +536,9 @@ impl Validator<'_> {
             return Err(self.err("time", "only allowed when solver.analysis = \"dynamic\""));
         }
         let analysis = match analysis_kind {
+            RawAnalysis::Static | RawAnalysis::Dynamic if s.warm_start_tolerance.is_some() => {
+                return Err(self.err("solver.warm_start_tolerance", "only used by an inverse analysis"));
+            }
             RawAnalysis::Static => {
                 let method = self.static_method("solver", s.method, s.relaxation)?;
                 if s.continuation_steps == 0 {
@@ -541,9 +547,25 @@ impl Validator<'_> {
                 Analysis::Static { method, tolerance: s.tolerance, max_iterations: s.max_iterations, continuation_steps: s.continuation_steps }
             }
             RawAnalysis::Inverse => {
-                let method = match self.static_method("solver", s.method, s.relaxation)? {
-                    StaticMethod::FixedPoint { relaxation } => InverseMethod::FixedPoint { relaxation },
-                    StaticMethod::Newton => InverseMethod::Newton,
+                // Both modes need the relaxation: Newton starts from the fixed point (I8).
+                let relaxation = match self.static_method("solver", RawMethod::FixedPoint, s.relaxation)? {
+                    StaticMethod::FixedPoint { relaxation } => relaxation,
+                    StaticMethod::Newton => unreachable!("asked for the fixed point"),
+                };
+                let method = match s.method {
+                    RawMethod::FixedPoint => {
+                        if s.warm_start_tolerance.is_some() {
+                            return Err(self.err("solver.warm_start_tolerance", "only used by method = \"newton\""));
+                        }
+                        InverseMethod::FixedPoint { relaxation }
+                    }
+                    RawMethod::Newton => {
+                        let w = s.warm_start_tolerance.ok_or_else(|| self.err("solver.warm_start_tolerance", "required by method = \"newton\" (Newton starts from the fixed point's iterate at this relative change, I8)"))?;
+                        if !(w > 0.0 && w < 1.0) {
+                            return Err(self.err("solver.warm_start_tolerance", format!("must lie in (0, 1), got {w}")));
+                        }
+                        InverseMethod::Newton { relaxation, warm_start_tolerance: w }
+                    }
                 };
                 if s.continuation_steps != 1 {
                     return Err(self.err("solver.continuation_steps", "not used by an inverse analysis"));

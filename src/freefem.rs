@@ -104,8 +104,7 @@ pub fn include_file(case: &Case) -> String {
         Analysis::Dynamic { end_time_s, steps, tolerance, max_iterations } => (1, 1, 1.0, tolerance, max_iterations, end_time_s, steps, 1),
         Analysis::Inverse(inv) => {
             let relax = match inv.method {
-                InverseMethod::FixedPoint { relaxation } => relaxation,
-                InverseMethod::Newton => 1.0,
+                InverseMethod::FixedPoint { relaxation } | InverseMethod::Newton { relaxation, .. } => relaxation,
             };
             (0, 0, relax, inv.tolerance, inv.max_iterations, 0.0, 0, 1)
         }
@@ -129,7 +128,7 @@ pub fn include_file(case: &Case) -> String {
 /// `workdir` as `data.csv` unless it is already there). `data` is the parsed content of that file.
 pub fn run_inverse(case: &Case, data: NodalState, data_path: &Path, workdir: &Path) -> Result<RunResult, FreeFemError> {
     let inv = case.inverse().ok_or_else(|| FreeFemError::BadOutput { path: data_path.to_path_buf(), reason: format!("case `{}` is not an inverse case", case.name) })?;
-    if inv.method == InverseMethod::Newton {
+    if matches!(inv.method, InverseMethod::Newton { .. }) {
         return Err(FreeFemError::Unsupported("the FreeFEM engine mirrors the paper's fixed point only (solver.method = \"fixed_point\")"));
     }
     let io = |path: &Path| {
@@ -162,6 +161,7 @@ pub fn run_inverse(case: &Case, data: NodalState, data_path: &Path, workdir: &Pa
             x_err_rel: r[2],
             tangent_misfit: r[3],
             objective: ObjectiveTerms { tracking: r[4], force: r[5], torque: r[6], shear: r[7], bending: r[8], angular: r[9] },
+            residual: None,
         })
         .collect();
     let info = read_info(&workdir.join("ff_info.csv"))?;
@@ -184,6 +184,7 @@ pub fn run_inverse(case: &Case, data: NodalState, data_path: &Path, workdir: &Pa
             xhat: rows.iter().map(|r| v3(r, 7)).collect(),
             ahat: rows.iter().map(|r| v3(r, 10)).collect(),
             history,
+            kappa_err: Vec::new(),
             lambda_f: w.lambda_f,
             lambda_l: w.lambda_l,
         }),

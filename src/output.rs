@@ -31,10 +31,15 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
 }
 
 fn csv_text(header: &[&str], rows: impl Iterator<Item = Vec<f64>>) -> String {
+    csv_text_opt(header, rows.map(|r| r.into_iter().map(Some).collect()))
+}
+
+/// CSV with empty fields where a value does not apply.
+fn csv_text_opt(header: &[&str], rows: impl Iterator<Item = Vec<Option<f64>>>) -> String {
     let mut s = header.join(",");
     s.push('\n');
     for r in rows {
-        let line: Vec<String> = r.iter().map(|v| format!("{v:.17e}")).collect();
+        let line: Vec<String> = r.iter().map(|v| v.map(|v| format!("{v:.17e}")).unwrap_or_default()).collect();
         s.push_str(&line.join(","));
         s.push('\n');
     }
@@ -119,12 +124,24 @@ fn write_inverse(r: &RunResult, inv: &InverseOutput, put: &mut impl FnMut(&str, 
     )?;
     let mut header = vec!["iteration", "rel_change", "x_err_rel", "tangent_misfit_m05"];
     header.extend(ObjectiveTerms::NAMES);
-    let rows = inv.history.iter().map(|h| {
-        let mut row = vec![h.iteration as f64, h.rel_change, h.x_err_rel, h.tangent_misfit];
-        row.extend(h.objective.values());
+    // Newton runs add the equilibrated residual ‖D_r R‖/‖D_r R₀‖ of I8 (empty on the rows of
+    // the fixed-point warm start).
+    let newton = inv.history.iter().any(|h| h.residual.is_some());
+    if newton {
+        header.push("newton_residual_rel");
+    }
+    header.extend(["kappa_err_rel", "kappa_err_rel_inner"]);
+    let rows = inv.history.iter().enumerate().map(|(i, h)| {
+        let mut row: Vec<Option<f64>> = [h.iteration as f64, h.rel_change, h.x_err_rel, h.tangent_misfit].into_iter().map(Some).collect();
+        row.extend(h.objective.values().into_iter().map(Some));
+        if newton {
+            row.push(h.residual);
+        }
+        let k = inv.kappa_err.get(i);
+        row.extend([k.map(|k| k[0]), k.map(|k| k[1])]);
         row
     });
-    put("inverse_history.csv", csv_text(&header, rows).into_bytes())?;
+    put("inverse_history.csv", csv_text_opt(&header, rows).into_bytes())?;
     Ok(())
 }
 
@@ -181,26 +198,35 @@ fn inverse_panels(case: &Case, r: &RunResult, inv: &InverseOutput) -> Vec<LinePl
     let hist = vec![
         series("relative change".into(), it.clone(), inv.history.iter().map(|h| h.rel_change).collect()),
         series("|x - x_g|/|x_g|".into(), it.clone(), inv.history.iter().map(|h| h.x_err_rel).collect()),
-        series("|x' - d3| [m^1/2]".into(), it, inv.history.iter().map(|h| h.tangent_misfit).collect()),
+        series("|x' - d3| [m^1/2]".into(), it.clone(), inv.history.iter().map(|h| h.tangent_misfit).collect()),
     ];
+    let mut hist = hist;
+    if inv.kappa_err.len() == it.len() {
+        hist.push(series("|kappa - kappa_f|/|kappa_f|".into(), it, inv.kappa_err.iter().map(|k| k[0]).collect()));
+    }
     vec![
         plot(format!("{}: centreline, data vs inverse", case.name), "s [m]", "position [m]", pos, false),
         plot("curvature (eq. 28), data vs inverse".into(), "s [m]", "kappa [1/m]", curv, false),
         plot("recovered force f = x^/lambda_f (eq. 54)".into(), "s [m]", "f [N/m]", ctrl(&f, "f"), false),
         plot("recovered torque l = a^/lambda_l (eq. 54)".into(), "s [m]", "l [N m/m]", ctrl(&l, "l"), false),
-        plot("convergence of the fixed point".into(), "iteration", "value", hist, true),
+        plot("convergence history".into(), "iteration", "value", hist, true),
     ]
 }
 
 /// Convergence histories of several runs in one figure (Figs. 9–11 style, log-log): for inverse
-/// runs ‖x − x_g‖/‖x_g‖ and the relative change per iteration, for static runs the change.
+/// runs ‖x − x_g‖/‖x_g‖, the curvature error and the relative change per iteration, for static
+/// runs the change.
 pub fn write_convergence_plot(runs: &[(&String, &RunResult)], path: &Path) -> Result<(), OutputError> {
     let plot = |title: &str, yl: &str, series: Vec<Series>| LinePlot { title: title.into(), x_label: "iteration".into(), y_label: yl.into(), series, log_x: true, log_y: true };
     let mut xerr = Vec::new();
+    let mut kerr = Vec::new();
     let mut change = Vec::new();
     for (name, r) in runs {
         if let Some(inv) = &r.inverse {
             let it: Vec<f64> = inv.history.iter().map(|h| h.iteration as f64).collect();
+            if inv.kappa_err.len() == it.len() {
+                kerr.push(Series { label: name.to_string(), x: it.clone(), y: inv.kappa_err.iter().map(|k| k[0]).collect() });
+            }
             xerr.push(Series { label: name.to_string(), x: it.clone(), y: inv.history.iter().map(|h| h.x_err_rel).collect() });
             change.push(Series { label: name.to_string(), x: it, y: inv.history.iter().map(|h| h.rel_change).collect() });
         } else if !r.history.is_empty() {
@@ -210,6 +236,9 @@ pub fn write_convergence_plot(runs: &[(&String, &RunResult)], path: &Path) -> Re
     let mut panels = Vec::new();
     if !xerr.is_empty() {
         panels.push(plot("|x - x_g| / |x_g|", "relative error", xerr));
+    }
+    if !kerr.is_empty() {
+        panels.push(plot("|kappa - kappa_f| / |kappa_f| (eq. 28)", "relative error", kerr));
     }
     if !change.is_empty() {
         panels.push(plot("relative change of (x, alpha)", "relative change", change));

@@ -108,6 +108,17 @@ pub fn d3(a: &Angles) -> Vector3<f64> {
     Vector3::new(-t.cb * t.sg, t.sb, t.cb * t.cg)
 }
 
+/// Second derivatives `∂²d3/∂α_i∂α_j` (symmetric in i, j; d3 does not depend on α), used by
+/// the Newton Jacobian of the λd term of the inverse problem (eqs. 56–58 differentiated once more).
+pub fn d3_second_derivatives(a: &Angles) -> [[Vector3<f64>; 3]; 3] {
+    let t = Trig::new(a);
+    let z = Vector3::zeros();
+    let bb = Vector3::new(t.cb * t.sg, -t.sb, -t.cb * t.cg);
+    let bg = Vector3::new(t.sb * t.cg, 0.0, t.sb * t.sg);
+    let gg = Vector3::new(t.cb * t.sg, 0.0, -t.cb * t.cg);
+    [[z, z, z], [z, bb, bg], [z, bg, gg]]
+}
+
 /// Local curvature `κˡ = A(α) ∂s α` [1/m], eq. (28).
 pub fn curvature(a: &Angles, da_ds: &Vector3<f64>) -> Vector3<f64> {
     a_matrix(a) * da_ds
@@ -218,6 +229,25 @@ mod tests {
             let fa = (a_matrix(&ap) - a_matrix(&am)) / (2.0 * h);
             assert!((fq - dq[j]).amax() < 1e-9, "dQ/da_{j}");
             assert!((fa - da[j]).amax() < 1e-9, "dA/da_{j}");
+        }
+    }
+
+    #[test]
+    fn d3_second_derivatives_match_finite_differences() {
+        let h = 1e-6;
+        for a in [Vector3::new(0.4, -0.7, 1.2), Vector3::new(-1.1, 2.8, -0.3), Vector3::zeros()] {
+            let dd = d3_second_derivatives(&a);
+            for j in 0..3 {
+                let mut ap = a;
+                ap[j] += h;
+                let mut am = a;
+                am[j] -= h;
+                let (dp, dm) = (rotation_derivatives(&ap), rotation_derivatives(&am));
+                for i in 0..3 {
+                    let fd: Vector3<f64> = (dp[i].row(2) - dm[i].row(2)).transpose() / (2.0 * h);
+                    assert!((fd - dd[i][j]).amax() < 1e-9, "d2 d3 / da_{i} da_{j} at {a}");
+                }
+            }
         }
     }
 

@@ -7,6 +7,7 @@ use nalgebra::{DVector, Vector3};
 use crate::case::{Analysis, Case, InverseMethod, InverseSettings, StaticMethod};
 use crate::data::{read_data, write_data, DataError};
 use crate::freefem::{self, FreeFemError};
+use crate::metrics::INNER_SKIP_ELEMENTS;
 use crate::solve::dynamics::{self, DynamicParams, TipRecord};
 use crate::solve::inverse::{self, InverseParams, InverseRecord};
 use crate::solve::inverse_newton;
@@ -113,6 +114,9 @@ pub struct InverseOutput {
     pub ahat: Vec<Vector3<f64>>,
     /// one record per iteration (relative change, fit measures, objective terms of (41))
     pub history: Vec<InverseRecord>,
+    /// per iteration: curvature error against the data's `[all elements, inner]`
+    /// (`metrics::inverse_metrics`); empty when the engine does not report it (FreeFEM)
+    pub kappa_err: Vec<[f64; 2]>,
     pub lambda_f: f64,
     pub lambda_l: f64,
 }
@@ -154,8 +158,7 @@ pub fn inverse_params(settings: &InverseSettings) -> InverseParams {
         alpha0: settings.alpha0_rad,
         frame: 0,
         relaxation: match settings.method {
-            InverseMethod::FixedPoint { relaxation } => relaxation,
-            InverseMethod::Newton => 1.0,
+            InverseMethod::FixedPoint { relaxation } | InverseMethod::Newton { relaxation, .. } => relaxation,
         },
         tolerance: settings.tolerance,
         max_iterations: settings.max_iterations,
@@ -176,10 +179,16 @@ pub fn run_rust_inverse(case: &Case, data: &NodalState, mut progress: impl FnMut
     let n = case.mesh.nodes();
     let prev = vec![Vector3::zeros(); n];
     let start = Instant::now();
-    let report = |r: &InverseRecord| progress(r.iteration, params.max_iterations);
+    let truth: Vec<Vector3<f64>> = data.element_curvature().into_iter().map(|(_, k)| k).collect();
+    let mut kappa_err = Vec::new();
+    let report = |r: &InverseRecord, u: &DVector<f64>| {
+        let k = inverse::element_curvatures(&problem, u);
+        kappa_err.push([inverse::relative_error(&k, &truth, 0), inverse::relative_error(&k, &truth, INNER_SKIP_ELEMENTS)]);
+        progress(r.iteration, params.max_iterations)
+    };
     let sol = match settings.method {
-        InverseMethod::FixedPoint { .. } => inverse::solve_frame(&problem, &params, &data.x, &prev, &problem.reference_state(), report)?,
-        InverseMethod::Newton => inverse_newton::solve_frame_newton(&problem, &params, &data.x, &prev, &problem.reference_state(), report)?,
+        InverseMethod::FixedPoint { .. } => inverse::solve_frame_observed(&problem, &params, &data.x, &prev, &problem.reference_state(), report)?,
+        InverseMethod::Newton { warm_start_tolerance, .. } => inverse_newton::solve_frame_warm(&problem, &params, warm_start_tolerance, &data.x, &prev, &problem.reference_state(), report)?,
     };
     let wall_time_s = start.elapsed().as_secs_f64();
     let last = sol.history.last().map(|h| h.rel_change);
@@ -190,7 +199,7 @@ pub fn run_rust_inverse(case: &Case, data: &NodalState, mut progress: impl FnMut
         history: Vec::new(),
         tip: Vec::new(),
         stats: SolverStats { iterations: sol.history.len(), last_change: last, residual: None, max_newton_iterations: None, wall_time_s },
-        inverse: Some(InverseOutput { data: data.clone(), xhat, ahat, history: sol.history, lambda_f: params.lambda_f, lambda_l: params.lambda_l }),
+        inverse: Some(InverseOutput { data: data.clone(), xhat, ahat, history: sol.history, kappa_err, lambda_f: params.lambda_f, lambda_l: params.lambda_l }),
     })
 }
 

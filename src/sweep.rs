@@ -49,7 +49,7 @@ pub fn known_keys(case: &Case) -> &'static [&'static str] {
     match case.analysis {
         Analysis::Inverse(_) => &[
             "lambda_g", "lambda_f", "lambda_l", "lambda_d", "lambda_kappa1", "lambda_kappa2", "lambda_kappa3", "lambda_omega1", "lambda_omega2", "lambda_omega3",
-            "relaxation", "tolerance", "max_iterations", "elements",
+            "relaxation", "warm_start_tolerance", "tolerance", "max_iterations", "elements",
         ],
         Analysis::Static { .. } => &["relaxation", "tolerance", "max_iterations", "continuation_steps", "elements"],
         Analysis::Dynamic { .. } => &["tolerance", "max_iterations", "steps", "elements"],
@@ -91,8 +91,11 @@ pub fn apply(case: &mut Case, key: &str, v: f64) -> Result<(), SweepError> {
             "lambda_kappa1" | "lambda_kappa2" | "lambda_kappa3" => s.weights.lambda_kappa[key.as_bytes()[12] as usize - b'1' as usize] = nonneg(v)?,
             "lambda_omega1" | "lambda_omega2" | "lambda_omega3" => s.weights.lambda_omega[key.as_bytes()[12] as usize - b'1' as usize] = nonneg(v)?,
             "relaxation" => match &mut s.method {
-                InverseMethod::FixedPoint { relaxation } => *relaxation = relax(v)?,
-                InverseMethod::Newton => return Err(invalid("not used by method = \"newton\"".into())),
+                InverseMethod::FixedPoint { relaxation } | InverseMethod::Newton { relaxation, .. } => *relaxation = relax(v)?,
+            },
+            "warm_start_tolerance" => match &mut s.method {
+                InverseMethod::Newton { warm_start_tolerance, .. } => *warm_start_tolerance = unit(v)?,
+                InverseMethod::FixedPoint { .. } => return Err(invalid("only used by method = \"newton\"".into())),
             },
             "tolerance" => s.tolerance = unit(v)?,
             "max_iterations" => s.max_iterations = count(key, v)?,

@@ -94,7 +94,7 @@ fn inverse_run_writes_frame_controls_history_and_plot() {
         assert!(dot13.abs() < 1e-14 && (n2 - 1.0).abs() < 1e-14);
     }
     let hist = std::fs::read_to_string(dir.path().join("inverse_history.csv")).expect("history");
-    assert!(hist.starts_with("iteration,rel_change,x_err_rel,tangent_misfit_m05,j_tracking,j_force,j_torque,j_shear,j_bending,j_angular,j_total\n"));
+    assert!(hist.starts_with("iteration,rel_change,x_err_rel,tangent_misfit_m05,j_tracking,j_force,j_torque,j_shear,j_bending,j_angular,j_total,kappa_err_rel,kappa_err_rel_inner\n"));
     assert!(dir.path().join("data.csv").is_file() && dir.path().join("inverse_curvature.csv").is_file());
     let m: std::collections::BTreeMap<String, f64> = serde_json::from_str(&std::fs::read_to_string(dir.path().join("metrics.json")).expect("metrics")).expect("json");
     assert!(m["x_err_rel"] < 2e-5 && m["kappa_err_rel_inner"] < 1e-2, "{m:?}");

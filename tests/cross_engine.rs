@@ -48,6 +48,10 @@ fn every_case_agrees_between_rust_and_freefem() {
             case.compare.angles_rel = case.compare.angles_rel.min(PREFIX_REL);
             case.compare.metric_rel = case.compare.metric_rel.min(PREFIX_REL);
         }
+        if matches!(case.inverse().map(|i| i.method), Some(cosserat::case::InverseMethod::Newton { .. })) {
+            eprintln!("{}: inverse Newton is Rust-only (FreeFEM mirrors the paper's fixed point); its fixed-point twin is compared", case.name);
+            continue;
+        }
         let dir = tempfile::tempdir().expect("tempdir");
         let (rust, ff) = if case.inverse().is_some() {
             // Inverse cases: both engines read the same data file (I7) and run the same fixed

@@ -23,8 +23,8 @@ use crate::rotation::{a_matrix, d3, rotation_derivatives};
 
 /// Unknowns per node of the KKT system: `[x, α, x̂, α̂]`.
 pub const BLOCK: usize = 12;
-type KktMat = SMatrix<f64, 24, 24>;
-type KktVec = SVector<f64, 24>;
+pub(crate) type KktMat = SMatrix<f64, 24, 24>;
+pub(crate) type KktVec = SVector<f64, 24>;
 
 /// Regularisation weights of eq. (41) and the iteration settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -62,6 +62,9 @@ pub struct InverseRecord {
     pub x_err_rel: f64,
     pub tangent_misfit: f64,
     pub objective: ObjectiveTerms,
+    /// Newton only (`docs/inverse.md`, I8): equilibrated KKT residual `‖D_r R(U)‖₂` after the
+    /// step, relative to its value at the start of Newton; `None` for the fixed point
+    pub residual: Option<f64>,
 }
 
 /// The six terms of the objective (41), each with its weight and the ½, with the
@@ -105,18 +108,18 @@ pub struct InverseSolution {
 
 /// Map a forward local index (`[x_a, α_a, x_b, α_b]`) to the KKT local index; `hat` selects
 /// the adjoint copy.
-fn kkt(i: usize, hat: bool) -> usize {
+pub(crate) fn kkt(i: usize, hat: bool) -> usize {
     BLOCK * (i / 6) + i % 6 + if hat { 6 } else { 0 }
 }
 
 /// `∂d3/∂α = [0 | d_β | d_γ]` (eqs. 56–58).
-fn d3_jacobian(alpha: &Vector3<f64>) -> Matrix3<f64> {
+pub(crate) fn d3_jacobian(alpha: &Vector3<f64>) -> Matrix3<f64> {
     let dq = rotation_derivatives(alpha);
     Matrix3::from_columns(&[dq[0].row(2).transpose(), dq[1].row(2).transpose(), dq[2].row(2).transpose()])
 }
 
 /// Local KKT matrix and right-hand side of one element (I4).
-fn element_system(problem: &Problem, p: &InverseParams, uk: &LocalVec, xg: [Vector3<f64>; 2], alpha_prev: [Vector3<f64>; 2]) -> (KktMat, KktVec) {
+pub(crate) fn element_system(problem: &Problem, p: &InverseParams, uk: &LocalVec, xg: [Vector3<f64>; 2], alpha_prev: [Vector3<f64>; 2]) -> (KktMat, KktVec) {
     let h = problem.mesh.h();
     let mut m = KktMat::zeros();
     let mut r = KktVec::zeros();
@@ -218,6 +221,19 @@ pub fn solve_frame(
     u0: &DVector<f64>,
     mut progress: impl FnMut(&InverseRecord),
 ) -> Result<InverseSolution, SolveError> {
+    solve_frame_observed(problem, p, x_g, alpha_prev, u0, |r, _| progress(r))
+}
+
+/// [`solve_frame`] whose callback also sees the relaxed state `(x, α)` (6 per node) of each
+/// iteration, e.g. to follow the curvature error against known data.
+pub fn solve_frame_observed(
+    problem: &Problem,
+    p: &InverseParams,
+    x_g: &[Vector3<f64>],
+    alpha_prev: &[Vector3<f64>],
+    u0: &DVector<f64>,
+    mut progress: impl FnMut(&InverseRecord, &DVector<f64>),
+) -> Result<InverseSolution, SolveError> {
     let mesh = problem.mesh;
     let nodes = mesh.nodes();
     let pattern = Pattern::with_block(&mesh, BLOCK);
@@ -250,8 +266,8 @@ pub fn solve_frame(
         }
         let (x_err_rel, tangent_misfit) = fit_measures(problem, &u, x_g);
         let objective = objective_terms(problem, p, &u, &adjoint, x_g, alpha_prev);
-        let rec = InverseRecord { iteration: k, rel_change, x_err_rel, tangent_misfit, objective };
-        progress(&rec);
+        let rec = InverseRecord { iteration: k, rel_change, x_err_rel, tangent_misfit, objective, residual: None };
+        progress(&rec, &u);
         history.push(rec);
         if rel_change <= p.tolerance {
             return Ok(InverseSolution { u, adjoint, history });
@@ -290,11 +306,20 @@ pub fn assemble_kkt(
     x_g: &[Vector3<f64>],
     alpha_prev: &[Vector3<f64>],
 ) -> DVector<f64> {
+    assemble_blocks(problem, pattern, values, |e| {
+        let uk = LocalVec::from_column_slice(&u.as_slice()[6 * e..6 * e + 12]);
+        element_system(problem, p, &uk, [x_g[e], x_g[e + 1]], [alpha_prev[e], alpha_prev[e + 1]])
+    })
+}
+
+/// The one element loop of the inverse problem (fixed point and Newton): zero `values`, add
+/// each element's local KKT matrix `kernel(e).0` into them, and return the sum of the local
+/// vectors `kernel(e).1` (12 unknowns per node).
+pub(crate) fn assemble_blocks(problem: &Problem, pattern: &Pattern, values: &mut [f64], mut kernel: impl FnMut(usize) -> (KktMat, KktVec)) -> DVector<f64> {
     values.iter_mut().for_each(|v| *v = 0.0);
     let mut rhs = DVector::zeros(BLOCK * problem.mesh.nodes());
     for e in 0..problem.mesh.elements {
-        let uk = LocalVec::from_column_slice(&u.as_slice()[6 * e..6 * e + 12]);
-        let (m, r) = element_system(problem, p, &uk, [x_g[e], x_g[e + 1]], [alpha_prev[e], alpha_prev[e + 1]]);
+        let (m, r) = kernel(e);
         pattern.scatter_local(values, e, &m);
         for i in 0..24 {
             rhs[BLOCK * e + i] += r[i];

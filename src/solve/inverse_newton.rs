@@ -1,11 +1,289 @@
-//! Newton mode of the inverse problem (issue 3): Newton on the discrete equations of Problem 2,
-//! eq. (61), whose fixed point `inverse::solve_frame` seeks. Work in progress.
-use nalgebra::{DVector, Vector3};
+//! Newton mode of the inverse problem of one frame (`docs/inverse.md`, I8): Newton on the
+//! discrete equations whose fixed point [`inverse::solve_frame`](super::inverse::solve_frame)
+//! seeks, eq. (61) with the readings I3–I5.
+//!
+//! ```text
+//!   R(U) = K(u) U − r(u),     U = (u, û),  u = (x, α) the state part of U
+//!   J(U) = K(u) + ∂/∂u [K(u) V − r(u)]|_{V = U}
+//! ```
+//! `K`, `r` are the fixed point's KKT matrix and right-hand side (I4) with every coefficient
+//! (Q, A, B, q3, d3, D = [0 | d_β | d_γ]) at the current state; the Dirichlet rows of I5 are
+//! `U_d − v_d`. The coefficient derivative is exact: on the primal rows it is `∂G/∂u − L(u)`
+//! (the forward tangent of `element::internal_force` minus the frozen operator, since
+//! `L(u) u − b(u) = G(u)`), on the adjoint rows it is the derivative of `L(u)ᵀ û` and of the
+//! λd, Λκ and Λω terms (`coefficient_derivative`). A zero of `R` is a fixed point of the
+//! paper's scheme, so both modes converge to the same discrete solution. Remark 8's variant
+//! (an adjoint that also varies Q, A, B) is a different problem and is not used.
+//!
+//! Steps are damped by backtracking on the equilibrated residual norm `‖D_r R‖₂` (D_r: Ruiz
+//! row factors of the first Jacobian, I6). Stop when the full Newton step has
+//! `relative_change(x, α) ≤ tol` (D5); that step is taken without line search.
+//!
+//! ## References
+//! 1. Wang et al., Comput. Mech. 71 (2023), §3–4, eqs. (52)–(61), Remark 8, Remark 10.
+#![allow(non_snake_case)]
+use nalgebra::{DVector, Matrix3, Vector3};
 
-use super::inverse::{InverseParams, InverseRecord, InverseSolution};
+use super::inverse::{
+    assemble_blocks, dirichlet, element_system, fit_measures, kkt, objective_terms, InverseParams, InverseRecord, InverseSolution, KktMat, KktVec,
+    BLOCK,
+};
+use super::statics::relative_change;
 use super::{Problem, SolveError};
+use crate::assembly::{LinearSolver, Pattern};
+use crate::element::{frozen_operator, internal_force, interpolate, LocalMat, LocalVec};
+use crate::mesh::GAUSS2;
+use crate::rotation::{a_matrix, a_matrix_derivatives, d3, d3_second_derivatives, rotation, rotation_derivatives, skew};
 
-/// Not available yet: an error, never a silent substitute.
-pub fn solve_frame_newton(_problem: &Problem, _p: &InverseParams, _x_g: &[Vector3<f64>], _alpha_prev: &[Vector3<f64>], _u0: &DVector<f64>, _progress: impl FnMut(&InverseRecord)) -> Result<InverseSolution, SolveError> {
-    Err(SolveError::Unsupported("solver.method = \"newton\" for inverse cases is not implemented yet"))
+/// Smallest step fraction of the backtracking line search (2⁻¹⁰).
+const MIN_STEP: f64 = 1.0 / 1024.0;
+/// Armijo constant of the line search: accept `t` if `φ(U + t δ) ≤ (1 − c t) φ(U)`.
+const ARMIJO: f64 = 1e-4;
+
+/// `∂/∂u [K_e(u) V − r_e(u)]` at `V = U_e` for one element (24 × 24, KKT numbering; only the
+/// state columns are non-zero): the derivative of the frozen coefficients of I4.
+///
+/// ```text
+///   primal rows:   ∂G/∂u − L(u)                                   (G(u) = L(u) u − b(u), D5)
+///   adjoint rows:  ∂/∂u [L(u)ᵀ û]:  ∫ ∂sδx · S(α) (∂s x̂ + ∂s x × α̂),  S = QᵀKQ   (stretch–shear rule)
+///                                   ∫ ∂sδα · (QᵀJA)ᵀ ∂s α̂                    (bending rule)
+///                  λd:  −λd ∫ δα · [v·∂²d3/∂α_i∂α_j] δα,  v = ∂s x − d3            (stretch–shear rule)
+///                  Λκ:  ∫ ∂sδα · ∂_α(AᵀΛκA) ∂sα                                    (bending rule)
+///                  Λω:  ∫ δα · ∂_α(AᵀΛωA) (α − α_{n−1}) / Δt²                      (load rule)
+/// ```
+fn coefficient_derivative(problem: &Problem, p: &InverseParams, ue: &KktVec, alpha_prev: [Vector3<f64>; 2]) -> KktMat {
+    let h = problem.mesh.h();
+    let props = &problem.props;
+    let state = LocalVec::from_fn(|i, _| ue[kkt(i, false)]);
+    let adj = LocalVec::from_fn(|i, _| ue[kkt(i, true)]);
+    let mut e = KktMat::zeros();
+    // Primal rows: ∂G/∂u − L(u).
+    let mut t = LocalMat::zeros();
+    internal_force(props, problem.scheme, h, &state, Some(&mut t));
+    let (l, _) = frozen_operator(props, problem.scheme, h, &state);
+    for i in 0..12 {
+        for j in 0..12 {
+            e[(kkt(i, true), kkt(j, false))] = t[(i, j)] - l[(i, j)];
+        }
+    }
+    let add3 = |e: &mut KktMat, ro: usize, co: usize, blk: &Matrix3<f64>| {
+        for i in 0..3 {
+            for j in 0..3 {
+                e[(ro + i, co + j)] += blk[(i, j)];
+            }
+        }
+    };
+    let columns = |c: [Vector3<f64>; 3]| Matrix3::from_columns(&c);
+    let (X, AL) = ([0, 12], [3, 15]);
+    let K = Matrix3::from_diagonal(&props.shear_stretch_n);
+    let Jm = Matrix3::from_diagonal(&props.bend_twist_nm2);
+    // Stretch–shear rule: L(u)ᵀ û on the x rows, and the λd term.
+    let rule = problem.scheme.stretch_shear();
+    for (xi, w) in rule.points.iter().zip(rule.weights) {
+        let (q, qa) = (interpolate(&state, h, *xi), interpolate(&adj, h, *xi));
+        let wh = w * h;
+        let Q = rotation(&q.alpha);
+        let dQ = rotation_derivatives(&q.alpha);
+        let S = Q.transpose() * K * Q;
+        let v = qa.dx + q.dx.cross(&qa.alpha);
+        let dS_v = columns([0, 1, 2].map(|j| (dQ[j].transpose() * K * Q + Q.transpose() * K * dQ[j]) * v));
+        let dS_dx = -S * skew(&qa.alpha);
+        let dd = d3_second_derivatives(&q.alpha);
+        let mis = q.dx - d3(&q.alpha);
+        let H2 = Matrix3::from_fn(|i, j| mis.dot(&dd[i][j])) * (-p.lambda_d);
+        for c in 0..2 {
+            for b in 0..2 {
+                add3(&mut e, X[c], AL[b], &(dS_v * (wh * q.dn[c] * q.n[b])));
+                add3(&mut e, X[c], X[b], &(dS_dx * (wh * q.dn[c] * q.dn[b])));
+                add3(&mut e, AL[c], AL[b], &(H2 * (wh * q.n[c] * q.n[b])));
+            }
+        }
+    }
+    // Bending rule: L(u)ᵀ û on the α rows, and the Λκ term.
+    let kappa_on = p.lambda_kappa.amax() > 0.0;
+    let Lk = Matrix3::from_diagonal(&p.lambda_kappa);
+    let rule = problem.scheme.bending();
+    for (xi, w) in rule.points.iter().zip(rule.weights) {
+        let (q, qa) = (interpolate(&state, h, *xi), interpolate(&adj, h, *xi));
+        let wh = w * h;
+        let Q = rotation(&q.alpha);
+        let A = a_matrix(&q.alpha);
+        let dQ = rotation_derivatives(&q.alpha);
+        let dA = a_matrix_derivatives(&q.alpha);
+        let mut blk = columns([0, 1, 2].map(|j| (dQ[j].transpose() * Jm * A + Q.transpose() * Jm * dA[j]).transpose() * qa.dalpha));
+        if kappa_on {
+            blk += columns([0, 1, 2].map(|j| (dA[j].transpose() * Lk * A + A.transpose() * Lk * dA[j]) * q.dalpha));
+        }
+        for c in 0..2 {
+            for b in 0..2 {
+                add3(&mut e, AL[c], AL[b], &(blk * (wh * q.dn[c] * q.n[b])));
+            }
+        }
+    }
+    // Load rule: the Λω term (as in `element_system`).
+    if !p.first_frame && p.lambda_omega.amax() > 0.0 {
+        let Lw = Matrix3::from_diagonal(&p.lambda_omega) / (p.dt * p.dt);
+        for (xi, w) in GAUSS2.points.iter().zip(GAUSS2.weights) {
+            let q = interpolate(&state, h, *xi);
+            let wh = w * h;
+            let A = a_matrix(&q.alpha);
+            let dA = a_matrix_derivatives(&q.alpha);
+            let da = q.alpha - (alpha_prev[0] * q.n[0] + alpha_prev[1] * q.n[1]);
+            let blk = columns([0, 1, 2].map(|j| (dA[j].transpose() * Lw * A + A.transpose() * Lw * dA[j]) * da));
+            for c in 0..2 {
+                for b in 0..2 {
+                    add3(&mut e, AL[c], AL[b], &(blk * (wh * q.n[c] * q.n[b])));
+                }
+            }
+        }
+    }
+    e
+}
+
+/// Newton residual `R(U) = K(u) U − r(u)` of I8 (12 unknowns per node, Dirichlet rows
+/// `U_d − v_d` of I5) and its exact Jacobian `J(U)` (into `values`, Dirichlet rows identity).
+pub fn assemble_newton(
+    problem: &Problem,
+    p: &InverseParams,
+    pattern: &Pattern,
+    values: &mut [f64],
+    big: &DVector<f64>,
+    x_g: &[Vector3<f64>],
+    alpha_prev: &[Vector3<f64>],
+) -> DVector<f64> {
+    let mut r = assemble_blocks(problem, pattern, values, |e| {
+        let ue = KktVec::from_column_slice(&big.as_slice()[BLOCK * e..BLOCK * (e + 2)]);
+        let uk = LocalVec::from_fn(|i, _| ue[kkt(i, false)]);
+        let ap = [alpha_prev[e], alpha_prev[e + 1]];
+        let (m, rhs) = element_system(problem, p, &uk, [x_g[e], x_g[e + 1]], ap);
+        (m + coefficient_derivative(problem, p, &ue, ap), m * ue - rhs)
+    });
+    let fixed = dirichlet(p, x_g);
+    for &(d, v) in &fixed {
+        r[d] = big[d] - v;
+    }
+    pattern.set_identity_rows(values, &fixed.iter().map(|f| f.0).collect::<Vec<_>>());
+    r
+}
+
+/// The state `(x, α)` (`hat = false`) or the adjoint `(x̂, α̂)` (`hat = true`), 6 per node, of
+/// a KKT vector (12 per node).
+fn part(big: &DVector<f64>, hat: bool) -> DVector<f64> {
+    let off = if hat { 6 } else { 0 };
+    DVector::from_fn(big.len() / 2, |i, _| big[BLOCK * (i / 6) + off + i % 6])
+}
+
+/// Solve one frame by Newton (I8) from the state `u0` (6 per node). The adjoint is started
+/// consistently by one linear solve of the fixed point, `K(u0) U = r(u0)` (I4). Arguments and
+/// records as [`solve_frame`](super::inverse::solve_frame); `p.relaxation` is not used,
+/// `p.tolerance` bounds the relative change of `(x, α)` of a full Newton step (D5), and each
+/// record carries the equilibrated residual relative to its start value.
+pub fn solve_frame_newton(
+    problem: &Problem,
+    p: &InverseParams,
+    x_g: &[Vector3<f64>],
+    alpha_prev: &[Vector3<f64>],
+    u0: &DVector<f64>,
+    mut progress: impl FnMut(&InverseRecord),
+) -> Result<InverseSolution, SolveError> {
+    solve_frame_newton_observed(problem, p, x_g, alpha_prev, u0, |r, _| progress(r))
+}
+
+/// [`solve_frame_newton`] whose callback also sees the state `(x, α)` after each step.
+pub fn solve_frame_newton_observed(
+    problem: &Problem,
+    p: &InverseParams,
+    x_g: &[Vector3<f64>],
+    alpha_prev: &[Vector3<f64>],
+    u0: &DVector<f64>,
+    mut progress: impl FnMut(&InverseRecord, &DVector<f64>),
+) -> Result<InverseSolution, SolveError> {
+    let pattern = Pattern::with_block(&problem.mesh, BLOCK);
+    let solver = LinearSolver::new(&pattern)?;
+    let fixed = dirichlet(p, x_g);
+    let rows: Vec<usize> = fixed.iter().map(|f| f.0).collect();
+    let mut values = vec![0.0; pattern.nnz()];
+    let mut scratch = vec![0.0; pattern.nnz()];
+    // Consistent start: one linear solve of the fixed point at u0.
+    let mut rhs = super::inverse::assemble_kkt(problem, p, &pattern, &mut values, u0, x_g, alpha_prev);
+    for &(d, v) in &fixed {
+        rhs[d] = v;
+    }
+    pattern.set_identity_rows(&mut values, &rows);
+    let mut big = solver.solve_equilibrated(&values, &rhs)?;
+    let mut history = Vec::new();
+    let mut weights: Option<Vec<f64>> = None;
+    let mut phi0 = f64::NAN;
+    let mut last = f64::NAN;
+    for k in 1..=p.max_iterations {
+        let r = assemble_newton(problem, p, &pattern, &mut values, &big, x_g, alpha_prev);
+        let w = weights.get_or_insert_with(|| solver.equilibrate(&values).1);
+        let merit = |r: &DVector<f64>| r.iter().zip(w.iter()).map(|(a, b)| (a * b).powi(2)).sum::<f64>().sqrt();
+        let phi = merit(&r);
+        if k == 1 {
+            phi0 = phi;
+        }
+        let delta = solver.solve_equilibrated(&values, &(-&r))?;
+        // A full step whose relative change is within the tolerance is taken without the
+        // line search: the merit is then at its round-off floor and cannot decrease reliably.
+        let full = relative_change(&part(&(&big + &delta), false), &part(&big, false)) <= p.tolerance;
+        let mut t = 1.0;
+        let (mut trial, mut phi_t);
+        loop {
+            trial = &big + &delta * t;
+            phi_t = merit(&assemble_newton(problem, p, &pattern, &mut scratch, &trial, x_g, alpha_prev));
+            if full || phi_t <= (1.0 - ARMIJO * t) * phi || t <= MIN_STEP {
+                break;
+            }
+            t *= 0.5;
+        }
+        let (u_old, u) = (part(&big, false), part(&trial, false));
+        let rel_change = relative_change(&u, &u_old);
+        big = trial;
+        if !rel_change.is_finite() || !phi_t.is_finite() || big.iter().any(|v| !v.is_finite()) {
+            return Err(SolveError::InverseNonFinite { frame: p.frame, iteration: k });
+        }
+        let adjoint = part(&big, true);
+        let (x_err_rel, tangent_misfit) = fit_measures(problem, &u, x_g);
+        let objective = objective_terms(problem, p, &u, &adjoint, x_g, alpha_prev);
+        last = phi_t / phi0;
+        let rec = InverseRecord { iteration: k, rel_change, x_err_rel, tangent_misfit, objective, residual: Some(last) };
+        progress(&rec, &u);
+        history.push(rec);
+        if full {
+            return Ok(InverseSolution { u, adjoint, history });
+        }
+    }
+    Err(SolveError::InverseNewtonNotConverged { frame: p.frame, iterations: p.max_iterations, residual: last })
+}
+
+/// Newton started from the paper's fixed point (I8): the fixed point (relaxation
+/// `p.relaxation`) runs from `u0` until its relative change is ≤ `warm_start_tolerance`, then
+/// [`solve_frame_newton`] continues from its state until `p.tolerance`. One history (the Newton
+/// records continue the iteration count and carry `residual`); `p.max_iterations` bounds the
+/// two phases together. From the straight reference state Newton alone can reach a spurious
+/// root (I8), hence the warm start. The callback sees each record and state.
+pub fn solve_frame_warm(
+    problem: &Problem,
+    p: &InverseParams,
+    warm_start_tolerance: f64,
+    x_g: &[Vector3<f64>],
+    alpha_prev: &[Vector3<f64>],
+    u0: &DVector<f64>,
+    mut progress: impl FnMut(&InverseRecord, &DVector<f64>),
+) -> Result<InverseSolution, SolveError> {
+    let warm = InverseParams { tolerance: warm_start_tolerance.max(p.tolerance), ..*p };
+    let start = super::inverse::solve_frame_observed(problem, &warm, x_g, alpha_prev, u0, &mut progress)?;
+    let done = start.history.len();
+    let rest = InverseParams { max_iterations: p.max_iterations.saturating_sub(done).max(1), ..*p };
+    let newton = solve_frame_newton_observed(problem, &rest, x_g, alpha_prev, &start.u, |r, u| {
+        progress(&InverseRecord { iteration: r.iteration + done, ..*r }, u);
+    })
+    .map_err(|e| match e {
+        SolveError::InverseNewtonNotConverged { frame, iterations, residual } => SolveError::InverseNewtonNotConverged { frame, iterations: iterations + done, residual },
+        other => other,
+    })?;
+    let mut history = start.history;
+    history.extend(newton.history.into_iter().map(|r| InverseRecord { iteration: r.iteration + done, ..r }));
+    Ok(InverseSolution { history, ..newton })
 }
