@@ -343,7 +343,7 @@ fn equivariance_error(p: &Problem, a: &DVector<f64>, b: &DVector<f64>, r: &Matri
 /// α(0) = θ) and `Q(α, β, γ) Ry(φ)ᵀ = Q(α, β, γ − φ)` (spatial rotation about **e2**). With
 /// translations these are exact symmetries of the discrete scheme (isotropic section,
 /// Λκ1 = Λκ2). A spatial rotation about **e3** is *not* one: `Q Rz(θ)ᵀ` mixes all three angles,
-/// contrary to the brief's expectation.
+/// although it is the obvious candidate.
 ///
 /// Measured (x rel., max |Q′ − L Q Rᵀ|, κ rel., max angle change), after 1 | 20 iterations:
 /// - translation c:           2.0e-15, 3.4e-6, 2.5e-4 | 2.8e-9, 9.4e-6, 2.0e-4
@@ -352,7 +352,7 @@ fn equivariance_error(p: &Problem, a: &DVector<f64>, b: &DVector<f64>, r: &Matri
 /// - spatial Rz(0.7) + c:     1.0e-15, 4.4e-2, 0.16   | 1.7e-2, 0.38, 2.8
 /// - general R + c:           1.9e-15, 4.2e-2, 0.13   | 6.1e-2, 2.0, 71
 ///
-/// (general R: axis (1, 2, 3), 0.5 rad; α0 from the chart of `Q(α_orig(0)) Rᵀ` — the brief's
+/// (general R: axis (1, 2, 3), 0.5 rad; α0 from the chart of `Q(α_orig(0)) Rᵀ` — the product
 /// `R Q` is the relabelling, not a spatial rotation, in this convention.) Not 1e-9 even for a
 /// pure translation: the angles are this sensitive to round-off (a side run: a 1e-15 relative
 /// perturbation of x_g alone moves them by 6.5e-6 after one iteration); the symmetric cases sit
