@@ -1,0 +1,414 @@
+//! The regularisation findings (2)–(4) of §5.2 of Wang et al. (2023) for the first data set,
+//! eq. (64), and the rigid-motion equivariance of the scheme (`docs/inverse.md`), measured on
+//! the Rust fixed point. Where our numbers differ from the paper's text, the test asserts what
+//! we measured and its doc comment says so.
+//!
+//! Base parameters (the paper's first test): λg = 1e9, λf = 1, λl = 1e-10, λd = 1e-6,
+//! Λκ = diag(0, 0, 1e-10), Λω = 0, w = 0.5, stop at relative change 3e-6 (reachable: the
+//! iteration plateaus near 1.6e-6). Runs that do not reach it are capped at `CAP` iterations.
+mod common;
+
+use std::sync::OnceLock;
+
+use common::{case_from, case_text, edit};
+use cosserat::case::Case;
+use cosserat::rotation::{angles_from_rotation, rotation};
+use cosserat::solve::inverse::{curvature_error, element_curvatures, solve_frame, InverseParams, InverseRecord};
+use cosserat::solve::statics::{self, Method, StaticParams};
+use cosserat::solve::{node_values, Problem};
+use nalgebra::{DVector, Matrix3, Rotation3, Unit, Vector3};
+use rayon::prelude::*;
+
+/// Iteration cap of the sweeps: the base run stops after 363 iterations.
+const CAP: usize = 600;
+
+/// Forward data of eq. (64): the Newton solution (truth) and its nodal positions x_g.
+struct Data {
+    case: Case,
+    truth: DVector<f64>,
+    xg: Vec<Vector3<f64>>,
+}
+
+impl Data {
+    fn new(elements: usize) -> Self {
+        let text = case_text("follower_bend_64");
+        let text = if elements == 100 { text } else { edit(&text, "elements = 100", &format!("elements = {elements}")) };
+        let case = case_from(&text, "f64");
+        let newton = StaticParams { method: Method::Newton, tolerance: 1e-13, max_iterations: 40, continuation_steps: 5 };
+        let truth = statics::solve(&Problem::from_case(&case), &newton, |_| {}).expect("forward data").u;
+        let xg = (0..case.mesh.nodes()).map(|i| node_values(&truth, i).0).collect();
+        Data { case, truth, xg }
+    }
+    fn problem(&self) -> Problem<'_> {
+        Problem::from_case(&self.case)
+    }
+}
+
+fn paper() -> InverseParams {
+    InverseParams {
+        lambda_g: 1e9,
+        lambda_f: 1.0,
+        lambda_l: 1e-10,
+        lambda_d: 1e-6,
+        lambda_kappa: Vector3::new(0.0, 0.0, 1e-10),
+        lambda_omega: Vector3::zeros(),
+        dt: 1.0,
+        first_frame: true,
+        alpha0: 0.0,
+        frame: 0,
+        relaxation: 0.5,
+        tolerance: 3e-6,
+        max_iterations: CAP,
+    }
+}
+
+/// One run of the fixed point with the state after every iteration.
+struct Run {
+    history: Vec<InverseRecord>,
+    /// `(‖κ − κ_f‖/‖κ_f‖` all elements, without 5 end elements) per iteration (if tracked)
+    kappa: Vec<(f64, f64)>,
+    converged: bool,
+    u: DVector<f64>,
+}
+
+impl Run {
+    fn last(&self) -> &InverseRecord {
+        self.history.last().expect("at least one iteration")
+    }
+    fn iterations(&self) -> usize {
+        self.history.len()
+    }
+    /// ‖l‖ [L² norm] from λl/2 ∫|l|² (l = α̂/λl of the last solve).
+    fn torque_norm(&self, lambda_l: f64) -> f64 {
+        (2.0 * self.last().objective.torque / lambda_l).sqrt()
+    }
+}
+
+/// The fixed point one iteration per `solve_frame` call (max_iterations 1, tolerance ∞). An
+/// iteration depends on the state `(x, α)` only (the adjoint is solved afresh), so this is the
+/// same sequence as one call, with the state available after every iteration. Stops at
+/// `params.tolerance`, after `params.max_iterations` or at the first solver error.
+fn run(d: &Data, params: &InverseParams, xg: &[Vector3<f64>], u0: &DVector<f64>, track_kappa: bool) -> Run {
+    let p = d.problem();
+    let prev = vec![Vector3::zeros(); xg.len()];
+    let one = InverseParams { max_iterations: 1, tolerance: f64::INFINITY, ..*params };
+    let mut u = u0.clone();
+    let (mut history, mut kappa, mut converged) = (Vec::new(), Vec::new(), false);
+    for k in 1..=params.max_iterations {
+        let Ok(sol) = solve_frame(&p, &one, xg, &prev, &u, |_| {}) else { break };
+        u = sol.u;
+        let rec = InverseRecord { iteration: k, ..sol.history[0] };
+        history.push(rec);
+        if track_kappa {
+            kappa.push((curvature_error(&p, &u, &d.truth, 0), curvature_error(&p, &u, &d.truth, 5)));
+        }
+        if rec.rel_change <= params.tolerance {
+            converged = true;
+            break;
+        }
+    }
+    Run { history, kappa, converged, u }
+}
+
+/// Eq. (64) data on 100 elements and the run with the base parameters (shared by the sweeps).
+fn base() -> &'static (Data, Run) {
+    static BASE: OnceLock<(Data, Run)> = OnceLock::new();
+    BASE.get_or_init(|| {
+        let d = Data::new(100);
+        let r = run(&d, &paper(), &d.xg, &d.problem().reference_state(), true);
+        (d, r)
+    })
+}
+
+/// Run `params` for each value in parallel; the base value reuses the shared run.
+fn sweep(values: &[f64], set: impl Fn(f64) -> InverseParams + Sync, base_value: f64, track_kappa: bool) -> Vec<(f64, Option<Run>)> {
+    let (d, _) = base();
+    let u0 = d.problem().reference_state();
+    values.par_iter().map(|&v| (v, (v != base_value).then(|| run(d, &set(v), &d.xg, &u0, track_kappa)))).collect()
+}
+
+fn line(name: &str, v: f64, r: &Run, lambda_l: f64) {
+    let (d, _) = base();
+    let p = d.problem();
+    let (last, o) = (r.last(), r.last().objective);
+    eprintln!(
+        "{name} {v:e}: converged {} after {} its (change {:.2e}); |x-xg|/|xg| {:.3e}; kappa err {:.4} (inner {:.4}); |l| {:.3e}; J tracking {:.3e} force {:.3e} torque {:.3e} shear {:.3e} bending {:.3e} total {:.3e}",
+        r.converged,
+        r.iterations(),
+        last.rel_change,
+        last.x_err_rel,
+        curvature_error(&p, &r.u, &d.truth, 0),
+        curvature_error(&p, &r.u, &d.truth, 5),
+        r.torque_norm(lambda_l),
+        o.tracking,
+        o.force,
+        o.torque,
+        o.shear,
+        o.bending,
+        o.total()
+    );
+}
+
+/// Largest relative difference between two histories over their common iterations.
+fn spread(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| (x - y).abs() / y.abs()).fold(0.0, f64::max)
+}
+
+/// Finding (2): "vary λl from 1e-20 to 1e3 … these convergence curves are exactly the same …
+/// l = α̂/λl always has a magnitude of 1e-7".
+///
+/// **Reproduced only for λl ∈ [1e-12, 1e-6]; roughly up to 1e-3; not at 1e-20, 1 or 1e3**
+/// (Λκ3 = 1e-10 here, the paper's Fig. 9 used 1e-20). Measured (100 elements, stop 3e-6,
+/// cap 600; κ error: all elements (without 5 end elements)):
+///
+/// | λl    | its  | ‖x−x_g‖/‖x_g‖ | κ error         | ‖l‖ [L²]           |
+/// |-------|------|---------------|-----------------|--------------------|
+/// | 1e-20 | 600✗ | 7.05e-5       | 278 (272)       | 2.5e-3 (noise)     |
+/// | 1e-12 | 379  | 8.02e-5       | 0.085 (0.019)   | 2.42e-8            |
+/// | 1e-10 | 363  | 8.17e-5       | 0.086 (0.018)   | 2.28e-8            |
+/// | 1e-6  | 364  | 8.16e-5       | 0.086 (0.018)   | 2.27e-8            |
+/// | 1e-3  | 378  | 8.01e-5       | 0.080 (0.018)   | 2.18e-8            |
+/// | 1     | 552  | 7.22e-5       | 0.027 (0.009)   | 7.5e-9             |
+/// | 1e3   | 600✗ | 1.81e-2       | 6.6 (6.1)       | 1.28e-7            |
+///
+/// Max relative spread of the histories against λl = 1e-10 (common iterations): 1e-12: x
+/// 1.3e-10, κ 5.7e-3, inner κ 9.9e-2; 1e-6: 1.3e-6, 2.8e-3, 7.8e-3; 1e-3: 1.7e-3, 0.68
+/// (transient; 7.7e-2 from iteration 100), 0.58. So "the same curves" and ‖l‖ ≈ 2.3e-8
+/// constant (not 1e-7) hold for 1e-12 … 1e-6. At 1e-20 the x-error curve is still the same
+/// (spread 3.4e-9), but the angles are not determined: the relative change stays O(1) and κ
+/// wanders (a side run: 1e-14 converges with κ error 0.33, 1e-16 does not converge). λl = 1
+/// converges more slowly to a *better* κ; at 1e3 the torque is too costly and x is not fitted.
+/// A side run with the paper's Λκ3 = 1e-20 gives the same picture (1e-10: 364 its, κ 0.086;
+/// 1e-20: no convergence, κ error 1e5; 1e3: no convergence, x 1.8e-2).
+#[test]
+fn lambda_l_sweep() {
+    let (_, b) = base();
+    let set = |l: f64| InverseParams { lambda_l: l, ..paper() };
+    let runs = sweep(&[1e-20, 1e-12, 1e-10, 1e-6, 1e-3, 1.0, 1e3], set, 1e-10, true);
+    let get = |l: f64| runs.iter().find(|(v, _)| *v == l).map(|(_, r)| r.as_ref().unwrap_or(b)).expect("value");
+    let xh = |r: &Run| r.history.iter().map(|h| h.x_err_rel).collect::<Vec<_>>();
+    let kh = |r: &Run, inner: bool| r.kappa.iter().map(|k| if inner { k.1 } else { k.0 }).collect::<Vec<_>>();
+    for (l, _) in &runs {
+        line("lambda_l", *l, get(*l), *l);
+    }
+    // 1e-12 and 1e-6: the same curves as 1e-10, and the same ‖l‖.
+    for l in [1e-12, 1e-6, 1e-3] {
+        let r = get(l);
+        let (sx, sk, ski) = (spread(&xh(r), &xh(b)), spread(&kh(r, false), &kh(b, false)), spread(&kh(r, true), &kh(b, true)));
+        let late = spread(&kh(r, false)[100..], &kh(b, false)[100..]);
+        let ln = r.torque_norm(l) / b.torque_norm(1e-10);
+        eprintln!("  lambda_l {l:e} vs 1e-10: spread x {sx:.2e}, kappa {sk:.2e} (from iteration 100: {late:.2e}), inner kappa {ski:.2e}; |l| ratio {ln:.3}");
+        assert!(r.converged && r.iterations() <= 400, "{l}: {}", r.iterations());
+        assert!((ln - 1.0).abs() < 0.1, "{l}: {ln}");
+        if l < 1e-3 {
+            // measured: x 1.3e-10 / 1.3e-6, κ 5.7e-3 / 2.8e-3, inner κ 9.9e-2 / 7.8e-3
+            let inner_bound = if l == 1e-12 { 0.15 } else { 0.02 };
+            assert!(sx < 1e-5 && sk < 0.02 && ski < inner_bound, "{l}: {sx} {sk} {ski}");
+        } else {
+            // 1e-3: x still the same curve; κ differs in the transient, agrees later.
+            assert!(sx < 5e-3 && sk > 0.3 && late < 0.1, "{l}: {sx} {sk} {late}");
+        }
+    }
+    assert!(b.converged && (b.torque_norm(1e-10) - 2.28e-8).abs() < 0.1e-8, "{}", b.torque_norm(1e-10));
+    // 1e-20: x follows the same curve, the angles do not settle.
+    let r = get(1e-20);
+    let sx = spread(&xh(r), &xh(b));
+    eprintln!("  lambda_l 1e-20 vs 1e-10: spread x {sx:.2e}; final kappa error {:.1}", r.kappa.last().unwrap().0);
+    assert!(!r.converged && sx < 1e-7, "{sx}");
+    assert!(r.kappa[100..].iter().all(|k| k.0 > 1.0), "kappa error of 1e-20 should stay O(1)+");
+    // 1: converges, later, to a smaller curvature error.
+    let r = get(1.0);
+    assert!(r.converged && (500..=600).contains(&r.iterations()), "{}", r.iterations());
+    assert!(r.kappa.last().unwrap().0 < 0.5 * b.kappa.last().unwrap().0);
+    assert!(r.torque_norm(1.0) < 0.5 * b.torque_norm(1e-10));
+    // 1e3: no convergence, x not fitted.
+    let r = get(1e3);
+    assert!(!r.converged && r.last().x_err_rel > 1e-2, "{}", r.last().x_err_rel);
+}
+
+/// Finding (3): "converge stably with λd varying from 1e1 to 1e-10".
+///
+/// **Reproduced for 1e-2 … 1e-10, not for 1e1.** Measured (stop 3e-6; κ error all elements
+/// (without 5 end elements)):
+///
+/// | λd    | its    | ‖x−x_g‖/‖x_g‖ | κ error       | ‖l‖     | J tracking / shear / total |
+/// |-------|--------|---------------|---------------|---------|----------------------------|
+/// | 1e1   | 600✗   | 1.37e-4       | 369 (360)     | 7.4e-4  | 1.5e-9 / 3.5e-9 / 5.4e-9   |
+/// | 1e-2  | 682    | 6.98e-5       | 0.170 (0.144) | 1.8e-7  | 3.9e-10 / 5.1e-12 / 9.5e-10|
+/// | 1e-6  | 363    | 8.17e-5       | 0.086 (0.018) | 2.3e-8  | 5.4e-10 / 5.1e-16 / 1.1e-9 |
+/// | 1e-10 | 364    | 8.16e-5       | 0.086 (0.018) | 2.3e-8  | 5.3e-10 / 5.1e-20 / 1.1e-9 |
+///
+/// At 1e1 the relative change stays at 5e-2 … 0.6 (also over 1500 iterations in a side run)
+/// while x is fitted: the angles zig-zag. 1e-2 converges, more slowly, with a worse κ.
+/// A side run with the paper's Λκ3 = 1e-20 for λd = 1e1: no convergence either (change 0.44
+/// at 600, κ error 760).
+#[test]
+fn lambda_d_sweep() {
+    let (d, b) = base();
+    let p = d.problem();
+    let set = |l: f64| InverseParams { lambda_d: l, max_iterations: if l == 1e-2 { 800 } else { CAP }, ..paper() };
+    let runs = sweep(&[1e1, 1e-2, 1e-6, 1e-10], set, 1e-6, false);
+    let get = |l: f64| runs.iter().find(|(v, _)| *v == l).map(|(_, r)| r.as_ref().unwrap_or(b)).expect("value");
+    for (l, _) in &runs {
+        line("lambda_d", *l, get(*l), 1e-10);
+    }
+    let kappa = |r: &Run| curvature_error(&p, &r.u, &d.truth, 0);
+    let r = get(1e-10);
+    assert!(r.converged && r.iterations().abs_diff(b.iterations()) <= 3);
+    assert!((kappa(r) / kappa(b) - 1.0).abs() < 0.01 && (r.last().x_err_rel / b.last().x_err_rel - 1.0).abs() < 0.01);
+    let r = get(1e-2);
+    assert!(r.converged && (600..=760).contains(&r.iterations()), "{}", r.iterations());
+    assert!(r.last().x_err_rel < 1e-4 && kappa(r) > 1.5 * kappa(b), "{}", kappa(r));
+    let r = get(1e1);
+    assert!(!r.converged && r.last().rel_change > 1e-3 && kappa(r) > 10.0, "{} {}", r.last().rel_change, kappa(r));
+    assert!(r.last().x_err_rel < 1e-3, "{}", r.last().x_err_rel);
+}
+
+/// Finding (4): "converges for λf from 1e-10 to 1e6 … λf must be sufficiently small for the
+/// objectives to be sufficiently reduced" (Fig. 11).
+///
+/// **The objective part is reproduced; convergence at 1e6 is not** (to our stopping rule).
+/// Measured (stop 3e-6; tracking term at iteration 1 ≈ 5.8e-2 (5.2e-2 for 1e6)):
+///
+/// | λf    | its  | ‖x−x_g‖/‖x_g‖ | κ error         | ‖l‖    | J tracking | J total | tracking/total |
+/// |-------|------|---------------|-----------------|--------|------------|---------|----------------|
+/// | 1e-10 | 23   | 2.03e-7       | 0.0026 (0.0025) | 7.5e-9 | 3.3e-15    | 3.9e-15 | 0.85           |
+/// | 1e-4  | 45   | 2.98e-7       | 0.011 (0.0029)  | 1.3e-8 | 7.1e-15    | 8.7e-14 | 0.08           |
+/// | 1     | 363  | 8.17e-5       | 0.086 (0.018)   | 2.3e-8 | 5.4e-10    | 1.1e-9  | 0.49           |
+/// | 1e6   | 600✗ | 0.117         | 0.44 (0.40)     | 1.1e-8 | 1.1e-3     | 1.1e-3  | 1.00           |
+///
+/// At 1e6 the relative change stalls at 1.4–1.7e-5 from iteration ~200 on (still at 1500 in a
+/// side run, x 0.10, tracking 8.6e-4). Small λf is also much *faster* and recovers κ best.
+#[test]
+fn lambda_f_sweep() {
+    let (d, b) = base();
+    let p = d.problem();
+    let set = |l: f64| InverseParams { lambda_f: l, ..paper() };
+    let runs = sweep(&[1e-10, 1e-4, 1.0, 1e6], set, 1.0, false);
+    let get = |l: f64| runs.iter().find(|(v, _)| *v == l).map(|(_, r)| r.as_ref().unwrap_or(b)).expect("value");
+    for (l, _) in &runs {
+        line("lambda_f", *l, get(*l), 1e-10);
+        let r = get(*l);
+        eprintln!("  tracking reduction {:.2e}, tracking/total {:.3}", r.last().objective.tracking / r.history[0].objective.tracking, r.last().objective.tracking / r.last().objective.total());
+    }
+    let (r10, r4, r6) = (get(1e-10), get(1e-4), get(1e6));
+    let track = |r: &Run| r.last().objective.tracking;
+    assert!(r10.converged && r10.iterations() <= 30 && r4.converged && r4.iterations() <= 60, "{} {}", r10.iterations(), r4.iterations());
+    assert!(r10.last().x_err_rel < 5e-7 && r4.last().x_err_rel < 5e-7);
+    assert!(curvature_error(&p, &r10.u, &d.truth, 0) < 0.01 && curvature_error(&p, &r4.u, &d.truth, 5) < 0.01);
+    // Ordering of the final tracking term: 1e-10 < 1e-4 ≪ 1 ≪ 1e6.
+    assert!(track(r10) < track(r4) && track(r4) < 1e-4 * track(b) && track(b) < 1e-5 * track(r6));
+    assert!(track(r10) / r10.history[0].objective.tracking < 1e-12);
+    assert!(track(r6) / r6.history[0].objective.tracking > 1e-2 && r6.last().x_err_rel > 0.05);
+    assert!(!r6.converged && r6.last().rel_change > 1e-5, "{}", r6.last().rel_change);
+}
+
+/// Transform a state rigidly: `x → R x + c` and `Q → L Q Rᵀ` (directors are the rows of Q, so
+/// a spatial rotation R acts on the right; L rotates the material frame about d3).
+fn transform(u: &DVector<f64>, r: &Matrix3<f64>, l: &Matrix3<f64>, c: &Vector3<f64>) -> DVector<f64> {
+    let mut v = u.clone();
+    for i in 0..u.len() / 6 {
+        let (x, a) = node_values(u, i);
+        let (x2, a2) = (r * x + c, angles_from_rotation(&(l * rotation(&a) * r.transpose())));
+        v.as_mut_slice()[6 * i..6 * i + 6].copy_from_slice(&[x2[0], x2[1], x2[2], a2[0], a2[1], a2[2]]);
+    }
+    v
+}
+
+/// `(x, Q, κ, angles)` differences between `a` and the transform of `b`: max |x−(Rx_b+c)|/max|x_b|,
+/// max |Q−L Q_b Rᵀ|, max |κ − L κ_b|/max |κ_b| (local curvature: Q′∂sQ′ᵀ = L Q∂sQᵀ Lᵀ), max |α−α_b|.
+fn equivariance_error(p: &Problem, a: &DVector<f64>, b: &DVector<f64>, r: &Matrix3<f64>, l: &Matrix3<f64>, c: &Vector3<f64>) -> [f64; 4] {
+    let mut e = [0.0f64; 4];
+    let mut nx = 0.0f64;
+    for i in 0..a.len() / 6 {
+        let ((xa, aa), (xb, ab)) = (node_values(a, i), node_values(b, i));
+        e[0] = e[0].max((xa - (r * xb + c)).norm());
+        nx = nx.max(xb.norm());
+        e[1] = e[1].max((rotation(&aa) - l * rotation(&ab) * r.transpose()).amax());
+        e[3] = e[3].max((aa - ab).amax());
+    }
+    let (ka, kb) = (element_curvatures(p, a), element_curvatures(p, b));
+    let nk = kb.iter().map(|k| k.norm()).fold(0.0, f64::max);
+    e[2] = ka.iter().zip(&kb).map(|(x, y)| (x - l * y).norm()).fold(0.0, f64::max) / nk;
+    e[0] /= nx;
+    e
+}
+
+/// Rigid motions of the data (50 elements, 20 iterations from the transformed straight state).
+///
+/// With directors the rows of `Q = Rz(α) Rx(β) Ry(γ)` (`e = Q ∂s x − e3`), a spatial rotation R
+/// maps `Q → Q Rᵀ`, and a constant rotation of the cross-section frame about d3 maps
+/// `Q → Rz(θ) Q`. The chart turns exactly two of these into shifts of one angle:
+/// `Rz(θ) Q(α, β, γ) = Q(α + θ, β, γ)` (frame relabelling; positions unchanged, with
+/// α(0) = θ) and `Q(α, β, γ) Ry(φ)ᵀ = Q(α, β, γ − φ)` (spatial rotation about **e2**). With
+/// translations these are exact symmetries of the discrete scheme (isotropic section,
+/// Λκ1 = Λκ2). A spatial rotation about **e3** is *not* one: `Q Rz(θ)ᵀ` mixes all three angles,
+/// although it is the obvious candidate.
+///
+/// Measured (x rel., max |Q′ − L Q Rᵀ|, κ rel., max angle change), after 1 | 20 iterations:
+/// - translation c:           2.0e-15, 3.4e-6, 2.5e-4 | 2.8e-9, 9.4e-6, 2.0e-4
+/// - relabelling Rz(0.7) + c: 2.0e-15, 5.8e-6, 3.3e-4 | 8.9e-7, 4.9e-5, 5.0e-4 (α + 0.7)
+/// - spatial Ry(0.6) + c:     1.4e-15, 4.6e-6, 2.6e-4 | 1.7e-6, 7.5e-5, 9.7e-4 (γ − 0.6)
+/// - spatial Rz(0.7) + c:     1.0e-15, 4.4e-2, 0.16   | 1.7e-2, 0.38, 2.8
+/// - general R + c:           1.9e-15, 4.2e-2, 0.13   | 6.1e-2, 2.0, 71
+///
+/// (general R: axis (1, 2, 3), 0.5 rad; α0 from the chart of `Q(α_orig(0)) Rᵀ` — the product
+/// `R Q` is the relabelling, not a spatial rotation, in this convention.) Not 1e-9 even for a
+/// pure translation: the angles are this sensitive to round-off (a side run: a 1e-15 relative
+/// perturbation of x_g alone moves them by 6.5e-6 after one iteration); the symmetric cases sit
+/// at that level after one iteration, the others 4 orders above. The rotated non-symmetric
+/// runs do not even converge (side run: relative change 3.6e-4 / 1.2e-4 after 1000
+/// iterations, ‖x−x_g‖/‖x_g‖ 5e-3 / 4e-3, against 428 iterations unrotated): this is not
+/// discretisation error — the Euler chart makes the scheme orientation dependent.
+#[test]
+fn rigid_motions() {
+    let d = Data::new(50);
+    let p = d.problem();
+    let u0 = p.reference_state();
+    let i3 = Matrix3::identity();
+    let c = Vector3::new(3e-4, -2e-4, 5e-4);
+    let rz = *Rotation3::from_axis_angle(&Vector3::z_axis(), 0.7).matrix();
+    let ry = *Rotation3::from_axis_angle(&Vector3::y_axis(), 0.6).matrix();
+    let rg = *Rotation3::from_axis_angle(&Unit::new_normalize(Vector3::new(1.0, 2.0, 3.0)), 0.5).matrix();
+    let cases = [("translation", i3, i3), ("relabel Rz(0.7)", i3, rz), ("spatial Ry(0.6)", ry, i3), ("spatial Rz(0.7)", rz, i3), ("general R", rg, i3)];
+    let errors = |iterations: usize| -> Vec<[f64; 4]> {
+        let params = InverseParams { tolerance: 0.0, max_iterations: iterations, ..paper() };
+        let orig = run(&d, &params, &d.xg, &u0, false);
+        assert_eq!(orig.iterations(), iterations);
+        let errs: Vec<[f64; 4]> = cases
+            .par_iter()
+            .map(|(_, r, l)| {
+                let xg: Vec<Vector3<f64>> = d.xg.iter().map(|x| r * x + c).collect();
+                let alpha0 = angles_from_rotation(&(l * rotation(&node_values(&orig.u, 0).1) * r.transpose()))[0];
+                let s = run(&d, &InverseParams { alpha0, ..params }, &xg, &transform(&u0, r, l, &c), false);
+                assert_eq!(s.iterations(), iterations);
+                equivariance_error(&p, &s.u, &orig.u, r, l, &c)
+            })
+            .collect();
+        for ((name, _, _), e) in cases.iter().zip(&errs) {
+            eprintln!("after {iterations:2} iterations, {name}: x {:.2e}, Q {:.2e}, kappa {:.2e}, angles {:.2e}", e[0], e[1], e[2], e[3]);
+        }
+        errs
+    };
+    // One iteration from the straight state: x is linear in the data for all five; the
+    // frames agree at round-off sensitivity for the symmetries and to 4e-2 otherwise.
+    let errs = errors(1);
+    for e in &errs {
+        assert!(e[0] < 1e-14, "{e:?}");
+    }
+    for e in &errs[..3] {
+        assert!(e[1] < 1e-5 && e[2] < 1e-3, "{e:?}");
+    }
+    for e in &errs[3..] {
+        assert!(e[1] > 1e-2 && e[2] > 0.05, "{e:?}");
+    }
+    let errs = errors(20);
+    // Exact in exact arithmetic: the round-off differences have grown, x most for the rotations.
+    for e in &errs[..3] {
+        assert!(e[0] < 1e-5 && e[1] < 3e-4 && e[2] < 3e-3, "{e:?}");
+    }
+    // Not exact: O(1) differences in the frames.
+    for e in &errs[3..] {
+        assert!(e[0] > 1e-3 && e[1] > 0.1 && e[2] > 1.0, "{e:?}");
+    }
+}
