@@ -1,12 +1,14 @@
 #!/usr/bin/env bash
 # The main job: every case of cases/ through both engines, full length (the dynamic cantilever
 # takes ~4-5 minutes in FreeFEM), writing out/<case>/{rust,freefem}/ and a comparison table
-# per case. Exit status 1 if any comparison fails.
+# per case (inverse cases: ~50 s of FreeFEM each; inverse Newton cases run in Rust only).
+# Exit status 1 if any comparison fails.
 set -uo pipefail
 cd "$(dirname "$0")/.."
 cargo build --release -q || exit 1
 bin=target/release/cosserat
 status=0
+mkdir -p out
 for c in cases/*.toml; do
   name=$(basename "$c" .toml)
   echo "== $name"
