@@ -50,8 +50,10 @@ enum Command {
     ///
     /// Writes one folder per run (the files of `run`), `summary.csv` (one row per run: the swept
     /// values, status, iterations, recovery errors, objective, wall time, error message) and
-    /// `convergence.svg` (log-log histories, one curve per run; Figs. 9-11 of the paper).
-    /// Exit status 1 if any run failed (after writing everything).
+    /// `convergence.svg` (log-log histories, one curve per run; Figs. 9-11 of the paper). A run
+    /// that reaches its iteration limit is `not_converged`: its folder holds the last iterate
+    /// and FAILED.txt, and its curve is plotted. Exit status 1 if any run failed or did not
+    /// converge (after writing everything).
     Sweep {
         /// Case file (TOML)
         case: PathBuf,
@@ -209,16 +211,44 @@ fn cmd_compare(path: &Path, out: Option<PathBuf>) -> Result<ExitCode> {
     Ok(if failed == 0 { ExitCode::SUCCESS } else { ExitCode::from(1) })
 }
 
-/// One run of a sweep in the Rust engine, writing its folder; the error text on failure.
-fn sweep_run(case: &Case, dir: &Path) -> std::result::Result<(cosserat::metrics::Metrics, RunResult), String> {
-    let inner = || -> Result<(cosserat::metrics::Metrics, RunResult)> {
-        let data = prepare_data(case, dir)?;
-        let r = run_engine(case, Engine::Rust, dir, data.as_deref(), true)?;
+/// What one run of a sweep produced.
+struct SweepOutcome {
+    status: cosserat::sweep::RunStatus,
+    metrics: Option<cosserat::metrics::Metrics>,
+    run: Option<RunResult>,
+    error: Option<String>,
+}
+
+/// One run of a sweep in the Rust engine, writing its folder. A run that stops at its iteration
+/// limit still writes the files of its last iterate, plus `FAILED.txt` with the error.
+fn sweep_run(case: &Case, dir: &Path) -> SweepOutcome {
+    use cosserat::run::RunError;
+    use cosserat::sweep::RunStatus;
+    let failed = |e: anyhow::Error| SweepOutcome { status: RunStatus::Failed, metrics: None, run: None, error: Some(format!("{e:#}")) };
+    let data = match prepare_data(case, dir) {
+        Ok(d) => d,
+        Err(e) => return failed(e),
+    };
+    let path = data.as_deref().unwrap_or(Path::new(""));
+    let work = dir.join("freefem_work");
+    let outcome = if data.is_some() { run_inverse_on(case, Engine::Rust, path, &work, |_, _| {}) } else { cosserat::run::run(case, Engine::Rust, &work, |_, _| {}) };
+    let (status, r, error) = match outcome {
+        Ok(r) => (RunStatus::Ok, r, None),
+        Err(RunError::Incomplete { source, partial }) => (RunStatus::NotConverged, *partial, Some(source.to_string())),
+        Err(e) => return failed(anyhow::Error::from(e).context(format!("case {}", case.name))),
+    };
+    let write = || -> Result<cosserat::metrics::Metrics> {
         let m = all_metrics(case, &r)?;
         write_run(case, &r, &m, dir)?;
-        Ok((m, r))
+        if let Some(e) = &error {
+            cosserat::output::write_atomic(&dir.join("FAILED.txt"), format!("{e}\nThe files here hold the last iterate.\n").as_bytes())?;
+        }
+        Ok(m)
     };
-    inner().map_err(|e| format!("{e:#}"))
+    match write() {
+        Ok(m) => SweepOutcome { status, metrics: Some(m), run: Some(r), error },
+        Err(e) => failed(e),
+    }
 }
 
 fn cmd_sweep(path: &Path, set: &[String], out: Option<PathBuf>, jobs: Option<usize>, quiet: bool) -> Result<ExitCode> {
@@ -243,18 +273,18 @@ fn cmd_sweep(path: &Path, set: &[String], out: Option<PathBuf>, jobs: Option<usi
     });
     pb.finish_and_clear();
     let keys: Vec<String> = params.iter().map(|p| p.key.clone()).collect();
-    let rows: Vec<SummaryRow> = results.iter().map(|(point, _, r)| SummaryRow { point: point.clone(), outcome: r.as_ref().map(|(m, _)| m.clone()).map_err(Clone::clone) }).collect();
+    let rows: Vec<SummaryRow> = results.iter().map(|(point, _, o)| SummaryRow { point: point.clone(), status: o.status, metrics: o.metrics.clone(), error: o.error.clone() }).collect();
     let summary = dir.join("summary.csv");
     cosserat::output::write_atomic(&summary, summary_csv(&keys, &rows)?.as_bytes())?;
-    let ok: Vec<(&String, &RunResult)> = results.iter().filter_map(|(_, name, r)| r.as_ref().ok().map(|(_, run)| (name, run))).collect();
-    if !ok.is_empty() {
-        cosserat::output::write_convergence_plot(&ok, &dir.join("convergence.svg"))?;
+    let curves: Vec<(&String, &RunResult)> = results.iter().filter_map(|(_, name, o)| o.run.as_ref().map(|run| (name, run))).collect();
+    if !curves.is_empty() {
+        cosserat::output::write_convergence_plot(&curves, &dir.join("convergence.svg"))?;
     }
-    let failed = rows.iter().filter(|r| r.outcome.is_err()).count();
-    println!("{}: {} runs, {} failed; wrote {} and one folder per run to {}", case.name, rows.len(), failed, summary.display(), dir.display());
-    for (_, name, r) in &results {
-        if let Err(e) = r {
-            eprintln!("  {name}: FAILED: {e}");
+    let failed = rows.iter().filter(|r| r.status != cosserat::sweep::RunStatus::Ok).count();
+    println!("{}: {} runs, {} failed or not converged; wrote {} and one folder per run to {}", case.name, rows.len(), failed, summary.display(), dir.display());
+    for (_, name, o) in &results {
+        if let Some(e) = &o.error {
+            eprintln!("  {name}: {}: {e}", o.status.as_str());
         }
     }
     Ok(if failed == 0 { ExitCode::SUCCESS } else { ExitCode::from(1) })

@@ -141,6 +141,10 @@ pub enum RunError {
     FreeFem(#[from] FreeFemError),
     #[error("inverse data")]
     Data(#[from] DataError),
+    /// The solver stopped without meeting its rule; `partial` holds the last iterate and the
+    /// history up to there (sweeps keep it so that non-converging values still show).
+    #[error("rust engine stopped after {} iterations without meeting its stopping rule", .partial.stats.iterations)]
+    Incomplete { source: SolveError, partial: Box<RunResult> },
 }
 
 /// The solver parameters of the first (only) frame of an inverse case.
@@ -181,26 +185,39 @@ pub fn run_rust_inverse(case: &Case, data: &NodalState, mut progress: impl FnMut
     let start = Instant::now();
     let truth: Vec<Vector3<f64>> = data.element_curvature().into_iter().map(|(_, k)| k).collect();
     let mut kappa_err = Vec::new();
-    let report = |r: &InverseRecord, u: &DVector<f64>| {
+    let mut records = Vec::new();
+    let mut last: Option<(DVector<f64>, DVector<f64>)> = None;
+    let report = |r: &InverseRecord, u: &DVector<f64>, adjoint: &DVector<f64>| {
         let k = inverse::element_curvatures(&problem, u);
         kappa_err.push([inverse::relative_error(&k, &truth, 0), inverse::relative_error(&k, &truth, INNER_SKIP_ELEMENTS)]);
+        records.push(*r);
+        last = Some((u.clone(), adjoint.clone()));
         progress(r.iteration, params.max_iterations)
     };
-    let sol = match settings.method {
-        InverseMethod::FixedPoint { .. } => inverse::solve_frame_observed(&problem, &params, &data.x, &prev, &problem.reference_state(), report)?,
-        InverseMethod::Newton { warm_start_tolerance, .. } => inverse_newton::solve_frame_warm(&problem, &params, warm_start_tolerance, &data.x, &prev, &problem.reference_state(), report)?,
+    let outcome = match settings.method {
+        InverseMethod::FixedPoint { .. } => inverse::solve_frame_observed(&problem, &params, &data.x, &prev, &problem.reference_state(), report),
+        InverseMethod::Newton { warm_start_tolerance, .. } => inverse_newton::solve_frame_warm(&problem, &params, warm_start_tolerance, &data.x, &prev, &problem.reference_state(), report),
     };
     let wall_time_s = start.elapsed().as_secs_f64();
-    let last = sol.history.last().map(|h| h.rel_change);
-    let (xhat, ahat) = (0..n).map(|i| node_values(&sol.adjoint, i)).unzip();
-    Ok(RunResult {
-        engine: Engine::Rust,
-        nodes: NodalState::from_vector(case, &sol.u),
-        history: Vec::new(),
-        tip: Vec::new(),
-        stats: SolverStats { iterations: sol.history.len(), last_change: last, residual: None, max_newton_iterations: None, wall_time_s },
-        inverse: Some(InverseOutput { data: data.clone(), xhat, ahat, history: sol.history, kappa_err, lambda_f: params.lambda_f, lambda_l: params.lambda_l }),
-    })
+    let result = |u: &DVector<f64>, adjoint: &DVector<f64>, history: Vec<InverseRecord>, kappa_err: Vec<[f64; 2]>| {
+        let (xhat, ahat) = (0..n).map(|i| node_values(adjoint, i)).unzip();
+        RunResult {
+            engine: Engine::Rust,
+            nodes: NodalState::from_vector(case, u),
+            history: Vec::new(),
+            tip: Vec::new(),
+            stats: SolverStats { iterations: history.len(), last_change: history.last().map(|h| h.rel_change), residual: None, max_newton_iterations: None, wall_time_s },
+            inverse: Some(InverseOutput { data: data.clone(), xhat, ahat, history, kappa_err, lambda_f: params.lambda_f, lambda_l: params.lambda_l }),
+        }
+    };
+    match outcome {
+        Ok(sol) => Ok(result(&sol.u, &sol.adjoint, sol.history, kappa_err)),
+        Err(source @ (SolveError::InverseNotConverged { .. } | SolveError::InverseNewtonNotConverged { .. })) => match &last {
+            Some((u, a)) => Err(RunError::Incomplete { source, partial: Box::new(result(u, a, records, kappa_err)) }),
+            None => Err(source.into()),
+        },
+        Err(e) => Err(e.into()),
+    }
 }
 
 /// Run `case` in the Rust engine. `progress(done, total)` is called per step/iteration.

@@ -176,14 +176,37 @@ pub fn fmt_value(v: f64) -> String {
 pub const SUMMARY_METRICS: [&str; 11] =
     ["iterations", "x_err_rel", "kappa_err_rel", "kappa_err_rel_inner", "tangent_misfit_m05", "j_tracking", "j_total", "force_l2_n_per_m05", "torque_l2_n_m05", "tip_y_m", "wall_time_s"];
 
-/// One row of the summary: the point, whether the run succeeded, its metrics or error.
+/// One row of the summary: the point, its status, its metrics (also those of the last iterate
+/// of a run that did not converge) and its error message.
 #[derive(Clone, Debug)]
 pub struct SummaryRow {
     pub point: Point,
-    pub outcome: Result<Metrics, String>,
+    pub status: RunStatus,
+    pub metrics: Option<Metrics>,
+    pub error: Option<String>,
 }
 
-/// CSV text of the summary (header: swept keys, `status`, [`SUMMARY_METRICS`], `error`).
+/// Outcome of one run of a sweep.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RunStatus {
+    Ok,
+    /// iteration limit reached; the metrics are those of the last iterate
+    NotConverged,
+    Failed,
+}
+
+impl RunStatus {
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            RunStatus::Ok => "ok",
+            RunStatus::NotConverged => "not_converged",
+            RunStatus::Failed => "failed",
+        }
+    }
+}
+
+/// CSV text of the summary (header: swept keys, `status` (`ok`, `not_converged`, `failed`),
+/// [`SUMMARY_METRICS`], `error`).
 pub fn summary_csv(keys: &[String], rows: &[SummaryRow]) -> Result<String, csv::Error> {
     let mut w = csv::Writer::from_writer(Vec::new());
     let mut header: Vec<String> = keys.to_vec();
@@ -192,19 +215,10 @@ pub fn summary_csv(keys: &[String], rows: &[SummaryRow]) -> Result<String, csv::
     header.push("error".into());
     w.write_record(&header)?;
     for r in rows {
-        let mut rec: Vec<String> = r.point.iter().map(|(_, v)| format!("{v:e}")).collect();
-        match &r.outcome {
-            Ok(m) => {
-                rec.push("ok".into());
-                rec.extend(SUMMARY_METRICS.iter().map(|k| m.get(*k).map(|v| format!("{v:.10e}")).unwrap_or_default()));
-                rec.push(String::new());
-            }
-            Err(e) => {
-                rec.push("failed".into());
-                rec.extend(SUMMARY_METRICS.iter().map(|_| String::new()));
-                rec.push(e.replace('\n', " "));
-            }
-        }
+        let mut rec: Vec<String> = r.point.iter().map(|(_, v)| fmt_value(*v)).collect();
+        rec.push(r.status.as_str().into());
+        rec.extend(SUMMARY_METRICS.iter().map(|k| r.metrics.as_ref().and_then(|m| m.get(*k)).map(|v| format!("{v:.10e}")).unwrap_or_default()));
+        rec.push(r.error.as_deref().unwrap_or("").replace('\n', " "));
         w.write_record(&rec)?;
     }
     let bytes = w.into_inner().map_err(|e| csv::Error::from(e.into_error()))?;
@@ -248,13 +262,15 @@ mod tests {
         let mut m = Metrics::new();
         m.insert("iterations".into(), 12.0);
         let rows = vec![
-            SummaryRow { point: vec![("lambda_l".into(), 1e-20)], outcome: Ok(m) },
-            SummaryRow { point: vec![("lambda_l".into(), 1e3)], outcome: Err("did not converge,\nat all".into()) },
+            SummaryRow { point: vec![("lambda_l".into(), 1e-20)], status: RunStatus::Ok, metrics: Some(m.clone()), error: None },
+            SummaryRow { point: vec![("lambda_l".into(), 1e3)], status: RunStatus::NotConverged, metrics: Some(m), error: Some("did not converge,\nat all".into()) },
+            SummaryRow { point: vec![("lambda_l".into(), 1.0)], status: RunStatus::Failed, metrics: None, error: Some("bad".into()) },
         ];
         let text = summary_csv(&["lambda_l".into()], &rows).unwrap();
         let lines: Vec<&str> = text.lines().collect();
         assert!(lines[0].starts_with("lambda_l,status,iterations,x_err_rel"));
         assert!(lines[1].starts_with("1e-20,ok,1.2000000000e1"));
-        assert!(lines[2].starts_with("1e3,failed,") && lines[2].ends_with("\"did not converge, at all\""), "{}", lines[2]);
+        assert!(lines[2].starts_with("1e3,not_converged,1.2000000000e1") && lines[2].ends_with("\"did not converge, at all\""), "{}", lines[2]);
+        assert!(lines[3].starts_with("1,failed,,") && lines[3].ends_with(",bad"), "{}", lines[3]);
     }
 }

@@ -110,12 +110,12 @@ fn sweep_writes_one_folder_per_run_a_summary_and_a_convergence_plot() {
         .arg(dir.path())
         .assert()
         .success()
-        .stdout(predicate::str::contains("2 runs, 0 failed"));
+        .stdout(predicate::str::contains("2 runs, 0 failed or not converged"));
     let summary = std::fs::read_to_string(dir.path().join("summary.csv")).expect("summary");
     let lines: Vec<&str> = summary.lines().collect();
     assert!(lines[0].starts_with("lambda_l,tolerance,status,iterations,x_err_rel"), "{}", lines[0]);
     assert_eq!(lines.len(), 3);
-    assert!(lines[1].starts_with("1e-6,1e-3,ok,") && lines[2].starts_with("1e0,1e-3,ok,"), "{summary}");
+    assert!(lines[1].starts_with("1e-6,1e-3,ok,") && lines[2].starts_with("1,1e-3,ok,"), "{summary}");
     assert!(dir.path().join("lambda_l=1e-6_tolerance=1e-3/inverse_history.csv").is_file());
     assert!(std::fs::read_to_string(dir.path().join("convergence.svg")).expect("svg").contains("<svg"));
     // A run that hits its iteration limit is a failed row naming frame, iteration and change.
@@ -126,6 +126,10 @@ fn sweep_writes_one_folder_per_run_a_summary_and_a_convergence_plot() {
         .code(1)
         .stderr(predicate::str::contains("frame 0 did not converge after 3 iterations"));
     let summary = std::fs::read_to_string(dir.path().join("fail/summary.csv")).expect("summary");
-    assert!(summary.lines().nth(1).expect("row").starts_with("3e0,failed,"), "{summary}");
+    assert!(summary.lines().nth(1).expect("row").starts_with("3,not_converged,3.0000000000e0,"), "{summary}");
+    // The last iterate is kept, labelled, and its history plotted.
+    assert!(std::fs::read_to_string(dir.path().join("fail/max_iterations=3/FAILED.txt")).expect("FAILED.txt").contains("did not converge"));
+    assert_eq!(std::fs::read_to_string(dir.path().join("fail/max_iterations=3/inverse_history.csv")).expect("history").lines().count(), 4);
+    assert!(dir.path().join("fail/convergence.svg").is_file());
     cosserat().args(["sweep", "cases/inverse_bend_twist.toml", "--set", "lambda_q=1"]).assert().code(1).stderr(predicate::str::contains("unknown parameter"));
 }

@@ -221,18 +221,19 @@ pub fn solve_frame(
     u0: &DVector<f64>,
     mut progress: impl FnMut(&InverseRecord),
 ) -> Result<InverseSolution, SolveError> {
-    solve_frame_observed(problem, p, x_g, alpha_prev, u0, |r, _| progress(r))
+    solve_frame_observed(problem, p, x_g, alpha_prev, u0, |r, _, _| progress(r))
 }
 
-/// [`solve_frame`] whose callback also sees the relaxed state `(x, α)` (6 per node) of each
-/// iteration, e.g. to follow the curvature error against known data.
+/// [`solve_frame`] whose callback also sees the relaxed state `(x, α)` and the adjoint
+/// `(x̂, α̂)` (6 per node each) of each iteration, e.g. to follow the curvature error against
+/// known data or to keep the last iterate of a run that fails.
 pub fn solve_frame_observed(
     problem: &Problem,
     p: &InverseParams,
     x_g: &[Vector3<f64>],
     alpha_prev: &[Vector3<f64>],
     u0: &DVector<f64>,
-    mut progress: impl FnMut(&InverseRecord, &DVector<f64>),
+    mut progress: impl FnMut(&InverseRecord, &DVector<f64>, &DVector<f64>),
 ) -> Result<InverseSolution, SolveError> {
     let mesh = problem.mesh;
     let nodes = mesh.nodes();
@@ -267,7 +268,7 @@ pub fn solve_frame_observed(
         let (x_err_rel, tangent_misfit) = fit_measures(problem, &u, x_g);
         let objective = objective_terms(problem, p, &u, &adjoint, x_g, alpha_prev);
         let rec = InverseRecord { iteration: k, rel_change, x_err_rel, tangent_misfit, objective, residual: None };
-        progress(&rec, &u);
+        progress(&rec, &u, &adjoint);
         history.push(rec);
         if rel_change <= p.tolerance {
             return Ok(InverseSolution { u, adjoint, history });

@@ -186,17 +186,17 @@ pub fn solve_frame_newton(
     u0: &DVector<f64>,
     mut progress: impl FnMut(&InverseRecord),
 ) -> Result<InverseSolution, SolveError> {
-    solve_frame_newton_observed(problem, p, x_g, alpha_prev, u0, |r, _| progress(r))
+    solve_frame_newton_observed(problem, p, x_g, alpha_prev, u0, |r, _, _| progress(r))
 }
 
-/// [`solve_frame_newton`] whose callback also sees the state `(x, α)` after each step.
+/// [`solve_frame_newton`] whose callback also sees the state `(x, α)` and adjoint after each step.
 pub fn solve_frame_newton_observed(
     problem: &Problem,
     p: &InverseParams,
     x_g: &[Vector3<f64>],
     alpha_prev: &[Vector3<f64>],
     u0: &DVector<f64>,
-    mut progress: impl FnMut(&InverseRecord, &DVector<f64>),
+    mut progress: impl FnMut(&InverseRecord, &DVector<f64>, &DVector<f64>),
 ) -> Result<InverseSolution, SolveError> {
     let pattern = Pattern::with_block(&problem.mesh, BLOCK);
     let solver = LinearSolver::new(&pattern)?;
@@ -248,7 +248,7 @@ pub fn solve_frame_newton_observed(
         let objective = objective_terms(problem, p, &u, &adjoint, x_g, alpha_prev);
         last = phi_t / phi0;
         let rec = InverseRecord { iteration: k, rel_change, x_err_rel, tangent_misfit, objective, residual: Some(last) };
-        progress(&rec, &u);
+        progress(&rec, &u, &adjoint);
         history.push(rec);
         if full {
             return Ok(InverseSolution { u, adjoint, history });
@@ -270,14 +270,14 @@ pub fn solve_frame_warm(
     x_g: &[Vector3<f64>],
     alpha_prev: &[Vector3<f64>],
     u0: &DVector<f64>,
-    mut progress: impl FnMut(&InverseRecord, &DVector<f64>),
+    mut progress: impl FnMut(&InverseRecord, &DVector<f64>, &DVector<f64>),
 ) -> Result<InverseSolution, SolveError> {
     let warm = InverseParams { tolerance: warm_start_tolerance.max(p.tolerance), ..*p };
     let start = super::inverse::solve_frame_observed(problem, &warm, x_g, alpha_prev, u0, &mut progress)?;
     let done = start.history.len();
     let rest = InverseParams { max_iterations: p.max_iterations.saturating_sub(done).max(1), ..*p };
-    let newton = solve_frame_newton_observed(problem, &rest, x_g, alpha_prev, &start.u, |r, u| {
-        progress(&InverseRecord { iteration: r.iteration + done, ..*r }, u);
+    let newton = solve_frame_newton_observed(problem, &rest, x_g, alpha_prev, &start.u, |r, u, a| {
+        progress(&InverseRecord { iteration: r.iteration + done, ..*r }, u, a);
     })
     .map_err(|e| match e {
         SolveError::InverseNewtonNotConverged { frame, iterations, residual } => SolveError::InverseNewtonNotConverged { frame, iterations: iterations + done, residual },
