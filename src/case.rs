@@ -80,6 +80,8 @@ struct RawInverse {
     frame_interval_s: Option<Scalar>,
     #[serde(default)]
     alpha0_rad: Option<Scalar>,
+    #[serde(default)]
+    stabilisation: Option<Scalar>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -258,6 +260,8 @@ pub struct InverseSettings {
     pub frame_interval_s: f64,
     /// Dirichlet value of the first angle at s = 0 [rad] (Remark 6: 0)
     pub alpha0_rad: f64,
+    /// weight of the two-point rule in the λd term (docs/inverse.md, I11); 0 = the paper's element
+    pub stabilisation: f64,
     pub data: DataSolve,
 }
 
@@ -617,10 +621,20 @@ impl Validator<'_> {
                     Some(v) => self.scalar("inverse.alpha0_rad", v, c)?,
                     None => 0.0,
                 };
+                let stabilisation = match &inv.stabilisation {
+                    Some(v) => {
+                        let e = self.scalar("inverse.stabilisation", v, c)?;
+                        if !(0.0..=1.0).contains(&e) {
+                            return Err(self.err("inverse.stabilisation", format!("must lie in [0, 1], got {e}")));
+                        }
+                        e
+                    }
+                    None => 0.0,
+                };
                 if rc_adjoint_missing(&raw.compare) {
                     return Err(self.err("compare.adjoint_rel", "required for an inverse case (tolerance on the adjoint x̂, α̂)"));
                 }
-                Analysis::Inverse(InverseSettings { method, tolerance: s.tolerance, max_iterations: s.max_iterations, weights, frame_interval_s, alpha0_rad, data })
+                Analysis::Inverse(InverseSettings { method, tolerance: s.tolerance, max_iterations: s.max_iterations, weights, frame_interval_s, alpha0_rad, stabilisation, data })
             }
             RawAnalysis::Dynamic => {
                 if s.method != RawMethod::Newton {

@@ -119,7 +119,7 @@ pub fn include_file(case: &Case) -> String {
         let _ = writeln!(o, "real lambdaG = {}, lambdaF = {}, lambdaL = {}, lambdaD = {};", num(w.lambda_g), num(w.lambda_f), num(w.lambda_l), num(w.lambda_d));
         let _ = writeln!(o, "real LamK1 = {}, LamK2 = {}, LamK3 = {};", num(w.lambda_kappa[0]), num(w.lambda_kappa[1]), num(w.lambda_kappa[2]));
         let _ = writeln!(o, "real LamW1 = {}, LamW2 = {}, LamW3 = {};", num(w.lambda_omega[0]), num(w.lambda_omega[1]), num(w.lambda_omega[2]));
-        let _ = writeln!(o, "real dt = {};\nint firstFrame = 1;\nreal alpha0 = {};", num(inv.frame_interval_s), num(inv.alpha0_rad));
+        let _ = writeln!(o, "real dt = {};\nint firstFrame = 1;\nreal alpha0 = {};\nreal stab = {};", num(inv.frame_interval_s), num(inv.alpha0_rad), num(inv.stabilisation));
     }
     o
 }

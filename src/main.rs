@@ -59,7 +59,8 @@ enum Command {
         case: PathBuf,
         /// Parameter and values, e.g. `--set lambda_l=1e-20,1e-10,1,1e3`; repeat for a
         /// cartesian product. Inverse cases: lambda_g, lambda_f, lambda_l, lambda_d,
-        /// lambda_kappa1..3, lambda_omega1..3, relaxation, tolerance, max_iterations, elements
+        /// lambda_kappa1..3, lambda_omega1..3, relaxation, warm_start_tolerance, tolerance,
+        /// max_iterations, elements, stabilisation
         #[arg(long = "set", value_name = "KEY=V1,V2,...", required = true)]
         set: Vec<String>,
         /// Output directory [default: out/<case name>/sweep]

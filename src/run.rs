@@ -161,6 +161,7 @@ pub fn inverse_params(settings: &InverseSettings) -> InverseParams {
         first_frame: true,
         alpha0: settings.alpha0_rad,
         frame: 0,
+        stabilisation: settings.stabilisation,
         relaxation: match settings.method {
             InverseMethod::FixedPoint { relaxation } | InverseMethod::Newton { relaxation, .. } => relaxation,
         },

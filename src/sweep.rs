@@ -49,7 +49,7 @@ pub fn known_keys(case: &Case) -> &'static [&'static str] {
     match case.analysis {
         Analysis::Inverse(_) => &[
             "lambda_g", "lambda_f", "lambda_l", "lambda_d", "lambda_kappa1", "lambda_kappa2", "lambda_kappa3", "lambda_omega1", "lambda_omega2", "lambda_omega3",
-            "relaxation", "warm_start_tolerance", "tolerance", "max_iterations", "elements",
+            "relaxation", "warm_start_tolerance", "tolerance", "max_iterations", "elements", "stabilisation",
         ],
         Analysis::Static { .. } => &["relaxation", "tolerance", "max_iterations", "continuation_steps", "elements"],
         Analysis::Dynamic { .. } => &["tolerance", "max_iterations", "steps", "elements"],
@@ -99,6 +99,7 @@ pub fn apply(case: &mut Case, key: &str, v: f64) -> Result<(), SweepError> {
             },
             "tolerance" => s.tolerance = unit(v)?,
             "max_iterations" => s.max_iterations = count(key, v)?,
+            "stabilisation" => s.stabilisation = if (0.0..=1.0).contains(&v) { v } else { return Err(invalid(format!("must lie in [0, 1], got {v}"))) },
             _ => unreachable!("checked against known_keys"),
         },
         Analysis::Static { method, tolerance, max_iterations, continuation_steps } => match key {

@@ -47,6 +47,10 @@ pub struct InverseParams {
     pub alpha0: f64,
     /// frame index, used in error messages only
     pub frame: usize,
+    /// weight ε ∈ [0, 1] of the two-point rule in the λd term (I11): the term is integrated
+    /// with (1 − ε)·(the stretch–shear rule, D4) + ε·(2-point Gauss). 0 is the paper's element;
+    /// ε > 0 penalises the nodal zig-zag of the angles that the one-point rule cannot see.
+    pub stabilisation: f64,
     pub relaxation: f64,
     pub tolerance: f64,
     pub max_iterations: usize,
@@ -104,6 +108,19 @@ pub struct InverseSolution {
     /// adjoint `(x̂, α̂)`, 6 per node (last solve)
     pub adjoint: DVector<f64>,
     pub history: Vec<InverseRecord>,
+}
+
+/// Points and weights of the λd term's rule (I11): `(1 − ε)` times the stretch–shear rule of
+/// the scheme plus `ε` times 2-point Gauss (the same rule when the scheme is already full).
+pub fn tangent_rule(problem: &Problem, p: &InverseParams) -> Vec<(f64, f64)> {
+    let base = problem.scheme.stretch_shear();
+    let eps = p.stabilisation;
+    let mut rule: Vec<(f64, f64)> = base.points.iter().zip(base.weights).map(|(x, w)| (*x, w * (1.0 - eps))).collect();
+    if eps > 0.0 {
+        rule.extend(GAUSS2.points.iter().zip(GAUSS2.weights).map(|(x, w)| (*x, w * eps)));
+    }
+    rule.retain(|(_, w)| *w != 0.0);
+    rule
 }
 
 /// Map a forward local index (`[x_a, α_a, x_b, α_b]`) to the KKT local index; `hat` selects
@@ -171,10 +188,9 @@ pub(crate) fn element_system(problem: &Problem, p: &InverseParams, uk: &LocalVec
             }
         }
     }
-    // λd term (stretch–shear rule): λd ∫ (∂sδx − D δα)·(∂s x − D α − d3^k + D α_k).
-    let rule = problem.scheme.stretch_shear();
-    for (xi, w) in rule.points.iter().zip(rule.weights) {
-        let q = interpolate(uk, h, *xi);
+    // λd term (its rule, I11): λd ∫ (∂sδx − D δα)·(∂s x − D α − d3^k + D α_k).
+    for (xi, w) in tangent_rule(problem, p) {
+        let q = interpolate(uk, h, xi);
         let wh = w * h * p.lambda_d;
         let D = d3_jacobian(&q.alpha);
         let c = d3(&q.alpha) - D * q.alpha;
@@ -265,7 +281,7 @@ pub fn solve_frame_observed(
         if !rel_change.is_finite() || u.iter().chain(adjoint.iter()).any(|v| !v.is_finite()) {
             return Err(SolveError::InverseNonFinite { frame: p.frame, iteration: k });
         }
-        let (x_err_rel, tangent_misfit) = fit_measures(problem, &u, x_g);
+        let (x_err_rel, tangent_misfit) = fit_measures(problem, p, &u, x_g);
         let objective = objective_terms(problem, p, &u, &adjoint, x_g, alpha_prev);
         let rec = InverseRecord { iteration: k, rel_change, x_err_rel, tangent_misfit, objective, residual: None };
         progress(&rec, &u, &adjoint);
@@ -329,11 +345,12 @@ pub(crate) fn assemble_blocks(problem: &Problem, pattern: &Pattern, values: &mut
     rhs
 }
 
-/// `(‖x − x_g‖/‖x_g‖, ‖∂s x − d3‖)` with the integration rules of I2.
-pub fn fit_measures(problem: &Problem, u: &DVector<f64>, x_g: &[Vector3<f64>]) -> (f64, f64) {
+/// `(‖x − x_g‖/‖x_g‖, ‖∂s x − d3‖)` with the integration rules of I2 (the misfit with the λd
+/// term's rule, I11).
+pub fn fit_measures(problem: &Problem, p: &InverseParams, u: &DVector<f64>, x_g: &[Vector3<f64>]) -> (f64, f64) {
     let h = problem.mesh.h();
     let (mut e2, mut g2, mut t2) = (0.0, 0.0, 0.0);
-    let rule = problem.scheme.stretch_shear();
+    let rule = tangent_rule(problem, p);
     for e in 0..problem.mesh.elements {
         let ue = LocalVec::from_column_slice(&u.as_slice()[6 * e..6 * e + 12]);
         for (xi, w) in GAUSS2.points.iter().zip(GAUSS2.weights) {
@@ -342,8 +359,8 @@ pub fn fit_measures(problem: &Problem, u: &DVector<f64>, x_g: &[Vector3<f64>]) -
             e2 += w * h * (q.x - xg).norm_squared();
             g2 += w * h * xg.norm_squared();
         }
-        for (xi, w) in rule.points.iter().zip(rule.weights) {
-            let q = interpolate(&ue, h, *xi);
+        for &(xi, w) in &rule {
+            let q = interpolate(&ue, h, xi);
             t2 += w * h * (q.dx - d3(&q.alpha)).norm_squared();
         }
     }
@@ -373,8 +390,8 @@ pub fn objective_terms(problem: &Problem, p: &InverseParams, u: &DVector<f64>, a
                 t.angular += wh * om.component_mul(&om).dot(&p.lambda_omega);
             }
         }
-        for (xi, w) in problem.scheme.stretch_shear().points.iter().zip(problem.scheme.stretch_shear().weights) {
-            let q = interpolate(&ue, h, *xi);
+        for (xi, w) in tangent_rule(problem, p) {
+            let q = interpolate(&ue, h, xi);
             t.shear += 0.5 * w * h * p.lambda_d * (q.dx - d3(&q.alpha)).norm_squared();
         }
         for (xi, w) in problem.scheme.bending().points.iter().zip(problem.scheme.bending().weights) {
@@ -429,7 +446,7 @@ mod tests {
         let p = InverseParams {
             lambda_g: 1e9, lambda_f: 1.0, lambda_l: 1e-10, lambda_d: 1e-6,
             lambda_kappa: Vector3::new(0.0, 1e-12, 1e-10), lambda_omega: Vector3::new(1e-3, 0.0, 1e-2), dt: 0.04,
-            first_frame: false, alpha0: 0.0, frame: 0, relaxation: 0.5, tolerance: 1e-6, max_iterations: 1,
+            first_frame: false, alpha0: 0.0, frame: 0, stabilisation: 0.0, relaxation: 0.5, tolerance: 1e-6, max_iterations: 1,
         };
         let (m, _) = element_system(&problem, &p, &uk, [Vector3::zeros(), Vector3::new(0.0, 0.0, h)], [Vector3::zeros(); 2]);
         let asym = (m - m.transpose()).amax() / m.amax();

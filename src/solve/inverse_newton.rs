@@ -25,7 +25,7 @@
 use nalgebra::{DVector, Matrix3, Vector3};
 
 use super::inverse::{
-    assemble_blocks, dirichlet, element_system, fit_measures, kkt, objective_terms, InverseParams, InverseRecord, InverseSolution, KktMat, KktVec,
+    assemble_blocks, dirichlet, element_system, fit_measures, kkt, objective_terms, tangent_rule, InverseParams, InverseRecord, InverseSolution, KktMat, KktVec,
     BLOCK,
 };
 use super::statics::relative_change;
@@ -88,13 +88,22 @@ fn coefficient_derivative(problem: &Problem, p: &InverseParams, ue: &KktVec, alp
         let v = qa.dx + q.dx.cross(&qa.alpha);
         let dS_v = columns([0, 1, 2].map(|j| (dQ[j].transpose() * K * Q + Q.transpose() * K * dQ[j]) * v));
         let dS_dx = -S * skew(&qa.alpha);
+        for c in 0..2 {
+            for b in 0..2 {
+                add3(&mut e, X[c], AL[b], &(dS_v * (wh * q.dn[c] * q.n[b])));
+                add3(&mut e, X[c], X[b], &(dS_dx * (wh * q.dn[c] * q.dn[b])));
+            }
+        }
+    }
+    // The λd term's rule (I11): the second derivative of d3 in −λd ∫ δα·D(α)ᵀ(∂s x − d3).
+    for (xi, w) in tangent_rule(problem, p) {
+        let q = interpolate(&state, h, xi);
+        let wh = w * h;
         let dd = d3_second_derivatives(&q.alpha);
         let mis = q.dx - d3(&q.alpha);
         let H2 = Matrix3::from_fn(|i, j| mis.dot(&dd[i][j])) * (-p.lambda_d);
         for c in 0..2 {
             for b in 0..2 {
-                add3(&mut e, X[c], AL[b], &(dS_v * (wh * q.dn[c] * q.n[b])));
-                add3(&mut e, X[c], X[b], &(dS_dx * (wh * q.dn[c] * q.dn[b])));
                 add3(&mut e, AL[c], AL[b], &(H2 * (wh * q.n[c] * q.n[b])));
             }
         }
@@ -244,7 +253,7 @@ pub fn solve_frame_newton_observed(
             return Err(SolveError::InverseNonFinite { frame: p.frame, iteration: k });
         }
         let adjoint = part(&big, true);
-        let (x_err_rel, tangent_misfit) = fit_measures(problem, &u, x_g);
+        let (x_err_rel, tangent_misfit) = fit_measures(problem, p, &u, x_g);
         let objective = objective_terms(problem, p, &u, &adjoint, x_g, alpha_prev);
         last = phi_t / phi0;
         let rec = InverseRecord { iteration: k, rel_change, x_err_rel, tangent_misfit, objective, residual: Some(last) };
