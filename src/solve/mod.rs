@@ -6,6 +6,7 @@ pub mod dynamics;
 pub mod inverse;
 pub mod inverse_newton;
 pub mod modes;
+pub mod sequence;
 pub mod statics;
 
 use nalgebra::{DVector, Vector3};

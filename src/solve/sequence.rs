@@ -1,0 +1,123 @@
+//! The inverse problem over a clip of frames (paper §3.4, §6): one monolithic solve per frame
+//! (Problem 2, eq. 61), the first frame with α(a) = α0 and Λω = 0 (Remark 6), every later frame
+//! with Λω, the previous frame's angles as α_{n−1} and its state as the initial iterate.
+//!
+//! The angle chart of eq. (1) is singular where cos β = 0 (det A = −cos β): every frame is
+//! guarded, and a frame whose recovered β comes within `min_cos_beta` of ±π/2 at any node
+//! stops the clip with an error naming frame and node (the failure is otherwise silent: the
+//! fit stays good while α and κ3 explode, PAPER-NOTES).
+use nalgebra::{DVector, Vector3};
+
+use super::inverse::{solve_frame_observed, InverseParams, InverseRecord, InverseSolution, ObjectiveTerms};
+use super::inverse_newton::solve_frame_warm;
+use super::{node_values, Problem, SolveError};
+
+/// How each frame is solved.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum FrameMethod {
+    /// the paper's fixed point (relaxation from the parameters)
+    FixedPoint,
+    /// Newton from the fixed point's iterate at `warm_start_tolerance` (I8)
+    Newton { warm_start_tolerance: f64 },
+}
+
+/// Settings of a clip solve.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SequenceParams {
+    /// weights, Δt, relaxation, tolerance and per-frame iteration budget; `first_frame` and
+    /// `frame` are set per frame
+    pub frame: InverseParams,
+    pub method: FrameMethod,
+    /// guard of the angle chart: stop when |cos β| < this at any node
+    pub min_cos_beta: f64,
+}
+
+/// Per-frame report.
+#[derive(Clone, Copy, Debug)]
+pub struct FrameReport {
+    pub frame: usize,
+    pub iterations: usize,
+    /// relative change of (x, α) of the last iteration (D5)
+    pub last_change: f64,
+    pub x_err_rel: f64,
+    /// ‖∂s x − d3‖ [m^½]
+    pub tangent_misfit: f64,
+    pub objective: ObjectiveTerms,
+    /// smallest |cos β| over the nodes, and where
+    pub min_cos_beta: f64,
+    pub min_cos_beta_node: usize,
+    /// max over elements of |j − 1|, j = |Δx_g|/h the data's stretch (Remark 9)
+    pub max_stretch_deviation: f64,
+    pub wall_time_s: f64,
+}
+
+/// Errors of a clip solve: the frame's own error, or the chart guard.
+#[derive(Debug, thiserror::Error)]
+pub enum SequenceError {
+    #[error("frame {frame}: |cos β| = {cos_beta:.3e} at node {node} (below the guard {guard:e}): the angle chart of eq. (1) is singular there; place planar clips in the x–z plane")]
+    SingularChart { frame: usize, node: usize, cos_beta: f64, guard: f64 },
+    #[error(transparent)]
+    Solve(#[from] SolveError),
+    #[error("frame {frame}: {message}")]
+    Callback { frame: usize, message: String },
+}
+
+/// Smallest |cos β| over the nodes of a state and its node.
+pub fn min_cos_beta(u: &DVector<f64>) -> (f64, usize) {
+    (0..u.len() / 6).map(|i| (node_values(u, i).1[1].cos().abs(), i)).fold((f64::INFINITY, 0), |a, b| if b.0 < a.0 { b } else { a })
+}
+
+/// max_e |j_e − 1|, j_e = |x_{e+1} − x_e| / h (Remark 9).
+pub fn max_stretch_deviation(x_g: &[Vector3<f64>], h: f64) -> f64 {
+    x_g.windows(2).map(|w| ((w[1] - w[0]).norm() / h - 1.0).abs()).fold(0.0, f64::max)
+}
+
+/// Solve every frame of `frames` (positions per node, the mesh's nodes) in order. `u0` is the
+/// initial iterate of the first frame. `on_frame` receives each converged frame (e.g. to stream
+/// it to disk) and may stop the clip by returning an error message; `on_iteration` sees
+/// every iteration's record.
+pub fn solve_sequence(
+    problem: &Problem,
+    sp: &SequenceParams,
+    frames: &[Vec<Vector3<f64>>],
+    u0: &DVector<f64>,
+    mut on_iteration: impl FnMut(usize, &InverseRecord),
+    mut on_frame: impl FnMut(&FrameReport, &InverseSolution) -> Result<(), String>,
+) -> Result<Vec<FrameReport>, SequenceError> {
+    let n = problem.mesh.nodes();
+    let h = problem.mesh.h();
+    let mut reports = Vec::with_capacity(frames.len());
+    let mut u = u0.clone();
+    let mut prev = vec![Vector3::zeros(); n];
+    for (k, x_g) in frames.iter().enumerate() {
+        let start = std::time::Instant::now();
+        let p = InverseParams { first_frame: k == 0, frame: k, ..sp.frame };
+        let report = |r: &InverseRecord, _: &DVector<f64>, _: &DVector<f64>| on_iteration(k, r);
+        let sol = match sp.method {
+            FrameMethod::FixedPoint => solve_frame_observed(problem, &p, x_g, &prev, &u, report)?,
+            FrameMethod::Newton { warm_start_tolerance } => solve_frame_warm(problem, &p, warm_start_tolerance, x_g, &prev, &u, report)?,
+        };
+        let (cos_beta, node) = min_cos_beta(&sol.u);
+        if cos_beta < sp.min_cos_beta {
+            return Err(SequenceError::SingularChart { frame: k, node, cos_beta, guard: sp.min_cos_beta });
+        }
+        let last = sol.history.last().copied().ok_or(SequenceError::Callback { frame: k, message: "no iteration ran".into() })?;
+        let rep = FrameReport {
+            frame: k,
+            iterations: sol.history.len(),
+            last_change: last.rel_change,
+            x_err_rel: last.x_err_rel,
+            tangent_misfit: last.tangent_misfit,
+            objective: last.objective,
+            min_cos_beta: cos_beta,
+            min_cos_beta_node: node,
+            max_stretch_deviation: max_stretch_deviation(x_g, h),
+            wall_time_s: start.elapsed().as_secs_f64(),
+        };
+        on_frame(&rep, &sol).map_err(|message| SequenceError::Callback { frame: k, message })?;
+        prev = (0..n).map(|i| node_values(&sol.u, i).1).collect();
+        u = sol.u;
+        reports.push(rep);
+    }
+    Ok(reports)
+}
