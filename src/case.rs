@@ -53,6 +53,26 @@ struct RawCase {
     data: Option<RawData>,
     /// inverse cases: the weights of eq. (41)
     inverse: Option<RawInverse>,
+    /// inverse cases on a recorded clip (instead of `[data]`)
+    clip: Option<RawClip>,
+}
+
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+enum RawClipKind {
+    Kymogram,
+    Recording,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawClip {
+    kind: RawClipKind,
+    file: PathBuf,
+    frame_interval_s: Scalar,
+    /// `[first, end)` frame range
+    frames: Option<[usize; 2]>,
+    min_cos_beta: f64,
 }
 
 #[derive(Debug, Deserialize)]
@@ -248,8 +268,42 @@ pub struct DataSolve {
     pub continuation_steps: usize,
 }
 
-/// An inverse analysis of one frame (Problem 2, eq. 61).
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// Where the centreline data of an inverse case come from.
+#[derive(Clone, Debug, PartialEq)]
+pub enum DataSource {
+    /// a static forward solve of the case's own `[loads]` (synthetic data, I7)
+    Forward(DataSolve),
+    /// a recorded clip (`[clip]`), solved frame by frame
+    Clip(ClipSource),
+}
+
+/// File format of a clip.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ClipKind {
+    /// joint-angle kymogram (.npy, frames × joint angles [rad]) of the `elegansbot` package,
+    /// turned into a spline centreline of the rod's length with `elements + 1` nodes, placed
+    /// in the x–z plane
+    Kymogram,
+    /// positions: CSV `frame,node,x_m,y_m,z_m` or NPY frames × nodes × 3 [m]
+    Recording,
+}
+
+/// A recorded clip.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ClipSource {
+    pub kind: ClipKind,
+    /// resolved against the case file's directory
+    pub file: PathBuf,
+    /// Δt between frames [s]
+    pub frame_interval_s: f64,
+    /// `[first, end)` frame range, all frames if `None`
+    pub frames: Option<(usize, usize)>,
+    /// chart guard: stop when |cos β| < this at any node (`solve::sequence`)
+    pub min_cos_beta: f64,
+}
+
+/// An inverse analysis (Problem 2, eq. 61): one frame of synthetic data, or a clip.
+#[derive(Clone, Debug, PartialEq)]
 pub struct InverseSettings {
     pub method: InverseMethod,
     /// stopping rule: relative change of (x, α) (D5) ≤ tolerance
@@ -262,11 +316,11 @@ pub struct InverseSettings {
     pub alpha0_rad: f64,
     /// weight of the two-point rule in the λd term (docs/inverse.md, I11); 0 = the paper's element
     pub stabilisation: f64,
-    pub data: DataSolve,
+    pub data: DataSource,
 }
 
 /// What is solved.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub enum Analysis {
     /// `continuation_steps` ≥ 1: all loads ramped by k/steps, each step solved from the last.
     Static { method: StaticMethod, tolerance: f64, max_iterations: usize, continuation_steps: usize },
@@ -361,7 +415,7 @@ impl Case {
     /// The static forward case that generates an inverse case's data (same rod and loads).
     pub fn data_case(&self) -> Option<Case> {
         let inv = self.inverse()?;
-        let d = inv.data;
+        let DataSource::Forward(d) = inv.data else { return None };
         let mut c = self.clone();
         c.analysis = Analysis::Static { method: d.method, tolerance: d.tolerance, max_iterations: d.max_iterations, continuation_steps: d.continuation_steps };
         Some(c)
@@ -532,6 +586,9 @@ impl Validator<'_> {
             if raw.data.is_some() {
                 return Err(self.err("data", "only allowed when solver.analysis = \"inverse\""));
             }
+            if raw.clip.is_some() {
+                return Err(self.err("clip", "only allowed when solver.analysis = \"inverse\""));
+            }
             if raw.inverse.is_some() {
                 return Err(self.err("inverse", "only allowed when solver.analysis = \"inverse\""));
             }
@@ -574,14 +631,40 @@ impl Validator<'_> {
                 if s.continuation_steps != 1 {
                     return Err(self.err("solver.continuation_steps", "not used by an inverse analysis"));
                 }
-                let d = raw.data.as_ref().ok_or_else(|| self.err("data", "required when solver.analysis = \"inverse\" (the forward solve generating the centreline data)"))?;
-                if !(d.tolerance > 0.0 && d.tolerance < 1.0) {
-                    return Err(self.err("data.tolerance", format!("must lie in (0, 1), got {}", d.tolerance)));
-                }
-                if d.max_iterations == 0 || d.continuation_steps == 0 {
-                    return Err(self.err("data.max_iterations", "max_iterations and continuation_steps must be ≥ 1"));
-                }
-                let data = DataSolve { method: self.static_method("data", d.method, d.relaxation)?, tolerance: d.tolerance, max_iterations: d.max_iterations, continuation_steps: d.continuation_steps };
+                let data = match (&raw.data, &raw.clip) {
+                    (Some(d), None) => {
+                        if !(d.tolerance > 0.0 && d.tolerance < 1.0) {
+                            return Err(self.err("data.tolerance", format!("must lie in (0, 1), got {}", d.tolerance)));
+                        }
+                        if d.max_iterations == 0 || d.continuation_steps == 0 {
+                            return Err(self.err("data.max_iterations", "max_iterations and continuation_steps must be ≥ 1"));
+                        }
+                        DataSource::Forward(DataSolve { method: self.static_method("data", d.method, d.relaxation)?, tolerance: d.tolerance, max_iterations: d.max_iterations, continuation_steps: d.continuation_steps })
+                    }
+                    (None, Some(cl)) => {
+                        let base = self.path.parent().unwrap_or(Path::new(""));
+                        let frames = match cl.frames {
+                            Some([a, b]) if a < b => Some((a, b)),
+                            Some([a, b]) => return Err(self.err("clip.frames", format!("expected [first, end) with first < end, got [{a}, {b}]"))),
+                            None => None,
+                        };
+                        if !(cl.min_cos_beta >= 0.0 && cl.min_cos_beta < 1.0) {
+                            return Err(self.err("clip.min_cos_beta", format!("must lie in [0, 1), got {}", cl.min_cos_beta)));
+                        }
+                        DataSource::Clip(ClipSource {
+                            kind: match cl.kind {
+                                RawClipKind::Kymogram => ClipKind::Kymogram,
+                                RawClipKind::Recording => ClipKind::Recording,
+                            },
+                            file: base.join(&cl.file),
+                            frame_interval_s: self.positive("clip.frame_interval_s", &cl.frame_interval_s, c)?,
+                            frames,
+                            min_cos_beta: cl.min_cos_beta,
+                        })
+                    }
+                    (Some(_), Some(_)) => return Err(self.err("clip", "give either [data] (synthetic) or [clip] (recorded), not both")),
+                    (None, None) => return Err(self.err("data", "an inverse case needs [data] (a forward solve generating the centreline) or [clip] (a recorded clip)")),
+                };
                 let inv = raw.inverse.as_ref().ok_or_else(|| self.err("inverse", "required when solver.analysis = \"inverse\" (the weights of eq. 41)"))?;
                 let nonneg = |key: &str, v: &Scalar| -> Result<f64, CaseError> {
                     let x = self.scalar(key, v, c)?;

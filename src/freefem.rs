@@ -96,7 +96,7 @@ pub fn include_file(case: &Case) -> String {
             let _ = writeln!(o, "macro {prefix}{}{args} ({}) //", k + 1, case.loads.exprs[g][k].to_freefem(&rename));
         }
     }
-    let (dynamic, method, relax, tol, maxit, tend, steps, cont) = match case.analysis {
+    let (dynamic, method, relax, tol, maxit, tend, steps, cont) = match case.analysis.clone() {
         Analysis::Static { method, tolerance, max_iterations, continuation_steps } => match method {
             StaticMethod::FixedPoint { relaxation } => (0, 0, relaxation, tolerance, max_iterations, 0.0, 0, continuation_steps),
             StaticMethod::Newton => (0, 1, 1.0, tolerance, max_iterations, 0.0, 0, continuation_steps),

@@ -241,7 +241,7 @@ mod tests {
         let pts = product(&case(), &params).unwrap();
         assert_eq!(pts.len(), 6);
         assert_eq!(pts[0].1.name, "lambda_l=1e-20_lambda_kappa3=0");
-        let Analysis::Inverse(s) = pts[5].1.analysis else { panic!() };
+        let Analysis::Inverse(ref s) = pts[5].1.analysis else { panic!() };
         assert_eq!((s.weights.lambda_l, s.weights.lambda_kappa[2], s.weights.lambda_kappa[1]), (1e3, 1.0, 0.0));
     }
 
