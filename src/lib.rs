@@ -51,3 +51,4 @@ pub mod run;
 pub mod solve;
 pub mod sweep;
 pub mod theory;
+pub mod vtk;

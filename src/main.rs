@@ -157,6 +157,9 @@ fn run_engine(case: &Case, engine: Engine, dir: &Path, data: Option<&Path>, quie
 fn cmd_run(path: &Path, engine: Engine, out: Option<PathBuf>, quiet: bool) -> Result<ExitCode> {
     let case = load(path)?;
     let dir = out.unwrap_or_else(|| PathBuf::from("out").join(&case.name).join(engine.to_string()));
+    if matches!(case.inverse().map(|i| &i.data), Some(cosserat::case::DataSource::Clip(_))) {
+        return cmd_run_clip(&case, engine, &dir, quiet);
+    }
     let data = prepare_data(&case, &dir)?;
     let r = run_engine(&case, engine, &dir, data.as_deref(), quiet)?;
     let m = all_metrics(&case, &r)?;
@@ -171,6 +174,43 @@ fn cmd_run(path: &Path, engine: Engine, out: Option<PathBuf>, quiet: bool) -> Re
         r.stats.iterations,
         r.stats.wall_time_s,
         written.len(),
+        dir.display()
+    );
+    Ok(ExitCode::SUCCESS)
+}
+
+/// A clip case: frames solved in order and streamed to `dir`; a summary plot at the end.
+fn cmd_run_clip(case: &Case, engine: Engine, dir: &Path, quiet: bool) -> Result<ExitCode> {
+    if engine != Engine::Rust {
+        anyhow::bail!("case {}: clips run in the Rust engine (`--engine rust`); FreeFEM cross-checks a prefix in the tests", case.name);
+    }
+    let pb = progress_bar(quiet, &format!("{} [frames]", case.name));
+    let result = cosserat::run::run_clip(case, dir, |done, total| {
+        pb.set_length(total as u64);
+        pb.set_position(done as u64);
+    });
+    pb.finish_and_clear();
+    let run = match result {
+        Ok(r) => r,
+        Err(e) => {
+            let e = anyhow::Error::from(e).context(format!("case {}", case.name));
+            let _ = cosserat::output::write_atomic(&dir.join("FAILED.txt"), format!("{e:#}\nThe converged frames before it are in this folder.\n").as_bytes());
+            return Err(e);
+        }
+    };
+    cosserat::output::write_clip_plot(case, &run.reports, &run.roughness, &dir.join("plot.svg"))?;
+    let n = run.reports.len();
+    let its: Vec<usize> = run.reports.iter().map(|r| r.iterations).collect();
+    let worst = run.reports.iter().map(|r| r.x_err_rel).fold(0.0, f64::max);
+    let jmax = run.reports.iter().map(|r| r.max_stretch_deviation).fold(0.0, f64::max);
+    println!(
+        "{} [rust]: {n} frames in {:.2} s ({:.1} frames/s); iterations per frame min {} / mean {:.1} / max {}; max |x - x_g|/|x_g| {worst:.3e}; max |j - 1| {jmax:.3e}; wrote {}",
+        case.name,
+        run.wall_time_s,
+        n as f64 / run.wall_time_s,
+        its.iter().min().copied().unwrap_or(0),
+        its.iter().sum::<usize>() as f64 / n.max(1) as f64,
+        its.iter().max().copied().unwrap_or(0),
         dir.display()
     );
     Ok(ExitCode::SUCCESS)

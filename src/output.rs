@@ -248,3 +248,159 @@ pub fn write_convergence_plot(runs: &[(&String, &RunResult)], path: &Path) -> Re
     }
     write_panels_svg(&panels, 2, path).map_err(|e| OutputError::Plot { path: path.to_path_buf(), reason: e.to_string() })
 }
+
+/// Planar curvature of a centreline in the x–z plane at interior nodes [1/m]:
+/// `(θ_e − θ_{e−1})/h`, θ the tangent angle from e3 towards e1. For a frame with α = β = 0 this
+/// is κ2 of eq. (28) (κ = A ∂sα with A(0) gives κ2 = −∂sγ = ∂sθ).
+pub fn planar_xz_curvature(x: &[nalgebra::Vector3<f64>], h: f64) -> Vec<f64> {
+    let theta: Vec<f64> = x.windows(2).map(|w| (w[1][0] - w[0][0]).atan2(w[1][2] - w[0][2])).collect();
+    theta
+        .windows(2)
+        .map(|t| {
+            let d = t[1] - t[0];
+            let d = (d + std::f64::consts::PI).rem_euclid(2.0 * std::f64::consts::PI) - std::f64::consts::PI;
+            d / h
+        })
+        .collect()
+}
+
+/// Roughness of a sequence: the fraction of interior points where the first difference changes
+/// sign (a local extremum). A smooth curvature profile of a worm has a handful of extrema; a
+/// nodal zig-zag has one at almost every point (roughness → 1).
+pub fn sign_alternation(k: &[f64]) -> f64 {
+    if k.len() < 3 {
+        return 0.0;
+    }
+    let d: Vec<f64> = k.windows(2).map(|w| w[1] - w[0]).collect();
+    let flips = d.windows(2).filter(|w| w[0] * w[1] < 0.0).count();
+    flips as f64 / (k.len() - 2) as f64
+}
+
+/// Streams a clip solve to disk, one frame at a time (`frames.csv`, `fields.csv`,
+/// `curvature.csv`, ParaView `vtk/frame_NNNNN.vtp` + `clip.pvd`). Every line is flushed with
+/// its frame, so a clip that stops keeps every converged frame.
+pub struct ClipWriter {
+    dir: PathBuf,
+    frames: std::io::BufWriter<std::fs::File>,
+    fields: std::io::BufWriter<std::fs::File>,
+    curvature: std::io::BufWriter<std::fs::File>,
+    pvd: Vec<(f64, String)>,
+}
+
+/// Columns of `frames.csv`.
+pub const CLIP_FRAME_COLUMNS: [&str; 18] = [
+    "frame", "time_s", "iterations", "rel_change", "x_err_rel", "tangent_misfit_m05", "j_tracking", "j_force", "j_torque", "j_shear", "j_bending", "j_angular", "j_total",
+    "min_abs_cos_beta", "min_abs_cos_beta_node", "max_abs_j_minus_1", "kappa_roughness", "data_kappa_roughness",
+];
+
+impl ClipWriter {
+    /// Create the streamed files in `dir` (headers written).
+    pub fn create(dir: &Path) -> Result<Self, OutputError> {
+        let err = |path: PathBuf| move |source| OutputError::Io { path: path.clone(), source };
+        std::fs::create_dir_all(dir.join("vtk")).map_err(err(dir.join("vtk")))?;
+        let open = |name: &str, header: &str| -> Result<std::io::BufWriter<std::fs::File>, OutputError> {
+            let p = dir.join(name);
+            let mut f = std::io::BufWriter::new(std::fs::File::create(&p).map_err(err(p.clone()))?);
+            writeln!(f, "{header}").map_err(err(p))?;
+            Ok(f)
+        };
+        let mut fields_header = vec!["frame", "node", "s_m", "x_m", "y_m", "z_m", "alpha_rad", "beta_rad", "gamma_rad"];
+        fields_header.extend(["d1_x", "d1_y", "d1_z", "d2_x", "d2_y", "d2_z", "d3_x", "d3_y", "d3_z"]);
+        fields_header.extend(["f_x_n_per_m", "f_y_n_per_m", "f_z_n_per_m", "l_x_nm_per_m", "l_y_nm_per_m", "l_z_nm_per_m", "data_x_m", "data_y_m", "data_z_m"]);
+        Ok(ClipWriter {
+            dir: dir.to_path_buf(),
+            frames: open("frames.csv", &CLIP_FRAME_COLUMNS.join(","))?,
+            fields: open("fields.csv", &fields_header.join(","))?,
+            curvature: open("curvature.csv", "frame,s_mid_m,kappa1_per_m,kappa2_per_m,kappa3_per_m")?,
+            pvd: Vec::new(),
+        })
+    }
+
+    /// Append one converged frame: its report row, nodal fields, element curvature and VTK file.
+    /// `nodes`: the recovered state; `xhat`, `ahat`: adjoint; `data`: the frame's positions.
+    #[allow(clippy::too_many_arguments)]
+    pub fn frame(
+        &mut self,
+        report: &crate::solve::sequence::FrameReport,
+        time_s: f64,
+        nodes: &crate::run::NodalState,
+        force: &[nalgebra::Vector3<f64>],
+        torque: &[nalgebra::Vector3<f64>],
+        data: &[nalgebra::Vector3<f64>],
+        roughness: (f64, f64),
+    ) -> Result<(), OutputError> {
+        let err = |name: &str| {
+            let p = self.dir.join(name);
+            move |source| OutputError::Io { path: p.clone(), source }
+        };
+        let r = report;
+        let mut row = vec![r.frame as f64, time_s, r.iterations as f64, r.last_change, r.x_err_rel, r.tangent_misfit];
+        row.extend(r.objective.values());
+        row.extend([r.min_cos_beta, r.min_cos_beta_node as f64, r.max_stretch_deviation, roughness.0, roughness.1]);
+        let line: Vec<String> = row.iter().map(|v| format!("{v:.10e}")).collect();
+        writeln!(self.frames, "{}", line.join(",")).and_then(|_| self.frames.flush()).map_err(err("frames.csv"))?;
+        let d = nodes.directors();
+        for i in 0..nodes.s.len() {
+            let mut v = vec![nodes.s[i]];
+            v.extend(nodes.x[i].iter());
+            v.extend(nodes.alpha[i].iter());
+            for k in 0..3 {
+                v.extend(d[i][k].iter());
+            }
+            v.extend(force[i].iter());
+            v.extend(torque[i].iter());
+            v.extend(data[i].iter());
+            let text: Vec<String> = v.iter().map(|x| format!("{x:.10e}")).collect();
+            writeln!(self.fields, "{},{i},{}", r.frame, text.join(",")).map_err(err("fields.csv"))?;
+        }
+        self.fields.flush().map_err(err("fields.csv"))?;
+        let kappa = nodes.element_curvature();
+        for (s, k) in &kappa {
+            writeln!(self.curvature, "{},{s:.10e},{:.10e},{:.10e},{:.10e}", r.frame, k[0], k[1], k[2]).map_err(err("curvature.csv"))?;
+        }
+        self.curvature.flush().map_err(err("curvature.csv"))?;
+        let (d1, d2, d3): (Vec<_>, Vec<_>, Vec<_>) = (d.iter().map(|x| x[0]).collect(), d.iter().map(|x| x[1]).collect(), d.iter().map(|x| x[2]).collect());
+        // κ at nodes: mean of the adjacent elements (ends: the end element).
+        let kn: Vec<nalgebra::Vector3<f64>> = (0..nodes.s.len()).map(|i| {
+            let a = kappa[i.saturating_sub(1).min(kappa.len() - 1)].1;
+            let b = kappa[i.min(kappa.len() - 1)].1;
+            (a + b) * 0.5
+        }).collect();
+        let name = format!("frame_{:05}.vtp", r.frame);
+        crate::vtk::write_vtp(
+            &self.dir.join("vtk").join(&name),
+            &crate::vtk::PolylineFields {
+                points: &nodes.x,
+                vectors: vec![("d1", &d1), ("d2", &d2), ("d3", &d3), ("f_n_per_m", force), ("l_nm_per_m", torque), ("kappa_per_m", &kn), ("data_position_m", data)],
+                scalars: vec![],
+            },
+        )?;
+        self.pvd.push((time_s, format!("vtk/{name}")));
+        Ok(())
+    }
+
+    /// Write the ParaView collection of the frames written so far.
+    pub fn finish(&mut self) -> Result<PathBuf, OutputError> {
+        let p = self.dir.join("clip.pvd");
+        crate::vtk::write_pvd(&p, &self.pvd)?;
+        Ok(p)
+    }
+}
+
+/// Per-frame summary of a clip run: iterations, fit, chart guard and roughness against frame.
+pub fn write_clip_plot(case: &Case, reports: &[crate::solve::sequence::FrameReport], roughness: &[(f64, f64)], path: &Path) -> Result<(), OutputError> {
+    if reports.is_empty() {
+        return Ok(());
+    }
+    let f: Vec<f64> = reports.iter().map(|r| r.frame as f64).collect();
+    let s = |label: &str, y: Vec<f64>| Series { label: label.into(), x: f.clone(), y };
+    let plot = |title: String, yl: &str, series: Vec<Series>, log_y: bool| LinePlot { title, x_label: "frame".into(), y_label: yl.into(), series, log_x: false, log_y };
+    let panels = vec![
+        plot(format!("{}: iterations per frame", case.name), "iterations", vec![s("iterations", reports.iter().map(|r| r.iterations as f64).collect())], false),
+        plot("fit per frame".into(), "value", vec![s("|x - x_g|/|x_g|", reports.iter().map(|r| r.x_err_rel).collect()), s("|x' - d3| [m^1/2]", reports.iter().map(|r| r.tangent_misfit).collect()), s("last relative change", reports.iter().map(|r| r.last_change).collect())], true),
+        plot("angle chart: min |cos beta| over the nodes".into(), "|cos beta|", vec![s("min |cos beta|", reports.iter().map(|r| r.min_cos_beta).collect())], false),
+        plot("objective (41)".into(), "J", vec![s("tracking", reports.iter().map(|r| r.objective.tracking).collect()), s("total", reports.iter().map(|r| r.objective.total()).collect())], true),
+        plot("roughness of the curvature (sign alternation of its differences)".into(), "fraction of elements", vec![s("recovered kappa_2", roughness.iter().map(|r| r.0).collect()), s("data", roughness.iter().map(|r| r.1).collect())], false),
+    ];
+    write_panels_svg(&panels, 2, path).map_err(|e| OutputError::Plot { path: path.to_path_buf(), reason: e.to_string() })
+}

@@ -4,7 +4,10 @@ use std::time::Instant;
 
 use nalgebra::{DVector, Vector3};
 
-use crate::case::{Analysis, Case, InverseMethod, InverseSettings, StaticMethod};
+use crate::case::{Analysis, Case, ClipKind, DataSource, InverseMethod, InverseSettings, StaticMethod};
+use crate::clip::{read_kymogram, read_recording, Clip, ClipError, ClipPlane, KymogramParams};
+use crate::output::{planar_xz_curvature, sign_alternation, ClipWriter, OutputError};
+use crate::solve::sequence::{solve_sequence, FrameMethod, FrameReport, SequenceError, SequenceParams};
 use crate::data::{read_data, write_data, DataError};
 use crate::freefem::{self, FreeFemError};
 use crate::metrics::INNER_SKIP_ELEMENTS;
@@ -141,6 +144,14 @@ pub enum RunError {
     FreeFem(#[from] FreeFemError),
     #[error("inverse data")]
     Data(#[from] DataError),
+    #[error("clip")]
+    Clip(#[from] ClipError),
+    #[error("clip: {0}")]
+    ClipShape(String),
+    #[error("clip")]
+    Sequence(#[from] SequenceError),
+    #[error("writing the clip")]
+    Output(#[from] OutputError),
     /// The solver stopped without meeting its rule; `partial` holds the last iterate and the
     /// history up to there (sweeps keep it so that non-converging values still show).
     #[error("rust engine stopped after {} iterations without meeting its stopping rule", .partial.stats.iterations)]
@@ -298,4 +309,81 @@ pub fn run_inverse_on(case: &Case, engine: Engine, data_path: &Path, workdir: &P
         Engine::Rust => run_rust_inverse(case, &data, progress),
         Engine::Freefem => Ok(freefem::run_inverse(case, data, data_path, workdir)?),
     }
+}
+
+/// Read the clip of a clip case: kymograms become spline centrelines with the mesh's node
+/// count and the rod's length in the x–z plane; recordings must have that node count. The
+/// frame range of the case is applied.
+pub fn load_clip(case: &Case) -> Result<Clip, RunError> {
+    let settings = case.inverse().ok_or_else(|| SolveError::NotInverse(case.name.clone()))?;
+    let DataSource::Clip(src) = &settings.data else { return Err(SolveError::NotInverse(case.name.clone()).into()) };
+    let mut clip = match src.kind {
+        ClipKind::Kymogram => {
+            let params = KymogramParams { length_m: case.mesh.length_m, nodes: case.mesh.nodes(), dt_s: src.frame_interval_s, plane: ClipPlane::Xz };
+            read_kymogram(&src.file, &params)?
+        }
+        ClipKind::Recording => read_recording(&src.file, src.frame_interval_s)?,
+    };
+    if clip.node_count() != case.mesh.nodes() {
+        return Err(RunError::ClipShape(format!("{}: {} nodes per frame, but the case's mesh has {} (rod.elements + 1)", src.file.display(), clip.node_count(), case.mesh.nodes())));
+    }
+    if let Some((a, b)) = src.frames {
+        if b > clip.frame_count() {
+            return Err(RunError::ClipShape(format!("{}: clip.frames = [{a}, {b}) but the clip has {} frames", src.file.display(), clip.frame_count())));
+        }
+        clip.frames = clip.frames[a..b].to_vec();
+    }
+    Ok(clip)
+}
+
+/// Summary of a clip run.
+#[derive(Clone, Debug)]
+pub struct ClipRun {
+    pub reports: Vec<FrameReport>,
+    /// per frame: sign alternation of the recovered κ2 and of the data's planar curvature
+    /// (`output::sign_alternation`)
+    pub roughness: Vec<(f64, f64)>,
+    pub wall_time_s: f64,
+    pub source: String,
+}
+
+/// Solve a clip case frame by frame in the Rust engine, streaming every converged frame into
+/// `out` (`output::ClipWriter`). On failure the converged frames stay on disk and the error
+/// names the frame.
+pub fn run_clip(case: &Case, out: &Path, mut progress: impl FnMut(usize, usize)) -> Result<ClipRun, RunError> {
+    let settings = case.inverse().ok_or_else(|| SolveError::NotInverse(case.name.clone()))?;
+    let DataSource::Clip(src) = &settings.data else { return Err(SolveError::NotInverse(case.name.clone()).into()) };
+    let clip = load_clip(case)?;
+    let problem = Problem::from_case(case);
+    let params = inverse_params(settings);
+    let method = match settings.method {
+        InverseMethod::FixedPoint { .. } => FrameMethod::FixedPoint,
+        InverseMethod::Newton { warm_start_tolerance, .. } => FrameMethod::Newton { warm_start_tolerance },
+    };
+    let first_frame = src.frames.map(|f| f.0).unwrap_or(0);
+    let sp = SequenceParams { frame: InverseParams { dt: src.frame_interval_s, ..params }, method, min_cos_beta: src.min_cos_beta, frame_offset: first_frame };
+    let mut writer = ClipWriter::create(out)?;
+    let total = clip.frame_count();
+    let h = case.mesh.h();
+    let start = Instant::now();
+    let mut rough = Vec::new();
+    let result = solve_sequence(&problem, &sp, &clip.frames, &problem.reference_state(), |_, _| {}, |rep, sol| {
+        let nodes = NodalState::from_vector(case, &sol.u);
+        let (force, torque): (Vec<_>, Vec<_>) = (0..nodes.s.len())
+            .map(|i| {
+                let (xh, ah) = node_values(&sol.adjoint, i);
+                (xh / params.lambda_f, ah / params.lambda_l)
+            })
+            .unzip();
+        let data = &clip.frames[rep.frame - first_frame];
+        let k2: Vec<f64> = nodes.element_curvature().iter().map(|(_, k)| k[1]).collect();
+        let roughness = (sign_alternation(&k2), sign_alternation(&planar_xz_curvature(data, h)));
+        rough.push(roughness);
+        writer.frame(rep, rep.frame as f64 * clip.dt_s, &nodes, &force, &torque, data, roughness).map_err(|e| e.to_string())?;
+        progress(rep.frame - first_frame + 1, total);
+        Ok(())
+    });
+    writer.finish()?;
+    let reports = result?;
+    Ok(ClipRun { reports, roughness: rough, wall_time_s: start.elapsed().as_secs_f64(), source: clip.source })
 }

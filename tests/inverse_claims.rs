@@ -56,6 +56,7 @@ fn paper() -> InverseParams {
         first_frame: true,
         alpha0: 0.0,
         frame: 0,
+        stabilisation: 0.0,
         relaxation: 0.5,
         tolerance: 3e-6,
         max_iterations: CAP,

@@ -43,7 +43,7 @@ fn quasi_static_clip_is_recovered_frame_by_frame() {
         truths.push(u);
     }
     let p = Problem::from_case(&case);
-    let sp = SequenceParams { frame: params(), method: FrameMethod::FixedPoint, min_cos_beta: 1e-3 };
+    let sp = SequenceParams { frame: params(), method: FrameMethod::FixedPoint, min_cos_beta: 1e-3, frame_offset: 0 };
     let mut streamed = 0;
     let reports = solve_sequence(&p, &sp, &frames, &p.reference_state(), |_, _| {}, |_, _| {
         streamed += 1;
@@ -77,6 +77,7 @@ fn chart_guard_names_frame_and_node() {
         frame: InverseParams { lambda_f: 1.0, lambda_l: 1e-10, lambda_kappa: Vector3::new(0.0, 0.0, 1e-10), lambda_omega: Vector3::zeros(), tolerance: 1e-4, ..params() },
         method: FrameMethod::FixedPoint,
         min_cos_beta: 0.2,
+        frame_offset: 0,
     };
     let err = solve_sequence(&p, &sp, &[x_g], &DVector::from(p.reference_state()), |_, _| {}, |_, _| Ok(())).expect_err("the guard must fire");
     eprintln!("{err}");

@@ -30,6 +30,8 @@ pub struct SequenceParams {
     pub method: FrameMethod,
     /// guard of the angle chart: stop when |cos β| < this at any node
     pub min_cos_beta: f64,
+    /// number of the first frame in reports and errors (the clip's frame range may not start at 0)
+    pub frame_offset: usize,
 }
 
 /// Per-frame report.
@@ -89,9 +91,10 @@ pub fn solve_sequence(
     let mut reports = Vec::with_capacity(frames.len());
     let mut u = u0.clone();
     let mut prev = vec![Vector3::zeros(); n];
-    for (k, x_g) in frames.iter().enumerate() {
+    for (i, x_g) in frames.iter().enumerate() {
+        let k = i + sp.frame_offset;
         let start = std::time::Instant::now();
-        let p = InverseParams { first_frame: k == 0, frame: k, ..sp.frame };
+        let p = InverseParams { first_frame: i == 0, frame: k, ..sp.frame };
         let report = |r: &InverseRecord, _: &DVector<f64>, _: &DVector<f64>| on_iteration(k, r);
         let sol = match sp.method {
             FrameMethod::FixedPoint => solve_frame_observed(problem, &p, x_g, &prev, &u, report)?,
