@@ -1,12 +1,14 @@
 #!/usr/bin/env bash
-# Install what the project needs on a fresh Debian machine: FreeFEM (Debian packages) and,
-# if absent, a Rust toolchain from Debian. Idempotent; run as root (or with sudo available).
+# Install what the project needs on a fresh Debian machine: FreeFEM (Debian packages), pip
+# (scripts/fetch_worm_data.sh downloads the worm clips with it) and, if absent, a Rust
+# toolchain from Debian. Idempotent; run as root (or with sudo available).
 set -euo pipefail
 SUDO=""
 if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
 need=()
 command -v FreeFem++ >/dev/null 2>&1 || need+=(freefem++ libfreefem++)
 command -v cargo >/dev/null 2>&1 || need+=(cargo rustc)
+python3 -m pip --version >/dev/null 2>&1 || need+=(python3-pip)
 if [ ${#need[@]} -gt 0 ]; then
   echo "installing: ${need[*]}"
   $SUDO apt-get update -qq

@@ -1,0 +1,216 @@
+//! A small strict reader and writer of NumPy `.npy` files (format versions 1.0, 2.0, 3.0) for
+//! the one kind of array the clips use: little-endian float64 (`'<f8'`), C order.
+//!
+//! File layout (NumPy enhancement proposal 1, "A simple file format for NumPy arrays"):
+//!
+//! ```text
+//! \x93NUMPY  major minor  header_len (u16 LE for 1.x, u32 LE for 2.x/3.x)
+//! {'descr': '<f8', 'fortran_order': False, 'shape': (600, 24), }   (padded with spaces, '\n')
+//! raw data, product(shape) * 8 bytes
+//! ```
+//!
+//! Anything else (another dtype, big-endian, Fortran order, a data block of the wrong length)
+//! is an error that says what was found; no value is guessed or converted.
+use std::path::Path;
+
+use crate::output::write_atomic;
+
+use super::ClipError;
+
+const MAGIC: &[u8] = b"\x93NUMPY";
+
+/// A C-order float64 array read from an `.npy` file.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NpyArray {
+    /// Extent of each axis.
+    pub shape: Vec<usize>,
+    /// Values in C (row-major) order, `shape.iter().product()` of them.
+    pub data: Vec<f64>,
+}
+
+/// Read a little-endian float64, C-order `.npy` file.
+pub fn read_npy(path: &Path) -> Result<NpyArray, ClipError> {
+    let bytes = std::fs::read(path).map_err(|e| ClipError::Read { path: path.to_path_buf(), reason: e.to_string() })?;
+    parse_npy(&bytes).map_err(|reason| ClipError::Npy { path: path.to_path_buf(), reason })
+}
+
+/// Write `data` (C order) with the given shape as a version 1.0 `.npy` file, atomically.
+pub fn write_npy(path: &Path, shape: &[usize], data: &[f64]) -> Result<(), ClipError> {
+    let count: usize = shape.iter().product();
+    if count != data.len() {
+        return Err(ClipError::Shape { path: path.to_path_buf(), reason: format!("shape {shape:?} holds {count} values, but {} were given", data.len()) });
+    }
+    Ok(write_atomic(path, &npy_bytes(shape, data))?)
+}
+
+/// Bytes of a version 1.0 `.npy` file (header padded so that the data start at a multiple of 64).
+pub fn npy_bytes(shape: &[usize], data: &[f64]) -> Vec<u8> {
+    let dims = match shape {
+        [n] => format!("({n},)"),
+        _ => format!("({})", shape.iter().map(|n| n.to_string()).collect::<Vec<_>>().join(", ")),
+    };
+    let mut header = format!("{{'descr': '<f8', 'fortran_order': False, 'shape': {dims}, }}");
+    let unpadded = MAGIC.len() + 2 + 2 + header.len() + 1;
+    header.push_str(&" ".repeat((64 - unpadded % 64) % 64));
+    header.push('\n');
+    let mut out = Vec::with_capacity(MAGIC.len() + 4 + header.len() + 8 * data.len());
+    out.extend_from_slice(MAGIC);
+    out.extend_from_slice(&[1, 0]);
+    out.extend_from_slice(&(header.len() as u16).to_le_bytes());
+    out.extend_from_slice(header.as_bytes());
+    for v in data {
+        out.extend_from_slice(&v.to_le_bytes());
+    }
+    out
+}
+
+/// Parse the bytes of an `.npy` file; the error is the reason, without the file name.
+fn parse_npy(bytes: &[u8]) -> Result<NpyArray, String> {
+    if bytes.len() < MAGIC.len() + 2 || &bytes[..MAGIC.len()] != MAGIC {
+        return Err("missing the magic string \\x93NUMPY (not an .npy file, or truncated)".into());
+    }
+    let major = bytes[MAGIC.len()];
+    let start = MAGIC.len() + 2;
+    let (header_len, data_start) = match major {
+        1 => {
+            let b = bytes.get(start..start + 2).ok_or("truncated in the header length")?;
+            (u16::from_le_bytes([b[0], b[1]]) as usize, start + 2)
+        }
+        2 | 3 => {
+            let b = bytes.get(start..start + 4).ok_or("truncated in the header length")?;
+            (u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize, start + 4)
+        }
+        v => return Err(format!("format version {v}.x is not supported (1.0, 2.0 or 3.0)")),
+    };
+    let header = bytes.get(data_start..data_start + header_len).ok_or_else(|| format!("truncated: the header is {header_len} bytes, the file ends before it does"))?;
+    let header = std::str::from_utf8(header).map_err(|_| "the header is not text".to_string())?;
+    let (descr, fortran, shape) = parse_header(header)?;
+    if descr != "<f8" {
+        return Err(format!("dtype '{descr}', expected little-endian float64 '<f8'"));
+    }
+    if fortran {
+        return Err("Fortran-order array (fortran_order: True); expected C order".into());
+    }
+    let count = shape.iter().try_fold(1usize, |a, &n| a.checked_mul(n)).ok_or("shape overflows")?;
+    let body = &bytes[data_start + header_len..];
+    let expected = count.checked_mul(8).ok_or("shape overflows")?;
+    if body.len() < expected {
+        return Err(format!("truncated: shape {shape:?} needs {expected} data bytes, the file has {}", body.len()));
+    }
+    if body.len() > expected {
+        return Err(format!("{} bytes after the data of shape {shape:?} ({expected} bytes)", body.len() - expected));
+    }
+    let data = body.chunks_exact(8).map(|c| f64::from_le_bytes(c.try_into().expect("chunks of 8"))).collect();
+    Ok(NpyArray { shape, data })
+}
+
+/// The three entries of the header dictionary: `descr`, `fortran_order`, `shape`.
+fn parse_header(header: &str) -> Result<(String, bool, Vec<usize>), String> {
+    let inner = header.trim().strip_prefix('{').and_then(|h| h.strip_suffix('}')).ok_or_else(|| format!("header {header:?} is not a dictionary"))?;
+    let (mut descr, mut fortran, mut shape) = (None, None, None);
+    let mut rest = inner.trim();
+    while !rest.is_empty() {
+        let (key, after) = quoted(rest).ok_or_else(|| format!("header {inner:?}: expected a quoted key at {rest:?}"))?;
+        let after = after.trim_start().strip_prefix(':').ok_or_else(|| format!("header: expected ':' after '{key}'"))?.trim_start();
+        let after = match key {
+            "descr" => {
+                let (v, a) = quoted(after).ok_or("header: 'descr' is not a quoted string (structured dtypes are not supported)")?;
+                descr = Some(v.to_string());
+                a
+            }
+            "fortran_order" => {
+                let (v, a) = if let Some(a) = after.strip_prefix("True") {
+                    (true, a)
+                } else if let Some(a) = after.strip_prefix("False") {
+                    (false, a)
+                } else {
+                    return Err(format!("header: 'fortran_order' is neither True nor False at {after:?}"));
+                };
+                fortran = Some(v);
+                a
+            }
+            "shape" => {
+                let body = after.strip_prefix('(').ok_or("header: 'shape' is not a tuple")?;
+                let close = body.find(')').ok_or("header: 'shape' tuple is not closed")?;
+                let dims = body[..close]
+                    .split(',')
+                    .map(str::trim)
+                    .filter(|t| !t.is_empty())
+                    .map(|t| t.parse::<usize>().map_err(|_| format!("header: shape entry '{t}' is not a non-negative integer")))
+                    .collect::<Result<Vec<_>, _>>()?;
+                shape = Some(dims);
+                &body[close + 1..]
+            }
+            other => return Err(format!("header: unknown key '{other}'")),
+        };
+        rest = after.trim_start();
+        rest = rest.strip_prefix(',').unwrap_or(rest).trim_start();
+    }
+    Ok((descr.ok_or("header has no 'descr'")?, fortran.ok_or("header has no 'fortran_order'")?, shape.ok_or("header has no 'shape'")?))
+}
+
+/// A single- or double-quoted string at the start of `s`, and the rest after it.
+fn quoted(s: &str) -> Option<(&str, &str)> {
+    let q = s.chars().next().filter(|c| *c == '\'' || *c == '"')?;
+    let end = s[1..].find(q)? + 1;
+    Some((&s[1..end], &s[end + 1..]))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn npy_round_trips_and_is_aligned() {
+        let data: Vec<f64> = (0..24).map(|i| (i as f64).sin() * 1e-3).collect();
+        for shape in [vec![24], vec![4, 6], vec![2, 4, 3]] {
+            let b = npy_bytes(&shape, &data);
+            let header_len = u16::from_le_bytes([b[8], b[9]]) as usize;
+            assert_eq!((10 + header_len) % 64, 0);
+            assert_eq!(parse_npy(&b).unwrap(), NpyArray { shape: shape.clone(), data: data.clone() });
+        }
+    }
+
+    #[test]
+    fn npy_version_2_header_and_double_quotes_are_read() {
+        let header = "{\"descr\": \"<f8\", \"fortran_order\": False, \"shape\": (1, 2)}\n";
+        let mut b = MAGIC.to_vec();
+        b.extend_from_slice(&[2, 0]);
+        b.extend_from_slice(&(header.len() as u32).to_le_bytes());
+        b.extend_from_slice(header.as_bytes());
+        b.extend_from_slice(&1.5f64.to_le_bytes());
+        b.extend_from_slice(&(-2.0f64).to_le_bytes());
+        assert_eq!(parse_npy(&b).unwrap(), NpyArray { shape: vec![1, 2], data: vec![1.5, -2.0] });
+    }
+
+    #[test]
+    fn malformed_npy_says_what_is_wrong() {
+        let good = npy_bytes(&[2, 3], &[0.0; 6]);
+        let text = |b: &[u8]| String::from_utf8_lossy(b).into_owned();
+        let edit = |from: &str, to: &str| {
+            let t = text(&good).replacen(from, to, 1);
+            let mut b = good.clone();
+            let start = good.windows(from.len()).position(|w| w == from.as_bytes()).unwrap();
+            b.splice(start..start + from.len(), to.bytes());
+            assert_eq!(b.len(), good.len(), "{t}");
+            b
+        };
+        let e = parse_npy(&edit("<f8", ">f8")).unwrap_err();
+        assert!(e.contains("dtype '>f8'") && e.contains("'<f8'"), "{e}");
+        let e = parse_npy(&edit("<f8", "<f4")).unwrap_err();
+        assert!(e.contains("dtype '<f4'"), "{e}");
+        let e = parse_npy(&edit("False", "True ")).unwrap_err();
+        assert!(e.contains("Fortran-order"), "{e}");
+        let e = parse_npy(&good[..good.len() - 5]).unwrap_err();
+        assert!(e.contains("truncated") && e.contains("48 data bytes") && e.contains("has 43"), "{e}");
+        let e = parse_npy(&good[..20]).unwrap_err();
+        assert!(e.contains("truncated"), "{e}");
+        let e = parse_npy(b"PK\x03\x04 not npy").unwrap_err();
+        assert!(e.contains("magic"), "{e}");
+        let mut long = good.clone();
+        long.extend_from_slice(&[0; 8]);
+        assert!(parse_npy(&long).unwrap_err().contains("8 bytes after the data"));
+        let e = parse_npy(&edit("(2, 3)", "(2,-3)")).unwrap_err();
+        assert!(e.contains("'-3'"), "{e}");
+    }
+}
