@@ -693,12 +693,14 @@ impl Validator<'_> {
                     lambda_kappa: diag("inverse.lambda_kappa", &Some(inv.lambda_kappa.clone()))?,
                     lambda_omega: diag("inverse.lambda_omega", &inv.lambda_omega)?,
                 };
-                let frame_interval_s = match &inv.frame_interval_s {
-                    Some(v) => self.positive("inverse.frame_interval_s", v, c)?,
-                    None if weights.lambda_omega.iter().any(|&w| w > 0.0) => {
+                let frame_interval_s = match (&inv.frame_interval_s, &raw.clip) {
+                    (Some(_), Some(_)) => return Err(self.err("inverse.frame_interval_s", "a clip case takes Δt from clip.frame_interval_s")),
+                    (Some(v), None) => self.positive("inverse.frame_interval_s", v, c)?,
+                    (None, Some(cl)) => self.positive("clip.frame_interval_s", &cl.frame_interval_s, c)?,
+                    (None, None) if weights.lambda_omega.iter().any(|&w| w > 0.0) => {
                         return Err(self.err("inverse.frame_interval_s", "required when lambda_omega is non-zero"));
                     }
-                    None => 1.0,
+                    (None, None) => 1.0,
                 };
                 let alpha0_rad = match &inv.alpha0_rad {
                     Some(v) => self.scalar("inverse.alpha0_rad", v, c)?,

@@ -181,6 +181,7 @@ pub fn run_inverse(case: &Case, data: NodalState, data_path: &Path, workdir: &Pa
         stats,
         inverse: Some(InverseOutput {
             data,
+            angles_known: crate::run::angles_known(case),
             xhat: rows.iter().map(|r| v3(r, 7)).collect(),
             ahat: rows.iter().map(|r| v3(r, 10)).collect(),
             history,

@@ -49,10 +49,12 @@ pub fn inverse_metrics(r: &RunResult) -> Metrics {
     let Some(last) = inv.history.last() else { return m };
     m.insert("x_err_rel".into(), last.x_err_rel);
     m.insert("tangent_misfit_m05".into(), last.tangent_misfit);
-    let k: Vec<_> = r.nodes.element_curvature().into_iter().map(|(_, k)| k).collect();
-    let kf: Vec<_> = inv.data.element_curvature().into_iter().map(|(_, k)| k).collect();
-    m.insert("kappa_err_rel".into(), relative_error(&k, &kf, 0));
-    m.insert("kappa_err_rel_inner".into(), relative_error(&k, &kf, INNER_SKIP_ELEMENTS));
+    if inv.angles_known {
+        let k: Vec<_> = r.nodes.element_curvature().into_iter().map(|(_, k)| k).collect();
+        let kf: Vec<_> = inv.data.element_curvature().into_iter().map(|(_, k)| k).collect();
+        m.insert("kappa_err_rel".into(), relative_error(&k, &kf, 0));
+        m.insert("kappa_err_rel_inner".into(), relative_error(&k, &kf, INNER_SKIP_ELEMENTS));
+    }
     for (name, v) in ObjectiveTerms::NAMES.iter().zip(last.objective.values()) {
         m.insert(format!("{name}"), v);
     }
@@ -147,7 +149,7 @@ pub fn compare(case: &Case, rust: &RunResult, ff: &RunResult) -> Vec<ComparisonR
         }
         // Recovery errors (κ amplifies angle differences by ~1/h), compared relatively.
         let (ma, mb) = (inverse_metrics(rust), inverse_metrics(ff));
-        for name in ["x_err_rel", "kappa_err_rel", "kappa_err_rel_inner"] {
+        for name in ["x_err_rel", "kappa_err_rel", "kappa_err_rel_inner"].into_iter().filter(|n| ma.contains_key(*n)) {
             let (x, y) = (ma.get(name).copied().unwrap_or(f64::NAN), mb.get(name).copied().unwrap_or(f64::NAN));
             let d = (x - y).abs();
             rows.push(ComparisonRow { name: name.into(), rust: Some(x), freefem: Some(y), difference: if d.is_nan() { f64::INFINITY } else { d }, tolerance: tol.metric_rel * x.abs() });
