@@ -152,11 +152,16 @@ pub struct KymogramParams {
     pub dt_s: f64,
     /// Target plane of the rigid placement.
     pub plane: ClipPlane,
+    /// Scale each frame about its head so that the spline's arc length is `length_m`. The
+    /// spline through the joints is longer than the joint polygon (by up to ~0.8 % on the
+    /// elegansbot clips, the chord-vs-arc excess of bent segments); with this, `j ≈ 1`, but the
+    /// nodes no longer pass through the joints.
+    pub scale_to_length: bool,
 }
 
 impl Default for KymogramParams {
     fn default() -> Self {
-        KymogramParams { length_m: WORM_LENGTH_M, nodes: PAPER_NODES, dt_s: 1.0 / KYMOGRAM_FPS, plane: ClipPlane::Xz }
+        KymogramParams { length_m: WORM_LENGTH_M, nodes: PAPER_NODES, dt_s: 1.0 / KYMOGRAM_FPS, plane: ClipPlane::Xz, scale_to_length: false }
     }
 }
 
@@ -200,7 +205,13 @@ pub fn clip_from_angles(rows: &[Vec<f64>], params: &KymogramParams, source: Stri
         .iter()
         .map(|frame| {
             let placed: Vec<Vector3<f64>> = frame.iter().map(place).collect();
-            Spline::through(&placed).resample_by_arc_length(params.nodes).0
+            let (nodes, arc) = Spline::through(&placed).resample_by_arc_length(params.nodes);
+            if params.scale_to_length {
+                let (origin, k) = (nodes[0], params.length_m / arc);
+                nodes.iter().map(|p| origin + (p - origin) * k).collect()
+            } else {
+                nodes
+            }
         })
         .collect();
     Clip { frames, dt_s: params.dt_s, source, length_m: params.length_m }
@@ -220,7 +231,8 @@ pub fn read_kymogram(path: &Path, params: &KymogramParams) -> Result<Clip, ClipE
         return Err(ClipError::NonFiniteAngle { path: path.to_path_buf(), frame: k / joints, joint: k % joints, value: a.data[k] });
     }
     let rows: Vec<Vec<f64>> = a.data.chunks_exact(joints).map(<[f64]>::to_vec).collect();
-    let source = format!("{} ({frames} frames × {joints} joint angles; spline resampled to {} nodes, {:?} plane)", path.display(), params.nodes, params.plane);
+    let scaled = if params.scale_to_length { ", scaled to the body length" } else { "" };
+    let source = format!("{} ({frames} frames × {joints} joint angles; spline resampled to {} nodes{scaled}, {:?} plane)", path.display(), params.nodes, params.plane);
     Ok(clip_from_angles(&rows, params, source))
 }
 
@@ -584,5 +596,49 @@ mod tests {
         std::fs::write(&p, b).unwrap();
         let e = read_recording(&p, 0.04).unwrap_err().to_string();
         assert!(e.contains("fortran.npy") && e.contains("Fortran-order"), "{e}");
+    }
+
+    /// The real clips of `scripts/fetch_worm_data.sh`; skipped with a notice when absent.
+    #[test]
+    fn elegansbot_clips_load_when_fetched() {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/elegansbot");
+        if !dir.is_dir() {
+            println!("SKIPPED: {} is absent (run scripts/fetch_worm_data.sh)", dir.display());
+            return;
+        }
+        for (name, frames) in [("kymogram_omega-turn.npy", 600), ("kymogram_delta-turn.npy", 300)] {
+            let path = dir.join(name);
+            let raw = read_npy(&path).unwrap();
+            assert_eq!(raw.shape, vec![frames, 24], "{name}");
+            let max_angle = raw.data.iter().fold(0.0f64, |m, a| m.max(a.abs()));
+            let clip = read_kymogram(&path, &KymogramParams::default()).unwrap();
+            assert_eq!((clip.frame_count(), clip.node_count(), clip.dt_s), (frames, 128, 1.0 / 32.0));
+            assert!(clip.frames.iter().flatten().all(|p| p.iter().all(|v| v.is_finite()) && p.y == 0.0));
+            let (jf, jdev) = clip.max_stretch_deviation();
+            let xz = clip.frames_with_tangent_near(&Vector3::y(), 1e-3).len();
+            let xy = read_kymogram(&path, &KymogramParams { plane: ClipPlane::Xy, ..KymogramParams::default() }).unwrap();
+            let xy_near = xy.frames_with_tangent_near(&Vector3::y(), 1e-3).len();
+            // elegansbot's own orientation: head segment along +e1 in every frame, no rotation.
+            let unrotated = Clip {
+                frames: raw.data.chunks_exact(24).map(|a| Spline::through(&planar(&kymogram_joints(a, WORM_LENGTH_M))).resample_by_arc_length(128).0).collect(),
+                ..clip.clone()
+            };
+            let unrotated_near = unrotated.frames_with_tangent_near(&Vector3::y(), 1e-3).len();
+            // Frames whose continuous tangent passes through ±e2 somewhere: the x-component of
+            // the segment tangents changes sign (x–y placements).
+            let crossing = |c: &Clip| c.frames.iter().filter(|f| f.windows(3).any(|w| (w[1].x - w[0].x) * (w[2].x - w[1].x) <= 0.0)).count();
+            println!("{name}: frames whose tangent passes through ±e2: x–y chord along +e1 {}, x–y head along +e1 {}", crossing(&xy), crossing(&unrotated));
+            let kappa_max = clip.frames.iter().flat_map(|f| menger_curvature(f)).fold(0.0, f64::max);
+            let scaled = read_kymogram(&path, &KymogramParams { scale_to_length: true, ..KymogramParams::default() }).unwrap();
+            let (sf, sdev) = scaled.max_stretch_deviation();
+            println!("{name}: scaled to the body length: max |j − 1| {sdev:.3e} (frame {sf})");
+            assert!(sdev < 1e-3, "{name}: scaled max |j − 1| = {sdev}");
+            println!(
+                "{name}: {frames} × 24, max |a_j| {max_angle:.3} rad, max |j − 1| {jdev:.3e} (frame {jf}), max κ {kappa_max:.4e} 1/m; \
+                 frames with a tangent within 1e-3 of ±e2: x–z {xz}, x–y chord along +e1 {xy_near}, x–y head along +e1 {unrotated_near}"
+            );
+            assert_eq!(xz, 0, "{name}: x–z placement keeps tangents off ±e2");
+            assert!(jdev < 0.02, "{name}: max |j − 1| = {jdev}");
+        }
     }
 }
