@@ -340,7 +340,7 @@ pub fn load_clip(case: &Case) -> Result<Clip, RunError> {
     let DataSource::Clip(src) = &settings.data else { return Err(SolveError::NotInverse(case.name.clone()).into()) };
     let mut clip = match src.kind {
         ClipKind::Kymogram => {
-            let params = KymogramParams { length_m: case.mesh.length_m, nodes: case.mesh.nodes(), dt_s: src.frame_interval_s, plane: ClipPlane::Xz };
+            let params = KymogramParams { length_m: case.mesh.length_m, nodes: case.mesh.nodes(), dt_s: src.frame_interval_s, plane: ClipPlane::Xz, scale_to_length: true };
             read_kymogram(&src.file, &params)?
         }
         ClipKind::Recording => read_recording(&src.file, src.frame_interval_s)?,

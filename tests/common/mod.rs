@@ -32,3 +32,23 @@ pub fn sig(v: f64, digits: i32) -> f64 {
     let f = 10f64.powi(p);
     (v * f).round() / f
 }
+
+/// A case file of `cases/` read from disk (relative paths inside it resolve against `cases/`).
+pub fn case_file(name: &str) -> Case {
+    Case::from_file(&cases_dir().join(format!("{name}.toml"))).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// Are the worm clips of `scripts/fetch_worm_data.sh` present? Prints a notice when not.
+pub fn worm_data_present(test: &str) -> bool {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/elegansbot");
+    let ok = ["kymogram_omega-turn.npy", "kymogram_delta-turn.npy"].iter().all(|f| dir.join(f).is_file());
+    if !ok {
+        eprintln!("{test}: SKIPPED: the worm clips are not in {} (run scripts/fetch_worm_data.sh)", dir.display());
+    }
+    ok
+}
+
+/// Is this case a recorded clip (`[clip]`)?
+pub fn is_clip(case: &Case) -> bool {
+    matches!(case.inverse().map(|i| &i.data), Some(cosserat::case::DataSource::Clip(_)))
+}
