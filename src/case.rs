@@ -73,6 +73,17 @@ struct RawClip {
     /// `[first, end)` frame range
     frames: Option<[usize; 2]>,
     min_cos_beta: f64,
+    /// "previous_frame" (default) or "data_guess"
+    #[serde(default)]
+    start: RawStart,
+}
+
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default)]
+#[serde(rename_all = "snake_case")]
+enum RawStart {
+    #[default]
+    PreviousFrame,
+    DataGuess,
 }
 
 #[derive(Debug, Deserialize)]
@@ -300,6 +311,8 @@ pub struct ClipSource {
     pub frames: Option<(usize, usize)>,
     /// chart guard: stop when |cos β| < this at any node (`solve::sequence`)
     pub min_cos_beta: f64,
+    /// initial iterate of the frames after the first (D13)
+    pub start: crate::solve::sequence::FrameStart,
 }
 
 /// An inverse analysis (Problem 2, eq. 61): one frame of synthetic data, or a clip.
@@ -660,6 +673,10 @@ impl Validator<'_> {
                             frame_interval_s: self.positive("clip.frame_interval_s", &cl.frame_interval_s, c)?,
                             frames,
                             min_cos_beta: cl.min_cos_beta,
+                            start: match cl.start {
+                                RawStart::PreviousFrame => crate::solve::sequence::FrameStart::PreviousFrame,
+                                RawStart::DataGuess => crate::solve::sequence::FrameStart::DataGuess,
+                            },
                         })
                     }
                     (Some(_), Some(_)) => return Err(self.err("clip", "give either [data] (synthetic) or [clip] (recorded), not both")),

@@ -199,6 +199,7 @@ fn cmd_run_clip(case: &Case, engine: Engine, dir: &Path, quiet: bool) -> Result<
         }
     };
     cosserat::output::write_clip_plot(case, &run.reports, &run.roughness, &dir.join("plot.svg"))?;
+    cosserat::output::write_clip_kymographs(case, &run, &dir.join("kymograph.svg"))?;
     let n = run.reports.len();
     let its: Vec<usize> = run.reports.iter().map(|r| r.iterations).collect();
     let worst = run.reports.iter().map(|r| r.x_err_rel).fold(0.0, f64::max);

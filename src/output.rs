@@ -288,9 +288,9 @@ pub struct ClipWriter {
 }
 
 /// Columns of `frames.csv`.
-pub const CLIP_FRAME_COLUMNS: [&str; 18] = [
+pub const CLIP_FRAME_COLUMNS: [&str; 19] = [
     "frame", "time_s", "iterations", "rel_change", "x_err_rel", "tangent_misfit_m05", "j_tracking", "j_force", "j_torque", "j_shear", "j_bending", "j_angular", "j_total",
-    "min_abs_cos_beta", "min_abs_cos_beta_node", "max_abs_j_minus_1", "kappa_roughness", "data_kappa_roughness",
+    "min_abs_cos_beta", "min_abs_cos_beta_node", "max_abs_j_minus_1", "kappa_roughness", "data_kappa_roughness", "restarted",
 ];
 
 impl ClipWriter {
@@ -336,7 +336,7 @@ impl ClipWriter {
         let r = report;
         let mut row = vec![r.frame as f64, time_s, r.iterations as f64, r.last_change, r.x_err_rel, r.tangent_misfit];
         row.extend(r.objective.values());
-        row.extend([r.min_cos_beta, r.min_cos_beta_node as f64, r.max_stretch_deviation, roughness.0, roughness.1]);
+        row.extend([r.min_cos_beta, r.min_cos_beta_node as f64, r.max_stretch_deviation, roughness.0, roughness.1, f64::from(u8::from(r.restarted))]);
         let line: Vec<String> = row.iter().map(|v| format!("{v:.10e}")).collect();
         writeln!(self.frames, "{}", line.join(",")).and_then(|_| self.frames.flush()).map_err(err("frames.csv"))?;
         let d = nodes.directors();
@@ -403,4 +403,41 @@ pub fn write_clip_plot(case: &Case, reports: &[crate::solve::sequence::FrameRepo
         plot("roughness of the curvature (sign alternation of its differences)".into(), "fraction of elements", vec![s("recovered kappa_2", roughness.iter().map(|r| r.0).collect()), s("data", roughness.iter().map(|r| r.1).collect())], false),
     ];
     write_panels_svg(&panels, 2, path).map_err(|e| OutputError::Plot { path: path.to_path_buf(), reason: e.to_string() })
+}
+
+/// Kymographs of a planar clip (Fig. 17 style): the data's curvature and the recovered κ2 over
+/// frames (x) and arc length (y), on one colour scale (±the 99th percentile of |data|). At most
+/// ~150 frames and 64 positions are drawn (strided) to keep the SVG small.
+pub fn write_clip_kymographs(case: &Case, run: &crate::run::ClipRun, path: &Path) -> Result<(), OutputError> {
+    use crate::plot::{write_heatmaps_svg, Heatmap};
+    let nf = run.kappa2.len();
+    if nf < 2 {
+        return Ok(());
+    }
+    let fs = nf.div_ceil(150);
+    let frames: Vec<usize> = (0..nf).step_by(fs).collect();
+    let x: Vec<f64> = frames.iter().map(|&i| run.reports[i].frame as f64).collect();
+    let h = case.mesh.h();
+    let grid = |field: &Vec<Vec<f64>>, s_of: &dyn Fn(usize) -> f64| {
+        let m = field[0].len();
+        let ss = m.div_ceil(64);
+        let cols: Vec<usize> = (0..m).step_by(ss).collect();
+        let y: Vec<f64> = cols.iter().map(|&j| s_of(j) * 1e3).collect();
+        let values: Vec<Vec<f64>> = frames.iter().map(|&i| cols.iter().map(|&j| field[i][j]).collect()).collect();
+        (y, values)
+    };
+    let mut all: Vec<f64> = run.data_kappa.iter().flatten().map(|v| v.abs()).filter(|v| v.is_finite()).collect();
+    all.sort_by(f64::total_cmp);
+    let limit = all.get((all.len() as f64 * 0.99) as usize).copied().unwrap_or(1.0);
+    let (yd, vd) = grid(&run.data_kappa, &|j| (j + 1) as f64 * h);
+    let (yr, vr) = grid(&run.kappa2, &|j| (j as f64 + 0.5) * h);
+    let map = |title: String, y: Vec<f64>, values: Vec<Vec<f64>>| Heatmap { title, x_label: "frame".into(), y_label: "s [mm]".into(), x: x.clone(), y, values, limit };
+    write_heatmaps_svg(
+        &[
+            map(format!("{}: data curvature [1/m], colour ±{limit:.0}", case.name), yd, vd),
+            map("recovered kappa_2 [1/m]".into(), yr, vr),
+        ],
+        path,
+    )
+    .map_err(|e| OutputError::Plot { path: path.to_path_buf(), reason: e.to_string() })
 }

@@ -515,3 +515,64 @@ mod tests {
         let _ = std::fs::remove_dir_all(path.parent().expect("dir"));
     }
 }
+
+/// A value field over a regular grid drawn as coloured cells (a kymograph): `values[i][j]` at
+/// `(x[i], y[j])`, a diverging colour map symmetric about 0 (blue < 0 < red), clipped at
+/// `±limit`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Heatmap {
+    pub title: String,
+    pub x_label: String,
+    pub y_label: String,
+    pub x: Vec<f64>,
+    pub y: Vec<f64>,
+    pub values: Vec<Vec<f64>>,
+    pub limit: f64,
+}
+
+fn diverging(v: f64, limit: f64) -> RGBColor {
+    let t = if limit > 0.0 && v.is_finite() { (v / limit).clamp(-1.0, 1.0) } else { 0.0 };
+    let (r, g, b) = if t >= 0.0 { (1.0, 1.0 - t, 1.0 - t) } else { (1.0 + t, 1.0 + t, 1.0) };
+    RGBColor((r * 255.0) as u8, (g * 255.0) as u8, (b * 255.0) as u8)
+}
+
+/// Writes heatmaps side by side (one row) into one SVG at `path`.
+pub fn write_heatmaps_svg(maps: &[Heatmap], path: &Path) -> Result<(), PlotError> {
+    if maps.is_empty() {
+        return Err(PlotError::InvalidGrid { panels: 0, cols: 0 });
+    }
+    for m in maps {
+        if m.x.len() < 2 || m.y.len() < 2 || m.values.len() != m.x.len() || m.values.iter().any(|r| r.len() != m.y.len()) {
+            return Err(PlotError::LengthMismatch { title: m.title.clone(), series: "values".into(), x_len: m.x.len(), y_len: m.y.len() });
+        }
+    }
+    let size = (PLOT_SIZE.0 * maps.len() as u32, PLOT_SIZE.1);
+    let title = maps[0].title.clone();
+    let svg = render(size, &title, |root| {
+        for (m, area) in maps.iter().zip(root.split_evenly((1, maps.len()))) {
+            let (x0, x1) = (m.x[0], m.x[m.x.len() - 1]);
+            let (y0, y1) = (m.y[0], m.y[m.y.len() - 1]);
+            let mut chart = ChartBuilder::on(&area)
+                .caption(&m.title, ("sans-serif", 20))
+                .margin(10)
+                .x_label_area_size(40)
+                .y_label_area_size(70)
+                .build_cartesian_2d(x0..x1, y0..y1)
+                .map_err(|e| draw_err(&m.title, e))?;
+            chart.configure_mesh().disable_mesh().x_desc(m.x_label.as_str()).y_desc(m.y_label.as_str()).draw().map_err(|e| draw_err(&m.title, e))?;
+            let half = |v: &[f64], i: usize| -> (f64, f64) {
+                let lo = if i == 0 { v[0] } else { 0.5 * (v[i - 1] + v[i]) };
+                let hi = if i + 1 == v.len() { v[i] } else { 0.5 * (v[i] + v[i + 1]) };
+                (lo, hi)
+            };
+            let cells = (0..m.x.len()).flat_map(|i| (0..m.y.len()).map(move |j| (i, j))).map(|(i, j)| {
+                let (xa, xb) = half(&m.x, i);
+                let (ya, yb) = half(&m.y, j);
+                Rectangle::new([(xa, ya), (xb, yb)], diverging(m.values[i][j], m.limit).filled())
+            });
+            chart.draw_series(cells).map_err(|e| draw_err(&m.title, e))?;
+        }
+        Ok(())
+    })?;
+    write_atomic(path, &svg)
+}

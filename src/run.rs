@@ -8,6 +8,7 @@ use crate::case::{Analysis, Case, ClipKind, DataSource, InverseMethod, InverseSe
 use crate::clip::{read_kymogram, read_recording, Clip, ClipError, ClipPlane, KymogramParams};
 use crate::output::{planar_xz_curvature, sign_alternation, ClipWriter, OutputError};
 use crate::solve::sequence::{solve_sequence, FrameMethod, FrameReport, SequenceError, SequenceParams};
+pub use crate::solve::sequence::FrameStart;
 use crate::data::{read_data, write_data, DataError};
 use crate::freefem::{self, FreeFemError};
 use crate::metrics::INNER_SKIP_ELEMENTS;
@@ -364,6 +365,10 @@ pub struct ClipRun {
     /// per frame: sign alternation of the recovered κ2 and of the data's planar curvature
     /// (`output::sign_alternation`)
     pub roughness: Vec<(f64, f64)>,
+    /// per frame: recovered κ2 at element midpoints and the data's planar curvature at the
+    /// interior nodes [1/m] (x–z clips: the bending curvature; `output::planar_xz_curvature`)
+    pub kappa2: Vec<Vec<f64>>,
+    pub data_kappa: Vec<Vec<f64>>,
     pub wall_time_s: f64,
     pub source: String,
 }
@@ -382,13 +387,15 @@ pub fn run_clip(case: &Case, out: &Path, mut progress: impl FnMut(usize, usize))
         InverseMethod::Newton { warm_start_tolerance, .. } => FrameMethod::Newton { warm_start_tolerance },
     };
     let first_frame = src.frames.map(|f| f.0).unwrap_or(0);
-    let sp = SequenceParams { frame: InverseParams { dt: src.frame_interval_s, ..params }, method, min_cos_beta: src.min_cos_beta, frame_offset: first_frame };
+    let sp = SequenceParams { frame: InverseParams { dt: src.frame_interval_s, ..params }, method, min_cos_beta: src.min_cos_beta, frame_offset: first_frame, start: src.start };
     let mut writer = ClipWriter::create(out)?;
     let total = clip.frame_count();
     let h = case.mesh.h();
     let start = Instant::now();
     let mut rough = Vec::new();
-    let result = solve_sequence(&problem, &sp, &clip.frames, &problem.reference_state(), |_, _| {}, |rep, sol| {
+    let (mut kappa2, mut data_kappa) = (Vec::new(), Vec::new());
+    let guess = crate::solve::sequence::data_frame_guess(&clip.frames[0]);
+    let result = solve_sequence(&problem, &sp, &clip.frames, &guess, |_, _| {}, |rep, sol| {
         let nodes = NodalState::from_vector(case, &sol.u);
         let (force, torque): (Vec<_>, Vec<_>) = (0..nodes.s.len())
             .map(|i| {
@@ -398,13 +405,16 @@ pub fn run_clip(case: &Case, out: &Path, mut progress: impl FnMut(usize, usize))
             .unzip();
         let data = &clip.frames[rep.frame - first_frame];
         let k2: Vec<f64> = nodes.element_curvature().iter().map(|(_, k)| k[1]).collect();
-        let roughness = (sign_alternation(&k2), sign_alternation(&planar_xz_curvature(data, h)));
+        let kd = planar_xz_curvature(data, h);
+        let roughness = (sign_alternation(&k2), sign_alternation(&kd));
         rough.push(roughness);
+        kappa2.push(k2);
+        data_kappa.push(kd);
         writer.frame(rep, rep.frame as f64 * clip.dt_s, &nodes, &force, &torque, data, roughness).map_err(|e| e.to_string())?;
         progress(rep.frame - first_frame + 1, total);
         Ok(())
     });
     writer.finish()?;
     let reports = result?;
-    Ok(ClipRun { reports, roughness: rough, wall_time_s: start.elapsed().as_secs_f64(), source: clip.source })
+    Ok(ClipRun { reports, roughness: rough, kappa2, data_kappa, wall_time_s: start.elapsed().as_secs_f64(), source: clip.source })
 }

@@ -43,7 +43,7 @@ fn quasi_static_clip_is_recovered_frame_by_frame() {
         truths.push(u);
     }
     let p = Problem::from_case(&case);
-    let sp = SequenceParams { frame: params(), method: FrameMethod::FixedPoint, min_cos_beta: 1e-3, frame_offset: 0 };
+    let sp = SequenceParams { frame: params(), method: FrameMethod::FixedPoint, min_cos_beta: 1e-3, frame_offset: 0, start: cosserat::solve::sequence::FrameStart::PreviousFrame };
     let mut streamed = 0;
     let reports = solve_sequence(&p, &sp, &frames, &p.reference_state(), |_, _| {}, |_, _| {
         streamed += 1;
@@ -78,6 +78,7 @@ fn chart_guard_names_frame_and_node() {
         method: FrameMethod::FixedPoint,
         min_cos_beta: 0.2,
         frame_offset: 0,
+        start: cosserat::solve::sequence::FrameStart::PreviousFrame,
     };
     let err = solve_sequence(&p, &sp, &[x_g], &DVector::from(p.reference_state()), |_, _| {}, |_, _| Ok(())).expect_err("the guard must fire");
     eprintln!("{err}");
@@ -88,5 +89,49 @@ fn chart_guard_names_frame_and_node() {
             assert!(node.abs_diff(singular) <= 8, "guard at node {node}, data singular near node {singular}");
         }
         other => panic!("expected the chart guard, got {other}"),
+    }
+}
+
+/// The data guess (D13): its d3 is the data tangent at every node, its angles have no 2π jumps,
+/// and for a planar curve in the x–z plane it is α = β = 0, γ = −θ.
+#[test]
+fn data_guess_follows_the_tangent_without_jumps() {
+    use cosserat::rotation::rotation;
+    use cosserat::solve::sequence::data_frame_guess;
+    // A planar spiral in the x–z plane turning by 7 rad (more than 2π).
+    let n = 200;
+    let h = 1e-3 / (n - 1) as f64;
+    let mut x = vec![Vector3::zeros()];
+    let theta = |i: usize| 7.0 * (i as f64 / (n - 1) as f64).powi(2);
+    for i in 1..n {
+        let t = theta(i - 1) * 0.5 + theta(i) * 0.5;
+        let p = x[i - 1] + Vector3::new(t.sin(), 0.0, t.cos()) * h;
+        x.push(p);
+    }
+    let u = data_frame_guess(&x);
+    let mut worst_jump: f64 = 0.0;
+    for i in 0..n {
+        let a = Vector3::new(u[6 * i + 3], u[6 * i + 4], u[6 * i + 5]);
+        assert!(a[0].abs() < 1e-12 && a[1].abs() < 1e-12, "node {i}: {a:?}");
+        let (lo, hi) = (i.saturating_sub(1), (i + 1).min(n - 1));
+        let t = (x[hi] - x[lo]).normalize();
+        assert!((rotation(&a).row(2).transpose() - t).norm() < 1e-12, "node {i}: d3 is not the tangent");
+        if i > 0 {
+            worst_jump = worst_jump.max((u[6 * i + 5] - u[6 * i - 1]).abs());
+        }
+    }
+    assert!(worst_jump < 0.1, "{worst_jump}");
+    assert!((u[6 * (n - 1) + 5] + 7.0).abs() < 0.05, "γ at the end {} (θ ≈ 7)", u[6 * (n - 1) + 5]);
+    // A 3D helix: d3 is the tangent at every node.
+    let helix: Vec<Vector3<f64>> = (0..n).map(|i| {
+        let s = i as f64 * h * 5e3;
+        Vector3::new(s.cos(), s.sin(), 0.3 * s) * 2e-4
+    }).collect();
+    let u = data_frame_guess(&helix);
+    for i in 0..n {
+        let a = Vector3::new(u[6 * i + 3], u[6 * i + 4], u[6 * i + 5]);
+        let (lo, hi) = (i.saturating_sub(1), (i + 1).min(n - 1));
+        let t = (helix[hi] - helix[lo]).normalize();
+        assert!((rotation(&a).row(2).transpose() - t).norm() < 1e-9, "helix node {i}");
     }
 }

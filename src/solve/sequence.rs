@@ -6,7 +6,11 @@
 //! guarded, and a frame whose recovered β comes within `min_cos_beta` of ±π/2 at any node
 //! stops the clip with an error naming frame and node (the failure is otherwise silent: the
 //! fit stays good while α and κ3 explode, PAPER-NOTES).
-use nalgebra::{DVector, Vector3};
+use std::f64::consts::PI;
+
+use nalgebra::{DVector, Matrix3, Vector3};
+
+use crate::rotation::angles_from_rotation;
 
 use super::inverse::{solve_frame_observed, InverseParams, InverseRecord, InverseSolution, ObjectiveTerms};
 use super::inverse_newton::solve_frame_warm;
@@ -32,6 +36,17 @@ pub struct SequenceParams {
     pub min_cos_beta: f64,
     /// number of the first frame in reports and errors (the clip's frame range may not start at 0)
     pub frame_offset: usize,
+    /// initial iterate of every frame after the first
+    pub start: FrameStart,
+}
+
+/// Initial iterate of the frames after the first.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FrameStart {
+    /// the previous frame's solution (restart from the data guess if that fails)
+    PreviousFrame,
+    /// [`data_frame_guess`] of the frame itself (D13)
+    DataGuess,
 }
 
 /// Per-frame report.
@@ -50,6 +65,8 @@ pub struct FrameReport {
     pub min_cos_beta_node: usize,
     /// max over elements of |j − 1|, j = |Δx_g|/h the data's stretch (Remark 9)
     pub max_stretch_deviation: f64,
+    /// the frame failed from the previous frame's solution and was solved from the data guess
+    pub restarted: bool,
     pub wall_time_s: f64,
 }
 
@@ -74,8 +91,58 @@ pub fn max_stretch_deviation(x_g: &[Vector3<f64>], h: f64) -> f64 {
     x_g.windows(2).map(|w| ((w[1] - w[0]).norm() / h - 1.0).abs()).fold(0.0, f64::max)
 }
 
+/// An initial iterate read off the data (D13): x = x_g, and at each node the frame whose d3
+/// is the data tangent (central differences), carried along the rod by parallel transport
+/// (the minimal rotation between neighbouring tangents) from the frame at s = 0 that turns e3
+/// minimally onto the first tangent; angles from [`angles_from_rotation`], each unwrapped
+/// against the previous node (no 2π jumps). For a planar clip in the x–z plane this is
+/// α = β = 0, γ = −θ (θ the tangent angle from e3 towards e1).
+pub fn data_frame_guess(x_g: &[Vector3<f64>]) -> DVector<f64> {
+    let n = x_g.len();
+    let tangent = |i: usize| {
+        let (a, b) = (i.saturating_sub(1), (i + 1).min(n - 1));
+        (x_g[b] - x_g[a]).normalize()
+    };
+    // Rotation taking unit a to unit b minimally (Rodrigues); rows of Q are the directors, so
+    // the director frame transforms as Q → Q Rᵀ.
+    let minimal = |a: &Vector3<f64>, b: &Vector3<f64>| -> Matrix3<f64> {
+        let v = a.cross(b);
+        let c = a.dot(b);
+        if (1.0 + c).abs() < 1e-12 {
+            // opposite: half turn about any axis normal to a
+            let axis = if a.x.abs() < 0.9 { Vector3::x() } else { Vector3::y() };
+            let k = a.cross(&axis).normalize();
+            return Matrix3::identity() * -1.0 + k * k.transpose() * 2.0;
+        }
+        let vx = crate::rotation::skew(&v);
+        Matrix3::identity() + vx + vx * vx / (1.0 + c)
+    };
+    let mut u = DVector::zeros(6 * n);
+    let mut q = Matrix3::identity(); // rows d1, d2, d3; d3 = e3
+    let mut prev_t = Vector3::z();
+    let mut prev_a: Option<Vector3<f64>> = None;
+    for i in 0..n {
+        let t = tangent(i);
+        q *= minimal(&prev_t, &t).transpose();
+        prev_t = t;
+        let mut a = angles_from_rotation(&q);
+        if let Some(p) = prev_a {
+            for k in 0..3 {
+                a[k] += (2.0 * PI) * ((p[k] - a[k]) / (2.0 * PI)).round();
+            }
+        }
+        prev_a = Some(a);
+        for k in 0..3 {
+            u[6 * i + k] = x_g[i][k];
+            u[6 * i + 3 + k] = a[k];
+        }
+    }
+    u
+}
+
 /// Solve every frame of `frames` (positions per node, the mesh's nodes) in order. `u0` is the
-/// initial iterate of the first frame. `on_frame` receives each converged frame (e.g. to stream
+/// initial iterate of the first frame (e.g. [`data_frame_guess`]); every later frame starts
+/// from the previous frame's solution and, if that fails, once more from the data guess. `on_frame` receives each converged frame (e.g. to stream
 /// it to disk) and may stop the clip by returning an error message; `on_iteration` sees
 /// every iteration's record.
 pub fn solve_sequence(
@@ -95,10 +162,24 @@ pub fn solve_sequence(
         let k = i + sp.frame_offset;
         let start = std::time::Instant::now();
         let p = InverseParams { first_frame: i == 0, frame: k, ..sp.frame };
-        let report = |r: &InverseRecord, _: &DVector<f64>, _: &DVector<f64>| on_iteration(k, r);
-        let sol = match sp.method {
-            FrameMethod::FixedPoint => solve_frame_observed(problem, &p, x_g, &prev, &u, report)?,
-            FrameMethod::Newton { warm_start_tolerance } => solve_frame_warm(problem, &p, warm_start_tolerance, x_g, &prev, &u, report)?,
+        let mut solve = |start: &DVector<f64>, warm: bool| -> Result<InverseSolution, SolveError> {
+            let report = |r: &InverseRecord, _: &DVector<f64>, _: &DVector<f64>| on_iteration(k, r);
+            match sp.method {
+                FrameMethod::FixedPoint => solve_frame_observed(problem, &p, x_g, &prev, start, report),
+                // From the previous frame's solution (already close) Newton runs directly; from
+                // a guess it needs the fixed point's warm start (I8).
+                FrameMethod::Newton { .. } if warm => super::inverse_newton::solve_frame_newton_observed(problem, &p, x_g, &prev, start, report),
+                FrameMethod::Newton { warm_start_tolerance } => solve_frame_warm(problem, &p, warm_start_tolerance, x_g, &prev, start, report),
+            }
+        };
+        // A frame that does not converge from the previous frame's solution is solved again
+        // from the data guess (D13), and the restart is reported.
+        let from_previous = i > 0 && sp.start == FrameStart::PreviousFrame;
+        let first_start = if i > 0 && !from_previous { data_frame_guess(x_g) } else { u.clone() };
+        let (sol, restarted) = match solve(&first_start, from_previous) {
+            Ok(sol) => (sol, false),
+            Err(SolveError::InverseNotConverged { .. } | SolveError::InverseNewtonNotConverged { .. } | SolveError::InverseNonFinite { .. }) if from_previous => (solve(&data_frame_guess(x_g), false)?, true),
+            Err(e) => return Err(e.into()),
         };
         let (cos_beta, node) = min_cos_beta(&sol.u);
         if cos_beta < sp.min_cos_beta {
@@ -115,6 +196,7 @@ pub fn solve_sequence(
             min_cos_beta: cos_beta,
             min_cos_beta_node: node,
             max_stretch_deviation: max_stretch_deviation(x_g, h),
+            restarted,
             wall_time_s: start.elapsed().as_secs_f64(),
         };
         on_frame(&rep, &sol).map_err(|message| SequenceError::Callback { frame: k, message })?;
