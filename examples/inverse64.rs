@@ -16,7 +16,7 @@ fn main() {
     let params = InverseParams {
         lambda_g: 1e9, lambda_f: 1.0, lambda_l: 1e-10, lambda_d: 1e-6,
         lambda_kappa: Vector3::new(0.0, 0.0, 1e-10), lambda_omega: Vector3::zeros(), dt: 1.0,
-        first_frame: true, alpha0: 0.0, frame: 0, relaxation: 0.5, tolerance: std::env::args().nth(2).and_then(|a| a.parse().ok()).unwrap_or(1e-12), max_iterations: maxit,
+        first_frame: true, alpha0: 0.0, frame: 0, stabilisation: 0.0, relaxation: 0.5, tolerance: std::env::args().nth(2).and_then(|a| a.parse().ok()).unwrap_or(1e-12), max_iterations: maxit,
     };
     let t0 = std::time::Instant::now();
     let r = solve_frame(&p, &params, &xg, &prev, &p.reference_state(), |rec| {
