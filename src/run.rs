@@ -339,6 +339,9 @@ pub fn run_inverse_on(case: &Case, engine: Engine, data_path: &Path, workdir: &P
 pub fn load_clip(case: &Case) -> Result<Clip, RunError> {
     let settings = case.inverse().ok_or_else(|| SolveError::NotInverse(case.name.clone()))?;
     let DataSource::Clip(src) = &settings.data else { return Err(SolveError::NotInverse(case.name.clone()).into()) };
+    if !src.file.is_file() {
+        return Err(RunError::ClipShape(format!("{} does not exist (the elegansbot kymograms are fetched and checksum-verified by scripts/fetch_worm_data.sh)", src.file.display())));
+    }
     let mut clip = match src.kind {
         ClipKind::Kymogram => {
             let params = KymogramParams { length_m: case.mesh.length_m, nodes: case.mesh.nodes(), dt_s: src.frame_interval_s, plane: ClipPlane::Xz, scale_to_length: true };
