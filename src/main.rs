@@ -151,7 +151,7 @@ fn run_engine(case: &Case, engine: Engine, dir: &Path, data: Option<&Path>, quie
         None => cosserat::run::run(case, engine, &work, progress),
     };
     pb.finish_and_clear();
-    Ok(result.with_context(|| format!("case {}", case.name))?)
+    result.with_context(|| format!("case {}", case.name))
 }
 
 fn cmd_run(path: &Path, engine: Engine, out: Option<PathBuf>, quiet: bool) -> Result<ExitCode> {

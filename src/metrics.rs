@@ -56,7 +56,7 @@ pub fn inverse_metrics(r: &RunResult) -> Metrics {
         m.insert("kappa_err_rel_inner".into(), relative_error(&k, &kf, INNER_SKIP_ELEMENTS));
     }
     for (name, v) in ObjectiveTerms::NAMES.iter().zip(last.objective.values()) {
-        m.insert(format!("{name}"), v);
+        m.insert(name.to_string(), v);
     }
     m.insert("force_l2_n_per_m05".into(), (2.0 * last.objective.force / inv.lambda_f).sqrt());
     m.insert("torque_l2_n_m05".into(), (2.0 * last.objective.torque / inv.lambda_l).sqrt());
