@@ -251,39 +251,19 @@ pub fn solve_frame_observed(
     u0: &DVector<f64>,
     mut progress: impl FnMut(&InverseRecord, &DVector<f64>, &DVector<f64>),
 ) -> Result<InverseSolution, SolveError> {
-    let mesh = problem.mesh;
-    let nodes = mesh.nodes();
-    let pattern = Pattern::with_block(&mesh, BLOCK);
-    let solver = LinearSolver::new(&pattern)?;
-    let fixed = dirichlet(p, x_g);
-    let rows: Vec<usize> = fixed.iter().map(|f| f.0).collect();
+    let mut kkt = KktSolve::new(problem, p, x_g)?;
     let mut u = u0.clone();
-    let mut values = vec![0.0; pattern.nnz()];
     let mut history = Vec::new();
-    let mut adjoint = DVector::zeros(6 * nodes);
     for k in 1..=p.max_iterations {
-        let mut rhs = assemble_kkt(problem, p, &pattern, &mut values, &u, x_g, alpha_prev);
-        for &(d, v) in &fixed {
-            rhs[d] = v;
-        }
-        pattern.set_identity_rows(&mut values, &rows);
-        let sol = solver.solve_equilibrated(&values, &rhs)?;
-        let mut u_new = DVector::zeros(6 * nodes);
-        for node in 0..nodes {
-            for c in 0..6 {
-                u_new[6 * node + c] = sol[BLOCK * node + c];
-                adjoint[6 * node + c] = sol[BLOCK * node + 6 + c];
-            }
-        }
+        let sol = kkt.solve_at(problem, p, &u, x_g, alpha_prev)?;
+        let (u_new, adjoint) = (part(&sol, false), part(&sol, true));
         let u_next = &u_new * p.relaxation + &u * (1.0 - p.relaxation);
         let rel_change = relative_change(&u_next, &u);
         u = u_next;
         if !rel_change.is_finite() || u.iter().chain(adjoint.iter()).any(|v| !v.is_finite()) {
             return Err(SolveError::InverseNonFinite { frame: p.frame, iteration: k });
         }
-        let (x_err_rel, tangent_misfit) = fit_measures(problem, p, &u, x_g);
-        let objective = objective_terms(problem, p, &u, &adjoint, x_g, alpha_prev);
-        let rec = InverseRecord { iteration: k, rel_change, x_err_rel, tangent_misfit, objective, residual: None };
+        let rec = record(problem, p, k, rel_change, &u, &adjoint, x_g, alpha_prev, None);
         progress(&rec, &u, &adjoint);
         history.push(rec);
         if rel_change <= p.tolerance {
@@ -291,6 +271,63 @@ pub fn solve_frame_observed(
         }
     }
     Err(SolveError::InverseNotConverged { frame: p.frame, iterations: p.max_iterations, rel_change: history.last().map(|h| h.rel_change).unwrap_or(f64::NAN) })
+}
+
+/// The linear KKT solve of one fixed-point iteration (I4–I6): sparsity pattern, symbolic LU
+/// and Dirichlet rows set up once, the matrix assembled at each state.
+pub(crate) struct KktSolve {
+    pub(crate) pattern: Pattern,
+    pub(crate) solver: LinearSolver,
+    pub(crate) fixed: Vec<(usize, f64)>,
+    rows: Vec<usize>,
+    pub(crate) values: Vec<f64>,
+}
+
+impl KktSolve {
+    pub(crate) fn new(problem: &Problem, p: &InverseParams, x_g: &[Vector3<f64>]) -> Result<Self, SolveError> {
+        let pattern = Pattern::with_block(&problem.mesh, BLOCK);
+        let solver = LinearSolver::new(&pattern)?;
+        let fixed = dirichlet(p, x_g);
+        let rows = fixed.iter().map(|f| f.0).collect();
+        let values = vec![0.0; pattern.nnz()];
+        Ok(KktSolve { pattern, solver, fixed, rows, values })
+    }
+
+    /// Solve `K(u) U = r(u)` with the boundary conditions of I5 (equilibrated, I6); `U` has
+    /// [`BLOCK`] unknowns per node.
+    pub(crate) fn solve_at(&mut self, problem: &Problem, p: &InverseParams, u: &DVector<f64>, x_g: &[Vector3<f64>], alpha_prev: &[Vector3<f64>]) -> Result<DVector<f64>, SolveError> {
+        let mut rhs = assemble_kkt(problem, p, &self.pattern, &mut self.values, u, x_g, alpha_prev);
+        for &(d, v) in &self.fixed {
+            rhs[d] = v;
+        }
+        self.pattern.set_identity_rows(&mut self.values, &self.rows);
+        Ok(self.solver.solve_equilibrated(&self.values, &rhs)?)
+    }
+}
+
+/// The state (`hat = false`) or adjoint part, 6 per node, of a KKT vector ([`BLOCK`] per node).
+pub(crate) fn part(big: &DVector<f64>, hat: bool) -> DVector<f64> {
+    let off = if hat { 6 } else { 0 };
+    DVector::from_fn(big.len() / 2, |i, _| big[BLOCK * (i / 6) + off + i % 6])
+}
+
+/// The per-iteration record at the state `u` with the adjoint `adjoint` (fit measures and the
+/// objective terms of (41)).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn record(
+    problem: &Problem,
+    p: &InverseParams,
+    iteration: usize,
+    rel_change: f64,
+    u: &DVector<f64>,
+    adjoint: &DVector<f64>,
+    x_g: &[Vector3<f64>],
+    alpha_prev: &[Vector3<f64>],
+    residual: Option<f64>,
+) -> InverseRecord {
+    let (x_err_rel, tangent_misfit) = fit_measures(problem, p, u, x_g);
+    let objective = objective_terms(problem, p, u, adjoint, x_g, alpha_prev);
+    InverseRecord { iteration, rel_change, x_err_rel, tangent_misfit, objective, residual }
 }
 
 /// Dirichlet unknowns of I5 in KKT numbering with their values: `x = x_g` and `x̂ = α̂ = 0`

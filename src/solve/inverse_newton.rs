@@ -25,12 +25,11 @@
 use nalgebra::{DVector, Matrix3, Vector3};
 
 use super::inverse::{
-    assemble_blocks, dirichlet, element_system, fit_measures, kkt, objective_terms, tangent_rule, InverseParams, InverseRecord, InverseSolution, KktMat, KktVec,
-    BLOCK,
+    assemble_blocks, dirichlet, element_system, kkt, part, record, tangent_rule, InverseParams, InverseRecord, InverseSolution, KktMat, KktSolve, KktVec, BLOCK,
 };
 use super::statics::relative_change;
 use super::{Problem, SolveError};
-use crate::assembly::{LinearSolver, Pattern};
+use crate::assembly::Pattern;
 use crate::element::{frozen_operator, internal_force, interpolate, LocalMat, LocalVec};
 use crate::mesh::GAUSS2;
 use crate::rotation::{a_matrix, a_matrix_derivatives, d3, d3_second_derivatives, rotation, rotation_derivatives, skew};
@@ -177,10 +176,6 @@ pub fn assemble_newton(
 
 /// The state `(x, α)` (`hat = false`) or the adjoint `(x̂, α̂)` (`hat = true`), 6 per node, of
 /// a KKT vector (12 per node).
-fn part(big: &DVector<f64>, hat: bool) -> DVector<f64> {
-    let off = if hat { 6 } else { 0 };
-    DVector::from_fn(big.len() / 2, |i, _| big[BLOCK * (i / 6) + off + i % 6])
-}
 
 /// Solve one frame by Newton (I8) from the state `u0` (6 per node). The adjoint is started
 /// consistently by one linear solve of the fixed point, `K(u0) U = r(u0)` (I4). Arguments and
@@ -207,19 +202,11 @@ pub fn solve_frame_newton_observed(
     u0: &DVector<f64>,
     mut progress: impl FnMut(&InverseRecord, &DVector<f64>, &DVector<f64>),
 ) -> Result<InverseSolution, SolveError> {
-    let pattern = Pattern::with_block(&problem.mesh, BLOCK);
-    let solver = LinearSolver::new(&pattern)?;
-    let fixed = dirichlet(p, x_g);
-    let rows: Vec<usize> = fixed.iter().map(|f| f.0).collect();
-    let mut values = vec![0.0; pattern.nnz()];
-    let mut scratch = vec![0.0; pattern.nnz()];
     // Consistent start: one linear solve of the fixed point at u0.
-    let mut rhs = super::inverse::assemble_kkt(problem, p, &pattern, &mut values, u0, x_g, alpha_prev);
-    for &(d, v) in &fixed {
-        rhs[d] = v;
-    }
-    pattern.set_identity_rows(&mut values, &rows);
-    let mut big = solver.solve_equilibrated(&values, &rhs)?;
+    let mut kkt = KktSolve::new(problem, p, x_g)?;
+    let mut big = kkt.solve_at(problem, p, u0, x_g, alpha_prev)?;
+    let KktSolve { pattern, solver, mut values, .. } = kkt;
+    let mut scratch = vec![0.0; pattern.nnz()];
     let mut history = Vec::new();
     let mut weights: Option<Vec<f64>> = None;
     let mut phi0 = f64::NAN;
@@ -253,10 +240,8 @@ pub fn solve_frame_newton_observed(
             return Err(SolveError::InverseNonFinite { frame: p.frame, iteration: k });
         }
         let adjoint = part(&big, true);
-        let (x_err_rel, tangent_misfit) = fit_measures(problem, p, &u, x_g);
-        let objective = objective_terms(problem, p, &u, &adjoint, x_g, alpha_prev);
         last = phi_t / phi0;
-        let rec = InverseRecord { iteration: k, rel_change, x_err_rel, tangent_misfit, objective, residual: Some(last) };
+        let rec = record(problem, p, k, rel_change, &u, &adjoint, x_g, alpha_prev, Some(last));
         progress(&rec, &u, &adjoint);
         history.push(rec);
         if full {
