@@ -2,8 +2,7 @@
 mod common;
 
 use common::{case_from, case_text};
-use cosserat::solve::inverse::{curvature_error, solve_frame, InverseParams, InverseRecord};
-use cosserat::solve::statics::{self, Method, StaticParams};
+use cosserat::solve::inverse::{curvature_error, solve_frame, InverseRecord};
 use cosserat::solve::{node_values, Problem};
 use nalgebra::Vector3;
 
@@ -16,30 +15,14 @@ use nalgebra::Vector3;
 fn recovers_eq64_frames_from_the_centreline() {
     let case = case_from(&case_text("follower_bend_64"), "f64");
     let p = Problem::from_case(&case);
-    let fwd = statics::solve(&p, &StaticParams { method: Method::Newton, tolerance: 1e-13, max_iterations: 40, continuation_steps: 5 }, |_| {}).expect("forward data");
+    let (fwd_u, xg) = common::forward_data(&case, 5);
     let n = case.mesh.nodes();
-    let xg: Vec<Vector3<f64>> = (0..n).map(|i| node_values(&fwd.u, i).0).collect();
-    let params = InverseParams {
-        lambda_g: 1e9,
-        lambda_f: 1.0,
-        lambda_l: 1e-10,
-        lambda_d: 1e-6,
-        lambda_kappa: Vector3::new(0.0, 0.0, 1e-10),
-        lambda_omega: Vector3::zeros(),
-        dt: 1.0,
-        first_frame: true,
-        alpha0: 0.0,
-        frame: 0,
-        stabilisation: 0.0,
-        relaxation: 0.5,
-        tolerance: 3e-6,
-        max_iterations: 1000,
-    };
+    let params = common::paper_params_64();
     let mut hist: Vec<InverseRecord> = Vec::new();
     let sol = solve_frame(&p, &params, &xg, &vec![Vector3::zeros(); n], &p.reference_state(), |r| hist.push(*r)).expect("inverse");
     let at = |k: usize| hist[k - 1].rel_change;
     let last = sol.history.last().expect("history");
-    let (k_all, k_inner) = (curvature_error(&p, &sol.u, &fwd.u, 0), curvature_error(&p, &sol.u, &fwd.u, 5));
+    let (k_all, k_inner) = (curvature_error(&p, &sol.u, &fwd_u, 0), curvature_error(&p, &sol.u, &fwd_u, 5));
     eprintln!(
         "eq. 64 inverse: change {:.2e} @50, {:.2e} @200; stopped after {} iterations; |x-xg|/|xg| {:.2e}; |x'-d3| {:.2e}; kappa error {k_all:.3} (without 5 end elements {k_inner:.3})",
         at(50),
@@ -72,28 +55,12 @@ fn adjoint_gradient_matches_finite_differences() {
     let text = common::edit(&case_text("follower_bend_64"), "elements = 100", "elements = 10");
     let case = case_from(&text, "f64_10");
     let p = Problem::from_case(&case);
-    let fwd = statics::solve(&p, &StaticParams { method: Method::Newton, tolerance: 1e-13, max_iterations: 40, continuation_steps: 5 }, |_| {}).expect("forward");
+    let (fwd_u, xg) = common::forward_data(&case, 5);
     let nodes = case.mesh.nodes();
-    let xg: Vec<Vector3<f64>> = (0..nodes).map(|i| node_values(&fwd.u, i).0).collect();
-    let prev: Vec<Vector3<f64>> = (0..nodes).map(|i| node_values(&fwd.u, i).1 * 0.9).collect();
+    let prev: Vec<Vector3<f64>> = (0..nodes).map(|i| node_values(&fwd_u, i).1 * 0.9).collect();
     // A frozen iterate near, not at, the data; every term of (41) switched on.
-    let uk = DVector::from_fn(6 * nodes, |i, _| fwd.u[i] + if i % 6 >= 3 { 0.05 * ((i as f64) * 0.7).sin() } else { 0.0 });
-    let params = InverseParams {
-        lambda_g: 1e9,
-        lambda_f: 1e-2,
-        lambda_l: 1e-6,
-        lambda_d: 1e-3,
-        lambda_kappa: Vector3::new(1e-12, 2e-12, 1e-10),
-        lambda_omega: Vector3::new(1e-9, 1e-9, 1e-8),
-        dt: 0.04,
-        first_frame: false,
-        alpha0: 0.0,
-        frame: 0,
-        stabilisation: 0.0,
-        relaxation: 0.5,
-        tolerance: 1e-6,
-        max_iterations: 1,
-    };
+    let uk = DVector::from_fn(6 * nodes, |i, _| fwd_u[i] + if i % 6 >= 3 { 0.05 * ((i as f64) * 0.7).sin() } else { 0.0 });
+    let params = common::all_terms_params();
     let pattern = Pattern::with_block(&case.mesh, BLOCK);
     let mut values = vec![0.0; pattern.nnz()];
     let rhs = assemble_kkt(&p, &params, &pattern, &mut values, &uk, &xg, &prev);

@@ -14,7 +14,6 @@ use common::{case_from, case_text, edit};
 use cosserat::case::Case;
 use cosserat::rotation::{angles_from_rotation, rotation};
 use cosserat::solve::inverse::{curvature_error, element_curvatures, solve_frame, InverseParams, InverseRecord};
-use cosserat::solve::statics::{self, Method, StaticParams};
 use cosserat::solve::{node_values, Problem};
 use nalgebra::{DVector, Matrix3, Rotation3, Unit, Vector3};
 use rayon::prelude::*;
@@ -34,9 +33,7 @@ impl Data {
         let text = case_text("follower_bend_64");
         let text = if elements == 100 { text } else { edit(&text, "elements = 100", &format!("elements = {elements}")) };
         let case = case_from(&text, "f64");
-        let newton = StaticParams { method: Method::Newton, tolerance: 1e-13, max_iterations: 40, continuation_steps: 5 };
-        let truth = statics::solve(&Problem::from_case(&case), &newton, |_| {}).expect("forward data").u;
-        let xg = (0..case.mesh.nodes()).map(|i| node_values(&truth, i).0).collect();
+        let (truth, xg) = common::forward_data(&case, 5);
         Data { case, truth, xg }
     }
     fn problem(&self) -> Problem<'_> {
@@ -45,22 +42,7 @@ impl Data {
 }
 
 fn paper() -> InverseParams {
-    InverseParams {
-        lambda_g: 1e9,
-        lambda_f: 1.0,
-        lambda_l: 1e-10,
-        lambda_d: 1e-6,
-        lambda_kappa: Vector3::new(0.0, 0.0, 1e-10),
-        lambda_omega: Vector3::zeros(),
-        dt: 1.0,
-        first_frame: true,
-        alpha0: 0.0,
-        frame: 0,
-        stabilisation: 0.0,
-        relaxation: 0.5,
-        tolerance: 3e-6,
-        max_iterations: CAP,
-    }
+    InverseParams { max_iterations: CAP, ..common::paper_params_64() }
 }
 
 /// One run of the fixed point with the state after every iteration.

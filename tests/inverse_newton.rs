@@ -3,39 +3,15 @@ mod common;
 
 use common::{case_from, case_text};
 use cosserat::assembly::{LinearSolver, Pattern};
-use cosserat::case::Case;
 use cosserat::solve::inverse::{curvature_error, element_curvatures, solve_frame, InverseParams, InverseRecord, BLOCK};
 use cosserat::solve::inverse_newton::{assemble_newton, solve_frame_newton};
-use cosserat::solve::statics::{self, Method, StaticParams};
 use cosserat::solve::{node_values, split_norms_inf, Problem};
 use nalgebra::{DVector, Vector3};
 
-/// Forward data by Newton with load continuation: the solution and its nodal positions.
-fn forward(case: &Case, steps: usize) -> (DVector<f64>, Vec<Vector3<f64>>) {
-    let p = Problem::from_case(case);
-    let fwd = statics::solve(&p, &StaticParams { method: Method::Newton, tolerance: 1e-13, max_iterations: 40, continuation_steps: steps }, |_| {}).expect("forward data");
-    let xg = (0..case.mesh.nodes()).map(|i| node_values(&fwd.u, i).0).collect();
-    (fwd.u, xg)
-}
 
-/// Paper §5.2, first test (as `tests/inverse.rs`).
+/// Paper §5.2, first test (`common::paper_params_64`), Newton stopping settings.
 fn paper_params_64() -> InverseParams {
-    InverseParams {
-        lambda_g: 1e9,
-        lambda_f: 1.0,
-        lambda_l: 1e-10,
-        lambda_d: 1e-6,
-        lambda_kappa: Vector3::new(0.0, 0.0, 1e-10),
-        lambda_omega: Vector3::zeros(),
-        dt: 1.0,
-        first_frame: true,
-        alpha0: 0.0,
-        frame: 0,
-        stabilisation: 0.0,
-        relaxation: 0.5,
-        tolerance: 1e-10,
-        max_iterations: 30,
-    }
+    InverseParams { tolerance: 1e-10, max_iterations: 30, ..common::paper_params_64() }
 }
 
 /// The exact Jacobian of I8 against central differences of the global residual (Dirichlet rows
@@ -62,25 +38,10 @@ fn jacobian_check(lambda_g: f64) -> (f64, f64) {
     let text = common::edit(&case_text("follower_bend_64"), "elements = 100", "elements = 10");
     let case = case_from(&text, "f64_10");
     let p = Problem::from_case(&case);
-    let (fwd, xg) = forward(&case, 5);
+    let (fwd, xg) = common::forward_data(&case, 5);
     let nodes = case.mesh.nodes();
     let prev: Vec<Vector3<f64>> = (0..nodes).map(|i| node_values(&fwd, i).1 * 0.9).collect();
-    let params = InverseParams {
-        lambda_g,
-        lambda_f: 1e-2,
-        lambda_l: 1e-6,
-        lambda_d: 1e-3,
-        lambda_kappa: Vector3::new(1e-12, 2e-12, 1e-10),
-        lambda_omega: Vector3::new(1e-9, 1e-9, 1e-8),
-        dt: 0.04,
-        first_frame: false,
-        alpha0: 0.0,
-        frame: 0,
-        stabilisation: 0.0,
-        relaxation: 0.5,
-        tolerance: 1e-6,
-        max_iterations: 1,
-    };
+    let params = InverseParams { lambda_g, ..common::all_terms_params() };
     let big = DVector::from_fn(BLOCK * nodes, |i, _| {
         let (n, c) = (i / BLOCK, i % BLOCK);
         let s = (i as f64 * 0.7).sin();
@@ -196,7 +157,7 @@ fn assert_fast(hist: &[InverseRecord], max_its: usize, floor: f64) {
 fn newton_converges_on_eq64_with_a_small_bending_weight() {
     let case = case_from(&case_text("follower_bend_64"), "f64");
     let p = Problem::from_case(&case);
-    let (fwd, xg) = forward(&case, 5);
+    let (fwd, xg) = common::forward_data(&case, 5);
     let params = InverseParams { lambda_kappa: Vector3::new(1e-14, 1e-14, 1e-10), ..paper_params_64() };
     let (hist, _, d, u) = newton_vs_fixed_point(&p, &params, &xg, 1e-4, 1e-9);
     let (k_all, k_inner) = (curvature_error(&p, &u, &fwd, 0), curvature_error(&p, &u, &fwd, 5));
@@ -211,7 +172,7 @@ fn newton_converges_on_eq64_with_a_small_bending_weight() {
 fn newton_converges_on_eq65() {
     let case = case_from(&case_text("follower_bend_twist_65"), "f65");
     let p = Problem::from_case(&case);
-    let (fwd, xg) = forward(&case, 10);
+    let (fwd, xg) = common::forward_data(&case, 10);
     let params = InverseParams { lambda_f: 1e-2, lambda_l: 1e-6, lambda_d: 1e-6, lambda_kappa: Vector3::repeat(1e-20), ..paper_params_64() };
     let (hist, _, d, u) = newton_vs_fixed_point(&p, &params, &xg, 1e-4, 1e-6);
     let (k_all, k_inner) = (curvature_error(&p, &u, &fwd, 0), curvature_error(&p, &u, &fwd, 5));
@@ -231,7 +192,7 @@ fn newton_converges_on_eq65() {
 fn newton_on_eq64_paper_parameters_fails_with_a_clear_error() {
     let case = case_from(&case_text("follower_bend_64"), "f64");
     let p = Problem::from_case(&case);
-    let (_, xg) = forward(&case, 5);
+    let (_, xg) = common::forward_data(&case, 5);
     let prev = vec![Vector3::zeros(); xg.len()];
     let params = InverseParams { frame: 7, ..paper_params_64() };
     let start = solve_frame(&p, &InverseParams { tolerance: 3e-6, max_iterations: 1000, ..params }, &xg, &prev, &p.reference_state(), |_| {}).expect("fixed point");
@@ -249,7 +210,7 @@ fn newton_on_eq64_paper_parameters_fails_with_a_clear_error() {
 fn jacobian_spectrum_eq64() {
     let case = case_from(&case_text("follower_bend_64"), "f64");
     let p = Problem::from_case(&case);
-    let (_fwd, xg) = forward(&case, 5);
+    let (_fwd, xg) = common::forward_data(&case, 5);
     let n = case.mesh.nodes();
     let prev = vec![Vector3::zeros(); n];
     let params = paper_params_64();

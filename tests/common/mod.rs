@@ -52,3 +52,51 @@ pub fn worm_data_present(test: &str) -> bool {
 pub fn is_clip(case: &Case) -> bool {
     matches!(case.inverse().map(|i| &i.data), Some(cosserat::case::DataSource::Clip(_)))
 }
+
+/// Forward data by Newton (tolerance 1e-13) with `steps` load-continuation steps: the solution
+/// and its nodal positions x_g.
+pub fn forward_data(case: &Case, steps: usize) -> (nalgebra::DVector<f64>, Vec<nalgebra::Vector3<f64>>) {
+    use cosserat::solve::statics::{self, Method, StaticParams};
+    let p = cosserat::solve::Problem::from_case(case);
+    let fwd = statics::solve(&p, &StaticParams { method: Method::Newton, tolerance: 1e-13, max_iterations: 40, continuation_steps: steps }, |_| {}).expect("forward data");
+    let xg = (0..case.mesh.nodes()).map(|i| cosserat::solve::node_values(&fwd.u, i).0).collect();
+    (fwd.u, xg)
+}
+
+/// The paper's first inverse test (§5.2): λg = 1e9, λf = 1, λl = 1e-10, λd = 1e-6,
+/// Λκ = diag(0, 0, 1e-10), Λω = 0, w = 0.5, first frame; stop at relative change 3e-6 within
+/// 1000 iterations (tests override the stopping settings as they need).
+pub fn paper_params_64() -> cosserat::solve::inverse::InverseParams {
+    cosserat::solve::inverse::InverseParams {
+        lambda_g: 1e9,
+        lambda_f: 1.0,
+        lambda_l: 1e-10,
+        lambda_d: 1e-6,
+        lambda_kappa: nalgebra::Vector3::new(0.0, 0.0, 1e-10),
+        lambda_omega: nalgebra::Vector3::zeros(),
+        dt: 1.0,
+        first_frame: true,
+        alpha0: 0.0,
+        frame: 0,
+        stabilisation: 0.0,
+        relaxation: 0.5,
+        tolerance: 3e-6,
+        max_iterations: 1000,
+    }
+}
+
+/// Every term of (41) switched on, a frame after the first (Λω active), for derivative checks.
+pub fn all_terms_params() -> cosserat::solve::inverse::InverseParams {
+    cosserat::solve::inverse::InverseParams {
+        lambda_f: 1e-2,
+        lambda_l: 1e-6,
+        lambda_d: 1e-3,
+        lambda_kappa: nalgebra::Vector3::new(1e-12, 2e-12, 1e-10),
+        lambda_omega: nalgebra::Vector3::new(1e-9, 1e-9, 1e-8),
+        dt: 0.04,
+        first_frame: false,
+        tolerance: 1e-6,
+        max_iterations: 1,
+        ..paper_params_64()
+    }
+}
