@@ -76,6 +76,32 @@ struct RawClip {
     /// "previous_frame" (default) or "data_guess"
     #[serde(default)]
     start: RawStart,
+    /// "rebased" (default) or "global_euler"
+    #[serde(default)]
+    rotation: RawRotation,
+    /// kymograms: "xz" (default) or "xy"
+    #[serde(default)]
+    plane: RawPlane,
+    /// rotation vector [rad] applied to every frame after the placement
+    orientation: Option<[f64; 3]>,
+    /// first frame's roll gauge vector (before `orientation`)
+    gauge: Option<[f64; 3]>,
+}
+
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default)]
+#[serde(rename_all = "snake_case")]
+enum RawRotation {
+    #[default]
+    Rebased,
+    GlobalEuler,
+}
+
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default)]
+#[serde(rename_all = "snake_case")]
+enum RawPlane {
+    #[default]
+    Xz,
+    Xy,
 }
 
 #[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default)]
@@ -313,6 +339,16 @@ pub struct ClipSource {
     pub min_cos_beta: f64,
     /// initial iterate of the frames after the first (D13)
     pub start: crate::solve::sequence::FrameStart,
+    /// angle chart per frame (`docs/rotation.md`)
+    pub rotation: crate::solve::sequence::RotationTreatment,
+    /// plane of a kymogram's placement (`crate::clip`)
+    pub plane: crate::clip::ClipPlane,
+    /// rigid rotation applied to every frame after the placement (`clip.orientation`, a
+    /// rotation vector [rad]; identity if absent)
+    pub orientation: nalgebra::Matrix3<f64>,
+    /// unit gauge vector of the first frame in space coordinates (R7): `clip.gauge` rotated by
+    /// `orientation`; default the placement plane's normal (e2 for x–z, e3 for x–y)
+    pub gauge: nalgebra::Vector3<f64>,
 }
 
 /// An inverse analysis (Problem 2, eq. 61): one frame of synthetic data, or a clip.
@@ -664,6 +700,24 @@ impl Validator<'_> {
                         if !(cl.min_cos_beta >= 0.0 && cl.min_cos_beta < 1.0) {
                             return Err(self.err("clip.min_cos_beta", format!("must lie in [0, 1), got {}", cl.min_cos_beta)));
                         }
+                        let plane = match cl.plane {
+                            RawPlane::Xz => crate::clip::ClipPlane::Xz,
+                            RawPlane::Xy => crate::clip::ClipPlane::Xy,
+                        };
+                        if let Some(v) = cl.orientation.iter().flatten().find(|v| !v.is_finite()) {
+                            return Err(self.err("clip.orientation", format!("must be a finite rotation vector [rad], got {v}")));
+                        }
+                        let orientation = nalgebra::Rotation3::new(nalgebra::Vector3::from(cl.orientation.unwrap_or([0.0; 3]))).into_inner();
+                        let gauge = match cl.gauge {
+                            Some(g) => nalgebra::Vector3::from(g)
+                                .try_normalize(1e-12)
+                                .filter(|v| v.iter().all(|c| c.is_finite()))
+                                .ok_or_else(|| self.err("clip.gauge", format!("must be a finite non-zero vector, got {g:?}")))?,
+                            None => match plane {
+                                crate::clip::ClipPlane::Xz => nalgebra::Vector3::y(),
+                                crate::clip::ClipPlane::Xy => nalgebra::Vector3::z(),
+                            },
+                        };
                         DataSource::Clip(ClipSource {
                             kind: match cl.kind {
                                 RawClipKind::Kymogram => ClipKind::Kymogram,
@@ -677,6 +731,13 @@ impl Validator<'_> {
                                 RawStart::PreviousFrame => crate::solve::sequence::FrameStart::PreviousFrame,
                                 RawStart::DataGuess => crate::solve::sequence::FrameStart::DataGuess,
                             },
+                            rotation: match cl.rotation {
+                                RawRotation::Rebased => crate::solve::sequence::RotationTreatment::Rebased,
+                                RawRotation::GlobalEuler => crate::solve::sequence::RotationTreatment::GlobalEuler,
+                            },
+                            plane,
+                            orientation,
+                            gauge: orientation * gauge,
                         })
                     }
                     (Some(_), Some(_)) => return Err(self.err("clip", "give either [data] (synthetic) or [clip] (recorded), not both")),

@@ -55,7 +55,7 @@ pub fn read_data(path: &Path, mesh: &Mesh) -> Result<NodalState, DataError> {
     if headers != DATA_HEADER {
         return Err(read(format!("header {headers:?}, expected {DATA_HEADER:?}")));
     }
-    let mut nodes = NodalState { s: Vec::new(), x: Vec::new(), alpha: Vec::new() };
+    let mut nodes = NodalState { s: Vec::new(), x: Vec::new(), alpha: Vec::new(), chart: Default::default() };
     for (i, rec) in rdr.records().enumerate() {
         let row = i + 1;
         let bad = |reason: String| DataError::Row { path: path.to_path_buf(), row, reason };
@@ -93,6 +93,7 @@ mod tests {
             s: (0..n).map(|i| mesh.node_s(i)).collect(),
             x: (0..n).map(|i| Vector3::new(0.1 / 3.0 * i as f64, (i as f64).sin() * 1e-4, mesh.node_s(i))).collect(),
             alpha: (0..n).map(|i| Vector3::new(std::f64::consts::PI / 7.0, -0.3 * i as f64, 0.25)).collect(),
+            chart: Default::default(),
         }
     }
 

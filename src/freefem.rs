@@ -150,7 +150,7 @@ pub fn run_inverse(case: &Case, data: NodalState, data_path: &Path, workdir: &Pa
         return Err(FreeFemError::BadOutput { path: nodes_path, reason: format!("{} rows, expected {}", rows.len(), case.mesh.nodes()) });
     }
     let v3 = |r: &Vec<f64>, k: usize| Vector3::new(r[k], r[k + 1], r[k + 2]);
-    let nodes = NodalState { s: rows.iter().map(|r| r[0]).collect(), x: rows.iter().map(|r| v3(r, 1)).collect(), alpha: rows.iter().map(|r| v3(r, 4)).collect() };
+    let nodes = NodalState { s: rows.iter().map(|r| r[0]).collect(), x: rows.iter().map(|r| v3(r, 1)).collect(), alpha: rows.iter().map(|r| v3(r, 4)).collect(), chart: Default::default() };
     let mut hist_header = vec!["iteration", "rel_change", "x_err_rel", "tangent_misfit"];
     hist_header.extend(ObjectiveTerms::NAMES);
     let history = read_table(&workdir.join("ff_inverse_history.csv"), &hist_header)?
@@ -272,6 +272,7 @@ fn read_outputs(case: &Case, dir: &Path) -> Result<RunResult, FreeFemError> {
         s: rows.iter().map(|r| r[0]).collect(),
         x: rows.iter().map(|r| Vector3::new(r[1], r[2], r[3])).collect(),
         alpha: rows.iter().map(|r| Vector3::new(r[4], r[5], r[6])).collect(),
+        chart: Default::default(),
     };
     let info = read_info(&dir.join("ff_info.csv"))?;
     let get = |k: &str| info.get(k).copied();

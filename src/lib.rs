@@ -35,6 +35,7 @@
 //!    3 (1945) — elastica reference values.
 pub mod assembly;
 pub mod case;
+pub mod chart;
 pub mod clip;
 pub mod data;
 pub mod element;

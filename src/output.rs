@@ -288,9 +288,11 @@ pub struct ClipWriter {
 }
 
 /// Columns of `frames.csv`.
-pub const CLIP_FRAME_COLUMNS: [&str; 19] = [
+/// `min_abs_cos_beta` is the chart's (the angles of `fields.csv` are in the frame's chart
+/// `Q = Q_E(α) B`, whose singular axis `n = Bᵀ e2` is `chart_axis_*`; `docs/rotation.md`).
+pub const CLIP_FRAME_COLUMNS: [&str; 22] = [
     "frame", "time_s", "iterations", "rel_change", "x_err_rel", "tangent_misfit_m05", "j_tracking", "j_force", "j_torque", "j_shear", "j_bending", "j_angular", "j_total",
-    "min_abs_cos_beta", "min_abs_cos_beta_node", "max_abs_j_minus_1", "kappa_roughness", "data_kappa_roughness", "restarted",
+    "min_abs_cos_beta", "min_abs_cos_beta_node", "max_abs_j_minus_1", "kappa_roughness", "data_kappa_roughness", "restarted", "chart_axis_x", "chart_axis_y", "chart_axis_z",
 ];
 
 impl ClipWriter {
@@ -337,6 +339,7 @@ impl ClipWriter {
         let mut row = vec![r.frame as f64, time_s, r.iterations as f64, r.last_change, r.x_err_rel, r.tangent_misfit];
         row.extend(r.objective.values());
         row.extend([r.min_cos_beta, r.min_cos_beta_node as f64, r.max_stretch_deviation, roughness.0, roughness.1, f64::from(u8::from(r.restarted))]);
+        row.extend(r.chart_axis.iter());
         let line: Vec<String> = row.iter().map(|v| format!("{v:.10e}")).collect();
         writeln!(self.frames, "{}", line.join(",")).and_then(|_| self.frames.flush()).map_err(err("frames.csv"))?;
         let d = nodes.directors();

@@ -5,7 +5,7 @@ use std::time::Instant;
 use nalgebra::{DVector, Vector3};
 
 use crate::case::{Analysis, Case, ClipKind, DataSource, InverseMethod, InverseSettings, StaticMethod};
-use crate::clip::{read_kymogram, read_recording, Clip, ClipError, ClipPlane, KymogramParams};
+use crate::clip::{read_kymogram, read_recording, Clip, ClipError, KymogramParams};
 use crate::output::{planar_xz_curvature, sign_alternation, ClipWriter, OutputError};
 use crate::solve::sequence::{solve_sequence, FrameMethod, FrameReport, SequenceError, SequenceParams};
 pub use crate::solve::sequence::FrameStart;
@@ -41,15 +41,17 @@ pub struct NodalState {
     pub s: Vec<f64>,
     /// position [m]
     pub x: Vec<Vector3<f64>>,
-    /// angles (α, β, γ) [rad]
+    /// angles (α, β, γ) [rad] in `chart`
     pub alpha: Vec<Vector3<f64>>,
+    /// the angles' chart (`crate::chart`; the paper's global chart unless a clip was rebased)
+    pub chart: crate::chart::Chart,
 }
 
 impl NodalState {
     pub fn from_vector(case: &Case, u: &DVector<f64>) -> Self {
         let n = case.mesh.nodes();
         let (x, alpha) = (0..n).map(|i| node_values(u, i)).unzip();
-        NodalState { s: (0..n).map(|i| case.mesh.node_s(i)).collect(), x, alpha }
+        NodalState { s: (0..n).map(|i| case.mesh.node_s(i)).collect(), x, alpha, chart: Default::default() }
     }
     /// Element-midpoint curvature `κˡ = A(α) ∂s α` [1/m] with the midpoint arc length [m] (eq. 28).
     pub fn element_curvature(&self) -> Vec<(f64, Vector3<f64>)> {
@@ -66,7 +68,7 @@ impl NodalState {
         self.alpha
             .iter()
             .map(|a| {
-                let q = crate::rotation::rotation(a);
+                let q = self.chart.rotation(a);
                 [q.row(0).transpose(), q.row(1).transpose(), q.row(2).transpose()]
             })
             .collect()
@@ -195,7 +197,7 @@ pub fn generate_data(case: &Case) -> Result<NodalState, RunError> {
         let clip = load_clip(case)?;
         let x = clip.frames.into_iter().next().ok_or_else(|| RunError::ClipShape(format!("case {}: the clip has no frames", case.name)))?;
         let n = x.len();
-        return Ok(NodalState { s: (0..n).map(|i| case.mesh.node_s(i)).collect(), x, alpha: vec![Vector3::zeros(); n] });
+        return Ok(NodalState { s: (0..n).map(|i| case.mesh.node_s(i)).collect(), x, alpha: vec![Vector3::zeros(); n], chart: Default::default() });
     }
     let data_case = case.data_case().ok_or_else(|| SolveError::NotInverse(case.name.clone()))?;
     Ok(run_rust(&data_case, |_, _| {})?.nodes)
@@ -344,7 +346,7 @@ pub fn load_clip(case: &Case) -> Result<Clip, RunError> {
     }
     let mut clip = match src.kind {
         ClipKind::Kymogram => {
-            let params = KymogramParams { length_m: case.mesh.length_m, nodes: case.mesh.nodes(), dt_s: src.frame_interval_s, plane: ClipPlane::Xz, scale_to_length: true };
+            let params = KymogramParams { length_m: case.mesh.length_m, nodes: case.mesh.nodes(), dt_s: src.frame_interval_s, plane: src.plane, scale_to_length: true };
             read_kymogram(&src.file, &params)?
         }
         ClipKind::Recording => read_recording(&src.file, src.frame_interval_s)?,
@@ -357,6 +359,11 @@ pub fn load_clip(case: &Case) -> Result<Clip, RunError> {
             return Err(RunError::ClipShape(format!("{}: clip.frames = [{a}, {b}) but the clip has {} frames", src.file.display(), clip.frame_count())));
         }
         clip.frames = clip.frames[a..b].to_vec();
+    }
+    if src.orientation != nalgebra::Matrix3::identity() {
+        for frame in &mut clip.frames {
+            frame.iter_mut().for_each(|x| *x = src.orientation * *x);
+        }
     }
     Ok(clip)
 }
@@ -390,16 +397,16 @@ pub fn run_clip(case: &Case, out: &Path, mut progress: impl FnMut(usize, usize))
         InverseMethod::Newton { warm_start_tolerance, .. } => FrameMethod::Newton { warm_start_tolerance },
     };
     let first_frame = src.frames.map(|f| f.0).unwrap_or(0);
-    let sp = SequenceParams { frame: InverseParams { dt: src.frame_interval_s, ..params }, method, min_cos_beta: src.min_cos_beta, frame_offset: first_frame, start: src.start };
+    let sp = SequenceParams { frame: InverseParams { dt: src.frame_interval_s, ..params }, method, min_cos_beta: src.min_cos_beta, frame_offset: first_frame, start: src.start, rotation: src.rotation, gauge: src.gauge };
     let mut writer = ClipWriter::create(out)?;
     let total = clip.frame_count();
     let h = case.mesh.h();
     let start = Instant::now();
     let mut rough = Vec::new();
     let (mut kappa2, mut data_kappa) = (Vec::new(), Vec::new());
-    let guess = crate::solve::sequence::data_frame_guess(&clip.frames[0]);
-    let result = solve_sequence(&problem, &sp, &clip.frames, &guess, |_, _| {}, |rep, sol| {
-        let nodes = NodalState::from_vector(case, &sol.u);
+    let result = solve_sequence(&problem, &sp, &clip.frames, None, |_, _| {}, |rep, frame| {
+        let sol = frame.solution;
+        let nodes = NodalState { chart: frame.chart, ..NodalState::from_vector(case, &sol.u) };
         let (force, torque): (Vec<_>, Vec<_>) = (0..nodes.s.len())
             .map(|i| {
                 let (xh, ah) = node_values(&sol.adjoint, i);

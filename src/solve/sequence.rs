@@ -2,15 +2,19 @@
 //! (Problem 2, eq. 61), the first frame with α(a) = α0 and Λω = 0 (Remark 6), every later frame
 //! with Λω, the previous frame's angles as α_{n−1} and its state as the initial iterate.
 //!
-//! The angle chart of eq. (1) is singular where cos β = 0 (det A = −cos β): every frame is
-//! guarded, and a frame whose recovered β comes within `min_cos_beta` of ±π/2 at any node
-//! stops the clip with an error naming frame and node (the failure is otherwise silent: the
-//! fit stays good while α and κ3 explode, PAPER-NOTES).
+//! The angle chart of eq. (1) is singular where cos β = 0 (det A = −cos β). With
+//! [`RotationTreatment::Rebased`] (the default) each frame is solved in its own chart
+//! `Q = Q_E(α) B` whose singular axis is chosen away from the frame's tangents
+//! (`crate::chart`, `docs/rotation.md`); with [`RotationTreatment::GlobalEuler`] every frame uses
+//! the paper's chart. Either way every frame is guarded: a frame whose recovered β comes within
+//! `min_cos_beta` of ±π/2 at any node stops the clip with an error naming frame and node (the
+//! failure is otherwise silent: the fit stays good while α and κ3 explode, PAPER-NOTES).
 use std::f64::consts::PI;
 
 use nalgebra::{DVector, Matrix3, Vector3};
 
-use crate::rotation::angles_from_rotation;
+use crate::chart::{frame_axis, Chart};
+use crate::rotation::{angles_from_rotation, Angles};
 
 use super::inverse::{solve_frame_observed, InverseParams, InverseRecord, InverseSolution, ObjectiveTerms};
 use super::inverse_newton::solve_frame_warm;
@@ -38,6 +42,22 @@ pub struct SequenceParams {
     pub frame_offset: usize,
     /// initial iterate of every frame after the first
     pub start: FrameStart,
+    /// angle chart of each frame
+    pub rotation: RotationTreatment,
+    /// first frame's roll gauge (Remark 6 read in space, R7): the chart's singular axis of the
+    /// first frame, so that `α(0) = α0` means `d1(0) ⟂ gauge` (for α0 = 0); e2 is the paper's
+    pub gauge: Vector3<f64>,
+}
+
+/// Angle chart of each frame (`docs/rotation.md`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum RotationTreatment {
+    /// the paper's chart of eq. (1) for every frame (the one FreeFEM mirrors)
+    GlobalEuler,
+    /// per frame the chart `Q = Q_E(α) B` whose singular axis is [`frame_axis`] of the frame's
+    /// data (the gauge on the first frame), R1–R7
+    #[default]
+    Rebased,
 }
 
 /// Initial iterate of the frames after the first.
@@ -67,14 +87,16 @@ pub struct FrameReport {
     pub max_stretch_deviation: f64,
     /// the frame failed from the previous frame's solution and was solved from the data guess
     pub restarted: bool,
+    /// singular axis `n = Bᵀ e2` of the frame's chart (e2 for the global chart)
+    pub chart_axis: Vector3<f64>,
     pub wall_time_s: f64,
 }
 
 /// Errors of a clip solve: the frame's own error, or the chart guard.
 #[derive(Debug, thiserror::Error)]
 pub enum SequenceError {
-    #[error("frame {frame}: |cos β| = {cos_beta:.3e} at node {node} (below the guard {guard:e}): the angle chart of eq. (1) is singular there; place planar clips in the x–z plane")]
-    SingularChart { frame: usize, node: usize, cos_beta: f64, guard: f64 },
+    #[error("frame {frame}: |cos β| = {cos_beta:.3e} at node {node} (below the guard {guard:e}): the frame's tangent there is along the angle chart's singular axis ({:.3}, {:.3}, {:.3}) (eq. 1, det A = −cos β). With clip.rotation = \"rebased\" only the first frame's axis is fixed, by clip.gauge: choose a gauge vector away from the first frame's tangents (e.g. the normal of its plane)", axis[0], axis[1], axis[2])]
+    SingularChart { frame: usize, node: usize, cos_beta: f64, guard: f64, axis: [f64; 3] },
     #[error(transparent)]
     Solve(#[from] SolveError),
     #[error("frame {frame}: {message}")]
@@ -93,10 +115,12 @@ pub fn max_stretch_deviation(x_g: &[Vector3<f64>], h: f64) -> f64 {
 
 /// An initial iterate read off the data (D13): x = x_g, and at each node the frame whose d3
 /// is the data tangent (central differences), carried along the rod by parallel transport
-/// (the minimal rotation between neighbouring tangents) from the frame at s = 0 that turns e3
-/// minimally onto the first tangent; angles from [`angles_from_rotation`], each unwrapped
-/// against the previous node (no 2π jumps). For a planar clip in the x–z plane this is
-/// α = β = 0, γ = −θ (θ the tangent angle from e3 towards e1).
+/// (the minimal rotation between neighbouring tangents) from the frame at s = 0 with
+/// `d3 = t_0`, `d1 ∥ e2 × t_0`, `d2·e2 > 0` — the gauge α(0) = 0 of Remark 6 (R7); the
+/// construction commutes with rotations about e2, so it rotates with the data in a rebased
+/// chart (R5). Angles from [`angles_from_rotation`], each unwrapped against the previous node
+/// (no 2π jumps). For a planar clip in the x–z plane this is α = β = 0, γ = −θ (θ the tangent
+/// angle from e3 towards e1).
 pub fn data_frame_guess(x_g: &[Vector3<f64>]) -> DVector<f64> {
     let n = x_g.len();
     let tangent = |i: usize| {
@@ -118,8 +142,13 @@ pub fn data_frame_guess(x_g: &[Vector3<f64>]) -> DVector<f64> {
         Matrix3::identity() + vx + vx * vx / (1.0 + c)
     };
     let mut u = DVector::zeros(6 * n);
-    let mut q = Matrix3::identity(); // rows d1, d2, d3; d3 = e3
-    let mut prev_t = Vector3::z();
+    // rows d1, d2, d3 at s = 0 (the gauge frame; e3's minimal turn if t_0 = ±e2)
+    let t0 = tangent(0);
+    let mut q = match Vector3::y().cross(&t0).try_normalize(1e-9) {
+        Some(d1) => Matrix3::from_rows(&[d1.transpose(), t0.cross(&d1).transpose(), t0.transpose()]),
+        None => minimal(&Vector3::z(), &t0).transpose(),
+    };
+    let mut prev_t = t0;
     let mut prev_a: Option<Vector3<f64>> = None;
     for i in 0..n {
         let t = tangent(i);
@@ -140,50 +169,79 @@ pub fn data_frame_guess(x_g: &[Vector3<f64>]) -> DVector<f64> {
     u
 }
 
+/// A converged frame in space coordinates: positions, the force adjoint x̂ and the moment
+/// adjoint α̂ rotated back from the chart (R3); the angles stay the chart's, with `chart`.
+pub struct FrameSolution<'a> {
+    pub solution: &'a InverseSolution,
+    pub chart: Chart,
+}
+
 /// Solve every frame of `frames` (positions per node, the mesh's nodes) in order. `u0` is the
-/// initial iterate of the first frame (e.g. [`data_frame_guess`]); every later frame starts
-/// from the previous frame's solution and, if that fails, once more from the data guess. `on_frame` receives each converged frame (e.g. to stream
-/// it to disk) and may stop the clip by returning an error message; `on_iteration` sees
+/// initial iterate of the first frame in the chart of the first frame (e.g. [`data_frame_guess`]
+/// of the data in that chart; `None`: that guess). Later frames start from the previous frame's
+/// solution re-expressed in their chart (and, if that fails, once more from the data guess) or
+/// from the data guess, as `sp.start` says. `on_frame` receives each converged frame (e.g. to
+/// stream it to disk) and may stop the clip by returning an error message; `on_iteration` sees
 /// every iteration's record.
 pub fn solve_sequence(
     problem: &Problem,
     sp: &SequenceParams,
     frames: &[Vec<Vector3<f64>>],
-    u0: &DVector<f64>,
+    u0: Option<&DVector<f64>>,
     mut on_iteration: impl FnMut(usize, &InverseRecord),
-    mut on_frame: impl FnMut(&FrameReport, &InverseSolution) -> Result<(), String>,
+    mut on_frame: impl FnMut(&FrameReport, &FrameSolution) -> Result<(), String>,
 ) -> Result<Vec<FrameReport>, SequenceError> {
     let n = problem.mesh.nodes();
     let h = problem.mesh.h();
     let mut reports = Vec::with_capacity(frames.len());
-    let mut u = u0.clone();
-    let mut prev = vec![Vector3::zeros(); n];
-    for (i, x_g) in frames.iter().enumerate() {
+    // Previous frame: its chart, its state in that chart, its angles.
+    let mut prev: Option<(Chart, DVector<f64>)> = None;
+    for (i, x_space) in frames.iter().enumerate() {
         let k = i + sp.frame_offset;
         let start = std::time::Instant::now();
+        let chart = match (sp.rotation, &prev) {
+            (RotationTreatment::GlobalEuler, _) => Chart::identity(),
+            (RotationTreatment::Rebased, None) => Chart::with_axis(&sp.gauge),
+            (RotationTreatment::Rebased, Some((c, _))) => Chart::with_axis(&frame_axis(x_space, Some(&c.axis()))),
+        };
+        let x_g: Vec<Vector3<f64>> = if chart.is_identity() { x_space.clone() } else { x_space.iter().map(|x| chart.to_chart(x)).collect() };
+        let guess = || data_frame_guess(&x_g);
+        // The previous frame's state in this frame's chart (R6).
+        let carried = prev.as_ref().map(|(c, u)| carry_state(&chart, c, u));
+        let first_start = match (&carried, sp.start, u0) {
+            (None, _, Some(u0)) => u0.clone(),
+            (Some(u), FrameStart::PreviousFrame, _) => u.clone(),
+            _ => guess(),
+        };
+        let alpha_prev: Vec<Angles> = match &prev {
+            None => vec![Vector3::zeros(); n],
+            Some((c, u)) => {
+                let near: Vec<Angles> = (0..n).map(|j| node_values(&first_start, j).1).collect();
+                chart.reexpress(c, &(0..n).map(|j| node_values(u, j).1).collect::<Vec<_>>(), Some(&near))
+            }
+        };
         let p = InverseParams { first_frame: i == 0, frame: k, ..sp.frame };
         let mut solve = |start: &DVector<f64>, warm: bool| -> Result<InverseSolution, SolveError> {
             let report = |r: &InverseRecord, _: &DVector<f64>, _: &DVector<f64>| on_iteration(k, r);
             match sp.method {
-                FrameMethod::FixedPoint => solve_frame_observed(problem, &p, x_g, &prev, start, report),
+                FrameMethod::FixedPoint => solve_frame_observed(problem, &p, &x_g, &alpha_prev, start, report),
                 // From the previous frame's solution (already close) Newton runs directly; from
                 // a guess it needs the fixed point's warm start (I8).
-                FrameMethod::Newton { .. } if warm => super::inverse_newton::solve_frame_newton_observed(problem, &p, x_g, &prev, start, report),
-                FrameMethod::Newton { warm_start_tolerance } => solve_frame_warm(problem, &p, warm_start_tolerance, x_g, &prev, start, report),
+                FrameMethod::Newton { .. } if warm => super::inverse_newton::solve_frame_newton_observed(problem, &p, &x_g, &alpha_prev, start, report),
+                FrameMethod::Newton { warm_start_tolerance } => solve_frame_warm(problem, &p, warm_start_tolerance, &x_g, &alpha_prev, start, report),
             }
         };
         // A frame that does not converge from the previous frame's solution is solved again
         // from the data guess (D13), and the restart is reported.
         let from_previous = i > 0 && sp.start == FrameStart::PreviousFrame;
-        let first_start = if i > 0 && !from_previous { data_frame_guess(x_g) } else { u.clone() };
         let (sol, restarted) = match solve(&first_start, from_previous) {
             Ok(sol) => (sol, false),
-            Err(SolveError::InverseNotConverged { .. } | SolveError::InverseNewtonNotConverged { .. } | SolveError::InverseNonFinite { .. }) if from_previous => (solve(&data_frame_guess(x_g), false)?, true),
+            Err(SolveError::InverseNotConverged { .. } | SolveError::InverseNewtonNotConverged { .. } | SolveError::InverseNonFinite { .. }) if from_previous => (solve(&guess(), false)?, true),
             Err(e) => return Err(e.into()),
         };
         let (cos_beta, node) = min_cos_beta(&sol.u);
         if cos_beta < sp.min_cos_beta {
-            return Err(SequenceError::SingularChart { frame: k, node, cos_beta, guard: sp.min_cos_beta });
+            return Err(SequenceError::SingularChart { frame: k, node, cos_beta, guard: sp.min_cos_beta, axis: chart.axis().into() });
         }
         let last = sol.history.last().copied().ok_or(SequenceError::Callback { frame: k, message: "no iteration ran".into() })?;
         let rep = FrameReport {
@@ -195,14 +253,52 @@ pub fn solve_sequence(
             objective: last.objective,
             min_cos_beta: cos_beta,
             min_cos_beta_node: node,
-            max_stretch_deviation: max_stretch_deviation(x_g, h),
+            max_stretch_deviation: max_stretch_deviation(x_space, h),
             restarted,
+            chart_axis: chart.axis(),
             wall_time_s: start.elapsed().as_secs_f64(),
         };
-        on_frame(&rep, &sol).map_err(|message| SequenceError::Callback { frame: k, message })?;
-        prev = (0..n).map(|i| node_values(&sol.u, i).1).collect();
-        u = sol.u;
+        let in_space = if chart.is_identity() { None } else { Some(to_space(&chart, &sol)) };
+        on_frame(&rep, &FrameSolution { solution: in_space.as_ref().unwrap_or(&sol), chart }).map_err(|message| SequenceError::Callback { frame: k, message })?;
+        prev = Some((chart, sol.u));
         reports.push(rep);
     }
     Ok(reports)
+}
+
+/// A state `(x, α)` of chart `from` in chart `to` (R6): positions rotated by `B_to B_fromᵀ`,
+/// angles re-expressed node by node without 2π jumps along the rod.
+fn carry_state(to: &Chart, from: &Chart, u: &DVector<f64>) -> DVector<f64> {
+    if to.base == from.base {
+        return u.clone();
+    }
+    let n = u.len() / 6;
+    let alpha: Vec<Angles> = (0..n).map(|j| node_values(u, j).1).collect();
+    let alpha = to.reexpress(from, &alpha, None);
+    let mut out = DVector::zeros(u.len());
+    for j in 0..n {
+        let x = to.to_chart(&from.to_space(&node_values(u, j).0));
+        for c in 0..3 {
+            out[6 * j + c] = x[c];
+            out[6 * j + 3 + c] = alpha[j][c];
+        }
+    }
+    out
+}
+
+/// The solution with positions and adjoints in space coordinates (R3); angles unchanged.
+fn to_space(chart: &Chart, sol: &InverseSolution) -> InverseSolution {
+    let rotate = |v: &DVector<f64>, both: bool| {
+        let mut out = v.clone();
+        for j in 0..v.len() / 6 {
+            let (a, b) = node_values(v, j);
+            let (a, b) = (chart.to_space(&a), if both { chart.to_space(&b) } else { b });
+            for c in 0..3 {
+                out[6 * j + c] = a[c];
+                out[6 * j + 3 + c] = b[c];
+            }
+        }
+        out
+    };
+    InverseSolution { u: rotate(&sol.u, false), adjoint: rotate(&sol.adjoint, true), history: sol.history.clone() }
 }
