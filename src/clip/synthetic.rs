@@ -638,6 +638,14 @@ mod tests {
         }
         println!("planar: max |θ(s_knot) − ∫k ds| {worst:.2e} rad");
         assert!(worst < 1e-11, "{worst:e}");
+        // Rolled by π/2 (bending about −d1): the last frame lies in the y–z plane, d1 = e1.
+        let rolled = RollClipParams { roll_total_rad: PI / 2.0, ..params };
+        let (clip, truth) = roll_clip(&rows, None, &rolled).unwrap();
+        let last = clip.frames.len() - 1;
+        let off_plane = clip.frames[last].iter().map(|p| p.x.abs()).fold(0.0, f64::max);
+        assert!(off_plane < 1e-15 * rolled.length_m, "{off_plane:e}");
+        assert!(truth.frames[last].q.iter().all(|q| (row(q, 0) - Vector3::x()).amax() < 1e-14));
+        assert!(clip.frames[last].iter().any(|p| p.y.abs() > 0.1 * rolled.length_m), "bent in y");
     }
 
     /// Clip frames that fall on kymogram rows reproduce them; joints carry `a_j (M + 1)/L`.
@@ -793,6 +801,12 @@ mod tests {
             );
             assert!(clip.frames.iter().flatten().all(|p| p.iter().all(|v| v.is_finite())));
             if mapping == TimeMapping::StretchOmega {
+                for roll in [PI / 6.0, PI / 4.0, PI / 3.0] {
+                    let (_, t) = roll_clip(&omega, None, &RollClipParams { roll_total_rad: roll, ..params.clone() }).unwrap();
+                    let a = t.max_tangent_alignment(&Vector3::y());
+                    let near = a.iter().filter(|&&v| v > 0.99).count();
+                    println!("  roll_total {roll:.4} rad: max |d3·e2| {:.4}, frames with |d3·e2| > 0.99: {near}/1160", a.iter().cloned().fold(0.0, f64::max));
+                }
                 let (fine, fine_truth) = roll_clip(&omega, None, &RollClipParams { substeps: 32, ..params.clone() }).unwrap();
                 let ex = clip.frames.iter().flatten().zip(fine.frames.iter().flatten()).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max) / params.length_m;
                 let eq = truth.frames.iter().flat_map(|f| &f.q).zip(fine_truth.frames.iter().flat_map(|f| &f.q)).map(|(a, b)| (a - b).amax()).fold(0.0, f64::max);
