@@ -45,6 +45,7 @@ use crate::output::OutputError;
 
 mod npy;
 mod spline;
+pub mod synthetic;
 
 pub use npy::{npy_bytes, read_npy, write_npy, NpyArray};
 pub use spline::Spline;
@@ -79,6 +80,22 @@ pub enum ClipError {
     DuplicateRow { path: PathBuf, row: usize, first_row: usize, frame: usize, node: usize },
     #[error("clip file {path}, row {row}: {reason}")]
     Row { path: PathBuf, row: usize, reason: String },
+    #[error("synthetic clip: kymogram {which} has {frames} frames, need at least {minimum}")]
+    SyntheticTooFewFrames { which: &'static str, frames: usize, minimum: usize },
+    #[error("synthetic clip: kymogram {which}, frame {frame}: {joints} joint angles, but frame 0 has {expected}")]
+    SyntheticRowLength { which: &'static str, frame: usize, joints: usize, expected: usize },
+    #[error("synthetic clip: kymogram {which}, frame 0: 0 joint angles, need at least 1")]
+    SyntheticNoJoints { which: &'static str },
+    #[error("synthetic clip: kymogram {which}, frame {frame}, joint {joint}: angle {value} is not finite")]
+    SyntheticNonFiniteAngle { which: &'static str, frame: usize, joint: usize, value: f64 },
+    #[error("synthetic clip: parameter {name} = {value} is invalid, must be {requirement}")]
+    SyntheticParameter { name: &'static str, value: f64, requirement: &'static str },
+    #[error("synthetic clip: time mapping OmegaThenDelta needs the delta-turn kymogram")]
+    SyntheticMissingDelta,
+    #[error("frame comparison: {what} has {len} nodes, truth has {expected}")]
+    ComparisonSize { what: &'static str, len: usize, expected: usize },
+    #[error("frame comparison: skipping {skip} nodes at each end of {nodes} leaves none")]
+    ComparisonSkip { skip: usize, nodes: usize },
     #[error(transparent)]
     Write(#[from] OutputError),
 }
