@@ -62,6 +62,8 @@ struct RawCase {
 enum RawClipKind {
     Kymogram,
     Recording,
+    #[serde(rename = "roll_3d")]
+    Roll3d,
 }
 
 #[derive(Debug, Deserialize)]
@@ -86,6 +88,14 @@ struct RawClip {
     orientation: Option<[f64; 3]>,
     /// first frame's roll gauge vector (before `orientation`)
     gauge: Option<[f64; 3]>,
+    /// roll_3d: total roll of the bending plane over the clip [rad]
+    roll_total_rad: Option<Scalar>,
+    /// roll_3d: constant twist κ3 [rad/m]
+    twist_per_m: Option<Scalar>,
+    /// roll_3d: number of frames to build
+    clip_frames: Option<usize>,
+    /// roll_3d: integration steps per element
+    substeps: Option<usize>,
 }
 
 #[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default)]
@@ -323,6 +333,9 @@ pub enum ClipKind {
     Kymogram,
     /// positions: CSV `frame,node,x_m,y_m,z_m` or NPY frames × nodes × 3 [m]
     Recording,
+    /// the 3D ground-truth clip built from a kymogram's curvature with a rolling bending plane
+    /// and a twist (`crate::clip::synthetic`); `file` is the omega-turn kymogram
+    Roll3d,
 }
 
 /// A recorded clip.
@@ -349,6 +362,8 @@ pub struct ClipSource {
     /// unit gauge vector of the first frame in space coordinates (R7): `clip.gauge` rotated by
     /// `orientation`; default the placement plane's normal (e2 for x–z, e3 for x–y)
     pub gauge: nalgebra::Vector3<f64>,
+    /// [`ClipKind::Roll3d`]: the synthetic clip's parameters (nodes and length are the mesh's)
+    pub synthetic: Option<crate::clip::synthetic::RollClipParams>,
 }
 
 /// An inverse analysis (Problem 2, eq. 61): one frame of synthetic data, or a clip.
@@ -718,13 +733,39 @@ impl Validator<'_> {
                                 crate::clip::ClipPlane::Xy => nalgebra::Vector3::z(),
                             },
                         };
+                        let frame_interval_s = self.positive("clip.frame_interval_s", &cl.frame_interval_s, c)?;
+                        let synthetic = match cl.kind {
+                            RawClipKind::Roll3d => {
+                                let d = crate::clip::synthetic::RollClipParams::default();
+                                let p = crate::clip::synthetic::RollClipParams {
+                                    length_m: length,
+                                    nodes: raw.rod.elements + 1,
+                                    frames: cl.clip_frames.unwrap_or(d.frames),
+                                    dt_s: frame_interval_s,
+                                    roll_total_rad: cl.roll_total_rad.as_ref().map(|v| self.scalar("clip.roll_total_rad", v, c)).transpose()?.unwrap_or(d.roll_total_rad),
+                                    twist_per_m: cl.twist_per_m.as_ref().map(|v| self.scalar("clip.twist_per_m", v, c)).transpose()?.unwrap_or(d.twist_per_m),
+                                    time_mapping: d.time_mapping,
+                                    substeps: cl.substeps.unwrap_or(d.substeps),
+                                };
+                                p.validate().map_err(|e| self.err("clip", e.to_string()))?;
+                                Some(p)
+                            }
+                            _ => {
+                                if cl.roll_total_rad.is_some() || cl.twist_per_m.is_some() || cl.clip_frames.is_some() || cl.substeps.is_some() {
+                                    return Err(self.err("clip", "roll_total_rad, twist_per_m, clip_frames and substeps apply to kind = \"roll_3d\" only"));
+                                }
+                                None
+                            }
+                        };
                         DataSource::Clip(ClipSource {
                             kind: match cl.kind {
                                 RawClipKind::Kymogram => ClipKind::Kymogram,
                                 RawClipKind::Recording => ClipKind::Recording,
+                                RawClipKind::Roll3d => ClipKind::Roll3d,
                             },
+                            synthetic,
                             file: base.join(&cl.file),
-                            frame_interval_s: self.positive("clip.frame_interval_s", &cl.frame_interval_s, c)?,
+                            frame_interval_s,
                             frames,
                             min_cos_beta: cl.min_cos_beta,
                             start: match cl.start {

@@ -200,6 +200,20 @@ fn cmd_run_clip(case: &Case, engine: Engine, dir: &Path, quiet: bool) -> Result<
     };
     cosserat::output::write_clip_plot(case, &run.reports, &run.roughness, &dir.join("plot.svg"))?;
     cosserat::output::write_clip_kymographs(case, &run, &dir.join("kymograph.svg"))?;
+    cosserat::output::write_truth_plot(case, &run, &dir.join("truth.svg"))?;
+    if let Some(t) = &run.truth {
+        let max = |f: &dyn Fn(&cosserat::clip::synthetic::FrameComparison) -> f64| t.comparisons.iter().map(f).fold(0.0, f64::max);
+        println!(
+            "{} ground truth (all frames, max): |x - x_true|/|x_true| {:.2e}; bending k1^2+k2^2 rel. L2 {:.2e}; angle(d3, true d3) {:.2e} rad; |roll offset| {:.3} rad; kappa_3 rms error {:.1} rad/m (true twist {:.1} rad/m); see truth.csv, truth.svg, truth_errors.svg",
+            case.name,
+            max(&|c| c.position_rel_l2),
+            max(&|c| c.bending_rel_l2),
+            max(&|c| c.max_tangent_angle_rad),
+            max(&|c| c.roll_offset_rad.abs()),
+            max(&|c| c.twist_rms_error_per_m),
+            t.twist_per_m.first().copied().unwrap_or(0.0)
+        );
+    }
     let n = run.reports.len();
     let its: Vec<usize> = run.reports.iter().map(|r| r.iterations).collect();
     let worst = run.reports.iter().map(|r| r.x_err_rel).fold(0.0, f64::max);

@@ -363,12 +363,7 @@ impl ClipWriter {
         }
         self.curvature.flush().map_err(err("curvature.csv"))?;
         let (d1, d2, d3): (Vec<_>, Vec<_>, Vec<_>) = (d.iter().map(|x| x[0]).collect(), d.iter().map(|x| x[1]).collect(), d.iter().map(|x| x[2]).collect());
-        // κ at nodes: mean of the adjacent elements (ends: the end element).
-        let kn: Vec<nalgebra::Vector3<f64>> = (0..nodes.s.len()).map(|i| {
-            let a = kappa[i.saturating_sub(1).min(kappa.len() - 1)].1;
-            let b = kappa[i.min(kappa.len() - 1)].1;
-            (a + b) * 0.5
-        }).collect();
+        let kn = crate::run::nodal_curvature(&kappa);
         let name = format!("frame_{:05}.vtp", r.frame);
         crate::vtk::write_vtp(
             &self.dir.join("vtk").join(&name),
@@ -388,6 +383,73 @@ impl ClipWriter {
         crate::vtk::write_pvd(&p, &self.pvd)?;
         Ok(p)
     }
+}
+
+/// Columns of `truth.csv` (synthetic clips, `clip::synthetic::FrameComparison`).
+pub const TRUTH_COLUMNS: [&str; 10] = [
+    "frame", "time_s", "true_roll_rad", "true_twist_per_m", "x_err_rel_l2", "bending_err_rel_l2", "max_tangent_angle_rad", "twist_mean_per_m", "twist_rms_err_per_m", "roll_offset_rad",
+];
+
+/// `truth.csv`, streamed frame by frame like [`ClipWriter`].
+pub struct TruthWriter {
+    path: PathBuf,
+    file: std::io::BufWriter<std::fs::File>,
+}
+
+impl TruthWriter {
+    pub fn create(dir: &Path) -> Result<Self, OutputError> {
+        let path = dir.join("truth.csv");
+        let err = |source| OutputError::Io { path: dir.join("truth.csv"), source };
+        let mut file = std::io::BufWriter::new(std::fs::File::create(&path).map_err(err)?);
+        writeln!(file, "{}", TRUTH_COLUMNS.join(",")).map_err(err)?;
+        Ok(TruthWriter { path, file })
+    }
+
+    pub fn frame(&mut self, frame: usize, time_s: f64, roll_rad: f64, twist_per_m: f64, c: &crate::clip::synthetic::FrameComparison) -> Result<(), OutputError> {
+        let v = [time_s, roll_rad, twist_per_m, c.position_rel_l2, c.bending_rel_l2, c.max_tangent_angle_rad, c.twist_mean_per_m, c.twist_rms_error_per_m, c.roll_offset_rad];
+        let text: Vec<String> = v.iter().map(|x| format!("{x:.10e}")).collect();
+        writeln!(self.file, "{frame},{}", text.join(",")).and_then(|_| self.file.flush()).map_err(|source| OutputError::Io { path: self.path.clone(), source })
+    }
+}
+
+/// Recovered vs true for a synthetic clip (`truth.svg`): bending κ1² + κ2² kymographs (true,
+/// recovered) and per frame the errors, the roll offset against the true roll, and κ3.
+pub fn write_truth_plot(case: &Case, run: &crate::run::ClipRun, path: &Path) -> Result<(), OutputError> {
+    use crate::plot::{write_heatmaps_svg, Heatmap};
+    let Some(t) = &run.truth else { return Ok(()) };
+    let nf = t.comparisons.len();
+    if nf < 2 {
+        return Ok(());
+    }
+    let to_err = |e: crate::plot::PlotError, p: &Path| OutputError::Plot { path: p.to_path_buf(), reason: e.to_string() };
+    let f: Vec<f64> = run.reports.iter().map(|r| r.frame as f64).collect();
+    let s = |label: &str, y: Vec<f64>| Series { label: label.into(), x: f.clone(), y };
+    let plot = |title: String, yl: &str, series: Vec<Series>, log_y: bool| LinePlot { title, x_label: "frame".into(), y_label: yl.into(), series, log_x: false, log_y };
+    let c = &t.comparisons;
+    let panels = vec![
+        plot(format!("{}: errors against the ground truth", case.name), "relative error / rad", vec![
+            s("|x - x_true|/|x_true|", c.iter().map(|v| v.position_rel_l2).collect()),
+            s("bending k1^2+k2^2, rel. L2", c.iter().map(|v| v.bending_rel_l2).collect()),
+            s("max angle(d3, true d3) [rad]", c.iter().map(|v| v.max_tangent_angle_rad).collect()),
+        ], true),
+        plot("roll of the frame about d3".into(), "angle [rad]", vec![s("true roll psi of the bending plane", t.roll_rad.clone()), s("recovered d1 vs true d1 (offset)", c.iter().map(|v| v.roll_offset_rad).collect())], false),
+        plot("twist kappa_3".into(), "kappa_3 [rad/m]", vec![s("true", t.twist_per_m.clone()), s("recovered (mean over inner nodes)", c.iter().map(|v| v.twist_mean_per_m).collect()), s("rms error", c.iter().map(|v| v.twist_rms_error_per_m).collect())], false),
+        plot("angle chart: min |cos beta| over the nodes".into(), "|cos beta|", vec![s("rebased chart", run.reports.iter().map(|r| r.min_cos_beta).collect())], false),
+    ];
+    let lines = path.with_file_name("truth_errors.svg");
+    write_panels_svg(&panels, 2, &lines).map_err(|e| to_err(e, &lines))?;
+    let fs = nf.div_ceil(150);
+    let frames: Vec<usize> = (0..nf).step_by(fs).collect();
+    let x: Vec<f64> = frames.iter().map(|&i| run.reports[i].frame as f64).collect();
+    let m = t.bending_true[0].len();
+    let cols: Vec<usize> = (0..m).step_by(m.div_ceil(64)).collect();
+    let y: Vec<f64> = cols.iter().map(|&j| j as f64 * case.mesh.h() * 1e3).collect();
+    let grid = |field: &Vec<Vec<f64>>| -> Vec<Vec<f64>> { frames.iter().map(|&i| cols.iter().map(|&j| field[i][j].sqrt()).collect()).collect() };
+    let mut all: Vec<f64> = t.bending_true.iter().flatten().map(|v| v.sqrt()).collect();
+    all.sort_by(f64::total_cmp);
+    let limit = all.get((all.len() as f64 * 0.99) as usize).copied().unwrap_or(1.0);
+    let map = |title: String, values: Vec<Vec<f64>>| Heatmap { title, x_label: "frame".into(), y_label: "s [mm]".into(), x: x.clone(), y: y.clone(), values, limit };
+    write_heatmaps_svg(&[map(format!("true bending sqrt(k1^2+k2^2) [1/m], colour 0..{limit:.0}"), grid(&t.bending_true)), map("recovered sqrt(k1^2+k2^2) [1/m]".into(), grid(&t.bending_recovered))], path).map_err(|e| to_err(e, path))
 }
 
 /// Per-frame summary of a clip run: iterations, fit, chart guard and roughness against frame.

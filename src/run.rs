@@ -5,6 +5,7 @@ use std::time::Instant;
 use nalgebra::{DVector, Vector3};
 
 use crate::case::{Analysis, Case, ClipKind, DataSource, InverseMethod, InverseSettings, StaticMethod};
+use crate::clip::synthetic::{compare_frame, roll_clip, FrameComparison, GroundTruth, RecoveredFrame};
 use crate::clip::{read_kymogram, read_recording, Clip, ClipError, KymogramParams};
 use crate::output::{planar_xz_curvature, sign_alternation, ClipWriter, OutputError};
 use crate::solve::sequence::{solve_sequence, FrameMethod, FrameReport, SequenceError, SequenceParams};
@@ -339,17 +340,34 @@ pub fn run_inverse_on(case: &Case, engine: Engine, data_path: &Path, workdir: &P
 /// count and the rod's length in the x–z plane; recordings must have that node count. The
 /// frame range of the case is applied.
 pub fn load_clip(case: &Case) -> Result<Clip, RunError> {
+    Ok(load_clip_with_truth(case)?.0)
+}
+
+/// [`load_clip`], and for a synthetic clip (`kind = "roll_3d"`) its ground truth: frames,
+/// curvature and roll per frame (`crate::clip::synthetic`), with the same frame range and
+/// orientation as the positions.
+pub fn load_clip_with_truth(case: &Case) -> Result<(Clip, Option<GroundTruth>), RunError> {
     let settings = case.inverse().ok_or_else(|| SolveError::NotInverse(case.name.clone()))?;
     let DataSource::Clip(src) = &settings.data else { return Err(SolveError::NotInverse(case.name.clone()).into()) };
     if !src.file.is_file() {
         return Err(RunError::ClipShape(format!("{} does not exist (the elegansbot kymograms are fetched and checksum-verified by scripts/fetch_worm_data.sh)", src.file.display())));
     }
-    let mut clip = match src.kind {
-        ClipKind::Kymogram => {
+    let (mut clip, mut truth) = match (src.kind, &src.synthetic) {
+        (ClipKind::Kymogram, _) => {
             let params = KymogramParams { length_m: case.mesh.length_m, nodes: case.mesh.nodes(), dt_s: src.frame_interval_s, plane: src.plane, scale_to_length: true };
-            read_kymogram(&src.file, &params)?
+            (read_kymogram(&src.file, &params)?, None)
         }
-        ClipKind::Recording => read_recording(&src.file, src.frame_interval_s)?,
+        (ClipKind::Recording, _) => (read_recording(&src.file, src.frame_interval_s)?, None),
+        (ClipKind::Roll3d, Some(params)) => {
+            let a = crate::clip::read_npy(&src.file)?;
+            let &[_, joints] = a.shape.as_slice() else {
+                return Err(RunError::ClipShape(format!("{}: kymogram of shape {:?}, expected frames × joint angles", src.file.display(), a.shape)));
+            };
+            let rows: Vec<Vec<f64>> = a.data.chunks_exact(joints.max(1)).map(<[f64]>::to_vec).collect();
+            let (clip, truth) = roll_clip(&rows, None, params)?;
+            (clip, Some(truth))
+        }
+        (ClipKind::Roll3d, None) => return Err(RunError::ClipShape("roll_3d clip without parameters".into())),
     };
     if clip.node_count() != case.mesh.nodes() {
         return Err(RunError::ClipShape(format!("{}: {} nodes per frame, but the case's mesh has {} (rod.elements + 1)", src.file.display(), clip.node_count(), case.mesh.nodes())));
@@ -359,13 +377,28 @@ pub fn load_clip(case: &Case) -> Result<Clip, RunError> {
             return Err(RunError::ClipShape(format!("{}: clip.frames = [{a}, {b}) but the clip has {} frames", src.file.display(), clip.frame_count())));
         }
         clip.frames = clip.frames[a..b].to_vec();
-    }
-    if src.orientation != nalgebra::Matrix3::identity() {
-        for frame in &mut clip.frames {
-            frame.iter_mut().for_each(|x| *x = src.orientation * *x);
+        if let Some(t) = &mut truth {
+            t.frames = t.frames[a..b].to_vec();
         }
     }
-    Ok(clip)
+    let r = src.orientation;
+    if r != nalgebra::Matrix3::identity() {
+        for frame in &mut clip.frames {
+            frame.iter_mut().for_each(|x| *x = r * *x);
+        }
+        // Directors rotate with the data: Q → Q Rᵀ (rows are the directors).
+        for f in truth.iter_mut().flat_map(|t| t.frames.iter_mut()) {
+            f.q.iter_mut().for_each(|q| *q *= r.transpose());
+        }
+    }
+    Ok((clip, truth))
+}
+
+/// Curvature at the nodes from element-midpoint values: the mean of the adjacent elements
+/// (the end element at the ends).
+pub fn nodal_curvature(kappa: &[(f64, Vector3<f64>)]) -> Vec<Vector3<f64>> {
+    let m = kappa.len();
+    (0..=m).map(|i| (kappa[i.saturating_sub(1).min(m - 1)].1 + kappa[i.min(m - 1)].1) * 0.5).collect()
 }
 
 /// Summary of a clip run.
@@ -379,9 +412,28 @@ pub struct ClipRun {
     /// interior nodes [1/m] (x–z clips: the bending curvature; `output::planar_xz_curvature`)
     pub kappa2: Vec<Vec<f64>>,
     pub data_kappa: Vec<Vec<f64>>,
+    /// synthetic clips: per frame the errors against the ground truth (end nodes skipped:
+    /// [`TRUTH_SKIP_NODES`]), and the true and recovered bending `κ1² + κ2²` [1/m²] per node
+    pub truth: Option<TruthRun>,
     pub wall_time_s: f64,
     pub source: String,
 }
+
+/// Ground-truth scores of a synthetic clip run.
+#[derive(Clone, Debug, Default)]
+pub struct TruthRun {
+    pub comparisons: Vec<FrameComparison>,
+    /// true roll ψ of the bending plane per frame [rad]
+    pub roll_rad: Vec<f64>,
+    /// true twist κ3 per frame (mean over nodes) [rad/m]
+    pub twist_per_m: Vec<f64>,
+    pub bending_true: Vec<Vec<f64>>,
+    pub bending_recovered: Vec<Vec<f64>>,
+}
+
+/// Nodes skipped at each end when scoring curvature against a ground truth (the curvature of
+/// the inverse solution is least reliable at the free ends; as `metrics::INNER_SKIP_ELEMENTS`).
+pub const TRUTH_SKIP_NODES: usize = INNER_SKIP_ELEMENTS;
 
 /// Solve a clip case frame by frame in the Rust engine, streaming every converged frame into
 /// `out` (`output::ClipWriter`). On failure the converged frames stay on disk and the error
@@ -389,7 +441,7 @@ pub struct ClipRun {
 pub fn run_clip(case: &Case, out: &Path, mut progress: impl FnMut(usize, usize)) -> Result<ClipRun, RunError> {
     let settings = case.inverse().ok_or_else(|| SolveError::NotInverse(case.name.clone()))?;
     let DataSource::Clip(src) = &settings.data else { return Err(SolveError::NotInverse(case.name.clone()).into()) };
-    let clip = load_clip(case)?;
+    let (clip, truth) = load_clip_with_truth(case)?;
     let problem = Problem::from_case(case);
     let params = inverse_params(settings);
     let method = match settings.method {
@@ -399,6 +451,8 @@ pub fn run_clip(case: &Case, out: &Path, mut progress: impl FnMut(usize, usize))
     let first_frame = src.frames.map(|f| f.0).unwrap_or(0);
     let sp = SequenceParams { frame: InverseParams { dt: src.frame_interval_s, ..params }, method, min_cos_beta: src.min_cos_beta, frame_offset: first_frame, start: src.start, rotation: src.rotation, gauge: src.gauge };
     let mut writer = ClipWriter::create(out)?;
+    let mut truth_writer = truth.as_ref().map(|_| crate::output::TruthWriter::create(out)).transpose()?;
+    let mut truth_run = truth.as_ref().map(|_| TruthRun::default());
     let total = clip.frame_count();
     let h = case.mesh.h();
     let start = Instant::now();
@@ -414,8 +468,26 @@ pub fn run_clip(case: &Case, out: &Path, mut progress: impl FnMut(usize, usize))
             })
             .unzip();
         let data = &clip.frames[rep.frame - first_frame];
-        let k2: Vec<f64> = nodes.element_curvature().iter().map(|(_, k)| k[1]).collect();
-        let kd = planar_xz_curvature(data, h);
+        let kappa = nodes.element_curvature();
+        let k2: Vec<f64> = kappa.iter().map(|(_, k)| k[1]).collect();
+        // The data's curvature in the plane normal to the chart's axis (exactly the x–z
+        // curvature for an x–z clip; rotates with the data, R5).
+        let in_chart: Vec<Vector3<f64>> = data.iter().map(|x| frame.chart.to_chart(x)).collect();
+        let kd = planar_xz_curvature(&in_chart, h);
+        if let (Some(t), Some(tw), Some(tr)) = (&truth, &mut truth_writer, &mut truth_run) {
+            let ft = &t.frames[rep.frame - first_frame];
+            let q: Vec<nalgebra::Matrix3<f64>> = nodes.alpha.iter().map(|a| nodes.chart.rotation(a)).collect();
+            let kn = nodal_curvature(&kappa);
+            let c = compare_frame(data, ft, &RecoveredFrame { x: &nodes.x, q: &q, kappa: &kn }, TRUTH_SKIP_NODES).map_err(|e| e.to_string())?;
+            let twist = ft.kappa.iter().map(|k| k.z).sum::<f64>() / ft.kappa.len() as f64;
+            tw.frame(rep.frame, rep.frame as f64 * clip.dt_s, ft.roll_rad, twist, &c).map_err(|e| e.to_string())?;
+            let bend = |k: &Vector3<f64>| k.x * k.x + k.y * k.y;
+            tr.comparisons.push(c);
+            tr.roll_rad.push(ft.roll_rad);
+            tr.twist_per_m.push(twist);
+            tr.bending_true.push(ft.kappa.iter().map(bend).collect());
+            tr.bending_recovered.push(kn.iter().map(bend).collect());
+        }
         let roughness = (sign_alternation(&k2), sign_alternation(&kd));
         rough.push(roughness);
         kappa2.push(k2);
@@ -426,5 +498,5 @@ pub fn run_clip(case: &Case, out: &Path, mut progress: impl FnMut(usize, usize))
     });
     writer.finish()?;
     let reports = result?;
-    Ok(ClipRun { reports, roughness: rough, kappa2, data_kappa, wall_time_s: start.elapsed().as_secs_f64(), source: clip.source })
+    Ok(ClipRun { reports, roughness: rough, kappa2, data_kappa, truth: truth_run, wall_time_s: start.elapsed().as_secs_f64(), source: clip.source })
 }
