@@ -1,30 +1,53 @@
 #!/usr/bin/env bash
-# Benchmark of what exists today (groundwork for issue 5's speed goals; not those goals):
-# wall time and peak memory of whole processes, Rust vs FreeFEM where both run.
-#   - Timoshenko 10 %: `cosserat run` end to end (best of 5).
-#   - Dynamic cantilever: `cosserat run` end to end.
-#   - Worm clip (omega turn, Table 1 by Newton, 600 frames): frames/s, iterations, peak RSS.
-#   - FreeFEM vs Rust on the first worm frame (same element, same data): per-frame time ratio.
-# Needs the worm data (scripts/fetch_worm_data.sh). Prints a table; writes nothing else.
+# Speed benchmark of issue 5, in one run on one machine (not a test: nothing here asserts).
+#   1. worm_roll_3d: the full 1160-frame 3D clip in Rust (Newton warm-started from the previous
+#      frame, rebased chart): wall time, frames/s, mean iterations per frame, peak RSS.
+#   2. FreeFEM vs Rust on the prefix FreeFEM can handle: frame 0 of worm_roll_3d (the global
+#      chart is regular there) with the fixed point, FreeFEM's only method, at the case's own
+#      tolerance (1e-9): per-frame time of each engine and the ratios.
+#   3. timoshenko_10pct end to end (best of 5) and cantilever_dynamic end to end.
+# Goals (2-core machine): 3D clip <= 10 s and <= 200 MB; >= 50x FreeFEM per frame;
+# Timoshenko <= 30 ms; dynamic cantilever <= 1 s.
+# Needs FreeFem++ and the worm data (scripts/fetch_worm_data.sh). Prints a table (markdown);
+# writes nothing outside a temporary folder.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cargo build --release -q
 bin=target/release/cosserat
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-wall() { /usr/bin/time -f "%e %M" -o "$tmp/t" "$@" >/dev/null 2>&1; cat "$tmp/t"; }
+# Whole-process wall time [s] and peak RSS [KB] of a command.
+wall() { /usr/bin/time -f "%e %M" -o "$tmp/t" "$@" >/dev/null 2>"$tmp/err" || { cat "$tmp/err" >&2; exit 1; }; cat "$tmp/t"; }
+py() { python3 -c "$1"; }
+
+sed -e "s|file = \"../data|file = \"$PWD/data|" cases/worm_roll_3d.toml > "$tmp/roll.toml"
+read -r t3 m3 < <(wall $bin run "$tmp/roll.toml" --quiet --out "$tmp/roll")
+frames=$(($(wc -l < "$tmp/roll/frames.csv") - 1))
+its=$(py "import csv; r=list(csv.DictReader(open('$tmp/roll/frames.csv'))); print('%.2f' % (sum(float(x['iterations']) for x in r)/len(r)))")
+rust_frame=$(py "print($t3/$frames)")
+
+# FreeFEM's method (the fixed point) on frame 0, same tolerance; `compare` runs both engines.
+sed -e 's/^method = "newton"/method = "fixed_point"/' -e '/^warm_start_tolerance/d' -e 's/^max_iterations = 300/max_iterations = 5000/' \
+    "$tmp/roll.toml" > "$tmp/roll_fp.toml"
+$bin compare "$tmp/roll_fp.toml" --out "$tmp/cmp" > "$tmp/cmp.txt" || true
+ff=$(sed -n 's/.*wall time: rust \([0-9.]*\) s, freefem \([0-9.]*\) s.*/\2/p' "$tmp/cmp.txt")
+rust_fp=$(sed -n 's/.*wall time: rust \([0-9.]*\) s, freefem \([0-9.]*\) s.*/\1/p' "$tmp/cmp.txt")
+ff_its=$(sed -n 's/^iterations *\([0-9.e+-]*\) *\([0-9.e+-]*\).*/\2/p' "$tmp/cmp.txt")
+
 best=1e9
 for _ in 1 2 3 4 5; do
   t=$(wall $bin run cases/timoshenko_10pct.toml --quiet --out "$tmp/t10" | cut -d' ' -f1)
-  best=$(python3 -c "print(min($best, $t))")
+  best=$(py "print(min($best, $t))")
 done
-echo "timoshenko_10pct   whole process best of 5: ${best} s"
-read -r t m < <(wall $bin run cases/cantilever_dynamic.toml --quiet --out "$tmp/dyn")
-echo "cantilever_dynamic whole process: ${t} s, peak RSS $((m / 1024)) MB"
-sed -e 's/^method = "fixed_point"/method = "newton"\nwarm_start_tolerance = 1e-3/' -e 's/^tolerance = 1e-6/tolerance = 1e-10/' \
-    -e "s|file = \"../data|file = \"$PWD/data|" cases/worm_omega_turn.toml > "$tmp/worm.toml"
-read -r t m < <(wall $bin run "$tmp/worm.toml" --quiet --out "$tmp/worm")
-frames=$(($(wc -l < "$tmp/worm/frames.csv") - 1))
-its=$(python3 -c "import csv; r=list(csv.DictReader(open('$tmp/worm/frames.csv'))); print('%.1f' % (sum(float(x['iterations']) for x in r)/len(r)))")
-echo "worm_omega_turn (Table 1, Newton): ${frames} frames in ${t} s ($(python3 -c "print('%.1f' % ($frames/$t))") frames/s), mean ${its} iterations/frame, peak RSS $((m / 1024)) MB"
-$bin compare cases/worm_omega_turn.toml --out "$tmp/cmp" | grep "wall time"
+read -r td md < <(wall $bin run cases/cantilever_dynamic.toml --quiet --out "$tmp/dyn")
+
+echo "| measurement | value | goal |"
+echo "|---|---|---|"
+echo "| worm_roll_3d, Rust, whole process | $frames frames in ${t3} s ($(py "print('%.0f' % ($frames/$t3))") frames/s), mean ${its} Newton iterations/frame, peak RSS $((m3 / 1024)) MB | <= 10 s, <= 200 MB |"
+echo "| frame 0 of worm_roll_3d, FreeFEM fixed point to 1e-9 | ${ff} s (${ff_its} iterations) | - |"
+echo "| same frame, Rust fixed point to 1e-9 (same method) | ${rust_fp} s: FreeFEM/Rust = $(py "print('%.0f' % ($ff/$rust_fp))") | - |"
+echo "| Rust per frame in the clip (Newton warm start, tolerance 1e-9) | $(py "print('%.1f' % (1e3*$rust_frame))") ms: FreeFEM/Rust = $(py "print('%.0f' % ($ff/$rust_frame))") | >= 50 |"
+echo "| timoshenko_10pct, whole process, best of 5 | $(py "print('%.0f' % (1e3*$best))") ms | <= 30 ms |"
+echo "| cantilever_dynamic, whole process | ${td} s, peak RSS $((md / 1024)) MB | <= 1 s |"
+echo
+echo "machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs)"
