@@ -44,7 +44,7 @@ pub struct DynamicSolution {
 /// Integrate from the reference configuration at rest.
 pub fn solve(problem: &Problem, params: &DynamicParams, mut progress: impl FnMut(usize, usize)) -> Result<DynamicSolution, SolveError> {
     let pattern = Pattern::new(&problem.mesh);
-    let solver = LinearSolver::new(&pattern)?;
+    let mut solver = LinearSolver::new(&pattern)?;
     let fixed = problem.clamped_dofs();
     let dt = params.end_time_s / params.steps as f64;
     let last = problem.mesh.nodes() - 1;

@@ -249,13 +249,29 @@ pub fn solve_frame_observed(
     x_g: &[Vector3<f64>],
     alpha_prev: &[Vector3<f64>],
     u0: &DVector<f64>,
+    progress: impl FnMut(&InverseRecord, &DVector<f64>, &DVector<f64>),
+) -> Result<InverseSolution, SolveError> {
+    solve_frame_observed_in(&mut InverseWorkspace::new(problem)?, problem, p, x_g, alpha_prev, u0, progress)
+}
+
+/// [`solve_frame_observed`] in a workspace made once per mesh (e.g. once per clip) and reused
+/// for every frame: no symbolic set-up and no allocation of the system per frame.
+#[allow(clippy::too_many_arguments)]
+pub fn solve_frame_observed_in(
+    ws: &mut InverseWorkspace,
+    problem: &Problem,
+    p: &InverseParams,
+    x_g: &[Vector3<f64>],
+    alpha_prev: &[Vector3<f64>],
+    u0: &DVector<f64>,
     mut progress: impl FnMut(&InverseRecord, &DVector<f64>, &DVector<f64>),
 ) -> Result<InverseSolution, SolveError> {
-    let mut kkt = KktSolve::new(problem, p, x_g)?;
+    ws.check(problem)?;
+    ws.set_dirichlet(p, x_g);
     let mut u = u0.clone();
     let mut history = Vec::new();
     for k in 1..=p.max_iterations {
-        let sol = kkt.solve_at(problem, p, &u, x_g, alpha_prev)?;
+        let sol = ws.solve_at(problem, p, &u, x_g, alpha_prev)?;
         let (u_new, adjoint) = (part(&sol, false), part(&sol, true));
         let u_next = &u_new * p.relaxation + &u * (1.0 - p.relaxation);
         let rel_change = relative_change(&u_next, &u);
@@ -273,28 +289,58 @@ pub fn solve_frame_observed(
     Err(SolveError::InverseNotConverged { frame: p.frame, iterations: p.max_iterations, rel_change: history.last().map(|h| h.rel_change).unwrap_or(f64::NAN) })
 }
 
-/// The linear KKT solve of one fixed-point iteration (I4–I6): sparsity pattern, symbolic LU
-/// and Dirichlet rows set up once, the matrix assembled at each state.
-pub(crate) struct KktSolve {
+/// Everything the inverse solvers of one frame (fixed point, Newton, warm start) need besides
+/// the data, built once per mesh and reused for every frame of a clip: the KKT sparsity
+/// pattern ([`BLOCK`] unknowns per node, block tridiagonal), the banded LU's storage and
+/// scratch ([`LinearSolver`]), the value arrays of the Jacobian and of the line search, and
+/// the Dirichlet rows of I5 (refilled per frame by [`InverseWorkspace::set_dirichlet`]: the
+/// positions depend only on `first_frame`, the values on the frame's data).
+///
+/// ```ignore
+/// let mut ws = InverseWorkspace::new(&problem)?;        // once per clip
+/// for frame in frames {
+///     solve_frame_warm_in(&mut ws, &problem, &p, tol, x_g, &prev, &u0, |_, _, _| {})?;
+/// }
+/// ```
+pub struct InverseWorkspace {
+    pub(crate) nodes: usize,
     pub(crate) pattern: Pattern,
     pub(crate) solver: LinearSolver,
+    /// Dirichlet unknowns of I5 and their values (KKT numbering)
     pub(crate) fixed: Vec<(usize, f64)>,
-    rows: Vec<usize>,
+    pub(crate) rows: Vec<usize>,
+    /// system values (pattern order)
     pub(crate) values: Vec<f64>,
+    /// Newton: the residual merit's row weights (Ruiz row factors of the first Jacobian)
+    pub(crate) weights: Vec<f64>,
 }
 
-impl KktSolve {
-    pub(crate) fn new(problem: &Problem, p: &InverseParams, x_g: &[Vector3<f64>]) -> Result<Self, SolveError> {
+impl InverseWorkspace {
+    /// Workspace for the mesh of `problem`.
+    pub fn new(problem: &Problem) -> Result<Self, SolveError> {
         let pattern = Pattern::with_block(&problem.mesh, BLOCK);
         let solver = LinearSolver::new(&pattern)?;
-        let fixed = dirichlet(p, x_g);
-        let rows = fixed.iter().map(|f| f.0).collect();
         let values = vec![0.0; pattern.nnz()];
-        Ok(KktSolve { pattern, solver, fixed, rows, values })
+        Ok(InverseWorkspace { nodes: problem.mesh.nodes(), pattern, solver, fixed: Vec::new(), rows: Vec::new(), values, weights: Vec::new() })
+    }
+
+    /// The workspace must have been made for this mesh.
+    pub(crate) fn check(&self, problem: &Problem) -> Result<(), SolveError> {
+        if problem.mesh.nodes() != self.nodes {
+            return Err(SolveError::Unsupported("inverse workspace made for another mesh"));
+        }
+        Ok(())
+    }
+
+    /// Dirichlet rows and values of I5 for the frame (`p.first_frame`, data `x_g`).
+    pub fn set_dirichlet(&mut self, p: &InverseParams, x_g: &[Vector3<f64>]) {
+        dirichlet_into(p, x_g, &mut self.fixed);
+        self.rows.clear();
+        self.rows.extend(self.fixed.iter().map(|f| f.0));
     }
 
     /// Solve `K(u) U = r(u)` with the boundary conditions of I5 (equilibrated, I6); `U` has
-    /// [`BLOCK`] unknowns per node.
+    /// [`BLOCK`] unknowns per node. [`InverseWorkspace::set_dirichlet`] must have run for the frame.
     pub(crate) fn solve_at(&mut self, problem: &Problem, p: &InverseParams, u: &DVector<f64>, x_g: &[Vector3<f64>], alpha_prev: &[Vector3<f64>]) -> Result<DVector<f64>, SolveError> {
         let mut rhs = assemble_kkt(problem, p, &self.pattern, &mut self.values, u, x_g, alpha_prev);
         for &(d, v) in &self.fixed {
@@ -333,8 +379,15 @@ pub(crate) fn record(
 /// Dirichlet unknowns of I5 in KKT numbering with their values: `x = x_g` and `x̂ = α̂ = 0`
 /// at both ends, and at the first frame `α(0) = 0` (first angle only).
 pub fn dirichlet(p: &InverseParams, x_g: &[Vector3<f64>]) -> Vec<(usize, f64)> {
-    let last = x_g.len() - 1;
     let mut fixed = Vec::new();
+    dirichlet_into(p, x_g, &mut fixed);
+    fixed
+}
+
+/// [`dirichlet`] into a reused vector (cleared first).
+pub(crate) fn dirichlet_into(p: &InverseParams, x_g: &[Vector3<f64>], fixed: &mut Vec<(usize, f64)>) {
+    fixed.clear();
+    let last = x_g.len() - 1;
     for node in [0, last] {
         for k in 0..3 {
             fixed.push((BLOCK * node + k, x_g[node][k]));
@@ -346,7 +399,6 @@ pub fn dirichlet(p: &InverseParams, x_g: &[Vector3<f64>]) -> Vec<(usize, f64)> {
     if p.first_frame {
         fixed.push((3, p.alpha0));
     }
-    fixed
 }
 
 /// Assemble the KKT matrix (into `values`, zeroed first) and right-hand side of I4 with the
