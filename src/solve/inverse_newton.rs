@@ -32,7 +32,7 @@ use super::{Problem, SolveError};
 use crate::assembly::Pattern;
 use crate::element::{frozen_operator, internal_force, interpolate, LocalMat, LocalVec};
 use crate::mesh::GAUSS2;
-use crate::rotation::{a_matrix, a_matrix_derivatives, d3, d3_second_derivatives, rotation, rotation_derivatives, skew};
+use crate::rotation::{a_matrix, a_matrix_derivatives, d3, d3_second_derivatives, rotation, rotation_derivatives, skew, PointFrame};
 
 /// Smallest step fraction of the backtracking line search (2⁻¹⁰).
 const MIN_STEP: f64 = 1.0 / 1024.0;
@@ -114,10 +114,8 @@ fn coefficient_derivative(problem: &Problem, p: &InverseParams, ue: &KktVec, alp
     for (xi, w) in rule.points.iter().zip(rule.weights) {
         let (q, qa) = (interpolate(&state, h, *xi), interpolate(&adj, h, *xi));
         let wh = w * h;
-        let Q = rotation(&q.alpha);
-        let A = a_matrix(&q.alpha);
-        let dQ = rotation_derivatives(&q.alpha);
-        let dA = a_matrix_derivatives(&q.alpha);
+        let f = PointFrame::new(&q.alpha, true);
+        let (Q, A, dQ, dA) = (f.q, f.a, f.dq, f.da);
         let mut blk = columns([0, 1, 2].map(|j| (dQ[j].transpose() * Jm * A + Q.transpose() * Jm * dA[j]).transpose() * qa.dalpha));
         if kappa_on {
             blk += columns([0, 1, 2].map(|j| (dA[j].transpose() * Lk * A + A.transpose() * Lk * dA[j]) * q.dalpha));
