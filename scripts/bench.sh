@@ -27,4 +27,8 @@ read -r t m < <(wall $bin run "$tmp/worm.toml" --quiet --out "$tmp/worm")
 frames=$(($(wc -l < "$tmp/worm/frames.csv") - 1))
 its=$(python3 -c "import csv; r=list(csv.DictReader(open('$tmp/worm/frames.csv'))); print('%.1f' % (sum(float(x['iterations']) for x in r)/len(r)))")
 echo "worm_omega_turn (Table 1, Newton): ${frames} frames in ${t} s ($(python3 -c "print('%.1f' % ($frames/$t))") frames/s), mean ${its} iterations/frame, peak RSS $((m / 1024)) MB"
+read -r t m < <(wall $bin run cases/worm_omega_turn_ld1.toml --quiet --out "$tmp/ld1")
+frames=$(($(wc -l < "$tmp/ld1/frames.csv") - 1))
+echo "worm_omega_turn_ld1 (case file): ${frames} frames in ${t} s ($(python3 -c "print('%.1f' % ($frames/$t))") frames/s), peak RSS $((m / 1024)) MB"
+cargo run --release -q --example bench_kkt
 $bin compare cases/worm_omega_turn.toml --out "$tmp/cmp" | grep "wall time"

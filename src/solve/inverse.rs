@@ -113,13 +113,40 @@ pub struct InverseSolution {
 /// Points and weights of the λd term's rule (I11): `(1 − ε)` times the stretch–shear rule of
 /// the scheme plus `ε` times 2-point Gauss (the same rule when the scheme is already full).
 pub fn tangent_rule(problem: &Problem, p: &InverseParams) -> Vec<(f64, f64)> {
+    tangent_points(problem, p).iter().collect()
+}
+
+/// [`tangent_rule`] without allocation (at most 2 + 2 points), for the element loops.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct PointRule {
+    points: [(f64, f64); 4],
+    len: usize,
+}
+
+impl PointRule {
+    pub(crate) fn iter(&self) -> impl Iterator<Item = (f64, f64)> + '_ {
+        self.points[..self.len].iter().copied()
+    }
+}
+
+pub(crate) fn tangent_points(problem: &Problem, p: &InverseParams) -> PointRule {
     let base = problem.scheme.stretch_shear();
     let eps = p.stabilisation;
-    let mut rule: Vec<(f64, f64)> = base.points.iter().zip(base.weights).map(|(x, w)| (*x, w * (1.0 - eps))).collect();
-    if eps > 0.0 {
-        rule.extend(GAUSS2.points.iter().zip(GAUSS2.weights).map(|(x, w)| (*x, w * eps)));
+    let mut rule = PointRule { points: [(0.0, 0.0); 4], len: 0 };
+    let mut push = |x: f64, w: f64| {
+        if w != 0.0 {
+            rule.points[rule.len] = (x, w);
+            rule.len += 1;
+        }
+    };
+    for (x, w) in base.points.iter().zip(base.weights) {
+        push(*x, w * (1.0 - eps));
     }
-    rule.retain(|(_, w)| *w != 0.0);
+    if eps > 0.0 {
+        for (x, w) in GAUSS2.points.iter().zip(GAUSS2.weights) {
+            push(*x, w * eps);
+        }
+    }
     rule
 }
 
@@ -189,7 +216,7 @@ pub(crate) fn element_system(problem: &Problem, p: &InverseParams, uk: &LocalVec
         }
     }
     // λd term (its rule, I11): λd ∫ (∂sδx − D δα)·(∂s x − D α − d3^k + D α_k).
-    for (xi, w) in tangent_rule(problem, p) {
+    for (xi, w) in tangent_points(problem, p).iter() {
         let q = interpolate(uk, h, xi);
         let wh = w * h * p.lambda_d;
         let D = d3_jacobian(&q.alpha);
@@ -439,7 +466,7 @@ pub(crate) fn assemble_blocks(problem: &Problem, pattern: &Pattern, values: &mut
 pub fn fit_measures(problem: &Problem, p: &InverseParams, u: &DVector<f64>, x_g: &[Vector3<f64>]) -> (f64, f64) {
     let h = problem.mesh.h();
     let (mut e2, mut g2, mut t2) = (0.0, 0.0, 0.0);
-    let rule = tangent_rule(problem, p);
+    let rule = tangent_points(problem, p);
     for e in 0..problem.mesh.elements {
         let ue = LocalVec::from_column_slice(&u.as_slice()[6 * e..6 * e + 12]);
         for (xi, w) in GAUSS2.points.iter().zip(GAUSS2.weights) {
@@ -448,7 +475,7 @@ pub fn fit_measures(problem: &Problem, p: &InverseParams, u: &DVector<f64>, x_g:
             e2 += w * h * (q.x - xg).norm_squared();
             g2 += w * h * xg.norm_squared();
         }
-        for &(xi, w) in &rule {
+        for (xi, w) in rule.iter() {
             let q = interpolate(&ue, h, xi);
             t2 += w * h * (q.dx - d3(&q.alpha)).norm_squared();
         }
@@ -479,7 +506,7 @@ pub fn objective_terms(problem: &Problem, p: &InverseParams, u: &DVector<f64>, a
                 t.angular += wh * om.component_mul(&om).dot(&p.lambda_omega);
             }
         }
-        for (xi, w) in tangent_rule(problem, p) {
+        for (xi, w) in tangent_points(problem, p).iter() {
             let q = interpolate(&ue, h, xi);
             t.shear += 0.5 * w * h * p.lambda_d * (q.dx - d3(&q.alpha)).norm_squared();
         }

@@ -25,7 +25,7 @@
 use nalgebra::{DVector, Matrix3, Vector3};
 
 use super::inverse::{
-    assemble_blocks, dirichlet, element_system, kkt, part, record, tangent_rule, InverseParams, InverseRecord, InverseSolution, InverseWorkspace, KktMat, KktVec, BLOCK,
+    assemble_blocks, dirichlet, element_system, kkt, part, record, tangent_points, InverseParams, InverseRecord, InverseSolution, InverseWorkspace, KktMat, KktVec, BLOCK,
 };
 use super::statics::relative_change;
 use super::{Problem, SolveError};
@@ -95,7 +95,7 @@ fn coefficient_derivative(problem: &Problem, p: &InverseParams, ue: &KktVec, alp
         }
     }
     // The λd term's rule (I11): the second derivative of d3 in −λd ∫ δα·D(α)ᵀ(∂s x − d3).
-    for (xi, w) in tangent_rule(problem, p) {
+    for (xi, w) in tangent_points(problem, p).iter() {
         let q = interpolate(&state, h, xi);
         let wh = w * h;
         let dd = d3_second_derivatives(&q.alpha);
