@@ -16,7 +16,7 @@ use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 
 use crate::material::RodProperties;
 use crate::mesh::{QuadratureScheme, Rule};
-use crate::rotation::{a_matrix, a_matrix_derivatives, rotation, rotation_derivatives, skew};
+use crate::rotation::{rotation, rotation_derivatives, skew, PointFrame};
 
 /// Local element vector (12 entries).
 pub type LocalVec = SVector<f64, 12>;
@@ -83,8 +83,10 @@ pub fn internal_force(
     let K = Matrix3::from_diagonal(&props.shear_stretch_n);
     let J = Matrix3::from_diagonal(&props.bend_twist_nm2);
     let mut r = LocalVec::zeros();
+    let with_tangent = tangent.is_some();
     for_each_point(&scheme.stretch_shear(), h, u, |p, wh| {
-        let Q = rotation(&p.alpha);
+        let f = PointFrame::new(&p.alpha, with_tangent);
+        let Q = f.q;
         let e = Q * p.dx - Vector3::z();
         let n = Q.transpose() * K * e;
         let c = p.dx.cross(&n);
@@ -93,7 +95,7 @@ pub fn internal_force(
             add_vec(&mut r, ALPHA[a], &(c * (-wh * p.n[a])));
         }
         if let Some(t) = tangent.as_deref_mut() {
-            let dQ = rotation_derivatives(&p.alpha);
+            let dQ = f.dq;
             let dn_dx = Q.transpose() * K * Q;
             let dn_da = columns([0, 1, 2].map(|j| dQ[j].transpose() * K * e + Q.transpose() * K * dQ[j] * p.dx));
             let dc_dx = -skew(&n) + skew(&p.dx) * dn_dx;
@@ -109,15 +111,14 @@ pub fn internal_force(
         }
     });
     for_each_point(&scheme.bending(), h, u, |p, wh| {
-        let Q = rotation(&p.alpha);
-        let A = a_matrix(&p.alpha);
+        let f = PointFrame::new(&p.alpha, with_tangent);
+        let (Q, A) = (f.q, f.a);
         let m = Q.transpose() * J * A * p.dalpha;
         for a in 0..2 {
             add_vec(&mut r, ALPHA[a], &(m * (wh * p.dn[a])));
         }
         if let Some(t) = tangent.as_deref_mut() {
-            let dQ = rotation_derivatives(&p.alpha);
-            let dA = a_matrix_derivatives(&p.alpha);
+            let (dQ, dA) = (f.dq, f.da);
             let dm_dda = Q.transpose() * J * A;
             let dm_da = columns([0, 1, 2].map(|j| (dQ[j].transpose() * J * A + Q.transpose() * J * dA[j]) * p.dalpha));
             for a in 0..2 {
@@ -155,8 +156,8 @@ pub fn frozen_operator(props: &RodProperties, scheme: QuadratureScheme, h: f64, 
         }
     });
     for_each_point(&scheme.bending(), h, uk, |p, wh| {
-        let Q = rotation(&p.alpha);
-        let A = a_matrix(&p.alpha);
+        let f = PointFrame::new(&p.alpha, false);
+        let (Q, A) = (f.q, f.a);
         let C = Q.transpose() * J * A;
         for a in 0..2 {
             for c in 0..2 {
@@ -186,8 +187,8 @@ pub fn momentum(
         let p = interpolate(u, h, *xi);
         let v = interpolate(udot, h, *xi);
         let wh = w * h;
-        let Q = rotation(&p.alpha);
-        let A = a_matrix(&p.alpha);
+        let f = PointFrame::new(&p.alpha, d_u.is_some());
+        let (Q, A) = (f.q, f.a);
         let H = Q.transpose() * I * A;
         let px = v.x * rho_a;
         let pa = H * v.alpha;
@@ -205,8 +206,7 @@ pub fn momentum(
             }
         }
         if let Some(t) = d_u.as_deref_mut() {
-            let dQ = rotation_derivatives(&p.alpha);
-            let dA = a_matrix_derivatives(&p.alpha);
+            let (dQ, dA) = (f.dq, f.da);
             let dp_da = columns([0, 1, 2].map(|j| (dQ[j].transpose() * I * A + Q.transpose() * I * dA[j]) * v.alpha));
             for a in 0..2 {
                 for b in 0..2 {

@@ -34,6 +34,7 @@
 //! 3. [R3] K. E. Bisshopp, D. C. Drucker, *Large deflection of cantilever beams*, Q. Appl. Math.
 //!    3 (1945) — elastica reference values.
 pub mod assembly;
+pub mod banded;
 pub mod case;
 pub mod chart;
 pub mod clip;

@@ -61,13 +61,19 @@ fn dry(c: f64, s: f64) -> Matrix3<f64> {
 
 /// The rotation matrix `Q(α)` of eq. (1).
 pub fn rotation(a: &Angles) -> Matrix3<f64> {
-    let t = Trig::new(a);
+    rotation_t(&Trig::new(a))
+}
+
+fn rotation_t(t: &Trig) -> Matrix3<f64> {
     rz(t.ca, t.sa) * rx(t.cb, t.sb) * ry(t.cg, t.sg)
 }
 
 /// `∂Q/∂α_j` for j = 0, 1, 2 (derivative of eq. (1) with respect to α, β, γ).
 pub fn rotation_derivatives(a: &Angles) -> [Matrix3<f64>; 3] {
-    let t = Trig::new(a);
+    rotation_derivatives_t(&Trig::new(a))
+}
+
+fn rotation_derivatives_t(t: &Trig) -> [Matrix3<f64>; 3] {
     let (z, x, y) = (rz(t.ca, t.sa), rx(t.cb, t.sb), ry(t.cg, t.sg));
     [
         drz(t.ca, t.sa) * x * y,
@@ -78,7 +84,10 @@ pub fn rotation_derivatives(a: &Angles) -> [Matrix3<f64>; 3] {
 
 /// The matrix `A(α)` of eqs. (27)/(28), mapping angle rates to local angular velocity/curvature.
 pub fn a_matrix(a: &Angles) -> Matrix3<f64> {
-    let t = Trig::new(a);
+    a_matrix_t(&Trig::new(a))
+}
+
+fn a_matrix_t(t: &Trig) -> Matrix3<f64> {
     Matrix3::new(
         0.0,
         -t.ca,
@@ -94,12 +103,36 @@ pub fn a_matrix(a: &Angles) -> Matrix3<f64> {
 
 /// `∂A/∂α_j` for j = 0, 1, 2.
 pub fn a_matrix_derivatives(a: &Angles) -> [Matrix3<f64>; 3] {
-    let t = Trig::new(a);
+    a_matrix_derivatives_t(&Trig::new(a))
+}
+
+fn a_matrix_derivatives_t(t: &Trig) -> [Matrix3<f64>; 3] {
     [
         Matrix3::new(0.0, t.sa, t.ca * t.cb, 0.0, -t.ca, t.sa * t.cb, 0.0, 0.0, 0.0),
         Matrix3::new(0.0, 0.0, -t.sa * t.sb, 0.0, 0.0, t.ca * t.sb, 0.0, 0.0, -t.cb),
         Matrix3::zeros(),
     ]
+}
+
+/// `Q`, `A` and, if asked, `∂Q/∂α_j`, `∂A/∂α_j` at one point from one evaluation of the sines
+/// and cosines: the same numbers as [`rotation`], [`a_matrix`], [`rotation_derivatives`] and
+/// [`a_matrix_derivatives`], for kernels that need several of them at the same angles.
+#[derive(Clone, Copy, Debug)]
+pub struct PointFrame {
+    pub q: Matrix3<f64>,
+    pub a: Matrix3<f64>,
+    /// `∂Q/∂α_j` (zeros unless made with derivatives)
+    pub dq: [Matrix3<f64>; 3],
+    /// `∂A/∂α_j` (zeros unless made with derivatives)
+    pub da: [Matrix3<f64>; 3],
+}
+
+impl PointFrame {
+    pub fn new(a: &Angles, derivatives: bool) -> Self {
+        let t = Trig::new(a);
+        let (dq, da) = if derivatives { (rotation_derivatives_t(&t), a_matrix_derivatives_t(&t)) } else { ([Matrix3::zeros(); 3], [Matrix3::zeros(); 3]) };
+        PointFrame { q: rotation_t(&t), a: a_matrix_t(&t), dq, da }
+    }
 }
 
 /// Director `d3 = q3 = (−cos β sin γ, sin β, cos β cos γ)`, third row of Q (eq. (2), §4).
@@ -248,6 +281,18 @@ mod tests {
                     assert!((fd - dd[i][j]).amax() < 1e-9, "d2 d3 / da_{i} da_{j} at {a}");
                 }
             }
+        }
+    }
+
+    #[test]
+    fn point_frame_is_the_separate_functions() {
+        for k in 0..10 {
+            let a = field(0.7 * k as f64) * 2.0;
+            let f = PointFrame::new(&a, true);
+            assert_eq!(f.q, rotation(&a));
+            assert_eq!(f.a, a_matrix(&a));
+            assert_eq!(f.dq, rotation_derivatives(&a));
+            assert_eq!(f.da, a_matrix_derivatives(&a));
         }
     }
 

@@ -12,6 +12,7 @@ use nalgebra::{DVector, Vector3};
 
 use super::{node_values, Problem, SolveError};
 use crate::assembly::{LinearSolver, Pattern};
+use crate::loads::LoadFrame;
 
 /// Time-stepping parameters.
 #[derive(Clone, Copy, Debug)]
@@ -44,7 +45,7 @@ pub struct DynamicSolution {
 /// Integrate from the reference configuration at rest.
 pub fn solve(problem: &Problem, params: &DynamicParams, mut progress: impl FnMut(usize, usize)) -> Result<DynamicSolution, SolveError> {
     let pattern = Pattern::new(&problem.mesh);
-    let solver = LinearSolver::new(&pattern)?;
+    let mut solver = LinearSolver::new(&pattern)?;
     let fixed = problem.clamped_dofs();
     let dt = params.end_time_s / params.steps as f64;
     let last = problem.mesh.nodes() - 1;
@@ -60,12 +61,16 @@ pub fn solve(problem: &Problem, params: &DynamicParams, mut progress: impl FnMut
     };
     let mut tip = vec![record(0.0, &u_prev, 0)];
     let (mut total, mut max_it) = (0, 0);
+    // Global-frame (or no distributed) loads do not depend on the state: F(t_n) once per step
+    // instead of once per Newton iteration and again after it (the same numbers).
+    let state_free_loads = !(problem.loads.has_distributed() && matches!(problem.loads.frame, LoadFrame::Local));
 
     for n in 1..=params.steps {
         let t = n as f64 * dt;
         let mut u = &u_prev + &v_prev * dt;
         let mut converged = None;
         let mut increment = f64::NAN;
+        let f_step = if state_free_loads { Some(problem.loads_at(&u, t, None)) } else { None };
         for it in 1..=params.newton_max_iterations {
             let v = (&u - &u_prev) * (2.0 / dt) - &v_prev;
             let u_mid = (&u + &u_prev) * 0.5;
@@ -73,7 +78,14 @@ pub fn solve(problem: &Problem, params: &DynamicParams, mut progress: impl FnMut
             let p = problem.momentum(&u, &v, Some((&pattern, &mut values, 1.0 / dt, 2.0 / (dt * dt))));
             let g = problem.internal_force(&u_mid, Some((&pattern, &mut values, 0.5)));
             // ½[F(t_n, u_n) + F(t_{n−1}, u_{n−1})]: only the first half depends on u_n.
-            let f_n = problem.loads_at(&u, t, Some((&pattern, &mut values, -0.5)));
+            let f_state;
+            let f_n = match &f_step {
+                Some(f) => f,
+                None => {
+                    f_state = problem.loads_at(&u, t, Some((&pattern, &mut values, -0.5)));
+                    &f_state
+                }
+            };
             let mut r = (p - &p_prev) / dt + g - (f_n + &f_prev) * 0.5;
             for &d in &fixed {
                 r[d] = 0.0;
@@ -95,7 +107,10 @@ pub fn solve(problem: &Problem, params: &DynamicParams, mut progress: impl FnMut
         max_it = max_it.max(it);
         let v = (&u - &u_prev) * (2.0 / dt) - &v_prev;
         p_prev = problem.momentum(&u, &v, None);
-        f_prev = problem.loads_at(&u, t, None);
+        f_prev = match f_step {
+            Some(f) => f,
+            None => problem.loads_at(&u, t, None),
+        };
         tip.push(record(t, &u, it));
         u_prev = u;
         v_prev = v;

@@ -113,13 +113,40 @@ pub struct InverseSolution {
 /// Points and weights of the λd term's rule (I11): `(1 − ε)` times the stretch–shear rule of
 /// the scheme plus `ε` times 2-point Gauss (the same rule when the scheme is already full).
 pub fn tangent_rule(problem: &Problem, p: &InverseParams) -> Vec<(f64, f64)> {
+    tangent_points(problem, p).iter().collect()
+}
+
+/// [`tangent_rule`] without allocation (at most 2 + 2 points), for the element loops.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct PointRule {
+    points: [(f64, f64); 4],
+    len: usize,
+}
+
+impl PointRule {
+    pub(crate) fn iter(&self) -> impl Iterator<Item = (f64, f64)> + '_ {
+        self.points[..self.len].iter().copied()
+    }
+}
+
+pub(crate) fn tangent_points(problem: &Problem, p: &InverseParams) -> PointRule {
     let base = problem.scheme.stretch_shear();
     let eps = p.stabilisation;
-    let mut rule: Vec<(f64, f64)> = base.points.iter().zip(base.weights).map(|(x, w)| (*x, w * (1.0 - eps))).collect();
-    if eps > 0.0 {
-        rule.extend(GAUSS2.points.iter().zip(GAUSS2.weights).map(|(x, w)| (*x, w * eps)));
+    let mut rule = PointRule { points: [(0.0, 0.0); 4], len: 0 };
+    let mut push = |x: f64, w: f64| {
+        if w != 0.0 {
+            rule.points[rule.len] = (x, w);
+            rule.len += 1;
+        }
+    };
+    for (x, w) in base.points.iter().zip(base.weights) {
+        push(*x, w * (1.0 - eps));
     }
-    rule.retain(|(_, w)| *w != 0.0);
+    if eps > 0.0 {
+        for (x, w) in GAUSS2.points.iter().zip(GAUSS2.weights) {
+            push(*x, w * eps);
+        }
+    }
     rule
 }
 
@@ -189,7 +216,7 @@ pub(crate) fn element_system(problem: &Problem, p: &InverseParams, uk: &LocalVec
         }
     }
     // λd term (its rule, I11): λd ∫ (∂sδx − D δα)·(∂s x − D α − d3^k + D α_k).
-    for (xi, w) in tangent_rule(problem, p) {
+    for (xi, w) in tangent_points(problem, p).iter() {
         let q = interpolate(uk, h, xi);
         let wh = w * h * p.lambda_d;
         let D = d3_jacobian(&q.alpha);
@@ -249,13 +276,29 @@ pub fn solve_frame_observed(
     x_g: &[Vector3<f64>],
     alpha_prev: &[Vector3<f64>],
     u0: &DVector<f64>,
+    progress: impl FnMut(&InverseRecord, &DVector<f64>, &DVector<f64>),
+) -> Result<InverseSolution, SolveError> {
+    solve_frame_observed_in(&mut InverseWorkspace::new(problem)?, problem, p, x_g, alpha_prev, u0, progress)
+}
+
+/// [`solve_frame_observed`] in a workspace made once per mesh (e.g. once per clip) and reused
+/// for every frame: no symbolic set-up and no allocation of the system per frame.
+#[allow(clippy::too_many_arguments)]
+pub fn solve_frame_observed_in(
+    ws: &mut InverseWorkspace,
+    problem: &Problem,
+    p: &InverseParams,
+    x_g: &[Vector3<f64>],
+    alpha_prev: &[Vector3<f64>],
+    u0: &DVector<f64>,
     mut progress: impl FnMut(&InverseRecord, &DVector<f64>, &DVector<f64>),
 ) -> Result<InverseSolution, SolveError> {
-    let mut kkt = KktSolve::new(problem, p, x_g)?;
+    ws.check(problem)?;
+    ws.set_dirichlet(p, x_g);
     let mut u = u0.clone();
     let mut history = Vec::new();
     for k in 1..=p.max_iterations {
-        let sol = kkt.solve_at(problem, p, &u, x_g, alpha_prev)?;
+        let sol = ws.solve_at(problem, p, &u, x_g, alpha_prev)?;
         let (u_new, adjoint) = (part(&sol, false), part(&sol, true));
         let u_next = &u_new * p.relaxation + &u * (1.0 - p.relaxation);
         let rel_change = relative_change(&u_next, &u);
@@ -273,28 +316,58 @@ pub fn solve_frame_observed(
     Err(SolveError::InverseNotConverged { frame: p.frame, iterations: p.max_iterations, rel_change: history.last().map(|h| h.rel_change).unwrap_or(f64::NAN) })
 }
 
-/// The linear KKT solve of one fixed-point iteration (I4–I6): sparsity pattern, symbolic LU
-/// and Dirichlet rows set up once, the matrix assembled at each state.
-pub(crate) struct KktSolve {
+/// Everything the inverse solvers of one frame (fixed point, Newton, warm start) need besides
+/// the data, built once per mesh and reused for every frame of a clip: the KKT sparsity
+/// pattern ([`BLOCK`] unknowns per node, block tridiagonal), the banded LU's storage and
+/// scratch ([`LinearSolver`]), the value arrays of the Jacobian and of the line search, and
+/// the Dirichlet rows of I5 (refilled per frame by [`InverseWorkspace::set_dirichlet`]: the
+/// positions depend only on `first_frame`, the values on the frame's data).
+///
+/// ```ignore
+/// let mut ws = InverseWorkspace::new(&problem)?;        // once per clip
+/// for frame in frames {
+///     solve_frame_warm_in(&mut ws, &problem, &p, tol, x_g, &prev, &u0, |_, _, _| {})?;
+/// }
+/// ```
+pub struct InverseWorkspace {
+    pub(crate) nodes: usize,
     pub(crate) pattern: Pattern,
     pub(crate) solver: LinearSolver,
+    /// Dirichlet unknowns of I5 and their values (KKT numbering)
     pub(crate) fixed: Vec<(usize, f64)>,
-    rows: Vec<usize>,
+    pub(crate) rows: Vec<usize>,
+    /// system values (pattern order)
     pub(crate) values: Vec<f64>,
+    /// Newton: the residual merit's row weights (Ruiz row factors of the first Jacobian)
+    pub(crate) weights: Vec<f64>,
 }
 
-impl KktSolve {
-    pub(crate) fn new(problem: &Problem, p: &InverseParams, x_g: &[Vector3<f64>]) -> Result<Self, SolveError> {
+impl InverseWorkspace {
+    /// Workspace for the mesh of `problem`.
+    pub fn new(problem: &Problem) -> Result<Self, SolveError> {
         let pattern = Pattern::with_block(&problem.mesh, BLOCK);
         let solver = LinearSolver::new(&pattern)?;
-        let fixed = dirichlet(p, x_g);
-        let rows = fixed.iter().map(|f| f.0).collect();
         let values = vec![0.0; pattern.nnz()];
-        Ok(KktSolve { pattern, solver, fixed, rows, values })
+        Ok(InverseWorkspace { nodes: problem.mesh.nodes(), pattern, solver, fixed: Vec::new(), rows: Vec::new(), values, weights: Vec::new() })
+    }
+
+    /// The workspace must have been made for this mesh.
+    pub(crate) fn check(&self, problem: &Problem) -> Result<(), SolveError> {
+        if problem.mesh.nodes() != self.nodes {
+            return Err(SolveError::Unsupported("inverse workspace made for another mesh"));
+        }
+        Ok(())
+    }
+
+    /// Dirichlet rows and values of I5 for the frame (`p.first_frame`, data `x_g`).
+    pub fn set_dirichlet(&mut self, p: &InverseParams, x_g: &[Vector3<f64>]) {
+        dirichlet_into(p, x_g, &mut self.fixed);
+        self.rows.clear();
+        self.rows.extend(self.fixed.iter().map(|f| f.0));
     }
 
     /// Solve `K(u) U = r(u)` with the boundary conditions of I5 (equilibrated, I6); `U` has
-    /// [`BLOCK`] unknowns per node.
+    /// [`BLOCK`] unknowns per node. [`InverseWorkspace::set_dirichlet`] must have run for the frame.
     pub(crate) fn solve_at(&mut self, problem: &Problem, p: &InverseParams, u: &DVector<f64>, x_g: &[Vector3<f64>], alpha_prev: &[Vector3<f64>]) -> Result<DVector<f64>, SolveError> {
         let mut rhs = assemble_kkt(problem, p, &self.pattern, &mut self.values, u, x_g, alpha_prev);
         for &(d, v) in &self.fixed {
@@ -333,8 +406,15 @@ pub(crate) fn record(
 /// Dirichlet unknowns of I5 in KKT numbering with their values: `x = x_g` and `x̂ = α̂ = 0`
 /// at both ends, and at the first frame `α(0) = 0` (first angle only).
 pub fn dirichlet(p: &InverseParams, x_g: &[Vector3<f64>]) -> Vec<(usize, f64)> {
-    let last = x_g.len() - 1;
     let mut fixed = Vec::new();
+    dirichlet_into(p, x_g, &mut fixed);
+    fixed
+}
+
+/// [`dirichlet`] into a reused vector (cleared first).
+pub(crate) fn dirichlet_into(p: &InverseParams, x_g: &[Vector3<f64>], fixed: &mut Vec<(usize, f64)>) {
+    fixed.clear();
+    let last = x_g.len() - 1;
     for node in [0, last] {
         for k in 0..3 {
             fixed.push((BLOCK * node + k, x_g[node][k]));
@@ -346,7 +426,6 @@ pub fn dirichlet(p: &InverseParams, x_g: &[Vector3<f64>]) -> Vec<(usize, f64)> {
     if p.first_frame {
         fixed.push((3, p.alpha0));
     }
-    fixed
 }
 
 /// Assemble the KKT matrix (into `values`, zeroed first) and right-hand side of I4 with the
@@ -387,7 +466,7 @@ pub(crate) fn assemble_blocks(problem: &Problem, pattern: &Pattern, values: &mut
 pub fn fit_measures(problem: &Problem, p: &InverseParams, u: &DVector<f64>, x_g: &[Vector3<f64>]) -> (f64, f64) {
     let h = problem.mesh.h();
     let (mut e2, mut g2, mut t2) = (0.0, 0.0, 0.0);
-    let rule = tangent_rule(problem, p);
+    let rule = tangent_points(problem, p);
     for e in 0..problem.mesh.elements {
         let ue = LocalVec::from_column_slice(&u.as_slice()[6 * e..6 * e + 12]);
         for (xi, w) in GAUSS2.points.iter().zip(GAUSS2.weights) {
@@ -396,7 +475,7 @@ pub fn fit_measures(problem: &Problem, p: &InverseParams, u: &DVector<f64>, x_g:
             e2 += w * h * (q.x - xg).norm_squared();
             g2 += w * h * xg.norm_squared();
         }
-        for &(xi, w) in &rule {
+        for (xi, w) in rule.iter() {
             let q = interpolate(&ue, h, xi);
             t2 += w * h * (q.dx - d3(&q.alpha)).norm_squared();
         }
@@ -427,7 +506,7 @@ pub fn objective_terms(problem: &Problem, p: &InverseParams, u: &DVector<f64>, a
                 t.angular += wh * om.component_mul(&om).dot(&p.lambda_omega);
             }
         }
-        for (xi, w) in tangent_rule(problem, p) {
+        for (xi, w) in tangent_points(problem, p).iter() {
             let q = interpolate(&ue, h, xi);
             t.shear += 0.5 * w * h * p.lambda_d * (q.dx - d3(&q.alpha)).norm_squared();
         }

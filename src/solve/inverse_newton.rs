@@ -25,14 +25,14 @@
 use nalgebra::{DVector, Matrix3, Vector3};
 
 use super::inverse::{
-    assemble_blocks, dirichlet, element_system, kkt, part, record, tangent_rule, InverseParams, InverseRecord, InverseSolution, KktMat, KktSolve, KktVec, BLOCK,
+    assemble_blocks, dirichlet, element_system, kkt, part, record, tangent_points, InverseParams, InverseRecord, InverseSolution, InverseWorkspace, KktMat, KktVec, BLOCK,
 };
 use super::statics::relative_change;
 use super::{Problem, SolveError};
 use crate::assembly::Pattern;
 use crate::element::{frozen_operator, internal_force, interpolate, LocalMat, LocalVec};
 use crate::mesh::GAUSS2;
-use crate::rotation::{a_matrix, a_matrix_derivatives, d3, d3_second_derivatives, rotation, rotation_derivatives, skew};
+use crate::rotation::{a_matrix, a_matrix_derivatives, d3, d3_second_derivatives, rotation, rotation_derivatives, skew, PointFrame};
 
 /// Smallest step fraction of the backtracking line search (2⁻¹⁰).
 const MIN_STEP: f64 = 1.0 / 1024.0;
@@ -95,7 +95,7 @@ fn coefficient_derivative(problem: &Problem, p: &InverseParams, ue: &KktVec, alp
         }
     }
     // The λd term's rule (I11): the second derivative of d3 in −λd ∫ δα·D(α)ᵀ(∂s x − d3).
-    for (xi, w) in tangent_rule(problem, p) {
+    for (xi, w) in tangent_points(problem, p).iter() {
         let q = interpolate(&state, h, xi);
         let wh = w * h;
         let dd = d3_second_derivatives(&q.alpha);
@@ -114,10 +114,8 @@ fn coefficient_derivative(problem: &Problem, p: &InverseParams, ue: &KktVec, alp
     for (xi, w) in rule.points.iter().zip(rule.weights) {
         let (q, qa) = (interpolate(&state, h, *xi), interpolate(&adj, h, *xi));
         let wh = w * h;
-        let Q = rotation(&q.alpha);
-        let A = a_matrix(&q.alpha);
-        let dQ = rotation_derivatives(&q.alpha);
-        let dA = a_matrix_derivatives(&q.alpha);
+        let f = PointFrame::new(&q.alpha, true);
+        let (Q, A, dQ, dA) = (f.q, f.a, f.dq, f.da);
         let mut blk = columns([0, 1, 2].map(|j| (dQ[j].transpose() * Jm * A + Q.transpose() * Jm * dA[j]).transpose() * qa.dalpha));
         if kappa_on {
             blk += columns([0, 1, 2].map(|j| (dA[j].transpose() * Lk * A + A.transpose() * Lk * dA[j]) * q.dalpha));
@@ -159,6 +157,24 @@ pub fn assemble_newton(
     x_g: &[Vector3<f64>],
     alpha_prev: &[Vector3<f64>],
 ) -> DVector<f64> {
+    let fixed = dirichlet(p, x_g);
+    let rows: Vec<usize> = fixed.iter().map(|f| f.0).collect();
+    assemble_newton_with(problem, p, pattern, values, big, x_g, alpha_prev, &fixed, &rows)
+}
+
+/// [`assemble_newton`] with the Dirichlet unknowns given (`fixed`, and their indices `rows`).
+#[allow(clippy::too_many_arguments)]
+fn assemble_newton_with(
+    problem: &Problem,
+    p: &InverseParams,
+    pattern: &Pattern,
+    values: &mut [f64],
+    big: &DVector<f64>,
+    x_g: &[Vector3<f64>],
+    alpha_prev: &[Vector3<f64>],
+    fixed: &[(usize, f64)],
+    rows: &[usize],
+) -> DVector<f64> {
     let mut r = assemble_blocks(problem, pattern, values, |e| {
         let ue = KktVec::from_column_slice(&big.as_slice()[BLOCK * e..BLOCK * (e + 2)]);
         let uk = LocalVec::from_fn(|i, _| ue[kkt(i, false)]);
@@ -166,16 +182,31 @@ pub fn assemble_newton(
         let (m, rhs) = element_system(problem, p, &uk, [x_g[e], x_g[e + 1]], ap);
         (m + coefficient_derivative(problem, p, &ue, ap), m * ue - rhs)
     });
-    let fixed = dirichlet(p, x_g);
-    for &(d, v) in &fixed {
+    for &(d, v) in fixed {
         r[d] = big[d] - v;
     }
-    pattern.set_identity_rows(values, &fixed.iter().map(|f| f.0).collect::<Vec<_>>());
+    pattern.set_identity_rows(values, rows);
     r
 }
 
-/// The state `(x, α)` (`hat = false`) or the adjoint `(x̂, α̂)` (`hat = true`), 6 per node, of
-/// a KKT vector (12 per node).
+/// The residual of [`assemble_newton`] alone (the line search's merit needs no Jacobian):
+/// the same element sums in the same order, so the same numbers.
+fn newton_residual(problem: &Problem, p: &InverseParams, big: &DVector<f64>, x_g: &[Vector3<f64>], alpha_prev: &[Vector3<f64>], fixed: &[(usize, f64)]) -> DVector<f64> {
+    let mut r = DVector::zeros(BLOCK * problem.mesh.nodes());
+    for e in 0..problem.mesh.elements {
+        let ue = KktVec::from_column_slice(&big.as_slice()[BLOCK * e..BLOCK * (e + 2)]);
+        let uk = LocalVec::from_fn(|i, _| ue[kkt(i, false)]);
+        let (m, rhs) = element_system(problem, p, &uk, [x_g[e], x_g[e + 1]], [alpha_prev[e], alpha_prev[e + 1]]);
+        let re = m * ue - rhs;
+        for i in 0..24 {
+            r[BLOCK * e + i] += re[i];
+        }
+    }
+    for &(d, v) in fixed {
+        r[d] = big[d] - v;
+    }
+    r
+}
 
 /// Solve one frame by Newton (I8) from the state `u0` (6 per node). The adjoint is started
 /// consistently by one linear solve of the fixed point, `K(u0) U = r(u0)` (I4). Arguments and
@@ -200,26 +231,43 @@ pub fn solve_frame_newton_observed(
     x_g: &[Vector3<f64>],
     alpha_prev: &[Vector3<f64>],
     u0: &DVector<f64>,
+    progress: impl FnMut(&InverseRecord, &DVector<f64>, &DVector<f64>),
+) -> Result<InverseSolution, SolveError> {
+    solve_frame_newton_observed_in(&mut InverseWorkspace::new(problem)?, problem, p, x_g, alpha_prev, u0, progress)
+}
+
+/// [`solve_frame_newton_observed`] in a workspace reused across frames (see [`InverseWorkspace`]).
+#[allow(clippy::too_many_arguments)]
+pub fn solve_frame_newton_observed_in(
+    ws: &mut InverseWorkspace,
+    problem: &Problem,
+    p: &InverseParams,
+    x_g: &[Vector3<f64>],
+    alpha_prev: &[Vector3<f64>],
+    u0: &DVector<f64>,
     mut progress: impl FnMut(&InverseRecord, &DVector<f64>, &DVector<f64>),
 ) -> Result<InverseSolution, SolveError> {
+    ws.check(problem)?;
+    ws.set_dirichlet(p, x_g);
     // Consistent start: one linear solve of the fixed point at u0.
-    let mut kkt = KktSolve::new(problem, p, x_g)?;
-    let mut big = kkt.solve_at(problem, p, u0, x_g, alpha_prev)?;
-    let KktSolve { pattern, solver, mut values, .. } = kkt;
-    let mut scratch = vec![0.0; pattern.nnz()];
+    let mut big = ws.solve_at(problem, p, u0, x_g, alpha_prev)?;
+    let InverseWorkspace { pattern, solver, fixed, rows, values, weights, .. } = ws;
     let mut history = Vec::new();
-    let mut weights: Option<Vec<f64>> = None;
     let mut phi0 = f64::NAN;
     let mut last = f64::NAN;
     for k in 1..=p.max_iterations {
-        let r = assemble_newton(problem, p, &pattern, &mut values, &big, x_g, alpha_prev);
-        let w = weights.get_or_insert_with(|| solver.equilibrate(&values).1);
-        let merit = |r: &DVector<f64>| r.iter().zip(w.iter()).map(|(a, b)| (a * b).powi(2)).sum::<f64>().sqrt();
+        let r = assemble_newton_with(problem, p, pattern, values, &big, x_g, alpha_prev, fixed, rows);
+        let delta = solver.solve_equilibrated(values, &(-&r))?;
+        if k == 1 {
+            // the Ruiz row factors of the first Jacobian weigh the merit of the whole frame
+            weights.clear();
+            weights.extend_from_slice(solver.row_factors());
+        }
+        let merit = |r: &DVector<f64>| r.iter().zip(weights.iter()).map(|(a, b)| (a * b).powi(2)).sum::<f64>().sqrt();
         let phi = merit(&r);
         if k == 1 {
             phi0 = phi;
         }
-        let delta = solver.solve_equilibrated(&values, &(-&r))?;
         // A full step whose relative change is within the tolerance is taken without the
         // line search: the merit is then at its round-off floor and cannot decrease reliably.
         let full = relative_change(&part(&(&big + &delta), false), &part(&big, false)) <= p.tolerance;
@@ -227,7 +275,7 @@ pub fn solve_frame_newton_observed(
         let (mut trial, mut phi_t);
         loop {
             trial = &big + &delta * t;
-            phi_t = merit(&assemble_newton(problem, p, &pattern, &mut scratch, &trial, x_g, alpha_prev));
+            phi_t = merit(&newton_residual(problem, p, &trial, x_g, alpha_prev, fixed));
             if full || phi_t <= (1.0 - ARMIJO * t) * phi || t <= MIN_STEP {
                 break;
             }
@@ -264,13 +312,28 @@ pub fn solve_frame_warm(
     x_g: &[Vector3<f64>],
     alpha_prev: &[Vector3<f64>],
     u0: &DVector<f64>,
+    progress: impl FnMut(&InverseRecord, &DVector<f64>, &DVector<f64>),
+) -> Result<InverseSolution, SolveError> {
+    solve_frame_warm_in(&mut InverseWorkspace::new(problem)?, problem, p, warm_start_tolerance, x_g, alpha_prev, u0, progress)
+}
+
+/// [`solve_frame_warm`] in a workspace reused across frames (see [`InverseWorkspace`]).
+#[allow(clippy::too_many_arguments)]
+pub fn solve_frame_warm_in(
+    ws: &mut InverseWorkspace,
+    problem: &Problem,
+    p: &InverseParams,
+    warm_start_tolerance: f64,
+    x_g: &[Vector3<f64>],
+    alpha_prev: &[Vector3<f64>],
+    u0: &DVector<f64>,
     mut progress: impl FnMut(&InverseRecord, &DVector<f64>, &DVector<f64>),
 ) -> Result<InverseSolution, SolveError> {
     let warm = InverseParams { tolerance: warm_start_tolerance.max(p.tolerance), ..*p };
-    let start = super::inverse::solve_frame_observed(problem, &warm, x_g, alpha_prev, u0, &mut progress)?;
+    let start = super::inverse::solve_frame_observed_in(ws, problem, &warm, x_g, alpha_prev, u0, &mut progress)?;
     let done = start.history.len();
     let rest = InverseParams { max_iterations: p.max_iterations.saturating_sub(done).max(1), ..*p };
-    let newton = solve_frame_newton_observed(problem, &rest, x_g, alpha_prev, &start.u, |r, u, a| {
+    let newton = solve_frame_newton_observed_in(ws, problem, &rest, x_g, alpha_prev, &start.u, |r, u, a| {
         progress(&InverseRecord { iteration: r.iteration + done, ..*r }, u, a);
     })
     .map_err(|e| match e {

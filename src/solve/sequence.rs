@@ -16,8 +16,8 @@ use nalgebra::{DVector, Matrix3, Vector3};
 use crate::chart::{frame_axis, Chart};
 use crate::rotation::{angles_from_rotation, Angles};
 
-use super::inverse::{solve_frame_observed, InverseParams, InverseRecord, InverseSolution, ObjectiveTerms};
-use super::inverse_newton::solve_frame_warm;
+use super::inverse::{solve_frame_observed_in, InverseParams, InverseRecord, InverseSolution, InverseWorkspace, ObjectiveTerms};
+use super::inverse_newton::{solve_frame_newton_observed_in, solve_frame_warm_in};
 use super::{node_values, Problem, SolveError};
 
 /// How each frame is solved.
@@ -196,6 +196,8 @@ pub fn solve_sequence(
     let mut reports = Vec::with_capacity(frames.len());
     // Previous frame: its chart, its state in that chart, its angles.
     let mut prev: Option<(Chart, DVector<f64>)> = None;
+    // pattern, LU storage and scratch once per clip, reused by every frame
+    let mut ws = InverseWorkspace::new(problem)?;
     for (i, x_space) in frames.iter().enumerate() {
         let k = i + sp.frame_offset;
         let start = std::time::Instant::now();
@@ -224,11 +226,11 @@ pub fn solve_sequence(
         let mut solve = |start: &DVector<f64>, warm: bool| -> Result<InverseSolution, SolveError> {
             let report = |r: &InverseRecord, _: &DVector<f64>, _: &DVector<f64>| on_iteration(k, r);
             match sp.method {
-                FrameMethod::FixedPoint => solve_frame_observed(problem, &p, &x_g, &alpha_prev, start, report),
+                FrameMethod::FixedPoint => solve_frame_observed_in(&mut ws, problem, &p, &x_g, &alpha_prev, start, report),
                 // From the previous frame's solution (already close) Newton runs directly; from
                 // a guess it needs the fixed point's warm start (I8).
-                FrameMethod::Newton { .. } if warm => super::inverse_newton::solve_frame_newton_observed(problem, &p, &x_g, &alpha_prev, start, report),
-                FrameMethod::Newton { warm_start_tolerance } => solve_frame_warm(problem, &p, warm_start_tolerance, &x_g, &alpha_prev, start, report),
+                FrameMethod::Newton { .. } if warm => solve_frame_newton_observed_in(&mut ws, problem, &p, &x_g, &alpha_prev, start, report),
+                FrameMethod::Newton { warm_start_tolerance } => solve_frame_warm_in(&mut ws, problem, &p, warm_start_tolerance, &x_g, &alpha_prev, start, report),
             }
         };
         // A frame that does not converge from the previous frame's solution is solved again

@@ -58,14 +58,14 @@ pub struct StaticSolution {
 /// Solve the static problem from the reference configuration, with load continuation.
 pub fn solve(problem: &Problem, params: &StaticParams, mut progress: impl FnMut(&IterationRecord)) -> Result<StaticSolution, SolveError> {
     let pattern = Pattern::new(&problem.mesh);
-    let solver = LinearSolver::new(&pattern)?;
+    let mut solver = LinearSolver::new(&pattern)?;
     let steps = params.continuation_steps.max(1);
     let mut u = problem.reference_state();
     let mut history = Vec::new();
     let mut last_change = f64::NAN;
     for step in 1..=steps {
         let p = Problem { load_factor: problem.load_factor * step as f64 / steps as f64, ..*problem };
-        let (u_new, change) = solve_step(&p, params, &pattern, &solver, u, step, &mut history, &mut progress)?;
+        let (u_new, change) = solve_step(&p, params, &pattern, &mut solver, u, step, &mut history, &mut progress)?;
         u = u_new;
         last_change = change;
     }
@@ -79,7 +79,7 @@ fn solve_step(
     problem: &Problem,
     params: &StaticParams,
     pattern: &Pattern,
-    solver: &LinearSolver,
+    solver: &mut LinearSolver,
     mut u: DVector<f64>,
     step: usize,
     history: &mut Vec<IterationRecord>,
