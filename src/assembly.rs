@@ -272,7 +272,7 @@ fn row_col_max(r: &mut [f64], a: &[f64]) -> f64 {
 /// the accumulated row and column factors in `dr`, `dc` (`r`, `c`, `r_next`: scratch). Each pass takes
 /// the row and column maxima of `a`, then scales `a_ij ← a_ij (1/√r_i)(1/√c_j)`; the scaling
 /// of one pass and the maxima of the next share one sweep over the values.
-#[allow(clippy::too_many_arguments)]
+#[allow(clippy::too_many_arguments, clippy::needless_range_loop)] // j indexes columns of a, c, dc and col_ptr together
 fn ruiz(col_ptr: &[usize], row_idx: &[usize], values: &[f64], a: &mut [f64], dr: &mut [f64], dc: &mut [f64], r: &mut [f64], c: &mut [f64], r_next: &mut [f64]) {
     let n = col_ptr.len() - 1;
     a.copy_from_slice(values);
@@ -319,6 +319,7 @@ mod tests {
 
     /// The Ruiz scaling as first written (two sweeps per pass, `f64::max`, factors per entry):
     /// the reference for the fused, branch-free version.
+    #[allow(clippy::needless_range_loop)]
     fn ruiz_reference(p: &Pattern, values: &[f64]) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
         let n = p.ndofs;
         let mut a = values.to_vec();
@@ -352,7 +353,7 @@ mod tests {
             let mesh = Mesh::new(1.0, elements);
             let p = Pattern::with_block(&mesh, block);
             // entries over many decades, some zero rows (identity rows after Dirichlet)
-            let vals: Vec<f64> = (0..p.nnz()).map(|k| ((k as f64 * 0.37).sin() * 10f64.powi((k % 13) as i32 - 6))).collect();
+            let vals: Vec<f64> = (0..p.nnz()).map(|k| (k as f64 * 0.37).sin() * 10f64.powi((k % 13) as i32 - 6)).collect();
             let mut vals2 = vals.clone();
             p.set_identity_rows(&mut vals2, &[0, 2, block + 1]);
             for v in [vals, vals2] {
@@ -394,7 +395,7 @@ mod tests {
             .flat_map(|j| (p.col_ptr[j]..p.col_ptr[j + 1]).map(move |k| (j, k)))
             .map(|(j, k)| {
                 let i = p.row_idx[k];
-                if i == j && i % 12 == 0 {
+                if i == j && i.is_multiple_of(12) {
                     0.0
                 } else {
                     (0.7 * k as f64).sin() + if i == j { 12.0 } else { 0.0 }

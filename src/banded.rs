@@ -48,6 +48,7 @@ impl BandLu {
     /// the end of the next node's block for a block-tridiagonal matrix.
     #[inline]
     fn reach(&self, i: usize) -> usize {
+        #[allow(clippy::manual_checked_ops)] // the division by block is guarded by block > 0
         let r = if self.block > 0 { (i / self.block + 2) * self.block - 1 } else { i + self.kl };
         r.min(self.n - 1)
     }
