@@ -458,45 +458,61 @@ pub fn run_clip(case: &Case, out: &Path, mut progress: impl FnMut(usize, usize))
     let start = Instant::now();
     let mut rough = Vec::new();
     let (mut kappa2, mut data_kappa) = (Vec::new(), Vec::new());
-    let result = solve_sequence(&problem, &sp, &clip.frames, None, |_, _| {}, |rep, frame| {
-        let sol = frame.solution;
-        let nodes = NodalState { chart: frame.chart, ..NodalState::from_vector(case, &sol.u) };
-        let (force, torque): (Vec<_>, Vec<_>) = (0..nodes.s.len())
-            .map(|i| {
-                let (xh, ah) = node_values(&sol.adjoint, i);
-                (xh / params.lambda_f, ah / params.lambda_l)
-            })
-            .unzip();
-        let data = &clip.frames[rep.frame - first_frame];
-        let kappa = nodes.element_curvature();
-        let k2: Vec<f64> = kappa.iter().map(|(_, k)| k[1]).collect();
-        // The data's curvature in the plane normal to the chart's axis (exactly the x–z
-        // curvature for an x–z clip; rotates with the data, R5).
-        let in_chart: Vec<Vector3<f64>> = data.iter().map(|x| frame.chart.to_chart(x)).collect();
-        let kd = planar_xz_curvature(&in_chart, h);
-        if let (Some(t), Some(tw), Some(tr)) = (&truth, &mut truth_writer, &mut truth_run) {
-            let ft = &t.frames[rep.frame - first_frame];
-            let q: Vec<nalgebra::Matrix3<f64>> = nodes.alpha.iter().map(|a| nodes.chart.rotation(a)).collect();
-            let kn = nodal_curvature(&kappa);
-            let c = compare_frame(data, ft, &RecoveredFrame { x: &nodes.x, q: &q, kappa: &kn }, TRUTH_SKIP_NODES).map_err(|e| e.to_string())?;
-            let twist = ft.kappa.iter().map(|k| k.z).sum::<f64>() / ft.kappa.len() as f64;
-            tw.frame(rep.frame, rep.frame as f64 * clip.dt_s, ft.roll_rad, twist, &c).map_err(|e| e.to_string())?;
-            let bend = |k: &Vector3<f64>| k.x * k.x + k.y * k.y;
-            tr.comparisons.push(c);
-            tr.roll_rad.push(ft.roll_rad);
-            tr.twist_per_m.push(twist);
-            tr.bending_true.push(ft.kappa.iter().map(bend).collect());
-            tr.bending_recovered.push(kn.iter().map(bend).collect());
-        }
-        let roughness = (sign_alternation(&k2), sign_alternation(&kd));
-        rough.push(roughness);
-        kappa2.push(k2);
-        data_kappa.push(kd);
-        writer.frame(rep, rep.frame as f64 * clip.dt_s, &nodes, &force, &torque, data, roughness).map_err(|e| e.to_string())?;
-        progress(rep.frame - first_frame + 1, total);
-        Ok(())
+    // The files are formatted and written on a second thread, in frame order, while the next
+    // frame is solved; a write error stops the clip at the next frame.
+    type Job = (FrameReport, f64, NodalState, Vec<Vector3<f64>>, Vec<Vector3<f64>>, Vec<Vector3<f64>>, (f64, f64));
+    let (tx, rx) = std::sync::mpsc::sync_channel::<Job>(8);
+    let (result, written) = std::thread::scope(|scope| {
+        let io = scope.spawn(move || -> Result<(), OutputError> {
+            for (rep, t, nodes, force, torque, data, roughness) in rx {
+                writer.frame(&rep, t, &nodes, &force, &torque, &data, roughness)?;
+            }
+            writer.finish().map(|_| ())
+        });
+        let result = solve_sequence(&problem, &sp, &clip.frames, None, |_, _| {}, |rep, frame| {
+            let sol = frame.solution;
+            let nodes = NodalState { chart: frame.chart, ..NodalState::from_vector(case, &sol.u) };
+            let (force, torque): (Vec<_>, Vec<_>) = (0..nodes.s.len())
+                .map(|i| {
+                    let (xh, ah) = node_values(&sol.adjoint, i);
+                    (xh / params.lambda_f, ah / params.lambda_l)
+                })
+                .unzip();
+            let data = &clip.frames[rep.frame - first_frame];
+            let kappa = nodes.element_curvature();
+            let k2: Vec<f64> = kappa.iter().map(|(_, k)| k[1]).collect();
+            // The data's curvature in the plane normal to the chart's axis (exactly the x–z
+            // curvature for an x–z clip; rotates with the data, R5).
+            let in_chart: Vec<Vector3<f64>> = data.iter().map(|x| frame.chart.to_chart(x)).collect();
+            let kd = planar_xz_curvature(&in_chart, h);
+            if let (Some(t), Some(tw), Some(tr)) = (&truth, &mut truth_writer, &mut truth_run) {
+                let ft = &t.frames[rep.frame - first_frame];
+                let q: Vec<nalgebra::Matrix3<f64>> = nodes.alpha.iter().map(|a| nodes.chart.rotation(a)).collect();
+                let kn = nodal_curvature(&kappa);
+                let c = compare_frame(data, ft, &RecoveredFrame { x: &nodes.x, q: &q, kappa: &kn }, TRUTH_SKIP_NODES).map_err(|e| e.to_string())?;
+                let twist = ft.kappa.iter().map(|k| k.z).sum::<f64>() / ft.kappa.len() as f64;
+                tw.frame(rep.frame, rep.frame as f64 * clip.dt_s, ft.roll_rad, twist, &c).map_err(|e| e.to_string())?;
+                let bend = |k: &Vector3<f64>| k.x * k.x + k.y * k.y;
+                tr.comparisons.push(c);
+                tr.roll_rad.push(ft.roll_rad);
+                tr.twist_per_m.push(twist);
+                tr.bending_true.push(ft.kappa.iter().map(bend).collect());
+                tr.bending_recovered.push(kn.iter().map(bend).collect());
+            }
+            let roughness = (sign_alternation(&k2), sign_alternation(&kd));
+            rough.push(roughness);
+            kappa2.push(k2);
+            data_kappa.push(kd);
+            tx.send((*rep, rep.frame as f64 * clip.dt_s, nodes, force, torque, data.clone(), roughness)).map_err(|_| "the output thread stopped (see the write error)".to_string())?;
+            progress(rep.frame - first_frame + 1, total);
+            Ok(())
+        });
+        drop(tx);
+        let written = io.join().unwrap_or_else(|_| Err(OutputError::Plot { path: out.to_path_buf(), reason: "the output thread panicked".into() }));
+        (result, written)
     });
-    writer.finish()?;
+    // A write error explains a stopped clip better than the stop itself.
+    written?;
     let reports = result?;
     Ok(ClipRun { reports, roughness: rough, kappa2, data_kappa, truth: truth_run, wall_time_s: start.elapsed().as_secs_f64(), source: clip.source })
 }

@@ -404,14 +404,13 @@ fn integrate_frame(profile: &BendingProfile, roll_rad: f64, params: &RollClipPar
 /// [rad], e.g. from [`crate::clip::read_npy`] of `data/elegansbot/kymogram_*.npy`.
 pub fn roll_clip(omega_rows: &[Vec<f64>], delta_rows: Option<&[Vec<f64>]>, params: &RollClipParams) -> Result<(Clip, GroundTruth), ClipError> {
     let field = KymogramField::new(omega_rows, delta_rows, params)?;
-    let mut positions = Vec::with_capacity(params.frames);
-    let mut truth = Vec::with_capacity(params.frames);
-    for n in 0..params.frames {
-        let profile = field.profile(field.row_at_frame(n));
-        let (x, t) = integrate_frame(&profile, params.roll_at_frame(n), params);
-        positions.push(x);
-        truth.push(t);
-    }
+    // Frames are independent: integrated in parallel (rayon), collected in order, so the
+    // result does not depend on the thread count.
+    use rayon::prelude::*;
+    let (positions, truth): (Vec<_>, Vec<_>) = (0..params.frames)
+        .into_par_iter()
+        .map(|n| integrate_frame(&field.profile(field.row_at_frame(n)), params.roll_at_frame(n), params))
+        .unzip();
     let clip_s = (params.frames.saturating_sub(1)) as f64 * params.dt_s;
     let kymo_s = (field.row_count() - 1) as f64 / KYMOGRAM_FPS;
     let source = format!(

@@ -195,7 +195,10 @@ pub fn solve_sequence(
     let h = problem.mesh.h();
     let mut reports = Vec::with_capacity(frames.len());
     // Previous frame: its chart, its state in that chart, its angles.
+    // the previous frame: its chart and its state in that chart
     let mut prev: Option<(Chart, DVector<f64>)> = None;
+    // the frame before that, for the linear predictor of a warm start
+    let mut prev2: Option<(Chart, DVector<f64>)> = None;
     // pattern, LU storage and scratch once per clip, reused by every frame
     let mut ws = InverseWorkspace::new(problem)?;
     for (i, x_space) in frames.iter().enumerate() {
@@ -209,7 +212,17 @@ pub fn solve_sequence(
         let x_g: Vec<Vector3<f64>> = if chart.is_identity() { x_space.clone() } else { x_space.iter().map(|x| chart.to_chart(x)).collect() };
         let guess = || data_frame_guess(&x_g);
         // The previous frame's state in this frame's chart (R6).
-        let carried = prev.as_ref().map(|(c, u)| carry_state(&chart, c, u));
+        // The previous frame's state in this frame's chart (R6); with two previous frames, the
+        // linear predictor 2 u_{n−1} − u_{n−2} (the clip is sampled smoothly in time).
+        // (Carrying the adjoint as well, instead of Newton's consistent-start solve, sent frame
+        // 659 of worm_roll_3d to a wrong root: not done.)
+        let carried = prev.as_ref().map(|(c, u)| {
+            let u1 = carry_state(&chart, c, u, None);
+            match &prev2 {
+                Some((c2, u2)) => &u1 * 2.0 - carry_state(&chart, c2, u2, Some(&u1)),
+                None => u1,
+            }
+        });
         let first_start = match (&carried, sp.start, u0) {
             (None, _, Some(u0)) => u0.clone(),
             (Some(u), FrameStart::PreviousFrame, _) => u.clone(),
@@ -262,6 +275,7 @@ pub fn solve_sequence(
         };
         let in_space = if chart.is_identity() { None } else { Some(to_space(&chart, &sol)) };
         on_frame(&rep, &FrameSolution { solution: in_space.as_ref().unwrap_or(&sol), chart }).map_err(|message| SequenceError::Callback { frame: k, message })?;
+        prev2 = prev.take();
         prev = Some((chart, sol.u));
         reports.push(rep);
     }
@@ -269,14 +283,16 @@ pub fn solve_sequence(
 }
 
 /// A state `(x, α)` of chart `from` in chart `to` (R6): positions rotated by `B_to B_fromᵀ`,
-/// angles re-expressed node by node without 2π jumps along the rod.
-fn carry_state(to: &Chart, from: &Chart, u: &DVector<f64>) -> DVector<f64> {
+/// angles re-expressed node by node without 2π jumps along the rod (or against `near`).
+/// `near`: a state in chart `to` whose angles the result's are unwrapped against (R6).
+fn carry_state(to: &Chart, from: &Chart, u: &DVector<f64>, near: Option<&DVector<f64>>) -> DVector<f64> {
     if to.base == from.base {
         return u.clone();
     }
     let n = u.len() / 6;
     let alpha: Vec<Angles> = (0..n).map(|j| node_values(u, j).1).collect();
-    let alpha = to.reexpress(from, &alpha, None);
+    let near: Option<Vec<Angles>> = near.map(|v| (0..n).map(|j| node_values(v, j).1).collect());
+    let alpha = to.reexpress(from, &alpha, near.as_deref());
     let mut out = DVector::zeros(u.len());
     for j in 0..n {
         let x = to.to_chart(&from.to_space(&node_values(u, j).0));
