@@ -181,7 +181,8 @@ fn lambda_l_sweep() {
         let late = spread(&kh(r, false)[100..], &kh(b, false)[100..]);
         let ln = r.torque_norm(l) / b.torque_norm(1e-10);
         eprintln!("  lambda_l {l:e} vs 1e-10: spread x {sx:.2e}, kappa {sk:.2e} (from iteration 100: {late:.2e}), inner kappa {ski:.2e}; |l| ratio {ln:.3}");
-        assert!(r.converged && r.iterations() <= 400, "{l}: {}", r.iterations());
+        // 363–418 iterations: where the plateau's 3e-6 stop falls is set by round-off (I9)
+        assert!(r.converged && r.iterations() <= 450, "{l}: {}", r.iterations());
         assert!((ln - 1.0).abs() < 0.1, "{l}: {ln}");
         if l < 1e-3 {
             // measured: x 1.3e-10 / 1.3e-6, κ 5.7e-3 / 2.8e-3, inner κ 9.9e-2 / 7.8e-3
@@ -217,19 +218,22 @@ fn lambda_l_sweep() {
 /// | λd    | its    | ‖x−x_g‖/‖x_g‖ | κ error       | ‖l‖     | J tracking / shear / total |
 /// |-------|--------|---------------|---------------|---------|----------------------------|
 /// | 1e1   | 600✗   | 1.37e-4       | 369 (360)     | 7.4e-4  | 1.5e-9 / 3.5e-9 / 5.4e-9   |
-/// | 1e-2  | 682    | 6.98e-5       | 0.170 (0.144) | 1.8e-7  | 3.9e-10 / 5.1e-12 / 9.5e-10|
+/// | 1e-2  | 2827   | 1.36e-4       | 0.119 (0.081) | 8.8e-8  | 1.5e-9 / 4.8e-12 / 2.1e-9  |
 /// | 1e-6  | 363    | 8.17e-5       | 0.086 (0.018) | 2.3e-8  | 5.4e-10 / 5.1e-16 / 1.1e-9 |
 /// | 1e-10 | 364    | 8.16e-5       | 0.086 (0.018) | 2.3e-8  | 5.3e-10 / 5.1e-20 / 1.1e-9 |
 ///
 /// At 1e1 the relative change stays at 5e-2 … 0.6 (also over 1500 iterations in a side run)
-/// while x is fitted: the angles zig-zag. 1e-2 converges, more slowly, with a worse κ.
+/// while x is fitted: the angles zig-zag. 1e-2 converges, more slowly, with a worse κ. How
+/// slowly is set by round-off: with faer's sparse LU it stopped after 682 iterations (x 6.98e-5,
+/// κ 0.170), with the banded LU (issue 5) after 2827 (row above). Only the 1e-6 and 1e-10
+/// rows are insensitive to it.
 /// A side run with the paper's Λκ3 = 1e-20 for λd = 1e1: no convergence either (change 0.44
 /// at 600, κ error 760).
 #[test]
 fn lambda_d_sweep() {
     let (d, b) = base();
     let p = d.problem();
-    let set = |l: f64| InverseParams { lambda_d: l, max_iterations: if l == 1e-2 { 800 } else { CAP }, ..paper() };
+    let set = |l: f64| InverseParams { lambda_d: l, max_iterations: if l == 1e-2 { 3000 } else { CAP }, ..paper() };
     let runs = sweep(&[1e1, 1e-2, 1e-6, 1e-10], set, 1e-6, false);
     let get = |l: f64| runs.iter().find(|(v, _)| *v == l).map(|(_, r)| r.as_ref().unwrap_or(b)).expect("value");
     for (l, _) in &runs {
@@ -240,8 +244,8 @@ fn lambda_d_sweep() {
     assert!(r.converged && r.iterations().abs_diff(b.iterations()) <= 3);
     assert!((kappa(r) / kappa(b) - 1.0).abs() < 0.01 && (r.last().x_err_rel / b.last().x_err_rel - 1.0).abs() < 0.01);
     let r = get(1e-2);
-    assert!(r.converged && (600..=760).contains(&r.iterations()), "{}", r.iterations());
-    assert!(r.last().x_err_rel < 1e-4 && kappa(r) > 1.5 * kappa(b), "{}", kappa(r));
+    assert!(r.converged && 2 * r.iterations() > 3 * b.iterations(), "{}", r.iterations());
+    assert!(r.last().x_err_rel < 2e-4 && kappa(r) > 1.2 * kappa(b), "{}", kappa(r));
     let r = get(1e1);
     assert!(!r.converged && r.last().rel_change > 1e-3 && kappa(r) > 10.0, "{} {}", r.last().rel_change, kappa(r));
     assert!(r.last().x_err_rel < 1e-3, "{}", r.last().x_err_rel);
@@ -379,8 +383,10 @@ fn rigid_motions() {
     for e in &errs {
         assert!(e[0] < 1e-14, "{e:?}");
     }
+    // (measured up to 1.2e-5 in Q: a 1e-15 change of the data moves the angles by 6.5e-6, and
+    // the LU's elimination order changes the round-off by as much)
     for e in &errs[..3] {
-        assert!(e[1] < 1e-5 && e[2] < 1e-3, "{e:?}");
+        assert!(e[1] < 3e-5 && e[2] < 3e-3, "{e:?}");
     }
     for e in &errs[3..] {
         assert!(e[1] > 1e-2 && e[2] > 0.05, "{e:?}");
