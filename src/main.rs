@@ -219,10 +219,11 @@ fn cmd_run_clip(case: &Case, engine: Engine, dir: &Path, quiet: bool) -> Result<
     let worst = run.reports.iter().map(|r| r.x_err_rel).fold(0.0, f64::max);
     let jmax = run.reports.iter().map(|r| r.max_stretch_deviation).fold(0.0, f64::max);
     println!(
-        "{} [rust]: {n} frames in {:.2} s ({:.1} frames/s); iterations per frame min {} / mean {:.1} / max {}; max |x - x_g|/|x_g| {worst:.3e}; max |j - 1| {jmax:.3e}; wrote {}",
+        "{} [rust]: {n} frames in {:.2} s ({:.1} frames/s; solving {:.2} s); iterations per frame min {} / mean {:.1} / max {}; max |x - x_g|/|x_g| {worst:.3e}; max |j - 1| {jmax:.3e}; wrote {}",
         case.name,
         run.wall_time_s,
         n as f64 / run.wall_time_s,
+        run.reports.iter().map(|r| r.wall_time_s).sum::<f64>(),
         its.iter().min().copied().unwrap_or(0),
         its.iter().sum::<usize>() as f64 / n.max(1) as f64,
         its.iter().max().copied().unwrap_or(0),
