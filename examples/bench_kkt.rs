@@ -49,11 +49,28 @@ fn main() -> Result<()> {
     // Frame 0, then frame 1 up to the warm start: a realistic Newton start.
     let p0 = InverseParams { first_frame: true, frame: 0, ..base };
     let zero = vec![Vector3::zeros(); n];
-    let f0 = solve_frame_warm_in(&mut ws, &problem, &p0, warm, &clip.frames[0], &zero, &data_frame_guess(&clip.frames[0]), |_, _, _| {})?;
+    let f0 = solve_frame_warm_in(
+        &mut ws,
+        &problem,
+        &p0,
+        warm,
+        &clip.frames[0],
+        &zero,
+        &data_frame_guess(&clip.frames[0]),
+        |_, _, _| {},
+    )?;
     let prev: Vec<Vector3<f64>> = (0..n).map(|i| node_values(&f0.u, i).1).collect();
     let p1 = InverseParams { first_frame: false, frame: 1, ..base };
     let x_g = &clip.frames[1];
-    let start = cosserat::solve::inverse::solve_frame_observed_in(&mut ws, &problem, &InverseParams { tolerance: warm, ..p1 }, x_g, &prev, &data_frame_guess(x_g), |_, _, _| {})?;
+    let start = cosserat::solve::inverse::solve_frame_observed_in(
+        &mut ws,
+        &problem,
+        &InverseParams { tolerance: warm, ..p1 },
+        x_g,
+        &prev,
+        &data_frame_guess(x_g),
+        |_, _, _| {},
+    )?;
 
     // The KKT vector at the start (state and adjoint of the last fixed-point solve).
     let mut big = DVector::zeros(BLOCK * n);
@@ -95,6 +112,10 @@ fn main() -> Result<()> {
     println!("{} nodes, {} unknowns, {} stored entries", n, BLOCK * n, pattern.nnz());
     println!("Newton Jacobian + residual assembly: {:8.3} ms", assemble * 1e3);
     println!("equilibrated banded LU solve:       {:8.3} ms (relative residual {res:.1e})", solve * 1e3);
-    println!("whole Newton iteration:             {:8.3} ms ({} iterations per frame)", newton * 1e3, iterations / runs);
+    println!(
+        "whole Newton iteration:             {:8.3} ms ({} iterations per frame)",
+        newton * 1e3,
+        iterations / runs
+    );
     Ok(())
 }

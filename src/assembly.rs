@@ -10,7 +10,6 @@ use crate::banded::BandLu;
 use crate::element::{LocalMat, LocalVec};
 use crate::mesh::{Mesh, DOFS_PER_ELEMENT};
 
-
 /// Errors of the linear algebra layer.
 #[derive(Debug, thiserror::Error)]
 pub enum LinearError {
@@ -142,7 +141,6 @@ impl Pattern {
         }
         m
     }
-
 }
 
 /// Passes of Ruiz equilibration.
@@ -214,7 +212,17 @@ impl LinearSolver {
 
     /// [`LinearSolver::equilibrate`] into `scaled` and the solver's own factors `self.dr`, `self.dc`.
     fn equilibrate_into(&mut self, values: &[f64], scaled: &mut [f64]) {
-        ruiz(&self.col_ptr, &self.row_idx, values, scaled, &mut self.dr, &mut self.dc, &mut self.rmax, &mut self.cmax, &mut self.rnext);
+        ruiz(
+            &self.col_ptr,
+            &self.row_idx,
+            values,
+            scaled,
+            &mut self.dr,
+            &mut self.dc,
+            &mut self.rmax,
+            &mut self.cmax,
+            &mut self.rnext,
+        );
     }
 
     /// Solve `M x = b` for the matrix with the pattern's structure and the given values.
@@ -273,15 +281,29 @@ fn row_col_max(r: &mut [f64], a: &[f64]) -> f64 {
 /// the row and column maxima of `a`, then scales `a_ij ← a_ij (1/√r_i)(1/√c_j)`; the scaling
 /// of one pass and the maxima of the next share one sweep over the values.
 #[allow(clippy::too_many_arguments, clippy::needless_range_loop)] // j indexes columns of a, c, dc and col_ptr together
-fn ruiz(col_ptr: &[usize], row_idx: &[usize], values: &[f64], a: &mut [f64], dr: &mut [f64], dc: &mut [f64], r: &mut [f64], c: &mut [f64], r_next: &mut [f64]) {
+fn ruiz(
+    col_ptr: &[usize],
+    row_idx: &[usize],
+    values: &[f64],
+    a: &mut [f64],
+    dr: &mut [f64],
+    dc: &mut [f64],
+    r: &mut [f64],
+    c: &mut [f64],
+    r_next: &mut [f64],
+) {
     let n = col_ptr.len() - 1;
     a.copy_from_slice(values);
     dr.iter_mut().for_each(|v| *v = 1.0);
     dc.iter_mut().for_each(|v| *v = 1.0);
-    debug_assert!((0..n).all(|j| (col_ptr[j]..col_ptr[j + 1]).all(|k| row_idx[k] == row_idx[col_ptr[j]] + k - col_ptr[j])), "rows of a column must be contiguous");
+    debug_assert!(
+        (0..n).all(|j| (col_ptr[j]..col_ptr[j + 1]).all(|k| row_idx[k] == row_idx[col_ptr[j]] + k - col_ptr[j])),
+        "rows of a column must be contiguous"
+    );
     let inv_sqrt = |v: f64| if v > 0.0 { 1.0 / v.sqrt() } else { 1.0 };
     // the rows of a column are contiguous (block-tridiagonal pattern): slices, no gathers
-    let column = |j: usize| (col_ptr[j], col_ptr[j + 1], if col_ptr[j] < col_ptr[j + 1] { row_idx[col_ptr[j]] } else { 0 });
+    let column =
+        |j: usize| (col_ptr[j], col_ptr[j + 1], if col_ptr[j] < col_ptr[j + 1] { row_idx[col_ptr[j]] } else { 0 });
     // maxima of the unscaled values
     r.iter_mut().for_each(|v| *v = 0.0);
     for j in 0..n {
@@ -353,7 +375,8 @@ mod tests {
             let mesh = Mesh::new(1.0, elements);
             let p = Pattern::with_block(&mesh, block);
             // entries over many decades, some zero rows (identity rows after Dirichlet)
-            let vals: Vec<f64> = (0..p.nnz()).map(|k| (k as f64 * 0.37).sin() * 10f64.powi((k % 13) as i32 - 6)).collect();
+            let vals: Vec<f64> =
+                (0..p.nnz()).map(|k| (k as f64 * 0.37).sin() * 10f64.powi((k % 13) as i32 - 6)).collect();
             let mut vals2 = vals.clone();
             p.set_identity_rows(&mut vals2, &[0, 2, block + 1]);
             for v in [vals, vals2] {
@@ -406,15 +429,24 @@ mod tests {
         let b = DVector::from_fn(p.ndofs, |i, _| (0.3 * i as f64).cos());
         let x = LinearSolver::new(&p).unwrap().solve(&vals, &b).unwrap();
         let sym = SymbolicSparseColMat::new_checked(p.ndofs, p.ndofs, p.col_ptr.clone(), None, p.row_idx.clone());
-        let lu = Lu::try_new_with_symbolic(SymbolicLu::try_new(sym.as_ref()).unwrap(), SparseColMatRef::new(sym.as_ref(), &vals)).unwrap();
+        let lu = Lu::try_new_with_symbolic(
+            SymbolicLu::try_new(sym.as_ref()).unwrap(),
+            SparseColMatRef::new(sym.as_ref(), &vals),
+        )
+        .unwrap();
         let mut y = b.clone();
         let n = y.len();
         lu.solve_in_place_with_conj(faer::Conj::No, faer::MatMut::from_column_major_slice_mut(y.as_mut_slice(), n, 1));
         let dense = p.to_dense(&vals);
         let scale = dense.norm() * x.norm();
         assert!((&dense * &x - &b).norm() <= 1e-14 * scale, "banded residual {:e}", (&dense * &x - &b).norm() / scale);
-        let cond = dense.clone().svd(false, false).singular_values.max() / dense.svd(false, false).singular_values.min();
-        assert!((&x - &y).norm() <= 1e-12 * y.norm(), "banded vs faer {:e} (condition {cond:e})", (&x - &y).norm() / y.norm());
+        let cond =
+            dense.clone().svd(false, false).singular_values.max() / dense.svd(false, false).singular_values.min();
+        assert!(
+            (&x - &y).norm() <= 1e-12 * y.norm(),
+            "banded vs faer {:e} (condition {cond:e})",
+            (&x - &y).norm() / y.norm()
+        );
     }
 
     #[test]

@@ -122,7 +122,9 @@ impl BandLu {
             }
             self.piv[j] = j + p;
             if best == 0.0 || !best.is_finite() {
-                return Err(LinearError::Factorisation(format!("zero or non-finite pivot {best:e} in column {j} of the band LU")));
+                return Err(LinearError::Factorisation(format!(
+                    "zero or non-finite pivot {best:e} in column {j} of the band LU"
+                )));
             }
             // the pivot row reaches column j + p + ku (general band) or the end of the node
             // after its own (block tridiagonal)

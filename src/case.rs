@@ -439,7 +439,8 @@ pub struct Case {
 impl Case {
     /// Read and validate a case file.
     pub fn from_file(path: &Path) -> Result<Case, CaseError> {
-        let text = std::fs::read_to_string(path).map_err(|source| CaseError::Io { path: path.to_path_buf(), source })?;
+        let text =
+            std::fs::read_to_string(path).map_err(|source| CaseError::Io { path: path.to_path_buf(), source })?;
         let name = path.file_stem().and_then(|s| s.to_str()).unwrap_or("case").to_string();
         let mut case = Case::from_toml(&text, &name, path)?;
         case.source = Some(path.to_path_buf());
@@ -448,7 +449,8 @@ impl Case {
 
     /// Parse and validate TOML text; `path` is only used in messages.
     pub fn from_toml(text: &str, name: &str, path: &Path) -> Result<Case, CaseError> {
-        let raw: RawCase = toml::from_str(text).map_err(|e| CaseError::Syntax { path: path.to_path_buf(), message: e.to_string() })?;
+        let raw: RawCase =
+            toml::from_str(text).map_err(|e| CaseError::Syntax { path: path.to_path_buf(), message: e.to_string() })?;
         Validator { path }.case(raw, name)
     }
 
@@ -458,7 +460,8 @@ impl Case {
         let mut c = self.clone();
         if let Analysis::Dynamic { end_time_s, steps: n, tolerance, max_iterations } = self.analysis {
             let k = steps.min(n).max(1);
-            c.analysis = Analysis::Dynamic { end_time_s: end_time_s * k as f64 / n as f64, steps: k, tolerance, max_iterations };
+            c.analysis =
+                Analysis::Dynamic { end_time_s: end_time_s * k as f64 / n as f64, steps: k, tolerance, max_iterations };
         }
         c
     }
@@ -481,7 +484,12 @@ impl Case {
         let inv = self.inverse()?;
         let DataSource::Forward(d) = inv.data else { return None };
         let mut c = self.clone();
-        c.analysis = Analysis::Static { method: d.method, tolerance: d.tolerance, max_iterations: d.max_iterations, continuation_steps: d.continuation_steps };
+        c.analysis = Analysis::Static {
+            method: d.method,
+            tolerance: d.tolerance,
+            max_iterations: d.max_iterations,
+            continuation_steps: d.continuation_steps,
+        };
         Some(c)
     }
 }
@@ -496,7 +504,12 @@ fn rc_adjoint_missing(rc: &RawCompare) -> bool {
 
 impl Validator<'_> {
     /// `method` (+ `relaxation`) of a static solve in table `table`.
-    fn static_method(&self, table: &str, method: RawMethod, relaxation: Option<f64>) -> Result<StaticMethod, CaseError> {
+    fn static_method(
+        &self,
+        table: &str,
+        method: RawMethod,
+        relaxation: Option<f64>,
+    ) -> Result<StaticMethod, CaseError> {
         match method {
             RawMethod::FixedPoint => {
                 let key = format!("{table}.relaxation");
@@ -538,7 +551,13 @@ impl Validator<'_> {
         Ok(x)
     }
 
-    fn expr(&self, key: &str, v: &Scalar, allowed: &[&str], constants: &BTreeMap<String, f64>) -> Result<Expr, CaseError> {
+    fn expr(
+        &self,
+        key: &str,
+        v: &Scalar,
+        allowed: &[&str],
+        constants: &BTreeMap<String, f64>,
+    ) -> Result<Expr, CaseError> {
         let text = match v {
             Scalar::Number(x) => format!("{x:e}"),
             Scalar::Text(s) => s.clone(),
@@ -546,13 +565,25 @@ impl Validator<'_> {
         let e = Expr::parse(&text).map_err(|e| self.err(key, format!("cannot parse `{text}`: {e}")))?;
         for var in e.variables() {
             if !allowed.contains(&var.as_str()) && !constants.contains_key(&var) {
-                return Err(self.err(key, format!("unknown name `{var}` in `{text}` (allowed: {}, or a [constants] entry)", allowed.join(", "))));
+                return Err(self.err(
+                    key,
+                    format!(
+                        "unknown name `{var}` in `{text}` (allowed: {}, or a [constants] entry)",
+                        allowed.join(", ")
+                    ),
+                ));
             }
         }
         Ok(e)
     }
 
-    fn vector(&self, key: &str, v: &Option<[Scalar; 3]>, allowed: &[&str], constants: &BTreeMap<String, f64>) -> Result<[Expr; 3], CaseError> {
+    fn vector(
+        &self,
+        key: &str,
+        v: &Option<[Scalar; 3]>,
+        allowed: &[&str],
+        constants: &BTreeMap<String, f64>,
+    ) -> Result<[Expr; 3], CaseError> {
         let zero = Scalar::Number(0.0);
         let items = v.clone().unwrap_or([zero.clone(), zero.clone(), zero]);
         let mut out = Vec::with_capacity(3);
@@ -568,8 +599,12 @@ impl Validator<'_> {
         let mut constants = BTreeMap::new();
         let mut pending: Vec<(String, Scalar)> = raw.constants.into_iter().collect();
         for (k, _) in &pending {
-            if matches!(k.as_str(), "s" | "t" | "pi") || Expr::parse(k).map(|e| e.variables().len() != 1).unwrap_or(true) {
-                return Err(self.err(&format!("constants.{k}"), "not a valid constant name (identifier other than s, t, pi)"));
+            if matches!(k.as_str(), "s" | "t" | "pi")
+                || Expr::parse(k).map(|e| e.variables().len() != 1).unwrap_or(true)
+            {
+                return Err(
+                    self.err(&format!("constants.{k}"), "not a valid constant name (identifier other than s, t, pi)")
+                );
             }
         }
         while !pending.is_empty() {
@@ -600,7 +635,9 @@ impl Validator<'_> {
         let density = match (&raw.material.density_kg_m3, analysis_kind) {
             (Some(d), _) => self.positive("material.density_kg_m3", d, c)?,
             (None, RawAnalysis::Static | RawAnalysis::Inverse) => 1.0,
-            (None, RawAnalysis::Dynamic) => return Err(self.err("material.density_kg_m3", "required for a dynamic analysis")),
+            (None, RawAnalysis::Dynamic) => {
+                return Err(self.err("material.density_kg_m3", "required for a dynamic analysis"))
+            }
         };
         let material = Material {
             young_modulus_pa: self.positive("material.young_modulus_pa", &raw.material.young_modulus_pa, c)?,
@@ -609,7 +646,9 @@ impl Validator<'_> {
             shear_correction: self.positive("material.shear_correction", &raw.material.shear_correction, c)?,
         };
         let section = match &raw.cross_section {
-            RawSection::Circle { radius_m } => CrossSection::Circle { radius_m: self.positive("cross_section.radius_m", radius_m, c)? },
+            RawSection::Circle { radius_m } => {
+                CrossSection::Circle { radius_m: self.positive("cross_section.radius_m", radius_m, c)? }
+            }
             RawSection::Rectangle { width_m, height_m } => CrossSection::Rectangle {
                 width_m: self.positive("cross_section.width_m", width_m, c)?,
                 height_m: self.positive("cross_section.height_m", height_m, c)?,
@@ -669,7 +708,12 @@ impl Validator<'_> {
                 if s.continuation_steps == 0 {
                     return Err(self.err("solver.continuation_steps", "must be ≥ 1"));
                 }
-                Analysis::Static { method, tolerance: s.tolerance, max_iterations: s.max_iterations, continuation_steps: s.continuation_steps }
+                Analysis::Static {
+                    method,
+                    tolerance: s.tolerance,
+                    max_iterations: s.max_iterations,
+                    continuation_steps: s.continuation_steps,
+                }
             }
             RawAnalysis::Inverse => {
                 // Both modes need the relaxation: Newton starts from the fixed point (I8).
@@ -784,7 +828,9 @@ impl Validator<'_> {
                     (Some(_), Some(_)) => return Err(self.err("clip", "give either [data] (synthetic) or [clip] (recorded), not both")),
                     (None, None) => return Err(self.err("data", "an inverse case needs [data] (a forward solve generating the centreline) or [clip] (a recorded clip)")),
                 };
-                let inv = raw.inverse.as_ref().ok_or_else(|| self.err("inverse", "required when solver.analysis = \"inverse\" (the weights of eq. 41)"))?;
+                let inv = raw.inverse.as_ref().ok_or_else(|| {
+                    self.err("inverse", "required when solver.analysis = \"inverse\" (the weights of eq. 41)")
+                })?;
                 let nonneg = |key: &str, v: &Scalar| -> Result<f64, CaseError> {
                     let x = self.scalar(key, v, c)?;
                     if x < 0.0 {
@@ -813,7 +859,11 @@ impl Validator<'_> {
                     lambda_omega: diag("inverse.lambda_omega", &inv.lambda_omega)?,
                 };
                 let frame_interval_s = match (&inv.frame_interval_s, &raw.clip) {
-                    (Some(_), Some(_)) => return Err(self.err("inverse.frame_interval_s", "a clip case takes Δt from clip.frame_interval_s")),
+                    (Some(_), Some(_)) => {
+                        return Err(
+                            self.err("inverse.frame_interval_s", "a clip case takes Δt from clip.frame_interval_s")
+                        )
+                    }
                     (Some(v), None) => self.positive("inverse.frame_interval_s", v, c)?,
                     (None, Some(cl)) => self.positive("clip.frame_interval_s", &cl.frame_interval_s, c)?,
                     (None, None) if weights.lambda_omega.iter().any(|&w| w > 0.0) => {
@@ -836,9 +886,20 @@ impl Validator<'_> {
                     None => 0.0,
                 };
                 if rc_adjoint_missing(&raw.compare) {
-                    return Err(self.err("compare.adjoint_rel", "required for an inverse case (tolerance on the adjoint x̂, α̂)"));
+                    return Err(
+                        self.err("compare.adjoint_rel", "required for an inverse case (tolerance on the adjoint x̂, α̂)")
+                    );
                 }
-                Analysis::Inverse(InverseSettings { method, tolerance: s.tolerance, max_iterations: s.max_iterations, weights, frame_interval_s, alpha0_rad, stabilisation, data })
+                Analysis::Inverse(InverseSettings {
+                    method,
+                    tolerance: s.tolerance,
+                    max_iterations: s.max_iterations,
+                    weights,
+                    frame_interval_s,
+                    alpha0_rad,
+                    stabilisation,
+                    data,
+                })
             }
             RawAnalysis::Dynamic => {
                 if s.method != RawMethod::Newton {
@@ -850,7 +911,8 @@ impl Validator<'_> {
                 if s.continuation_steps != 1 {
                     return Err(self.err("solver.continuation_steps", "only for a static analysis"));
                 }
-                let t = raw.time.as_ref().ok_or_else(|| self.err("time", "required when solver.analysis = \"dynamic\""))?;
+                let t =
+                    raw.time.as_ref().ok_or_else(|| self.err("time", "required when solver.analysis = \"dynamic\""))?;
                 if t.steps == 0 {
                     return Err(self.err("time.steps", "must be ≥ 1"));
                 }
@@ -868,7 +930,11 @@ impl Validator<'_> {
             RawQuadrature::Reduced => QuadratureScheme::Reduced,
         };
         let rc = &raw.compare;
-        for (k, v) in [("compare.displacement_rel", rc.displacement_rel), ("compare.angles_rel", rc.angles_rel), ("compare.metric_rel", rc.metric_rel)] {
+        for (k, v) in [
+            ("compare.displacement_rel", rc.displacement_rel),
+            ("compare.angles_rel", rc.angles_rel),
+            ("compare.metric_rel", rc.metric_rel),
+        ] {
             if !(v > 0.0 && v.is_finite()) {
                 return Err(self.err(k, format!("must be > 0, got {v}")));
             }
@@ -969,7 +1035,9 @@ metric_rel = 1e-6
         assert_eq!(c.mesh.elements, 10);
         assert!((c.mesh.length_m - 1e-3).abs() < 1e-18);
         assert!((c.material.shear_correction - 4.0 / 3.0).abs() < 1e-15);
-        assert!(matches!(c.analysis, Analysis::Static { method: StaticMethod::FixedPoint { relaxation }, .. } if relaxation == 0.5));
+        assert!(
+            matches!(c.analysis, Analysis::Static { method: StaticMethod::FixedPoint { relaxation }, .. } if relaxation == 0.5)
+        );
     }
 
     fn expect_key(text: &str, key: &str) {

@@ -257,7 +257,8 @@ mod tests {
         let from = Chart { base: random_rotation(11) };
         let to = Chart { base: random_rotation(12) };
         // A smooth frame field regular in both charts.
-        let alpha: Vec<Angles> = (0..40).map(|i| Vector3::new(0.1 * i as f64, 0.2 * (0.1 * i as f64).sin(), 0.15 * i as f64)).collect();
+        let alpha: Vec<Angles> =
+            (0..40).map(|i| Vector3::new(0.1 * i as f64, 0.2 * (0.1 * i as f64).sin(), 0.15 * i as f64)).collect();
         let mid = to.reexpress(&from, &alpha, None);
         for (a, m) in alpha.iter().zip(&mid) {
             assert!((from.rotation(a) - to.rotation(m)).amax() < 1e-13);

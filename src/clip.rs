@@ -132,14 +132,22 @@ impl Clip {
 
     /// `max |j − 1|` over the frames, and the frame where it occurs.
     pub fn max_stretch_deviation(&self) -> (usize, f64) {
-        (0..self.frame_count()).map(|f| (f, (self.stretch(f) - 1.0).abs())).fold((0, 0.0), |a, b| if b.1 > a.1 { b } else { a })
+        (0..self.frame_count()).map(|f| (f, (self.stretch(f) - 1.0).abs())).fold((0, 0.0), |a, b| {
+            if b.1 > a.1 {
+                b
+            } else {
+                a
+            }
+        })
     }
 
     /// Frames in which some segment's unit tangent is within `tol` of `±direction` (a unit
     /// vector). With `direction = e2` these are the frames that touch `β = ±π/2`.
     pub fn frames_with_tangent_near(&self, direction: &Vector3<f64>, tol: f64) -> Vec<usize> {
         let near = |t: Vector3<f64>| (t - direction).norm() < tol || (t + direction).norm() < tol;
-        (0..self.frame_count()).filter(|&f| self.frames[f].windows(2).any(|w| near((w[1] - w[0]).normalize()))).collect()
+        (0..self.frame_count())
+            .filter(|&f| self.frames[f].windows(2).any(|w| near((w[1] - w[0]).normalize())))
+            .collect()
     }
 }
 
@@ -178,7 +186,13 @@ pub struct KymogramParams {
 
 impl Default for KymogramParams {
     fn default() -> Self {
-        KymogramParams { length_m: WORM_LENGTH_M, nodes: PAPER_NODES, dt_s: 1.0 / KYMOGRAM_FPS, plane: ClipPlane::Xz, scale_to_length: false }
+        KymogramParams {
+            length_m: WORM_LENGTH_M,
+            nodes: PAPER_NODES,
+            dt_s: 1.0 / KYMOGRAM_FPS,
+            plane: ClipPlane::Xz,
+            scale_to_length: false,
+        }
     }
 }
 
@@ -245,11 +259,21 @@ pub fn read_kymogram(path: &Path, params: &KymogramParams) -> Result<Clip, ClipE
         return Err(shape(format!("kymogram of shape {:?} is empty", a.shape)));
     }
     if let Some(k) = a.data.iter().position(|v| !v.is_finite()) {
-        return Err(ClipError::NonFiniteAngle { path: path.to_path_buf(), frame: k / joints, joint: k % joints, value: a.data[k] });
+        return Err(ClipError::NonFiniteAngle {
+            path: path.to_path_buf(),
+            frame: k / joints,
+            joint: k % joints,
+            value: a.data[k],
+        });
     }
     let rows: Vec<Vec<f64>> = a.data.chunks_exact(joints).map(<[f64]>::to_vec).collect();
     let scaled = if params.scale_to_length { ", scaled to the body length" } else { "" };
-    let source = format!("{} ({frames} frames × {joints} joint angles; spline resampled to {} nodes{scaled}, {:?} plane)", path.display(), params.nodes, params.plane);
+    let source = format!(
+        "{} ({frames} frames × {joints} joint angles; spline resampled to {} nodes{scaled}, {:?} plane)",
+        path.display(),
+        params.nodes,
+        params.plane
+    );
     Ok(clip_from_angles(&rows, params, source))
 }
 
@@ -259,7 +283,12 @@ pub fn read_recording(path: &Path, dt_s: f64) -> Result<Clip, ClipError> {
     let frames = match path.extension().and_then(|e| e.to_str()) {
         Some("npy") => recording_npy(path)?,
         Some("csv") => recording_csv(path)?,
-        _ => return Err(ClipError::Read { path: path.to_path_buf(), reason: "unknown extension, expected .csv or .npy".into() }),
+        _ => {
+            return Err(ClipError::Read {
+                path: path.to_path_buf(),
+                reason: "unknown extension, expected .csv or .npy".into(),
+            })
+        }
     };
     let length_m = polyline_length(&frames[0]);
     if length_m <= 0.0 {
@@ -271,7 +300,13 @@ pub fn read_recording(path: &Path, dt_s: f64) -> Result<Clip, ClipError> {
 
 fn check_position(path: &Path, frame: usize, node: usize, p: &Vector3<f64>) -> Result<(), ClipError> {
     match (0..3).find(|&k| !p[k].is_finite()) {
-        Some(k) => Err(ClipError::NonFinitePosition { path: path.to_path_buf(), frame, node, axis: ['x', 'y', 'z'][k], value: p[k] }),
+        Some(k) => Err(ClipError::NonFinitePosition {
+            path: path.to_path_buf(),
+            frame,
+            node,
+            axis: ['x', 'y', 'z'][k],
+            value: p[k],
+        }),
         None => Ok(()),
     }
 }
@@ -312,9 +347,14 @@ fn recording_csv(path: &Path) -> Result<Vec<Vec<Vector3<f64>>>, ClipError> {
         if rec.len() != 5 {
             return Err(bad(format!("{} columns, expected 5", rec.len())));
         }
-        let index = |k: usize| rec[k].parse::<usize>().map_err(|_| bad(format!("{} `{}` is not a non-negative integer", RECORDING_HEADER[k], &rec[k])));
+        let index = |k: usize| {
+            rec[k]
+                .parse::<usize>()
+                .map_err(|_| bad(format!("{} `{}` is not a non-negative integer", RECORDING_HEADER[k], &rec[k])))
+        };
         let (frame, node) = (index(0)?, index(1)?);
-        let coord = |k: usize| rec[k].parse::<f64>().map_err(|e| bad(format!("{} `{}`: {e}", RECORDING_HEADER[k], &rec[k])));
+        let coord =
+            |k: usize| rec[k].parse::<f64>().map_err(|e| bad(format!("{} `{}`: {e}", RECORDING_HEADER[k], &rec[k])));
         let p = Vector3::new(coord(2)?, coord(3)?, coord(4)?);
         check_position(path, frame, node, &p)?;
         if let Some(&(first_row, _)) = rows.get(&(frame, node)) {
@@ -342,7 +382,10 @@ fn recording_csv(path: &Path) -> Result<Vec<Vec<Vector3<f64>>>, ClipError> {
         }
     }
     if expected < 3 {
-        return Err(ClipError::Shape { path: path.to_path_buf(), reason: format!("{expected} nodes per frame, need at least 3") });
+        return Err(ClipError::Shape {
+            path: path.to_path_buf(),
+            reason: format!("{expected} nodes per frame, need at least 3"),
+        });
     }
     Ok(frames)
 }
@@ -413,7 +456,11 @@ mod tests {
             assert!(radius_err < 0.05 * c.powi(4), "radius error {radius_err:e}");
             assert!(arc_err < 1e-5, "arc length error {arc_err:e}");
             assert!(spacing_err < 3e-3 * c * c, "spacing error {spacing_err:e}");
-            assert!(peak / mean < 1.0 + 0.6 * c * c && kappa_err < 0.6 * c * c, "curvature max/mean {}, max |κR − 1| {kappa_err:e}", peak / mean);
+            assert!(
+                peak / mean < 1.0 + 0.6 * c * c && kappa_err < 0.6 * c * c,
+                "curvature max/mean {}, max |κR − 1| {kappa_err:e}",
+                peak / mean
+            );
             assert!(linear_ratio > 2.0, "linear resampling concentrates curvature: {linear_ratio}");
         }
     }
@@ -454,7 +501,10 @@ mod tests {
         assert!(clip.frames.iter().flatten().all(|p| p.y == 0.0), "y = 0");
         // Same motion for every frame: all distances between nodes of any two frames are those
         // of the unplaced, resampled body-plane curves.
-        let raw: Vec<Vec<Vector3<f64>>> = rows.iter().map(|a| Spline::through(&planar(&kymogram_joints(a, params.length_m))).resample_by_arc_length(128).0).collect();
+        let raw: Vec<Vec<Vector3<f64>>> = rows
+            .iter()
+            .map(|a| Spline::through(&planar(&kymogram_joints(a, params.length_m))).resample_by_arc_length(128).0)
+            .collect();
         let mut worst: f64 = 0.0;
         for (f, g) in [(0, 1), (0, 2), (1, 2)] {
             for i in (0..128).step_by(7) {
@@ -548,7 +598,9 @@ mod tests {
     }
 
     fn sample_frames() -> Vec<Vec<Vector3<f64>>> {
-        (0..3).map(|f| (0..4).map(|i| Vector3::new(1e-5 * f as f64, 2e-5 * (i as f64).sin(), 3e-4 * i as f64)).collect()).collect()
+        (0..3)
+            .map(|f| (0..4).map(|i| Vector3::new(1e-5 * f as f64, 2e-5 * (i as f64).sin(), 3e-4 * i as f64)).collect())
+            .collect()
     }
 
     #[test]
@@ -557,7 +609,10 @@ mod tests {
         let frames = sample_frames();
         let p = write(dir.path(), "rec.csv", &csv_text(&frames));
         let clip = read_recording(&p, 0.04).unwrap();
-        assert_eq!((clip.frames.clone(), clip.dt_s, clip.frame_count(), clip.node_count()), (frames.clone(), 0.04, 3, 4));
+        assert_eq!(
+            (clip.frames.clone(), clip.dt_s, clip.frame_count(), clip.node_count()),
+            (frames.clone(), 0.04, 3, 4)
+        );
         assert!((clip.length_m - polyline_length(&frames[0])).abs() == 0.0);
         // Rows in any order.
         let text = csv_text(&frames);
@@ -586,7 +641,11 @@ mod tests {
         check("inf.csv", &good.replacen(",0e0\n", ",inf\n", 1), "frame 0, node 0: z = inf is not finite");
         check("header.csv", &good.replace("x_m", "x"), "expected [\"frame\", \"node\", \"x_m\", \"y_m\", \"z_m\"]");
         check("missing.csv", &[&lines[..6], &lines[7..]].concat().join("\n"), "frame 1, node 1: no row");
-        check("dup.csv", &[&lines[..], &[lines[6]]].concat().join("\n"), "row 13: frame 1, node 1 already given in row 6");
+        check(
+            "dup.csv",
+            &[&lines[..], &[lines[6]]].concat().join("\n"),
+            "row 13: frame 1, node 1 already given in row 6",
+        );
         check("count.csv", &[&lines[..], &["1,4,0,0,0"]].concat().join("\n"), "frame 1: 5 nodes, but frame 0 has 4");
         check("gap.csv", &good.replace("\n2,", "\n3,"), "frame 2, node 0: no row");
         check("few.csv", "frame,node,x_m,y_m,z_m\n0,0,0,0,0\n0,1,0,0,1\n", "2 nodes per frame, need at least 3");
@@ -633,20 +692,32 @@ mod tests {
             assert!(clip.frames.iter().flatten().all(|p| p.iter().all(|v| v.is_finite()) && p.y == 0.0));
             let (jf, jdev) = clip.max_stretch_deviation();
             let xz = clip.frames_with_tangent_near(&Vector3::y(), 1e-3).len();
-            let xy = read_kymogram(&path, &KymogramParams { plane: ClipPlane::Xy, ..KymogramParams::default() }).unwrap();
+            let xy =
+                read_kymogram(&path, &KymogramParams { plane: ClipPlane::Xy, ..KymogramParams::default() }).unwrap();
             let xy_near = xy.frames_with_tangent_near(&Vector3::y(), 1e-3).len();
             // elegansbot's own orientation: head segment along +e1 in every frame, no rotation.
             let unrotated = Clip {
-                frames: raw.data.chunks_exact(24).map(|a| Spline::through(&planar(&kymogram_joints(a, WORM_LENGTH_M))).resample_by_arc_length(128).0).collect(),
+                frames: raw
+                    .data
+                    .chunks_exact(24)
+                    .map(|a| Spline::through(&planar(&kymogram_joints(a, WORM_LENGTH_M))).resample_by_arc_length(128).0)
+                    .collect(),
                 ..clip.clone()
             };
             let unrotated_near = unrotated.frames_with_tangent_near(&Vector3::y(), 1e-3).len();
             // Frames whose continuous tangent passes through ±e2 somewhere: the x-component of
             // the segment tangents changes sign (x–y placements).
-            let crossing = |c: &Clip| c.frames.iter().filter(|f| f.windows(3).any(|w| (w[1].x - w[0].x) * (w[2].x - w[1].x) <= 0.0)).count();
-            println!("{name}: frames whose tangent passes through ±e2: x–y chord along +e1 {}, x–y head along +e1 {}", crossing(&xy), crossing(&unrotated));
+            let crossing = |c: &Clip| {
+                c.frames.iter().filter(|f| f.windows(3).any(|w| (w[1].x - w[0].x) * (w[2].x - w[1].x) <= 0.0)).count()
+            };
+            println!(
+                "{name}: frames whose tangent passes through ±e2: x–y chord along +e1 {}, x–y head along +e1 {}",
+                crossing(&xy),
+                crossing(&unrotated)
+            );
             let kappa_max = clip.frames.iter().flat_map(|f| menger_curvature(f)).fold(0.0, f64::max);
-            let scaled = read_kymogram(&path, &KymogramParams { scale_to_length: true, ..KymogramParams::default() }).unwrap();
+            let scaled =
+                read_kymogram(&path, &KymogramParams { scale_to_length: true, ..KymogramParams::default() }).unwrap();
             let (sf, sdev) = scaled.max_stretch_deviation();
             println!("{name}: scaled to the body length: max |j − 1| {sdev:.3e} (frame {sf})");
             assert!(sdev < 1e-3, "{name}: scaled max |j − 1| = {sdev}");

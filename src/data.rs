@@ -60,7 +60,8 @@ pub fn read_data(path: &Path, mesh: &Mesh) -> Result<NodalState, DataError> {
         let row = i + 1;
         let bad = |reason: String| DataError::Row { path: path.to_path_buf(), row, reason };
         let rec = rec.map_err(|e| bad(e.to_string()))?;
-        let v: Vec<f64> = rec.iter().map(|t| t.parse::<f64>().map_err(|e| bad(format!("`{t}`: {e}")))).collect::<Result<_, _>>()?;
+        let v: Vec<f64> =
+            rec.iter().map(|t| t.parse::<f64>().map_err(|e| bad(format!("`{t}`: {e}")))).collect::<Result<_, _>>()?;
         if v.len() != 7 {
             return Err(bad(format!("{} columns, expected 7", v.len())));
         }
@@ -77,7 +78,11 @@ pub fn read_data(path: &Path, mesh: &Mesh) -> Result<NodalState, DataError> {
     }
     for (i, &s) in nodes.s.iter().enumerate() {
         if (s - mesh.node_s(i)).abs() > 1e-9 * mesh.length_m {
-            return Err(DataError::Row { path: path.to_path_buf(), row: i + 1, reason: format!("s = {s} m, but mesh node {i} is at {} m", mesh.node_s(i)) });
+            return Err(DataError::Row {
+                path: path.to_path_buf(),
+                row: i + 1,
+                reason: format!("s = {s} m, but mesh node {i} is at {} m", mesh.node_s(i)),
+            });
         }
     }
     Ok(nodes)

@@ -220,7 +220,12 @@ pub fn momentum(
 
 /// Distributed loads of one element starting at `s0` [m]: `∫ N_a f`, `∫ N_a l` with the load
 /// rule of D4; `field(s, out_f, out_l)` fills the global force [N/m] and torque [N m/m] at `s`.
-pub fn distributed_load(scheme: QuadratureScheme, h: f64, s0: f64, field: &mut dyn FnMut(f64) -> (Vector3<f64>, Vector3<f64>)) -> LocalVec {
+pub fn distributed_load(
+    scheme: QuadratureScheme,
+    h: f64,
+    s0: f64,
+    field: &mut dyn FnMut(f64) -> (Vector3<f64>, Vector3<f64>),
+) -> LocalVec {
     let mut r = LocalVec::zeros();
     let rule = scheme.loads();
     for (xi, w) in rule.points.iter().zip(rule.weights) {
@@ -282,7 +287,12 @@ mod tests {
     use crate::material::{CrossSection, Material, RodProperties};
 
     fn props() -> RodProperties {
-        let mat = Material { young_modulus_pa: 7.1e10, shear_modulus_pa: 2.69e10, density_kg_m3: 2.73e3, shear_correction: 0.833 };
+        let mat = Material {
+            young_modulus_pa: 7.1e10,
+            shear_modulus_pa: 2.69e10,
+            density_kg_m3: 2.73e3,
+            shear_correction: 0.833,
+        };
         RodProperties::new(&mat, &CrossSection::Rectangle { width_m: 0.06, height_m: 0.04 })
     }
 

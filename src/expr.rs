@@ -38,22 +38,13 @@ pub enum ExprError {
     InvalidNumber { text: String, column: usize },
     /// A token that does not fit the grammar at this point.
     #[error("unexpected {found} at column {column}, expected {expected}")]
-    Unexpected {
-        found: String,
-        column: usize,
-        expected: &'static str,
-    },
+    Unexpected { found: String, column: usize, expected: &'static str },
     /// `name(...)` where `name` is not a known function.
     #[error("unknown function '{name}' at column {column}")]
     UnknownFunction { name: String, column: usize },
     /// A known function called with the wrong number of arguments.
     #[error("function '{name}' at column {column} takes {expected} argument(s), got {found}")]
-    WrongArity {
-        name: String,
-        column: usize,
-        expected: usize,
-        found: usize,
-    },
+    WrongArity { name: String, column: usize, expected: usize, found: usize },
     /// A function name used without parentheses (e.g. `2*sin`).
     #[error("function '{name}' used as a variable at column {column}")]
     FunctionAsVariable { name: String, column: usize },
@@ -196,11 +187,7 @@ fn lex(src: &str) -> Result<Vec<(Tok, usize)>, ExprError> {
                     i += 1;
                 }
                 // A malformed exponent swallows the rest of the word; parse() then fails.
-                i = if chars.get(i).is_some_and(|&d| digit(d)) {
-                    skip(i, &digit)
-                } else {
-                    skip(i, &word)
-                };
+                i = if chars.get(i).is_some_and(|&d| digit(d)) { skip(i, &digit) } else { skip(i, &word) };
             }
             let text: String = chars[start..i].iter().collect();
             match text.parse::<f64>() {
@@ -236,11 +223,7 @@ impl Parser {
         self.toks.get(self.pos).map_or(0, |t| t.1)
     }
     fn unexpected(&self, expected: &'static str) -> ExprError {
-        ExprError::Unexpected {
-            found: describe(self.peek()),
-            column: self.column(),
-            expected,
-        }
+        ExprError::Unexpected { found: describe(self.peek()), column: self.column(), expected }
     }
     fn eat(&mut self, c: char) -> bool {
         if *self.peek() == Tok::Op(c) {
@@ -341,23 +324,13 @@ impl Parser {
         }
         let expected = if f1.is_some() { 1 } else { 2 };
         if args.len() != expected {
-            return Err(ExprError::WrongArity {
-                name,
-                column,
-                expected,
-                found: args.len(),
-            });
+            return Err(ExprError::WrongArity { name, column, expected, found: args.len() });
         }
         let mut it = args.into_iter().map(Box::new);
         match (f1, f2, it.next(), it.next()) {
             (Some(f), _, Some(a), None) => Ok(Node::Call1(f, a)),
             (_, Some(f), Some(a), Some(b)) => Ok(Node::Call2(f, a, b)),
-            _ => Err(ExprError::WrongArity {
-                name,
-                column,
-                expected,
-                found: 0,
-            }),
+            _ => Err(ExprError::WrongArity { name, column, expected, found: 0 }),
         }
     }
 }
@@ -407,9 +380,7 @@ impl Expr {
             Ok(match n {
                 Node::Num(v) => *v,
                 Node::Pi => std::f64::consts::PI,
-                Node::Var(name) => {
-                    vars(name).ok_or_else(|| ExprError::UnknownVariable { name: name.clone() })?
-                }
+                Node::Var(name) => vars(name).ok_or_else(|| ExprError::UnknownVariable { name: name.clone() })?,
                 Node::Neg(a) => -ev(a, vars)?,
                 Node::Bin(op, a, b) => binop(*op, ev(a, vars)?, ev(b, vars)?),
                 Node::Call1(f, a) => f.apply(ev(a, vars)?),
@@ -432,24 +403,13 @@ impl Expr {
                     None => return Err(ExprError::UnknownVariable { name: name.clone() }),
                 },
                 Node::Neg(a) => CNode::Neg(Box::new(comp(a, names)?)),
-                Node::Bin(op, a, b) => {
-                    CNode::Bin(*op, Box::new(comp(a, names)?), Box::new(comp(b, names)?))
-                }
+                Node::Bin(op, a, b) => CNode::Bin(*op, Box::new(comp(a, names)?), Box::new(comp(b, names)?)),
                 Node::Call1(f, a) => CNode::F1(*f, Box::new(comp(a, names)?)),
-                Node::Call2(f, a, b) => {
-                    CNode::F2(*f, Box::new(comp(a, names)?), Box::new(comp(b, names)?))
-                }
+                Node::Call2(f, a, b) => CNode::F2(*f, Box::new(comp(a, names)?), Box::new(comp(b, names)?)),
             };
-            Ok(if c.is_const() {
-                CNode::Const(c.eval(&[]))
-            } else {
-                c
-            })
+            Ok(if c.is_const() { CNode::Const(c.eval(&[])) } else { c })
         }
-        Ok(Compiled {
-            root: comp(&self.root, names)?,
-            n_slots: names.len(),
-        })
+        Ok(Compiled { root: comp(&self.root, names)?, n_slots: names.len() })
     }
 
     /// Writes fully parenthesised FreeFEM source. Identifiers go through
@@ -632,73 +592,26 @@ mod tests {
     #[test]
     fn errors_with_positions() {
         let e = Expr::parse("(1+2))").unwrap_err();
-        assert_eq!(
-            e.to_string(),
-            "unexpected ')' at column 6, expected an operator or end of input"
-        );
+        assert_eq!(e.to_string(), "unexpected ')' at column 6, expected an operator or end of input");
         let e = Expr::parse("sin(1+)").unwrap_err();
         assert!(matches!(e, ExprError::Unexpected { column: 7, .. }), "{e}");
         assert!(e.to_string().starts_with("unexpected ')' at column 7"));
         assert_eq!(
             Expr::parse("2*sinn(s)").unwrap_err(),
-            ExprError::UnknownFunction {
-                name: "sinn".into(),
-                column: 3
-            }
+            ExprError::UnknownFunction { name: "sinn".into(), column: 3 }
         );
-        assert_eq!(
-            Expr::parse("2*sinn(s)").unwrap_err().to_string(),
-            "unknown function 'sinn' at column 3"
-        );
-        assert!(matches!(
-            Expr::parse("pow(1)"),
-            Err(ExprError::WrongArity {
-                expected: 2,
-                found: 1,
-                ..
-            })
-        ));
-        assert!(matches!(
-            Expr::parse("sin(1,2)"),
-            Err(ExprError::WrongArity {
-                expected: 1,
-                found: 2,
-                ..
-            })
-        ));
-        assert!(matches!(
-            Expr::parse("1e"),
-            Err(ExprError::InvalidNumber { column: 1, .. })
-        ));
-        assert!(matches!(
-            Expr::parse("1e999"),
-            Err(ExprError::InvalidNumber { .. })
-        ));
+        assert_eq!(Expr::parse("2*sinn(s)").unwrap_err().to_string(), "unknown function 'sinn' at column 3");
+        assert!(matches!(Expr::parse("pow(1)"), Err(ExprError::WrongArity { expected: 2, found: 1, .. })));
+        assert!(matches!(Expr::parse("sin(1,2)"), Err(ExprError::WrongArity { expected: 1, found: 2, .. })));
+        assert!(matches!(Expr::parse("1e"), Err(ExprError::InvalidNumber { column: 1, .. })));
+        assert!(matches!(Expr::parse("1e999"), Err(ExprError::InvalidNumber { .. })));
         assert!(matches!(Expr::parse("  "), Err(ExprError::Empty)));
-        assert!(matches!(
-            Expr::parse("2 # 3"),
-            Err(ExprError::InvalidCharacter { ch: '#', column: 3 })
-        ));
-        assert!(matches!(
-            Expr::parse("2*sin"),
-            Err(ExprError::FunctionAsVariable { column: 3, .. })
-        ));
-        assert!(matches!(
-            Expr::parse("(1+2"),
-            Err(ExprError::Unexpected { column: 5, .. })
-        ));
-        assert!(matches!(
-            Expr::parse("2 3"),
-            Err(ExprError::Unexpected { column: 3, .. })
-        ));
-        assert!(matches!(
-            Expr::parse("*3"),
-            Err(ExprError::Unexpected { column: 1, .. })
-        ));
-        let e = Expr::parse("a+b")
-            .unwrap()
-            .eval(&|n| (n == "a").then_some(1.0))
-            .unwrap_err();
+        assert!(matches!(Expr::parse("2 # 3"), Err(ExprError::InvalidCharacter { ch: '#', column: 3 })));
+        assert!(matches!(Expr::parse("2*sin"), Err(ExprError::FunctionAsVariable { column: 3, .. })));
+        assert!(matches!(Expr::parse("(1+2"), Err(ExprError::Unexpected { column: 5, .. })));
+        assert!(matches!(Expr::parse("2 3"), Err(ExprError::Unexpected { column: 3, .. })));
+        assert!(matches!(Expr::parse("*3"), Err(ExprError::Unexpected { column: 1, .. })));
+        let e = Expr::parse("a+b").unwrap().eval(&|n| (n == "a").then_some(1.0)).unwrap_err();
         assert_eq!(e.to_string(), "unknown variable 'b'");
         assert_eq!(
             Expr::parse("a+b").unwrap().compile(&["a"]).unwrap_err(),
@@ -713,22 +626,9 @@ mod tests {
         assert_eq!(v, ["Fmax", "L0", "s", "t"]);
         let mut c = BTreeMap::new();
         c.insert("E".to_string(), 1.1e5);
-        assert_eq!(
-            eval_const("E/(2*(1+0.4))", &c).unwrap(),
-            1.1e5 / (2.0 * (1.0 + 0.4))
-        );
-        assert!(matches!(
-            eval_const("E/G", &c),
-            Err(ExprError::UnknownVariable { .. })
-        ));
-        assert_eq!(
-            Expr::parse("2*pi")
-                .unwrap()
-                .compile(&[])
-                .unwrap()
-                .as_constant(),
-            Some(2.0 * std::f64::consts::PI)
-        );
+        assert_eq!(eval_const("E/(2*(1+0.4))", &c).unwrap(), 1.1e5 / (2.0 * (1.0 + 0.4)));
+        assert!(matches!(eval_const("E/G", &c), Err(ExprError::UnknownVariable { .. })));
+        assert_eq!(Expr::parse("2*pi").unwrap().compile(&[]).unwrap().as_constant(), Some(2.0 * std::f64::consts::PI));
     }
 
     struct Rng(u64);
@@ -790,23 +690,12 @@ mod tests {
                     .unwrap();
                 let y = c.eval(&vals);
                 let z = again.compile(&["a", "b", "c"]).unwrap().eval(&vals);
-                assert!(
-                    x.to_bits() == y.to_bits() || (x.is_nan() && y.is_nan()),
-                    "{src}: {x} vs {y}"
-                );
-                assert!(
-                    x.to_bits() == z.to_bits() || (x.is_nan() && z.is_nan()),
-                    "{src}: {x} vs {z}"
-                );
+                assert!(x.to_bits() == y.to_bits() || (x.is_nan() && y.is_nan()), "{src}: {x} vs {y}");
+                assert!(x.to_bits() == z.to_bits() || (x.is_nan() && z.is_nan()), "{src}: {x} vs {z}");
             }
         }
         // Too few slots: NaN instead of a panic.
-        assert!(Expr::parse("a+b")
-            .unwrap()
-            .compile(&["a", "b"])
-            .unwrap()
-            .eval(&[1.0])
-            .is_nan());
+        assert!(Expr::parse("a+b").unwrap().compile(&["a", "b"]).unwrap().eval(&[1.0]).is_nan());
     }
 
     #[test]
@@ -842,19 +731,10 @@ mod tests {
             other => format!("k_{other}"),
         };
         let ff = |src: &str| Expr::parse(src).unwrap().to_freefem(&rename);
-        assert_eq!(
-            ff("2e3*sin(pi*s)*sin(8*omega0*t)"),
-            "((2e3*sin((pi*S)))*sin(((8e0*k_omega0)*T)))"
-        );
+        assert_eq!(ff("2e3*sin(pi*s)*sin(8*omega0*t)"), "((2e3*sin((pi*S)))*sin(((8e0*k_omega0)*T)))");
         assert_eq!(ff("-F"), "(-k_F)");
-        assert_eq!(
-            ff("-Fmax*(exp(4*s/L0)-1)/3"),
-            "(((-k_Fmax)*(exp(((4e0*S)/k_L0))-1e0))/3e0)"
-        );
+        assert_eq!(ff("-Fmax*(exp(4*s/L0)-1)/3"), "(((-k_Fmax)*(exp(((4e0*S)/k_L0))-1e0))/3e0)");
         assert_eq!(ff("E/(2*(1+0.4))"), "(k_E/(2e0*(1e0+4e-1)))");
-        assert_eq!(
-            ff("-2^2 + atan2(s,t) + max(s, 1.5)"),
-            "(((-pow(2e0,2e0))+atan2(S,T))+max(S,1.5e0))"
-        );
+        assert_eq!(ff("-2^2 + atan2(s,t) + max(s, 1.5)"), "(((-pow(2e0,2e0))+atan2(S,T))+max(S,1.5e0))");
     }
 }

@@ -12,8 +12,8 @@ use crate::case::{Analysis, Case, InverseMethod, StaticMethod};
 use crate::loads::LoadFrame;
 use crate::mesh::QuadratureScheme;
 use crate::run::{Engine, InverseOutput, NodalState, RunResult, SolverStats};
-use crate::solve::inverse::{InverseRecord, ObjectiveTerms};
 use crate::solve::dynamics::TipRecord;
+use crate::solve::inverse::{InverseRecord, ObjectiveTerms};
 use crate::solve::statics::IterationRecord;
 
 /// Environment variable pointing at the `freefem/` script directory (default: the crate's).
@@ -42,7 +42,9 @@ pub enum FreeFemError {
 
 /// Directory holding `forward.edp` and `rotation.idp`.
 pub fn script_dir() -> PathBuf {
-    std::env::var_os(SCRIPT_DIR_ENV).map(PathBuf::from).unwrap_or_else(|| PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/freefem")))
+    std::env::var_os(SCRIPT_DIR_ENV)
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/freefem")))
 }
 
 /// Path of the FreeFEM executable, if installed.
@@ -98,10 +100,14 @@ pub fn include_file(case: &Case) -> String {
     }
     let (dynamic, method, relax, tol, maxit, tend, steps, cont) = match case.analysis.clone() {
         Analysis::Static { method, tolerance, max_iterations, continuation_steps } => match method {
-            StaticMethod::FixedPoint { relaxation } => (0, 0, relaxation, tolerance, max_iterations, 0.0, 0, continuation_steps),
+            StaticMethod::FixedPoint { relaxation } => {
+                (0, 0, relaxation, tolerance, max_iterations, 0.0, 0, continuation_steps)
+            }
             StaticMethod::Newton => (0, 1, 1.0, tolerance, max_iterations, 0.0, 0, continuation_steps),
         },
-        Analysis::Dynamic { end_time_s, steps, tolerance, max_iterations } => (1, 1, 1.0, tolerance, max_iterations, end_time_s, steps, 1),
+        Analysis::Dynamic { end_time_s, steps, tolerance, max_iterations } => {
+            (1, 1, 1.0, tolerance, max_iterations, end_time_s, steps, 1)
+        }
         Analysis::Inverse(inv) => {
             let relax = match inv.method {
                 InverseMethod::FixedPoint { relaxation } | InverseMethod::Newton { relaxation, .. } => relaxation,
@@ -110,16 +116,54 @@ pub fn include_file(case: &Case) -> String {
         }
     };
     let local = i32::from(case.loads.frame == LoadFrame::Local);
-    let _ = writeln!(o, "int localLoads = {local}; // distributed loads in the local frame (f^g = Q^T f^l)\nint contSteps = {cont};");
-    let _ = writeln!(o, "int isDynamic = {dynamic};\nint method = {method};\nreal relax = {};\nreal tol = {};\nint maxit = {maxit};", num(relax), num(tol));
-    let _ = writeln!(o, "real Tend = {};\nint nsteps = {steps};\nreal newtonTol = {};\nint newtonMaxit = {maxit};", num(tend), num(tol));
+    let _ = writeln!(
+        o,
+        "int localLoads = {local}; // distributed loads in the local frame (f^g = Q^T f^l)\nint contSteps = {cont};"
+    );
+    let _ = writeln!(
+        o,
+        "int isDynamic = {dynamic};\nint method = {method};\nreal relax = {};\nreal tol = {};\nint maxit = {maxit};",
+        num(relax),
+        num(tol)
+    );
+    let _ = writeln!(
+        o,
+        "real Tend = {};\nint nsteps = {steps};\nreal newtonTol = {};\nint newtonMaxit = {maxit};",
+        num(tend),
+        num(tol)
+    );
     if let Analysis::Inverse(inv) = &case.analysis {
         let w = &inv.weights;
         let _ = writeln!(o, "// inverse problem (docs/inverse.md): weights of eq. (41), first frame");
-        let _ = writeln!(o, "real lambdaG = {}, lambdaF = {}, lambdaL = {}, lambdaD = {};", num(w.lambda_g), num(w.lambda_f), num(w.lambda_l), num(w.lambda_d));
-        let _ = writeln!(o, "real LamK1 = {}, LamK2 = {}, LamK3 = {};", num(w.lambda_kappa[0]), num(w.lambda_kappa[1]), num(w.lambda_kappa[2]));
-        let _ = writeln!(o, "real LamW1 = {}, LamW2 = {}, LamW3 = {};", num(w.lambda_omega[0]), num(w.lambda_omega[1]), num(w.lambda_omega[2]));
-        let _ = writeln!(o, "real dt = {};\nint firstFrame = 1;\nreal alpha0 = {};\nreal stab = {};", num(inv.frame_interval_s), num(inv.alpha0_rad), num(inv.stabilisation));
+        let _ = writeln!(
+            o,
+            "real lambdaG = {}, lambdaF = {}, lambdaL = {}, lambdaD = {};",
+            num(w.lambda_g),
+            num(w.lambda_f),
+            num(w.lambda_l),
+            num(w.lambda_d)
+        );
+        let _ = writeln!(
+            o,
+            "real LamK1 = {}, LamK2 = {}, LamK3 = {};",
+            num(w.lambda_kappa[0]),
+            num(w.lambda_kappa[1]),
+            num(w.lambda_kappa[2])
+        );
+        let _ = writeln!(
+            o,
+            "real LamW1 = {}, LamW2 = {}, LamW3 = {};",
+            num(w.lambda_omega[0]),
+            num(w.lambda_omega[1]),
+            num(w.lambda_omega[2])
+        );
+        let _ = writeln!(
+            o,
+            "real dt = {};\nint firstFrame = 1;\nreal alpha0 = {};\nreal stab = {};",
+            num(inv.frame_interval_s),
+            num(inv.alpha0_rad),
+            num(inv.stabilisation)
+        );
     }
     o
 }
@@ -127,9 +171,14 @@ pub fn include_file(case: &Case) -> String {
 /// Run `freefem/inverse.edp` on an inverse case with the data file `data_path` (copied into
 /// `workdir` as `data.csv` unless it is already there). `data` is the parsed content of that file.
 pub fn run_inverse(case: &Case, data: NodalState, data_path: &Path, workdir: &Path) -> Result<RunResult, FreeFemError> {
-    let inv = case.inverse().ok_or_else(|| FreeFemError::BadOutput { path: data_path.to_path_buf(), reason: format!("case `{}` is not an inverse case", case.name) })?;
+    let inv = case.inverse().ok_or_else(|| FreeFemError::BadOutput {
+        path: data_path.to_path_buf(),
+        reason: format!("case `{}` is not an inverse case", case.name),
+    })?;
     if matches!(inv.method, InverseMethod::Newton { .. }) {
-        return Err(FreeFemError::Unsupported("the FreeFEM engine mirrors the paper's fixed point only (solver.method = \"fixed_point\")"));
+        return Err(FreeFemError::Unsupported(
+            "the FreeFEM engine mirrors the paper's fixed point only (solver.method = \"fixed_point\")",
+        ));
     }
     let io = |path: &Path| {
         let path = path.to_path_buf();
@@ -137,7 +186,11 @@ pub fn run_inverse(case: &Case, data: NodalState, data_path: &Path, workdir: &Pa
     };
     std::fs::create_dir_all(workdir).map_err(io(workdir))?;
     let target = workdir.join("data.csv");
-    let same = std::fs::canonicalize(data_path).ok().zip(std::fs::canonicalize(&target).ok()).map(|(a, b)| a == b).unwrap_or(false);
+    let same = std::fs::canonicalize(data_path)
+        .ok()
+        .zip(std::fs::canonicalize(&target).ok())
+        .map(|(a, b)| a == b)
+        .unwrap_or(false);
     if !same {
         std::fs::copy(data_path, &target).map_err(io(&target))?;
     }
@@ -147,10 +200,18 @@ pub fn run_inverse(case: &Case, data: NodalState, data_path: &Path, workdir: &Pa
     header.extend(["xhat_1", "xhat_2", "xhat_3", "ahat_1", "ahat_2", "ahat_3"]);
     let rows = read_table(&nodes_path, &header)?;
     if rows.len() != case.mesh.nodes() {
-        return Err(FreeFemError::BadOutput { path: nodes_path, reason: format!("{} rows, expected {}", rows.len(), case.mesh.nodes()) });
+        return Err(FreeFemError::BadOutput {
+            path: nodes_path,
+            reason: format!("{} rows, expected {}", rows.len(), case.mesh.nodes()),
+        });
     }
     let v3 = |r: &Vec<f64>, k: usize| Vector3::new(r[k], r[k + 1], r[k + 2]);
-    let nodes = NodalState { s: rows.iter().map(|r| r[0]).collect(), x: rows.iter().map(|r| v3(r, 1)).collect(), alpha: rows.iter().map(|r| v3(r, 4)).collect(), chart: Default::default() };
+    let nodes = NodalState {
+        s: rows.iter().map(|r| r[0]).collect(),
+        x: rows.iter().map(|r| v3(r, 1)).collect(),
+        alpha: rows.iter().map(|r| v3(r, 4)).collect(),
+        chart: Default::default(),
+    };
     let mut hist_header = vec!["iteration", "rel_change", "x_err_rel", "tangent_misfit"];
     hist_header.extend(ObjectiveTerms::NAMES);
     let history = read_table(&workdir.join("ff_inverse_history.csv"), &hist_header)?
@@ -160,7 +221,14 @@ pub fn run_inverse(case: &Case, data: NodalState, data_path: &Path, workdir: &Pa
             rel_change: r[1],
             x_err_rel: r[2],
             tangent_misfit: r[3],
-            objective: ObjectiveTerms { tracking: r[4], force: r[5], torque: r[6], shear: r[7], bending: r[8], angular: r[9] },
+            objective: ObjectiveTerms {
+                tracking: r[4],
+                force: r[5],
+                torque: r[6],
+                shear: r[7],
+                bending: r[8],
+                angular: r[9],
+            },
             residual: None,
         })
         .collect();
@@ -224,7 +292,11 @@ fn execute(case: &Case, workdir: &Path, script: &str, outputs: &[&str]) -> Resul
     let out = cmd.output().map_err(io(&script))?;
     let text = format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
     if !out.status.success() {
-        return Err(FreeFemError::Failed { status: out.status.code().unwrap_or(-1), workdir: workdir.to_path_buf(), output: text });
+        return Err(FreeFemError::Failed {
+            status: out.status.code().unwrap_or(-1),
+            workdir: workdir.to_path_buf(),
+            output: text,
+        });
     }
     Ok(())
 }
@@ -232,7 +304,8 @@ fn execute(case: &Case, workdir: &Path, script: &str, outputs: &[&str]) -> Resul
 fn read_info(info_path: &Path) -> Result<BTreeMap<String, f64>, FreeFemError> {
     let bad = |reason: String| FreeFemError::BadOutput { path: info_path.to_path_buf(), reason };
     let mut info = BTreeMap::new();
-    let mut rdr = csv::ReaderBuilder::new().trim(csv::Trim::All).from_path(info_path).map_err(|e| bad(e.to_string()))?;
+    let mut rdr =
+        csv::ReaderBuilder::new().trim(csv::Trim::All).from_path(info_path).map_err(|e| bad(e.to_string()))?;
     for rec in rdr.records() {
         let rec = rec.map_err(|e| bad(e.to_string()))?;
         if let (Some(k), Some(v)) = (rec.get(0), rec.get(1).and_then(|v| v.parse::<f64>().ok())) {
@@ -266,7 +339,10 @@ fn read_outputs(case: &Case, dir: &Path) -> Result<RunResult, FreeFemError> {
     let nodes_path = dir.join("ff_nodes.csv");
     let rows = read_table(&nodes_path, &["s_m", "x_m", "y_m", "z_m", "alpha_rad", "beta_rad", "gamma_rad"])?;
     if rows.len() != case.mesh.nodes() {
-        return Err(FreeFemError::BadOutput { path: nodes_path, reason: format!("{} rows, expected {}", rows.len(), case.mesh.nodes()) });
+        return Err(FreeFemError::BadOutput {
+            path: nodes_path,
+            reason: format!("{} rows, expected {}", rows.len(), case.mesh.nodes()),
+        });
     }
     let nodes = NodalState {
         s: rows.iter().map(|r| r[0]).collect(),
@@ -286,13 +362,24 @@ fn read_outputs(case: &Case, dir: &Path) -> Result<RunResult, FreeFemError> {
     let mut history = Vec::new();
     let mut tip = Vec::new();
     if case.is_dynamic() {
-        for r in read_table(&dir.join("ff_tip.csv"), &["time_s", "x_m", "y_m", "z_m", "alpha_rad", "beta_rad", "gamma_rad", "newton_iterations"])? {
-            tip.push(TipRecord { time_s: r[0], position_m: Vector3::new(r[1], r[2], r[3]), angles_rad: Vector3::new(r[4], r[5], r[6]), newton_iterations: r[7] as usize });
+        for r in read_table(
+            &dir.join("ff_tip.csv"),
+            &["time_s", "x_m", "y_m", "z_m", "alpha_rad", "beta_rad", "gamma_rad", "newton_iterations"],
+        )? {
+            tip.push(TipRecord {
+                time_s: r[0],
+                position_m: Vector3::new(r[1], r[2], r[3]),
+                angles_rad: Vector3::new(r[4], r[5], r[6]),
+                newton_iterations: r[7] as usize,
+            });
         }
     } else {
         for r in read_table(&dir.join("ff_history.csv"), &["iteration", "rel_change"])? {
             let iteration = r[0] as usize;
-            let step = history.last().map(|h: &IterationRecord| if iteration <= h.iteration { h.step + 1 } else { h.step }).unwrap_or(1);
+            let step = history
+                .last()
+                .map(|h: &IterationRecord| if iteration <= h.iteration { h.step + 1 } else { h.step })
+                .unwrap_or(1);
             history.push(IterationRecord { step, iteration, change: r[1] });
         }
     }

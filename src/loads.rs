@@ -32,7 +32,14 @@ pub struct Loads {
 }
 
 impl Loads {
-    pub fn new(frame: LoadFrame, force: [Expr; 3], torque: [Expr; 3], end_force: [Expr; 3], end_torque: [Expr; 3], constants: &BTreeMap<String, f64>) -> Result<Self, ExprError> {
+    pub fn new(
+        frame: LoadFrame,
+        force: [Expr; 3],
+        torque: [Expr; 3],
+        end_force: [Expr; 3],
+        end_torque: [Expr; 3],
+        constants: &BTreeMap<String, f64>,
+    ) -> Result<Self, ExprError> {
         let names: Vec<&str> = FIXED.iter().copied().chain(constants.keys().map(|k| k.as_str())).collect();
         let exprs = [force, torque, end_force, end_torque];
         let mut compiled = Vec::with_capacity(12);

@@ -7,9 +7,9 @@ use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use cosserat::case::{case_files, Case};
+use cosserat::data::write_data;
 use cosserat::metrics::{all_metrics, compare};
 use cosserat::output::write_run;
-use cosserat::data::write_data;
 use cosserat::run::{generate_data, run_inverse_on, Engine, RunResult};
 use cosserat::solve::modes::modal_model;
 use cosserat::solve::Problem;
@@ -119,7 +119,11 @@ fn progress_bar(quiet: bool, label: &str) -> ProgressBar {
         return ProgressBar::hidden();
     }
     let pb = ProgressBar::new(0);
-    pb.set_style(ProgressStyle::with_template("{prefix} [{bar:40}] {pos}/{len} {per_sec} eta {eta}").unwrap_or_else(|_| ProgressStyle::default_bar()).progress_chars("=> "));
+    pb.set_style(
+        ProgressStyle::with_template("{prefix} [{bar:40}] {pos}/{len} {per_sec} eta {eta}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar())
+            .progress_chars("=> "),
+    );
     pb.set_prefix(label.to_string());
     pb
 }
@@ -182,7 +186,10 @@ fn cmd_run(path: &Path, engine: Engine, out: Option<PathBuf>, quiet: bool) -> Re
 /// A clip case: frames solved in order and streamed to `dir`; a summary plot at the end.
 fn cmd_run_clip(case: &Case, engine: Engine, dir: &Path, quiet: bool) -> Result<ExitCode> {
     if engine != Engine::Rust {
-        anyhow::bail!("case {}: clips run in the Rust engine (`--engine rust`); FreeFEM cross-checks a prefix in the tests", case.name);
+        anyhow::bail!(
+            "case {}: clips run in the Rust engine (`--engine rust`); FreeFEM cross-checks a prefix in the tests",
+            case.name
+        );
     }
     let pb = progress_bar(quiet, &format!("{} [frames]", case.name));
     let result = cosserat::run::run_clip(case, dir, |done, total| {
@@ -194,7 +201,10 @@ fn cmd_run_clip(case: &Case, engine: Engine, dir: &Path, quiet: bool) -> Result<
         Ok(r) => r,
         Err(e) => {
             let e = anyhow::Error::from(e).context(format!("case {}", case.name));
-            let _ = cosserat::output::write_atomic(&dir.join("FAILED.txt"), format!("{e:#}\nThe converged frames before it are in this folder.\n").as_bytes());
+            let _ = cosserat::output::write_atomic(
+                &dir.join("FAILED.txt"),
+                format!("{e:#}\nThe converged frames before it are in this folder.\n").as_bytes(),
+            );
             return Err(e);
         }
     };
@@ -202,7 +212,9 @@ fn cmd_run_clip(case: &Case, engine: Engine, dir: &Path, quiet: bool) -> Result<
     cosserat::output::write_clip_kymographs(case, &run, &dir.join("kymograph.svg"))?;
     cosserat::output::write_truth_plot(case, &run, &dir.join("truth.svg"))?;
     if let Some(t) = &run.truth {
-        let max = |f: &dyn Fn(&cosserat::clip::synthetic::FrameComparison) -> f64| t.comparisons.iter().map(f).fold(0.0, f64::max);
+        let max = |f: &dyn Fn(&cosserat::clip::synthetic::FrameComparison) -> f64| {
+            t.comparisons.iter().map(f).fold(0.0, f64::max)
+        };
         println!(
             "{} ground truth (all frames, max): |x - x_true|/|x_true| {:.2e}; bending k1^2+k2^2 rel. L2 {:.2e}; angle(d3, true d3) {:.2e} rad; |roll offset| {:.3} rad; kappa_3 rms error {:.1} rad/m (true twist {:.1} rad/m); see truth.csv, truth.svg, truth_errors.svg",
             case.name,
@@ -257,7 +269,14 @@ fn cmd_compare(path: &Path, out: Option<PathBuf>) -> Result<ExitCode> {
         let verdict = if r.passed() { "PASS" } else { "FAIL" };
         failed += usize::from(!r.passed());
         let v = |x: Option<f64>| x.map(|x| format!("{x:.8e}")).unwrap_or_else(|| "-".into());
-        println!("{:<34} {:>15} {:>15} {:>11.3e} {:>11.3e}  {verdict}", r.name, v(r.rust), v(r.freefem), r.difference, r.tolerance);
+        println!(
+            "{:<34} {:>15} {:>15} {:>11.3e} {:>11.3e}  {verdict}",
+            r.name,
+            v(r.rust),
+            v(r.freefem),
+            r.difference,
+            r.tolerance
+        );
     }
     println!(
         "wall time: rust {:.3} s, freefem {:.3} s (ratio freefem/rust {:.1})",
@@ -281,14 +300,23 @@ struct SweepOutcome {
 fn sweep_run(case: &Case, dir: &Path) -> SweepOutcome {
     use cosserat::run::RunError;
     use cosserat::sweep::RunStatus;
-    let failed = |e: anyhow::Error| SweepOutcome { status: RunStatus::Failed, metrics: None, run: None, error: Some(format!("{e:#}")) };
+    let failed = |e: anyhow::Error| SweepOutcome {
+        status: RunStatus::Failed,
+        metrics: None,
+        run: None,
+        error: Some(format!("{e:#}")),
+    };
     let data = match prepare_data(case, dir) {
         Ok(d) => d,
         Err(e) => return failed(e),
     };
     let path = data.as_deref().unwrap_or(Path::new(""));
     let work = dir.join("freefem_work");
-    let outcome = if data.is_some() { run_inverse_on(case, Engine::Rust, path, &work, |_, _| {}) } else { cosserat::run::run(case, Engine::Rust, &work, |_, _| {}) };
+    let outcome = if data.is_some() {
+        run_inverse_on(case, Engine::Rust, path, &work, |_, _| {})
+    } else {
+        cosserat::run::run(case, Engine::Rust, &work, |_, _| {})
+    };
     let (status, r, error) = match outcome {
         Ok(r) => (RunStatus::Ok, r, None),
         Err(RunError::Incomplete { source, partial }) => (RunStatus::NotConverged, *partial, Some(source.to_string())),
@@ -298,7 +326,10 @@ fn sweep_run(case: &Case, dir: &Path) -> SweepOutcome {
         let m = all_metrics(case, &r)?;
         write_run(case, &r, &m, dir)?;
         if let Some(e) = &error {
-            cosserat::output::write_atomic(&dir.join("FAILED.txt"), format!("{e}\nThe files here hold the last iterate.\n").as_bytes())?;
+            cosserat::output::write_atomic(
+                &dir.join("FAILED.txt"),
+                format!("{e}\nThe files here hold the last iterate.\n").as_bytes(),
+            )?;
         }
         Ok(m)
     };
@@ -330,15 +361,31 @@ fn cmd_sweep(path: &Path, set: &[String], out: Option<PathBuf>, jobs: Option<usi
     });
     pb.finish_and_clear();
     let keys: Vec<String> = params.iter().map(|p| p.key.clone()).collect();
-    let rows: Vec<SummaryRow> = results.iter().map(|(point, _, o)| SummaryRow { point: point.clone(), status: o.status, metrics: o.metrics.clone(), error: o.error.clone() }).collect();
+    let rows: Vec<SummaryRow> = results
+        .iter()
+        .map(|(point, _, o)| SummaryRow {
+            point: point.clone(),
+            status: o.status,
+            metrics: o.metrics.clone(),
+            error: o.error.clone(),
+        })
+        .collect();
     let summary = dir.join("summary.csv");
     cosserat::output::write_atomic(&summary, summary_csv(&keys, &rows)?.as_bytes())?;
-    let curves: Vec<(&String, &RunResult)> = results.iter().filter_map(|(_, name, o)| o.run.as_ref().map(|run| (name, run))).collect();
+    let curves: Vec<(&String, &RunResult)> =
+        results.iter().filter_map(|(_, name, o)| o.run.as_ref().map(|run| (name, run))).collect();
     if !curves.is_empty() {
         cosserat::output::write_convergence_plot(&curves, &dir.join("convergence.svg"))?;
     }
     let failed = rows.iter().filter(|r| r.status != cosserat::sweep::RunStatus::Ok).count();
-    println!("{}: {} runs, {} failed or not converged; wrote {} and one folder per run to {}", case.name, rows.len(), failed, summary.display(), dir.display());
+    println!(
+        "{}: {} runs, {} failed or not converged; wrote {} and one folder per run to {}",
+        case.name,
+        rows.len(),
+        failed,
+        summary.display(),
+        dir.display()
+    );
     for (_, name, o) in &results {
         if let Some(e) = &o.error {
             eprintln!("  {name}: {}: {e}", o.status.as_str());
@@ -355,7 +402,10 @@ fn cmd_list(dir: &Path) -> Result<ExitCode> {
     for f in files {
         match Case::from_file(&f) {
             Ok(c) => println!("{:<24} {}", c.name, c.description),
-            Err(e) => println!("{:<24} INVALID: {e}", f.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default()),
+            Err(e) => println!(
+                "{:<24} INVALID: {e}",
+                f.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default()
+            ),
         }
     }
     Ok(ExitCode::SUCCESS)
@@ -364,7 +414,10 @@ fn cmd_list(dir: &Path) -> Result<ExitCode> {
 fn cmd_modes(path: &Path, count: usize) -> Result<ExitCode> {
     let case = load(path)?;
     let model = modal_model(&Problem::from_case(&case))?;
-    println!("{}: natural frequencies of the linearised rod (clamped at s = 0, {} elements)", case.name, case.mesh.elements);
+    println!(
+        "{}: natural frequencies of the linearised rod (clamped at s = 0, {} elements)",
+        case.name, case.mesh.elements
+    );
     println!("{:>4} {:>16} {:>14}", "mode", "omega_rad_per_s", "f_hz");
     for (i, w) in model.omegas.iter().take(count).enumerate() {
         println!("{:>4} {:>16.6} {:>14.6}", i + 1, w, w / (2.0 * std::f64::consts::PI));

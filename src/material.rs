@@ -88,7 +88,12 @@ mod tests {
     #[test]
     fn circle_matches_remark_2() {
         let r = 1e-3 / 40.0;
-        let mat = Material { young_modulus_pa: 1.1e5, shear_modulus_pa: 5e4, density_kg_m3: 1e3, shear_correction: 4.0 / 3.0 };
+        let mat = Material {
+            young_modulus_pa: 1.1e5,
+            shear_modulus_pa: 5e4,
+            density_kg_m3: 1e3,
+            shear_correction: 4.0 / 3.0,
+        };
         let p = RodProperties::new(&mat, &CrossSection::Circle { radius_m: r });
         let a = std::f64::consts::PI * r * r;
         let pi = std::f64::consts::PI;
@@ -101,7 +106,12 @@ mod tests {
 
     #[test]
     fn rectangle_matches_section_5_1() {
-        let mat = Material { young_modulus_pa: 7.1e10, shear_modulus_pa: 2.69e10, density_kg_m3: 2.73e3, shear_correction: 0.833 };
+        let mat = Material {
+            young_modulus_pa: 7.1e10,
+            shear_modulus_pa: 2.69e10,
+            density_kg_m3: 2.73e3,
+            shear_correction: 0.833,
+        };
         let p = RodProperties::new(&mat, &CrossSection::Rectangle { width_m: 0.06, height_m: 0.04 });
         let (a, b) = (0.06_f64, 0.04_f64);
         assert!((p.bend_twist_nm2[0] / (7.1e10 * a * b.powi(3) / 12.0) - 1.0).abs() < 1e-14);

@@ -113,7 +113,8 @@ mod tests {
     #[test]
     fn gauss_rules_integrate_polynomials() {
         // 1-point exact for degree 1, 2-point for degree 3 on (0,1).
-        let integ = |r: &Rule, f: &dyn Fn(f64) -> f64| r.points.iter().zip(r.weights).map(|(p, w)| w * f(*p)).sum::<f64>();
+        let integ =
+            |r: &Rule, f: &dyn Fn(f64) -> f64| r.points.iter().zip(r.weights).map(|(p, w)| w * f(*p)).sum::<f64>();
         assert!((integ(&GAUSS1, &|x| 3.0 * x + 1.0) - 2.5).abs() < 1e-15);
         assert!((integ(&GAUSS2, &|x| x * x * x) - 0.25).abs() < 1e-15);
         assert!((integ(&GAUSS2, &|x| x * x) - 1.0 / 3.0).abs() < 1e-15);

@@ -118,14 +118,24 @@ pub fn compare(case: &Case, rust: &RunResult, ff: &RunResult) -> Vec<ComparisonR
     let tol: &CompareTolerances = &case.compare;
     let mut rows = Vec::new();
     let nodes_match = rust.nodes.s.len() == ff.nodes.s.len();
-    let field = |name: &str, value: f64, tolerance: f64| ComparisonRow { name: name.into(), rust: None, freefem: None, difference: value, tolerance };
+    let field = |name: &str, value: f64, tolerance: f64| ComparisonRow {
+        name: name.into(),
+        rust: None,
+        freefem: None,
+        difference: value,
+        tolerance,
+    };
     if nodes_match {
         rows.push(field(
             "nodewise_rel_diff_displacement",
             max_relative_difference(&rust.nodes.displacement(), &ff.nodes.displacement()),
             tol.displacement_rel,
         ));
-        rows.push(field("nodewise_rel_diff_angles", max_relative_difference(&rust.nodes.alpha, &ff.nodes.alpha), tol.angles_rel));
+        rows.push(field(
+            "nodewise_rel_diff_angles",
+            max_relative_difference(&rust.nodes.alpha, &ff.nodes.alpha),
+            tol.angles_rel,
+        ));
     } else {
         rows.push(field("node_count", f64::INFINITY, 0.0));
     }
@@ -133,7 +143,13 @@ pub fn compare(case: &Case, rust: &RunResult, ff: &RunResult) -> Vec<ComparisonR
     for (name, &a) in &mr {
         let b = mf.get(name).copied().unwrap_or(f64::NAN);
         let d = (a - b).abs();
-        rows.push(ComparisonRow { name: name.clone(), rust: Some(a), freefem: Some(b), difference: if d.is_nan() { f64::INFINITY } else { d }, tolerance: tol.metric_rel * a.abs() + tol.metric_abs });
+        rows.push(ComparisonRow {
+            name: name.clone(),
+            rust: Some(a),
+            freefem: Some(b),
+            difference: if d.is_nan() { f64::INFINITY } else { d },
+            tolerance: tol.metric_rel * a.abs() + tol.metric_abs,
+        });
     }
     if rust.tip.len() == ff.tip.len() && !rust.tip.is_empty() {
         let a: Vec<_> = rust.tip.iter().map(|t| t.position_m).collect();
@@ -152,13 +168,26 @@ pub fn compare(case: &Case, rust: &RunResult, ff: &RunResult) -> Vec<ComparisonR
         for name in ["x_err_rel", "kappa_err_rel", "kappa_err_rel_inner"].into_iter().filter(|n| ma.contains_key(*n)) {
             let (x, y) = (ma.get(name).copied().unwrap_or(f64::NAN), mb.get(name).copied().unwrap_or(f64::NAN));
             let d = (x - y).abs();
-            rows.push(ComparisonRow { name: name.into(), rust: Some(x), freefem: Some(y), difference: if d.is_nan() { f64::INFINITY } else { d }, tolerance: tol.metric_rel * x.abs() });
+            rows.push(ComparisonRow {
+                name: name.into(),
+                rust: Some(x),
+                freefem: Some(y),
+                difference: if d.is_nan() { f64::INFINITY } else { d },
+                tolerance: tol.metric_rel * x.abs(),
+            });
         }
     }
     // Both engines run the identical fixed point (D5), so their iteration counts are compared.
-    if matches!(case.analysis, Analysis::Static { method: StaticMethod::FixedPoint { .. }, .. } | Analysis::Inverse(_)) {
+    if matches!(case.analysis, Analysis::Static { method: StaticMethod::FixedPoint { .. }, .. } | Analysis::Inverse(_))
+    {
         let (a, b) = (rust.stats.iterations as f64, ff.stats.iterations as f64);
-        rows.push(ComparisonRow { name: "iterations".into(), rust: Some(a), freefem: Some(b), difference: (a - b).abs(), tolerance: tol.iterations_abs });
+        rows.push(ComparisonRow {
+            name: "iterations".into(),
+            rust: Some(a),
+            freefem: Some(b),
+            difference: (a - b).abs(),
+            tolerance: tol.iterations_abs,
+        });
     }
     rows
 }

@@ -62,22 +62,50 @@ pub fn write_run(case: &Case, r: &RunResult, metrics: &Metrics, dir: &Path) -> R
     });
     put(
         "nodes.csv",
-        csv_text(&["s_m", "x_m", "y_m", "z_m", "ux_m", "uy_m", "uz_m", "alpha_rad", "beta_rad", "gamma_rad"], rows).into_bytes(),
+        csv_text(&["s_m", "x_m", "y_m", "z_m", "ux_m", "uy_m", "uz_m", "alpha_rad", "beta_rad", "gamma_rad"], rows)
+            .into_bytes(),
     )?;
     let kappa = r.nodes.element_curvature();
     put(
         "curvature.csv",
-        csv_text(&["s_mid_m", "kappa1_per_m", "kappa2_per_m", "kappa3_per_m"], kappa.iter().map(|(s, k)| vec![*s, k[0], k[1], k[2]])).into_bytes(),
+        csv_text(
+            &["s_mid_m", "kappa1_per_m", "kappa2_per_m", "kappa3_per_m"],
+            kappa.iter().map(|(s, k)| vec![*s, k[0], k[1], k[2]]),
+        )
+        .into_bytes(),
     )?;
     if !r.history.is_empty() {
-        put("history.csv", csv_text(&["continuation_step", "iteration", "change"], r.history.iter().map(|h| vec![h.step as f64, h.iteration as f64, h.change])).into_bytes())?;
+        put(
+            "history.csv",
+            csv_text(
+                &["continuation_step", "iteration", "change"],
+                r.history.iter().map(|h| vec![h.step as f64, h.iteration as f64, h.change]),
+            )
+            .into_bytes(),
+        )?;
     }
     if !r.tip.is_empty() {
         let rows = r.tip.iter().map(|t| {
             let (x, a) = (t.position_m, t.angles_rad);
             vec![t.time_s, x[0], x[1], x[2], a[0], a[1], a[2], t.newton_iterations as f64]
         });
-        put("tip_history.csv", csv_text(&["time_s", "tip_x_m", "tip_y_m", "tip_z_m", "tip_alpha_rad", "tip_beta_rad", "tip_gamma_rad", "newton_iterations"], rows).into_bytes())?;
+        put(
+            "tip_history.csv",
+            csv_text(
+                &[
+                    "time_s",
+                    "tip_x_m",
+                    "tip_y_m",
+                    "tip_z_m",
+                    "tip_alpha_rad",
+                    "tip_beta_rad",
+                    "tip_gamma_rad",
+                    "newton_iterations",
+                ],
+                rows,
+            )
+            .into_bytes(),
+        )?;
     }
     if let Some(inv) = &r.inverse {
         write_inverse(r, inv, &mut put)?;
@@ -85,17 +113,23 @@ pub fn write_run(case: &Case, r: &RunResult, metrics: &Metrics, dir: &Path) -> R
     let json = serde_json::to_string_pretty(metrics).unwrap_or_else(|_| "{}".into());
     put("metrics.json", json.into_bytes())?;
     let plot_path = dir.join("plot.svg");
-    write_panels_svg(&headline_panels(case, r), 2, &plot_path).map_err(|e| OutputError::Plot { path: plot_path.clone(), reason: e.to_string() })?;
+    write_panels_svg(&headline_panels(case, r), 2, &plot_path)
+        .map_err(|e| OutputError::Plot { path: plot_path.clone(), reason: e.to_string() })?;
     written.push(plot_path);
     Ok(written)
 }
 
 /// The inverse-specific files: recovered frame and controls along the rod, curvature against
 /// the data's, and the per-iteration history.
-fn write_inverse(r: &RunResult, inv: &InverseOutput, put: &mut impl FnMut(&str, Vec<u8>) -> Result<(), OutputError>) -> Result<(), OutputError> {
+fn write_inverse(
+    r: &RunResult,
+    inv: &InverseOutput,
+    put: &mut impl FnMut(&str, Vec<u8>) -> Result<(), OutputError>,
+) -> Result<(), OutputError> {
     let d = r.nodes.directors();
     let (f, l) = (inv.force(), inv.torque());
-    let mut header: Vec<String> = ["s_m", "x_m", "y_m", "z_m", "alpha_rad", "beta_rad", "gamma_rad"].iter().map(|s| s.to_string()).collect();
+    let mut header: Vec<String> =
+        ["s_m", "x_m", "y_m", "z_m", "alpha_rad", "beta_rad", "gamma_rad"].iter().map(|s| s.to_string()).collect();
     for i in 1..=3 {
         header.extend(["x", "y", "z"].iter().map(|c| format!("d{i}_{c}")));
     }
@@ -120,7 +154,19 @@ fn write_inverse(r: &RunResult, inv: &InverseOutput, put: &mut impl FnMut(&str, 
     let rows = k.iter().zip(&kf).map(|((s, a), (_, b))| vec![*s, a[0], a[1], a[2], b[0], b[1], b[2]]);
     put(
         "inverse_curvature.csv",
-        csv_text(&["s_mid_m", "kappa1_per_m", "kappa2_per_m", "kappa3_per_m", "data_kappa1_per_m", "data_kappa2_per_m", "data_kappa3_per_m"], rows).into_bytes(),
+        csv_text(
+            &[
+                "s_mid_m",
+                "kappa1_per_m",
+                "kappa2_per_m",
+                "kappa3_per_m",
+                "data_kappa1_per_m",
+                "data_kappa2_per_m",
+                "data_kappa3_per_m",
+            ],
+            rows,
+        )
+        .into_bytes(),
     )?;
     let mut header = vec!["iteration", "rel_change", "x_err_rel", "tangent_misfit_m05"];
     header.extend(ObjectiveTerms::NAMES);
@@ -132,7 +178,8 @@ fn write_inverse(r: &RunResult, inv: &InverseOutput, put: &mut impl FnMut(&str, 
     }
     header.extend(["kappa_err_rel", "kappa_err_rel_inner"]);
     let rows = inv.history.iter().enumerate().map(|(i, h)| {
-        let mut row: Vec<Option<f64>> = [h.iteration as f64, h.rel_change, h.x_err_rel, h.tangent_misfit].into_iter().map(Some).collect();
+        let mut row: Vec<Option<f64>> =
+            [h.iteration as f64, h.rel_change, h.x_err_rel, h.tangent_misfit].into_iter().map(Some).collect();
         row.extend(h.objective.values().into_iter().map(Some));
         if newton {
             row.push(h.residual);
@@ -149,7 +196,14 @@ fn write_inverse(r: &RunResult, inv: &InverseOutput, put: &mut impl FnMut(&str, 
 /// curvature along the rod for static runs (Fig. 7 analogue).
 pub fn headline_panels(case: &Case, r: &RunResult) -> Vec<LinePlot> {
     let series = |label: &str, x: Vec<f64>, y: Vec<f64>| Series { label: label.into(), x, y };
-    let plot = |title: &str, xl: &str, yl: &str, s: Vec<Series>| LinePlot { title: title.into(), x_label: xl.into(), y_label: yl.into(), series: s, log_x: false, log_y: false };
+    let plot = |title: &str, xl: &str, yl: &str, s: Vec<Series>| LinePlot {
+        title: title.into(),
+        x_label: xl.into(),
+        y_label: yl.into(),
+        series: s,
+        log_x: false,
+        log_y: false,
+    };
     if let Some(inv) = &r.inverse {
         return inverse_panels(case, r, inv);
     }
@@ -158,8 +212,22 @@ pub fn headline_panels(case: &Case, r: &RunResult) -> Vec<LinePlot> {
         let comp = |k: usize| r.tip.iter().map(|p| p.position_m[k] - r.tip[0].position_m[k]).collect::<Vec<_>>();
         let ang = |k: usize| r.tip.iter().map(|p| p.angles_rad[k]).collect::<Vec<_>>();
         vec![
-            plot(&format!("{}: tip displacement", case.name), "t [s]", "displacement [m]", vec![series("u_x", t.clone(), comp(0)), series("u_y", t.clone(), comp(1)), series("u_z", t.clone(), comp(2))]),
-            plot("tip rotation", "t [s]", "angle [rad]", vec![series("alpha", t.clone(), ang(0)), series("beta", t.clone(), ang(1)), series("gamma", t, ang(2))]),
+            plot(
+                &format!("{}: tip displacement", case.name),
+                "t [s]",
+                "displacement [m]",
+                vec![
+                    series("u_x", t.clone(), comp(0)),
+                    series("u_y", t.clone(), comp(1)),
+                    series("u_z", t.clone(), comp(2)),
+                ],
+            ),
+            plot(
+                "tip rotation",
+                "t [s]",
+                "angle [rad]",
+                vec![series("alpha", t.clone(), ang(0)), series("beta", t.clone(), ang(1)), series("gamma", t, ang(2))],
+            ),
         ]
     } else {
         let s = r.nodes.s.clone();
@@ -167,8 +235,24 @@ pub fn headline_panels(case: &Case, r: &RunResult) -> Vec<LinePlot> {
         let kappa = r.nodes.element_curvature();
         let sk: Vec<f64> = kappa.iter().map(|k| k.0).collect();
         vec![
-            plot(&format!("{}: displacement", case.name), "s [m]", "displacement [m]", (0..3).map(|k| series(["u_x", "u_y", "u_z"][k], s.clone(), disp.iter().map(|u| u[k]).collect())).collect()),
-            plot("curvature (eq. 28)", "s [m]", "kappa [1/m]", (0..3).map(|k| series(["kappa_1", "kappa_2", "kappa_3"][k], sk.clone(), kappa.iter().map(|c| c.1[k]).collect())).collect()),
+            plot(
+                &format!("{}: displacement", case.name),
+                "s [m]",
+                "displacement [m]",
+                (0..3)
+                    .map(|k| series(["u_x", "u_y", "u_z"][k], s.clone(), disp.iter().map(|u| u[k]).collect()))
+                    .collect(),
+            ),
+            plot(
+                "curvature (eq. 28)",
+                "s [m]",
+                "kappa [1/m]",
+                (0..3)
+                    .map(|k| {
+                        series(["kappa_1", "kappa_2", "kappa_3"][k], sk.clone(), kappa.iter().map(|c| c.1[k]).collect())
+                    })
+                    .collect(),
+            ),
         ]
     }
 }
@@ -177,7 +261,14 @@ pub fn headline_panels(case: &Case, r: &RunResult) -> Vec<LinePlot> {
 /// and the convergence history (Figs. 9–11 style, log-log).
 fn inverse_panels(case: &Case, r: &RunResult, inv: &InverseOutput) -> Vec<LinePlot> {
     let series = |label: String, x: Vec<f64>, y: Vec<f64>| Series { label, x, y };
-    let plot = |title: String, xl: &str, yl: &str, s: Vec<Series>, log: bool| LinePlot { title, x_label: xl.into(), y_label: yl.into(), series: s, log_x: log, log_y: log };
+    let plot = |title: String, xl: &str, yl: &str, s: Vec<Series>, log: bool| LinePlot {
+        title,
+        x_label: xl.into(),
+        y_label: yl.into(),
+        series: s,
+        log_x: log,
+        log_y: log,
+    };
     let s = r.nodes.s.clone();
     let comp = ["x", "y", "z"];
     let mut pos = Vec::new();
@@ -193,7 +284,11 @@ fn inverse_panels(case: &Case, r: &RunResult, inv: &InverseOutput) -> Vec<LinePl
         curv.push(series(format!("kappa_{} inverse", c + 1), sk.clone(), k.iter().map(|p| p.1[c]).collect()));
     }
     let (f, l) = (inv.force(), inv.torque());
-    let ctrl = |v: &[nalgebra::Vector3<f64>], name: &str| (0..3).map(|c| series(format!("{name}_{}", comp[c]), s.clone(), v.iter().map(|x| x[c]).collect())).collect::<Vec<_>>();
+    let ctrl = |v: &[nalgebra::Vector3<f64>], name: &str| {
+        (0..3)
+            .map(|c| series(format!("{name}_{}", comp[c]), s.clone(), v.iter().map(|x| x[c]).collect()))
+            .collect::<Vec<_>>()
+    };
     let it: Vec<f64> = inv.history.iter().map(|h| h.iteration as f64).collect();
     let hist = vec![
         series("relative change".into(), it.clone(), inv.history.iter().map(|h| h.rel_change).collect()),
@@ -217,7 +312,14 @@ fn inverse_panels(case: &Case, r: &RunResult, inv: &InverseOutput) -> Vec<LinePl
 /// runs ‖x − x_g‖/‖x_g‖, the curvature error and the relative change per iteration, for static
 /// runs the change.
 pub fn write_convergence_plot(runs: &[(&String, &RunResult)], path: &Path) -> Result<(), OutputError> {
-    let plot = |title: &str, yl: &str, series: Vec<Series>| LinePlot { title: title.into(), x_label: "iteration".into(), y_label: yl.into(), series, log_x: true, log_y: true };
+    let plot = |title: &str, yl: &str, series: Vec<Series>| LinePlot {
+        title: title.into(),
+        x_label: "iteration".into(),
+        y_label: yl.into(),
+        series,
+        log_x: true,
+        log_y: true,
+    };
     let mut xerr = Vec::new();
     let mut kerr = Vec::new();
     let mut change = Vec::new();
@@ -225,12 +327,28 @@ pub fn write_convergence_plot(runs: &[(&String, &RunResult)], path: &Path) -> Re
         if let Some(inv) = &r.inverse {
             let it: Vec<f64> = inv.history.iter().map(|h| h.iteration as f64).collect();
             if inv.kappa_err.len() == it.len() {
-                kerr.push(Series { label: name.to_string(), x: it.clone(), y: inv.kappa_err.iter().map(|k| k[0]).collect() });
+                kerr.push(Series {
+                    label: name.to_string(),
+                    x: it.clone(),
+                    y: inv.kappa_err.iter().map(|k| k[0]).collect(),
+                });
             }
-            xerr.push(Series { label: name.to_string(), x: it.clone(), y: inv.history.iter().map(|h| h.x_err_rel).collect() });
-            change.push(Series { label: name.to_string(), x: it, y: inv.history.iter().map(|h| h.rel_change).collect() });
+            xerr.push(Series {
+                label: name.to_string(),
+                x: it.clone(),
+                y: inv.history.iter().map(|h| h.x_err_rel).collect(),
+            });
+            change.push(Series {
+                label: name.to_string(),
+                x: it,
+                y: inv.history.iter().map(|h| h.rel_change).collect(),
+            });
         } else if !r.history.is_empty() {
-            change.push(Series { label: name.to_string(), x: (1..=r.history.len()).map(|k| k as f64).collect(), y: r.history.iter().map(|h| h.change).collect() });
+            change.push(Series {
+                label: name.to_string(),
+                x: (1..=r.history.len()).map(|k| k as f64).collect(),
+                y: r.history.iter().map(|h| h.change).collect(),
+            });
         }
     }
     let mut panels = Vec::new();
@@ -246,7 +364,8 @@ pub fn write_convergence_plot(runs: &[(&String, &RunResult)], path: &Path) -> Re
     if panels.is_empty() {
         return Ok(());
     }
-    write_panels_svg(&panels, 2, path).map_err(|e| OutputError::Plot { path: path.to_path_buf(), reason: e.to_string() })
+    write_panels_svg(&panels, 2, path)
+        .map_err(|e| OutputError::Plot { path: path.to_path_buf(), reason: e.to_string() })
 }
 
 /// Planar curvature of a centreline in the x–z plane at interior nodes [1/m]:
@@ -291,8 +410,28 @@ pub struct ClipWriter {
 /// `min_abs_cos_beta` is the chart's (the angles of `fields.csv` are in the frame's chart
 /// `Q = Q_E(α) B`, whose singular axis `n = Bᵀ e2` is `chart_axis_*`; `docs/rotation.md`).
 pub const CLIP_FRAME_COLUMNS: [&str; 22] = [
-    "frame", "time_s", "iterations", "rel_change", "x_err_rel", "tangent_misfit_m05", "j_tracking", "j_force", "j_torque", "j_shear", "j_bending", "j_angular", "j_total",
-    "min_abs_cos_beta", "min_abs_cos_beta_node", "max_abs_j_minus_1", "kappa_roughness", "data_kappa_roughness", "restarted", "chart_axis_x", "chart_axis_y", "chart_axis_z",
+    "frame",
+    "time_s",
+    "iterations",
+    "rel_change",
+    "x_err_rel",
+    "tangent_misfit_m05",
+    "j_tracking",
+    "j_force",
+    "j_torque",
+    "j_shear",
+    "j_bending",
+    "j_angular",
+    "j_total",
+    "min_abs_cos_beta",
+    "min_abs_cos_beta_node",
+    "max_abs_j_minus_1",
+    "kappa_roughness",
+    "data_kappa_roughness",
+    "restarted",
+    "chart_axis_x",
+    "chart_axis_y",
+    "chart_axis_z",
 ];
 
 impl ClipWriter {
@@ -308,7 +447,17 @@ impl ClipWriter {
         };
         let mut fields_header = vec!["frame", "node", "s_m", "x_m", "y_m", "z_m", "alpha_rad", "beta_rad", "gamma_rad"];
         fields_header.extend(["d1_x", "d1_y", "d1_z", "d2_x", "d2_y", "d2_z", "d3_x", "d3_y", "d3_z"]);
-        fields_header.extend(["f_x_n_per_m", "f_y_n_per_m", "f_z_n_per_m", "l_x_nm_per_m", "l_y_nm_per_m", "l_z_nm_per_m", "data_x_m", "data_y_m", "data_z_m"]);
+        fields_header.extend([
+            "f_x_n_per_m",
+            "f_y_n_per_m",
+            "f_z_n_per_m",
+            "l_x_nm_per_m",
+            "l_y_nm_per_m",
+            "l_z_nm_per_m",
+            "data_x_m",
+            "data_y_m",
+            "data_z_m",
+        ]);
         Ok(ClipWriter {
             dir: dir.to_path_buf(),
             frames: open("frames.csv", &CLIP_FRAME_COLUMNS.join(","))?,
@@ -338,7 +487,14 @@ impl ClipWriter {
         let r = report;
         let mut row = vec![r.frame as f64, time_s, r.iterations as f64, r.last_change, r.x_err_rel, r.tangent_misfit];
         row.extend(r.objective.values());
-        row.extend([r.min_cos_beta, r.min_cos_beta_node as f64, r.max_stretch_deviation, roughness.0, roughness.1, f64::from(u8::from(r.restarted))]);
+        row.extend([
+            r.min_cos_beta,
+            r.min_cos_beta_node as f64,
+            r.max_stretch_deviation,
+            roughness.0,
+            roughness.1,
+            f64::from(u8::from(r.restarted)),
+        ]);
         row.extend(r.chart_axis.iter());
         let line: Vec<String> = row.iter().map(|v| format!("{v:.10e}")).collect();
         writeln!(self.frames, "{}", line.join(",")).and_then(|_| self.frames.flush()).map_err(err("frames.csv"))?;
@@ -359,17 +515,27 @@ impl ClipWriter {
         self.fields.flush().map_err(err("fields.csv"))?;
         let kappa = nodes.element_curvature();
         for (s, k) in &kappa {
-            writeln!(self.curvature, "{},{s:.10e},{:.10e},{:.10e},{:.10e}", r.frame, k[0], k[1], k[2]).map_err(err("curvature.csv"))?;
+            writeln!(self.curvature, "{},{s:.10e},{:.10e},{:.10e},{:.10e}", r.frame, k[0], k[1], k[2])
+                .map_err(err("curvature.csv"))?;
         }
         self.curvature.flush().map_err(err("curvature.csv"))?;
-        let (d1, d2, d3): (Vec<_>, Vec<_>, Vec<_>) = (d.iter().map(|x| x[0]).collect(), d.iter().map(|x| x[1]).collect(), d.iter().map(|x| x[2]).collect());
+        let (d1, d2, d3): (Vec<_>, Vec<_>, Vec<_>) =
+            (d.iter().map(|x| x[0]).collect(), d.iter().map(|x| x[1]).collect(), d.iter().map(|x| x[2]).collect());
         let kn = crate::run::nodal_curvature(&kappa);
         let name = format!("frame_{:05}.vtp", r.frame);
         crate::vtk::write_vtp(
             &self.dir.join("vtk").join(&name),
             &crate::vtk::PolylineFields {
                 points: &nodes.x,
-                vectors: vec![("d1", &d1), ("d2", &d2), ("d3", &d3), ("f_n_per_m", force), ("l_nm_per_m", torque), ("kappa_per_m", &kn), ("data_position_m", data)],
+                vectors: vec![
+                    ("d1", &d1),
+                    ("d2", &d2),
+                    ("d3", &d3),
+                    ("f_n_per_m", force),
+                    ("l_nm_per_m", torque),
+                    ("kappa_per_m", &kn),
+                    ("data_position_m", data),
+                ],
                 scalars: vec![],
             },
         )?;
@@ -387,7 +553,16 @@ impl ClipWriter {
 
 /// Columns of `truth.csv` (synthetic clips, `clip::synthetic::FrameComparison`).
 pub const TRUTH_COLUMNS: [&str; 10] = [
-    "frame", "time_s", "true_roll_rad", "true_twist_per_m", "x_err_rel_l2", "bending_err_rel_l2", "max_tangent_angle_rad", "twist_mean_per_m", "twist_rms_err_per_m", "roll_offset_rad",
+    "frame",
+    "time_s",
+    "true_roll_rad",
+    "true_twist_per_m",
+    "x_err_rel_l2",
+    "bending_err_rel_l2",
+    "max_tangent_angle_rad",
+    "twist_mean_per_m",
+    "twist_rms_err_per_m",
+    "roll_offset_rad",
 ];
 
 /// `truth.csv`, streamed frame by frame like [`ClipWriter`].
@@ -405,10 +580,29 @@ impl TruthWriter {
         Ok(TruthWriter { path, file })
     }
 
-    pub fn frame(&mut self, frame: usize, time_s: f64, roll_rad: f64, twist_per_m: f64, c: &crate::clip::synthetic::FrameComparison) -> Result<(), OutputError> {
-        let v = [time_s, roll_rad, twist_per_m, c.position_rel_l2, c.bending_rel_l2, c.max_tangent_angle_rad, c.twist_mean_per_m, c.twist_rms_error_per_m, c.roll_offset_rad];
+    pub fn frame(
+        &mut self,
+        frame: usize,
+        time_s: f64,
+        roll_rad: f64,
+        twist_per_m: f64,
+        c: &crate::clip::synthetic::FrameComparison,
+    ) -> Result<(), OutputError> {
+        let v = [
+            time_s,
+            roll_rad,
+            twist_per_m,
+            c.position_rel_l2,
+            c.bending_rel_l2,
+            c.max_tangent_angle_rad,
+            c.twist_mean_per_m,
+            c.twist_rms_error_per_m,
+            c.roll_offset_rad,
+        ];
         let text: Vec<String> = v.iter().map(|x| format!("{x:.10e}")).collect();
-        writeln!(self.file, "{frame},{}", text.join(",")).and_then(|_| self.file.flush()).map_err(|source| OutputError::Io { path: self.path.clone(), source })
+        writeln!(self.file, "{frame},{}", text.join(","))
+            .and_then(|_| self.file.flush())
+            .map_err(|source| OutputError::Io { path: self.path.clone(), source })
     }
 }
 
@@ -421,20 +615,55 @@ pub fn write_truth_plot(case: &Case, run: &crate::run::ClipRun, path: &Path) -> 
     if nf < 2 {
         return Ok(());
     }
-    let to_err = |e: crate::plot::PlotError, p: &Path| OutputError::Plot { path: p.to_path_buf(), reason: e.to_string() };
+    let to_err =
+        |e: crate::plot::PlotError, p: &Path| OutputError::Plot { path: p.to_path_buf(), reason: e.to_string() };
     let f: Vec<f64> = run.reports.iter().map(|r| r.frame as f64).collect();
     let s = |label: &str, y: Vec<f64>| Series { label: label.into(), x: f.clone(), y };
-    let plot = |title: String, yl: &str, series: Vec<Series>, log_y: bool| LinePlot { title, x_label: "frame".into(), y_label: yl.into(), series, log_x: false, log_y };
+    let plot = |title: String, yl: &str, series: Vec<Series>, log_y: bool| LinePlot {
+        title,
+        x_label: "frame".into(),
+        y_label: yl.into(),
+        series,
+        log_x: false,
+        log_y,
+    };
     let c = &t.comparisons;
     let panels = vec![
-        plot(format!("{}: errors against the ground truth", case.name), "relative error / rad", vec![
-            s("|x - x_true|/|x_true|", c.iter().map(|v| v.position_rel_l2).collect()),
-            s("bending k1^2+k2^2, rel. L2", c.iter().map(|v| v.bending_rel_l2).collect()),
-            s("max angle(d3, true d3) [rad]", c.iter().map(|v| v.max_tangent_angle_rad).collect()),
-        ], true),
-        plot("roll of the frame about d3".into(), "angle [rad]", vec![s("true roll psi of the bending plane", t.roll_rad.clone()), s("recovered d1 vs true d1 (offset)", c.iter().map(|v| v.roll_offset_rad).collect())], false),
-        plot("twist kappa_3".into(), "kappa_3 [rad/m]", vec![s("true", t.twist_per_m.clone()), s("recovered (mean over inner nodes)", c.iter().map(|v| v.twist_mean_per_m).collect()), s("rms error", c.iter().map(|v| v.twist_rms_error_per_m).collect())], false),
-        plot("angle chart: min |cos beta| over the nodes".into(), "|cos beta|", vec![s("rebased chart", run.reports.iter().map(|r| r.min_cos_beta).collect())], false),
+        plot(
+            format!("{}: errors against the ground truth", case.name),
+            "relative error / rad",
+            vec![
+                s("|x - x_true|/|x_true|", c.iter().map(|v| v.position_rel_l2).collect()),
+                s("bending k1^2+k2^2, rel. L2", c.iter().map(|v| v.bending_rel_l2).collect()),
+                s("max angle(d3, true d3) [rad]", c.iter().map(|v| v.max_tangent_angle_rad).collect()),
+            ],
+            true,
+        ),
+        plot(
+            "roll of the frame about d3".into(),
+            "angle [rad]",
+            vec![
+                s("true roll psi of the bending plane", t.roll_rad.clone()),
+                s("recovered d1 vs true d1 (offset)", c.iter().map(|v| v.roll_offset_rad).collect()),
+            ],
+            false,
+        ),
+        plot(
+            "twist kappa_3".into(),
+            "kappa_3 [rad/m]",
+            vec![
+                s("true", t.twist_per_m.clone()),
+                s("recovered (mean over inner nodes)", c.iter().map(|v| v.twist_mean_per_m).collect()),
+                s("rms error", c.iter().map(|v| v.twist_rms_error_per_m).collect()),
+            ],
+            false,
+        ),
+        plot(
+            "angle chart: min |cos beta| over the nodes".into(),
+            "|cos beta|",
+            vec![s("rebased chart", run.reports.iter().map(|r| r.min_cos_beta).collect())],
+            false,
+        ),
     ];
     let lines = path.with_file_name("truth_errors.svg");
     write_panels_svg(&panels, 2, &lines).map_err(|e| to_err(e, &lines))?;
@@ -444,30 +673,95 @@ pub fn write_truth_plot(case: &Case, run: &crate::run::ClipRun, path: &Path) -> 
     let m = t.bending_true[0].len();
     let cols: Vec<usize> = (0..m).step_by(m.div_ceil(64)).collect();
     let y: Vec<f64> = cols.iter().map(|&j| j as f64 * case.mesh.h() * 1e3).collect();
-    let grid = |field: &Vec<Vec<f64>>| -> Vec<Vec<f64>> { frames.iter().map(|&i| cols.iter().map(|&j| field[i][j].sqrt()).collect()).collect() };
+    let grid = |field: &Vec<Vec<f64>>| -> Vec<Vec<f64>> {
+        frames.iter().map(|&i| cols.iter().map(|&j| field[i][j].sqrt()).collect()).collect()
+    };
     let mut all: Vec<f64> = t.bending_true.iter().flatten().map(|v| v.sqrt()).collect();
     all.sort_by(f64::total_cmp);
     let limit = all.get((all.len() as f64 * 0.99) as usize).copied().unwrap_or(1.0);
-    let map = |title: String, values: Vec<Vec<f64>>| Heatmap { title, x_label: "frame".into(), y_label: "s [mm]".into(), x: x.clone(), y: y.clone(), values, limit };
-    write_heatmaps_svg(&[map(format!("true bending sqrt(k1^2+k2^2) [1/m], colour 0..{limit:.0}"), grid(&t.bending_true)), map("recovered sqrt(k1^2+k2^2) [1/m]".into(), grid(&t.bending_recovered))], path).map_err(|e| to_err(e, path))
+    let map = |title: String, values: Vec<Vec<f64>>| Heatmap {
+        title,
+        x_label: "frame".into(),
+        y_label: "s [mm]".into(),
+        x: x.clone(),
+        y: y.clone(),
+        values,
+        limit,
+    };
+    write_heatmaps_svg(
+        &[
+            map(format!("true bending sqrt(k1^2+k2^2) [1/m], colour 0..{limit:.0}"), grid(&t.bending_true)),
+            map("recovered sqrt(k1^2+k2^2) [1/m]".into(), grid(&t.bending_recovered)),
+        ],
+        path,
+    )
+    .map_err(|e| to_err(e, path))
 }
 
 /// Per-frame summary of a clip run: iterations, fit, chart guard and roughness against frame.
-pub fn write_clip_plot(case: &Case, reports: &[crate::solve::sequence::FrameReport], roughness: &[(f64, f64)], path: &Path) -> Result<(), OutputError> {
+pub fn write_clip_plot(
+    case: &Case,
+    reports: &[crate::solve::sequence::FrameReport],
+    roughness: &[(f64, f64)],
+    path: &Path,
+) -> Result<(), OutputError> {
     if reports.is_empty() {
         return Ok(());
     }
     let f: Vec<f64> = reports.iter().map(|r| r.frame as f64).collect();
     let s = |label: &str, y: Vec<f64>| Series { label: label.into(), x: f.clone(), y };
-    let plot = |title: String, yl: &str, series: Vec<Series>, log_y: bool| LinePlot { title, x_label: "frame".into(), y_label: yl.into(), series, log_x: false, log_y };
+    let plot = |title: String, yl: &str, series: Vec<Series>, log_y: bool| LinePlot {
+        title,
+        x_label: "frame".into(),
+        y_label: yl.into(),
+        series,
+        log_x: false,
+        log_y,
+    };
     let panels = vec![
-        plot(format!("{}: iterations per frame", case.name), "iterations", vec![s("iterations", reports.iter().map(|r| r.iterations as f64).collect())], false),
-        plot("fit per frame".into(), "value", vec![s("|x - x_g|/|x_g|", reports.iter().map(|r| r.x_err_rel).collect()), s("|x' - d3| [m^1/2]", reports.iter().map(|r| r.tangent_misfit).collect()), s("last relative change", reports.iter().map(|r| r.last_change).collect())], true),
-        plot("angle chart: min |cos beta| over the nodes".into(), "|cos beta|", vec![s("min |cos beta|", reports.iter().map(|r| r.min_cos_beta).collect())], false),
-        plot("objective (41)".into(), "J", vec![s("tracking", reports.iter().map(|r| r.objective.tracking).collect()), s("total", reports.iter().map(|r| r.objective.total()).collect())], true),
-        plot("roughness of the curvature (sign alternation of its differences)".into(), "fraction of elements", vec![s("recovered kappa_2", roughness.iter().map(|r| r.0).collect()), s("data", roughness.iter().map(|r| r.1).collect())], false),
+        plot(
+            format!("{}: iterations per frame", case.name),
+            "iterations",
+            vec![s("iterations", reports.iter().map(|r| r.iterations as f64).collect())],
+            false,
+        ),
+        plot(
+            "fit per frame".into(),
+            "value",
+            vec![
+                s("|x - x_g|/|x_g|", reports.iter().map(|r| r.x_err_rel).collect()),
+                s("|x' - d3| [m^1/2]", reports.iter().map(|r| r.tangent_misfit).collect()),
+                s("last relative change", reports.iter().map(|r| r.last_change).collect()),
+            ],
+            true,
+        ),
+        plot(
+            "angle chart: min |cos beta| over the nodes".into(),
+            "|cos beta|",
+            vec![s("min |cos beta|", reports.iter().map(|r| r.min_cos_beta).collect())],
+            false,
+        ),
+        plot(
+            "objective (41)".into(),
+            "J",
+            vec![
+                s("tracking", reports.iter().map(|r| r.objective.tracking).collect()),
+                s("total", reports.iter().map(|r| r.objective.total()).collect()),
+            ],
+            true,
+        ),
+        plot(
+            "roughness of the curvature (sign alternation of its differences)".into(),
+            "fraction of elements",
+            vec![
+                s("recovered kappa_2", roughness.iter().map(|r| r.0).collect()),
+                s("data", roughness.iter().map(|r| r.1).collect()),
+            ],
+            false,
+        ),
     ];
-    write_panels_svg(&panels, 2, path).map_err(|e| OutputError::Plot { path: path.to_path_buf(), reason: e.to_string() })
+    write_panels_svg(&panels, 2, path)
+        .map_err(|e| OutputError::Plot { path: path.to_path_buf(), reason: e.to_string() })
 }
 
 /// Kymographs of a planar clip (Fig. 17 style): the data's curvature and the recovered κ2 over
@@ -496,7 +790,15 @@ pub fn write_clip_kymographs(case: &Case, run: &crate::run::ClipRun, path: &Path
     let limit = all.get((all.len() as f64 * 0.99) as usize).copied().unwrap_or(1.0);
     let (yd, vd) = grid(&run.data_kappa, &|j| (j + 1) as f64 * h);
     let (yr, vr) = grid(&run.kappa2, &|j| (j as f64 + 0.5) * h);
-    let map = |title: String, y: Vec<f64>, values: Vec<Vec<f64>>| Heatmap { title, x_label: "frame".into(), y_label: "s [mm]".into(), x: x.clone(), y, values, limit };
+    let map = |title: String, y: Vec<f64>, values: Vec<Vec<f64>>| Heatmap {
+        title,
+        x_label: "frame".into(),
+        y_label: "s [mm]".into(),
+        x: x.clone(),
+        y,
+        values,
+        limit,
+    };
     write_heatmaps_svg(
         &[
             map(format!("{}: data curvature [1/m], colour ±{limit:.0}", case.name), yd, vd),

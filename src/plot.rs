@@ -56,19 +56,10 @@ pub enum PlotError {
     EmptySeries { title: String, series: String },
     /// `x` and `y` lengths differ.
     #[error("series '{series}' of plot '{title}' has {x_len} x values but {y_len} y values")]
-    LengthMismatch {
-        title: String,
-        series: String,
-        x_len: usize,
-        y_len: usize,
-    },
+    LengthMismatch { title: String, series: String, x_len: usize, y_len: usize },
     /// Every point is non-finite (or non-positive on a log axis).
     #[error("plot '{title}' has no plottable point (log_x = {log_x}, log_y = {log_y}; non-finite and, on log axes, non-positive values are dropped)")]
-    NoPlottablePoints {
-        title: String,
-        log_x: bool,
-        log_y: bool,
-    },
+    NoPlottablePoints { title: String, log_x: bool, log_y: bool },
     /// `write_panels_svg` called with no panels or zero columns.
     #[error("invalid panel grid: {panels} panel(s) in {cols} column(s)")]
     InvalidGrid { panels: usize, cols: usize },
@@ -77,17 +68,11 @@ pub enum PlotError {
     Draw { title: String, detail: String },
     /// Creating, writing or renaming the output file failed.
     #[error("cannot write '{}': {source}", path.display())]
-    Io {
-        path: PathBuf,
-        source: std::io::Error,
-    },
+    Io { path: PathBuf, source: std::io::Error },
 }
 
 fn draw_err(title: &str, e: impl std::fmt::Display) -> PlotError {
-    PlotError::Draw {
-        title: title.to_string(),
-        detail: e.to_string(),
-    }
+    PlotError::Draw { title: title.to_string(), detail: e.to_string() }
 }
 
 fn keep(v: f64, log: bool) -> bool {
@@ -97,16 +82,9 @@ fn keep(v: f64, log: bool) -> bool {
 /// Validates `plot` and returns the padded (x, y) ranges.
 fn ranges(plot: &LinePlot) -> Result<(Range<f64>, Range<f64>), PlotError> {
     if plot.series.is_empty() {
-        return Err(PlotError::NoSeries {
-            title: plot.title.clone(),
-        });
+        return Err(PlotError::NoSeries { title: plot.title.clone() });
     }
-    let (mut x0, mut x1, mut y0, mut y1) = (
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-    );
+    let (mut x0, mut x1, mut y0, mut y1) = (f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY);
     for s in &plot.series {
         if s.x.len() != s.y.len() {
             return Err(PlotError::LengthMismatch {
@@ -117,10 +95,7 @@ fn ranges(plot: &LinePlot) -> Result<(Range<f64>, Range<f64>), PlotError> {
             });
         }
         if s.x.is_empty() {
-            return Err(PlotError::EmptySeries {
-                title: plot.title.clone(),
-                series: s.label.clone(),
-            });
+            return Err(PlotError::EmptySeries { title: plot.title.clone(), series: s.label.clone() });
         }
         for (&x, &y) in s.x.iter().zip(&s.y) {
             if keep(x, plot.log_x) && keep(y, plot.log_y) {
@@ -129,11 +104,7 @@ fn ranges(plot: &LinePlot) -> Result<(Range<f64>, Range<f64>), PlotError> {
         }
     }
     if x0 > x1 {
-        return Err(PlotError::NoPlottablePoints {
-            title: plot.title.clone(),
-            log_x: plot.log_x,
-            log_y: plot.log_y,
-        });
+        return Err(PlotError::NoPlottablePoints { title: plot.title.clone(), log_x: plot.log_x, log_y: plot.log_y });
     }
     Ok((pad(x0, x1, plot.log_x), pad(y0, y1, plot.log_y)))
 }
@@ -155,12 +126,7 @@ fn pad(lo: f64, hi: f64, log: bool) -> Range<f64> {
 }
 
 /// Draws one plot into `area` with the given coordinate specs.
-fn draw_with<DB, X, Y>(
-    area: &DrawingArea<DB, Shift>,
-    plot: &LinePlot,
-    xs: X,
-    ys: Y,
-) -> Result<(), PlotError>
+fn draw_with<DB, X, Y>(area: &DrawingArea<DB, Shift>, plot: &LinePlot, xs: X, ys: Y) -> Result<(), PlotError>
 where
     DB: DrawingBackend,
     X: AsRangedCoord<Value = f64>,
@@ -200,13 +166,9 @@ where
         let mut labelled = false;
         for run in runs.into_iter().filter(|r| !r.is_empty()) {
             let style = ShapeStyle::from(color).stroke_width(2);
-            let drawn = chart
-                .draw_series(LineSeries::new(run, style))
-                .map_err(|e| draw_err(t, e))?;
+            let drawn = chart.draw_series(LineSeries::new(run, style)).map_err(|e| draw_err(t, e))?;
             if !labelled {
-                drawn
-                    .label(s.label.as_str())
-                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+                drawn.label(s.label.as_str()).legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
                 labelled = true;
             }
         }
@@ -237,10 +199,7 @@ fn format_tick(v: f64) -> String {
     }
 }
 
-fn draw_plot<DB: DrawingBackend>(
-    area: &DrawingArea<DB, Shift>,
-    plot: &LinePlot,
-) -> Result<(), PlotError> {
+fn draw_plot<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, plot: &LinePlot) -> Result<(), PlotError> {
     let (xr, yr) = ranges(plot)?;
     match (plot.log_x, plot.log_y) {
         (false, false) => draw_with(area, plot, xr, yr),
@@ -254,22 +213,12 @@ static TMP_COUNTER: AtomicU64 = AtomicU64::new(0);
 
 /// Writes `contents` to `path` via a temporary sibling file and a rename.
 fn write_atomic(path: &Path, contents: &str) -> Result<(), PlotError> {
-    let io = |source| PlotError::Io {
-        path: path.to_path_buf(),
-        source,
-    };
-    let name = path.file_name().ok_or_else(|| {
-        io(std::io::Error::new(
-            std::io::ErrorKind::InvalidInput,
-            "path has no file name",
-        ))
-    })?;
+    let io = |source| PlotError::Io { path: path.to_path_buf(), source };
+    let name = path
+        .file_name()
+        .ok_or_else(|| io(std::io::Error::new(std::io::ErrorKind::InvalidInput, "path has no file name")))?;
     let n = TMP_COUNTER.fetch_add(1, Ordering::Relaxed);
-    let tmp = path.with_file_name(format!(
-        ".{}.{}.{n}.tmp",
-        name.to_string_lossy(),
-        std::process::id()
-    ));
+    let tmp = path.with_file_name(format!(".{}.{}.{n}.tmp", name.to_string_lossy(), std::process::id()));
     let result = std::fs::File::create(&tmp)
         .and_then(|mut f| {
             f.write_all(contents.as_bytes())?;
@@ -313,21 +262,14 @@ pub fn write_svg(plot: &LinePlot, path: &Path) -> Result<(), PlotError> {
 /// 1800 px. Errors if any panel is invalid, `panels` is empty or `cols` is 0.
 pub fn write_panels_svg(panels: &[LinePlot], cols: usize, path: &Path) -> Result<(), PlotError> {
     if panels.is_empty() || cols == 0 {
-        return Err(PlotError::InvalidGrid {
-            panels: panels.len(),
-            cols,
-        });
+        return Err(PlotError::InvalidGrid { panels: panels.len(), cols });
     }
     for p in panels {
         ranges(p)?;
     }
     let cols = cols.min(panels.len());
     let rows = panels.len().div_ceil(cols);
-    let (pw, ph) = if cols <= 2 {
-        PLOT_SIZE
-    } else {
-        (1800 / cols as u32, 1200 / cols as u32)
-    };
+    let (pw, ph) = if cols <= 2 { PLOT_SIZE } else { (1800 / cols as u32, 1200 / cols as u32) };
     let size = (pw * cols as u32, ph * rows as u32);
     let title = panels.first().map_or("", |p| p.title.as_str());
     let svg = render(size, title, |root| {
@@ -351,11 +293,7 @@ mod tests {
 
     fn series(label: &str, f: impl Fn(f64) -> f64) -> Series {
         let x: Vec<f64> = (0..50).map(|i| i as f64 * 0.1).collect();
-        Series {
-            label: label.into(),
-            y: x.iter().map(|&v| f(v)).collect(),
-            x,
-        }
+        Series { label: label.into(), y: x.iter().map(|&v| f(v)).collect(), x }
     }
 
     fn plot(series: Vec<Series>) -> LinePlot {
@@ -370,12 +308,9 @@ mod tests {
 
     fn no_tmp_left(path: &Path) -> bool {
         let dir = path.parent().expect("dir");
-        std::fs::read_dir(dir).expect("read_dir").all(|e| {
-            !e.expect("entry")
-                .file_name()
-                .to_string_lossy()
-                .ends_with(".tmp")
-        })
+        std::fs::read_dir(dir)
+            .expect("read_dir")
+            .all(|e| !e.expect("entry").file_name().to_string_lossy().ends_with(".tmp"))
     }
 
     #[test]
@@ -386,15 +321,7 @@ mod tests {
         s2.x[8] = f64::INFINITY;
         write_svg(&plot(vec![series("rust", |x| x.sin()), s2]), &path).unwrap();
         let svg = std::fs::read_to_string(&path).unwrap();
-        for text in [
-            "Tip deflection",
-            "time [s]",
-            "y(L) [m]",
-            "rust",
-            "constant",
-            "width=\"900\"",
-            "height=\"600\"",
-        ] {
+        for text in ["Tip deflection", "time [s]", "y(L) [m]", "rust", "constant", "width=\"900\"", "height=\"600\""] {
             assert!(svg.contains(text), "missing {text}");
         }
         assert!(no_tmp_left(&path));
@@ -406,19 +333,13 @@ mod tests {
     #[test]
     fn log_axes() {
         let path = tmp("log");
-        let mut p = plot(vec![
-            series("err", |x| 10f64.powf(-x)),
-            series("with zero", |x| x),
-        ]);
+        let mut p = plot(vec![series("err", |x| 10f64.powf(-x)), series("with zero", |x| x)]);
         p.log_y = true;
         p.log_x = true; // x = 0 is dropped
         write_svg(&p, &path).unwrap();
         let svg = std::fs::read_to_string(&path).unwrap();
         assert!(svg.contains("err") && svg.contains("with zero"));
-        let all_negative = LinePlot {
-            log_y: true,
-            ..plot(vec![series("neg", |x| -1.0 - x)])
-        };
+        let all_negative = LinePlot { log_y: true, ..plot(vec![series("neg", |x| -1.0 - x)]) };
         assert!(matches!(
             write_svg(&all_negative, &path.with_file_name("neg.svg")),
             Err(PlotError::NoPlottablePoints { log_y: true, .. })
@@ -429,52 +350,24 @@ mod tests {
     #[test]
     fn bad_input_errors() {
         let path = tmp("bad");
-        let empty = plot(vec![Series {
-            label: "nothing".into(),
-            x: vec![],
-            y: vec![],
-        }]);
+        let empty = plot(vec![Series { label: "nothing".into(), x: vec![], y: vec![] }]);
         let e = write_svg(&empty, &path).unwrap_err();
         assert!(matches!(e, PlotError::EmptySeries { .. }));
-        assert!(
-            e.to_string().contains("'nothing'") && e.to_string().contains("empty"),
-            "{e}"
-        );
-        assert!(matches!(
-            write_svg(&plot(vec![]), &path),
-            Err(PlotError::NoSeries { .. })
-        ));
-        let mismatch = plot(vec![Series {
-            label: "m".into(),
-            x: vec![1.0, 2.0],
-            y: vec![1.0],
-        }]);
-        assert!(matches!(
-            write_svg(&mismatch, &path),
-            Err(PlotError::LengthMismatch {
-                x_len: 2,
-                y_len: 1,
-                ..
-            })
-        ));
+        assert!(e.to_string().contains("'nothing'") && e.to_string().contains("empty"), "{e}");
+        assert!(matches!(write_svg(&plot(vec![]), &path), Err(PlotError::NoSeries { .. })));
+        let mismatch = plot(vec![Series { label: "m".into(), x: vec![1.0, 2.0], y: vec![1.0] }]);
+        assert!(matches!(write_svg(&mismatch, &path), Err(PlotError::LengthMismatch { x_len: 2, y_len: 1, .. })));
         assert!(!path.exists());
-        assert!(matches!(
-            write_panels_svg(&[], 2, &path),
-            Err(PlotError::InvalidGrid { .. })
-        ));
+        assert!(matches!(write_panels_svg(&[], 2, &path), Err(PlotError::InvalidGrid { .. })));
         assert!(matches!(
             write_panels_svg(&[plot(vec![series("a", |x| x)])], 0, &path),
             Err(PlotError::InvalidGrid { .. })
         ));
         // Unwritable destination: an Io error naming the path, no temp file left.
-        let missing = std::env::temp_dir()
-            .join(format!("cosserat-plot-{}-no-such-dir", std::process::id()))
-            .join("x.svg");
+        let missing =
+            std::env::temp_dir().join(format!("cosserat-plot-{}-no-such-dir", std::process::id())).join("x.svg");
         let e = write_svg(&plot(vec![series("a", |x| x)]), &missing).unwrap_err();
-        assert!(
-            matches!(e, PlotError::Io { .. }) && e.to_string().contains("no-such-dir"),
-            "{e}"
-        );
+        assert!(matches!(e, PlotError::Io { .. }) && e.to_string().contains("no-such-dir"), "{e}");
         let _ = std::fs::remove_dir_all(path.parent().expect("dir"));
     }
 
@@ -498,10 +391,7 @@ mod tests {
                 title: n.to_string(),
                 x_label: "s [m]".into(),
                 y_label: format!("{n} [1/m]"),
-                series: vec![
-                    series(&format!("rust {n}"), move |x| (x * i as f64).cos()),
-                    series("freefem", |x| x),
-                ],
+                series: vec![series(&format!("rust {n}"), move |x| (x * i as f64).cos()), series("freefem", |x| x)],
                 ..Default::default()
             })
             .collect();
@@ -542,8 +432,17 @@ pub fn write_heatmaps_svg(maps: &[Heatmap], path: &Path) -> Result<(), PlotError
         return Err(PlotError::InvalidGrid { panels: 0, cols: 0 });
     }
     for m in maps {
-        if m.x.len() < 2 || m.y.len() < 2 || m.values.len() != m.x.len() || m.values.iter().any(|r| r.len() != m.y.len()) {
-            return Err(PlotError::LengthMismatch { title: m.title.clone(), series: "values".into(), x_len: m.x.len(), y_len: m.y.len() });
+        if m.x.len() < 2
+            || m.y.len() < 2
+            || m.values.len() != m.x.len()
+            || m.values.iter().any(|r| r.len() != m.y.len())
+        {
+            return Err(PlotError::LengthMismatch {
+                title: m.title.clone(),
+                series: "values".into(),
+                x_len: m.x.len(),
+                y_len: m.y.len(),
+            });
         }
     }
     let size = (PLOT_SIZE.0 * maps.len() as u32, PLOT_SIZE.1);
@@ -559,7 +458,13 @@ pub fn write_heatmaps_svg(maps: &[Heatmap], path: &Path) -> Result<(), PlotError
                 .y_label_area_size(70)
                 .build_cartesian_2d(x0..x1, y0..y1)
                 .map_err(|e| draw_err(&m.title, e))?;
-            chart.configure_mesh().disable_mesh().x_desc(m.x_label.as_str()).y_desc(m.y_label.as_str()).draw().map_err(|e| draw_err(&m.title, e))?;
+            chart
+                .configure_mesh()
+                .disable_mesh()
+                .x_desc(m.x_label.as_str())
+                .y_desc(m.y_label.as_str())
+                .draw()
+                .map_err(|e| draw_err(&m.title, e))?;
             let half = |v: &[f64], i: usize| -> (f64, f64) {
                 let lo = if i == 0 { v[0] } else { 0.5 * (v[i - 1] + v[i]) };
                 let hi = if i + 1 == v.len() { v[i] } else { 0.5 * (v[i] + v[i + 1]) };

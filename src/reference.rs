@@ -8,19 +8,10 @@ use thiserror::Error;
 pub enum ReferenceError {
     /// A parameter is non-finite or outside its admissible range.
     #[error("invalid parameter {name} = {value}: {requirement}")]
-    InvalidParameter {
-        name: &'static str,
-        value: f64,
-        requirement: &'static str,
-    },
+    InvalidParameter { name: &'static str, value: f64, requirement: &'static str },
     /// The shooting residual does not change sign over the search bracket.
     #[error("shooting residual has no sign change on [{lo}, {hi}] (f = {f_lo}, {f_hi})")]
-    NoBracket {
-        lo: f64,
-        hi: f64,
-        f_lo: f64,
-        f_hi: f64,
-    },
+    NoBracket { lo: f64, hi: f64, f_lo: f64, f_hi: f64 },
     /// The root finder hit its iteration limit.
     #[error("shooting did not converge in {iterations} iterations (residual {residual})")]
     NoConvergence { iterations: usize, residual: f64 },
@@ -28,19 +19,11 @@ pub enum ReferenceError {
 
 fn check(name: &'static str, value: f64, positive: bool) -> Result<(), ReferenceError> {
     let ok = value.is_finite() && (!positive || value > 0.0);
-    let requirement = if positive {
-        "must be finite and > 0"
-    } else {
-        "must be finite"
-    };
+    let requirement = if positive { "must be finite and > 0" } else { "must be finite" };
     if ok {
         Ok(())
     } else {
-        Err(ReferenceError::InvalidParameter {
-            name,
-            value,
-            requirement,
-        })
+        Err(ReferenceError::InvalidParameter { name, value, requirement })
     }
 }
 
@@ -68,13 +51,7 @@ pub fn timoshenko_tip_deflection(
     shear_stiffness_n: f64,
     bending_stiffness_nm2: f64,
 ) -> f64 {
-    timoshenko_deflection(
-        length_m,
-        force_n,
-        length_m,
-        shear_stiffness_n,
-        bending_stiffness_nm2,
-    )
+    timoshenko_deflection(length_m, force_n, length_m, shear_stiffness_n, bending_stiffness_nm2)
 }
 
 // ------------------------------------------------------------ planar elastica
@@ -140,10 +117,7 @@ pub const CURVE_SAMPLES: usize = 101;
 ///   fixed-step classical RK4 with [`DEFAULT_STEPS`] steps.
 ///
 /// Linearisation gives y(L) = −P L³/(3EI) − P L/(kGA) (Timoshenko).
-pub fn tip_loaded_cantilever(
-    rod: &PlanarRod,
-    force_n: f64,
-) -> Result<PlanarSolution, ReferenceError> {
+pub fn tip_loaded_cantilever(rod: &PlanarRod, force_n: f64) -> Result<PlanarSolution, ReferenceError> {
     tip_loaded_cantilever_steps(rod, force_n, DEFAULT_STEPS)
 }
 
@@ -186,29 +160,16 @@ pub fn tip_loaded_cantilever_steps(
         let mut next_sample = 0usize;
         for i in 0..=steps {
             if let Some(out) = sample.as_deref_mut() {
-                while next_sample < CURVE_SAMPLES
-                    && (next_sample as f64 * every).round() as usize == i
-                {
-                    out.push(PlanarPoint {
-                        s_m: i as f64 * h,
-                        y_m: x[2],
-                        z_m: x[3],
-                        theta_rad: x[0],
-                    });
+                while next_sample < CURVE_SAMPLES && (next_sample as f64 * every).round() as usize == i {
+                    out.push(PlanarPoint { s_m: i as f64 * h, y_m: x[2], z_m: x[3], theta_rad: x[0] });
                     next_sample += 1;
                 }
             }
             if i == steps {
                 break;
             }
-            let add = |a: [f64; 4], b: [f64; 4], c: f64| {
-                [
-                    a[0] + c * b[0],
-                    a[1] + c * b[1],
-                    a[2] + c * b[2],
-                    a[3] + c * b[3],
-                ]
-            };
+            let add =
+                |a: [f64; 4], b: [f64; 4], c: f64| [a[0] + c * b[0], a[1] + c * b[1], a[2] + c * b[2], a[3] + c * b[3]];
             let k1 = rhs(x);
             let k2 = rhs(add(x, k1, h / 2.0));
             let k3 = rhs(add(x, k2, h / 2.0));
@@ -222,13 +183,7 @@ pub fn tip_loaded_cantilever_steps(
     if p == 0.0 {
         let mut curve = Vec::with_capacity(CURVE_SAMPLES);
         let x = integrate(0.0, Some(&mut curve));
-        return Ok(PlanarSolution {
-            tip_y_m: x[2],
-            tip_z_m: x[3],
-            tip_angle_rad: x[0],
-            base_moment_nm: 0.0,
-            curve,
-        });
+        return Ok(PlanarSolution { tip_y_m: x[2], tip_z_m: x[3], tip_angle_rad: x[0], base_moment_nm: 0.0, curve });
     }
     // θ'(0) = P z(L)/EI and |z(L)| ≤ L·|r'|max, so the root lies between 0 and k_max.
     let stretch = ((1.0 + p.abs() * inv_ea).powi(2) + (p * inv_ga).powi(2)).sqrt();
@@ -236,13 +191,7 @@ pub fn tip_loaded_cantilever_steps(
     let k0 = brent(|k| integrate(k, None)[1], 0.0, k_max)?;
     let mut curve = Vec::with_capacity(CURVE_SAMPLES);
     let x = integrate(k0, Some(&mut curve));
-    Ok(PlanarSolution {
-        tip_y_m: x[2],
-        tip_z_m: x[3],
-        tip_angle_rad: x[0],
-        base_moment_nm: ei * k0,
-        curve,
-    })
+    Ok(PlanarSolution { tip_y_m: x[2], tip_z_m: x[3], tip_angle_rad: x[0], base_moment_nm: ei * k0, curve })
 }
 
 const BRENT_MAX_ITER: usize = 200;
@@ -259,12 +208,7 @@ fn brent(f: impl Fn(f64) -> f64, a: f64, b: f64) -> Result<f64, ReferenceError> 
     }
     let bracketed = fa * fb < 0.0;
     if !bracketed {
-        return Err(ReferenceError::NoBracket {
-            lo: a,
-            hi: b,
-            f_lo: fa,
-            f_hi: fb,
-        });
+        return Err(ReferenceError::NoBracket { lo: a, hi: b, f_lo: fa, f_hi: fb });
     }
     let (mut c, mut fc) = (a, fa);
     let (mut d, mut e) = (b - a, b - a);
@@ -294,10 +238,7 @@ fn brent(f: impl Fn(f64) -> f64, a: f64, b: f64) -> Result<f64, ReferenceError> 
                 (2.0 * m * s, 1.0 - s)
             } else {
                 let (q, r) = (fa / fc, fb / fc);
-                (
-                    s * (2.0 * m * q * (q - r) - (b - a) * (r - 1.0)),
-                    (q - 1.0) * (r - 1.0) * (s - 1.0),
-                )
+                (s * (2.0 * m * q * (q - r) - (b - a) * (r - 1.0)), (q - 1.0) * (r - 1.0) * (s - 1.0))
             };
             if p > 0.0 {
                 q = -q
@@ -320,10 +261,7 @@ fn brent(f: impl Fn(f64) -> f64, a: f64, b: f64) -> Result<f64, ReferenceError> 
         b += if d.abs() > tol { d } else { tol.copysign(m) };
         fb = f(b);
     }
-    Err(ReferenceError::NoConvergence {
-        iterations: BRENT_MAX_ITER,
-        residual: fb,
-    })
+    Err(ReferenceError::NoConvergence { iterations: BRENT_MAX_ITER, residual: fb })
 }
 
 // ------------------------------------------------------------ Euler–Bernoulli modes
@@ -333,10 +271,7 @@ fn brent(f: impl Fn(f64) -> f64, a: f64, b: f64) -> Result<f64, ReferenceError> 
 /// 1.8751040687, 4.6940911330, 7.8547574382, 10.9955407349, ...
 pub fn cantilever_beta_l(i: usize) -> f64 {
     let g = |x: f64| 1.0 / x.cosh() + x.cos();
-    let (lo, hi) = (
-        i as f64 * std::f64::consts::PI,
-        (i as f64 + 1.0) * std::f64::consts::PI,
-    );
+    let (lo, hi) = (i as f64 * std::f64::consts::PI, (i as f64 + 1.0) * std::f64::consts::PI);
     // The bracket always has a sign change (|sech| < 1); fall back to the asymptote.
     brent(g, lo, hi).unwrap_or((i as f64 + 0.5) * std::f64::consts::PI)
 }
@@ -350,17 +285,10 @@ pub fn euler_bernoulli_cantilever_omegas(
     bending_stiffness_nm2: f64,
     mass_per_length_kg_m: f64,
 ) -> Vec<f64> {
-    let valid = [length_m, bending_stiffness_nm2, mass_per_length_kg_m]
-        .iter()
-        .all(|v| v.is_finite() && *v > 0.0);
-    let scale = if valid {
-        (bending_stiffness_nm2 / (mass_per_length_kg_m * length_m.powi(4))).sqrt()
-    } else {
-        f64::NAN
-    };
-    (0..n_modes)
-        .map(|i| cantilever_beta_l(i).powi(2) * scale)
-        .collect()
+    let valid = [length_m, bending_stiffness_nm2, mass_per_length_kg_m].iter().all(|v| v.is_finite() && *v > 0.0);
+    let scale =
+        if valid { (bending_stiffness_nm2 / (mass_per_length_kg_m * length_m.powi(4))).sqrt() } else { f64::NAN };
+    (0..n_modes).map(|i| cantilever_beta_l(i).powi(2) * scale).collect()
 }
 
 /// Cantilever mode shape φ_i(s) (0-based `i`, matching the index of
@@ -398,12 +326,7 @@ fn sinc(x: f64) -> f64 {
 /// q = g/(ω+Ω) \[sin(ωt)/ω − t cos(½(ω+Ω)t) sinc(½(ω−Ω)t)\],
 /// which has no cancellation as Ω → ω and reduces at resonance to
 /// q = g/(2Ω²)(sin Ωt − Ωt cos Ωt). ω ≤ 0 or non-finite input gives NaN.
-pub fn undamped_forced_response(
-    omega_n: f64,
-    forcing_omega: f64,
-    modal_force_amp: f64,
-    t: f64,
-) -> f64 {
+pub fn undamped_forced_response(omega_n: f64, forcing_omega: f64, modal_force_amp: f64, t: f64) -> f64 {
     if omega_n.is_nan() || omega_n <= 0.0 || !forcing_omega.is_finite() {
         return f64::NAN;
     }
@@ -413,8 +336,7 @@ pub fn undamped_forced_response(
     } else {
         (omega_n, forcing_omega, modal_force_amp)
     };
-    g / (w + big_w)
-        * ((w * t).sin() / w - t * (0.5 * (w + big_w) * t).cos() * sinc(0.5 * (w - big_w) * t))
+    g / (w + big_w) * ((w * t).sin() / w - t * (0.5 * (w + big_w) * t).cos() * sinc(0.5 * (w - big_w) * t))
 }
 
 #[cfg(test)]
@@ -440,12 +362,7 @@ mod tests {
     }
 
     fn elastica(l: f64, ei: f64) -> PlanarRod {
-        PlanarRod {
-            length_m: l,
-            bending_stiffness_nm2: ei,
-            shear_stiffness_n: None,
-            axial_stiffness_n: None,
-        }
+        PlanarRod { length_m: l, bending_stiffness_nm2: ei, shear_stiffness_n: None, axial_stiffness_n: None }
     }
 
     #[test]
@@ -453,26 +370,14 @@ mod tests {
         let (l, ei) = (2.0, 3.0);
         let p = 1e-5 * ei / (l * l); // nonlinear correction ~ 0.118·1e-10
         let sol = tip_loaded_cantilever(&elastica(l, ei), p).unwrap();
-        assert!(
-            rel(sol.tip_y_m, -p * l.powi(3) / (3.0 * ei)) < 1e-9,
-            "{}",
-            sol.tip_y_m
-        );
+        assert!(rel(sol.tip_y_m, -p * l.powi(3) / (3.0 * ei)) < 1e-9, "{}", sol.tip_y_m);
         assert!(rel(sol.tip_angle_rad, p * l * l / (2.0 * ei)) < 1e-9);
         assert!(rel(sol.base_moment_nm, p * l) < 1e-9);
         // Shearable + extensible: Timoshenko (axial effect is second order).
         let (kga, ea) = (0.5, 40.0);
-        let rod = PlanarRod {
-            shear_stiffness_n: Some(kga),
-            axial_stiffness_n: Some(ea),
-            ..elastica(l, ei)
-        };
+        let rod = PlanarRod { shear_stiffness_n: Some(kga), axial_stiffness_n: Some(ea), ..elastica(l, ei) };
         let sol = tip_loaded_cantilever(&rod, p).unwrap();
-        assert!(
-            rel(sol.tip_y_m, timoshenko_tip_deflection(p, l, kga, ei)) < 1e-9,
-            "{}",
-            sol.tip_y_m
-        );
+        assert!(rel(sol.tip_y_m, timoshenko_tip_deflection(p, l, kga, ei)) < 1e-9, "{}", sol.tip_y_m);
         // Upward load mirrors the solution.
         let up = tip_loaded_cantilever(&rod, -p).unwrap();
         assert!(rel(up.tip_y_m, -sol.tip_y_m) < 1e-12);
@@ -495,10 +400,7 @@ mod tests {
             let sol = tip_loaded_cantilever(&elastica(1.0, 1.0), alpha).unwrap();
             let ratio = -sol.tip_y_m / (alpha / 3.0);
             let approx = 1.0 - 0.118 * alpha * alpha;
-            assert!(
-                rel(ratio, approx) < 3e-3,
-                "alpha {alpha}: {ratio} vs {approx}"
-            );
+            assert!(rel(ratio, approx) < 3e-3, "alpha {alpha}: {ratio} vs {approx}");
         }
     }
 
@@ -506,22 +408,10 @@ mod tests {
     fn bisshopp_drucker_large_deflection() {
         let (l, ei) = (0.7, 2.5);
         let sol = tip_loaded_cantilever(&elastica(l, ei), ei / (l * l)).unwrap();
-        assert!(
-            (-sol.tip_y_m / l - 0.30172).abs() < 1e-4,
-            "{}",
-            -sol.tip_y_m / l
-        );
-        assert!(
-            ((l - sol.tip_z_m) / l - 0.05643).abs() < 1e-4,
-            "{}",
-            (l - sol.tip_z_m) / l
-        );
+        assert!((-sol.tip_y_m / l - 0.30172).abs() < 1e-4, "{}", -sol.tip_y_m / l);
+        assert!(((l - sol.tip_z_m) / l - 0.05643).abs() < 1e-4, "{}", (l - sol.tip_z_m) / l);
         // Inextensible: the curve keeps its length.
-        let len: f64 = sol
-            .curve
-            .windows(2)
-            .map(|w| (w[1].y_m - w[0].y_m).hypot(w[1].z_m - w[0].z_m))
-            .sum();
+        let len: f64 = sol.curve.windows(2).map(|w| (w[1].y_m - w[0].y_m).hypot(w[1].z_m - w[0].z_m)).sum();
         assert!(rel(len, l) < 1e-4);
     }
 
@@ -535,12 +425,7 @@ mod tests {
         };
         let a = tip_loaded_cantilever_steps(&rod, 2.0, DEFAULT_STEPS).unwrap();
         let b = tip_loaded_cantilever_steps(&rod, 2.0, 2 * DEFAULT_STEPS).unwrap();
-        assert!(
-            rel(a.tip_y_m, b.tip_y_m) <= 1e-10,
-            "{} {}",
-            a.tip_y_m,
-            b.tip_y_m
-        );
+        assert!(rel(a.tip_y_m, b.tip_y_m) <= 1e-10, "{} {}", a.tip_y_m, b.tip_y_m);
         assert!(rel(a.tip_z_m, b.tip_z_m) <= 1e-10);
         assert!(rel(a.tip_angle_rad, b.tip_angle_rad) <= 1e-10);
     }
@@ -550,22 +435,13 @@ mod tests {
         let bad = elastica(-1.0, 1.0);
         assert!(matches!(
             tip_loaded_cantilever(&bad, 1.0),
-            Err(ReferenceError::InvalidParameter {
-                name: "length_m",
-                ..
-            })
+            Err(ReferenceError::InvalidParameter { name: "length_m", .. })
         ));
         assert!(matches!(
             tip_loaded_cantilever(&elastica(1.0, 1.0), f64::NAN),
-            Err(ReferenceError::InvalidParameter {
-                name: "force_n",
-                ..
-            })
+            Err(ReferenceError::InvalidParameter { name: "force_n", .. })
         ));
-        let rod = PlanarRod {
-            shear_stiffness_n: Some(0.0),
-            ..elastica(1.0, 1.0)
-        };
+        let rod = PlanarRod { shear_stiffness_n: Some(0.0), ..elastica(1.0, 1.0) };
         let e = tip_loaded_cantilever(&rod, 1.0).unwrap_err();
         assert!(e.to_string().contains("shear_stiffness_n"), "{e}");
         let zero = tip_loaded_cantilever(&elastica(1.0, 1.0), 0.0).unwrap();
@@ -577,11 +453,7 @@ mod tests {
     fn cantilever_roots_and_frequency() {
         let want = [1.8751040687, 4.6940911330, 7.8547574382, 10.9955407349];
         for (i, w) in want.iter().enumerate() {
-            assert!(
-                (cantilever_beta_l(i) - w).abs() < 1e-9,
-                "{i}: {}",
-                cantilever_beta_l(i)
-            );
+            assert!((cantilever_beta_l(i) - w).abs() < 1e-9, "{i}: {}", cantilever_beta_l(i));
             let x = cantilever_beta_l(i);
             assert!((1.0 + x.cos() * x.cosh()).abs() < 1e-9 * x.cosh());
         }
@@ -590,15 +462,8 @@ mod tests {
         let om = euler_bernoulli_cantilever_omegas(3, 1.0, e * b * h.powi(3) / 12.0, rho * b * h);
         assert_eq!(om.len(), 3);
         assert!(rel(om[0], 207.0236) < 5e-4, "{}", om[0]);
-        assert!(
-            rel(
-                om[1] / om[0],
-                (cantilever_beta_l(1) / cantilever_beta_l(0)).powi(2)
-            ) < 1e-12
-        );
-        assert!(euler_bernoulli_cantilever_omegas(2, 0.0, 1.0, 1.0)
-            .iter()
-            .all(|w| w.is_nan()));
+        assert!(rel(om[1] / om[0], (cantilever_beta_l(1) / cantilever_beta_l(0)).powi(2)) < 1e-12);
+        assert!(euler_bernoulli_cantilever_omegas(2, 0.0, 1.0, 1.0).iter().all(|w| w.is_nan()));
     }
 
     fn simpson(f: impl Fn(f64) -> f64, a: f64, b: f64, n: usize) -> f64 {
@@ -625,20 +490,12 @@ mod tests {
         for i in 0..6 {
             assert!(euler_bernoulli_cantilever_mode_shape(i, 0.0, l).abs() < 1e-12);
             assert!((euler_bernoulli_cantilever_mode_shape(i, l, l).abs() - 2.0).abs() < 1e-8);
-            let norm = simpson(
-                |s| euler_bernoulli_cantilever_mode_shape(i, s, l).powi(2),
-                0.0,
-                l,
-                4000,
-            );
+            let norm = simpson(|s| euler_bernoulli_cantilever_mode_shape(i, s, l).powi(2), 0.0, l, 4000);
             assert!(rel(norm, l) < 1e-9, "mode {i}: {norm}");
         }
         for (i, j) in [(0, 1), (1, 2), (0, 4)] {
             let ip = simpson(
-                |s| {
-                    euler_bernoulli_cantilever_mode_shape(i, s, l)
-                        * euler_bernoulli_cantilever_mode_shape(j, s, l)
-                },
+                |s| euler_bernoulli_cantilever_mode_shape(i, s, l) * euler_bernoulli_cantilever_mode_shape(j, s, l),
                 0.0,
                 l,
                 4000,
@@ -656,14 +513,8 @@ mod tests {
         for k in 0..n {
             let t = k as f64 * h;
             let k1 = f(t, x);
-            let k2 = f(
-                t + h / 2.0,
-                [x[0] + h / 2.0 * k1[0], x[1] + h / 2.0 * k1[1]],
-            );
-            let k3 = f(
-                t + h / 2.0,
-                [x[0] + h / 2.0 * k2[0], x[1] + h / 2.0 * k2[1]],
-            );
+            let k2 = f(t + h / 2.0, [x[0] + h / 2.0 * k1[0], x[1] + h / 2.0 * k1[1]]);
+            let k3 = f(t + h / 2.0, [x[0] + h / 2.0 * k2[0], x[1] + h / 2.0 * k2[1]]);
             let k4 = f(t + h, [x[0] + h * k3[0], x[1] + h * k3[1]]);
             for j in 0..2 {
                 x[j] += h / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j]);
@@ -680,17 +531,12 @@ mod tests {
                 let q = undamped_forced_response(w, big_w, g, t);
                 let num = rk4_oscillator(w, big_w, g, t, 20000);
                 assert!(
-                    (q - num).abs() < 1e-9 * (1.0 + num.abs())
-                        && (q - num).abs() < 1e-6 * num.abs().max(1e-6),
+                    (q - num).abs() < 1e-9 * (1.0 + num.abs()) && (q - num).abs() < 1e-6 * num.abs().max(1e-6),
                     "{big_w} {t}: {q} vs {num}"
                 );
                 if (w - big_w).abs() > 1.0 {
-                    let direct = g / (w * w - big_w * big_w)
-                        * ((big_w * t).sin() - big_w / w * (w * t).sin());
-                    assert!(
-                        (q - direct).abs() <= 1e-12 * direct.abs().max(1e-6),
-                        "{q} {direct}"
-                    );
+                    let direct = g / (w * w - big_w * big_w) * ((big_w * t).sin() - big_w / w * (w * t).sin());
+                    assert!((q - direct).abs() <= 1e-12 * direct.abs().max(1e-6), "{q} {direct}");
                 }
             }
         }

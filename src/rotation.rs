@@ -75,11 +75,7 @@ pub fn rotation_derivatives(a: &Angles) -> [Matrix3<f64>; 3] {
 
 fn rotation_derivatives_t(t: &Trig) -> [Matrix3<f64>; 3] {
     let (z, x, y) = (rz(t.ca, t.sa), rx(t.cb, t.sb), ry(t.cg, t.sg));
-    [
-        drz(t.ca, t.sa) * x * y,
-        z * drx(t.cb, t.sb) * y,
-        z * x * dry(t.cg, t.sg),
-    ]
+    [drz(t.ca, t.sa) * x * y, z * drx(t.cb, t.sb) * y, z * x * dry(t.cg, t.sg)]
 }
 
 /// The matrix `A(α)` of eqs. (27)/(28), mapping angle rates to local angular velocity/curvature.
@@ -88,17 +84,7 @@ pub fn a_matrix(a: &Angles) -> Matrix3<f64> {
 }
 
 fn a_matrix_t(t: &Trig) -> Matrix3<f64> {
-    Matrix3::new(
-        0.0,
-        -t.ca,
-        t.sa * t.cb,
-        0.0,
-        -t.sa,
-        -t.ca * t.cb,
-        -1.0,
-        0.0,
-        -t.sb,
-    )
+    Matrix3::new(0.0, -t.ca, t.sa * t.cb, 0.0, -t.sa, -t.ca * t.cb, -1.0, 0.0, -t.sb)
 }
 
 /// `∂A/∂α_j` for j = 0, 1, 2.
@@ -130,7 +116,11 @@ pub struct PointFrame {
 impl PointFrame {
     pub fn new(a: &Angles, derivatives: bool) -> Self {
         let t = Trig::new(a);
-        let (dq, da) = if derivatives { (rotation_derivatives_t(&t), a_matrix_derivatives_t(&t)) } else { ([Matrix3::zeros(); 3], [Matrix3::zeros(); 3]) };
+        let (dq, da) = if derivatives {
+            (rotation_derivatives_t(&t), a_matrix_derivatives_t(&t))
+        } else {
+            ([Matrix3::zeros(); 3], [Matrix3::zeros(); 3])
+        };
         PointFrame { q: rotation_t(&t), a: a_matrix_t(&t), dq, da }
     }
 }

@@ -7,15 +7,15 @@ use nalgebra::{DVector, Vector3};
 use crate::case::{Analysis, Case, ClipKind, DataSource, InverseMethod, InverseSettings, StaticMethod};
 use crate::clip::synthetic::{compare_frame, roll_clip, FrameComparison, GroundTruth, RecoveredFrame};
 use crate::clip::{read_kymogram, read_recording, Clip, ClipError, KymogramParams};
-use crate::output::{planar_xz_curvature, sign_alternation, ClipWriter, OutputError};
-use crate::solve::sequence::{solve_sequence, FrameMethod, FrameReport, SequenceError, SequenceParams};
-pub use crate::solve::sequence::FrameStart;
 use crate::data::{read_data, write_data, DataError};
 use crate::freefem::{self, FreeFemError};
 use crate::metrics::INNER_SKIP_ELEMENTS;
+use crate::output::{planar_xz_curvature, sign_alternation, ClipWriter, OutputError};
 use crate::solve::dynamics::{self, DynamicParams, TipRecord};
 use crate::solve::inverse::{self, InverseParams, InverseRecord};
 use crate::solve::inverse_newton;
+pub use crate::solve::sequence::FrameStart;
+use crate::solve::sequence::{solve_sequence, FrameMethod, FrameReport, SequenceError, SequenceParams};
 use crate::solve::statics::{self, IterationRecord, Method, StaticParams};
 use crate::solve::{node_values, Problem, SolveError};
 
@@ -60,7 +60,10 @@ impl NodalState {
             .map(|e| {
                 let h = self.s[e + 1] - self.s[e];
                 let mid = (self.alpha[e] + self.alpha[e + 1]) * 0.5;
-                ((self.s[e] + self.s[e + 1]) * 0.5, crate::rotation::curvature(&mid, &((self.alpha[e + 1] - self.alpha[e]) / h)))
+                (
+                    (self.s[e] + self.s[e + 1]) * 0.5,
+                    crate::rotation::curvature(&mid, &((self.alpha[e + 1] - self.alpha[e]) / h)),
+                )
             })
             .collect()
     }
@@ -196,9 +199,18 @@ pub fn inverse_params(settings: &InverseSettings) -> InverseParams {
 pub fn generate_data(case: &Case) -> Result<NodalState, RunError> {
     if matches!(case.inverse().map(|i| &i.data), Some(DataSource::Clip(_))) {
         let clip = load_clip(case)?;
-        let x = clip.frames.into_iter().next().ok_or_else(|| RunError::ClipShape(format!("case {}: the clip has no frames", case.name)))?;
+        let x = clip
+            .frames
+            .into_iter()
+            .next()
+            .ok_or_else(|| RunError::ClipShape(format!("case {}: the clip has no frames", case.name)))?;
         let n = x.len();
-        return Ok(NodalState { s: (0..n).map(|i| case.mesh.node_s(i)).collect(), x, alpha: vec![Vector3::zeros(); n], chart: Default::default() });
+        return Ok(NodalState {
+            s: (0..n).map(|i| case.mesh.node_s(i)).collect(),
+            x,
+            alpha: vec![Vector3::zeros(); n],
+            chart: Default::default(),
+        });
     }
     let data_case = case.data_case().ok_or_else(|| SolveError::NotInverse(case.name.clone()))?;
     Ok(run_rust(&data_case, |_, _| {})?.nodes)
@@ -210,7 +222,11 @@ pub fn angles_known(case: &Case) -> bool {
 }
 
 /// Solve the inverse case `case` in the Rust engine on the given data.
-pub fn run_rust_inverse(case: &Case, data: &NodalState, mut progress: impl FnMut(usize, usize)) -> Result<RunResult, RunError> {
+pub fn run_rust_inverse(
+    case: &Case,
+    data: &NodalState,
+    mut progress: impl FnMut(usize, usize),
+) -> Result<RunResult, RunError> {
     let settings = case.inverse().ok_or_else(|| SolveError::NotInverse(case.name.clone()))?;
     let problem = Problem::from_case(case);
     let params = inverse_params(settings);
@@ -225,15 +241,28 @@ pub fn run_rust_inverse(case: &Case, data: &NodalState, mut progress: impl FnMut
     let report = |r: &InverseRecord, u: &DVector<f64>, adjoint: &DVector<f64>| {
         if known {
             let k = inverse::element_curvatures(&problem, u);
-            kappa_err.push([inverse::relative_error(&k, &truth, 0), inverse::relative_error(&k, &truth, INNER_SKIP_ELEMENTS)]);
+            kappa_err.push([
+                inverse::relative_error(&k, &truth, 0),
+                inverse::relative_error(&k, &truth, INNER_SKIP_ELEMENTS),
+            ]);
         }
         records.push(*r);
         last = Some((u.clone(), adjoint.clone()));
         progress(r.iteration, params.max_iterations)
     };
     let outcome = match settings.method {
-        InverseMethod::FixedPoint { .. } => inverse::solve_frame_observed(&problem, &params, &data.x, &prev, &problem.reference_state(), report),
-        InverseMethod::Newton { warm_start_tolerance, .. } => inverse_newton::solve_frame_warm(&problem, &params, warm_start_tolerance, &data.x, &prev, &problem.reference_state(), report),
+        InverseMethod::FixedPoint { .. } => {
+            inverse::solve_frame_observed(&problem, &params, &data.x, &prev, &problem.reference_state(), report)
+        }
+        InverseMethod::Newton { warm_start_tolerance, .. } => inverse_newton::solve_frame_warm(
+            &problem,
+            &params,
+            warm_start_tolerance,
+            &data.x,
+            &prev,
+            &problem.reference_state(),
+            report,
+        ),
     };
     let wall_time_s = start.elapsed().as_secs_f64();
     let result = |u: &DVector<f64>, adjoint: &DVector<f64>, history: Vec<InverseRecord>, kappa_err: Vec<[f64; 2]>| {
@@ -243,16 +272,35 @@ pub fn run_rust_inverse(case: &Case, data: &NodalState, mut progress: impl FnMut
             nodes: NodalState::from_vector(case, u),
             history: Vec::new(),
             tip: Vec::new(),
-            stats: SolverStats { iterations: history.len(), last_change: history.last().map(|h| h.rel_change), residual: None, max_newton_iterations: None, wall_time_s },
-            inverse: Some(InverseOutput { data: data.clone(), angles_known: known, xhat, ahat, history, kappa_err, lambda_f: params.lambda_f, lambda_l: params.lambda_l }),
+            stats: SolverStats {
+                iterations: history.len(),
+                last_change: history.last().map(|h| h.rel_change),
+                residual: None,
+                max_newton_iterations: None,
+                wall_time_s,
+            },
+            inverse: Some(InverseOutput {
+                data: data.clone(),
+                angles_known: known,
+                xhat,
+                ahat,
+                history,
+                kappa_err,
+                lambda_f: params.lambda_f,
+                lambda_l: params.lambda_l,
+            }),
         }
     };
     match outcome {
         Ok(sol) => Ok(result(&sol.u, &sol.adjoint, sol.history, kappa_err)),
-        Err(source @ (SolveError::InverseNotConverged { .. } | SolveError::InverseNewtonNotConverged { .. })) => match &last {
-            Some((u, a)) => Err(RunError::Incomplete { source, partial: Box::new(result(u, a, records, kappa_err)) }),
-            None => Err(source.into()),
-        },
+        Err(source @ (SolveError::InverseNotConverged { .. } | SolveError::InverseNewtonNotConverged { .. })) => {
+            match &last {
+                Some((u, a)) => {
+                    Err(RunError::Incomplete { source, partial: Box::new(result(u, a, records, kappa_err)) })
+                }
+                None => Err(source.into()),
+            }
+        }
         Err(e) => Err(e.into()),
     }
 }
@@ -292,7 +340,8 @@ pub fn run_rust(case: &Case, mut progress: impl FnMut(usize, usize)) -> Result<R
             })
         }
         Analysis::Dynamic { end_time_s, steps, tolerance, max_iterations } => {
-            let params = DynamicParams { end_time_s, steps, newton_tolerance: tolerance, newton_max_iterations: max_iterations };
+            let params =
+                DynamicParams { end_time_s, steps, newton_tolerance: tolerance, newton_max_iterations: max_iterations };
             let sol = dynamics::solve(&problem, &params, &mut progress)?;
             Ok(RunResult {
                 engine: Engine::Rust,
@@ -314,7 +363,12 @@ pub fn run_rust(case: &Case, mut progress: impl FnMut(usize, usize)) -> Result<R
 
 /// Run `case` in the chosen engine; FreeFEM works in `workdir`. An inverse case first writes
 /// its data to `workdir/data.csv` (Rust forward engine) and then runs on that file.
-pub fn run(case: &Case, engine: Engine, workdir: &Path, progress: impl FnMut(usize, usize)) -> Result<RunResult, RunError> {
+pub fn run(
+    case: &Case,
+    engine: Engine,
+    workdir: &Path,
+    progress: impl FnMut(usize, usize),
+) -> Result<RunResult, RunError> {
     if case.inverse().is_some() {
         let path = workdir.join("data.csv");
         write_data(&path, &generate_data(case)?)?;
@@ -328,7 +382,13 @@ pub fn run(case: &Case, engine: Engine, workdir: &Path, progress: impl FnMut(usi
 
 /// Run an inverse case in the chosen engine on the data file `data_path` (I7); FreeFEM works in
 /// `workdir`. Both engines read the same file.
-pub fn run_inverse_on(case: &Case, engine: Engine, data_path: &Path, workdir: &Path, progress: impl FnMut(usize, usize)) -> Result<RunResult, RunError> {
+pub fn run_inverse_on(
+    case: &Case,
+    engine: Engine,
+    data_path: &Path,
+    workdir: &Path,
+    progress: impl FnMut(usize, usize),
+) -> Result<RunResult, RunError> {
     let data = read_data(data_path, &case.mesh)?;
     match engine {
         Engine::Rust => run_rust_inverse(case, &data, progress),
@@ -354,14 +414,24 @@ pub fn load_clip_with_truth(case: &Case) -> Result<(Clip, Option<GroundTruth>), 
     }
     let (mut clip, mut truth) = match (src.kind, &src.synthetic) {
         (ClipKind::Kymogram, _) => {
-            let params = KymogramParams { length_m: case.mesh.length_m, nodes: case.mesh.nodes(), dt_s: src.frame_interval_s, plane: src.plane, scale_to_length: true };
+            let params = KymogramParams {
+                length_m: case.mesh.length_m,
+                nodes: case.mesh.nodes(),
+                dt_s: src.frame_interval_s,
+                plane: src.plane,
+                scale_to_length: true,
+            };
             (read_kymogram(&src.file, &params)?, None)
         }
         (ClipKind::Recording, _) => (read_recording(&src.file, src.frame_interval_s)?, None),
         (ClipKind::Roll3d, Some(params)) => {
             let a = crate::clip::read_npy(&src.file)?;
             let &[_, joints] = a.shape.as_slice() else {
-                return Err(RunError::ClipShape(format!("{}: kymogram of shape {:?}, expected frames × joint angles", src.file.display(), a.shape)));
+                return Err(RunError::ClipShape(format!(
+                    "{}: kymogram of shape {:?}, expected frames × joint angles",
+                    src.file.display(),
+                    a.shape
+                )));
             };
             let rows: Vec<Vec<f64>> = a.data.chunks_exact(joints.max(1)).map(<[f64]>::to_vec).collect();
             let (clip, truth) = roll_clip(&rows, None, params)?;
@@ -370,11 +440,20 @@ pub fn load_clip_with_truth(case: &Case) -> Result<(Clip, Option<GroundTruth>), 
         (ClipKind::Roll3d, None) => return Err(RunError::ClipShape("roll_3d clip without parameters".into())),
     };
     if clip.node_count() != case.mesh.nodes() {
-        return Err(RunError::ClipShape(format!("{}: {} nodes per frame, but the case's mesh has {} (rod.elements + 1)", src.file.display(), clip.node_count(), case.mesh.nodes())));
+        return Err(RunError::ClipShape(format!(
+            "{}: {} nodes per frame, but the case's mesh has {} (rod.elements + 1)",
+            src.file.display(),
+            clip.node_count(),
+            case.mesh.nodes()
+        )));
     }
     if let Some((a, b)) = src.frames {
         if b > clip.frame_count() {
-            return Err(RunError::ClipShape(format!("{}: clip.frames = [{a}, {b}) but the clip has {} frames", src.file.display(), clip.frame_count())));
+            return Err(RunError::ClipShape(format!(
+                "{}: clip.frames = [{a}, {b}) but the clip has {} frames",
+                src.file.display(),
+                clip.frame_count()
+            )));
         }
         clip.frames = clip.frames[a..b].to_vec();
         if let Some(t) = &mut truth {
@@ -449,7 +528,15 @@ pub fn run_clip(case: &Case, out: &Path, mut progress: impl FnMut(usize, usize))
         InverseMethod::Newton { warm_start_tolerance, .. } => FrameMethod::Newton { warm_start_tolerance },
     };
     let first_frame = src.frames.map(|f| f.0).unwrap_or(0);
-    let sp = SequenceParams { frame: InverseParams { dt: src.frame_interval_s, ..params }, method, min_cos_beta: src.min_cos_beta, frame_offset: first_frame, start: src.start, rotation: src.rotation, gauge: src.gauge };
+    let sp = SequenceParams {
+        frame: InverseParams { dt: src.frame_interval_s, ..params },
+        method,
+        min_cos_beta: src.min_cos_beta,
+        frame_offset: first_frame,
+        start: src.start,
+        rotation: src.rotation,
+        gauge: src.gauge,
+    };
     let mut writer = ClipWriter::create(out)?;
     let mut truth_writer = truth.as_ref().map(|_| crate::output::TruthWriter::create(out)).transpose()?;
     let mut truth_run = truth.as_ref().map(|_| TruthRun::default());
@@ -469,50 +556,71 @@ pub fn run_clip(case: &Case, out: &Path, mut progress: impl FnMut(usize, usize))
             }
             writer.finish().map(|_| ())
         });
-        let result = solve_sequence(&problem, &sp, &clip.frames, None, |_, _| {}, |rep, frame| {
-            let sol = frame.solution;
-            let nodes = NodalState { chart: frame.chart, ..NodalState::from_vector(case, &sol.u) };
-            let (force, torque): (Vec<_>, Vec<_>) = (0..nodes.s.len())
-                .map(|i| {
-                    let (xh, ah) = node_values(&sol.adjoint, i);
-                    (xh / params.lambda_f, ah / params.lambda_l)
-                })
-                .unzip();
-            let data = &clip.frames[rep.frame - first_frame];
-            let kappa = nodes.element_curvature();
-            let k2: Vec<f64> = kappa.iter().map(|(_, k)| k[1]).collect();
-            // The data's curvature in the plane normal to the chart's axis (exactly the x–z
-            // curvature for an x–z clip; rotates with the data, R5).
-            let in_chart: Vec<Vector3<f64>> = data.iter().map(|x| frame.chart.to_chart(x)).collect();
-            let kd = planar_xz_curvature(&in_chart, h);
-            if let (Some(t), Some(tw), Some(tr)) = (&truth, &mut truth_writer, &mut truth_run) {
-                let ft = &t.frames[rep.frame - first_frame];
-                let q: Vec<nalgebra::Matrix3<f64>> = nodes.alpha.iter().map(|a| nodes.chart.rotation(a)).collect();
-                let kn = nodal_curvature(&kappa);
-                let c = compare_frame(data, ft, &RecoveredFrame { x: &nodes.x, q: &q, kappa: &kn }, TRUTH_SKIP_NODES).map_err(|e| e.to_string())?;
-                let twist = ft.kappa.iter().map(|k| k.z).sum::<f64>() / ft.kappa.len() as f64;
-                tw.frame(rep.frame, rep.frame as f64 * clip.dt_s, ft.roll_rad, twist, &c).map_err(|e| e.to_string())?;
-                let bend = |k: &Vector3<f64>| k.x * k.x + k.y * k.y;
-                tr.comparisons.push(c);
-                tr.roll_rad.push(ft.roll_rad);
-                tr.twist_per_m.push(twist);
-                tr.bending_true.push(ft.kappa.iter().map(bend).collect());
-                tr.bending_recovered.push(kn.iter().map(bend).collect());
-            }
-            let roughness = (sign_alternation(&k2), sign_alternation(&kd));
-            rough.push(roughness);
-            kappa2.push(k2);
-            data_kappa.push(kd);
-            tx.send((*rep, rep.frame as f64 * clip.dt_s, nodes, force, torque, data.clone(), roughness)).map_err(|_| "the output thread stopped (see the write error)".to_string())?;
-            progress(rep.frame - first_frame + 1, total);
-            Ok(())
-        });
+        let result = solve_sequence(
+            &problem,
+            &sp,
+            &clip.frames,
+            None,
+            |_, _| {},
+            |rep, frame| {
+                let sol = frame.solution;
+                let nodes = NodalState { chart: frame.chart, ..NodalState::from_vector(case, &sol.u) };
+                let (force, torque): (Vec<_>, Vec<_>) = (0..nodes.s.len())
+                    .map(|i| {
+                        let (xh, ah) = node_values(&sol.adjoint, i);
+                        (xh / params.lambda_f, ah / params.lambda_l)
+                    })
+                    .unzip();
+                let data = &clip.frames[rep.frame - first_frame];
+                let kappa = nodes.element_curvature();
+                let k2: Vec<f64> = kappa.iter().map(|(_, k)| k[1]).collect();
+                // The data's curvature in the plane normal to the chart's axis (exactly the x–z
+                // curvature for an x–z clip; rotates with the data, R5).
+                let in_chart: Vec<Vector3<f64>> = data.iter().map(|x| frame.chart.to_chart(x)).collect();
+                let kd = planar_xz_curvature(&in_chart, h);
+                if let (Some(t), Some(tw), Some(tr)) = (&truth, &mut truth_writer, &mut truth_run) {
+                    let ft = &t.frames[rep.frame - first_frame];
+                    let q: Vec<nalgebra::Matrix3<f64>> = nodes.alpha.iter().map(|a| nodes.chart.rotation(a)).collect();
+                    let kn = nodal_curvature(&kappa);
+                    let c =
+                        compare_frame(data, ft, &RecoveredFrame { x: &nodes.x, q: &q, kappa: &kn }, TRUTH_SKIP_NODES)
+                            .map_err(|e| e.to_string())?;
+                    let twist = ft.kappa.iter().map(|k| k.z).sum::<f64>() / ft.kappa.len() as f64;
+                    tw.frame(rep.frame, rep.frame as f64 * clip.dt_s, ft.roll_rad, twist, &c)
+                        .map_err(|e| e.to_string())?;
+                    let bend = |k: &Vector3<f64>| k.x * k.x + k.y * k.y;
+                    tr.comparisons.push(c);
+                    tr.roll_rad.push(ft.roll_rad);
+                    tr.twist_per_m.push(twist);
+                    tr.bending_true.push(ft.kappa.iter().map(bend).collect());
+                    tr.bending_recovered.push(kn.iter().map(bend).collect());
+                }
+                let roughness = (sign_alternation(&k2), sign_alternation(&kd));
+                rough.push(roughness);
+                kappa2.push(k2);
+                data_kappa.push(kd);
+                tx.send((*rep, rep.frame as f64 * clip.dt_s, nodes, force, torque, data.clone(), roughness))
+                    .map_err(|_| "the output thread stopped (see the write error)".to_string())?;
+                progress(rep.frame - first_frame + 1, total);
+                Ok(())
+            },
+        );
         drop(tx);
-        let written = io.join().unwrap_or_else(|_| Err(OutputError::Plot { path: out.to_path_buf(), reason: "the output thread panicked".into() }));
+        let written = io.join().unwrap_or_else(|_| {
+            Err(OutputError::Plot { path: out.to_path_buf(), reason: "the output thread panicked".into() })
+        });
         (result, written)
     });
     // A write error explains a stopped clip better than the stop itself.
     written?;
     let reports = result?;
-    Ok(ClipRun { reports, roughness: rough, kappa2, data_kappa, truth: truth_run, wall_time_s: start.elapsed().as_secs_f64(), source: clip.source })
+    Ok(ClipRun {
+        reports,
+        roughness: rough,
+        kappa2,
+        data_kappa,
+        truth: truth_run,
+        wall_time_s: start.elapsed().as_secs_f64(),
+        source: clip.source,
+    })
 }

@@ -2,8 +2,8 @@
 //! product, applied to a validated [`Case`] (typed, never through TOML text), and the summary
 //! table of the runs. The CLI runs the product in parallel and writes one folder per run.
 use crate::case::{Analysis, Case, InverseMethod, StaticMethod};
-use crate::metrics::Metrics;
 use crate::mesh::Mesh;
+use crate::metrics::Metrics;
 
 /// Errors of sweep specifications.
 #[derive(Debug, thiserror::Error)]
@@ -38,7 +38,10 @@ pub fn parse_set(spec: &str) -> Result<SweepParam, SweepError> {
         .split(',')
         .map(|v| {
             let v = v.trim();
-            v.parse::<f64>().ok().filter(|x| x.is_finite()).ok_or_else(|| SweepError::NotANumber { key: key.clone(), value: v.into() })
+            v.parse::<f64>()
+                .ok()
+                .filter(|x| x.is_finite())
+                .ok_or_else(|| SweepError::NotANumber { key: key.clone(), value: v.into() })
         })
         .collect::<Result<Vec<_>, _>>()?;
     Ok(SweepParam { key, values })
@@ -48,8 +51,22 @@ pub fn parse_set(spec: &str) -> Result<SweepParam, SweepError> {
 pub fn known_keys(case: &Case) -> &'static [&'static str] {
     match case.analysis {
         Analysis::Inverse(_) => &[
-            "lambda_g", "lambda_f", "lambda_l", "lambda_d", "lambda_kappa1", "lambda_kappa2", "lambda_kappa3", "lambda_omega1", "lambda_omega2", "lambda_omega3",
-            "relaxation", "warm_start_tolerance", "tolerance", "max_iterations", "elements", "stabilisation",
+            "lambda_g",
+            "lambda_f",
+            "lambda_l",
+            "lambda_d",
+            "lambda_kappa1",
+            "lambda_kappa2",
+            "lambda_kappa3",
+            "lambda_omega1",
+            "lambda_omega2",
+            "lambda_omega3",
+            "relaxation",
+            "warm_start_tolerance",
+            "tolerance",
+            "max_iterations",
+            "elements",
+            "stabilisation",
         ],
         Analysis::Static { .. } => &["relaxation", "tolerance", "max_iterations", "continuation_steps", "elements"],
         Analysis::Dynamic { .. } => &["tolerance", "max_iterations", "steps", "elements"],
@@ -68,7 +85,11 @@ fn count(key: &str, v: f64) -> Result<usize, SweepError> {
 pub fn apply(case: &mut Case, key: &str, v: f64) -> Result<(), SweepError> {
     let invalid = |reason: String| SweepError::Invalid { key: key.into(), reason };
     if !known_keys(case).contains(&key) {
-        return Err(SweepError::UnknownKey { key: key.into(), case: case.name.clone(), known: known_keys(case).join(", ") });
+        return Err(SweepError::UnknownKey {
+            key: key.into(),
+            case: case.name.clone(),
+            known: known_keys(case).join(", "),
+        });
     }
     if key == "elements" {
         let n = count(key, v)?;
@@ -88,10 +109,16 @@ pub fn apply(case: &mut Case, key: &str, v: f64) -> Result<(), SweepError> {
             "lambda_f" => s.weights.lambda_f = positive(v)?,
             "lambda_l" => s.weights.lambda_l = positive(v)?,
             "lambda_d" => s.weights.lambda_d = nonneg(v)?,
-            "lambda_kappa1" | "lambda_kappa2" | "lambda_kappa3" => s.weights.lambda_kappa[key.as_bytes()[12] as usize - b'1' as usize] = nonneg(v)?,
-            "lambda_omega1" | "lambda_omega2" | "lambda_omega3" => s.weights.lambda_omega[key.as_bytes()[12] as usize - b'1' as usize] = nonneg(v)?,
+            "lambda_kappa1" | "lambda_kappa2" | "lambda_kappa3" => {
+                s.weights.lambda_kappa[key.as_bytes()[12] as usize - b'1' as usize] = nonneg(v)?
+            }
+            "lambda_omega1" | "lambda_omega2" | "lambda_omega3" => {
+                s.weights.lambda_omega[key.as_bytes()[12] as usize - b'1' as usize] = nonneg(v)?
+            }
             "relaxation" => match &mut s.method {
-                InverseMethod::FixedPoint { relaxation } | InverseMethod::Newton { relaxation, .. } => *relaxation = relax(v)?,
+                InverseMethod::FixedPoint { relaxation } | InverseMethod::Newton { relaxation, .. } => {
+                    *relaxation = relax(v)?
+                }
             },
             "warm_start_tolerance" => match &mut s.method {
                 InverseMethod::Newton { warm_start_tolerance, .. } => *warm_start_tolerance = unit(v)?,
@@ -99,7 +126,13 @@ pub fn apply(case: &mut Case, key: &str, v: f64) -> Result<(), SweepError> {
             },
             "tolerance" => s.tolerance = unit(v)?,
             "max_iterations" => s.max_iterations = count(key, v)?,
-            "stabilisation" => s.stabilisation = if (0.0..=1.0).contains(&v) { v } else { return Err(invalid(format!("must lie in [0, 1], got {v}"))) },
+            "stabilisation" => {
+                s.stabilisation = if (0.0..=1.0).contains(&v) {
+                    v
+                } else {
+                    return Err(invalid(format!("must lie in [0, 1], got {v}")));
+                }
+            }
             _ => unreachable!("checked against known_keys"),
         },
         Analysis::Static { method, tolerance, max_iterations, continuation_steps } => match key {
@@ -135,11 +168,16 @@ pub fn product(case: &Case, params: &[SweepParam]) -> Result<Vec<(Point, Case)>,
     }
     let mut points: Vec<Point> = vec![Vec::new()];
     for p in params {
-        points = points.into_iter().flat_map(|pt| p.values.iter().map(move |&v| {
-            let mut q = pt.clone();
-            q.push((p.key.clone(), v));
-            q
-        })).collect();
+        points = points
+            .into_iter()
+            .flat_map(|pt| {
+                p.values.iter().map(move |&v| {
+                    let mut q = pt.clone();
+                    q.push((p.key.clone(), v));
+                    q
+                })
+            })
+            .collect();
     }
     points
         .into_iter()
@@ -174,8 +212,19 @@ pub fn fmt_value(v: f64) -> String {
 }
 
 /// Columns of the summary table after the swept keys.
-pub const SUMMARY_METRICS: [&str; 11] =
-    ["iterations", "x_err_rel", "kappa_err_rel", "kappa_err_rel_inner", "tangent_misfit_m05", "j_tracking", "j_total", "force_l2_n_per_m05", "torque_l2_n_m05", "tip_y_m", "wall_time_s"];
+pub const SUMMARY_METRICS: [&str; 11] = [
+    "iterations",
+    "x_err_rel",
+    "kappa_err_rel",
+    "kappa_err_rel_inner",
+    "tangent_misfit_m05",
+    "j_tracking",
+    "j_total",
+    "force_l2_n_per_m05",
+    "torque_l2_n_m05",
+    "tip_y_m",
+    "wall_time_s",
+];
 
 /// One row of the summary: the point, its status, its metrics (also those of the last iterate
 /// of a run that did not converge) and its error message.
@@ -218,7 +267,11 @@ pub fn summary_csv(keys: &[String], rows: &[SummaryRow]) -> Result<String, csv::
     for r in rows {
         let mut rec: Vec<String> = r.point.iter().map(|(_, v)| fmt_value(*v)).collect();
         rec.push(r.status.as_str().into());
-        rec.extend(SUMMARY_METRICS.iter().map(|k| r.metrics.as_ref().and_then(|m| m.get(*k)).map(|v| format!("{v:.10e}")).unwrap_or_default()));
+        rec.extend(
+            SUMMARY_METRICS
+                .iter()
+                .map(|k| r.metrics.as_ref().and_then(|m| m.get(*k)).map(|v| format!("{v:.10e}")).unwrap_or_default()),
+        );
         rec.push(r.error.as_deref().unwrap_or("").replace('\n', " "));
         w.write_record(&rec)?;
     }
@@ -231,7 +284,8 @@ mod tests {
     use super::*;
 
     fn case() -> Case {
-        let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/cases/inverse_bend.toml")).expect("case");
+        let text =
+            std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/cases/inverse_bend.toml")).expect("case");
         Case::from_toml(&text, "inverse_bend", std::path::Path::new("inverse_bend.toml")).expect("case")
     }
 
@@ -263,15 +317,35 @@ mod tests {
         let mut m = Metrics::new();
         m.insert("iterations".into(), 12.0);
         let rows = vec![
-            SummaryRow { point: vec![("lambda_l".into(), 1e-20)], status: RunStatus::Ok, metrics: Some(m.clone()), error: None },
-            SummaryRow { point: vec![("lambda_l".into(), 1e3)], status: RunStatus::NotConverged, metrics: Some(m), error: Some("did not converge,\nat all".into()) },
-            SummaryRow { point: vec![("lambda_l".into(), 1.0)], status: RunStatus::Failed, metrics: None, error: Some("bad".into()) },
+            SummaryRow {
+                point: vec![("lambda_l".into(), 1e-20)],
+                status: RunStatus::Ok,
+                metrics: Some(m.clone()),
+                error: None,
+            },
+            SummaryRow {
+                point: vec![("lambda_l".into(), 1e3)],
+                status: RunStatus::NotConverged,
+                metrics: Some(m),
+                error: Some("did not converge,\nat all".into()),
+            },
+            SummaryRow {
+                point: vec![("lambda_l".into(), 1.0)],
+                status: RunStatus::Failed,
+                metrics: None,
+                error: Some("bad".into()),
+            },
         ];
         let text = summary_csv(&["lambda_l".into()], &rows).unwrap();
         let lines: Vec<&str> = text.lines().collect();
         assert!(lines[0].starts_with("lambda_l,status,iterations,x_err_rel"));
         assert!(lines[1].starts_with("1e-20,ok,1.2000000000e1"));
-        assert!(lines[2].starts_with("1e3,not_converged,1.2000000000e1") && lines[2].ends_with("\"did not converge, at all\""), "{}", lines[2]);
+        assert!(
+            lines[2].starts_with("1e3,not_converged,1.2000000000e1")
+                && lines[2].ends_with("\"did not converge, at all\""),
+            "{}",
+            lines[2]
+        );
         assert!(lines[3].starts_with("1,failed,,") && lines[3].ends_with(",bad"), "{}", lines[3]);
     }
 }

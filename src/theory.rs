@@ -16,9 +16,19 @@ pub fn add_reference_metrics(case: &Case, r: &RunResult, m: &mut Metrics) -> Res
         return Ok(());
     };
     let tip_y = r.nodes.x.last().map(|x| x[1]).unwrap_or(f64::NAN);
-    let (l, kga, ea, ei) = (case.mesh.length_m, case.props.shear_stretch_n[0], case.props.shear_stretch_n[2], case.props.bend_twist_nm2[0]);
+    let (l, kga, ea, ei) = (
+        case.mesh.length_m,
+        case.props.shear_stretch_n[0],
+        case.props.shear_stretch_n[2],
+        case.props.bend_twist_nm2[0],
+    );
     let eq63 = timoshenko_tip_deflection(force_n, l, kga, ei);
-    let rod = |shearable: bool| PlanarRod { length_m: l, bending_stiffness_nm2: ei, shear_stiffness_n: shearable.then_some(kga), axial_stiffness_n: shearable.then_some(ea) };
+    let rod = |shearable: bool| PlanarRod {
+        length_m: l,
+        bending_stiffness_nm2: ei,
+        shear_stiffness_n: shearable.then_some(kga),
+        axial_stiffness_n: shearable.then_some(ea),
+    };
     let elastica = tip_loaded_cantilever(&rod(false), force_n)?.tip_y_m;
     let reissner = tip_loaded_cantilever(&rod(true), force_n)?.tip_y_m;
     for (name, value) in [("eq63", eq63), ("elastica", elastica), ("reissner", reissner)] {

@@ -58,7 +58,8 @@ pub fn write_vtp(path: &Path, f: &PolylineFields) -> Result<(), OutputError> {
 
 /// Write the `.pvd` collection: `(time [s], file name relative to the .pvd)` per frame.
 pub fn write_pvd(path: &Path, frames: &[(f64, String)]) -> Result<(), OutputError> {
-    let mut s = String::from("<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n  <Collection>\n");
+    let mut s =
+        String::from("<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n  <Collection>\n");
     for (t, file) in frames {
         let _ = writeln!(s, "    <DataSet timestep=\"{t:.9e}\" part=\"0\" file=\"{file}\"/>");
     }
@@ -75,8 +76,13 @@ mod tests {
         let pts = [Vector3::new(0.0, 0.0, 0.0), Vector3::new(0.0, 0.0, 0.5), Vector3::new(0.1, 0.0, 1.0)];
         let d3 = [Vector3::z(); 3];
         let k = [1.0, 2.0, 3.0];
-        let t = vtp_text(&PolylineFields { points: &pts, vectors: vec![("d3", &d3)], scalars: vec![("kappa2_per_m", &k)] });
-        assert!(t.contains("NumberOfPoints=\"3\"") && t.contains("Name=\"d3\" NumberOfComponents=\"3\"") && t.contains("Name=\"kappa2_per_m\""));
+        let t =
+            vtp_text(&PolylineFields { points: &pts, vectors: vec![("d3", &d3)], scalars: vec![("kappa2_per_m", &k)] });
+        assert!(
+            t.contains("NumberOfPoints=\"3\"")
+                && t.contains("Name=\"d3\" NumberOfComponents=\"3\"")
+                && t.contains("Name=\"kappa2_per_m\"")
+        );
         assert!(t.contains("1.000000000e-1 0.000000000e0 1.000000000e0"));
         assert!(t.contains("0 1 2 \n") && t.contains("          3\n"), "{t}");
         let dir = tempfile::tempdir().unwrap();

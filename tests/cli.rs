@@ -14,26 +14,38 @@ fn cosserat() -> Command {
 fn help_lists_the_subcommands() {
     let out = cosserat().arg("--help").assert().success().get_output().stdout.clone();
     insta::assert_snapshot!("help", String::from_utf8_lossy(&out));
-    cosserat().args(["run", "--help"]).assert().success().stdout(predicate::str::contains("--engine <ENGINE>").and(predicate::str::contains("freefem")));
+    cosserat()
+        .args(["run", "--help"])
+        .assert()
+        .success()
+        .stdout(predicate::str::contains("--engine <ENGINE>").and(predicate::str::contains("freefem")));
 }
 
 #[test]
 fn list_shows_every_case_with_its_description() {
-    cosserat()
-        .arg("list")
-        .assert()
-        .success()
-        .stdout(predicate::str::contains("timoshenko_5pct").and(predicate::str::contains("timoshenko_10pct")).and(predicate::str::contains("cantilever_dynamic")).and(predicate::str::contains("§5.1")));
+    cosserat().arg("list").assert().success().stdout(
+        predicate::str::contains("timoshenko_5pct")
+            .and(predicate::str::contains("timoshenko_10pct"))
+            .and(predicate::str::contains("cantilever_dynamic"))
+            .and(predicate::str::contains("§5.1")),
+    );
 }
 
 #[test]
 fn run_writes_csv_metrics_and_plot() {
     let dir = tempfile::tempdir().expect("tempdir");
-    cosserat().args(["run", "cases/timoshenko_5pct.toml", "--quiet", "--out"]).arg(dir.path()).assert().success().stdout(predicate::str::contains("timoshenko_5pct [rust]"));
+    cosserat()
+        .args(["run", "cases/timoshenko_5pct.toml", "--quiet", "--out"])
+        .arg(dir.path())
+        .assert()
+        .success()
+        .stdout(predicate::str::contains("timoshenko_5pct [rust]"));
     let nodes = std::fs::read_to_string(dir.path().join("nodes.csv")).expect("nodes.csv");
     assert!(nodes.starts_with("s_m,x_m,y_m,z_m,ux_m,uy_m,uz_m,alpha_rad,beta_rad,gamma_rad\n"));
     assert_eq!(nodes.lines().count(), 102);
-    let m: std::collections::BTreeMap<String, f64> = serde_json::from_str(&std::fs::read_to_string(dir.path().join("metrics.json")).expect("metrics")).expect("json");
+    let m: std::collections::BTreeMap<String, f64> =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("metrics.json")).expect("metrics"))
+            .expect("json");
     assert!((m["tip_y_m"] / -4.93e-5 - 1.0).abs() < 1e-3, "{m:?}");
     assert!(std::fs::read_to_string(dir.path().join("plot.svg")).expect("svg").contains("<svg"));
     assert!(dir.path().join("history.csv").is_file() && dir.path().join("curvature.csv").is_file());
@@ -43,20 +55,31 @@ fn run_writes_csv_metrics_and_plot() {
 fn bad_case_is_a_clear_error_not_a_panic() {
     let dir = tempfile::tempdir().expect("tempdir");
     let bad = dir.path().join("bad.toml");
-    std::fs::write(&bad, common::edit(&common::case_text("timoshenko_5pct"), "young_modulus_pa = 1.1e5", "young_modulus_pa = -1.1e5")).expect("write");
+    std::fs::write(
+        &bad,
+        common::edit(&common::case_text("timoshenko_5pct"), "young_modulus_pa = 1.1e5", "young_modulus_pa = -1.1e5"),
+    )
+    .expect("write");
+    cosserat().arg("run").arg(&bad).assert().code(1).stderr(
+        predicate::str::contains("material.young_modulus_pa")
+            .and(predicate::str::contains("must be > 0"))
+            .and(predicate::str::contains("panicked").not()),
+    );
     cosserat()
-        .arg("run")
-        .arg(&bad)
+        .args(["run", "cases/does_not_exist.toml"])
         .assert()
         .code(1)
-        .stderr(predicate::str::contains("material.young_modulus_pa").and(predicate::str::contains("must be > 0")).and(predicate::str::contains("panicked").not()));
-    cosserat().args(["run", "cases/does_not_exist.toml"]).assert().code(1).stderr(predicate::str::contains("cannot read case file"));
+        .stderr(predicate::str::contains("cannot read case file"));
     cosserat().args(["run", "cases/timoshenko_5pct.toml", "--engine", "abaqus"]).assert().code(2);
 }
 
 #[test]
 fn modes_prints_the_first_bending_frequency() {
-    cosserat().args(["modes", "cases/cantilever_dynamic.toml", "--count", "2"]).assert().success().stdout(predicate::str::contains("206.78"));
+    cosserat()
+        .args(["modes", "cases/cantilever_dynamic.toml", "--count", "2"])
+        .assert()
+        .success()
+        .stdout(predicate::str::contains("206.78"));
 }
 
 #[test]
@@ -65,12 +88,11 @@ fn compare_runs_both_engines() {
         return;
     }
     let dir = tempfile::tempdir().expect("tempdir");
-    cosserat()
-        .args(["compare", "cases/timoshenko_5pct.toml", "--out"])
-        .arg(dir.path())
-        .assert()
-        .success()
-        .stdout(predicate::str::contains("nodewise_rel_diff_displacement").and(predicate::str::contains("PASS")).and(predicate::str::contains("FAIL").not()));
+    cosserat().args(["compare", "cases/timoshenko_5pct.toml", "--out"]).arg(dir.path()).assert().success().stdout(
+        predicate::str::contains("nodewise_rel_diff_displacement")
+            .and(predicate::str::contains("PASS"))
+            .and(predicate::str::contains("FAIL").not()),
+    );
     assert!(dir.path().join("freefem/metrics.json").is_file() && dir.path().join("rust/metrics.json").is_file());
 }
 
@@ -89,14 +111,18 @@ fn inverse_run_writes_frame_controls_history_and_plot() {
     let at = |row: &[f64], name: &str| row[cols.iter().position(|c| *c == name).expect("column")];
     for line in nodes.lines().skip(1) {
         let row: Vec<f64> = line.split(',').map(|v| v.parse().expect("number")).collect();
-        let dot13 = at(&row, "d1_x") * at(&row, "d3_x") + at(&row, "d1_y") * at(&row, "d3_y") + at(&row, "d1_z") * at(&row, "d3_z");
+        let dot13 = at(&row, "d1_x") * at(&row, "d3_x")
+            + at(&row, "d1_y") * at(&row, "d3_y")
+            + at(&row, "d1_z") * at(&row, "d3_z");
         let n2 = at(&row, "d2_x").powi(2) + at(&row, "d2_y").powi(2) + at(&row, "d2_z").powi(2);
         assert!(dot13.abs() < 1e-14 && (n2 - 1.0).abs() < 1e-14);
     }
     let hist = std::fs::read_to_string(dir.path().join("inverse_history.csv")).expect("history");
     assert!(hist.starts_with("iteration,rel_change,x_err_rel,tangent_misfit_m05,j_tracking,j_force,j_torque,j_shear,j_bending,j_angular,j_total,kappa_err_rel,kappa_err_rel_inner\n"));
     assert!(dir.path().join("data.csv").is_file() && dir.path().join("inverse_curvature.csv").is_file());
-    let m: std::collections::BTreeMap<String, f64> = serde_json::from_str(&std::fs::read_to_string(dir.path().join("metrics.json")).expect("metrics")).expect("json");
+    let m: std::collections::BTreeMap<String, f64> =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("metrics.json")).expect("metrics"))
+            .expect("json");
     assert!(m["x_err_rel"] < 2e-5 && m["kappa_err_rel_inner"] < 1e-2, "{m:?}");
     assert_eq!(m["iterations"] as usize + 1, hist.lines().count());
     assert!(std::fs::read_to_string(dir.path().join("plot.svg")).expect("svg").contains("recovered torque"));
@@ -106,7 +132,16 @@ fn inverse_run_writes_frame_controls_history_and_plot() {
 fn sweep_writes_one_folder_per_run_a_summary_and_a_convergence_plot() {
     let dir = tempfile::tempdir().expect("tempdir");
     cosserat()
-        .args(["sweep", "cases/inverse_bend_twist.toml", "--quiet", "--set", "lambda_l=1e-6,1", "--set", "tolerance=1e-3", "--out"])
+        .args([
+            "sweep",
+            "cases/inverse_bend_twist.toml",
+            "--quiet",
+            "--set",
+            "lambda_l=1e-6,1",
+            "--set",
+            "tolerance=1e-3",
+            "--out",
+        ])
         .arg(dir.path())
         .assert()
         .success()
@@ -128,8 +163,20 @@ fn sweep_writes_one_folder_per_run_a_summary_and_a_convergence_plot() {
     let summary = std::fs::read_to_string(dir.path().join("fail/summary.csv")).expect("summary");
     assert!(summary.lines().nth(1).expect("row").starts_with("3,not_converged,3.0000000000e0,"), "{summary}");
     // The last iterate is kept, labelled, and its history plotted.
-    assert!(std::fs::read_to_string(dir.path().join("fail/max_iterations=3/FAILED.txt")).expect("FAILED.txt").contains("did not converge"));
-    assert_eq!(std::fs::read_to_string(dir.path().join("fail/max_iterations=3/inverse_history.csv")).expect("history").lines().count(), 4);
+    assert!(std::fs::read_to_string(dir.path().join("fail/max_iterations=3/FAILED.txt"))
+        .expect("FAILED.txt")
+        .contains("did not converge"));
+    assert_eq!(
+        std::fs::read_to_string(dir.path().join("fail/max_iterations=3/inverse_history.csv"))
+            .expect("history")
+            .lines()
+            .count(),
+        4
+    );
     assert!(dir.path().join("fail/convergence.svg").is_file());
-    cosserat().args(["sweep", "cases/inverse_bend_twist.toml", "--set", "lambda_q=1"]).assert().code(1).stderr(predicate::str::contains("unknown parameter"));
+    cosserat()
+        .args(["sweep", "cases/inverse_bend_twist.toml", "--set", "lambda_q=1"])
+        .assert()
+        .code(1)
+        .stderr(predicate::str::contains("unknown parameter"));
 }

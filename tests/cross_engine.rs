@@ -11,9 +11,9 @@
 mod common;
 
 use cosserat::case::{case_files, Case};
+use cosserat::data::write_data;
 use cosserat::freefem::{find_executable, INSTALL_HINT};
 use cosserat::metrics::compare;
-use cosserat::data::write_data;
 use cosserat::run::{generate_data, run, run_inverse_on, run_rust, Engine};
 
 const FREEFEM_DYNAMIC_STEPS: usize = 40;
@@ -62,18 +62,35 @@ fn every_case_agrees_between_rust_and_freefem() {
             // Inverse cases: both engines read the same data file (I7) and run the same fixed
             // point; the comparison includes the iteration count.
             let data = dir.path().join("data.csv");
-            write_data(&data, &generate_data(&case).unwrap_or_else(|e| panic!("{}: {e}", case.name))).expect("data.csv");
-            let on = |engine| run_inverse_on(&case, engine, &data, dir.path(), |_, _| {}).unwrap_or_else(|e| panic!("{} [{engine}]: {e}", case.name));
+            write_data(&data, &generate_data(&case).unwrap_or_else(|e| panic!("{}: {e}", case.name)))
+                .expect("data.csv");
+            let on = |engine| {
+                run_inverse_on(&case, engine, &data, dir.path(), |_, _| {})
+                    .unwrap_or_else(|e| panic!("{} [{engine}]: {e}", case.name))
+            };
             (on(Engine::Rust), on(Engine::Freefem))
         } else {
             let rust = run_rust(&case, |_, _| {}).unwrap_or_else(|e| panic!("{}: {e}", case.name));
             (rust, run(&case, Engine::Freefem, dir.path(), |_, _| {}).unwrap_or_else(|e| panic!("{}: {e}", case.name)))
         };
-        eprintln!("{}: rust {:.3} s, freefem {:.3} s (ratio {:.0})", case.name, rust.stats.wall_time_s, ff.stats.wall_time_s, ff.stats.wall_time_s / rust.stats.wall_time_s);
+        eprintln!(
+            "{}: rust {:.3} s, freefem {:.3} s (ratio {:.0})",
+            case.name,
+            rust.stats.wall_time_s,
+            ff.stats.wall_time_s,
+            ff.stats.wall_time_s / rust.stats.wall_time_s
+        );
         for row in compare(&case, &rust, &ff) {
-            eprintln!("  {:<32} |diff| {:.3e}  tol {:.3e}  {}", row.name, row.difference, row.tolerance, if row.passed() { "PASS" } else { "FAIL" });
+            eprintln!(
+                "  {:<32} |diff| {:.3e}  tol {:.3e}  {}",
+                row.name,
+                row.difference,
+                row.tolerance,
+                if row.passed() { "PASS" } else { "FAIL" }
+            );
             if !row.passed() {
-                failures.push(format!("{}: {} differs by {:e} > {:e}", case.name, row.name, row.difference, row.tolerance));
+                failures
+                    .push(format!("{}: {} differs by {:e} > {:e}", case.name, row.name, row.difference, row.tolerance));
             }
         }
     }

@@ -5,7 +5,10 @@ mod common;
 
 use common::{case_from, case_text, edit};
 use cosserat::case::Case;
-use cosserat::reference::{euler_bernoulli_cantilever_omegas, timoshenko_tip_deflection, tip_loaded_cantilever, undamped_forced_response, PlanarRod};
+use cosserat::reference::{
+    euler_bernoulli_cantilever_omegas, timoshenko_tip_deflection, tip_loaded_cantilever, undamped_forced_response,
+    PlanarRod,
+};
 use cosserat::solve::dynamics::{self, DynamicParams};
 use cosserat::solve::modes::modal_model;
 use cosserat::solve::statics::{self, Method, StaticParams};
@@ -14,7 +17,12 @@ use nalgebra::DVector;
 
 fn static_tip(case: &Case, method: Method, tol: f64) -> (f64, f64, usize) {
     let p = Problem::from_case(case);
-    let sol = statics::solve(&p, &StaticParams { method, tolerance: tol, max_iterations: 500, continuation_steps: 1 }, |_| {}).expect("static solve");
+    let sol = statics::solve(
+        &p,
+        &StaticParams { method, tolerance: tol, max_iterations: 500, continuation_steps: 1 },
+        |_| {},
+    )
+    .expect("static solve");
     let last = case.mesh.nodes() - 1;
     (sol.u[6 * last + 1], sol.u[6 * last + 2], sol.iterations)
 }
@@ -43,7 +51,10 @@ fn linear_limit_converges_to_eq63_at_second_order() {
         errors.push((y / eq63(&c, force) - 1.0).abs());
     }
     let orders: Vec<f64> = errors.windows(2).map(|w| (w[0] / w[1]).log2()).collect();
-    eprintln!("selective: tip errors {:?}, observed orders {orders:.3?}", errors.iter().map(|e| format!("{e:.2e}")).collect::<Vec<_>>());
+    eprintln!(
+        "selective: tip errors {:?}, observed orders {orders:.3?}",
+        errors.iter().map(|e| format!("{e:.2e}")).collect::<Vec<_>>()
+    );
     for o in &orders {
         assert!((1.9..2.1).contains(o), "observed order {o} (errors {errors:?})");
     }
@@ -97,14 +108,22 @@ fn nonlinear_tip_converges_at_second_order_to_reissner_rod() {
     for n in [25, 50, 100, 200] {
         let c = timoshenko("1e-8", n, "selective");
         let r = *reference.get_or_insert_with(|| {
-            let rod = PlanarRod { length_m: c.mesh.length_m, bending_stiffness_nm2: c.props.bend_twist_nm2[0], shear_stiffness_n: Some(c.props.shear_stretch_n[0]), axial_stiffness_n: Some(c.props.shear_stretch_n[2]) };
+            let rod = PlanarRod {
+                length_m: c.mesh.length_m,
+                bending_stiffness_nm2: c.props.bend_twist_nm2[0],
+                shear_stiffness_n: Some(c.props.shear_stretch_n[0]),
+                axial_stiffness_n: Some(c.props.shear_stretch_n[2]),
+            };
             tip_loaded_cantilever(&rod, 1e-8).expect("reissner").tip_y_m
         });
         let (y, _, _) = static_tip(&c, Method::Newton, 1e-13);
         errs.push((y / r - 1.0).abs());
     }
     let orders: Vec<f64> = errs.windows(2).map(|w| (w[0] / w[1]).log2()).collect();
-    eprintln!("10 % case vs Reissner rod: errors {:?}, orders {orders:.3?}", errs.iter().map(|e| format!("{e:.2e}")).collect::<Vec<_>>());
+    eprintln!(
+        "10 % case vs Reissner rod: errors {:?}, orders {orders:.3?}",
+        errs.iter().map(|e| format!("{e:.2e}")).collect::<Vec<_>>()
+    );
     for o in &orders {
         assert!((1.85..2.15).contains(o), "order {o} ({errs:?})");
     }
@@ -179,7 +198,8 @@ fn modes_against_euler_bernoulli() {
     let mut c = dynamic_case(1000);
     let m = c.props.mass_per_length_kg_m;
     let eb = |ei: f64| euler_bernoulli_cantilever_omegas(3, 1.0, ei, m);
-    let mut reference: Vec<f64> = eb(c.props.bend_twist_nm2[0]).into_iter().chain(eb(c.props.bend_twist_nm2[1])).collect();
+    let mut reference: Vec<f64> =
+        eb(c.props.bend_twist_nm2[0]).into_iter().chain(eb(c.props.bend_twist_nm2[1])).collect();
     reference.sort_by(f64::total_cmp);
     let w = modal_model(&Problem::from_case(&c)).expect("modes").omegas;
     let first = (w[0] / 207.0236 - 1.0).abs();
@@ -204,8 +224,23 @@ fn follower_load_eq64_large_bend() {
     let text = case_text("follower_bend_64");
     let c = case_from(&text, "f64");
     let p = Problem::from_case(&c);
-    let fp = statics::solve(&p, &StaticParams { method: Method::FixedPoint { relaxation: 0.5 }, tolerance: 1e-9, max_iterations: 2000, continuation_steps: 1 }, |_| {}).expect("fixed point");
-    let nt = statics::solve(&p, &StaticParams { method: Method::Newton, tolerance: 1e-12, max_iterations: 30, continuation_steps: 5 }, |_| {}).expect("newton");
+    let fp = statics::solve(
+        &p,
+        &StaticParams {
+            method: Method::FixedPoint { relaxation: 0.5 },
+            tolerance: 1e-9,
+            max_iterations: 2000,
+            continuation_steps: 1,
+        },
+        |_| {},
+    )
+    .expect("fixed point");
+    let nt = statics::solve(
+        &p,
+        &StaticParams { method: Method::Newton, tolerance: 1e-12, max_iterations: 30, continuation_steps: 5 },
+        |_| {},
+    )
+    .expect("newton");
     let last = c.mesh.nodes() - 1;
     let (y, z) = (fp.u[6 * last + 1], fp.u[6 * last + 2]);
     let min_beta = (0..c.mesh.nodes()).map(|i| fp.u[6 * i + 4]).fold(f64::INFINITY, f64::min);
@@ -227,13 +262,37 @@ fn follower_load_eq64_large_bend() {
 fn follower_load_eq65_needs_newton() {
     let c = case_from(&case_text("follower_bend_twist_65"), "f65");
     let p = Problem::from_case(&c);
-    let nt = statics::solve(&p, &StaticParams { method: Method::Newton, tolerance: 1e-12, max_iterations: 30, continuation_steps: 10 }, |_| {}).expect("newton");
+    let nt = statics::solve(
+        &p,
+        &StaticParams { method: Method::Newton, tolerance: 1e-12, max_iterations: 30, continuation_steps: 10 },
+        |_| {},
+    )
+    .expect("newton");
     let per_step_max = (1..=10).map(|s| nt.history.iter().filter(|h| h.step == s).count()).max().unwrap_or(0);
     let last = c.mesh.nodes() - 1;
-    eprintln!("eq. 65: Newton {} iterations (max {per_step_max} per step), residual {:.1e}, tip ({:.4e}, {:.4e}, {:.4e})", nt.iterations, nt.residual, nt.u[6 * last], nt.u[6 * last + 1], nt.u[6 * last + 2]);
+    eprintln!(
+        "eq. 65: Newton {} iterations (max {per_step_max} per step), residual {:.1e}, tip ({:.4e}, {:.4e}, {:.4e})",
+        nt.iterations,
+        nt.residual,
+        nt.u[6 * last],
+        nt.u[6 * last + 1],
+        nt.u[6 * last + 2]
+    );
     assert!(per_step_max <= 10, "{per_step_max}");
     assert!(nt.residual < 1e-8);
     assert!(nt.u[6 * last].abs() > 1e-4, "fully 3D: tip x {}", nt.u[6 * last]);
-    let fp = statics::solve(&p, &StaticParams { method: Method::FixedPoint { relaxation: 0.5 }, tolerance: 1e-9, max_iterations: 500, continuation_steps: 1 }, |_| {});
-    assert!(matches!(fp, Err(cosserat::solve::SolveError::FixedPointNotConverged { .. })), "the printed fixed point stalls at full load");
+    let fp = statics::solve(
+        &p,
+        &StaticParams {
+            method: Method::FixedPoint { relaxation: 0.5 },
+            tolerance: 1e-9,
+            max_iterations: 500,
+            continuation_steps: 1,
+        },
+        |_| {},
+    );
+    assert!(
+        matches!(fp, Err(cosserat::solve::SolveError::FixedPointNotConverged { .. })),
+        "the printed fixed point stalls at full load"
+    );
 }

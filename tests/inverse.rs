@@ -19,7 +19,8 @@ fn recovers_eq64_frames_from_the_centreline() {
     let n = case.mesh.nodes();
     let params = common::paper_params_64();
     let mut hist: Vec<InverseRecord> = Vec::new();
-    let sol = solve_frame(&p, &params, &xg, &vec![Vector3::zeros(); n], &p.reference_state(), |r| hist.push(*r)).expect("inverse");
+    let sol = solve_frame(&p, &params, &xg, &vec![Vector3::zeros(); n], &p.reference_state(), |r| hist.push(*r))
+        .expect("inverse");
     let at = |k: usize| hist[k - 1].rel_change;
     let last = sol.history.last().expect("history");
     let (k_all, k_inner) = (curvature_error(&p, &sol.u, &fwd_u, 0), curvature_error(&p, &sol.u, &fwd_u, 5));
@@ -59,7 +60,8 @@ fn adjoint_gradient_matches_finite_differences() {
     let nodes = case.mesh.nodes();
     let prev: Vec<Vector3<f64>> = (0..nodes).map(|i| node_values(&fwd_u, i).1 * 0.9).collect();
     // A frozen iterate near, not at, the data; every term of (41) switched on.
-    let uk = DVector::from_fn(6 * nodes, |i, _| fwd_u[i] + if i % 6 >= 3 { 0.05 * ((i as f64) * 0.7).sin() } else { 0.0 });
+    let uk =
+        DVector::from_fn(6 * nodes, |i, _| fwd_u[i] + if i % 6 >= 3 { 0.05 * ((i as f64) * 0.7).sin() } else { 0.0 });
     let params = common::all_terms_params();
     let pattern = Pattern::with_block(&case.mesh, BLOCK);
     let mut values = vec![0.0; pattern.nnz()];

@@ -31,7 +31,8 @@ struct Data {
 impl Data {
     fn new(elements: usize) -> Self {
         let text = case_text("follower_bend_64");
-        let text = if elements == 100 { text } else { edit(&text, "elements = 100", &format!("elements = {elements}")) };
+        let text =
+            if elements == 100 { text } else { edit(&text, "elements = 100", &format!("elements = {elements}")) };
         let case = case_from(&text, "f64");
         let (truth, xg) = common::forward_data(&case, 5);
         Data { case, truth, xg }
@@ -104,7 +105,12 @@ fn base() -> &'static (Data, Run) {
 }
 
 /// Run `params` for each value in parallel; the base value reuses the shared run.
-fn sweep(values: &[f64], set: impl Fn(f64) -> InverseParams + Sync, base_value: f64, track_kappa: bool) -> Vec<(f64, Option<Run>)> {
+fn sweep(
+    values: &[f64],
+    set: impl Fn(f64) -> InverseParams + Sync,
+    base_value: f64,
+    track_kappa: bool,
+) -> Vec<(f64, Option<Run>)> {
     let (d, _) = base();
     let u0 = d.problem().reference_state();
     values.par_iter().map(|&v| (v, (v != base_value).then(|| run(d, &set(v), &d.xg, &u0, track_kappa)))).collect()
@@ -177,7 +183,8 @@ fn lambda_l_sweep() {
     // 1e-12 and 1e-6: the same curves as 1e-10, and the same ‖l‖.
     for l in [1e-12, 1e-6, 1e-3] {
         let r = get(l);
-        let (sx, sk, ski) = (spread(&xh(r), &xh(b)), spread(&kh(r, false), &kh(b, false)), spread(&kh(r, true), &kh(b, true)));
+        let (sx, sk, ski) =
+            (spread(&xh(r), &xh(b)), spread(&kh(r, false), &kh(b, false)), spread(&kh(r, true), &kh(b, true)));
         let late = spread(&kh(r, false)[100..], &kh(b, false)[100..]);
         let ln = r.torque_norm(l) / b.torque_norm(1e-10);
         eprintln!("  lambda_l {l:e} vs 1e-10: spread x {sx:.2e}, kappa {sk:.2e} (from iteration 100: {late:.2e}), inner kappa {ski:.2e}; |l| ratio {ln:.3}");
@@ -276,11 +283,20 @@ fn lambda_f_sweep() {
     for (l, _) in &runs {
         line("lambda_f", *l, get(*l), 1e-10);
         let r = get(*l);
-        eprintln!("  tracking reduction {:.2e}, tracking/total {:.3}", r.last().objective.tracking / r.history[0].objective.tracking, r.last().objective.tracking / r.last().objective.total());
+        eprintln!(
+            "  tracking reduction {:.2e}, tracking/total {:.3}",
+            r.last().objective.tracking / r.history[0].objective.tracking,
+            r.last().objective.tracking / r.last().objective.total()
+        );
     }
     let (r10, r4, r6) = (get(1e-10), get(1e-4), get(1e6));
     let track = |r: &Run| r.last().objective.tracking;
-    assert!(r10.converged && r10.iterations() <= 30 && r4.converged && r4.iterations() <= 60, "{} {}", r10.iterations(), r4.iterations());
+    assert!(
+        r10.converged && r10.iterations() <= 30 && r4.converged && r4.iterations() <= 60,
+        "{} {}",
+        r10.iterations(),
+        r4.iterations()
+    );
     assert!(r10.last().x_err_rel < 5e-7 && r4.last().x_err_rel < 5e-7);
     assert!(curvature_error(&p, &r10.u, &d.truth, 0) < 0.01 && curvature_error(&p, &r4.u, &d.truth, 5) < 0.01);
     // Ordering of the final tracking term: 1e-10 < 1e-4 ≪ 1 ≪ 1e6.
@@ -304,7 +320,14 @@ fn transform(u: &DVector<f64>, r: &Matrix3<f64>, l: &Matrix3<f64>, c: &Vector3<f
 
 /// `(x, Q, κ, angles)` differences between `a` and the transform of `b`: max |x−(Rx_b+c)|/max|x_b|,
 /// max |Q−L Q_b Rᵀ|, max |κ − L κ_b|/max |κ_b| (local curvature: Q′∂sQ′ᵀ = L Q∂sQᵀ Lᵀ), max |α−α_b|.
-fn equivariance_error(p: &Problem, a: &DVector<f64>, b: &DVector<f64>, r: &Matrix3<f64>, l: &Matrix3<f64>, c: &Vector3<f64>) -> [f64; 4] {
+fn equivariance_error(
+    p: &Problem,
+    a: &DVector<f64>,
+    b: &DVector<f64>,
+    r: &Matrix3<f64>,
+    l: &Matrix3<f64>,
+    c: &Vector3<f64>,
+) -> [f64; 4] {
     let mut e = [0.0f64; 4];
     let mut nx = 0.0f64;
     for i in 0..a.len() / 6 {
@@ -357,7 +380,13 @@ fn rigid_motions() {
     let rz = *Rotation3::from_axis_angle(&Vector3::z_axis(), 0.7).matrix();
     let ry = *Rotation3::from_axis_angle(&Vector3::y_axis(), 0.6).matrix();
     let rg = *Rotation3::from_axis_angle(&Unit::new_normalize(Vector3::new(1.0, 2.0, 3.0)), 0.5).matrix();
-    let cases = [("translation", i3, i3), ("relabel Rz(0.7)", i3, rz), ("spatial Ry(0.6)", ry, i3), ("spatial Rz(0.7)", rz, i3), ("general R", rg, i3)];
+    let cases = [
+        ("translation", i3, i3),
+        ("relabel Rz(0.7)", i3, rz),
+        ("spatial Ry(0.6)", ry, i3),
+        ("spatial Rz(0.7)", rz, i3),
+        ("general R", rg, i3),
+    ];
     let errors = |iterations: usize| -> Vec<[f64; 4]> {
         let params = InverseParams { tolerance: 0.0, max_iterations: iterations, ..paper() };
         let orig = run(&d, &params, &d.xg, &u0, false);
@@ -373,7 +402,10 @@ fn rigid_motions() {
             })
             .collect();
         for ((name, _, _), e) in cases.iter().zip(&errs) {
-            eprintln!("after {iterations:2} iterations, {name}: x {:.2e}, Q {:.2e}, kappa {:.2e}, angles {:.2e}", e[0], e[1], e[2], e[3]);
+            eprintln!(
+                "after {iterations:2} iterations, {name}: x {:.2e}, Q {:.2e}, kappa {:.2e}, angles {:.2e}",
+                e[0], e[1], e[2], e[3]
+            );
         }
         errs
     };

@@ -8,7 +8,6 @@ use cosserat::solve::inverse_newton::{assemble_newton, solve_frame_newton};
 use cosserat::solve::{node_values, split_norms_inf, Problem};
 use nalgebra::{DVector, Vector3};
 
-
 /// Paper §5.2, first test (`common::paper_params_64`), Newton stopping settings.
 fn paper_params_64() -> InverseParams {
     InverseParams { tolerance: 1e-10, max_iterations: 30, ..common::paper_params_64() }
@@ -76,7 +75,9 @@ fn jacobian_check(lambda_g: f64) -> (f64, f64) {
         let (mut up, mut um) = (big.clone(), big.clone());
         up[j] += step;
         um[j] -= step;
-        let col = (assemble_newton(&p, &params, &pattern, &mut scratch, &up, &xg, &prev) - assemble_newton(&p, &params, &pattern, &mut scratch, &um, &xg, &prev)) / (2.0 * step);
+        let col = (assemble_newton(&p, &params, &pattern, &mut scratch, &up, &xg, &prev)
+            - assemble_newton(&p, &params, &pattern, &mut scratch, &um, &xg, &prev))
+            / (2.0 * step);
         fd.set_column(j, &col);
     }
     let kinds = ["x", "α", "x̂", "α̂"];
@@ -94,7 +95,10 @@ fn jacobian_check(lambda_g: f64) -> (f64, f64) {
                 }
             }
             if size > 0.0 {
-                eprintln!("block ({}, {}): |J−FD| {err:.2e}, |J| {size:.2e}, |J−K| {coef:.2e} (equilibrated)", kinds[rk], kinds[ck]);
+                eprintln!(
+                    "block ({}, {}): |J−FD| {err:.2e}, |J| {size:.2e}, |J−K| {coef:.2e} (equilibrated)",
+                    kinds[rk], kinds[ck]
+                );
                 worst_eq = worst_eq.max(err / size);
                 if coef > 1e-12 {
                     worst_coef = worst_coef.max(err / coef);
@@ -109,16 +113,29 @@ fn jacobian_check(lambda_g: f64) -> (f64, f64) {
 /// Newton from the fixed point's iterate at `fp_tol`, compared with the fixed point run to
 /// `tight` (printed) and with the fixed point restarted at Newton's solution (returned):
 /// (Newton records, ms per iteration, [‖Δx‖∞, ‖Δα‖∞, max|Δκ|/max|κ|], solution).
-fn newton_vs_fixed_point(p: &Problem, params: &InverseParams, xg: &[Vector3<f64>], fp_tol: f64, tight: f64) -> (Vec<InverseRecord>, f64, [f64; 3], DVector<f64>) {
+fn newton_vs_fixed_point(
+    p: &Problem,
+    params: &InverseParams,
+    xg: &[Vector3<f64>],
+    fp_tol: f64,
+    tight: f64,
+) -> (Vec<InverseRecord>, f64, [f64; 3], DVector<f64>) {
     let prev = vec![Vector3::zeros(); xg.len()];
     let fp_params = |tolerance| InverseParams { tolerance, max_iterations: 3000, ..*params };
-    let start = solve_frame(p, &fp_params(fp_tol), xg, &prev, &p.reference_state(), |_| {}).expect("fixed point (start)");
+    let start =
+        solve_frame(p, &fp_params(fp_tol), xg, &prev, &p.reference_state(), |_| {}).expect("fixed point (start)");
     let t0 = std::time::Instant::now();
     let mut hist = Vec::new();
     let sol = solve_frame_newton(p, params, xg, &prev, &start.u, |r| hist.push(*r)).expect("newton");
     let ms = t0.elapsed().as_secs_f64() * 1e3 / hist.len() as f64;
     for r in &hist {
-        eprintln!("  Newton {}: rel. change {:.2e}, residual {:.2e}, |x-xg|/|xg| {:.3e}", r.iteration, r.rel_change, r.residual.unwrap_or(f64::NAN), r.x_err_rel);
+        eprintln!(
+            "  Newton {}: rel. change {:.2e}, residual {:.2e}, |x-xg|/|xg| {:.3e}",
+            r.iteration,
+            r.rel_change,
+            r.residual.unwrap_or(f64::NAN),
+            r.x_err_rel
+        );
     }
     let fp = solve_frame(p, &fp_params(tight), xg, &prev, &p.reference_state(), |_| {}).expect("fixed point (tight)");
     let (dx, da) = split_norms_inf(&(&fp.u - &sol.u));
@@ -132,7 +149,9 @@ fn newton_vs_fixed_point(p: &Problem, params: &InverseParams, xg: &[Vector3<f64>
         fp.history.len()
     );
     // The fixed point started at Newton's solution stays there (it is a fixed point of I4).
-    let again = solve_frame(p, &InverseParams { tolerance: 1e-10, max_iterations: 5, ..*params }, xg, &prev, &sol.u, |_| {}).expect("fixed point from Newton's solution");
+    let again =
+        solve_frame(p, &InverseParams { tolerance: 1e-10, max_iterations: 5, ..*params }, xg, &prev, &sol.u, |_| {})
+            .expect("fixed point from Newton's solution");
     let (dx2, da2) = split_norms_inf(&(&again.u - &sol.u));
     let dk2 = element_curvatures(p, &again.u).iter().zip(&kn).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
     eprintln!("  fixed point from Newton's solution: {} its to 1e-10; |dx| {dx2:.2e} m, |dα| {da2:.2e} rad, |dκ|/max|κ| {:.2e}", again.history.len(), dk2 / kmax);
@@ -161,7 +180,10 @@ fn newton_converges_on_eq64_with_a_small_bending_weight() {
     let params = InverseParams { lambda_kappa: Vector3::new(1e-14, 1e-14, 1e-10), ..paper_params_64() };
     let (hist, _, d, u) = newton_vs_fixed_point(&p, &params, &xg, 1e-4, 1e-9);
     let (k_all, k_inner) = (curvature_error(&p, &u, &fwd, 0), curvature_error(&p, &u, &fwd, 5));
-    eprintln!("eq. 64 (Λκ1,2 = 1e-14): |x-xg|/|xg| {:.3e}, κ error {k_all:.3e} (without 5 end elements {k_inner:.3e})", hist.last().unwrap().x_err_rel);
+    eprintln!(
+        "eq. 64 (Λκ1,2 = 1e-14): |x-xg|/|xg| {:.3e}, κ error {k_all:.3e} (without 5 end elements {k_inner:.3e})",
+        hist.last().unwrap().x_err_rel
+    );
     assert_fast(&hist, 5, 1e-8);
     assert!(d[0] < 1e-10 && d[1] < 1e-6 && d[2] < 1e-5, "{d:?}");
 }
@@ -173,7 +195,13 @@ fn newton_converges_on_eq65() {
     let case = case_from(&case_text("follower_bend_twist_65"), "f65");
     let p = Problem::from_case(&case);
     let (fwd, xg) = common::forward_data(&case, 10);
-    let params = InverseParams { lambda_f: 1e-2, lambda_l: 1e-6, lambda_d: 1e-6, lambda_kappa: Vector3::repeat(1e-20), ..paper_params_64() };
+    let params = InverseParams {
+        lambda_f: 1e-2,
+        lambda_l: 1e-6,
+        lambda_d: 1e-6,
+        lambda_kappa: Vector3::repeat(1e-20),
+        ..paper_params_64()
+    };
     let (hist, _, d, u) = newton_vs_fixed_point(&p, &params, &xg, 1e-4, 1e-6);
     let (k_all, k_inner) = (curvature_error(&p, &u, &fwd, 0), curvature_error(&p, &u, &fwd, 5));
     let x_err = hist.last().unwrap().x_err_rel;
@@ -195,9 +223,20 @@ fn newton_on_eq64_paper_parameters_fails_with_a_clear_error() {
     let (_, xg) = common::forward_data(&case, 5);
     let prev = vec![Vector3::zeros(); xg.len()];
     let params = InverseParams { frame: 7, ..paper_params_64() };
-    let start = solve_frame(&p, &InverseParams { tolerance: 3e-6, max_iterations: 1000, ..params }, &xg, &prev, &p.reference_state(), |_| {}).expect("fixed point");
+    let start = solve_frame(
+        &p,
+        &InverseParams { tolerance: 3e-6, max_iterations: 1000, ..params },
+        &xg,
+        &prev,
+        &p.reference_state(),
+        |_| {},
+    )
+    .expect("fixed point");
     let mut hist = Vec::new();
-    let err = solve_frame_newton(&p, &InverseParams { max_iterations: 15, ..params }, &xg, &prev, &start.u, |r| hist.push(*r)).expect_err("Newton must not converge here");
+    let err = solve_frame_newton(&p, &InverseParams { max_iterations: 15, ..params }, &xg, &prev, &start.u, |r| {
+        hist.push(*r)
+    })
+    .expect_err("Newton must not converge here");
     let text = err.to_string();
     eprintln!("{text}; residuals {:?}", hist.iter().map(|r| r.residual.unwrap_or(f64::NAN)).collect::<Vec<_>>());
     assert!(text.contains("frame 7") && text.contains("after 15 iterations"), "{text}");
@@ -215,9 +254,23 @@ fn jacobian_spectrum_eq64() {
     let prev = vec![Vector3::zeros(); n];
     let params = paper_params_64();
     let tol_fp: f64 = std::env::var("FPTOL").map(|s| s.parse().unwrap()).unwrap_or(3e-6);
-    let fp = solve_frame(&p, &InverseParams { tolerance: tol_fp, max_iterations: 20000, ..params }, &xg, &prev, &p.reference_state(), |_| {}).expect("fp");
+    let fp = solve_frame(
+        &p,
+        &InverseParams { tolerance: tol_fp, max_iterations: 20000, ..params },
+        &xg,
+        &prev,
+        &p.reference_state(),
+        |_| {},
+    )
+    .expect("fp");
     eprintln!("fp iterations {}", fp.history.len());
-    let big = DVector::from_fn(BLOCK * n, |i, _| if i % BLOCK < 6 { fp.u[6 * (i / BLOCK) + i % BLOCK] } else { fp.adjoint[6 * (i / BLOCK) + i % BLOCK - 6] });
+    let big = DVector::from_fn(BLOCK * n, |i, _| {
+        if i % BLOCK < 6 {
+            fp.u[6 * (i / BLOCK) + i % BLOCK]
+        } else {
+            fp.adjoint[6 * (i / BLOCK) + i % BLOCK - 6]
+        }
+    });
     let pattern = Pattern::with_block(&case.mesh, BLOCK);
     let mut values = vec![0.0; pattern.nnz()];
     let r = assemble_newton(&p, &params, &pattern, &mut values, &big, &xg, &prev);
@@ -232,16 +285,24 @@ fn jacobian_spectrum_eq64() {
     let uu = svd.u.as_ref().unwrap();
     for &k in idx.iter().take(6) {
         let v = vt.row(k).transpose();
-        let kinds: Vec<String> = (0..12).map(|c| format!("{:.2}", (0..n).map(|nd| v[BLOCK * nd + c].powi(2)).sum::<f64>().sqrt())).collect();
+        let kinds: Vec<String> =
+            (0..12).map(|c| format!("{:.2}", (0..n).map(|nd| v[BLOCK * nd + c].powi(2)).sum::<f64>().sqrt())).collect();
         let proj = uu.column(k).dot(&rs);
-        let peak = (0..n).max_by(|&a, &b| (v[BLOCK*a+4].abs()).partial_cmp(&v[BLOCK*b+4].abs()).unwrap()).unwrap();
-        if kinds[4] == "1.00" { let shape: Vec<String> = (0..n).map(|nd| format!("{:.3}", v[BLOCK * nd + 4] * dc[BLOCK * nd + 4] / dc[BLOCK * 4 + 4])).collect(); eprintln!("beta mode (unscaled): {}", shape.join(" ")); }
-        eprintln!("sigma {:.3e}: u_k·D_rR {proj:.3e}, weight per component {kinds:?}, beta peak node {peak}", svd.singular_values[k]);
+        let peak =
+            (0..n).max_by(|&a, &b| (v[BLOCK * a + 4].abs()).partial_cmp(&v[BLOCK * b + 4].abs()).unwrap()).unwrap();
+        if kinds[4] == "1.00" {
+            let shape: Vec<String> =
+                (0..n).map(|nd| format!("{:.3}", v[BLOCK * nd + 4] * dc[BLOCK * nd + 4] / dc[BLOCK * 4 + 4])).collect();
+            eprintln!("beta mode (unscaled): {}", shape.join(" "));
+        }
+        eprintln!(
+            "sigma {:.3e}: u_k·D_rR {proj:.3e}, weight per component {kinds:?}, beta peak node {peak}",
+            svd.singular_values[k]
+        );
     }
     let bd: Vec<String> = (0..n).map(|nd| format!("{:.2}", dc[BLOCK * nd + 4].log10())).collect();
     eprintln!("log10 dc beta: {}", bd.join(" "));
 }
-
 
 /// The banded LU of `LinearSolver` on real KKT matrices of the inverse problem (the fixed
 /// point's K with its Dirichlet rows, and Newton's Jacobian; 64 elements, every term of (41)):
@@ -275,7 +336,10 @@ fn banded_solver_on_real_kkt_matrices() {
     for (values, b) in [(&kv, &rhs), (&jac, &r)] {
         let a = pattern.to_dense(values);
         let dense = a.clone().lu().solve(b).expect("dense LU");
-        for x in [solver.solve(values, b).expect("banded"), solver.solve_equilibrated(values, b).expect("banded, equilibrated")] {
+        for x in [
+            solver.solve(values, b).expect("banded"),
+            solver.solve_equilibrated(values, b).expect("banded, equilibrated"),
+        ] {
             // residual of the equilibrated system D_r A D_c y = D_r b, the one the LU solves (I6)
             let (ae, dr, dc) = solver.equilibrate(values);
             let ad = pattern.to_dense(&ae);

@@ -42,12 +42,22 @@ fn run(name: &str, clip_lines: &str, frames: Option<usize>) -> Result<Recovered,
     let curv = parse(&dir.path().join("curvature.csv"));
     let nf = r.reports.len();
     let nodes = fields.len() / nf;
-    let mut out = Recovered { x: vec![], d: vec![], kappa: vec![], axes: vec![], iterations: r.reports.iter().map(|f| f.iterations).collect() };
+    let mut out = Recovered {
+        x: vec![],
+        d: vec![],
+        kappa: vec![],
+        axes: vec![],
+        iterations: r.reports.iter().map(|f| f.iterations).collect(),
+    };
     for f in 0..nf {
         let rows = &fields[f * nodes..(f + 1) * nodes];
         out.x.push(rows.iter().map(|r| Vector3::new(r[3], r[4], r[5])).collect());
-        out.d.push(rows.iter().map(|r| Matrix3::new(r[9], r[10], r[11], r[12], r[13], r[14], r[15], r[16], r[17])).collect());
-        out.kappa.push(curv[f * (nodes - 1)..(f + 1) * (nodes - 1)].iter().map(|r| Vector3::new(r[2], r[3], r[4])).collect());
+        out.d.push(
+            rows.iter().map(|r| Matrix3::new(r[9], r[10], r[11], r[12], r[13], r[14], r[15], r[16], r[17])).collect(),
+        );
+        out.kappa.push(
+            curv[f * (nodes - 1)..(f + 1) * (nodes - 1)].iter().map(|r| Vector3::new(r[2], r[3], r[4])).collect(),
+        );
         let row = &frames_csv[f];
         out.axes.push(Vector3::new(row[19], row[20], row[21]));
     }
@@ -95,12 +105,20 @@ fn check_clip(name: &str, frames: Option<usize>) {
     // rebased chart is the global chart, frame by frame.
     assert!(rebased.axes.iter().all(|a| *a == Vector3::y()), "an x–z frame's axis is not e2");
     let same = differences(&reference, &rebased, &Matrix3::identity());
-    eprintln!("{name}: {n} frames; rebased vs global chart (x–z): x {:.1e}, d {:.1e}, κ {:.1e}; iterations equal: {}", same.0, same.1, same.2, reference.iterations == rebased.iterations);
+    eprintln!(
+        "{name}: {n} frames; rebased vs global chart (x–z): x {:.1e}, d {:.1e}, κ {:.1e}; iterations equal: {}",
+        same.0,
+        same.1,
+        same.2,
+        reference.iterations == rebased.iterations
+    );
     assert!(same.0 <= TOL && same.1 <= TOL && same.2 <= TOL, "{same:?}");
 
     // The global chart in the x–y plane meets its singular set.
     match run(name, "plane = \"xy\"\nrotation = \"global_euler\"", frames) {
-        Err(RunError::Sequence(SequenceError::SingularChart { frame, node, cos_beta, .. })) => eprintln!("{name}: global chart, x–y plane: stops at frame {frame}, node {node}, |cos β| {cos_beta:.1e}"),
+        Err(RunError::Sequence(SequenceError::SingularChart { frame, node, cos_beta, .. })) => {
+            eprintln!("{name}: global chart, x–y plane: stops at frame {frame}, node {node}, |cos β| {cos_beta:.1e}")
+        }
         Err(e) => eprintln!("{name}: global chart, x–y plane: fails: {e}"),
         Ok(r) => {
             let worst = r.x.len();
@@ -114,7 +132,8 @@ fn check_clip(name: &str, frames: Option<usize>) {
     eprintln!("{name}: x–y plane vs x–z rotated: x {:.1e}, d {:.1e}, κ {:.1e}", e.0, e.1, e.2);
     assert!(e.0 <= TOL && e.1 <= TOL && e.2 <= TOL, "x–y: {e:?}");
     let v = [0.9, -2.1, 1.3];
-    let random = run(name, &format!("orientation = [{}, {}, {}]", v[0], v[1], v[2]), frames).expect("rebased chart, random orientation");
+    let random = run(name, &format!("orientation = [{}, {}, {}]", v[0], v[1], v[2]), frames)
+        .expect("rebased chart, random orientation");
     let rot = Rotation3::new(Vector3::from(v)).into_inner();
     let e = differences(&reference, &random, &rot);
     eprintln!("{name}: orientation {v:?} vs x–z rotated: x {:.1e}, d {:.1e}, κ {:.1e}", e.0, e.1, e.2);

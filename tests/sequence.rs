@@ -4,7 +4,9 @@ mod common;
 
 use common::{case_from, case_text, edit};
 use cosserat::solve::inverse::InverseParams;
-use cosserat::solve::sequence::{solve_sequence, FrameMethod, FrameStart, RotationTreatment, SequenceError, SequenceParams};
+use cosserat::solve::sequence::{
+    solve_sequence, FrameMethod, FrameStart, RotationTreatment, SequenceError, SequenceParams,
+};
 use cosserat::solve::statics::{self, Method, StaticParams};
 use cosserat::solve::{node_values, Problem};
 use nalgebra::{DVector, Vector3};
@@ -38,28 +40,59 @@ fn quasi_static_clip_is_recovered_frame_by_frame() {
     let mut truths = Vec::new();
     for k in 1..=4 {
         let p = Problem { load_factor: k as f64 / 4.0, ..Problem::from_case(&case) };
-        let u = statics::solve(&p, &StaticParams { method: Method::Newton, tolerance: 1e-13, max_iterations: 40, continuation_steps: 3 * k }, |_| {}).expect("forward").u;
+        let u = statics::solve(
+            &p,
+            &StaticParams { method: Method::Newton, tolerance: 1e-13, max_iterations: 40, continuation_steps: 3 * k },
+            |_| {},
+        )
+        .expect("forward")
+        .u;
         frames.push((0..case.mesh.nodes()).map(|i| node_values(&u, i).0).collect::<Vec<_>>());
         truths.push(u);
     }
     let p = Problem::from_case(&case);
-    let sp = SequenceParams { frame: params(), method: FrameMethod::FixedPoint, min_cos_beta: 1e-3, frame_offset: 0, start: FrameStart::PreviousFrame, rotation: RotationTreatment::Rebased, gauge: Vector3::y() };
+    let sp = SequenceParams {
+        frame: params(),
+        method: FrameMethod::FixedPoint,
+        min_cos_beta: 1e-3,
+        frame_offset: 0,
+        start: FrameStart::PreviousFrame,
+        rotation: RotationTreatment::Rebased,
+        gauge: Vector3::y(),
+    };
     let mut streamed = 0;
-    let reports = solve_sequence(&p, &sp, &frames, Some(&p.reference_state()), |_, _| {}, |_, _| {
-        streamed += 1;
-        Ok(())
-    })
+    let reports = solve_sequence(
+        &p,
+        &sp,
+        &frames,
+        Some(&p.reference_state()),
+        |_, _| {},
+        |_, _| {
+            streamed += 1;
+            Ok(())
+        },
+    )
     .expect("clip");
     assert_eq!(streamed, 4);
     for r in &reports {
         eprintln!(
             "frame {}: {} iterations, change {:.2e}, |x-xg|/|xg| {:.2e}, min |cos β| {:.3} (node {}), max |j-1| {:.2e}",
-            r.frame, r.iterations, r.last_change, r.x_err_rel, r.min_cos_beta, r.min_cos_beta_node, r.max_stretch_deviation
+            r.frame,
+            r.iterations,
+            r.last_change,
+            r.x_err_rel,
+            r.min_cos_beta,
+            r.min_cos_beta_node,
+            r.max_stretch_deviation
         );
         assert!(r.x_err_rel < 1e-4, "frame {}: {}", r.frame, r.x_err_rel);
         assert!(r.max_stretch_deviation < 1e-2);
     }
-    assert!(reports[1..].iter().all(|r| r.iterations < reports[0].iterations), "warm start did not help: {:?}", reports.iter().map(|r| r.iterations).collect::<Vec<_>>());
+    assert!(
+        reports[1..].iter().all(|r| r.iterations < reports[0].iterations),
+        "warm start did not help: {:?}",
+        reports.iter().map(|r| r.iterations).collect::<Vec<_>>()
+    );
 }
 
 /// Eq. (64) bends the rod in the y–z plane through β = −π/2 (min β = −2.84 rad), where
@@ -69,12 +102,27 @@ fn quasi_static_clip_is_recovered_frame_by_frame() {
 fn chart_guard_names_frame_and_node() {
     let case = case_from(&edit(&case_text("follower_bend_64"), "elements = 100", "elements = 40"), "f64_40");
     let p = Problem::from_case(&case);
-    let u = statics::solve(&p, &StaticParams { method: Method::Newton, tolerance: 1e-13, max_iterations: 40, continuation_steps: 5 }, |_| {}).expect("forward").u;
+    let u = statics::solve(
+        &p,
+        &StaticParams { method: Method::Newton, tolerance: 1e-13, max_iterations: 40, continuation_steps: 5 },
+        |_| {},
+    )
+    .expect("forward")
+    .u;
     let n = case.mesh.nodes();
     let x_g: Vec<Vector3<f64>> = (0..n).map(|i| node_values(&u, i).0).collect();
-    let singular = (0..n).min_by(|&a, &b| node_values(&u, a).1[1].cos().abs().total_cmp(&node_values(&u, b).1[1].cos().abs())).expect("node");
+    let singular = (0..n)
+        .min_by(|&a, &b| node_values(&u, a).1[1].cos().abs().total_cmp(&node_values(&u, b).1[1].cos().abs()))
+        .expect("node");
     let sp = SequenceParams {
-        frame: InverseParams { lambda_f: 1.0, lambda_l: 1e-10, lambda_kappa: Vector3::new(0.0, 0.0, 1e-10), lambda_omega: Vector3::zeros(), tolerance: 1e-4, ..params() },
+        frame: InverseParams {
+            lambda_f: 1.0,
+            lambda_l: 1e-10,
+            lambda_kappa: Vector3::new(0.0, 0.0, 1e-10),
+            lambda_omega: Vector3::zeros(),
+            tolerance: 1e-4,
+            ..params()
+        },
         method: FrameMethod::FixedPoint,
         min_cos_beta: 0.2,
         frame_offset: 0,
@@ -82,7 +130,9 @@ fn chart_guard_names_frame_and_node() {
         rotation: RotationTreatment::GlobalEuler,
         gauge: Vector3::y(),
     };
-    let err = solve_sequence(&p, &sp, &[x_g.clone()], Some(&DVector::from(p.reference_state())), |_, _| {}, |_, _| Ok(())).expect_err("the guard must fire");
+    let err =
+        solve_sequence(&p, &sp, &[x_g.clone()], Some(&DVector::from(p.reference_state())), |_, _| {}, |_, _| Ok(()))
+            .expect_err("the guard must fire");
     eprintln!("{err}");
     match err {
         SequenceError::SingularChart { frame, node, cos_beta, .. } => {
@@ -97,7 +147,10 @@ fn chart_guard_names_frame_and_node() {
     for gauge in [Vector3::x(), -Vector3::x()] {
         let sp = SequenceParams { rotation: RotationTreatment::Rebased, gauge, ..sp };
         let reports = solve_sequence(&p, &sp, &[x_g.clone()], None, |_, _| {}, |_, _| Ok(())).expect("rebased chart");
-        eprintln!("rebased, gauge {gauge:?}: {} iterations, x error {:.2e}, min |cos β| {}", reports[0].iterations, reports[0].x_err_rel, reports[0].min_cos_beta);
+        eprintln!(
+            "rebased, gauge {gauge:?}: {} iterations, x error {:.2e}, min |cos β| {}",
+            reports[0].iterations, reports[0].x_err_rel, reports[0].min_cos_beta
+        );
         assert!(reports[0].min_cos_beta > 1.0 - 1e-12, "{}", reports[0].min_cos_beta);
         assert!(reports[0].x_err_rel < 1e-3);
     }
@@ -134,10 +187,12 @@ fn data_guess_follows_the_tangent_without_jumps() {
     assert!(worst_jump < 0.1, "{worst_jump}");
     assert!((u[6 * (n - 1) + 5] + 7.0).abs() < 0.05, "γ at the end {} (θ ≈ 7)", u[6 * (n - 1) + 5]);
     // A 3D helix: d3 is the tangent at every node.
-    let helix: Vec<Vector3<f64>> = (0..n).map(|i| {
-        let s = i as f64 * h * 5e3;
-        Vector3::new(s.cos(), s.sin(), 0.3 * s) * 2e-4
-    }).collect();
+    let helix: Vec<Vector3<f64>> = (0..n)
+        .map(|i| {
+            let s = i as f64 * h * 5e3;
+            Vector3::new(s.cos(), s.sin(), 0.3 * s) * 2e-4
+        })
+        .collect();
     let u = data_frame_guess(&helix);
     for i in 0..n {
         let a = Vector3::new(u[6 * i + 3], u[6 * i + 4], u[6 * i + 5]);
@@ -159,25 +214,54 @@ fn data_guess_follows_the_tangent_without_jumps() {
 fn rebased_and_global_charts_differ_at_second_order_on_a_3d_clip() {
     let mut diffs = Vec::new();
     for elements in [40, 80] {
-        let case = case_from(&edit(&case_text("follower_bend_twist_65"), "elements = 100", &format!("elements = {elements}")), "f65");
+        let case = case_from(
+            &edit(&case_text("follower_bend_twist_65"), "elements = 100", &format!("elements = {elements}")),
+            "f65",
+        );
         let n = case.mesh.nodes();
         let frames: Vec<Vec<Vector3<f64>>> = [1.0, 0.999, 0.998]
             .iter()
             .map(|&k| {
                 let p = Problem { load_factor: k, ..Problem::from_case(&case) };
-                let u = statics::solve(&p, &StaticParams { method: Method::Newton, tolerance: 1e-13, max_iterations: 40, continuation_steps: 10 }, |_| {}).expect("forward").u;
+                let u = statics::solve(
+                    &p,
+                    &StaticParams {
+                        method: Method::Newton,
+                        tolerance: 1e-13,
+                        max_iterations: 40,
+                        continuation_steps: 10,
+                    },
+                    |_| {},
+                )
+                .expect("forward")
+                .u;
                 (0..n).map(|i| node_values(&u, i).0).collect()
             })
             .collect();
         let p = Problem::from_case(&case);
         let run = |rotation| {
-            let sp = SequenceParams { frame: InverseParams { tolerance: 1e-10, ..params() }, method: FrameMethod::Newton { warm_start_tolerance: 1e-3 }, min_cos_beta: 1e-3, frame_offset: 0, start: FrameStart::DataGuess, rotation, gauge: Vector3::y() };
+            let sp = SequenceParams {
+                frame: InverseParams { tolerance: 1e-10, ..params() },
+                method: FrameMethod::Newton { warm_start_tolerance: 1e-3 },
+                min_cos_beta: 1e-3,
+                frame_offset: 0,
+                start: FrameStart::DataGuess,
+                rotation,
+                gauge: Vector3::y(),
+            };
             let mut out = Vec::new();
-            solve_sequence(&p, &sp, &frames, None, |_, _| {}, |rep, f| {
-                let q: Vec<_> = (0..n).map(|i| f.chart.rotation(&node_values(&f.solution.u, i).1)).collect();
-                out.push((rep.chart_axis, q));
-                Ok(())
-            })
+            solve_sequence(
+                &p,
+                &sp,
+                &frames,
+                None,
+                |_, _| {},
+                |rep, f| {
+                    let q: Vec<_> = (0..n).map(|i| f.chart.rotation(&node_values(&f.solution.u, i).1)).collect();
+                    out.push((rep.chart_axis, q));
+                    Ok(())
+                },
+            )
             .expect("clip");
             out
         };
@@ -186,8 +270,12 @@ fn rebased_and_global_charts_differ_at_second_order_on_a_3d_clip() {
         // First frame: the same chart, the same answer.
         let first = global[0].1.iter().zip(&rebased[0].1).map(|(a, b)| (a - b).amax()).fold(0.0, f64::max);
         assert!(first < 1e-9, "first frame differs by {first:e}");
-        let later = (1..3).flat_map(|f| global[f].1.iter().zip(&rebased[f].1).map(|(a, b)| (a - b).amax())).fold(0.0, f64::max);
-        eprintln!("{elements} elements: axes {:?}; max |ΔQ| first frame {first:.1e}, later frames {later:.2e}", rebased.iter().map(|r| r.0).collect::<Vec<_>>());
+        let later =
+            (1..3).flat_map(|f| global[f].1.iter().zip(&rebased[f].1).map(|(a, b)| (a - b).amax())).fold(0.0, f64::max);
+        eprintln!(
+            "{elements} elements: axes {:?}; max |ΔQ| first frame {first:.1e}, later frames {later:.2e}",
+            rebased.iter().map(|r| r.0).collect::<Vec<_>>()
+        );
         diffs.push(later);
     }
     let order = (diffs[0] / diffs[1]).log2();

@@ -29,7 +29,13 @@ fn case_metrics_snapshots() {
         }
         let r = run_rust(&case, |_, _| {}).unwrap_or_else(|e| panic!("{}: {e}", case.name));
         let inverse = case.inverse().is_some();
-        let digits = if case.is_dynamic() { DYNAMIC_DIGITS } else if inverse { INVERSE_DIGITS } else { DIGITS };
+        let digits = if case.is_dynamic() {
+            DYNAMIC_DIGITS
+        } else if inverse {
+            INVERSE_DIGITS
+        } else {
+            DIGITS
+        };
         let m: BTreeMap<String, f64> = all_metrics(&case, &r)
             .expect("reference metrics")
             .into_iter()
@@ -38,7 +44,13 @@ fn case_metrics_snapshots() {
             .filter(|(k, _)| !((case.is_dynamic() || inverse) && k == "iterations"))
             .map(|(k, v)| {
                 // Errors against theory are differences of nearly equal numbers: keep 3 digits.
-                let v = if k.contains("iterations") { v } else if k.ends_with("rel_error") { sig(v, 3) } else { sig(v, digits) };
+                let v = if k.contains("iterations") {
+                    v
+                } else if k.ends_with("rel_error") {
+                    sig(v, 3)
+                } else {
+                    sig(v, digits)
+                };
                 (k, v)
             })
             .collect();

@@ -111,7 +111,10 @@ fn newton_and_fixed_point_agree_on_the_first_frames() {
     }
     let itn: usize = rn.reports.iter().map(|r| r.iterations).sum();
     let itf: usize = rf.reports.iter().map(|r| r.iterations).sum();
-    eprintln!("first 8 frames: Newton {itn} iterations ({:.2} s), fixed point {itf} ({:.2} s); max |Δγ| {worst:.2e} rad", rn.wall_time_s, rf.wall_time_s);
+    eprintln!(
+        "first 8 frames: Newton {itn} iterations ({:.2} s), fixed point {itf} ({:.2} s); max |Δγ| {worst:.2e} rad",
+        rn.wall_time_s, rf.wall_time_s
+    );
     assert!(worst < 1e-4, "{worst}");
     assert!(itn * 4 < itf, "Newton {itn} vs fixed point {itf} iterations");
 }

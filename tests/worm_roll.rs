@@ -12,7 +12,8 @@ use std::path::Path;
 /// The case with an absolute data path and extra `[clip]` lines.
 fn case(extra: &str) -> cosserat::case::Case {
     let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/elegansbot");
-    let text = edit(&case_text("worm_roll_3d"), "file = \"../data/elegansbot/", &format!("file = \"{}/", data.display()));
+    let text =
+        edit(&case_text("worm_roll_3d"), "file = \"../data/elegansbot/", &format!("file = \"{}/", data.display()));
     case_from(&edit(&text, "rotation = \"rebased\"", extra), "worm_roll_3d")
 }
 
@@ -36,7 +37,9 @@ fn the_3d_clip_is_reconstructed_against_its_ground_truth() {
     let t = r.truth.as_ref().expect("ground truth");
     assert_eq!(r.reports.len(), 1160);
     assert_eq!(t.comparisons.len(), 1160);
-    let max = |f: &dyn Fn(&cosserat::clip::synthetic::FrameComparison) -> f64| t.comparisons.iter().map(f).fold(0.0, f64::max);
+    let max = |f: &dyn Fn(&cosserat::clip::synthetic::FrameComparison) -> f64| {
+        t.comparisons.iter().map(f).fold(0.0, f64::max)
+    };
     let (ex, eb, ed) = (max(&|c| c.position_rel_l2), max(&|c| c.bending_rel_l2), max(&|c| c.max_tangent_angle_rad));
     let cmin = r.reports.iter().map(|f| f.min_cos_beta).fold(1.0, f64::min);
     let restarts = r.reports.iter().filter(|f| f.restarted).count();
@@ -89,9 +92,18 @@ fn a_rotated_3d_clip_gives_the_rotated_answer() {
     let rot = Rotation3::new(Vector3::from(v)).into_inner();
     let (d0, d1) = (tempfile::tempdir().expect("tempdir"), tempfile::tempdir().expect("tempdir"));
     let a = run("rotation = \"rebased\"\nframes = [600, 640]", d0.path()).expect("original");
-    let b = run(&format!("rotation = \"rebased\"\nframes = [600, 640]\norientation = [{}, {}, {}]", v[0], v[1], v[2]), d1.path()).expect("rotated");
+    let b = run(
+        &format!("rotation = \"rebased\"\nframes = [600, 640]\norientation = [{}, {}, {}]", v[0], v[1], v[2]),
+        d1.path(),
+    )
+    .expect("rotated");
     let parse = |p: &Path| -> Vec<Vec<f64>> {
-        std::fs::read_to_string(p).expect("csv").lines().skip(1).map(|l| l.split(',').map(|x| x.parse().expect("number")).collect()).collect()
+        std::fs::read_to_string(p)
+            .expect("csv")
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').map(|x| x.parse().expect("number")).collect())
+            .collect()
     };
     let (fa, fb) = (parse(&d0.path().join("fields.csv")), parse(&d1.path().join("fields.csv")));
     let (ca, cb) = (parse(&d0.path().join("curvature.csv")), parse(&d1.path().join("curvature.csv")));
@@ -107,6 +119,10 @@ fn a_rotated_3d_clip_gives_the_rotated_answer() {
     for (ra, rb) in ca.iter().zip(&cb) {
         dk = dk.max((v3(ra, 2) - v3(rb, 2)).amax() / kmax);
     }
-    eprintln!("3D clip, orientation {v:?}: x {dx:.1e}, d {dd:.1e}, κ {dk:.1e}; iterations {:?} vs {:?}", a.reports.iter().map(|r| r.iterations).sum::<usize>(), b.reports.iter().map(|r| r.iterations).sum::<usize>());
+    eprintln!(
+        "3D clip, orientation {v:?}: x {dx:.1e}, d {dd:.1e}, κ {dk:.1e}; iterations {:?} vs {:?}",
+        a.reports.iter().map(|r| r.iterations).sum::<usize>(),
+        b.reports.iter().map(|r| r.iterations).sum::<usize>()
+    );
     assert!(dx < 1e-7 && dd < 1e-7 && dk < 1e-7, "{dx:e} {dd:e} {dk:e}");
 }

@@ -38,7 +38,10 @@ pub fn read_npy(path: &Path) -> Result<NpyArray, ClipError> {
 pub fn write_npy(path: &Path, shape: &[usize], data: &[f64]) -> Result<(), ClipError> {
     let count: usize = shape.iter().product();
     if count != data.len() {
-        return Err(ClipError::Shape { path: path.to_path_buf(), reason: format!("shape {shape:?} holds {count} values, but {} were given", data.len()) });
+        return Err(ClipError::Shape {
+            path: path.to_path_buf(),
+            reason: format!("shape {shape:?} holds {count} values, but {} were given", data.len()),
+        });
     }
     Ok(write_atomic(path, &npy_bytes(shape, data))?)
 }
@@ -82,7 +85,9 @@ fn parse_npy(bytes: &[u8]) -> Result<NpyArray, String> {
         }
         v => return Err(format!("format version {v}.x is not supported (1.0, 2.0 or 3.0)")),
     };
-    let header = bytes.get(data_start..data_start + header_len).ok_or_else(|| format!("truncated: the header is {header_len} bytes, the file ends before it does"))?;
+    let header = bytes
+        .get(data_start..data_start + header_len)
+        .ok_or_else(|| format!("truncated: the header is {header_len} bytes, the file ends before it does"))?;
     let header = std::str::from_utf8(header).map_err(|_| "the header is not text".to_string())?;
     let (descr, fortran, shape) = parse_header(header)?;
     if descr != "<f8" {
@@ -106,15 +111,25 @@ fn parse_npy(bytes: &[u8]) -> Result<NpyArray, String> {
 
 /// The three entries of the header dictionary: `descr`, `fortran_order`, `shape`.
 fn parse_header(header: &str) -> Result<(String, bool, Vec<usize>), String> {
-    let inner = header.trim().strip_prefix('{').and_then(|h| h.strip_suffix('}')).ok_or_else(|| format!("header {header:?} is not a dictionary"))?;
+    let inner = header
+        .trim()
+        .strip_prefix('{')
+        .and_then(|h| h.strip_suffix('}'))
+        .ok_or_else(|| format!("header {header:?} is not a dictionary"))?;
     let (mut descr, mut fortran, mut shape) = (None, None, None);
     let mut rest = inner.trim();
     while !rest.is_empty() {
-        let (key, after) = quoted(rest).ok_or_else(|| format!("header {inner:?}: expected a quoted key at {rest:?}"))?;
-        let after = after.trim_start().strip_prefix(':').ok_or_else(|| format!("header: expected ':' after '{key}'"))?.trim_start();
+        let (key, after) =
+            quoted(rest).ok_or_else(|| format!("header {inner:?}: expected a quoted key at {rest:?}"))?;
+        let after = after
+            .trim_start()
+            .strip_prefix(':')
+            .ok_or_else(|| format!("header: expected ':' after '{key}'"))?
+            .trim_start();
         let after = match key {
             "descr" => {
-                let (v, a) = quoted(after).ok_or("header: 'descr' is not a quoted string (structured dtypes are not supported)")?;
+                let (v, a) = quoted(after)
+                    .ok_or("header: 'descr' is not a quoted string (structured dtypes are not supported)")?;
                 descr = Some(v.to_string());
                 a
             }
@@ -136,7 +151,10 @@ fn parse_header(header: &str) -> Result<(String, bool, Vec<usize>), String> {
                     .split(',')
                     .map(str::trim)
                     .filter(|t| !t.is_empty())
-                    .map(|t| t.parse::<usize>().map_err(|_| format!("header: shape entry '{t}' is not a non-negative integer")))
+                    .map(|t| {
+                        t.parse::<usize>()
+                            .map_err(|_| format!("header: shape entry '{t}' is not a non-negative integer"))
+                    })
                     .collect::<Result<Vec<_>, _>>()?;
                 shape = Some(dims);
                 &body[close + 1..]
@@ -146,7 +164,11 @@ fn parse_header(header: &str) -> Result<(String, bool, Vec<usize>), String> {
         rest = after.trim_start();
         rest = rest.strip_prefix(',').unwrap_or(rest).trim_start();
     }
-    Ok((descr.ok_or("header has no 'descr'")?, fortran.ok_or("header has no 'fortran_order'")?, shape.ok_or("header has no 'shape'")?))
+    Ok((
+        descr.ok_or("header has no 'descr'")?,
+        fortran.ok_or("header has no 'fortran_order'")?,
+        shape.ok_or("header has no 'shape'")?,
+    ))
 }
 
 /// A single- or double-quoted string at the start of `s`, and the rest after it.

@@ -70,7 +70,9 @@ impl Spline {
         let i = self.interval(t);
         let h = self.t[i + 1] - self.t[i];
         let (a, b) = ((self.t[i + 1] - t) / h, (t - self.t[i]) / h);
-        self.y[i] * a + self.y[i + 1] * b + (self.m[i] * (a * a * a - a) + self.m[i + 1] * (b * b * b - b)) * (h * h / 6.0)
+        self.y[i] * a
+            + self.y[i + 1] * b
+            + (self.m[i] * (a * a * a - a) + self.m[i + 1] * (b * b * b - b)) * (h * h / 6.0)
     }
 
     /// Derivative r'(t).
@@ -78,7 +80,8 @@ impl Spline {
         let i = self.interval(t);
         let h = self.t[i + 1] - self.t[i];
         let (a, b) = ((self.t[i + 1] - t) / h, (t - self.t[i]) / h);
-        (self.y[i + 1] - self.y[i]) / h + (self.m[i + 1] * (3.0 * b * b - 1.0) - self.m[i] * (3.0 * a * a - 1.0)) * (h / 6.0)
+        (self.y[i + 1] - self.y[i]) / h
+            + (self.m[i + 1] * (3.0 * b * b - 1.0) - self.m[i] * (3.0 * a * a - 1.0)) * (h / 6.0)
     }
 
     /// Arc length between parameters `t0 < t1` inside one knot interval (Gauss–Legendre).

@@ -139,7 +139,10 @@ impl GroundTruth {
     /// Per frame, `max_i |d3(s_i) · axis|` (`axis` a unit vector). With `axis = e2` this
     /// measures how close the tangent gets to the singular set `β = ±π/2` of eq. (1).
     pub fn max_tangent_alignment(&self, axis: &Vector3<f64>) -> Vec<f64> {
-        self.frames.iter().map(|f| f.q.iter().map(|q| q.row(2).transpose().dot(axis).abs()).fold(0.0, f64::max)).collect()
+        self.frames
+            .iter()
+            .map(|f| f.q.iter().map(|q| q.row(2).transpose().dot(axis).abs()).fold(0.0, f64::max))
+            .collect()
     }
 }
 
@@ -252,7 +255,11 @@ fn check_rows(which: &'static str, rows: &[Vec<f64>], expected: Option<usize>) -
 impl KymogramField {
     /// Field from the omega rows (and the delta rows for [`TimeMapping::OmegaThenDelta`]);
     /// rows × joint angles [rad], at least 2 rows of equal length ≥ 1, finite.
-    pub fn new(omega_rows: &[Vec<f64>], delta_rows: Option<&[Vec<f64>]>, params: &RollClipParams) -> Result<Self, ClipError> {
+    pub fn new(
+        omega_rows: &[Vec<f64>],
+        delta_rows: Option<&[Vec<f64>]>,
+        params: &RollClipParams,
+    ) -> Result<Self, ClipError> {
         params.validate()?;
         check_rows("omega", omega_rows, None)?;
         let mut rows = omega_rows.to_vec();
@@ -334,7 +341,11 @@ impl BendingProfile {
     /// `∫₀ᴸ k ds` [rad], exact for the spline: `Σ h (k_i + k_{i+1})/2 − h³ (M_i + M_{i+1})/24`.
     pub fn integral(&self) -> f64 {
         let h = self.segment_m;
-        self.k.windows(2).zip(self.m.windows(2)).map(|(k, m)| h * (k[0] + k[1]) / 2.0 - h * h * h * (m[0] + m[1]) / 24.0).sum()
+        self.k
+            .windows(2)
+            .zip(self.m.windows(2))
+            .map(|(k, m)| h * (k[0] + k[1]) / 2.0 - h * h * h * (m[0] + m[1]) / 24.0)
+            .sum()
     }
 }
 
@@ -366,7 +377,11 @@ fn magnus_step(q: &Matrix3<f64>, kappa: &impl Fn(f64) -> Vector3<f64>, s: f64, e
 }
 
 /// One frame: positions, `Q` and `κˡ` at the nodes for bending profile `profile`.
-fn integrate_frame(profile: &BendingProfile, roll_rad: f64, params: &RollClipParams) -> (Vec<Vector3<f64>>, FrameTruth) {
+fn integrate_frame(
+    profile: &BendingProfile,
+    roll_rad: f64,
+    params: &RollClipParams,
+) -> (Vec<Vector3<f64>>, FrameTruth) {
     let n = params.nodes;
     let element = params.length_m / (n - 1) as f64;
     let h = element / params.substeps as f64;
@@ -402,7 +417,11 @@ fn integrate_frame(profile: &BendingProfile, roll_rad: f64, params: &RollClipPar
 /// The `worm_roll_3d` clip and its ground truth (module doc). `omega_rows` (and `delta_rows`
 /// for [`TimeMapping::OmegaThenDelta`]; ignored otherwise) are kymogram rows × joint angles
 /// [rad], e.g. from [`crate::clip::read_npy`] of `data/elegansbot/kymogram_*.npy`.
-pub fn roll_clip(omega_rows: &[Vec<f64>], delta_rows: Option<&[Vec<f64>]>, params: &RollClipParams) -> Result<(Clip, GroundTruth), ClipError> {
+pub fn roll_clip(
+    omega_rows: &[Vec<f64>],
+    delta_rows: Option<&[Vec<f64>]>,
+    params: &RollClipParams,
+) -> Result<(Clip, GroundTruth), ClipError> {
     let field = KymogramField::new(omega_rows, delta_rows, params)?;
     // Frames are independent: integrated in parallel (rayon), collected in order, so the
     // result does not depend on the thread count.
@@ -473,7 +492,12 @@ fn check_len(what: &'static str, len: usize, expected: usize) -> Result<(), Clip
 /// Compare a recovered frame with the truth: `truth_x` are the clip positions of the frame [m],
 /// `truth` its [`FrameTruth`]; the bending and twist errors skip `skip_end_nodes` nodes at
 /// each end (the curvature of the inverse solution is least reliable there).
-pub fn compare_frame(truth_x: &[Vector3<f64>], truth: &FrameTruth, recovered: &RecoveredFrame<'_>, skip_end_nodes: usize) -> Result<FrameComparison, ClipError> {
+pub fn compare_frame(
+    truth_x: &[Vector3<f64>],
+    truth: &FrameTruth,
+    recovered: &RecoveredFrame<'_>,
+    skip_end_nodes: usize,
+) -> Result<FrameComparison, ClipError> {
     let n = truth_x.len();
     check_len("truth q", truth.q.len(), n)?;
     check_len("truth kappa", truth.kappa.len(), n)?;
@@ -565,7 +589,14 @@ mod tests {
     #[test]
     fn finite_differences_of_the_frames_give_the_prescribed_curvature() {
         let nodes = 2001;
-        let params = RollClipParams { nodes, frames: 3, substeps: 2, roll_total_rad: 1.1, twist_per_m: 700.0, ..RollClipParams::default() };
+        let params = RollClipParams {
+            nodes,
+            frames: 3,
+            substeps: 2,
+            roll_total_rad: 1.1,
+            twist_per_m: 700.0,
+            ..RollClipParams::default()
+        };
         let (clip, truth) = roll_clip(&wave_rows(30), None, &params).unwrap();
         let h = params.length_m / (nodes - 1) as f64;
         let (mut tangent_err, mut kappa_err, mut kappa_max): (f64, f64, f64) = (0.0, 0.0, 0.0);
@@ -580,7 +611,9 @@ mod tests {
                 kappa_max = kappa_max.max(t.kappa[i].amax());
             }
         }
-        println!("FD: max |∂s x − d3| {tangent_err:.2e}, max |κˡ_FD − κˡ| {kappa_err:.2e} 1/m of max {kappa_max:.1} 1/m");
+        println!(
+            "FD: max |∂s x − d3| {tangent_err:.2e}, max |κˡ_FD − κˡ| {kappa_err:.2e} 1/m of max {kappa_max:.1} 1/m"
+        );
         // Central differences are second order: error ~ h² (κ² + κ'') / 6 ≈ 1e-6 here.
         assert!(tangent_err < 1e-5, "{tangent_err:e}");
         assert!(kappa_err < 1e-4 * kappa_max, "{kappa_err:e}");
@@ -590,12 +623,31 @@ mod tests {
     #[test]
     fn integration_converges_at_fourth_order() {
         let rows = wave_rows(20);
-        let run = |substeps| roll_clip(&rows, None, &RollClipParams { frames: 3, substeps, roll_total_rad: 1.0, ..RollClipParams::default() }).unwrap();
+        let run = |substeps| {
+            roll_clip(
+                &rows,
+                None,
+                &RollClipParams { frames: 3, substeps, roll_total_rad: 1.0, ..RollClipParams::default() },
+            )
+            .unwrap()
+        };
         let (reference, reference_truth) = run(64);
         let err = |substeps| {
             let (clip, truth) = run(substeps);
-            let ex = clip.frames.iter().flatten().zip(reference.frames.iter().flatten()).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
-            let eq = truth.frames.iter().flat_map(|f| &f.q).zip(reference_truth.frames.iter().flat_map(|f| &f.q)).map(|(a, b)| (a - b).amax()).fold(0.0, f64::max);
+            let ex = clip
+                .frames
+                .iter()
+                .flatten()
+                .zip(reference.frames.iter().flatten())
+                .map(|(a, b)| (a - b).norm())
+                .fold(0.0, f64::max);
+            let eq = truth
+                .frames
+                .iter()
+                .flat_map(|f| &f.q)
+                .zip(reference_truth.frames.iter().flat_map(|f| &f.q))
+                .map(|(a, b)| (a - b).amax())
+                .fold(0.0, f64::max);
             (ex / WORM_LENGTH_M, eq)
         };
         let e: Vec<(f64, f64)> = [1, 2, 4, 8].into_iter().map(err).collect();
@@ -605,7 +657,12 @@ mod tests {
             assert!((12.0..20.0).contains(&(q0 / q1)), "frame ratio {}", q0 / q1);
         }
         let default = err(RollClipParams::default().substeps);
-        println!("default substeps {}: max |Δx|/L {:.2e}, max |ΔQ| {:.2e}", RollClipParams::default().substeps, default.0, default.1);
+        println!(
+            "default substeps {}: max |Δx|/L {:.2e}, max |ΔQ| {:.2e}",
+            RollClipParams::default().substeps,
+            default.0,
+            default.1
+        );
         assert!(default.0 < 1e-10 && default.1 < 1e-9, "{default:?}");
     }
 
@@ -613,7 +670,13 @@ mod tests {
     /// is `∫ k ds` (at the knots, every 5th node with 126 nodes).
     #[test]
     fn planar_case_lies_in_the_xz_plane_and_turns_by_the_integral_of_k() {
-        let params = RollClipParams { nodes: 126, frames: 4, roll_total_rad: 0.0, twist_per_m: 0.0, ..RollClipParams::default() };
+        let params = RollClipParams {
+            nodes: 126,
+            frames: 4,
+            roll_total_rad: 0.0,
+            twist_per_m: 0.0,
+            ..RollClipParams::default()
+        };
         let rows = wave_rows(12);
         let (clip, truth) = roll_clip(&rows, None, &params).unwrap();
         let field = KymogramField::new(&rows, None, &params).unwrap();
@@ -629,7 +692,11 @@ mod tests {
                 theta += prev.cross(&d3).y.atan2(prev.dot(&d3));
                 prev = d3;
                 if i % 5 == 0 {
-                    let knot = BendingProfile { k: profile.k[..=i / 5].to_vec(), m: profile.m[..=i / 5].to_vec(), segment_m: profile.segment_m };
+                    let knot = BendingProfile {
+                        k: profile.k[..=i / 5].to_vec(),
+                        m: profile.m[..=i / 5].to_vec(),
+                        segment_m: profile.segment_m,
+                    };
                     worst = worst.max((theta - knot.integral()).abs());
                 }
             }
@@ -660,7 +727,9 @@ mod tests {
             let angles = field.joint_angles(field.row_at_frame(2 * r));
             let profile = field.profile(r as f64);
             for j in 0..24 {
-                worst = worst.max((angles[j] - row[j]).abs()).max((profile.at((j + 1) as f64 * segment) * segment - row[j]).abs());
+                worst = worst
+                    .max((angles[j] - row[j]).abs())
+                    .max((profile.at((j + 1) as f64 * segment) * segment - row[j]).abs());
             }
             assert_eq!((profile.at(0.0), profile.at(params.length_m)), (0.0, 0.0), "k = 0 at head and tail");
         }
@@ -669,7 +738,12 @@ mod tests {
         let mid = field.joint_angles(10.5);
         assert!((mid[3] - 0.5 * (rows[10][3] + rows[11][3])).abs() < 0.01);
         // Omega then delta plays both, stretched together.
-        let both = KymogramField::new(&rows, Some(&wave_rows(7)), &RollClipParams { time_mapping: TimeMapping::OmegaThenDelta, ..small(32) }).unwrap();
+        let both = KymogramField::new(
+            &rows,
+            Some(&wave_rows(7)),
+            &RollClipParams { time_mapping: TimeMapping::OmegaThenDelta, ..small(32) },
+        )
+        .unwrap();
         assert_eq!(both.row_count(), 32);
         assert_eq!(both.joint_angles(both.row_at_frame(31)), wave_rows(7)[6]);
         // Roll: 0 at the start, ψ_tot at the end, zero rate at both ends.
@@ -685,8 +759,20 @@ mod tests {
         let params = small(5);
         let (c1, t1) = roll_clip(&rows, None, &params).unwrap();
         let (c2, t2) = roll_clip(&rows, None, &params).unwrap();
-        let bits = |c: &Clip| c.frames.iter().flatten().flat_map(|p| p.iter().map(|v| v.to_bits()).collect::<Vec<_>>()).collect::<Vec<u64>>();
-        let qbits = |t: &GroundTruth| t.frames.iter().flat_map(|f| f.q.iter()).flat_map(|q| q.iter().map(|v| v.to_bits()).collect::<Vec<_>>()).collect::<Vec<u64>>();
+        let bits = |c: &Clip| {
+            c.frames
+                .iter()
+                .flatten()
+                .flat_map(|p| p.iter().map(|v| v.to_bits()).collect::<Vec<_>>())
+                .collect::<Vec<u64>>()
+        };
+        let qbits = |t: &GroundTruth| {
+            t.frames
+                .iter()
+                .flat_map(|f| f.q.iter())
+                .flat_map(|q| q.iter().map(|v| v.to_bits()).collect::<Vec<_>>())
+                .collect::<Vec<u64>>()
+        };
         assert_eq!(bits(&c1), bits(&c2));
         assert_eq!(qbits(&t1), qbits(&t2));
         assert_eq!((c1, t1), (c2, t2));
@@ -709,7 +795,9 @@ mod tests {
         let both = RollClipParams { time_mapping: TimeMapping::OmegaThenDelta, ..p.clone() };
         assert!(e(roll_clip(&rows, None, &both)).contains("needs the delta-turn kymogram"));
         let short: Vec<Vec<f64>> = rows.iter().map(|r| r[..20].to_vec()).collect();
-        assert!(e(roll_clip(&rows, Some(&short), &both)).contains("delta, frame 0: 20 joint angles, but frame 0 has 24"));
+        assert!(
+            e(roll_clip(&rows, Some(&short), &both)).contains("delta, frame 0: 20 joint angles, but frame 0 has 24")
+        );
         // Delta rows are ignored by the omega-only mapping.
         assert!(roll_clip(&rows, Some(&short), &p).is_ok());
         for (params, name) in [
@@ -735,7 +823,10 @@ mod tests {
         let (clip, truth) = roll_clip(&wave_rows(10), None, &small(3)).unwrap();
         let (x, t) = (&clip.frames[1], &truth.frames[1]);
         let same = compare_frame(x, t, &RecoveredFrame { x, q: &t.q, kappa: &t.kappa }, 3).unwrap();
-        assert_eq!((same.position_rel_l2, same.bending_rel_l2, same.max_tangent_angle_rad, same.roll_offset_rad), (0.0, 0.0, 0.0, 0.0));
+        assert_eq!(
+            (same.position_rel_l2, same.bending_rel_l2, same.max_tangent_angle_rad, same.roll_offset_rad),
+            (0.0, 0.0, 0.0, 0.0)
+        );
         assert_eq!(same.twist_rms_error_per_m, 0.0);
         assert!((same.twist_mean_per_m - 500.0).abs() < 1e-9);
         // Roll every frame by φ about its own d3: rows d1, d2 rotate, κˡ rotates about e3.
@@ -759,7 +850,8 @@ mod tests {
         assert!((c.max_tangent_angle_rad - 0.1).abs() < 1e-12);
         assert!((c.twist_mean_per_m - 1000.0).abs() < 1e-9 && (c.twist_rms_error_per_m - 500.0).abs() < 1e-9);
         // Size mismatches and too many skipped nodes are errors.
-        let e = compare_frame(x, t, &RecoveredFrame { x: &x[1..], q: &t.q, kappa: &t.kappa }, 0).unwrap_err().to_string();
+        let e =
+            compare_frame(x, t, &RecoveredFrame { x: &x[1..], q: &t.q, kappa: &t.kappa }, 0).unwrap_err().to_string();
         assert!(e.contains("recovered x has 127 nodes, truth has 128"), "{e}");
         let e = compare_frame(x, t, &RecoveredFrame { x, q: &t.q, kappa: &t.kappa }, 64).unwrap_err().to_string();
         assert!(e.contains("skipping 64 nodes at each end of 128"), "{e}");
@@ -801,14 +893,32 @@ mod tests {
             assert!(clip.frames.iter().flatten().all(|p| p.iter().all(|v| v.is_finite())));
             if mapping == TimeMapping::StretchOmega {
                 for roll in [PI / 6.0, PI / 4.0, PI / 3.0] {
-                    let (_, t) = roll_clip(&omega, None, &RollClipParams { roll_total_rad: roll, ..params.clone() }).unwrap();
+                    let (_, t) =
+                        roll_clip(&omega, None, &RollClipParams { roll_total_rad: roll, ..params.clone() }).unwrap();
                     let a = t.max_tangent_alignment(&Vector3::y());
                     let near = a.iter().filter(|&&v| v > 0.99).count();
-                    println!("  roll_total {roll:.4} rad: max |d3·e2| {:.4}, frames with |d3·e2| > 0.99: {near}/1160", a.iter().cloned().fold(0.0, f64::max));
+                    println!(
+                        "  roll_total {roll:.4} rad: max |d3·e2| {:.4}, frames with |d3·e2| > 0.99: {near}/1160",
+                        a.iter().cloned().fold(0.0, f64::max)
+                    );
                 }
-                let (fine, fine_truth) = roll_clip(&omega, None, &RollClipParams { substeps: 32, ..params.clone() }).unwrap();
-                let ex = clip.frames.iter().flatten().zip(fine.frames.iter().flatten()).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max) / params.length_m;
-                let eq = truth.frames.iter().flat_map(|f| &f.q).zip(fine_truth.frames.iter().flat_map(|f| &f.q)).map(|(a, b)| (a - b).amax()).fold(0.0, f64::max);
+                let (fine, fine_truth) =
+                    roll_clip(&omega, None, &RollClipParams { substeps: 32, ..params.clone() }).unwrap();
+                let ex = clip
+                    .frames
+                    .iter()
+                    .flatten()
+                    .zip(fine.frames.iter().flatten())
+                    .map(|(a, b)| (a - b).norm())
+                    .fold(0.0, f64::max)
+                    / params.length_m;
+                let eq = truth
+                    .frames
+                    .iter()
+                    .flat_map(|f| &f.q)
+                    .zip(fine_truth.frames.iter().flat_map(|f| &f.q))
+                    .map(|(a, b)| (a - b).amax())
+                    .fold(0.0, f64::max);
                 println!("  substeps {} vs 32: max |Δx|/L {ex:.2e}, max |ΔQ| {eq:.2e}", params.substeps);
                 assert!(ex < 1e-10, "{ex:e}");
             }

@@ -43,7 +43,11 @@ pub struct DynamicSolution {
 }
 
 /// Integrate from the reference configuration at rest.
-pub fn solve(problem: &Problem, params: &DynamicParams, mut progress: impl FnMut(usize, usize)) -> Result<DynamicSolution, SolveError> {
+pub fn solve(
+    problem: &Problem,
+    params: &DynamicParams,
+    mut progress: impl FnMut(usize, usize),
+) -> Result<DynamicSolution, SolveError> {
     let pattern = Pattern::new(&problem.mesh);
     let mut solver = LinearSolver::new(&pattern)?;
     let fixed = problem.clamped_dofs();
@@ -102,7 +106,11 @@ pub fn solve(problem: &Problem, params: &DynamicParams, mut progress: impl FnMut
                 break;
             }
         }
-        let it = converged.ok_or(SolveError::NewtonNotConverged { step: Some(n), iterations: params.newton_max_iterations, increment })?;
+        let it = converged.ok_or(SolveError::NewtonNotConverged {
+            step: Some(n),
+            iterations: params.newton_max_iterations,
+            increment,
+        })?;
         total += it;
         max_it = max_it.max(it);
         let v = (&u - &u_prev) * (2.0 / dt) - &v_prev;

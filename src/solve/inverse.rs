@@ -94,7 +94,8 @@ impl ObjectiveTerms {
         self.tracking + self.force + self.torque + self.shear + self.bending + self.angular
     }
     /// Names in CSV order, with units (J = the objective's unit).
-    pub const NAMES: [&'static str; 7] = ["j_tracking", "j_force", "j_torque", "j_shear", "j_bending", "j_angular", "j_total"];
+    pub const NAMES: [&'static str; 7] =
+        ["j_tracking", "j_force", "j_torque", "j_shear", "j_bending", "j_angular", "j_total"];
     pub fn values(&self) -> [f64; 7] {
         [self.tracking, self.force, self.torque, self.shear, self.bending, self.angular, self.total()]
     }
@@ -163,7 +164,13 @@ pub(crate) fn d3_jacobian(alpha: &Vector3<f64>) -> Matrix3<f64> {
 }
 
 /// Local KKT matrix and right-hand side of one element (I4).
-pub(crate) fn element_system(problem: &Problem, p: &InverseParams, uk: &LocalVec, xg: [Vector3<f64>; 2], alpha_prev: [Vector3<f64>; 2]) -> (KktMat, KktVec) {
+pub(crate) fn element_system(
+    problem: &Problem,
+    p: &InverseParams,
+    uk: &LocalVec,
+    xg: [Vector3<f64>; 2],
+    alpha_prev: [Vector3<f64>; 2],
+) -> (KktMat, KktVec) {
     let h = problem.mesh.h();
     let mut m = KktMat::zeros();
     let mut r = KktVec::zeros();
@@ -313,7 +320,11 @@ pub fn solve_frame_observed_in(
             return Ok(InverseSolution { u, adjoint, history });
         }
     }
-    Err(SolveError::InverseNotConverged { frame: p.frame, iterations: p.max_iterations, rel_change: history.last().map(|h| h.rel_change).unwrap_or(f64::NAN) })
+    Err(SolveError::InverseNotConverged {
+        frame: p.frame,
+        iterations: p.max_iterations,
+        rel_change: history.last().map(|h| h.rel_change).unwrap_or(f64::NAN),
+    })
 }
 
 /// Everything the inverse solvers of one frame (fixed point, Newton, warm start) need besides
@@ -348,7 +359,15 @@ impl InverseWorkspace {
         let pattern = Pattern::with_block(&problem.mesh, BLOCK);
         let solver = LinearSolver::new(&pattern)?;
         let values = vec![0.0; pattern.nnz()];
-        Ok(InverseWorkspace { nodes: problem.mesh.nodes(), pattern, solver, fixed: Vec::new(), rows: Vec::new(), values, weights: Vec::new() })
+        Ok(InverseWorkspace {
+            nodes: problem.mesh.nodes(),
+            pattern,
+            solver,
+            fixed: Vec::new(),
+            rows: Vec::new(),
+            values,
+            weights: Vec::new(),
+        })
     }
 
     /// The workspace must have been made for this mesh.
@@ -368,7 +387,14 @@ impl InverseWorkspace {
 
     /// Solve `K(u) U = r(u)` with the boundary conditions of I5 (equilibrated, I6); `U` has
     /// [`BLOCK`] unknowns per node. [`InverseWorkspace::set_dirichlet`] must have run for the frame.
-    pub(crate) fn solve_at(&mut self, problem: &Problem, p: &InverseParams, u: &DVector<f64>, x_g: &[Vector3<f64>], alpha_prev: &[Vector3<f64>]) -> Result<DVector<f64>, SolveError> {
+    pub(crate) fn solve_at(
+        &mut self,
+        problem: &Problem,
+        p: &InverseParams,
+        u: &DVector<f64>,
+        x_g: &[Vector3<f64>],
+        alpha_prev: &[Vector3<f64>],
+    ) -> Result<DVector<f64>, SolveError> {
         let mut rhs = assemble_kkt(problem, p, &self.pattern, &mut self.values, u, x_g, alpha_prev);
         for &(d, v) in &self.fixed {
             rhs[d] = v;
@@ -448,7 +474,12 @@ pub fn assemble_kkt(
 /// The one element loop of the inverse problem (fixed point and Newton): zero `values`, add
 /// each element's local KKT matrix `kernel(e).0` into them, and return the sum of the local
 /// vectors `kernel(e).1` (12 unknowns per node).
-pub(crate) fn assemble_blocks(problem: &Problem, pattern: &Pattern, values: &mut [f64], mut kernel: impl FnMut(usize) -> (KktMat, KktVec)) -> DVector<f64> {
+pub(crate) fn assemble_blocks(
+    problem: &Problem,
+    pattern: &Pattern,
+    values: &mut [f64],
+    mut kernel: impl FnMut(usize) -> (KktMat, KktVec),
+) -> DVector<f64> {
     values.iter_mut().for_each(|v| *v = 0.0);
     let mut rhs = DVector::zeros(BLOCK * problem.mesh.nodes());
     for e in 0..problem.mesh.elements {
@@ -485,7 +516,14 @@ pub fn fit_measures(problem: &Problem, p: &InverseParams, u: &DVector<f64>, x_g:
 
 /// The terms of the objective (41) at the state `u` with the adjoint `adjoint` (6 per node
 /// each), integrated with the rules of I2.
-pub fn objective_terms(problem: &Problem, p: &InverseParams, u: &DVector<f64>, adjoint: &DVector<f64>, x_g: &[Vector3<f64>], alpha_prev: &[Vector3<f64>]) -> ObjectiveTerms {
+pub fn objective_terms(
+    problem: &Problem,
+    p: &InverseParams,
+    u: &DVector<f64>,
+    adjoint: &DVector<f64>,
+    x_g: &[Vector3<f64>],
+    alpha_prev: &[Vector3<f64>],
+) -> ObjectiveTerms {
     let h = problem.mesh.h();
     let mut t = ObjectiveTerms::default();
     let omega_on = !p.first_frame;
@@ -554,17 +592,30 @@ mod tests {
     /// printed sign would make the α–α block λd DᵀD negative and break the symmetry.
     #[test]
     fn element_kkt_matrix_is_symmetric() {
-        let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/cases/follower_bend_64.toml")).expect("case");
+        let text =
+            std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/cases/follower_bend_64.toml")).expect("case");
         let case = Case::from_toml(&text, "c", std::path::Path::new("c")).expect("case");
         let problem = Problem::from_case(&case);
         let h = case.mesh.h();
         let uk = LocalVec::from_column_slice(&[0.0, 1e-6, 0.0, 0.1, -0.4, 0.2, 2e-7, 3e-6, h, 0.15, -0.5, 0.25]);
         let p = InverseParams {
-            lambda_g: 1e9, lambda_f: 1.0, lambda_l: 1e-10, lambda_d: 1e-6,
-            lambda_kappa: Vector3::new(0.0, 1e-12, 1e-10), lambda_omega: Vector3::new(1e-3, 0.0, 1e-2), dt: 0.04,
-            first_frame: false, alpha0: 0.0, frame: 0, stabilisation: 0.0, relaxation: 0.5, tolerance: 1e-6, max_iterations: 1,
+            lambda_g: 1e9,
+            lambda_f: 1.0,
+            lambda_l: 1e-10,
+            lambda_d: 1e-6,
+            lambda_kappa: Vector3::new(0.0, 1e-12, 1e-10),
+            lambda_omega: Vector3::new(1e-3, 0.0, 1e-2),
+            dt: 0.04,
+            first_frame: false,
+            alpha0: 0.0,
+            frame: 0,
+            stabilisation: 0.0,
+            relaxation: 0.5,
+            tolerance: 1e-6,
+            max_iterations: 1,
         };
-        let (m, _) = element_system(&problem, &p, &uk, [Vector3::zeros(), Vector3::new(0.0, 0.0, h)], [Vector3::zeros(); 2]);
+        let (m, _) =
+            element_system(&problem, &p, &uk, [Vector3::zeros(), Vector3::new(0.0, 0.0, h)], [Vector3::zeros(); 2]);
         let asym = (m - m.transpose()).amax() / m.amax();
         assert!(asym < 1e-14, "asymmetry {asym:e}");
         // The λd block alone is positive semi-definite.

@@ -25,14 +25,17 @@
 use nalgebra::{DVector, Matrix3, Vector3};
 
 use super::inverse::{
-    assemble_blocks, dirichlet, element_system, kkt, part, record, tangent_points, InverseParams, InverseRecord, InverseSolution, InverseWorkspace, KktMat, KktVec, BLOCK,
+    assemble_blocks, dirichlet, element_system, kkt, part, record, tangent_points, InverseParams, InverseRecord,
+    InverseSolution, InverseWorkspace, KktMat, KktVec, BLOCK,
 };
 use super::statics::relative_change;
 use super::{Problem, SolveError};
 use crate::assembly::Pattern;
 use crate::element::{frozen_operator, internal_force, interpolate, LocalMat, LocalVec};
 use crate::mesh::GAUSS2;
-use crate::rotation::{a_matrix, a_matrix_derivatives, d3, d3_second_derivatives, rotation, rotation_derivatives, skew, PointFrame};
+use crate::rotation::{
+    a_matrix, a_matrix_derivatives, d3, d3_second_derivatives, rotation, rotation_derivatives, skew, PointFrame,
+};
 
 /// Smallest step fraction of the backtracking line search (2⁻¹⁰).
 const MIN_STEP: f64 = 1.0 / 1024.0;
@@ -116,7 +119,9 @@ fn coefficient_derivative(problem: &Problem, p: &InverseParams, ue: &KktVec, alp
         let wh = w * h;
         let f = PointFrame::new(&q.alpha, true);
         let (Q, A, dQ, dA) = (f.q, f.a, f.dq, f.da);
-        let mut blk = columns([0, 1, 2].map(|j| (dQ[j].transpose() * Jm * A + Q.transpose() * Jm * dA[j]).transpose() * qa.dalpha));
+        let mut blk = columns(
+            [0, 1, 2].map(|j| (dQ[j].transpose() * Jm * A + Q.transpose() * Jm * dA[j]).transpose() * qa.dalpha),
+        );
         if kappa_on {
             blk += columns([0, 1, 2].map(|j| (dA[j].transpose() * Lk * A + A.transpose() * Lk * dA[j]) * q.dalpha));
         }
@@ -191,7 +196,14 @@ fn assemble_newton_with(
 
 /// The residual of [`assemble_newton`] alone (the line search's merit needs no Jacobian):
 /// the same element sums in the same order, so the same numbers.
-fn newton_residual(problem: &Problem, p: &InverseParams, big: &DVector<f64>, x_g: &[Vector3<f64>], alpha_prev: &[Vector3<f64>], fixed: &[(usize, f64)]) -> DVector<f64> {
+fn newton_residual(
+    problem: &Problem,
+    p: &InverseParams,
+    big: &DVector<f64>,
+    x_g: &[Vector3<f64>],
+    alpha_prev: &[Vector3<f64>],
+    fixed: &[(usize, f64)],
+) -> DVector<f64> {
     let mut r = DVector::zeros(BLOCK * problem.mesh.nodes());
     for e in 0..problem.mesh.elements {
         let ue = KktVec::from_column_slice(&big.as_slice()[BLOCK * e..BLOCK * (e + 2)]);
@@ -314,7 +326,16 @@ pub fn solve_frame_warm(
     u0: &DVector<f64>,
     progress: impl FnMut(&InverseRecord, &DVector<f64>, &DVector<f64>),
 ) -> Result<InverseSolution, SolveError> {
-    solve_frame_warm_in(&mut InverseWorkspace::new(problem)?, problem, p, warm_start_tolerance, x_g, alpha_prev, u0, progress)
+    solve_frame_warm_in(
+        &mut InverseWorkspace::new(problem)?,
+        problem,
+        p,
+        warm_start_tolerance,
+        x_g,
+        alpha_prev,
+        u0,
+        progress,
+    )
 }
 
 /// [`solve_frame_warm`] in a workspace reused across frames (see [`InverseWorkspace`]).
@@ -337,7 +358,9 @@ pub fn solve_frame_warm_in(
         progress(&InverseRecord { iteration: r.iteration + done, ..*r }, u, a);
     })
     .map_err(|e| match e {
-        SolveError::InverseNewtonNotConverged { frame, iterations, residual } => SolveError::InverseNewtonNotConverged { frame, iterations: iterations + done, residual },
+        SolveError::InverseNewtonNotConverged { frame, iterations, residual } => {
+            SolveError::InverseNewtonNotConverged { frame, iterations: iterations + done, residual }
+        }
         other => other,
     })?;
     let mut history = start.history;

@@ -94,8 +94,12 @@ impl<'a> Problem<'a> {
         };
         let mut f = match (self.loads.has_distributed(), self.loads.frame) {
             (false, _) => DVector::zeros(self.mesh.ndofs()),
-            (true, LoadFrame::Global) => assemble_vector(&self.mesh, |_, s0| distributed_load(self.scheme, h, s0, &mut field)),
-            (true, LoadFrame::Local) => self.assemble_with_tangent(tangent, |e, s0, t| follower_load(self.scheme, h, s0, &gather(u, e), &mut field, t)),
+            (true, LoadFrame::Global) => {
+                assemble_vector(&self.mesh, |_, s0| distributed_load(self.scheme, h, s0, &mut field))
+            }
+            (true, LoadFrame::Local) => self.assemble_with_tangent(tangent, |e, s0, t| {
+                follower_load(self.scheme, h, s0, &gather(u, e), &mut field, t)
+            }),
         };
         let (fe, le) = self.loads.end(t);
         let (fe, le) = (fe * lf, le * lf);
@@ -115,7 +119,12 @@ impl<'a> Problem<'a> {
     }
 
     /// Momentum `P(u, u̇)` of D6; optionally adds `scale_u · ∂P/∂u + scale_v · ∂P/∂u̇`.
-    pub fn momentum(&self, u: &DVector<f64>, udot: &DVector<f64>, tangent: Option<(&Pattern, &mut [f64], f64, f64)>) -> DVector<f64> {
+    pub fn momentum(
+        &self,
+        u: &DVector<f64>,
+        udot: &DVector<f64>,
+        tangent: Option<(&Pattern, &mut [f64], f64, f64)>,
+    ) -> DVector<f64> {
         let h = self.mesh.h();
         // One tangent out of two scaled kernel tangents: `su ∂P/∂u + sv ∂P/∂u̇`.
         let (su, sv) = tangent.as_ref().map(|t| (t.2, t.3)).unwrap_or((0.0, 0.0));

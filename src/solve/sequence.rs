@@ -16,7 +16,9 @@ use nalgebra::{DVector, Matrix3, Vector3};
 use crate::chart::{frame_axis, Chart};
 use crate::rotation::{angles_from_rotation, Angles};
 
-use super::inverse::{solve_frame_observed_in, InverseParams, InverseRecord, InverseSolution, InverseWorkspace, ObjectiveTerms};
+use super::inverse::{
+    solve_frame_observed_in, InverseParams, InverseRecord, InverseSolution, InverseWorkspace, ObjectiveTerms,
+};
 use super::inverse_newton::{solve_frame_newton_observed_in, solve_frame_warm_in};
 use super::{node_values, Problem, SolveError};
 
@@ -105,7 +107,13 @@ pub enum SequenceError {
 
 /// Smallest |cos β| over the nodes of a state and its node.
 pub fn min_cos_beta(u: &DVector<f64>) -> (f64, usize) {
-    (0..u.len() / 6).map(|i| (node_values(u, i).1[1].cos().abs(), i)).fold((f64::INFINITY, 0), |a, b| if b.0 < a.0 { b } else { a })
+    (0..u.len() / 6).map(|i| (node_values(u, i).1[1].cos().abs(), i)).fold((f64::INFINITY, 0), |a, b| {
+        if b.0 < a.0 {
+            b
+        } else {
+            a
+        }
+    })
 }
 
 /// max_e |j_e − 1|, j_e = |x_{e+1} − x_e| / h (Remark 9).
@@ -209,7 +217,8 @@ pub fn solve_sequence(
             (RotationTreatment::Rebased, None) => Chart::with_axis(&sp.gauge),
             (RotationTreatment::Rebased, Some((c, _))) => Chart::with_axis(&frame_axis(x_space, Some(&c.axis()))),
         };
-        let x_g: Vec<Vector3<f64>> = if chart.is_identity() { x_space.clone() } else { x_space.iter().map(|x| chart.to_chart(x)).collect() };
+        let x_g: Vec<Vector3<f64>> =
+            if chart.is_identity() { x_space.clone() } else { x_space.iter().map(|x| chart.to_chart(x)).collect() };
         let guess = || data_frame_guess(&x_g);
         // The previous frame's state in this frame's chart (R6).
         // The previous frame's state in this frame's chart (R6); with two previous frames, the
@@ -239,11 +248,17 @@ pub fn solve_sequence(
         let mut solve = |start: &DVector<f64>, warm: bool| -> Result<InverseSolution, SolveError> {
             let report = |r: &InverseRecord, _: &DVector<f64>, _: &DVector<f64>| on_iteration(k, r);
             match sp.method {
-                FrameMethod::FixedPoint => solve_frame_observed_in(&mut ws, problem, &p, &x_g, &alpha_prev, start, report),
+                FrameMethod::FixedPoint => {
+                    solve_frame_observed_in(&mut ws, problem, &p, &x_g, &alpha_prev, start, report)
+                }
                 // From the previous frame's solution (already close) Newton runs directly; from
                 // a guess it needs the fixed point's warm start (I8).
-                FrameMethod::Newton { .. } if warm => solve_frame_newton_observed_in(&mut ws, problem, &p, &x_g, &alpha_prev, start, report),
-                FrameMethod::Newton { warm_start_tolerance } => solve_frame_warm_in(&mut ws, problem, &p, warm_start_tolerance, &x_g, &alpha_prev, start, report),
+                FrameMethod::Newton { .. } if warm => {
+                    solve_frame_newton_observed_in(&mut ws, problem, &p, &x_g, &alpha_prev, start, report)
+                }
+                FrameMethod::Newton { warm_start_tolerance } => {
+                    solve_frame_warm_in(&mut ws, problem, &p, warm_start_tolerance, &x_g, &alpha_prev, start, report)
+                }
             }
         };
         // A frame that does not converge from the previous frame's solution is solved again
@@ -251,14 +266,28 @@ pub fn solve_sequence(
         let from_previous = i > 0 && sp.start == FrameStart::PreviousFrame;
         let (sol, restarted) = match solve(&first_start, from_previous) {
             Ok(sol) => (sol, false),
-            Err(SolveError::InverseNotConverged { .. } | SolveError::InverseNewtonNotConverged { .. } | SolveError::InverseNonFinite { .. }) if from_previous => (solve(&guess(), false)?, true),
+            Err(
+                SolveError::InverseNotConverged { .. }
+                | SolveError::InverseNewtonNotConverged { .. }
+                | SolveError::InverseNonFinite { .. },
+            ) if from_previous => (solve(&guess(), false)?, true),
             Err(e) => return Err(e.into()),
         };
         let (cos_beta, node) = min_cos_beta(&sol.u);
         if cos_beta < sp.min_cos_beta {
-            return Err(SequenceError::SingularChart { frame: k, node, cos_beta, guard: sp.min_cos_beta, axis: chart.axis().into() });
+            return Err(SequenceError::SingularChart {
+                frame: k,
+                node,
+                cos_beta,
+                guard: sp.min_cos_beta,
+                axis: chart.axis().into(),
+            });
         }
-        let last = sol.history.last().copied().ok_or(SequenceError::Callback { frame: k, message: "no iteration ran".into() })?;
+        let last = sol
+            .history
+            .last()
+            .copied()
+            .ok_or(SequenceError::Callback { frame: k, message: "no iteration ran".into() })?;
         let rep = FrameReport {
             frame: k,
             iterations: sol.history.len(),
@@ -274,7 +303,8 @@ pub fn solve_sequence(
             wall_time_s: start.elapsed().as_secs_f64(),
         };
         let in_space = if chart.is_identity() { None } else { Some(to_space(&chart, &sol)) };
-        on_frame(&rep, &FrameSolution { solution: in_space.as_ref().unwrap_or(&sol), chart }).map_err(|message| SequenceError::Callback { frame: k, message })?;
+        on_frame(&rep, &FrameSolution { solution: in_space.as_ref().unwrap_or(&sol), chart })
+            .map_err(|message| SequenceError::Callback { frame: k, message })?;
         prev2 = prev.take();
         prev = Some((chart, sol.u));
         reports.push(rep);

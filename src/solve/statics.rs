@@ -56,7 +56,11 @@ pub struct StaticSolution {
 }
 
 /// Solve the static problem from the reference configuration, with load continuation.
-pub fn solve(problem: &Problem, params: &StaticParams, mut progress: impl FnMut(&IterationRecord)) -> Result<StaticSolution, SolveError> {
+pub fn solve(
+    problem: &Problem,
+    params: &StaticParams,
+    mut progress: impl FnMut(&IterationRecord),
+) -> Result<StaticSolution, SolveError> {
     let pattern = Pattern::new(&problem.mesh);
     let mut solver = LinearSolver::new(&pattern)?;
     let steps = params.continuation_steps.max(1);
@@ -136,8 +140,12 @@ fn solve_step(
         }
     }
     match params.method {
-        Method::FixedPoint { .. } => Err(SolveError::FixedPointNotConverged { step, iterations: params.max_iterations, rel_change: last }),
-        Method::Newton => Err(SolveError::NewtonNotConverged { step: Some(step), iterations: params.max_iterations, increment: last }),
+        Method::FixedPoint { .. } => {
+            Err(SolveError::FixedPointNotConverged { step, iterations: params.max_iterations, rel_change: last })
+        }
+        Method::Newton => {
+            Err(SolveError::NewtonNotConverged { step: Some(step), iterations: params.max_iterations, increment: last })
+        }
     }
 }
 

@@ -58,7 +58,12 @@ pub fn is_clip(case: &Case) -> bool {
 pub fn forward_data(case: &Case, steps: usize) -> (nalgebra::DVector<f64>, Vec<nalgebra::Vector3<f64>>) {
     use cosserat::solve::statics::{self, Method, StaticParams};
     let p = cosserat::solve::Problem::from_case(case);
-    let fwd = statics::solve(&p, &StaticParams { method: Method::Newton, tolerance: 1e-13, max_iterations: 40, continuation_steps: steps }, |_| {}).expect("forward data");
+    let fwd = statics::solve(
+        &p,
+        &StaticParams { method: Method::Newton, tolerance: 1e-13, max_iterations: 40, continuation_steps: steps },
+        |_| {},
+    )
+    .expect("forward data");
     let xg = (0..case.mesh.nodes()).map(|i| cosserat::solve::node_values(&fwd.u, i).0).collect();
     (fwd.u, xg)
 }
