@@ -6,14 +6,15 @@
 use std::time::Instant;
 
 use anyhow::{Context, Result};
-use cosserat::assembly::{LinearSolver, Pattern};
 use cosserat::case::Case;
-use cosserat::run::{inverse_params, load_clip};
-use cosserat::solve::inverse::{InverseParams, InverseWorkspace, BLOCK};
-use cosserat::solve::inverse_newton::{assemble_newton, solve_frame_newton_observed_in, solve_frame_warm_in};
+use cosserat::io::clip_files::load_clip;
+use cosserat::linalg::LinearSolver;
+use cosserat::model::mesh::Field;
+use cosserat::solve::inverse::kkt::dirichlet;
+use cosserat::solve::inverse::newton::assemble_residual;
+use cosserat::solve::inverse::{Frame, FrameSolver, InverseMethod, InverseParams, Start};
 use cosserat::solve::sequence::data_frame_guess;
-use cosserat::solve::{node_values, Problem};
-use nalgebra::{DVector, Vector3};
+use nalgebra::DVector;
 
 /// CPU time of this thread [s] (Linux `schedstat`: immune to other processes on a shared
 /// machine), or wall time elsewhere.
@@ -38,55 +39,41 @@ fn main() -> Result<()> {
     let reps: usize = std::env::args().nth(1).map(|s| s.parse()).transpose()?.unwrap_or(200);
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/cases/worm_omega_turn_ld1.toml");
     let case = Case::from_file(std::path::Path::new(path)).context("case")?;
-    let clip = load_clip(&case).context("clip (scripts/fetch_worm_data.sh)")?;
-    let settings = case.inverse().context("inverse case")?;
-    let problem = Problem::from_case(&case);
-    let base = InverseParams { dt: clip.dt_s, ..inverse_params(settings) };
+    let (clip, _) = load_clip(&case).context("clip (scripts/fetch_worm_data.sh)")?;
+    let problem = case.problem();
+    let base = case.inverse().context("inverse case")?.params;
     let warm = 1e-3;
     let n = problem.mesh.nodes();
-    let mut ws = InverseWorkspace::new(&problem)?;
+    let (fwd, kd) = (problem.dofs(), problem.mesh.kkt_dofs());
 
     // Frame 0, then frame 1 up to the warm start: a realistic Newton start.
-    let p0 = InverseParams { first_frame: true, frame: 0, ..base };
-    let zero = vec![Vector3::zeros(); n];
-    let f0 = solve_frame_warm_in(
-        &mut ws,
-        &problem,
-        &p0,
-        warm,
-        &clip.frames[0],
-        &zero,
-        &data_frame_guess(&clip.frames[0]),
-        |_, _, _| {},
-    )?;
-    let prev: Vec<Vector3<f64>> = (0..n).map(|i| node_values(&f0.u, i).1).collect();
-    let p1 = InverseParams { first_frame: false, frame: 1, ..base };
+    let mut solver0 = FrameSolver::new(&problem, base);
+    let f0_frame = Frame { index: 0, x_g: &clip.frames[0], previous: None };
+    let f0 = solver0.solve(&f0_frame, &data_frame_guess(&clip.frames[0]), Start::Guess, |_, _, _| {})?.converged(0)?;
+    let prev = fwd.field(&f0.u, Field::Alpha);
     let x_g = &clip.frames[1];
-    let start = cosserat::solve::inverse::solve_frame_observed_in(
-        &mut ws,
-        &problem,
-        &InverseParams { tolerance: warm, ..p1 },
-        x_g,
-        &prev,
-        &data_frame_guess(x_g),
-        |_, _, _| {},
-    )?;
+    let frame = Frame { index: 1, x_g, previous: Some(&prev) };
+    let warm_params = InverseParams { method: InverseMethod::FixedPoint, tolerance: warm, ..base };
+    let start =
+        FrameSolver::new(&problem, warm_params).solve(&frame, &data_frame_guess(x_g), Start::Guess, |_, _, _| {})?;
 
     // The KKT vector at the start (state and adjoint of the last fixed-point solve).
-    let mut big = DVector::zeros(BLOCK * n);
+    let mut big = kd.zeros();
     for i in 0..n {
-        for k in 0..6 {
-            big[BLOCK * i + k] = start.u[6 * i + k];
-            big[BLOCK * i + 6 + k] = start.adjoint[6 * i + k];
+        for (field, hat) in [(Field::X, Field::XHat), (Field::Alpha, Field::AlphaHat)] {
+            kd.set(&mut big, i, field, &fwd.get(&start.u, i, field));
+            kd.set(&mut big, i, hat, &fwd.get(&start.adjoint, i, field));
         }
     }
-    let pattern = Pattern::with_block(&problem.mesh, BLOCK);
-    let mut solver = LinearSolver::new(&pattern)?;
+    let fixed = dirichlet(&kd, base.alpha0_rad, &frame);
+    let rows: Vec<usize> = fixed.iter().map(|f| f.0).collect();
+    let pattern = kd.pattern();
+    let mut solver = LinearSolver::new(&pattern);
     let mut values = vec![0.0; pattern.nnz()];
     let t = Clock::now();
     let mut r = DVector::zeros(0);
     for _ in 0..reps {
-        r = assemble_newton(&problem, &p1, &pattern, &mut values, &big, x_g, &prev);
+        r = assemble_residual(&problem, &base, &frame, &prev, &big, &fixed, Some((&pattern, &mut values, &rows)));
     }
     let assemble = elapsed(&t) / reps as f64;
     let t = Clock::now();
@@ -103,13 +90,14 @@ fn main() -> Result<()> {
     let t = Clock::now();
     let mut iterations = 0;
     let runs = (reps / 20).max(1);
+    let mut newton_solver = FrameSolver::new(&problem, base);
     for _ in 0..runs {
-        let sol = solve_frame_newton_observed_in(&mut ws, &problem, &p1, x_g, &prev, &start.u, |_, _, _| {})?;
+        let sol = newton_solver.solve(&frame, &start.u, Start::Near, |_, _, _| {})?;
         iterations += sol.history.len();
     }
     let newton = elapsed(&t) / iterations as f64;
     println!("(CPU time of the thread where /proc/thread-self/schedstat exists, else wall time)");
-    println!("{} nodes, {} unknowns, {} stored entries", n, BLOCK * n, pattern.nnz());
+    println!("{} nodes, {} unknowns, {} stored entries", n, kd.len(), pattern.nnz());
     println!("Newton Jacobian + residual assembly: {:8.3} ms", assemble * 1e3);
     println!("equilibrated banded LU solve:       {:8.3} ms (relative residual {res:.1e})", solve * 1e3);
     println!(

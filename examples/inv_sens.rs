@@ -1,25 +1,28 @@
 //! Conditioning probe: how far does a round-off-sized perturbation of the data move the inverse
 //! result at the same iteration count? Justifies the `compare.adjoint_rel` of the inverse cases.
-use cosserat::metrics::max_relative_difference;
-use cosserat::run::{generate_data, run_rust_inverse};
+//! `cargo run --release --example inv_sens -- cases/inverse_bend.toml [eps]`
+use anyhow::{Context, Result};
+use cosserat::case::{Analysis, Case};
+use cosserat::run::metrics::max_relative_difference;
+use cosserat::run::{forward_data, run_inverse};
 
-fn main() {
-    let path = std::env::args().nth(1).expect("case");
-    let eps: f64 = std::env::args().nth(2).and_then(|a| a.parse().ok()).unwrap_or(1e-15);
-    let mut case = cosserat::case::Case::from_file(std::path::Path::new(&path)).expect("case");
-    let data = generate_data(&case).expect("data");
+fn main() -> Result<()> {
+    let path = std::env::args().nth(1).context("usage: inv_sens CASE [eps]")?;
+    let eps: f64 = std::env::args().nth(2).map(|a| a.parse()).transpose()?.unwrap_or(1e-15);
+    let mut case = Case::from_file(std::path::Path::new(&path))?;
+    let data = forward_data(&case)?;
     // Stop both runs at the same iteration: a tolerance just above the unperturbed run's last change.
-    let first = run_rust_inverse(&case, &data, |_, _| {}).expect("first");
-    if let cosserat::case::Analysis::Inverse(s) = &mut case.analysis {
-        s.tolerance = first.stats.last_change.expect("change") * 1.001;
+    let first = run_inverse(&case, &data, |_, _| {})?;
+    if let Analysis::Inverse(s) = &mut case.analysis {
+        s.params.tolerance = first.stats.last_change.context("change")? * 1.001;
     }
     let mut pert = data.clone();
     for (i, x) in pert.x.iter_mut().enumerate() {
         *x *= 1.0 + eps * ((i as f64 * 1.7).sin());
     }
-    let a = run_rust_inverse(&case, &data, |_, _| {}).expect("a");
-    let b = run_rust_inverse(&case, &pert, |_, _| {}).expect("b");
-    let (ia, ib) = (a.inverse.unwrap(), b.inverse.unwrap());
+    let a = run_inverse(&case, &data, |_, _| {})?;
+    let b = run_inverse(&case, &pert, |_, _| {})?;
+    let (ia, ib) = (a.inverse.context("inverse")?, b.inverse.context("inverse")?);
     for k in [1usize, 10, 100, 300, 362] {
         if k < ia.history.len() && k < ib.history.len() {
             println!("iteration {}: change {:.6e} / {:.6e}", k + 1, ia.history[k].rel_change, ib.history[k].rel_change);
@@ -34,4 +37,5 @@ fn main() {
         max_relative_difference(&ia.xhat, &ib.xhat),
         max_relative_difference(&ia.ahat, &ib.ahat)
     );
+    Ok(())
 }

@@ -7,12 +7,15 @@ use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use cosserat::case::{case_files, Case};
-use cosserat::data::write_data;
-use cosserat::metrics::{all_metrics, compare};
-use cosserat::output::write_run;
-use cosserat::run::{generate_data, run_inverse_on, Engine, RunResult};
+use cosserat::io::clip_output::{write_clip_kymographs, write_clip_plot, write_truth_plot};
+use cosserat::io::data::write_data;
+use cosserat::io::engine::{load_data, run_case, run_clip_case, run_inverse_on};
+use cosserat::io::run_files::{write_convergence_plot, write_run};
+use cosserat::io::sweep::{run_point, summary_csv, RunStatus, SummaryRow};
+use cosserat::io::write_atomic;
+use cosserat::run::metrics::{all_metrics, compare};
+use cosserat::run::{Engine, RunResult};
 use cosserat::solve::modes::modal_model;
-use cosserat::solve::Problem;
 
 /// Forward Cosserat rods after Wang et al. (Comput. Mech. 71, 2023), in Rust and FreeFEM.
 #[derive(Parser, Debug)]
@@ -135,7 +138,7 @@ fn prepare_data(case: &Case, dir: &Path) -> Result<Option<PathBuf>> {
         return Ok(None);
     }
     let path = dir.join("data.csv");
-    let data = generate_data(case).with_context(|| format!("case {}: generating the forward data", case.name))?;
+    let data = load_data(case).with_context(|| format!("case {}: generating the forward data", case.name))?;
     write_data(&path, &data)?;
     Ok(Some(path))
 }
@@ -152,7 +155,7 @@ fn run_engine(case: &Case, engine: Engine, dir: &Path, data: Option<&Path>, quie
     let work = dir.join("freefem_work");
     let result = match data {
         Some(path) => run_inverse_on(case, engine, path, &work, progress),
-        None => cosserat::run::run(case, engine, &work, progress),
+        None => run_case(case, engine, &work, progress),
     };
     pb.finish_and_clear();
     result.with_context(|| format!("case {}", case.name))
@@ -161,7 +164,7 @@ fn run_engine(case: &Case, engine: Engine, dir: &Path, data: Option<&Path>, quie
 fn cmd_run(path: &Path, engine: Engine, out: Option<PathBuf>, quiet: bool) -> Result<ExitCode> {
     let case = load(path)?;
     let dir = out.unwrap_or_else(|| PathBuf::from("out").join(&case.name).join(engine.to_string()));
-    if matches!(case.inverse().map(|i| &i.data), Some(cosserat::case::DataSource::Clip(_))) {
+    if case.clip().is_some() {
         return cmd_run_clip(&case, engine, &dir, quiet);
     }
     let data = prepare_data(&case, &dir)?;
@@ -192,7 +195,7 @@ fn cmd_run_clip(case: &Case, engine: Engine, dir: &Path, quiet: bool) -> Result<
         );
     }
     let pb = progress_bar(quiet, &format!("{} [frames]", case.name));
-    let result = cosserat::run::run_clip(case, dir, |done, total| {
+    let result = run_clip_case(case, dir, |done, total| {
         pb.set_length(total as u64);
         pb.set_position(done as u64);
     });
@@ -201,16 +204,16 @@ fn cmd_run_clip(case: &Case, engine: Engine, dir: &Path, quiet: bool) -> Result<
         Ok(r) => r,
         Err(e) => {
             let e = anyhow::Error::from(e).context(format!("case {}", case.name));
-            let _ = cosserat::output::write_atomic(
+            let _ = write_atomic(
                 &dir.join("FAILED.txt"),
                 format!("{e:#}\nThe converged frames before it are in this folder.\n").as_bytes(),
             );
             return Err(e);
         }
     };
-    cosserat::output::write_clip_plot(case, &run.reports, &run.roughness, &dir.join("plot.svg"))?;
-    cosserat::output::write_clip_kymographs(case, &run, &dir.join("kymograph.svg"))?;
-    cosserat::output::write_truth_plot(case, &run, &dir.join("truth.svg"))?;
+    write_clip_plot(case, &run.reports, &run.roughness, &dir.join("plot.svg"))?;
+    write_clip_kymographs(case, &run, &dir.join("kymograph.svg"))?;
+    write_truth_plot(case, &run, &dir.join("truth.svg"))?;
     if let Some(t) = &run.truth {
         let max = |f: &dyn Fn(&cosserat::clip::synthetic::FrameComparison) -> f64| {
             t.comparisons.iter().map(f).fold(0.0, f64::max)
@@ -250,7 +253,7 @@ fn cmd_compare(path: &Path, out: Option<PathBuf>) -> Result<ExitCode> {
     let data = prepare_data(&case, &dir)?;
     let rust = run_engine(&case, Engine::Rust, &dir.join("rust"), data.as_deref(), false)?;
     write_run(&case, &rust, &all_metrics(&case, &rust)?, &dir.join("rust"))?;
-    if matches!(case.inverse().map(|i| i.method), Some(cosserat::case::InverseMethod::Newton { .. })) {
+    if matches!(case.inverse().map(|i| i.params.method), Some(cosserat::solve::inverse::InverseMethod::Newton { .. })) {
         println!(
             "{}: inverse Newton runs in the Rust engine only (FreeFEM mirrors the paper's fixed point); wrote {} ({} iterations, {:.3} s). Compare its fixed-point twin instead.",
             case.name,
@@ -287,60 +290,8 @@ fn cmd_compare(path: &Path, out: Option<PathBuf>) -> Result<ExitCode> {
     Ok(if failed == 0 { ExitCode::SUCCESS } else { ExitCode::from(1) })
 }
 
-/// What one run of a sweep produced.
-struct SweepOutcome {
-    status: cosserat::sweep::RunStatus,
-    metrics: Option<cosserat::metrics::Metrics>,
-    run: Option<RunResult>,
-    error: Option<String>,
-}
-
-/// One run of a sweep in the Rust engine, writing its folder. A run that stops at its iteration
-/// limit still writes the files of its last iterate, plus `FAILED.txt` with the error.
-fn sweep_run(case: &Case, dir: &Path) -> SweepOutcome {
-    use cosserat::run::RunError;
-    use cosserat::sweep::RunStatus;
-    let failed = |e: anyhow::Error| SweepOutcome {
-        status: RunStatus::Failed,
-        metrics: None,
-        run: None,
-        error: Some(format!("{e:#}")),
-    };
-    let data = match prepare_data(case, dir) {
-        Ok(d) => d,
-        Err(e) => return failed(e),
-    };
-    let path = data.as_deref().unwrap_or(Path::new(""));
-    let work = dir.join("freefem_work");
-    let outcome = if data.is_some() {
-        run_inverse_on(case, Engine::Rust, path, &work, |_, _| {})
-    } else {
-        cosserat::run::run(case, Engine::Rust, &work, |_, _| {})
-    };
-    let (status, r, error) = match outcome {
-        Ok(r) => (RunStatus::Ok, r, None),
-        Err(RunError::Incomplete { source, partial }) => (RunStatus::NotConverged, *partial, Some(source.to_string())),
-        Err(e) => return failed(anyhow::Error::from(e).context(format!("case {}", case.name))),
-    };
-    let write = || -> Result<cosserat::metrics::Metrics> {
-        let m = all_metrics(case, &r)?;
-        write_run(case, &r, &m, dir)?;
-        if let Some(e) = &error {
-            cosserat::output::write_atomic(
-                &dir.join("FAILED.txt"),
-                format!("{e}\nThe files here hold the last iterate.\n").as_bytes(),
-            )?;
-        }
-        Ok(m)
-    };
-    match write() {
-        Ok(m) => SweepOutcome { status, metrics: Some(m), run: Some(r), error },
-        Err(e) => failed(e),
-    }
-}
-
 fn cmd_sweep(path: &Path, set: &[String], out: Option<PathBuf>, jobs: Option<usize>, quiet: bool) -> Result<ExitCode> {
-    use cosserat::sweep::{parse_set, product, summary_csv, SummaryRow};
+    use cosserat::case::sweep::{parse_set, product};
     use rayon::prelude::*;
     let case = load(path)?;
     let params = set.iter().map(|s| parse_set(s)).collect::<Result<Vec<_>, _>>()?;
@@ -353,7 +304,7 @@ fn cmd_sweep(path: &Path, set: &[String], out: Option<PathBuf>, jobs: Option<usi
         points
             .par_iter()
             .map(|(point, c)| {
-                let r = sweep_run(c, &dir.join(&c.name));
+                let r = run_point(c, &dir.join(&c.name));
                 pb.inc(1);
                 (point.clone(), c.name.clone(), r)
             })
@@ -371,13 +322,13 @@ fn cmd_sweep(path: &Path, set: &[String], out: Option<PathBuf>, jobs: Option<usi
         })
         .collect();
     let summary = dir.join("summary.csv");
-    cosserat::output::write_atomic(&summary, summary_csv(&keys, &rows)?.as_bytes())?;
+    write_atomic(&summary, summary_csv(&keys, &rows)?.as_bytes())?;
     let curves: Vec<(&String, &RunResult)> =
         results.iter().filter_map(|(_, name, o)| o.run.as_ref().map(|run| (name, run))).collect();
     if !curves.is_empty() {
-        cosserat::output::write_convergence_plot(&curves, &dir.join("convergence.svg"))?;
+        write_convergence_plot(&curves, &dir.join("convergence.svg"))?;
     }
-    let failed = rows.iter().filter(|r| r.status != cosserat::sweep::RunStatus::Ok).count();
+    let failed = rows.iter().filter(|r| r.status != RunStatus::Ok).count();
     println!(
         "{}: {} runs, {} failed or not converged; wrote {} and one folder per run to {}",
         case.name,
@@ -413,7 +364,7 @@ fn cmd_list(dir: &Path) -> Result<ExitCode> {
 
 fn cmd_modes(path: &Path, count: usize) -> Result<ExitCode> {
     let case = load(path)?;
-    let model = modal_model(&Problem::from_case(&case))?;
+    let model = modal_model(&case.problem())?;
     println!(
         "{}: natural frequencies of the linearised rod (clamped at s = 0, {} elements)",
         case.name, case.mesh.elements

@@ -11,10 +11,12 @@
 mod common;
 
 use cosserat::case::{case_files, Case};
-use cosserat::data::write_data;
-use cosserat::freefem::{find_executable, INSTALL_HINT};
-use cosserat::metrics::compare;
-use cosserat::run::{generate_data, run, run_inverse_on, run_rust, Engine};
+use cosserat::io::data::write_data;
+use cosserat::io::engine::{load_data, run_case, run_inverse_on};
+use cosserat::io::freefem::{find_executable, INSTALL_HINT};
+use cosserat::run::metrics::compare;
+use cosserat::run::{run_forward, Engine};
+use cosserat::solve::inverse::InverseMethod;
 
 const FREEFEM_DYNAMIC_STEPS: usize = 40;
 /// Bound on the dynamic prefix, stricter than a case's full-run tolerance: over 40 steps the
@@ -53,7 +55,7 @@ fn every_case_agrees_between_rust_and_freefem() {
         if common::is_clip(&case) && !common::worm_data_present(&case.name) {
             continue;
         }
-        if matches!(case.inverse().map(|i| i.method), Some(cosserat::case::InverseMethod::Newton { .. })) {
+        if matches!(case.inverse().map(|i| i.params.method), Some(InverseMethod::Newton { .. })) {
             eprintln!("{}: inverse Newton is Rust-only (FreeFEM mirrors the paper's fixed point); its fixed-point twin is compared", case.name);
             continue;
         }
@@ -62,16 +64,16 @@ fn every_case_agrees_between_rust_and_freefem() {
             // Inverse cases: both engines read the same data file (I7) and run the same fixed
             // point; the comparison includes the iteration count.
             let data = dir.path().join("data.csv");
-            write_data(&data, &generate_data(&case).unwrap_or_else(|e| panic!("{}: {e}", case.name)))
-                .expect("data.csv");
+            write_data(&data, &load_data(&case).unwrap_or_else(|e| panic!("{}: {e}", case.name))).expect("data.csv");
             let on = |engine| {
                 run_inverse_on(&case, engine, &data, dir.path(), |_, _| {})
                     .unwrap_or_else(|e| panic!("{} [{engine}]: {e}", case.name))
             };
             (on(Engine::Rust), on(Engine::Freefem))
         } else {
-            let rust = run_rust(&case, |_, _| {}).unwrap_or_else(|e| panic!("{}: {e}", case.name));
-            (rust, run(&case, Engine::Freefem, dir.path(), |_, _| {}).unwrap_or_else(|e| panic!("{}: {e}", case.name)))
+            let rust = run_forward(&case, |_, _| {}).unwrap_or_else(|e| panic!("{}: {e}", case.name));
+            let ff = run_case(&case, Engine::Freefem, dir.path(), |_, _| {});
+            (rust, ff.unwrap_or_else(|e| panic!("{}: {e}", case.name)))
         };
         eprintln!(
             "{}: rust {:.3} s, freefem {:.3} s (ratio {:.0})",

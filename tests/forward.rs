@@ -5,6 +5,7 @@ mod common;
 
 use common::{case_from, case_text, edit};
 use cosserat::case::Case;
+use cosserat::model::mesh::Field;
 use cosserat::reference::{
     euler_bernoulli_cantilever_omegas, timoshenko_tip_deflection, tip_loaded_cantilever, undamped_forced_response,
     PlanarRod,
@@ -12,19 +13,24 @@ use cosserat::reference::{
 use cosserat::solve::dynamics::{self, DynamicParams};
 use cosserat::solve::modes::modal_model;
 use cosserat::solve::statics::{self, Method, StaticParams};
-use cosserat::solve::Problem;
-use nalgebra::DVector;
+use nalgebra::{DVector, Vector3};
 
 fn static_tip(case: &Case, method: Method, tol: f64) -> (f64, f64, usize) {
-    let p = Problem::from_case(case);
+    let p = case.problem();
     let sol = statics::solve(
         &p,
         &StaticParams { method, tolerance: tol, max_iterations: 500, continuation_steps: 1 },
         |_| {},
     )
+    .and_then(|s| s.converged())
     .expect("static solve");
-    let last = case.mesh.nodes() - 1;
-    (sol.u[6 * last + 1], sol.u[6 * last + 2], sol.iterations)
+    let tip = tip(case, &sol.u);
+    (tip[1], tip[2], sol.iterations)
+}
+
+/// Position of the end s = L of a state [m].
+fn tip(case: &Case, u: &DVector<f64>) -> Vector3<f64> {
+    case.mesh.dofs().get(u, case.mesh.nodes() - 1, Field::X)
 }
 
 fn timoshenko(force_expr: &str, elements: usize, quadrature: &str) -> Case {
@@ -150,7 +156,7 @@ fn dynamic_case(steps: usize) -> Case {
 #[test]
 fn dynamic_cantilever_against_modal_superposition() {
     let base = dynamic_case(1000);
-    let problem = Problem::from_case(&base);
+    let problem = base.problem();
     let model = modal_model(&problem).expect("modes");
     let omega_load = 8.0 * base.constants["omega0"];
     // Spatial load vector: F(t) = F_s sin(Ω t); evaluate where sin(Ω t) = 1.
@@ -159,12 +165,12 @@ fn dynamic_cantilever_against_modal_superposition() {
     let last = base.mesh.nodes() - 1;
     let exact = |t: f64, comp: usize| -> f64 {
         let q = DVector::from_fn(g.len(), |i, _| undamped_forced_response(model.omegas[i], omega_load, g[i], t));
-        model.displacement(6 * last + comp, &q)
+        model.displacement(base.mesh.dofs().index(last, Field::X, comp), &q)
     };
     let mut errors = Vec::new();
     for steps in [1000, 2000, 4000] {
         let c = dynamic_case(steps);
-        let p = Problem::from_case(&c);
+        let p = c.problem();
         let params = DynamicParams { end_time_s: 0.06, steps, newton_tolerance: 1e-12, newton_max_iterations: 25 };
         let sol = dynamics::solve(&p, &params, |_, _| {}).expect("dynamic solve");
         let stride = steps / 1000;
@@ -201,14 +207,14 @@ fn modes_against_euler_bernoulli() {
     let mut reference: Vec<f64> =
         eb(c.props.bend_twist_nm2[0]).into_iter().chain(eb(c.props.bend_twist_nm2[1])).collect();
     reference.sort_by(f64::total_cmp);
-    let w = modal_model(&Problem::from_case(&c)).expect("modes").omegas;
+    let w = modal_model(&c.problem()).expect("modes").omegas;
     let first = (w[0] / 207.0236 - 1.0).abs();
     eprintln!("Timoshenko rod: omega_1 = {:.4} 1/s ({:.3} % from omega0)", w[0], 100.0 * first);
     assert!(first < 5e-3 && w[0] < reference[0]);
     c.props.shear_stretch_n[0] *= 1e3;
     c.props.shear_stretch_n[1] *= 1e3;
     c.props.rotary_inertia_kg_m *= 1e-3;
-    let w = modal_model(&Problem::from_case(&c)).expect("modes").omegas;
+    let w = modal_model(&c.problem()).expect("modes").omegas;
     for k in 0..4 {
         let e = (w[k] / reference[k] - 1.0).abs();
         eprintln!("EB limit mode {}: {:.4} vs {:.4} (rel {e:.1e})", k + 1, w[k], reference[k]);
@@ -223,7 +229,7 @@ fn modes_against_euler_bernoulli() {
 fn follower_load_eq64_large_bend() {
     let text = case_text("follower_bend_64");
     let c = case_from(&text, "f64");
-    let p = Problem::from_case(&c);
+    let p = c.problem();
     let fp = statics::solve(
         &p,
         &StaticParams {
@@ -234,24 +240,26 @@ fn follower_load_eq64_large_bend() {
         },
         |_| {},
     )
+    .and_then(|s| s.converged())
     .expect("fixed point");
     let nt = statics::solve(
         &p,
         &StaticParams { method: Method::Newton, tolerance: 1e-12, max_iterations: 30, continuation_steps: 5 },
         |_| {},
     )
+    .and_then(|s| s.converged())
     .expect("newton");
-    let last = c.mesh.nodes() - 1;
-    let (y, z) = (fp.u[6 * last + 1], fp.u[6 * last + 2]);
-    let min_beta = (0..c.mesh.nodes()).map(|i| fp.u[6 * i + 4]).fold(f64::INFINITY, f64::min);
-    eprintln!("eq. 64: tip ({:.4e}, {y:.4e}, {z:.4e}) m, min beta {min_beta:.4}, fixed point {} iterations, Newton {} over 5 steps", fp.u[6 * last], fp.iterations, nt.iterations);
-    assert!(fp.u[6 * last].abs() < 1e-15);
+    let t = tip(&c, &fp.u);
+    let (y, z) = (t[1], t[2]);
+    let min_beta = p.dofs().field(&fp.u, Field::Alpha).iter().map(|a| a[1]).fold(f64::INFINITY, f64::min);
+    eprintln!("eq. 64: tip ({:.4e}, {y:.4e}, {z:.4e}) m, min beta {min_beta:.4}, fixed point {} iterations, Newton {} over 5 steps", t[0], fp.iterations, nt.iterations);
+    assert!(t[0].abs() < 1e-15);
     assert!((y / -5.77e-4 - 1.0).abs() < 1e-3 && (z / -2.36e-4 - 1.0).abs() < 3e-3);
     assert!((min_beta + 2.84).abs() < 0.01);
     // Fixed point stopped at a relative change of 1e-9 (D10), i.e. an error of a few 1e-9
     // relative; measured: positions agree to 1.0e-12 m,
     // angles to ~2e-9 rad.
-    let (dx, da) = cosserat::solve::split_norms_inf(&(&fp.u - &nt.u));
+    let (dx, da) = p.dofs().split_norms_inf(&(&fp.u - &nt.u));
     assert!(dx < 1e-8 * c.mesh.length_m && da < 1e-8, "fixed point vs Newton: {dx:e} m, {da:e} rad");
     assert!(nt.residual < 1e-8 && fp.residual < 1e-3, "{} {}", nt.residual, fp.residual);
 }
@@ -261,26 +269,23 @@ fn follower_load_eq64_large_bend() {
 #[test]
 fn follower_load_eq65_needs_newton() {
     let c = case_from(&case_text("follower_bend_twist_65"), "f65");
-    let p = Problem::from_case(&c);
+    let p = c.problem();
     let nt = statics::solve(
         &p,
         &StaticParams { method: Method::Newton, tolerance: 1e-12, max_iterations: 30, continuation_steps: 10 },
         |_| {},
     )
+    .and_then(|s| s.converged())
     .expect("newton");
     let per_step_max = (1..=10).map(|s| nt.history.iter().filter(|h| h.step == s).count()).max().unwrap_or(0);
-    let last = c.mesh.nodes() - 1;
+    let t = tip(&c, &nt.u);
     eprintln!(
         "eq. 65: Newton {} iterations (max {per_step_max} per step), residual {:.1e}, tip ({:.4e}, {:.4e}, {:.4e})",
-        nt.iterations,
-        nt.residual,
-        nt.u[6 * last],
-        nt.u[6 * last + 1],
-        nt.u[6 * last + 2]
+        nt.iterations, nt.residual, t[0], t[1], t[2]
     );
     assert!(per_step_max <= 10, "{per_step_max}");
     assert!(nt.residual < 1e-8);
-    assert!(nt.u[6 * last].abs() > 1e-4, "fully 3D: tip x {}", nt.u[6 * last]);
+    assert!(t[0].abs() > 1e-4, "fully 3D: tip x {}", t[0]);
     let fp = statics::solve(
         &p,
         &StaticParams {
@@ -290,7 +295,8 @@ fn follower_load_eq65_needs_newton() {
             continuation_steps: 1,
         },
         |_| {},
-    );
+    )
+    .and_then(|s| s.converged());
     assert!(
         matches!(fp, Err(cosserat::solve::SolveError::FixedPointNotConverged { .. })),
         "the printed fixed point stalls at full load"

@@ -1,10 +1,10 @@
 //! Inverse problem (Problem 2, eq. 61) in the Rust engine on forward data of eq. (64).
 mod common;
 
-use common::{case_from, case_text};
-use cosserat::solve::inverse::{curvature_error, solve_frame, InverseRecord};
-use cosserat::solve::{node_values, Problem};
-use nalgebra::Vector3;
+use common::{case_from, case_text, solve_frame};
+use cosserat::model::mesh::Field;
+use cosserat::run::metrics::curvature_error;
+use cosserat::solve::inverse::{InverseRecord, Start};
 
 /// Paper §5.2, first test: λf = 1, λl = 1e-10, λd = 1e-6, Λκ = diag(0, 0, 1e-10), Λω = 0.
 /// The printed fixed point converges sublinearly: an independent re-implementation
@@ -14,16 +14,17 @@ use nalgebra::Vector3;
 #[test]
 fn recovers_eq64_frames_from_the_centreline() {
     let case = case_from(&case_text("follower_bend_64"), "f64");
-    let p = Problem::from_case(&case);
+    let p = case.problem();
     let (fwd_u, xg) = common::forward_data(&case, 5);
     let n = case.mesh.nodes();
     let params = common::paper_params_64();
     let mut hist: Vec<InverseRecord> = Vec::new();
-    let sol = solve_frame(&p, &params, &xg, &vec![Vector3::zeros(); n], &p.reference_state(), |r| hist.push(*r))
-        .expect("inverse");
+    let sol =
+        solve_frame(&p, &params, &xg, None, &p.reference_state(), Start::Guess, |r| hist.push(*r)).expect("inverse");
     let at = |k: usize| hist[k - 1].rel_change;
     let last = sol.history.last().expect("history");
-    let (k_all, k_inner) = (curvature_error(&p, &sol.u, &fwd_u, 0), curvature_error(&p, &sol.u, &fwd_u, 5));
+    let (k_all, k_inner) =
+        (curvature_error(&case.mesh, &sol.u, &fwd_u, 0), curvature_error(&case.mesh, &sol.u, &fwd_u, 5));
     eprintln!(
         "eq. 64 inverse: change {:.2e} @50, {:.2e} @200; stopped after {} iterations; |x-xg|/|xg| {:.2e}; |x'-d3| {:.2e}; kappa error {k_all:.3} (without 5 end elements {k_inner:.3})",
         at(50),
@@ -37,7 +38,9 @@ fn recovers_eq64_frames_from_the_centreline() {
     assert!(last.x_err_rel < 2e-4);
     assert!(k_all < 0.12 && k_inner < 0.03, "{k_all} {k_inner}");
     // Planar data: the recovered frame stays planar (α = γ = 0 up to round-off).
-    let off_plane = (0..n).map(|i| sol.u[6 * i + 3].abs().max(sol.u[6 * i + 5].abs())).fold(0.0, f64::max);
+    let dofs = p.dofs();
+    let off_plane =
+        (0..n).map(|i| dofs.get(&sol.u, i, Field::Alpha)).map(|a| a[0].abs().max(a[2].abs())).fold(0.0, f64::max);
     assert!(off_plane < 1e-10, "{off_plane}");
 }
 
@@ -49,42 +52,50 @@ fn recovers_eq64_frames_from_the_centreline() {
 /// full KKT system must be a stationary point of `j`.
 #[test]
 fn adjoint_gradient_matches_finite_differences() {
-    use cosserat::assembly::Pattern;
-    use cosserat::solve::inverse::{assemble_kkt, dirichlet, BLOCK};
-    use nalgebra::{DMatrix, DVector};
+    use cosserat::solve::inverse::kkt::{assemble_system, dirichlet};
+    use cosserat::solve::inverse::Frame;
+    use nalgebra::{DMatrix, DVector, Vector3};
 
     let text = common::edit(&case_text("follower_bend_64"), "elements = 100", "elements = 10");
     let case = case_from(&text, "f64_10");
-    let p = Problem::from_case(&case);
+    let p = case.problem();
     let (fwd_u, xg) = common::forward_data(&case, 5);
     let nodes = case.mesh.nodes();
-    let prev: Vec<Vector3<f64>> = (0..nodes).map(|i| node_values(&fwd_u, i).1 * 0.9).collect();
+    let (fwd, kd) = (case.mesh.dofs(), case.mesh.kkt_dofs());
+    let prev: Vec<Vector3<f64>> = fwd.field(&fwd_u, Field::Alpha).iter().map(|a| a * 0.9).collect();
     // A frozen iterate near, not at, the data; every term of (41) switched on.
-    let uk =
-        DVector::from_fn(6 * nodes, |i, _| fwd_u[i] + if i % 6 >= 3 { 0.05 * ((i as f64) * 0.7).sin() } else { 0.0 });
+    let uk = DVector::from_fn(fwd.len(), |i, _| {
+        fwd_u[i] + if fwd.field_of(i) == Field::Alpha { 0.05 * ((i as f64) * 0.7).sin() } else { 0.0 }
+    });
     let params = common::all_terms_params();
-    let pattern = Pattern::with_block(&case.mesh, BLOCK);
+    let pattern = kd.pattern();
     let mut values = vec![0.0; pattern.nnz()];
-    let rhs = assemble_kkt(&p, &params, &pattern, &mut values, &uk, &xg, &prev);
+    let rhs = assemble_system(&p, &params, false, &pattern, &mut values, &uk, &xg, &prev);
     let k = pattern.to_dense(&values);
-    // Index sets (KKT numbering).
-    let state: Vec<usize> = (0..nodes).flat_map(|n| (0..6).map(move |c| BLOCK * n + c)).collect();
-    let x_fixed: Vec<usize> = [0, nodes - 1].iter().flat_map(|&n| (0..3).map(move |c| BLOCK * n + c)).collect();
-    let xi: Vec<usize> = [0, nodes - 1].iter().flat_map(|&n| (3..6).map(move |c| BLOCK * n + c)).collect();
-    let inner: Vec<usize> = (1..nodes - 1).flat_map(|n| (0..6).map(move |c| BLOCK * n + c)).collect();
-    let hats: Vec<usize> = (1..nodes - 1).flat_map(|n| (6..12).map(move |c| BLOCK * n + c)).collect();
+    // Index sets (KKT layout).
+    let set = |nodes: &[usize], fields: &[Field]| -> Vec<usize> {
+        nodes.iter().flat_map(|&n| fields.iter().flat_map(move |&f| (0..3).map(move |c| kd.index(n, f, c)))).collect()
+    };
+    let (all, ends, interior): (Vec<usize>, Vec<usize>, Vec<usize>) =
+        ((0..nodes).collect(), vec![0, nodes - 1], (1..nodes - 1).collect());
+    let state = set(&all, &[Field::X, Field::Alpha]);
+    let x_fixed = set(&ends, &[Field::X]);
+    let xi = set(&ends, &[Field::Alpha]);
+    let inner = set(&interior, &[Field::X, Field::Alpha]);
+    let hats = set(&interior, &[Field::XHat, Field::AlphaHat]);
     let sub = |rows: &[usize], cols: &[usize]| DMatrix::from_fn(rows.len(), cols.len(), |i, j| k[(rows[i], cols[j])]);
     let subv = |rows: &[usize]| DVector::from_fn(rows.len(), |i, _| rhs[rows[i]]);
     let pos = |set: &[usize], d: usize| set.iter().position(|&s| s == d).expect("index");
     let h_mat = sub(&state, &state);
     let h_vec = subv(&state);
     let b = subv(&hats);
-    let lam = |d: usize| if (d % BLOCK) < 9 { params.lambda_f } else { params.lambda_l };
+    let w8 = params.weights;
+    let lam = |d: usize| if kd.field_of(d) == Field::XHat { w8.lambda_f } else { w8.lambda_l };
     // Control mass M = λ C with C = −(hat–hat block).
     let mass = DMatrix::from_fn(hats.len(), hats.len(), |i, j| -k[(hats[i], hats[j])] * lam(hats[i]));
     let cost = DMatrix::from_fn(hats.len(), hats.len(), |i, j| mass[(i, j)] * lam(hats[i]));
     let (l_in, l_xi, l_fix) = (sub(&hats, &inner), sub(&hats, &xi), sub(&hats, &x_fixed));
-    let u_fix = DVector::from_fn(x_fixed.len(), |i, _| xg[x_fixed[i] / BLOCK][x_fixed[i] % BLOCK]);
+    let u_fix = DVector::from_fn(x_fixed.len(), |i, _| xg[if i < 3 { 0 } else { nodes - 1 }][i % 3]);
     let lu = l_in.clone().lu();
     let state_of = |c: &DVector<f64>, x: &DVector<f64>| -> DVector<f64> {
         let u_in = lu.solve(&(&b + &mass * c - &l_fix * &u_fix - &l_xi * x)).expect("primal");
@@ -132,7 +143,7 @@ fn adjoint_gradient_matches_finite_differences() {
     // The KKT solution is a stationary point of the reduced objective.
     let mut kb = k.clone();
     let mut rb = rhs.clone();
-    for (d, v) in dirichlet(&params, &xg) {
+    for (d, v) in dirichlet(&kd, params.alpha0_rad, &Frame { index: 1, x_g: &xg, previous: Some(&prev) }) {
         kb.row_mut(d).fill(0.0);
         kb[(d, d)] = 1.0;
         rb[d] = v;
@@ -154,7 +165,7 @@ fn adjoint_gradient_matches_finite_differences() {
 /// 0.066 / 0.005). Asserted with a margin of about 2×.
 #[test]
 fn recovers_eq65_bend_and_twist_from_the_case_file() {
-    use cosserat::metrics::inverse_metrics;
+    use cosserat::run::metrics::inverse_metrics;
     let case = case_from(&case_text("inverse_bend_twist"), "inverse_bend_twist");
     let r = cosserat::run::run_rust(&case, |_, _| {}).expect("inverse");
     let m = inverse_metrics(&r);

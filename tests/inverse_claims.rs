@@ -10,11 +10,14 @@ mod common;
 
 use std::sync::OnceLock;
 
-use common::{case_from, case_text, edit};
+use common::{case_from, case_text, edit, solve_frame, with_weights};
 use cosserat::case::Case;
-use cosserat::rotation::{angles_from_rotation, rotation};
-use cosserat::solve::inverse::{curvature_error, element_curvatures, solve_frame, InverseParams, InverseRecord};
-use cosserat::solve::{node_values, Problem};
+use cosserat::model::mesh::{DofMap, Field};
+use cosserat::model::rotation::{angles_from_rotation, rotation};
+use cosserat::run::metrics::curvature_error;
+use cosserat::run::NodalState;
+use cosserat::solve::inverse::{InverseParams, InverseRecord, Start};
+use cosserat::solve::Problem;
 use nalgebra::{DVector, Matrix3, Rotation3, Unit, Vector3};
 use rayon::prelude::*;
 
@@ -38,7 +41,7 @@ impl Data {
         Data { case, truth, xg }
     }
     fn problem(&self) -> Problem<'_> {
-        Problem::from_case(&self.case)
+        self.case.problem()
     }
 }
 
@@ -74,17 +77,16 @@ impl Run {
 /// `params.tolerance`, after `params.max_iterations` or at the first solver error.
 fn run(d: &Data, params: &InverseParams, xg: &[Vector3<f64>], u0: &DVector<f64>, track_kappa: bool) -> Run {
     let p = d.problem();
-    let prev = vec![Vector3::zeros(); xg.len()];
     let one = InverseParams { max_iterations: 1, tolerance: f64::INFINITY, ..*params };
     let mut u = u0.clone();
     let (mut history, mut kappa, mut converged) = (Vec::new(), Vec::new(), false);
     for k in 1..=params.max_iterations {
-        let Ok(sol) = solve_frame(&p, &one, xg, &prev, &u, |_| {}) else { break };
+        let Ok(sol) = solve_frame(&p, &one, xg, None, &u, Start::Guess, |_| {}) else { break };
         u = sol.u;
         let rec = InverseRecord { iteration: k, ..sol.history[0] };
         history.push(rec);
         if track_kappa {
-            kappa.push((curvature_error(&p, &u, &d.truth, 0), curvature_error(&p, &u, &d.truth, 5)));
+            kappa.push((curvature_error(&p.mesh, &u, &d.truth, 0), curvature_error(&p.mesh, &u, &d.truth, 5)));
         }
         if rec.rel_change <= params.tolerance {
             converged = true;
@@ -126,8 +128,8 @@ fn line(name: &str, v: f64, r: &Run, lambda_l: f64) {
         r.iterations(),
         last.rel_change,
         last.x_err_rel,
-        curvature_error(&p, &r.u, &d.truth, 0),
-        curvature_error(&p, &r.u, &d.truth, 5),
+        curvature_error(&p.mesh, &r.u, &d.truth, 0),
+        curvature_error(&p.mesh, &r.u, &d.truth, 5),
         r.torque_norm(lambda_l),
         o.tracking,
         o.force,
@@ -172,7 +174,7 @@ fn spread(a: &[f64], b: &[f64]) -> f64 {
 #[test]
 fn lambda_l_sweep() {
     let (_, b) = base();
-    let set = |l: f64| InverseParams { lambda_l: l, ..paper() };
+    let set = |l: f64| with_weights(&paper(), |w| w.lambda_l = l);
     let runs = sweep(&[1e-20, 1e-12, 1e-10, 1e-6, 1e-3, 1.0, 1e3], set, 1e-10, true);
     let get = |l: f64| runs.iter().find(|(v, _)| *v == l).map(|(_, r)| r.as_ref().unwrap_or(b)).expect("value");
     let xh = |r: &Run| r.history.iter().map(|h| h.x_err_rel).collect::<Vec<_>>();
@@ -240,13 +242,16 @@ fn lambda_l_sweep() {
 fn lambda_d_sweep() {
     let (d, b) = base();
     let p = d.problem();
-    let set = |l: f64| InverseParams { lambda_d: l, max_iterations: if l == 1e-2 { 3000 } else { CAP }, ..paper() };
+    let set = |l: f64| InverseParams {
+        max_iterations: if l == 1e-2 { 3000 } else { CAP },
+        ..with_weights(&paper(), |w| w.lambda_d = l)
+    };
     let runs = sweep(&[1e1, 1e-2, 1e-6, 1e-10], set, 1e-6, false);
     let get = |l: f64| runs.iter().find(|(v, _)| *v == l).map(|(_, r)| r.as_ref().unwrap_or(b)).expect("value");
     for (l, _) in &runs {
         line("lambda_d", *l, get(*l), 1e-10);
     }
-    let kappa = |r: &Run| curvature_error(&p, &r.u, &d.truth, 0);
+    let kappa = |r: &Run| curvature_error(&p.mesh, &r.u, &d.truth, 0);
     let r = get(1e-10);
     assert!(r.converged && r.iterations().abs_diff(b.iterations()) <= 3);
     assert!((kappa(r) / kappa(b) - 1.0).abs() < 0.01 && (r.last().x_err_rel / b.last().x_err_rel - 1.0).abs() < 0.01);
@@ -277,7 +282,7 @@ fn lambda_d_sweep() {
 fn lambda_f_sweep() {
     let (d, b) = base();
     let p = d.problem();
-    let set = |l: f64| InverseParams { lambda_f: l, ..paper() };
+    let set = |l: f64| with_weights(&paper(), |w| w.lambda_f = l);
     let runs = sweep(&[1e-10, 1e-4, 1.0, 1e6], set, 1.0, false);
     let get = |l: f64| runs.iter().find(|(v, _)| *v == l).map(|(_, r)| r.as_ref().unwrap_or(b)).expect("value");
     for (l, _) in &runs {
@@ -298,7 +303,9 @@ fn lambda_f_sweep() {
         r4.iterations()
     );
     assert!(r10.last().x_err_rel < 5e-7 && r4.last().x_err_rel < 5e-7);
-    assert!(curvature_error(&p, &r10.u, &d.truth, 0) < 0.01 && curvature_error(&p, &r4.u, &d.truth, 5) < 0.01);
+    assert!(
+        curvature_error(&p.mesh, &r10.u, &d.truth, 0) < 0.01 && curvature_error(&p.mesh, &r4.u, &d.truth, 5) < 0.01
+    );
     // Ordering of the final tracking term: 1e-10 < 1e-4 ≪ 1 ≪ 1e6.
     assert!(track(r10) < track(r4) && track(r4) < 1e-4 * track(b) && track(b) < 1e-5 * track(r6));
     assert!(track(r10) / r10.history[0].objective.tracking < 1e-12);
@@ -310,10 +317,11 @@ fn lambda_f_sweep() {
 /// a spatial rotation R acts on the right; L rotates the material frame about d3).
 fn transform(u: &DVector<f64>, r: &Matrix3<f64>, l: &Matrix3<f64>, c: &Vector3<f64>) -> DVector<f64> {
     let mut v = u.clone();
-    for i in 0..u.len() / 6 {
-        let (x, a) = node_values(u, i);
-        let (x2, a2) = (r * x + c, angles_from_rotation(&(l * rotation(&a) * r.transpose())));
-        v.as_mut_slice()[6 * i..6 * i + 6].copy_from_slice(&[x2[0], x2[1], x2[2], a2[0], a2[1], a2[2]]);
+    let dofs = DofMap::forward(u.len() / 6);
+    for i in 0..dofs.nodes() {
+        let (x, a) = (dofs.get(u, i, Field::X), dofs.get(u, i, Field::Alpha));
+        dofs.set(&mut v, i, Field::X, &(r * x + c));
+        dofs.set(&mut v, i, Field::Alpha, &angles_from_rotation(&(l * rotation(&a) * r.transpose())));
     }
     v
 }
@@ -330,14 +338,19 @@ fn equivariance_error(
 ) -> [f64; 4] {
     let mut e = [0.0f64; 4];
     let mut nx = 0.0f64;
-    for i in 0..a.len() / 6 {
-        let ((xa, aa), (xb, ab)) = (node_values(a, i), node_values(b, i));
+    let dofs = p.dofs();
+    for i in 0..dofs.nodes() {
+        let (xa, aa) = (dofs.get(a, i, Field::X), dofs.get(a, i, Field::Alpha));
+        let (xb, ab) = (dofs.get(b, i, Field::X), dofs.get(b, i, Field::Alpha));
         e[0] = e[0].max((xa - (r * xb + c)).norm());
         nx = nx.max(xb.norm());
         e[1] = e[1].max((rotation(&aa) - l * rotation(&ab) * r.transpose()).amax());
         e[3] = e[3].max((aa - ab).amax());
     }
-    let (ka, kb) = (element_curvatures(p, a), element_curvatures(p, b));
+    let kappa = |u: &DVector<f64>| -> Vec<Vector3<f64>> {
+        NodalState::from_vector(&p.mesh, u).element_curvature().into_iter().map(|(_, k)| k).collect()
+    };
+    let (ka, kb) = (kappa(a), kappa(b));
     let nk = kb.iter().map(|k| k.norm()).fold(0.0, f64::max);
     e[2] = ka.iter().zip(&kb).map(|(x, y)| (x - l * y).norm()).fold(0.0, f64::max) / nk;
     e[0] /= nx;
@@ -395,8 +408,9 @@ fn rigid_motions() {
             .par_iter()
             .map(|(_, r, l)| {
                 let xg: Vec<Vector3<f64>> = d.xg.iter().map(|x| r * x + c).collect();
-                let alpha0 = angles_from_rotation(&(l * rotation(&node_values(&orig.u, 0).1) * r.transpose()))[0];
-                let s = run(&d, &InverseParams { alpha0, ..params }, &xg, &transform(&u0, r, l, &c), false);
+                let a0 = p.dofs().get(&orig.u, 0, Field::Alpha);
+                let alpha0_rad = angles_from_rotation(&(l * rotation(&a0) * r.transpose()))[0];
+                let s = run(&d, &InverseParams { alpha0_rad, ..params }, &xg, &transform(&u0, r, l, &c), false);
                 assert_eq!(s.iterations(), iterations);
                 equivariance_error(&p, &s.u, &orig.u, r, l, &c)
             })

@@ -1,16 +1,69 @@
 //! Newton mode of the inverse problem (`docs/inverse.md`, I8) on forward data of eqs. (64), (65).
 mod common;
 
-use common::{case_from, case_text};
-use cosserat::assembly::{LinearSolver, Pattern};
-use cosserat::solve::inverse::{curvature_error, element_curvatures, solve_frame, InverseParams, InverseRecord, BLOCK};
-use cosserat::solve::inverse_newton::{assemble_newton, solve_frame_newton};
-use cosserat::solve::{node_values, split_norms_inf, Problem};
+use common::{case_from, case_text, solve_frame, solve_newton, with_weights};
+use cosserat::linalg::{LinearSolver, Pattern};
+use cosserat::model::mesh::{DofMap, Field, Mesh};
+use cosserat::run::metrics::curvature_error;
+use cosserat::run::NodalState;
+use cosserat::solve::inverse::kkt::{assemble_system, dirichlet};
+use cosserat::solve::inverse::newton::assemble_residual;
+use cosserat::solve::inverse::{Frame, InverseParams, InverseRecord, Start};
+use cosserat::solve::Problem;
 use nalgebra::{DVector, Vector3};
 
 /// Paper §5.2, first test (`common::paper_params_64`), Newton stopping settings.
 fn paper_params_64() -> InverseParams {
     InverseParams { tolerance: 1e-10, max_iterations: 30, ..common::paper_params_64() }
+}
+
+/// Newton's residual R(U) of I8 for `frame` with its Dirichlet rows, and the Jacobian into
+/// `jacobian` when given.
+fn newton_residual(
+    p: &Problem,
+    params: &InverseParams,
+    frame: &Frame,
+    prev: &[Vector3<f64>],
+    big: &DVector<f64>,
+    jacobian: Option<(&Pattern, &mut [f64])>,
+) -> DVector<f64> {
+    let fixed = dirichlet(&p.mesh.kkt_dofs(), params.alpha0_rad, frame);
+    let rows: Vec<usize> = fixed.iter().map(|f| f.0).collect();
+    assemble_residual(p, params, frame, prev, big, &fixed, jacobian.map(|(pt, v)| (pt, v, rows.as_slice())))
+}
+
+/// The fixed point's matrix K(u) with its Dirichlet rows, and its right-hand side.
+fn fixed_point_system(
+    p: &Problem,
+    params: &InverseParams,
+    frame: &Frame,
+    prev: &[Vector3<f64>],
+    u: &DVector<f64>,
+    pattern: &Pattern,
+) -> (Vec<f64>, DVector<f64>) {
+    let mut kv = vec![0.0; pattern.nnz()];
+    let rhs = assemble_system(p, params, frame.is_first(), pattern, &mut kv, u, frame.x_g, prev);
+    let rows: Vec<usize> = dirichlet(&p.mesh.kkt_dofs(), params.alpha0_rad, frame).iter().map(|f| f.0).collect();
+    pattern.set_identity_rows(&mut kv, &rows);
+    (kv, rhs)
+}
+
+/// A KKT vector from a state `u` and an adjoint `a` (forward layout each).
+fn kkt_vector(kd: &DofMap, u: &DVector<f64>, a: &DVector<f64>) -> DVector<f64> {
+    let fwd = DofMap::forward(kd.nodes());
+    let mut big = kd.zeros();
+    for n in 0..kd.nodes() {
+        for (field, hat) in [(Field::X, Field::XHat), (Field::Alpha, Field::AlphaHat)] {
+            kd.set(&mut big, n, field, &fwd.get(u, n, field));
+            kd.set(&mut big, n, hat, &fwd.get(a, n, field));
+        }
+    }
+    big
+}
+
+/// Element-midpoint curvatures of a state.
+fn element_curvatures(mesh: &Mesh, u: &DVector<f64>) -> Vec<Vector3<f64>> {
+    NodalState::from_vector(mesh, u).element_curvature().into_iter().map(|(_, k)| k).collect()
 }
 
 /// The exact Jacobian of I8 against central differences of the global residual (Dirichlet rows
@@ -36,58 +89,55 @@ fn jacobian_matches_central_differences() {
 fn jacobian_check(lambda_g: f64) -> (f64, f64) {
     let text = common::edit(&case_text("follower_bend_64"), "elements = 100", "elements = 10");
     let case = case_from(&text, "f64_10");
-    let p = Problem::from_case(&case);
+    let p = case.problem();
     let (fwd, xg) = common::forward_data(&case, 5);
-    let nodes = case.mesh.nodes();
-    let prev: Vec<Vector3<f64>> = (0..nodes).map(|i| node_values(&fwd, i).1 * 0.9).collect();
-    let params = InverseParams { lambda_g, ..common::all_terms_params() };
-    let big = DVector::from_fn(BLOCK * nodes, |i, _| {
-        let (n, c) = (i / BLOCK, i % BLOCK);
+    let (fd_map, kd) = (case.mesh.dofs(), case.mesh.kkt_dofs());
+    let prev: Vec<Vector3<f64>> = fd_map.field(&fwd, Field::Alpha).iter().map(|a| a * 0.9).collect();
+    let frame = Frame { index: 1, x_g: &xg, previous: Some(&prev) };
+    let params = with_weights(&common::all_terms_params(), |w| w.lambda_g = lambda_g);
+    let big = DVector::from_fn(kd.len(), |i, _| {
+        let (n, c) = (i / kd.block(), i % 3);
         let s = (i as f64 * 0.7).sin();
-        match c {
-            0..=2 => fwd[6 * n + c] + 2e-5 * s,
-            3..=5 => fwd[6 * n + c] + 0.05 * s,
-            6..=8 => 1e-4 * s,
-            _ => 1e-5 * (i as f64 * 1.1).cos(),
+        match kd.field_of(i) {
+            Field::X => fwd[fd_map.index(n, Field::X, c)] + 2e-5 * s,
+            Field::Alpha => fwd[fd_map.index(n, Field::Alpha, c)] + 0.05 * s,
+            Field::XHat => 1e-4 * s,
+            Field::AlphaHat => 1e-5 * (i as f64 * 1.1).cos(),
         }
     });
-    let pattern = Pattern::with_block(&case.mesh, BLOCK);
+    let pattern = kd.pattern();
     let mut values = vec![0.0; pattern.nnz()];
-    let mut scratch = vec![0.0; pattern.nnz()];
-    assemble_newton(&p, &params, &pattern, &mut values, &big, &xg, &prev);
+    newton_residual(&p, &params, &frame, &prev, &big, Some((&pattern, &mut values)));
     let jac = pattern.to_dense(&values);
-    let (_, dr, dc) = LinearSolver::new(&pattern).expect("lu").equilibrate(&values);
+    let (_, dr, dc) = LinearSolver::new(&pattern).equilibrate(&values);
     // K(u) with the same Dirichlet rows: the fixed point's matrix.
-    let u = DVector::from_fn(6 * nodes, |i, _| big[BLOCK * (i / 6) + i % 6]);
-    let mut kv = vec![0.0; pattern.nnz()];
-    cosserat::solve::inverse::assemble_kkt(&p, &params, &pattern, &mut kv, &u, &xg, &prev);
-    let rows: Vec<usize> = cosserat::solve::inverse::dirichlet(&params, &xg).iter().map(|f| f.0).collect();
-    pattern.set_identity_rows(&mut kv, &rows);
+    let u = kd.kkt_state(&big);
+    let (kv, _) = fixed_point_system(&p, &params, &frame, &prev, &u, &pattern);
     let kmat = pattern.to_dense(&kv);
-    let n = BLOCK * nodes;
+    let n = kd.len();
     let mut fd = nalgebra::DMatrix::zeros(n, n);
     for j in 0..n {
-        let step = match j % BLOCK {
-            0..=2 => 1e-5 * case.mesh.length_m,
-            3..=5 => 1e-4,
+        let step = match kd.field_of(j) {
+            Field::X => 1e-5 * case.mesh.length_m,
+            Field::Alpha => 1e-4,
             _ => 1.0,
         };
         let (mut up, mut um) = (big.clone(), big.clone());
         up[j] += step;
         um[j] -= step;
-        let col = (assemble_newton(&p, &params, &pattern, &mut scratch, &up, &xg, &prev)
-            - assemble_newton(&p, &params, &pattern, &mut scratch, &um, &xg, &prev))
+        let col = (newton_residual(&p, &params, &frame, &prev, &up, None)
+            - newton_residual(&p, &params, &frame, &prev, &um, None))
             / (2.0 * step);
         fd.set_column(j, &col);
     }
-    let kinds = ["x", "α", "x̂", "α̂"];
+    let kinds = [Field::X, Field::Alpha, Field::XHat, Field::AlphaHat];
     let mut worst_eq: f64 = 0.0;
     let mut worst_coef: f64 = 0.0;
-    for rk in 0..4 {
-        for ck in 0..4 {
+    for rk in kinds {
+        for ck in kinds {
             let (mut err, mut size, mut coef) = (0.0_f64, 0.0_f64, 0.0_f64);
-            for i in (0..n).filter(|i| (i % BLOCK) / 3 == rk) {
-                for j in (0..n).filter(|j| (j % BLOCK) / 3 == ck) {
+            for i in (0..n).filter(|&i| kd.field_of(i) == rk) {
+                for j in (0..n).filter(|&j| kd.field_of(j) == ck) {
                     let s = dr[i] * dc[j];
                     err = err.max((jac[(i, j)] - fd[(i, j)]).abs() * s);
                     size = size.max(jac[(i, j)].abs() * s);
@@ -95,10 +145,7 @@ fn jacobian_check(lambda_g: f64) -> (f64, f64) {
                 }
             }
             if size > 0.0 {
-                eprintln!(
-                    "block ({}, {}): |J−FD| {err:.2e}, |J| {size:.2e}, |J−K| {coef:.2e} (equilibrated)",
-                    kinds[rk], kinds[ck]
-                );
+                eprintln!("block ({rk:?}, {ck:?}): |J−FD| {err:.2e}, |J| {size:.2e}, |J−K| {coef:.2e} (equilibrated)");
                 worst_eq = worst_eq.max(err / size);
                 if coef > 1e-12 {
                     worst_coef = worst_coef.max(err / coef);
@@ -120,13 +167,12 @@ fn newton_vs_fixed_point(
     fp_tol: f64,
     tight: f64,
 ) -> (Vec<InverseRecord>, f64, [f64; 3], DVector<f64>) {
-    let prev = vec![Vector3::zeros(); xg.len()];
     let fp_params = |tolerance| InverseParams { tolerance, max_iterations: 3000, ..*params };
-    let start =
-        solve_frame(p, &fp_params(fp_tol), xg, &prev, &p.reference_state(), |_| {}).expect("fixed point (start)");
+    let start = solve_frame(p, &fp_params(fp_tol), xg, None, &p.reference_state(), Start::Guess, |_| {})
+        .expect("fixed point (start)");
     let t0 = std::time::Instant::now();
     let mut hist = Vec::new();
-    let sol = solve_frame_newton(p, params, xg, &prev, &start.u, |r| hist.push(*r)).expect("newton");
+    let sol = solve_newton(p, params, xg, None, &start.u, |r| hist.push(*r)).expect("newton");
     let ms = t0.elapsed().as_secs_f64() * 1e3 / hist.len() as f64;
     for r in &hist {
         eprintln!(
@@ -137,9 +183,10 @@ fn newton_vs_fixed_point(
             r.x_err_rel
         );
     }
-    let fp = solve_frame(p, &fp_params(tight), xg, &prev, &p.reference_state(), |_| {}).expect("fixed point (tight)");
-    let (dx, da) = split_norms_inf(&(&fp.u - &sol.u));
-    let (kn, kf) = (element_curvatures(p, &sol.u), element_curvatures(p, &fp.u));
+    let fp = solve_frame(p, &fp_params(tight), xg, None, &p.reference_state(), Start::Guess, |_| {})
+        .expect("fixed point (tight)");
+    let (dx, da) = p.dofs().split_norms_inf(&(&fp.u - &sol.u));
+    let (kn, kf) = (element_curvatures(&p.mesh, &sol.u), element_curvatures(&p.mesh, &fp.u));
     let dk = kn.iter().zip(&kf).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
     let kmax = kf.iter().map(|k| k.norm()).fold(0.0, f64::max);
     eprintln!(
@@ -149,11 +196,11 @@ fn newton_vs_fixed_point(
         fp.history.len()
     );
     // The fixed point started at Newton's solution stays there (it is a fixed point of I4).
-    let again =
-        solve_frame(p, &InverseParams { tolerance: 1e-10, max_iterations: 5, ..*params }, xg, &prev, &sol.u, |_| {})
-            .expect("fixed point from Newton's solution");
-    let (dx2, da2) = split_norms_inf(&(&again.u - &sol.u));
-    let dk2 = element_curvatures(p, &again.u).iter().zip(&kn).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
+    let again_params = InverseParams { tolerance: 1e-10, max_iterations: 5, ..*params };
+    let again = solve_frame(p, &again_params, xg, None, &sol.u, Start::Guess, |_| {})
+        .expect("fixed point from Newton's solution");
+    let (dx2, da2) = p.dofs().split_norms_inf(&(&again.u - &sol.u));
+    let dk2 = element_curvatures(&p.mesh, &again.u).iter().zip(&kn).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
     eprintln!("  fixed point from Newton's solution: {} its to 1e-10; |dx| {dx2:.2e} m, |dα| {da2:.2e} rad, |dκ|/max|κ| {:.2e}", again.history.len(), dk2 / kmax);
     (hist, ms, [dx2, da2, dk2 / kmax], sol.u)
 }
@@ -175,11 +222,11 @@ fn assert_fast(hist: &[InverseRecord], max_its: usize, floor: f64) {
 #[test]
 fn newton_converges_on_eq64_with_a_small_bending_weight() {
     let case = case_from(&case_text("follower_bend_64"), "f64");
-    let p = Problem::from_case(&case);
+    let p = case.problem();
     let (fwd, xg) = common::forward_data(&case, 5);
-    let params = InverseParams { lambda_kappa: Vector3::new(1e-14, 1e-14, 1e-10), ..paper_params_64() };
+    let params = with_weights(&paper_params_64(), |w| w.lambda_kappa = Vector3::new(1e-14, 1e-14, 1e-10));
     let (hist, _, d, u) = newton_vs_fixed_point(&p, &params, &xg, 1e-4, 1e-9);
-    let (k_all, k_inner) = (curvature_error(&p, &u, &fwd, 0), curvature_error(&p, &u, &fwd, 5));
+    let (k_all, k_inner) = (curvature_error(&p.mesh, &u, &fwd, 0), curvature_error(&p.mesh, &u, &fwd, 5));
     eprintln!(
         "eq. 64 (Λκ1,2 = 1e-14): |x-xg|/|xg| {:.3e}, κ error {k_all:.3e} (without 5 end elements {k_inner:.3e})",
         hist.last().unwrap().x_err_rel
@@ -193,17 +240,16 @@ fn newton_converges_on_eq64_with_a_small_bending_weight() {
 #[test]
 fn newton_converges_on_eq65() {
     let case = case_from(&case_text("follower_bend_twist_65"), "f65");
-    let p = Problem::from_case(&case);
+    let p = case.problem();
     let (fwd, xg) = common::forward_data(&case, 10);
-    let params = InverseParams {
-        lambda_f: 1e-2,
-        lambda_l: 1e-6,
-        lambda_d: 1e-6,
-        lambda_kappa: Vector3::repeat(1e-20),
-        ..paper_params_64()
-    };
+    let params = with_weights(&paper_params_64(), |w| {
+        w.lambda_f = 1e-2;
+        w.lambda_l = 1e-6;
+        w.lambda_d = 1e-6;
+        w.lambda_kappa = Vector3::repeat(1e-20);
+    });
     let (hist, _, d, u) = newton_vs_fixed_point(&p, &params, &xg, 1e-4, 1e-6);
-    let (k_all, k_inner) = (curvature_error(&p, &u, &fwd, 0), curvature_error(&p, &u, &fwd, 5));
+    let (k_all, k_inner) = (curvature_error(&p.mesh, &u, &fwd, 0), curvature_error(&p.mesh, &u, &fwd, 5));
     let x_err = hist.last().unwrap().x_err_rel;
     eprintln!("eq. 65: |x-xg|/|xg| {x_err:.3e}, κ error {k_all:.3e} (without 5 end elements {k_inner:.3e})");
     assert_fast(&hist, 6, 1e-8);
@@ -219,24 +265,22 @@ fn newton_converges_on_eq65() {
 #[test]
 fn newton_on_eq64_paper_parameters_fails_with_a_clear_error() {
     let case = case_from(&case_text("follower_bend_64"), "f64");
-    let p = Problem::from_case(&case);
+    let p = case.problem();
     let (_, xg) = common::forward_data(&case, 5);
-    let prev = vec![Vector3::zeros(); xg.len()];
-    let params = InverseParams { frame: 7, ..paper_params_64() };
-    let start = solve_frame(
-        &p,
-        &InverseParams { tolerance: 3e-6, max_iterations: 1000, ..params },
-        &xg,
-        &prev,
-        &p.reference_state(),
-        |_| {},
-    )
-    .expect("fixed point");
+    let params = paper_params_64();
+    let fp = InverseParams { tolerance: 3e-6, max_iterations: 1000, ..params };
+    let start = solve_frame(&p, &fp, &xg, None, &p.reference_state(), Start::Guess, |_| {}).expect("fixed point");
     let mut hist = Vec::new();
-    let err = solve_frame_newton(&p, &InverseParams { max_iterations: 15, ..params }, &xg, &prev, &start.u, |r| {
-        hist.push(*r)
-    })
-    .expect_err("Newton must not converge here");
+    let newton = InverseParams {
+        method: cosserat::solve::inverse::InverseMethod::Newton { warm_start_tolerance: 1e-3 },
+        max_iterations: 15,
+        ..params
+    };
+    let frame = Frame { index: 7, x_g: &xg, previous: None };
+    let err = cosserat::solve::inverse::FrameSolver::new(&p, newton)
+        .solve(&frame, &start.u, Start::Near, |r, _, _| hist.push(*r))
+        .and_then(|s| s.converged(7))
+        .expect_err("Newton must not converge here");
     let text = err.to_string();
     eprintln!("{text}; residuals {:?}", hist.iter().map(|r| r.residual.unwrap_or(f64::NAN)).collect::<Vec<_>>());
     assert!(text.contains("frame 7") && text.contains("after 15 iterations"), "{text}");
@@ -248,33 +292,23 @@ fn newton_on_eq64_paper_parameters_fails_with_a_clear_error() {
 #[ignore = "diagnostic: smallest singular values of the equilibrated Jacobian (dense SVD, slow)"]
 fn jacobian_spectrum_eq64() {
     let case = case_from(&case_text("follower_bend_64"), "f64");
-    let p = Problem::from_case(&case);
+    let p = case.problem();
     let (_fwd, xg) = common::forward_data(&case, 5);
     let n = case.mesh.nodes();
     let prev = vec![Vector3::zeros(); n];
     let params = paper_params_64();
     let tol_fp: f64 = std::env::var("FPTOL").map(|s| s.parse().unwrap()).unwrap_or(3e-6);
-    let fp = solve_frame(
-        &p,
-        &InverseParams { tolerance: tol_fp, max_iterations: 20000, ..params },
-        &xg,
-        &prev,
-        &p.reference_state(),
-        |_| {},
-    )
-    .expect("fp");
+    let fp_params = InverseParams { tolerance: tol_fp, max_iterations: 20000, ..params };
+    let fp = solve_frame(&p, &fp_params, &xg, None, &p.reference_state(), Start::Guess, |_| {}).expect("fp");
     eprintln!("fp iterations {}", fp.history.len());
-    let big = DVector::from_fn(BLOCK * n, |i, _| {
-        if i % BLOCK < 6 {
-            fp.u[6 * (i / BLOCK) + i % BLOCK]
-        } else {
-            fp.adjoint[6 * (i / BLOCK) + i % BLOCK - 6]
-        }
-    });
-    let pattern = Pattern::with_block(&case.mesh, BLOCK);
+    let kd = case.mesh.kkt_dofs();
+    const BLOCK: usize = 12;
+    let big = kkt_vector(&kd, &fp.u, &fp.adjoint);
+    let pattern = kd.pattern();
     let mut values = vec![0.0; pattern.nnz()];
-    let r = assemble_newton(&p, &params, &pattern, &mut values, &big, &xg, &prev);
-    let (a, dr, dc) = LinearSolver::new(&pattern).expect("lu").equilibrate(&values);
+    let frame = Frame { index: 0, x_g: &xg, previous: None };
+    let r = newton_residual(&p, &params, &frame, &prev, &big, Some((&pattern, &mut values)));
+    let (a, dr, dc) = LinearSolver::new(&pattern).equilibrate(&values);
     let m = pattern.to_dense(&a);
     let svd = m.clone().svd(true, true);
     let mut idx: Vec<usize> = (0..svd.singular_values.len()).collect();
@@ -311,28 +345,21 @@ fn jacobian_spectrum_eq64() {
 #[test]
 fn banded_solver_on_real_kkt_matrices() {
     let case = case_from(&case_text("follower_bend_64"), "f64");
-    let p = Problem::from_case(&case);
+    let p = case.problem();
     let (fwd, xg) = common::forward_data(&case, 5);
-    let nodes = case.mesh.nodes();
-    let prev: Vec<Vector3<f64>> = (0..nodes).map(|i| node_values(&fwd, i).1 * 0.9).collect();
+    let (fd_map, kd) = (case.mesh.dofs(), case.mesh.kkt_dofs());
+    let prev: Vec<Vector3<f64>> = fd_map.field(&fwd, Field::Alpha).iter().map(|a| a * 0.9).collect();
+    let frame = Frame { index: 1, x_g: &xg, previous: Some(&prev) };
     let params = common::all_terms_params();
-    let big = DVector::from_fn(BLOCK * nodes, |i, _| {
-        let (n, c) = (i / BLOCK, i % BLOCK);
-        let s = (i as f64 * 0.7).sin();
-        match c {
-            0..=5 => fwd[6 * n + c] + 1e-3 * s,
-            _ => 1e-5 * s,
-        }
-    });
-    let pattern = Pattern::with_block(&case.mesh, BLOCK);
-    let mut solver = LinearSolver::new(&pattern).expect("solver");
+    let state = DVector::from_fn(fd_map.len(), |i, _| fwd[i] + 1e-3 * (i as f64 * 0.7).sin());
+    let adjoint = DVector::from_fn(fd_map.len(), |i, _| 1e-5 * (i as f64 * 0.3).sin());
+    let big = kkt_vector(&kd, &state, &adjoint);
+    let pattern = kd.pattern();
+    let mut solver = LinearSolver::new(&pattern);
     let mut jac = vec![0.0; pattern.nnz()];
-    let r = assemble_newton(&p, &params, &pattern, &mut jac, &big, &xg, &prev);
-    let u = DVector::from_fn(6 * nodes, |i, _| big[BLOCK * (i / 6) + i % 6]);
-    let mut kv = vec![0.0; pattern.nnz()];
-    let rhs = cosserat::solve::inverse::assemble_kkt(&p, &params, &pattern, &mut kv, &u, &xg, &prev);
-    let rows: Vec<usize> = cosserat::solve::inverse::dirichlet(&params, &xg).iter().map(|f| f.0).collect();
-    pattern.set_identity_rows(&mut kv, &rows);
+    let r = newton_residual(&p, &params, &frame, &prev, &big, Some((&pattern, &mut jac)));
+    let u = kd.kkt_state(&big);
+    let (kv, rhs) = fixed_point_system(&p, &params, &frame, &prev, &u, &pattern);
     for (values, b) in [(&kv, &rhs), (&jac, &r)] {
         let a = pattern.to_dense(values);
         let dense = a.clone().lu().solve(b).expect("dense LU");

@@ -1,4 +1,4 @@
-//! Issue 5, the rebased angle chart (`cosserat::chart`, `docs/rotation.md`) on the real clips:
+//! Issue 5, the rebased angle chart (`cosserat::model::chart`, `docs/rotation.md`) on the real clips:
 //! agreement with the paper's global chart where that chart is regular (x–z placement), and
 //! invariance of the reconstruction under rigid rotations of the data (x–y placement, where the
 //! global chart fails, and a random orientation), for every frame of both elegansbot clips.
@@ -7,7 +7,8 @@
 mod common;
 
 use common::{case_from, case_text, edit, worm_data_present};
-use cosserat::run::{run_clip, RunError};
+use cosserat::io::engine::{run_clip_case, EngineError};
+use cosserat::run::RunError;
 use cosserat::solve::sequence::SequenceError;
 use nalgebra::{Matrix3, Rotation3, Vector3};
 use std::path::Path;
@@ -27,7 +28,7 @@ fn parse(path: &Path) -> Vec<Vec<f64>> {
 }
 
 /// The omega/delta Newton case (λd = 1) with extra `[clip]` lines, run into a temporary folder.
-fn run(name: &str, clip_lines: &str, frames: Option<usize>) -> Result<Recovered, RunError> {
+fn run(name: &str, clip_lines: &str, frames: Option<usize>) -> Result<Recovered, EngineError> {
     let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/elegansbot");
     let mut text = edit(&case_text(name), "file = \"../data/elegansbot/", &format!("file = \"{}/", data.display()));
     text = edit(&text, "start = \"data_guess\"", &format!("start = \"data_guess\"\n{clip_lines}"));
@@ -36,7 +37,7 @@ fn run(name: &str, clip_lines: &str, frames: Option<usize>) -> Result<Recovered,
     }
     let case = case_from(&text, name);
     let dir = tempfile::tempdir().expect("tempdir");
-    let r = run_clip(&case, dir.path(), |_, _| {})?;
+    let r = run_clip_case(&case, dir.path(), |_, _| {})?;
     let frames_csv = parse(&dir.path().join("frames.csv"));
     let fields = parse(&dir.path().join("fields.csv"));
     let curv = parse(&dir.path().join("curvature.csv"));
@@ -116,7 +117,7 @@ fn check_clip(name: &str, frames: Option<usize>) {
 
     // The global chart in the x–y plane meets its singular set.
     match run(name, "plane = \"xy\"\nrotation = \"global_euler\"", frames) {
-        Err(RunError::Sequence(SequenceError::SingularChart { frame, node, cos_beta, .. })) => {
+        Err(EngineError::Run(RunError::Sequence(SequenceError::SingularChart { frame, node, cos_beta, .. }))) => {
             eprintln!("{name}: global chart, x–y plane: stops at frame {frame}, node {node}, |cos β| {cos_beta:.1e}")
         }
         Err(e) => eprintln!("{name}: global chart, x–y plane: fails: {e}"),

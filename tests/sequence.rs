@@ -2,32 +2,39 @@
 //! and initial iterate, and the guard on the singular angle chart.
 mod common;
 
-use common::{case_from, case_text, edit};
-use cosserat::solve::inverse::InverseParams;
-use cosserat::solve::sequence::{
-    solve_sequence, FrameMethod, FrameStart, RotationTreatment, SequenceError, SequenceParams,
-};
+use common::{case_from, case_text, edit, with_weights};
+use cosserat::model::mesh::{DofMap, Field};
+use cosserat::solve::inverse::{InverseMethod, InverseParams, Weights};
+use cosserat::solve::sequence::{solve_sequence, FrameStart, RotationTreatment, SequenceError, SequenceParams};
 use cosserat::solve::statics::{self, Method, StaticParams};
-use cosserat::solve::{node_values, Problem};
+use cosserat::solve::Problem;
 use nalgebra::{DVector, Vector3};
 
 fn params() -> InverseParams {
     InverseParams {
-        lambda_g: 1e9,
-        lambda_f: 1e-2,
-        lambda_l: 1e-6,
-        lambda_d: 1e-6,
-        lambda_kappa: Vector3::repeat(1e-20),
-        lambda_omega: Vector3::repeat(1e-12),
-        dt: 0.04,
-        first_frame: true,
-        alpha0: 0.0,
-        frame: 0,
+        weights: Weights {
+            lambda_g: 1e9,
+            lambda_f: 1e-2,
+            lambda_l: 1e-6,
+            lambda_d: 1e-6,
+            lambda_kappa: Vector3::repeat(1e-20),
+            lambda_omega: Vector3::repeat(1e-12),
+        },
+        frame_interval_s: 0.04,
+        alpha0_rad: 0.0,
         stabilisation: 0.0,
         relaxation: 0.5,
+        method: InverseMethod::FixedPoint,
         tolerance: 1e-5,
         max_iterations: 400,
     }
+}
+
+/// The static solution of `p` by Newton with `steps` continuation steps.
+fn forward(p: &Problem, steps: usize) -> DVector<f64> {
+    let params =
+        StaticParams { method: Method::Newton, tolerance: 1e-13, max_iterations: 40, continuation_steps: steps };
+    statics::solve(p, &params, |_| {}).and_then(|s| s.converged()).expect("forward").u
 }
 
 /// A quasi-static clip: the eq. (65) rod (50 elements) under 1/4, 2/4, 3/4 and 4/4 of its load,
@@ -39,21 +46,14 @@ fn quasi_static_clip_is_recovered_frame_by_frame() {
     let mut frames = Vec::new();
     let mut truths = Vec::new();
     for k in 1..=4 {
-        let p = Problem { load_factor: k as f64 / 4.0, ..Problem::from_case(&case) };
-        let u = statics::solve(
-            &p,
-            &StaticParams { method: Method::Newton, tolerance: 1e-13, max_iterations: 40, continuation_steps: 3 * k },
-            |_| {},
-        )
-        .expect("forward")
-        .u;
-        frames.push((0..case.mesh.nodes()).map(|i| node_values(&u, i).0).collect::<Vec<_>>());
+        let p = Problem { load_factor: k as f64 / 4.0, ..case.problem() };
+        let u = forward(&p, 3 * k);
+        frames.push(p.dofs().field(&u, Field::X));
         truths.push(u);
     }
-    let p = Problem::from_case(&case);
+    let p = case.problem();
     let sp = SequenceParams {
-        frame: params(),
-        method: FrameMethod::FixedPoint,
+        inverse: params(),
         min_cos_beta: 1e-3,
         frame_offset: 0,
         start: FrameStart::PreviousFrame,
@@ -101,29 +101,23 @@ fn quasi_static_clip_is_recovered_frame_by_frame() {
 #[test]
 fn chart_guard_names_frame_and_node() {
     let case = case_from(&edit(&case_text("follower_bend_64"), "elements = 100", "elements = 40"), "f64_40");
-    let p = Problem::from_case(&case);
-    let u = statics::solve(
-        &p,
-        &StaticParams { method: Method::Newton, tolerance: 1e-13, max_iterations: 40, continuation_steps: 5 },
-        |_| {},
-    )
-    .expect("forward")
-    .u;
+    let p = case.problem();
+    let u = forward(&p, 5);
     let n = case.mesh.nodes();
-    let x_g: Vec<Vector3<f64>> = (0..n).map(|i| node_values(&u, i).0).collect();
-    let singular = (0..n)
-        .min_by(|&a, &b| node_values(&u, a).1[1].cos().abs().total_cmp(&node_values(&u, b).1[1].cos().abs()))
-        .expect("node");
+    let dofs = p.dofs();
+    let x_g = dofs.field(&u, Field::X);
+    let cos_beta = |i: usize| dofs.get(&u, i, Field::Alpha)[1].cos().abs();
+    let singular = (0..n).min_by(|&a, &b| cos_beta(a).total_cmp(&cos_beta(b))).expect("node");
     let sp = SequenceParams {
-        frame: InverseParams {
-            lambda_f: 1.0,
-            lambda_l: 1e-10,
-            lambda_kappa: Vector3::new(0.0, 0.0, 1e-10),
-            lambda_omega: Vector3::zeros(),
+        inverse: InverseParams {
             tolerance: 1e-4,
-            ..params()
+            ..with_weights(&params(), |w| {
+                w.lambda_f = 1.0;
+                w.lambda_l = 1e-10;
+                w.lambda_kappa = Vector3::new(0.0, 0.0, 1e-10);
+                w.lambda_omega = Vector3::zeros();
+            })
         },
-        method: FrameMethod::FixedPoint,
         min_cos_beta: 0.2,
         frame_offset: 0,
         start: FrameStart::PreviousFrame,
@@ -160,7 +154,7 @@ fn chart_guard_names_frame_and_node() {
 /// and for a planar curve in the x–z plane it is α = β = 0, γ = −θ.
 #[test]
 fn data_guess_follows_the_tangent_without_jumps() {
-    use cosserat::rotation::rotation;
+    use cosserat::model::rotation::rotation;
     use cosserat::solve::sequence::data_frame_guess;
     // A planar spiral in the x–z plane turning by 7 rad (more than 2π).
     let n = 200;
@@ -173,19 +167,21 @@ fn data_guess_follows_the_tangent_without_jumps() {
         x.push(p);
     }
     let u = data_frame_guess(&x);
+    let dofs = DofMap::forward(n);
+    let alpha = |u: &DVector<f64>, i: usize| dofs.get(u, i, Field::Alpha);
     let mut worst_jump: f64 = 0.0;
     for i in 0..n {
-        let a = Vector3::new(u[6 * i + 3], u[6 * i + 4], u[6 * i + 5]);
+        let a = alpha(&u, i);
         assert!(a[0].abs() < 1e-12 && a[1].abs() < 1e-12, "node {i}: {a:?}");
         let (lo, hi) = (i.saturating_sub(1), (i + 1).min(n - 1));
         let t = (x[hi] - x[lo]).normalize();
         assert!((rotation(&a).row(2).transpose() - t).norm() < 1e-12, "node {i}: d3 is not the tangent");
         if i > 0 {
-            worst_jump = worst_jump.max((u[6 * i + 5] - u[6 * i - 1]).abs());
+            worst_jump = worst_jump.max((alpha(&u, i)[2] - alpha(&u, i - 1)[2]).abs());
         }
     }
     assert!(worst_jump < 0.1, "{worst_jump}");
-    assert!((u[6 * (n - 1) + 5] + 7.0).abs() < 0.05, "γ at the end {} (θ ≈ 7)", u[6 * (n - 1) + 5]);
+    assert!((alpha(&u, n - 1)[2] + 7.0).abs() < 0.05, "γ at the end {} (θ ≈ 7)", alpha(&u, n - 1)[2]);
     // A 3D helix: d3 is the tangent at every node.
     let helix: Vec<Vector3<f64>> = (0..n)
         .map(|i| {
@@ -195,7 +191,7 @@ fn data_guess_follows_the_tangent_without_jumps() {
         .collect();
     let u = data_frame_guess(&helix);
     for i in 0..n {
-        let a = Vector3::new(u[6 * i + 3], u[6 * i + 4], u[6 * i + 5]);
+        let a = alpha(&u, i);
         let (lo, hi) = (i.saturating_sub(1), (i + 1).min(n - 1));
         let t = (helix[hi] - helix[lo]).normalize();
         assert!((rotation(&a).row(2).transpose() - t).norm() < 1e-9, "helix node {i}");
@@ -222,27 +218,19 @@ fn rebased_and_global_charts_differ_at_second_order_on_a_3d_clip() {
         let frames: Vec<Vec<Vector3<f64>>> = [1.0, 0.999, 0.998]
             .iter()
             .map(|&k| {
-                let p = Problem { load_factor: k, ..Problem::from_case(&case) };
-                let u = statics::solve(
-                    &p,
-                    &StaticParams {
-                        method: Method::Newton,
-                        tolerance: 1e-13,
-                        max_iterations: 40,
-                        continuation_steps: 10,
-                    },
-                    |_| {},
-                )
-                .expect("forward")
-                .u;
-                (0..n).map(|i| node_values(&u, i).0).collect()
+                let p = Problem { load_factor: k, ..case.problem() };
+                p.dofs().field(&forward(&p, 10), Field::X)
             })
             .collect();
-        let p = Problem::from_case(&case);
+        let p = case.problem();
+        let dofs = p.dofs();
         let run = |rotation| {
             let sp = SequenceParams {
-                frame: InverseParams { tolerance: 1e-10, ..params() },
-                method: FrameMethod::Newton { warm_start_tolerance: 1e-3 },
+                inverse: InverseParams {
+                    tolerance: 1e-10,
+                    method: InverseMethod::Newton { warm_start_tolerance: 1e-3 },
+                    ..params()
+                },
                 min_cos_beta: 1e-3,
                 frame_offset: 0,
                 start: FrameStart::DataGuess,
@@ -257,7 +245,8 @@ fn rebased_and_global_charts_differ_at_second_order_on_a_3d_clip() {
                 None,
                 |_, _| {},
                 |rep, f| {
-                    let q: Vec<_> = (0..n).map(|i| f.chart.rotation(&node_values(&f.solution.u, i).1)).collect();
+                    let q: Vec<_> =
+                        (0..n).map(|i| f.chart.rotation(&dofs.get(&f.solution.u, i, Field::Alpha))).collect();
                     out.push((rep.chart_axis, q));
                     Ok(())
                 },

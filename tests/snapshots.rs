@@ -7,8 +7,9 @@ use std::collections::BTreeMap;
 
 use common::sig;
 use cosserat::case::{case_files, Case};
-use cosserat::metrics::all_metrics;
-use cosserat::run::run_rust;
+use cosserat::io::engine::run_case;
+use cosserat::run::metrics::all_metrics;
+use cosserat::run::Engine;
 
 /// Significant digits kept for physical metrics of static cases (deterministic to ~1e-10).
 const DIGITS: i32 = 7;
@@ -27,7 +28,8 @@ fn case_metrics_snapshots() {
         if common::is_clip(&case) && !common::worm_data_present(&case.name) {
             continue;
         }
-        let r = run_rust(&case, |_, _| {}).unwrap_or_else(|e| panic!("{}: {e}", case.name));
+        let dir = tempfile::tempdir().expect("tempdir");
+        let r = run_case(&case, Engine::Rust, dir.path(), |_, _| {}).unwrap_or_else(|e| panic!("{}: {e}", case.name));
         let inverse = case.inverse().is_some();
         let digits = if case.is_dynamic() {
             DYNAMIC_DIGITS

@@ -4,28 +4,20 @@
 mod common;
 
 use common::{case_file, worm_data_present};
-use cosserat::case::{Analysis, Case};
-use cosserat::run::{run_clip, ClipRun};
+use cosserat::case::{Analysis, Case, DataSource};
+use cosserat::io::engine::run_clip_case;
+use cosserat::io::sweep::chain;
+use cosserat::run::clip::ClipRun;
+use cosserat::solve::inverse::InverseMethod;
 
 fn run(case: &Case) -> ClipRun {
     let dir = tempfile::tempdir().expect("tempdir");
-    run_clip(case, dir.path(), |_, _| {}).unwrap_or_else(|e| panic!("{}: {:#}", case.name, anyhow_like(&e)))
-}
-
-fn anyhow_like(e: &dyn std::error::Error) -> String {
-    let mut s = e.to_string();
-    let mut src = e.source();
-    while let Some(x) = src {
-        s.push_str(": ");
-        s.push_str(&x.to_string());
-        src = x.source();
-    }
-    s
+    run_clip_case(case, dir.path(), |_, _| {}).unwrap_or_else(|e| panic!("{}: {}", case.name, chain(&e)))
 }
 
 fn with_frames(mut case: Case, end: usize) -> Case {
     if let Analysis::Inverse(s) = &mut case.analysis {
-        if let cosserat::case::DataSource::Clip(c) = &mut s.data {
+        if let DataSource::Clip(c) = &mut s.data {
             c.frames = Some((0, end));
         }
     }
@@ -75,11 +67,11 @@ fn paper_element_does_not_converge_on_the_first_frame() {
     }
     let mut case = with_frames(case_file("worm_omega_turn"), 1);
     if let Analysis::Inverse(s) = &mut case.analysis {
-        s.stabilisation = 0.0;
+        s.params.stabilisation = 0.0;
     }
     let dir = tempfile::tempdir().expect("tempdir");
-    let err = run_clip(&case, dir.path(), |_, _| {}).expect_err("the paper's element must fail here");
-    let text = anyhow_like(&err);
+    let err = run_clip_case(&case, dir.path(), |_, _| {}).expect_err("the paper's element must fail here");
+    let text = chain(&err);
     eprintln!("{text}");
     assert!(text.contains("frame 0 did not converge after 300 iterations"), "{text}");
 }
@@ -94,13 +86,14 @@ fn newton_and_fixed_point_agree_on_the_first_frames() {
     let newton = with_frames(case_file("worm_omega_turn_ld1"), 8);
     let mut fp = newton.clone();
     if let Analysis::Inverse(s) = &mut fp.analysis {
-        s.method = cosserat::case::InverseMethod::FixedPoint { relaxation: 0.5 };
-        s.tolerance = 1e-7;
-        s.max_iterations = 2000;
+        s.params.method = InverseMethod::FixedPoint;
+        s.params.relaxation = 0.5;
+        s.params.tolerance = 1e-7;
+        s.params.max_iterations = 2000;
     }
     let (dn, df) = (tempfile::tempdir().expect("tmp"), tempfile::tempdir().expect("tmp"));
-    let rn = run_clip(&newton, dn.path(), |_, _| {}).expect("newton");
-    let rf = run_clip(&fp, df.path(), |_, _| {}).expect("fixed point");
+    let rn = run_clip_case(&newton, dn.path(), |_, _| {}).expect("newton");
+    let rf = run_clip_case(&fp, df.path(), |_, _| {}).expect("fixed point");
     let read = |d: &std::path::Path| std::fs::read_to_string(d.join("fields.csv")).expect("fields");
     let (a, b) = (read(dn.path()), read(df.path()));
     let mut worst: f64 = 0.0;

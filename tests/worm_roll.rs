@@ -3,8 +3,14 @@
 //! omega-turn kymogram (`scripts/fetch_worm_data.sh`); skipped with a notice without it.
 mod common;
 
+use std::f64::consts::PI;
+
 use common::{case_from, case_text, edit, worm_data_present};
-use cosserat::run::{run_clip, ClipRun, RunError};
+use cosserat::clip::synthetic::{roll_clip, RollClipParams, TimeMapping};
+use cosserat::io::clip_files::kymogram_rows;
+use cosserat::io::engine::{run_clip_case, EngineError};
+use cosserat::run::clip::ClipRun;
+use cosserat::run::RunError;
 use cosserat::solve::sequence::SequenceError;
 use nalgebra::{Rotation3, Vector3};
 use std::path::Path;
@@ -17,8 +23,8 @@ fn case(extra: &str) -> cosserat::case::Case {
     case_from(&edit(&text, "rotation = \"rebased\"", extra), "worm_roll_3d")
 }
 
-fn run(extra: &str, out: &Path) -> Result<ClipRun, RunError> {
-    run_clip(&case(extra), out, |_, _| {})
+fn run(extra: &str, out: &Path) -> Result<ClipRun, EngineError> {
+    run_clip_case(&case(extra), out, |_, _| {})
 }
 
 /// Every one of the 1160 frames converges from the previous frame's solution, and the
@@ -70,8 +76,8 @@ fn the_global_chart_fails_on_the_3d_clip() {
     }
     let dir = tempfile::tempdir().expect("tempdir");
     let c = case("rotation = \"global_euler\"\nframes = [700, 900]");
-    match run_clip(&c, dir.path(), |_, _| {}) {
-        Err(RunError::Sequence(SequenceError::SingularChart { frame, node, cos_beta, .. })) => {
+    match run_clip_case(&c, dir.path(), |_, _| {}) {
+        Err(EngineError::Run(RunError::Sequence(SequenceError::SingularChart { frame, node, cos_beta, .. }))) => {
             eprintln!("global chart: stops at frame {frame}, node {node}, |cos β| {cos_beta:.2e}");
             assert!((700..900).contains(&frame));
         }
@@ -125,4 +131,69 @@ fn a_rotated_3d_clip_gives_the_rotated_answer() {
         b.reports.iter().map(|r| r.iterations).sum::<usize>()
     );
     assert!(dx < 1e-7 && dd < 1e-7 && dk < 1e-7, "{dx:e} {dd:e} {dk:e}");
+}
+
+/// The default clip from the real omega turn; skipped with a notice when absent.
+#[test]
+fn default_synthetic_clip_from_the_omega_turn() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/elegansbot");
+    let omega_path = dir.join("kymogram_omega-turn.npy");
+    if !omega_path.is_file() {
+        println!("SKIPPED: {} is absent (run scripts/fetch_worm_data.sh)", omega_path.display());
+        return;
+    }
+    let to_rows = |p: &Path| kymogram_rows(p).expect("kymogram");
+    let omega = to_rows(&omega_path);
+    let delta = to_rows(&dir.join("kymogram_delta-turn.npy"));
+    for mapping in [TimeMapping::StretchOmega, TimeMapping::OmegaThenDelta] {
+        let params = RollClipParams { time_mapping: mapping, ..RollClipParams::default() };
+        let start = std::time::Instant::now();
+        let (clip, truth) = roll_clip(&omega, Some(&delta), &params).unwrap();
+        let wall = start.elapsed().as_secs_f64();
+        assert_eq!((clip.frame_count(), clip.node_count(), clip.dt_s), (1160, 128, 0.04));
+        let align = truth.max_tangent_alignment(&Vector3::y());
+        let max_align = align.iter().cloned().fold(0.0, f64::max);
+        let near = align.iter().filter(|&&a| a > 0.99).count();
+        let first_near = align.iter().position(|&a| a > 0.99);
+        let kmax = truth.frames.iter().flat_map(|f| &f.kappa).map(|k| k.x.hypot(k.y)).fold(0.0, f64::max);
+        let (jf, jdev) = clip.max_stretch_deviation();
+        println!(
+            "{mapping:?}: {wall:.3} s; max |d3·e2| {max_align:.6}; frames with |d3·e2| > 0.99: {near}/1160 ({:.1} %), first {first_near:?}; \
+             max bending {kmax:.0} 1/m; max |j − 1| {jdev:.2e} (frame {jf})\n  {}",
+            100.0 * near as f64 / 1160.0,
+            clip.source
+        );
+        assert!(clip.frames.iter().flatten().all(|p| p.iter().all(|v| v.is_finite())));
+        if mapping == TimeMapping::StretchOmega {
+            for roll in [PI / 6.0, PI / 4.0, PI / 3.0] {
+                let (_, t) =
+                    roll_clip(&omega, None, &RollClipParams { roll_total_rad: roll, ..params.clone() }).unwrap();
+                let a = t.max_tangent_alignment(&Vector3::y());
+                let near = a.iter().filter(|&&v| v > 0.99).count();
+                println!(
+                    "  roll_total {roll:.4} rad: max |d3·e2| {:.4}, frames with |d3·e2| > 0.99: {near}/1160",
+                    a.iter().cloned().fold(0.0, f64::max)
+                );
+            }
+            let (fine, fine_truth) =
+                roll_clip(&omega, None, &RollClipParams { substeps: 32, ..params.clone() }).unwrap();
+            let ex = clip
+                .frames
+                .iter()
+                .flatten()
+                .zip(fine.frames.iter().flatten())
+                .map(|(a, b)| (a - b).norm())
+                .fold(0.0, f64::max)
+                / params.length_m;
+            let eq = truth
+                .frames
+                .iter()
+                .flat_map(|f| &f.q)
+                .zip(fine_truth.frames.iter().flat_map(|f| &f.q))
+                .map(|(a, b)| (a - b).amax())
+                .fold(0.0, f64::max);
+            println!("  substeps {} vs 32: max |Δx|/L {ex:.2e}, max |ΔQ| {eq:.2e}", params.substeps);
+            assert!(ex < 1e-10, "{ex:e}");
+        }
+    }
 }

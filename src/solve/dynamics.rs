@@ -10,12 +10,14 @@
 //! used (errata: (Δt²/2) F_n and M_{n−2}; see PAPER-NOTES and `docs/decisions.md`).
 use nalgebra::{DVector, Vector3};
 
-use super::{node_values, Problem, SolveError};
-use crate::assembly::{LinearSolver, Pattern};
-use crate::loads::LoadFrame;
+use super::{Problem, SolveError};
+use crate::assemble::Tangent;
+use crate::linalg::LinearSolver;
+use crate::model::loads::LoadFrame;
+use crate::model::mesh::Field;
 
 /// Time-stepping parameters.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DynamicParams {
     pub end_time_s: f64,
     pub steps: usize,
@@ -48,8 +50,9 @@ pub fn solve(
     params: &DynamicParams,
     mut progress: impl FnMut(usize, usize),
 ) -> Result<DynamicSolution, SolveError> {
-    let pattern = Pattern::new(&problem.mesh);
-    let mut solver = LinearSolver::new(&pattern)?;
+    let dofs = problem.dofs();
+    let pattern = dofs.pattern();
+    let mut solver = LinearSolver::new(&pattern);
     let fixed = problem.clamped_dofs();
     let dt = params.end_time_s / params.steps as f64;
     let last = problem.mesh.nodes() - 1;
@@ -60,7 +63,7 @@ pub fn solve(
     let mut f_prev = problem.loads_at(&u_prev, 0.0, None);
     let mut values = vec![0.0; pattern.nnz()];
     let record = |t: f64, u: &DVector<f64>, it: usize| {
-        let (x, a) = node_values(u, last);
+        let (x, a) = (dofs.get(u, last, Field::X), dofs.get(u, last, Field::Alpha));
         TipRecord { time_s: t, position_m: x, angles_rad: a, newton_iterations: it }
     };
     let mut tip = vec![record(0.0, &u_prev, 0)];
@@ -79,14 +82,14 @@ pub fn solve(
             let v = (&u - &u_prev) * (2.0 / dt) - &v_prev;
             let u_mid = (&u + &u_prev) * 0.5;
             values.iter_mut().for_each(|x| *x = 0.0);
-            let p = problem.momentum(&u, &v, Some((&pattern, &mut values, 1.0 / dt, 2.0 / (dt * dt))));
-            let g = problem.internal_force(&u_mid, Some((&pattern, &mut values, 0.5)));
+            let p = problem.momentum(&u, &v, Some((Tangent::new(&pattern, &mut values, 1.0 / dt), 2.0 / (dt * dt))));
+            let g = problem.internal_force(&u_mid, Some(Tangent::new(&pattern, &mut values, 0.5)));
             // ½[F(t_n, u_n) + F(t_{n−1}, u_{n−1})]: only the first half depends on u_n.
             let f_state;
             let f_n = match &f_step {
                 Some(f) => f,
                 None => {
-                    f_state = problem.loads_at(&u, t, Some((&pattern, &mut values, -0.5)));
+                    f_state = problem.loads_at(&u, t, Some(Tangent::new(&pattern, &mut values, -0.5)));
                     &f_state
                 }
             };

@@ -8,8 +8,9 @@
 use nalgebra::{DMatrix, DVector, SymmetricEigen};
 
 use super::{Problem, SolveError};
-use crate::assembly::Pattern;
-use crate::rotation::a_matrix;
+use crate::assemble::Tangent;
+use crate::model::mesh::{DofMap, Field};
+use crate::model::rotation::a_matrix;
 
 /// Linearised modal model on the free unknowns (node 0 removed).
 pub struct ModalModel {
@@ -21,6 +22,8 @@ pub struct ModalModel {
     pub row_transform: DMatrix<f64>,
     /// largest relative asymmetry found in `K_s` and `M_s`
     pub asymmetry: f64,
+    /// full index of the first free unknown
+    first_free: usize,
 }
 
 /// Errors of the eigen-analysis.
@@ -34,28 +37,29 @@ pub enum ModesError {
     Solve(#[from] SolveError),
 }
 
-/// Number of free unknowns: all but the clamped node.
-fn free_range(problem: &Problem) -> std::ops::Range<usize> {
-    6..problem.mesh.ndofs()
+/// The free unknowns: all but the clamped node 0. They keep the forward layout, one node less.
+fn free_dofs(problem: &Problem) -> (std::ops::Range<usize>, DofMap) {
+    let dofs = problem.dofs();
+    (dofs.block()..dofs.len(), DofMap::forward(dofs.nodes() - 1))
 }
 
 /// Build the modal model (dense; intended for a few hundred unknowns).
 pub fn modal_model(problem: &Problem) -> Result<ModalModel, ModesError> {
-    let pattern = Pattern::new(&problem.mesh);
+    let pattern = problem.dofs().pattern();
     let u0 = problem.reference_state();
     let zero = DVector::zeros(u0.len());
     let mut kv = vec![0.0; pattern.nnz()];
-    problem.internal_force(&u0, Some((&pattern, &mut kv, 1.0)));
+    problem.internal_force(&u0, Some(Tangent::new(&pattern, &mut kv, 1.0)));
     let mut mv = vec![0.0; pattern.nnz()];
-    problem.momentum(&u0, &zero, Some((&pattern, &mut mv, 0.0, 1.0)));
-    let free = free_range(problem);
+    problem.momentum(&u0, &zero, Some((Tangent::new(&pattern, &mut mv, 0.0), 1.0)));
+    let (free, free_dofs) = free_dofs(problem);
     let n = free.len();
     let kd = pattern.to_dense(&kv).view((free.start, free.start), (n, n)).into_owned();
     let md = pattern.to_dense(&mv).view((free.start, free.start), (n, n)).into_owned();
     let a0t = a_matrix(&nalgebra::Vector3::zeros()).transpose();
     let mut t = DMatrix::identity(n, n);
-    for node in 0..n / 6 {
-        let o = 6 * node + 3;
+    for node in 0..free_dofs.nodes() {
+        let o = free_dofs.index(node, Field::Alpha, 0);
         t.view_mut((o, o), (3, 3)).copy_from(&a0t);
     }
     let ks = &t * kd;
@@ -79,19 +83,19 @@ pub fn modal_model(problem: &Problem) -> Result<ModalModel, ModesError> {
     let omegas = order.iter().map(|&i| eig.eigenvalues[i].max(0.0).sqrt()).collect();
     let y = DMatrix::from_fn(n, n, |r, c| eig.eigenvectors[(r, order[c])]);
     let shapes = l.transpose().solve_upper_triangular(&y).ok_or(ModesError::MassNotDefinite)?;
-    Ok(ModalModel { omegas, shapes, row_transform: t, asymmetry })
+    Ok(ModalModel { omegas, shapes, row_transform: t, asymmetry, first_free: free.start })
 }
 
 impl ModalModel {
     /// Modal load amplitudes `g = Φᵀ T F` for a full-length load vector `F` (node 0 dropped).
     pub fn project(&self, f_full: &DVector<f64>) -> DVector<f64> {
         let n = self.shapes.nrows();
-        let f = f_full.rows(6, n).into_owned();
+        let f = f_full.rows(self.first_free, n).into_owned();
         self.shapes.transpose() * (&self.row_transform * f)
     }
 
     /// Displacement of free unknown `index` (full numbering) for modal coordinates `q`.
     pub fn displacement(&self, index: usize, q: &DVector<f64>) -> f64 {
-        (self.shapes.row(index - 6) * q)[(0, 0)]
+        (self.shapes.row(index - self.first_free) * q)[(0, 0)]
     }
 }

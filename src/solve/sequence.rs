@@ -5,7 +5,7 @@
 //! The angle chart of eq. (1) is singular where cos β = 0 (det A = −cos β). With
 //! [`RotationTreatment::Rebased`] (the default) each frame is solved in its own chart
 //! `Q = Q_E(α) B` whose singular axis is chosen away from the frame's tangents
-//! (`crate::chart`, `docs/rotation.md`); with [`RotationTreatment::GlobalEuler`] every frame uses
+//! (`crate::model::chart`, `docs/rotation.md`); with [`RotationTreatment::GlobalEuler`] every frame uses
 //! the paper's chart. Either way every frame is guarded: a frame whose recovered β comes within
 //! `min_cos_beta` of ±π/2 at any node stops the clip with an error naming frame and node (the
 //! failure is otherwise silent: the fit stays good while α and κ3 explode, PAPER-NOTES).
@@ -13,31 +13,18 @@ use std::f64::consts::PI;
 
 use nalgebra::{DVector, Matrix3, Vector3};
 
-use crate::chart::{frame_axis, Chart};
-use crate::rotation::{angles_from_rotation, Angles};
+use crate::model::chart::{frame_axis, Chart};
+use crate::model::mesh::{DofMap, Field};
+use crate::model::rotation::{angles_from_rotation, skew, Angles};
 
-use super::inverse::{
-    solve_frame_observed_in, InverseParams, InverseRecord, InverseSolution, InverseWorkspace, ObjectiveTerms,
-};
-use super::inverse_newton::{solve_frame_newton_observed_in, solve_frame_warm_in};
-use super::{node_values, Problem, SolveError};
-
-/// How each frame is solved.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum FrameMethod {
-    /// the paper's fixed point (relaxation from the parameters)
-    FixedPoint,
-    /// Newton from the fixed point's iterate at `warm_start_tolerance` (I8)
-    Newton { warm_start_tolerance: f64 },
-}
+use super::inverse::{Frame, FrameSolver, InverseParams, InverseRecord, InverseSolution, ObjectiveTerms, Start};
+use super::{Problem, SolveError};
 
 /// Settings of a clip solve.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SequenceParams {
-    /// weights, Δt, relaxation, tolerance and per-frame iteration budget; `first_frame` and
-    /// `frame` are set per frame
-    pub frame: InverseParams,
-    pub method: FrameMethod,
+    /// weights, Δt, method, relaxation, tolerance and per-frame iteration budget
+    pub inverse: InverseParams,
     /// guard of the angle chart: stop when |cos β| < this at any node
     pub min_cos_beta: f64,
     /// number of the first frame in reports and errors (the clip's frame range may not start at 0)
@@ -105,9 +92,9 @@ pub enum SequenceError {
     Callback { frame: usize, message: String },
 }
 
-/// Smallest |cos β| over the nodes of a state and its node.
-pub fn min_cos_beta(u: &DVector<f64>) -> (f64, usize) {
-    (0..u.len() / 6).map(|i| (node_values(u, i).1[1].cos().abs(), i)).fold((f64::INFINITY, 0), |a, b| {
+/// Smallest |cos β| over the nodes of a state (forward layout `dofs`) and its node.
+pub fn min_cos_beta(dofs: &DofMap, u: &DVector<f64>) -> (f64, usize) {
+    (0..dofs.nodes()).map(|i| (dofs.get(u, i, Field::Alpha)[1].cos().abs(), i)).fold((f64::INFINITY, 0), |a, b| {
         if b.0 < a.0 {
             b
         } else {
@@ -146,10 +133,11 @@ pub fn data_frame_guess(x_g: &[Vector3<f64>]) -> DVector<f64> {
             let k = a.cross(&axis).normalize();
             return Matrix3::identity() * -1.0 + k * k.transpose() * 2.0;
         }
-        let vx = crate::rotation::skew(&v);
+        let vx = skew(&v);
         Matrix3::identity() + vx + vx * vx / (1.0 + c)
     };
-    let mut u = DVector::zeros(6 * n);
+    let dofs = DofMap::forward(n);
+    let mut u = dofs.zeros();
     // rows d1, d2, d3 at s = 0 (the gauge frame; e3's minimal turn if t_0 = ±e2)
     let t0 = tangent(0);
     let mut q = match Vector3::y().cross(&t0).try_normalize(1e-9) {
@@ -169,10 +157,8 @@ pub fn data_frame_guess(x_g: &[Vector3<f64>]) -> DVector<f64> {
             }
         }
         prev_a = Some(a);
-        for k in 0..3 {
-            u[6 * i + k] = x_g[i][k];
-            u[6 * i + 3 + k] = a[k];
-        }
+        dofs.set(&mut u, i, Field::X, &x_g[i]);
+        dofs.set(&mut u, i, Field::Alpha, &a);
     }
     u
 }
@@ -199,16 +185,15 @@ pub fn solve_sequence(
     mut on_iteration: impl FnMut(usize, &InverseRecord),
     mut on_frame: impl FnMut(&FrameReport, &FrameSolution) -> Result<(), String>,
 ) -> Result<Vec<FrameReport>, SequenceError> {
-    let n = problem.mesh.nodes();
+    let dofs = problem.dofs();
     let h = problem.mesh.h();
     let mut reports = Vec::with_capacity(frames.len());
-    // Previous frame: its chart, its state in that chart, its angles.
     // the previous frame: its chart and its state in that chart
     let mut prev: Option<(Chart, DVector<f64>)> = None;
     // the frame before that, for the linear predictor of a warm start
     let mut prev2: Option<(Chart, DVector<f64>)> = None;
     // pattern, LU storage and scratch once per clip, reused by every frame
-    let mut ws = InverseWorkspace::new(problem)?;
+    let mut solver = FrameSolver::new(problem, sp.inverse);
     for (i, x_space) in frames.iter().enumerate() {
         let k = i + sp.frame_offset;
         let start = std::time::Instant::now();
@@ -220,15 +205,14 @@ pub fn solve_sequence(
         let x_g: Vec<Vector3<f64>> =
             if chart.is_identity() { x_space.clone() } else { x_space.iter().map(|x| chart.to_chart(x)).collect() };
         let guess = || data_frame_guess(&x_g);
-        // The previous frame's state in this frame's chart (R6).
         // The previous frame's state in this frame's chart (R6); with two previous frames, the
         // linear predictor 2 u_{n−1} − u_{n−2} (the clip is sampled smoothly in time).
         // (Carrying the adjoint as well, instead of Newton's consistent-start solve, sent frame
         // 659 of worm_roll_3d to a wrong root: not done.)
         let carried = prev.as_ref().map(|(c, u)| {
-            let u1 = carry_state(&chart, c, u, None);
+            let u1 = carry_state(&dofs, &chart, c, u, None);
             match &prev2 {
-                Some((c2, u2)) => &u1 * 2.0 - carry_state(&chart, c2, u2, Some(&u1)),
+                Some((c2, u2)) => &u1 * 2.0 - carry_state(&dofs, &chart, c2, u2, Some(&u1)),
                 None => u1,
             }
         });
@@ -237,43 +221,30 @@ pub fn solve_sequence(
             (Some(u), FrameStart::PreviousFrame, _) => u.clone(),
             _ => guess(),
         };
-        let alpha_prev: Vec<Angles> = match &prev {
-            None => vec![Vector3::zeros(); n],
-            Some((c, u)) => {
-                let near: Vec<Angles> = (0..n).map(|j| node_values(&first_start, j).1).collect();
-                chart.reexpress(c, &(0..n).map(|j| node_values(u, j).1).collect::<Vec<_>>(), Some(&near))
-            }
-        };
-        let p = InverseParams { first_frame: i == 0, frame: k, ..sp.frame };
-        let mut solve = |start: &DVector<f64>, warm: bool| -> Result<InverseSolution, SolveError> {
-            let report = |r: &InverseRecord, _: &DVector<f64>, _: &DVector<f64>| on_iteration(k, r);
-            match sp.method {
-                FrameMethod::FixedPoint => {
-                    solve_frame_observed_in(&mut ws, problem, &p, &x_g, &alpha_prev, start, report)
-                }
-                // From the previous frame's solution (already close) Newton runs directly; from
-                // a guess it needs the fixed point's warm start (I8).
-                FrameMethod::Newton { .. } if warm => {
-                    solve_frame_newton_observed_in(&mut ws, problem, &p, &x_g, &alpha_prev, start, report)
-                }
-                FrameMethod::Newton { warm_start_tolerance } => {
-                    solve_frame_warm_in(&mut ws, problem, &p, warm_start_tolerance, &x_g, &alpha_prev, start, report)
-                }
-            }
+        let alpha_prev: Option<Vec<Angles>> = prev.as_ref().map(|(c, u)| {
+            let near = dofs.field(&first_start, Field::Alpha);
+            chart.reexpress(c, &dofs.field(u, Field::Alpha), Some(&near))
+        });
+        let frame = Frame { index: k, x_g: &x_g, previous: alpha_prev.as_deref() };
+        // From the previous frame's solution (already close) Newton runs directly; from a guess
+        // it needs the fixed point's warm start (I8).
+        let mut solve = |u0: &DVector<f64>, start: Start| -> Result<InverseSolution, SolveError> {
+            solver.solve(&frame, u0, start, |r, _, _| on_iteration(k, r))?.converged(k)
         };
         // A frame that does not converge from the previous frame's solution is solved again
         // from the data guess (D13), and the restart is reported.
         let from_previous = i > 0 && sp.start == FrameStart::PreviousFrame;
-        let (sol, restarted) = match solve(&first_start, from_previous) {
+        let first_kind = if from_previous { Start::Near } else { Start::Guess };
+        let (sol, restarted) = match solve(&first_start, first_kind) {
             Ok(sol) => (sol, false),
             Err(
                 SolveError::InverseNotConverged { .. }
                 | SolveError::InverseNewtonNotConverged { .. }
                 | SolveError::InverseNonFinite { .. },
-            ) if from_previous => (solve(&guess(), false)?, true),
+            ) if from_previous => (solve(&guess(), Start::Guess)?, true),
             Err(e) => return Err(e.into()),
         };
-        let (cos_beta, node) = min_cos_beta(&sol.u);
+        let (cos_beta, node) = min_cos_beta(&dofs, &sol.u);
         if cos_beta < sp.min_cos_beta {
             return Err(SequenceError::SingularChart {
                 frame: k,
@@ -302,7 +273,7 @@ pub fn solve_sequence(
             chart_axis: chart.axis(),
             wall_time_s: start.elapsed().as_secs_f64(),
         };
-        let in_space = if chart.is_identity() { None } else { Some(to_space(&chart, &sol)) };
+        let in_space = if chart.is_identity() { None } else { Some(to_space(&dofs, &chart, &sol)) };
         on_frame(&rep, &FrameSolution { solution: in_space.as_ref().unwrap_or(&sol), chart })
             .map_err(|message| SequenceError::Callback { frame: k, message })?;
         prev2 = prev.take();
@@ -315,38 +286,37 @@ pub fn solve_sequence(
 /// A state `(x, α)` of chart `from` in chart `to` (R6): positions rotated by `B_to B_fromᵀ`,
 /// angles re-expressed node by node without 2π jumps along the rod (or against `near`).
 /// `near`: a state in chart `to` whose angles the result's are unwrapped against (R6).
-fn carry_state(to: &Chart, from: &Chart, u: &DVector<f64>, near: Option<&DVector<f64>>) -> DVector<f64> {
+fn carry_state(dofs: &DofMap, to: &Chart, from: &Chart, u: &DVector<f64>, near: Option<&DVector<f64>>) -> DVector<f64> {
     if to.base == from.base {
         return u.clone();
     }
-    let n = u.len() / 6;
-    let alpha: Vec<Angles> = (0..n).map(|j| node_values(u, j).1).collect();
-    let near: Option<Vec<Angles>> = near.map(|v| (0..n).map(|j| node_values(v, j).1).collect());
+    let alpha = dofs.field(u, Field::Alpha);
+    let near: Option<Vec<Angles>> = near.map(|v| dofs.field(v, Field::Alpha));
     let alpha = to.reexpress(from, &alpha, near.as_deref());
-    let mut out = DVector::zeros(u.len());
-    for j in 0..n {
-        let x = to.to_chart(&from.to_space(&node_values(u, j).0));
-        for c in 0..3 {
-            out[6 * j + c] = x[c];
-            out[6 * j + 3 + c] = alpha[j][c];
-        }
+    let mut out = dofs.zeros();
+    for j in 0..dofs.nodes() {
+        dofs.set(&mut out, j, Field::X, &to.to_chart(&from.to_space(&dofs.get(u, j, Field::X))));
+        dofs.set(&mut out, j, Field::Alpha, &alpha[j]);
     }
     out
 }
 
 /// The solution with positions and adjoints in space coordinates (R3); angles unchanged.
-fn to_space(chart: &Chart, sol: &InverseSolution) -> InverseSolution {
+fn to_space(dofs: &DofMap, chart: &Chart, sol: &InverseSolution) -> InverseSolution {
     let rotate = |v: &DVector<f64>, both: bool| {
         let mut out = v.clone();
-        for j in 0..v.len() / 6 {
-            let (a, b) = node_values(v, j);
+        for j in 0..dofs.nodes() {
+            let (a, b) = (dofs.get(v, j, Field::X), dofs.get(v, j, Field::Alpha));
             let (a, b) = (chart.to_space(&a), if both { chart.to_space(&b) } else { b });
-            for c in 0..3 {
-                out[6 * j + c] = a[c];
-                out[6 * j + 3 + c] = b[c];
-            }
+            dofs.set(&mut out, j, Field::X, &a);
+            dofs.set(&mut out, j, Field::Alpha, &b);
         }
         out
     };
-    InverseSolution { u: rotate(&sol.u, false), adjoint: rotate(&sol.adjoint, true), history: sol.history.clone() }
+    InverseSolution {
+        u: rotate(&sol.u, false),
+        adjoint: rotate(&sol.adjoint, true),
+        history: sol.history.clone(),
+        stop: sol.stop,
+    }
 }

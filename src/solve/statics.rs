@@ -12,12 +12,14 @@
 //! 1. Wang et al., Comput. Mech. 71 (2023), §4, eqs. (52), (61), Remark 10.
 use nalgebra::DVector;
 
-use super::{split_norms_2, Problem, SolveError};
-use crate::assembly::{gather, LinearSolver, Pattern};
-use crate::element::frozen_operator;
+use super::{Problem, SolveError, Stop};
+use crate::assemble::{assemble, Tangent};
+use crate::linalg::{LinearSolver, Pattern};
+use crate::model::element::frozen_operator;
+use crate::model::mesh::DofMap;
 
 /// Static solver parameters.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct StaticParams {
     pub method: Method,
     pub tolerance: f64,
@@ -26,9 +28,12 @@ pub struct StaticParams {
     pub continuation_steps: usize,
 }
 
+/// Nonlinear solver of a static problem (D5).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Method {
+    /// The paper's relaxed fixed point (§4, Remark 10) with relaxation w ∈ (0, 1].
     FixedPoint { relaxation: f64 },
+    /// Newton with the exact Jacobian.
     Newton,
 }
 
@@ -43,7 +48,7 @@ pub struct IterationRecord {
     pub change: f64,
 }
 
-/// Result of a converged static solve.
+/// Result of a static solve: the last iterate and its info.
 #[derive(Clone, Debug)]
 pub struct StaticSolution {
     pub u: DVector<f64>,
@@ -53,31 +58,60 @@ pub struct StaticSolution {
     /// `‖R(u)‖∞ / ‖F‖∞` over the free unknowns (D5)
     pub residual: f64,
     pub history: Vec<IterationRecord>,
+    /// [`Stop::MaxIterations`]: a continuation step reached `max_iterations` (the last record
+    /// names it); `u` is its last iterate and the later steps did not run
+    pub stop: Stop,
+    pub method: Method,
 }
 
-/// Solve the static problem from the reference configuration, with load continuation.
+impl StaticSolution {
+    /// The solution if it met the stopping rule, else the error naming step and change.
+    pub fn converged(self) -> Result<Self, SolveError> {
+        if self.stop == Stop::Converged {
+            return Ok(self);
+        }
+        let last = self.history.last().copied();
+        let (step, iterations, change) =
+            last.map(|r| (r.step, r.iteration, r.change)).unwrap_or((1, self.iterations, f64::NAN));
+        Err(match self.method {
+            Method::FixedPoint { .. } => SolveError::FixedPointNotConverged { step, iterations, rel_change: change },
+            Method::Newton => SolveError::NewtonNotConverged { step: Some(step), iterations, increment: change },
+        })
+    }
+}
+
+/// Solve the static problem from the reference configuration, with load continuation. A step
+/// that reaches `max_iterations` ends the solve with [`Stop::MaxIterations`] (see
+/// [`StaticSolution::converged`]).
 pub fn solve(
     problem: &Problem,
     params: &StaticParams,
     mut progress: impl FnMut(&IterationRecord),
 ) -> Result<StaticSolution, SolveError> {
-    let pattern = Pattern::new(&problem.mesh);
-    let mut solver = LinearSolver::new(&pattern)?;
+    let pattern = problem.dofs().pattern();
+    let mut solver = LinearSolver::new(&pattern);
     let steps = params.continuation_steps.max(1);
     let mut u = problem.reference_state();
     let mut history = Vec::new();
     let mut last_change = f64::NAN;
+    let mut stop = Stop::Converged;
     for step in 1..=steps {
         let p = Problem { load_factor: problem.load_factor * step as f64 / steps as f64, ..*problem };
-        let (u_new, change) = solve_step(&p, params, &pattern, &mut solver, u, step, &mut history, &mut progress)?;
+        let (u_new, change, step_stop) =
+            solve_step(&p, params, &pattern, &mut solver, u, step, &mut history, &mut progress)?;
         u = u_new;
         last_change = change;
+        if step_stop != Stop::Converged {
+            stop = step_stop;
+            break;
+        }
     }
     let residual = relative_residual(problem, &u);
-    Ok(StaticSolution { iterations: history.len(), u, last_change, residual, history })
+    Ok(StaticSolution { iterations: history.len(), u, last_change, residual, history, stop, method: params.method })
 }
 
-/// One continuation step: iterate from `u` to the stopping rule of D5.
+/// One continuation step: iterate from `u` to the stopping rule of D5 (or the iteration
+/// limit): the last iterate, its change and why it stopped.
 #[allow(clippy::too_many_arguments)]
 fn solve_step(
     problem: &Problem,
@@ -88,7 +122,8 @@ fn solve_step(
     step: usize,
     history: &mut Vec<IterationRecord>,
     progress: &mut impl FnMut(&IterationRecord),
-) -> Result<(DVector<f64>, f64), SolveError> {
+) -> Result<(DVector<f64>, f64, Stop), SolveError> {
+    let dofs = problem.dofs();
     let fixed = problem.clamped_dofs();
     let reference = problem.reference_state();
     let mut values = vec![0.0; pattern.nnz()];
@@ -99,26 +134,26 @@ fn solve_step(
         let change = match params.method {
             Method::FixedPoint { relaxation } => {
                 let mut b = problem.loads_at(&u, 0.0, None);
-                for e in 0..problem.mesh.elements {
-                    let (l, bl) = frozen_operator(&problem.props, problem.scheme, h, &gather(&u, e));
-                    pattern.scatter_mat(&mut values, e, &l);
-                    for i in 0..12 {
-                        b[6 * e + i] += bl[i];
+                assemble(&dofs, &mut b, Some(Tangent::new(pattern, &mut values, 1.0)), |e, t| {
+                    let (l, bl) = frozen_operator(&problem.props, problem.scheme, h, &dofs.gather(&u, e));
+                    if let Some(t) = t {
+                        *t = l;
                     }
-                }
+                    bl
+                });
                 for &d in &fixed {
                     b[d] = reference[d];
                 }
                 pattern.set_identity_rows(&mut values, &fixed);
                 let u_hat = solver.solve(&values, &b)?;
                 let u_new = &u_hat * relaxation + &u * (1.0 - relaxation);
-                let change = relative_change(&u_new, &u);
+                let change = relative_change(&dofs, &u_new, &u);
                 u = u_new;
                 change
             }
             Method::Newton => {
-                let g = problem.internal_force(&u, Some((pattern, &mut values, 1.0)));
-                let mut r = g - problem.loads_at(&u, 0.0, Some((pattern, &mut values, -1.0)));
+                let g = problem.internal_force(&u, Some(Tangent::new(pattern, &mut values, 1.0)));
+                let mut r = g - problem.loads_at(&u, 0.0, Some(Tangent::new(pattern, &mut values, -1.0)));
                 for &d in &fixed {
                     r[d] = u[d] - reference[d];
                 }
@@ -136,23 +171,16 @@ fn solve_step(
         history.push(rec);
         last = change;
         if change <= params.tolerance {
-            return Ok((u, change));
+            return Ok((u, change, Stop::Converged));
         }
     }
-    match params.method {
-        Method::FixedPoint { .. } => {
-            Err(SolveError::FixedPointNotConverged { step, iterations: params.max_iterations, rel_change: last })
-        }
-        Method::Newton => {
-            Err(SolveError::NewtonNotConverged { step: Some(step), iterations: params.max_iterations, increment: last })
-        }
-    }
+    Ok((u, last, Stop::MaxIterations))
 }
 
-/// `max(‖Δx‖₂/‖x‖₂, ‖Δα‖₂/‖α‖₂)` with 0/0 = 0 (D5).
-pub fn relative_change(new: &DVector<f64>, old: &DVector<f64>) -> f64 {
-    let (dx, da) = split_norms_2(&(new - old));
-    let (nx, na) = split_norms_2(new);
+/// `max(‖Δx‖₂/‖x‖₂, ‖Δα‖₂/‖α‖₂)` with 0/0 = 0 (D5), of two forward nodal vectors.
+pub fn relative_change(dofs: &DofMap, new: &DVector<f64>, old: &DVector<f64>) -> f64 {
+    let (dx, da) = dofs.split_norms_2(&(new - old));
+    let (nx, na) = dofs.split_norms_2(new);
     let ratio = |d: f64, n: f64| if d == 0.0 { 0.0 } else { d / n };
     ratio(dx, nx).max(ratio(da, na))
 }

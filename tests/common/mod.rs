@@ -3,6 +3,12 @@
 use std::path::{Path, PathBuf};
 
 use cosserat::case::Case;
+use cosserat::model::mesh::Field;
+use cosserat::solve::inverse::{
+    Frame, FrameSolver, InverseMethod, InverseParams, InverseRecord, InverseSolution, Start, Weights,
+};
+use cosserat::solve::{Problem, SolveError};
+use nalgebra::{DVector, Vector3};
 
 pub fn cases_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("cases")
@@ -50,58 +56,101 @@ pub fn worm_data_present(test: &str) -> bool {
 
 /// Is this case a recorded clip (`[clip]`)?
 pub fn is_clip(case: &Case) -> bool {
-    matches!(case.inverse().map(|i| &i.data), Some(cosserat::case::DataSource::Clip(_)))
+    case.clip().is_some()
 }
 
 /// Forward data by Newton (tolerance 1e-13) with `steps` load-continuation steps: the solution
 /// and its nodal positions x_g.
 pub fn forward_data(case: &Case, steps: usize) -> (nalgebra::DVector<f64>, Vec<nalgebra::Vector3<f64>>) {
     use cosserat::solve::statics::{self, Method, StaticParams};
-    let p = cosserat::solve::Problem::from_case(case);
+    let p = case.problem();
     let fwd = statics::solve(
         &p,
         &StaticParams { method: Method::Newton, tolerance: 1e-13, max_iterations: 40, continuation_steps: steps },
         |_| {},
     )
+    .and_then(|s| s.converged())
     .expect("forward data");
-    let xg = (0..case.mesh.nodes()).map(|i| cosserat::solve::node_values(&fwd.u, i).0).collect();
+    let xg = p.dofs().field(&fwd.u, Field::X);
     (fwd.u, xg)
 }
 
 /// The paper's first inverse test (§5.2): λg = 1e9, λf = 1, λl = 1e-10, λd = 1e-6,
-/// Λκ = diag(0, 0, 1e-10), Λω = 0, w = 0.5, first frame; stop at relative change 3e-6 within
-/// 1000 iterations (tests override the stopping settings as they need).
-pub fn paper_params_64() -> cosserat::solve::inverse::InverseParams {
-    cosserat::solve::inverse::InverseParams {
-        lambda_g: 1e9,
-        lambda_f: 1.0,
-        lambda_l: 1e-10,
-        lambda_d: 1e-6,
-        lambda_kappa: nalgebra::Vector3::new(0.0, 0.0, 1e-10),
-        lambda_omega: nalgebra::Vector3::zeros(),
-        dt: 1.0,
-        first_frame: true,
-        alpha0: 0.0,
-        frame: 0,
+/// Λκ = diag(0, 0, 1e-10), Λω = 0, w = 0.5, the fixed point; stop at relative change 3e-6
+/// within 1000 iterations (tests override the stopping settings as they need).
+pub fn paper_params_64() -> InverseParams {
+    InverseParams {
+        weights: Weights {
+            lambda_g: 1e9,
+            lambda_f: 1.0,
+            lambda_l: 1e-10,
+            lambda_d: 1e-6,
+            lambda_kappa: Vector3::new(0.0, 0.0, 1e-10),
+            lambda_omega: Vector3::zeros(),
+        },
+        frame_interval_s: 1.0,
+        alpha0_rad: 0.0,
         stabilisation: 0.0,
         relaxation: 0.5,
+        method: InverseMethod::FixedPoint,
         tolerance: 3e-6,
         max_iterations: 1000,
     }
 }
 
-/// Every term of (41) switched on, a frame after the first (Λω active), for derivative checks.
-pub fn all_terms_params() -> cosserat::solve::inverse::InverseParams {
-    cosserat::solve::inverse::InverseParams {
-        lambda_f: 1e-2,
-        lambda_l: 1e-6,
-        lambda_d: 1e-3,
-        lambda_kappa: nalgebra::Vector3::new(1e-12, 2e-12, 1e-10),
-        lambda_omega: nalgebra::Vector3::new(1e-9, 1e-9, 1e-8),
-        dt: 0.04,
-        first_frame: false,
+/// Every term of (41) switched on (Λω acts on a frame with a previous one), for derivative
+/// checks.
+pub fn all_terms_params() -> InverseParams {
+    let p = paper_params_64();
+    InverseParams {
+        weights: Weights {
+            lambda_f: 1e-2,
+            lambda_l: 1e-6,
+            lambda_d: 1e-3,
+            lambda_kappa: Vector3::new(1e-12, 2e-12, 1e-10),
+            lambda_omega: Vector3::new(1e-9, 1e-9, 1e-8),
+            ..p.weights
+        },
+        frame_interval_s: 0.04,
         tolerance: 1e-6,
         max_iterations: 1,
-        ..paper_params_64()
+        ..p
     }
+}
+
+/// `params` with other weights.
+pub fn with_weights(params: &InverseParams, f: impl FnOnce(&mut Weights)) -> InverseParams {
+    let mut p = *params;
+    f(&mut p.weights);
+    p
+}
+
+/// One frame through the one inverse entry point: the method of `params` from `u0`
+/// (`Start::Guess`: Newton warm-started by the fixed point; `Start::Near`: Newton directly);
+/// `previous`: the previous frame's angles (None: a first frame). An error if it did not
+/// converge.
+pub fn solve_frame(
+    p: &Problem,
+    params: &InverseParams,
+    x_g: &[Vector3<f64>],
+    previous: Option<&[Vector3<f64>]>,
+    u0: &DVector<f64>,
+    start: Start,
+    mut on: impl FnMut(&InverseRecord),
+) -> Result<InverseSolution, SolveError> {
+    let frame = Frame { index: 0, x_g, previous };
+    FrameSolver::new(p, *params).solve(&frame, u0, start, |r, _, _| on(r))?.converged(0)
+}
+
+/// [`solve_frame`] by Newton directly from `u0` (no warm start), with `params`' stopping rule.
+pub fn solve_newton(
+    p: &Problem,
+    params: &InverseParams,
+    x_g: &[Vector3<f64>],
+    previous: Option<&[Vector3<f64>]>,
+    u0: &DVector<f64>,
+    on: impl FnMut(&InverseRecord),
+) -> Result<InverseSolution, SolveError> {
+    let newton = InverseParams { method: InverseMethod::Newton { warm_start_tolerance: 1e-3 }, ..*params };
+    solve_frame(p, &newton, x_g, previous, u0, Start::Near, on)
 }

@@ -1,147 +1,8 @@
-//! Gather → kernel → scatter, written once and used by every solver (static, dynamic, modes).
-//!
-//! Element `e` owns the contiguous global unknowns `[6e, 6e + 12)`, so gathering is a slice
-//! copy. The sparsity pattern (block tridiagonal, 6 × 6 blocks) and the symbolic LU are built
-//! once per mesh; every iterate only refills the values and refactors numerically.
+//! Direct solver of the block-tridiagonal systems ([`Pattern`]): Ruiz equilibration
+//! (`docs/inverse.md`, I6) and a banded LU with partial pivoting ([`BandLu`]).
 use nalgebra::DVector;
 
-use crate::banded::BandLu;
-
-use crate::element::{LocalMat, LocalVec};
-use crate::mesh::{Mesh, DOFS_PER_ELEMENT};
-
-/// Errors of the linear algebra layer.
-#[derive(Debug, thiserror::Error)]
-pub enum LinearError {
-    #[error("sparse LU factorisation failed: {0}")]
-    Factorisation(String),
-    #[error("linear solve produced a non-finite value at unknown {index}")]
-    NonFinite { index: usize },
-}
-
-/// Local unknowns of element `e`.
-pub fn gather(u: &DVector<f64>, e: usize) -> LocalVec {
-    LocalVec::from_column_slice(&u.as_slice()[6 * e..6 * e + DOFS_PER_ELEMENT])
-}
-
-/// Add a local vector into the global one.
-pub fn scatter_vec(r: &mut DVector<f64>, e: usize, local: &LocalVec) {
-    for i in 0..DOFS_PER_ELEMENT {
-        r[6 * e + i] += local[i];
-    }
-}
-
-/// Assemble `Σ_e kernel(e, s0_e, u_e)` into a global vector.
-pub fn assemble_vector(mesh: &Mesh, mut kernel: impl FnMut(usize, f64) -> LocalVec) -> DVector<f64> {
-    let mut r = DVector::zeros(mesh.ndofs());
-    for e in 0..mesh.elements {
-        let local = kernel(e, mesh.node_s(e));
-        scatter_vec(&mut r, e, &local);
-    }
-    r
-}
-
-/// CSC sparsity pattern of the block-tridiagonal system matrix (`block` unknowns per node,
-/// 6 for the forward problem, 12 for the inverse) with, per element, the position of each of
-/// its `(2 block)²` local entries in the value array.
-pub struct Pattern {
-    ndofs: usize,
-    block: usize,
-    col_ptr: Vec<usize>,
-    row_idx: Vec<usize>,
-    /// value index of local entry (i, j) of element e: `slots[e * n² + n i + j]`, n = 2 block
-    slots: Vec<usize>,
-    diag: Vec<usize>,
-}
-
-impl Pattern {
-    /// Pattern of the forward problem (6 unknowns per node).
-    pub fn new(mesh: &Mesh) -> Self {
-        Self::with_block(mesh, 6)
-    }
-
-    /// Pattern for `block` unknowns per node, element `e` owning `[block e, block (e + 2))`.
-    pub fn with_block(mesh: &Mesh, block: usize) -> Self {
-        let n = mesh.nodes() * block;
-        // Column j couples with rows of the nodes of every element containing node(j).
-        let mut col_ptr = Vec::with_capacity(n + 1);
-        let mut row_idx = Vec::new();
-        col_ptr.push(0);
-        for j in 0..n {
-            let node = j / block;
-            let lo = node.saturating_sub(1) * block;
-            let hi = ((node + 2).min(mesh.nodes())) * block;
-            row_idx.extend(lo..hi);
-            col_ptr.push(row_idx.len());
-        }
-        let find = |i: usize, j: usize| -> usize {
-            let range = col_ptr[j]..col_ptr[j + 1];
-            let first = row_idx[range.start];
-            range.start + (i - first)
-        };
-        let ne = 2 * block;
-        let mut slots = Vec::with_capacity(mesh.elements * ne * ne);
-        for e in 0..mesh.elements {
-            for i in 0..ne {
-                for j in 0..ne {
-                    slots.push(find(block * e + i, block * e + j));
-                }
-            }
-        }
-        let diag = (0..n).map(|j| find(j, j)).collect();
-        Pattern { ndofs: n, block, col_ptr, row_idx, slots, diag }
-    }
-
-    pub fn nnz(&self) -> usize {
-        self.row_idx.len()
-    }
-
-    /// Add a local matrix of element `e` into the values.
-    pub fn scatter_mat(&self, values: &mut [f64], e: usize, local: &LocalMat) {
-        self.scatter_local(values, e, local);
-    }
-
-    /// Add a local `(2 block)²` matrix of element `e` into the values.
-    pub fn scatter_local<const N: usize>(&self, values: &mut [f64], e: usize, local: &nalgebra::SMatrix<f64, N, N>) {
-        assert_eq!(N, 2 * self.block, "local matrix size must be twice the block size");
-        let s = &self.slots[e * N * N..(e + 1) * N * N];
-        for i in 0..N {
-            for j in 0..N {
-                values[s[N * i + j]] += local[(i, j)];
-            }
-        }
-    }
-
-    /// Replace the rows of the given unknowns by identity rows (exact Dirichlet conditions).
-    /// Touches only the entries of those rows (the columns of the neighbouring nodes).
-    pub fn set_identity_rows(&self, values: &mut [f64], rows: &[usize]) {
-        let nodes = self.ndofs / self.block;
-        for &r in rows {
-            let node = r / self.block;
-            let lo = node.saturating_sub(1) * self.block;
-            let hi = (node + 2).min(nodes) * self.block;
-            for j in lo..hi {
-                // column j holds the rows of the nodes around node(j), contiguously
-                let first = self.row_idx[self.col_ptr[j]];
-                values[self.col_ptr[j] + r - first] = 0.0;
-            }
-        }
-        for &r in rows {
-            values[self.diag[r]] = 1.0;
-        }
-    }
-
-    /// Dense copy (for eigenvalue problems of modest size).
-    pub fn to_dense(&self, values: &[f64]) -> nalgebra::DMatrix<f64> {
-        let mut m = nalgebra::DMatrix::zeros(self.ndofs, self.ndofs);
-        for j in 0..self.ndofs {
-            for k in self.col_ptr[j]..self.col_ptr[j + 1] {
-                m[(self.row_idx[k], j)] += values[k];
-            }
-        }
-        m
-    }
-}
+use super::{BandLu, LinearError, Pattern};
 
 /// Passes of Ruiz equilibration.
 const RUIZ_PASSES: usize = 5;
@@ -164,19 +25,19 @@ pub struct LinearSolver {
 }
 
 impl LinearSolver {
-    pub fn new(pattern: &Pattern) -> Result<Self, LinearError> {
-        let n = pattern.ndofs;
-        Ok(LinearSolver {
-            col_ptr: pattern.col_ptr.clone(),
-            row_idx: pattern.row_idx.clone(),
-            lu: BandLu::block_tridiagonal(n / pattern.block, pattern.block),
+    pub fn new(pattern: &Pattern) -> Self {
+        let n = pattern.ndofs();
+        LinearSolver {
+            col_ptr: pattern.col_ptr().to_vec(),
+            row_idx: pattern.row_idx().to_vec(),
+            lu: BandLu::block_tridiagonal(n / pattern.block(), pattern.block()),
             scaled: vec![0.0; pattern.nnz()],
             dr: vec![1.0; n],
             dc: vec![1.0; n],
             rmax: vec![0.0; n],
             cmax: vec![0.0; n],
             rnext: vec![0.0; n],
-        })
+        }
     }
 
     /// Solve `M x = b` after Ruiz equilibration (`docs/inverse.md`, I6): five passes of
@@ -343,22 +204,22 @@ mod tests {
     /// the reference for the fused, branch-free version.
     #[allow(clippy::needless_range_loop)]
     fn ruiz_reference(p: &Pattern, values: &[f64]) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
-        let n = p.ndofs;
+        let n = p.ndofs();
         let mut a = values.to_vec();
         let (mut dr, mut dc) = (vec![1.0; n], vec![1.0; n]);
         for _ in 0..RUIZ_PASSES {
             let (mut r, mut c) = (vec![0.0_f64; n], vec![0.0_f64; n]);
             for j in 0..n {
-                for k in p.col_ptr[j]..p.col_ptr[j + 1] {
+                for k in p.col_ptr()[j]..p.col_ptr()[j + 1] {
                     let v = a[k].abs();
-                    r[p.row_idx[k]] = r[p.row_idx[k]].max(v);
+                    r[p.row_idx()[k]] = r[p.row_idx()[k]].max(v);
                     c[j] = c[j].max(v);
                 }
             }
             let inv_sqrt = |v: f64| if v > 0.0 { 1.0 / v.sqrt() } else { 1.0 };
             for j in 0..n {
-                for k in p.col_ptr[j]..p.col_ptr[j + 1] {
-                    a[k] *= inv_sqrt(r[p.row_idx[k]]) * inv_sqrt(c[j]);
+                for k in p.col_ptr()[j]..p.col_ptr()[j + 1] {
+                    a[k] *= inv_sqrt(r[p.row_idx()[k]]) * inv_sqrt(c[j]);
                 }
             }
             for i in 0..n {
@@ -372,15 +233,14 @@ mod tests {
     #[test]
     fn ruiz_matches_the_reference_bit_for_bit() {
         for (elements, block) in [(3, 6), (7, 12), (1, 12)] {
-            let mesh = Mesh::new(1.0, elements);
-            let p = Pattern::with_block(&mesh, block);
+            let p = Pattern::block_tridiagonal(elements + 1, block);
             // entries over many decades, some zero rows (identity rows after Dirichlet)
             let vals: Vec<f64> =
                 (0..p.nnz()).map(|k| (k as f64 * 0.37).sin() * 10f64.powi((k % 13) as i32 - 6)).collect();
             let mut vals2 = vals.clone();
             p.set_identity_rows(&mut vals2, &[0, 2, block + 1]);
             for v in [vals, vals2] {
-                let solver = LinearSolver::new(&p).unwrap();
+                let solver = LinearSolver::new(&p);
                 assert_eq!(solver.equilibrate(&v), ruiz_reference(&p, &v));
             }
         }
@@ -388,8 +248,7 @@ mod tests {
 
     #[test]
     fn set_identity_rows_matches_a_dense_rewrite() {
-        let mesh = Mesh::new(1.0, 4);
-        let p = Pattern::with_block(&mesh, 12);
+        let p = Pattern::block_tridiagonal(5, 12);
         let vals: Vec<f64> = (0..p.nnz()).map(|k| 1.0 + k as f64).collect();
         let rows = [0, 3, 11, 12, 30, 59];
         let mut v = vals.clone();
@@ -410,14 +269,13 @@ mod tests {
         use faer::linalg::solvers::SolveCore;
         use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
         use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
-        let mesh = Mesh::new(1.0, 9);
-        let p = Pattern::with_block(&mesh, 12);
+        let p = Pattern::block_tridiagonal(10, 12);
         // diagonally heavy, but the first diagonal entry of every node block is zero: the
         // elimination must pivot there
-        let vals: Vec<f64> = (0..p.ndofs)
-            .flat_map(|j| (p.col_ptr[j]..p.col_ptr[j + 1]).map(move |k| (j, k)))
+        let vals: Vec<f64> = (0..p.ndofs())
+            .flat_map(|j| (p.col_ptr()[j]..p.col_ptr()[j + 1]).map(move |k| (j, k)))
             .map(|(j, k)| {
-                let i = p.row_idx[k];
+                let i = p.row_idx()[k];
                 if i == j && i.is_multiple_of(12) {
                     0.0
                 } else {
@@ -426,9 +284,10 @@ mod tests {
             })
             .collect();
         assert_eq!(vals.len(), p.nnz());
-        let b = DVector::from_fn(p.ndofs, |i, _| (0.3 * i as f64).cos());
-        let x = LinearSolver::new(&p).unwrap().solve(&vals, &b).unwrap();
-        let sym = SymbolicSparseColMat::new_checked(p.ndofs, p.ndofs, p.col_ptr.clone(), None, p.row_idx.clone());
+        let b = DVector::from_fn(p.ndofs(), |i, _| (0.3 * i as f64).cos());
+        let x = LinearSolver::new(&p).solve(&vals, &b).unwrap();
+        let sym =
+            SymbolicSparseColMat::new_checked(p.ndofs(), p.ndofs(), p.col_ptr().to_vec(), None, p.row_idx().to_vec());
         let lu = Lu::try_new_with_symbolic(
             SymbolicLu::try_new(sym.as_ref()).unwrap(),
             SparseColMatRef::new(sym.as_ref(), &vals),
@@ -451,17 +310,22 @@ mod tests {
 
     #[test]
     fn pattern_scatter_and_solve() {
-        let mesh = Mesh::new(1.0, 3);
-        let p = Pattern::new(&mesh);
+        let p = Pattern::block_tridiagonal(4, 6);
         let mut vals = vec![0.0; p.nnz()];
         // A diagonally dominant element matrix.
-        let local = LocalMat::from_fn(|i, j| if i == j { 10.0 } else { 1.0 / (1.0 + i as f64 + 2.0 * j as f64) });
-        for e in 0..mesh.elements {
-            p.scatter_mat(&mut vals, e, &local);
+        let local = nalgebra::SMatrix::<f64, 12, 12>::from_fn(|i, j| {
+            if i == j {
+                10.0
+            } else {
+                1.0 / (1.0 + i as f64 + 2.0 * j as f64)
+            }
+        });
+        for e in 0..3 {
+            p.scatter(&mut vals, e, &local);
         }
         let dense = p.to_dense(&vals);
-        let b = DVector::from_fn(mesh.ndofs(), |i, _| (i as f64).cos());
-        let mut solver = LinearSolver::new(&p).unwrap();
+        let b = DVector::from_fn(p.ndofs(), |i, _| (i as f64).cos());
+        let mut solver = LinearSolver::new(&p);
         let x = solver.solve(&vals, &b).unwrap();
         assert!((&dense * &x - &b).amax() < 1e-12);
         // Equilibration does not change the solution of a well-conditioned system.

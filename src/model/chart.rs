@@ -17,7 +17,7 @@
 use nalgebra::{Matrix3, SymmetricEigen, Vector3};
 use std::f64::consts::PI;
 
-use crate::rotation::{angles_from_rotation, rotation, Angles};
+use super::rotation::{angles_from_rotation, rotation, Angles};
 
 /// A chart `Q = Q_E(α) B` of eq. (1) composed with a constant base rotation `B` (R1).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -52,7 +52,7 @@ impl Chart {
             // half turn about e3 (n = −e2)
             Matrix3::from_diagonal(&Vector3::new(-1.0, -1.0, 1.0))
         } else {
-            let vx = crate::rotation::skew(&n.cross(&e2));
+            let vx = super::rotation::skew(&n.cross(&e2));
             Matrix3::identity() + vx + vx * vx / (1.0 + c)
         };
         Chart { base }
@@ -174,7 +174,7 @@ fn best_margin_axis(x: &[Vector3<f64>]) -> Vector3<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::rotation::{a_matrix, curvature, d3, rotation_derivatives};
+    use crate::model::rotation::{a_matrix, curvature, d3, rotation_derivatives};
 
     fn random_rotation(seed: u64) -> Matrix3<f64> {
         let mut s = seed;

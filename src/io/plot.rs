@@ -1,14 +1,10 @@
-//! Thin helpers over plotters' SVG backend: line plots (optionally log
-//! axes) and grids of sub-plots. Files are written atomically (temporary
-//! file in the target directory, then rename).
+//! Thin helpers over plotters' SVG backend: line plots (optionally log axes), grids of
+//! sub-plots and heatmaps, rendered to SVG text (written by `io::files::write_atomic`).
 
 use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
 use plotters::coord::Shift;
 use plotters::prelude::*;
-use std::io::Write;
 use std::ops::Range;
-use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicU64, Ordering};
 use thiserror::Error;
 
 /// Size of a single plot in pixels (width, height).
@@ -60,15 +56,12 @@ pub enum PlotError {
     /// Every point is non-finite (or non-positive on a log axis).
     #[error("plot '{title}' has no plottable point (log_x = {log_x}, log_y = {log_y}; non-finite and, on log axes, non-positive values are dropped)")]
     NoPlottablePoints { title: String, log_x: bool, log_y: bool },
-    /// `write_panels_svg` called with no panels or zero columns.
+    /// [`render_panels_svg`] called with no panels or zero columns.
     #[error("invalid panel grid: {panels} panel(s) in {cols} column(s)")]
     InvalidGrid { panels: usize, cols: usize },
     /// Drawing failed inside plotters.
     #[error("drawing plot '{title}' failed: {detail}")]
     Draw { title: String, detail: String },
-    /// Creating, writing or renaming the output file failed.
-    #[error("cannot write '{}': {source}", path.display())]
-    Io { path: PathBuf, source: std::io::Error },
 }
 
 fn draw_err(title: &str, e: impl std::fmt::Display) -> PlotError {
@@ -209,29 +202,6 @@ fn draw_plot<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, plot: &LinePlot)
     }
 }
 
-static TMP_COUNTER: AtomicU64 = AtomicU64::new(0);
-
-/// Writes `contents` to `path` via a temporary sibling file and a rename.
-fn write_atomic(path: &Path, contents: &str) -> Result<(), PlotError> {
-    let io = |source| PlotError::Io { path: path.to_path_buf(), source };
-    let name = path
-        .file_name()
-        .ok_or_else(|| io(std::io::Error::new(std::io::ErrorKind::InvalidInput, "path has no file name")))?;
-    let n = TMP_COUNTER.fetch_add(1, Ordering::Relaxed);
-    let tmp = path.with_file_name(format!(".{}.{}.{n}.tmp", name.to_string_lossy(), std::process::id()));
-    let result = std::fs::File::create(&tmp)
-        .and_then(|mut f| {
-            f.write_all(contents.as_bytes())?;
-            f.sync_all()
-        })
-        .and_then(|_| std::fs::rename(&tmp, path));
-    if let Err(e) = result {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(io(e));
-    }
-    Ok(())
-}
-
 /// Renders `draw` into an in-memory SVG of `size` pixels.
 fn render(
     size: (u32, u32),
@@ -248,19 +218,17 @@ fn render(
     Ok(svg)
 }
 
-/// Writes `plot` as a 900×600 SVG at `path` (with legend, axis labels and
-/// auto ranges padded by [`RANGE_MARGIN`]). Nothing is left at `path` if
-/// it fails.
-pub fn write_svg(plot: &LinePlot, path: &Path) -> Result<(), PlotError> {
+/// `plot` as a 900×600 SVG (with legend, axis labels and auto ranges padded by
+/// [`RANGE_MARGIN`]).
+pub fn render_svg(plot: &LinePlot) -> Result<String, PlotError> {
     ranges(plot)?; // validate before rendering
-    let svg = render(PLOT_SIZE, &plot.title, |root| draw_plot(root, plot))?;
-    write_atomic(path, &svg)
+    render(PLOT_SIZE, &plot.title, |root| draw_plot(root, plot))
 }
 
-/// Writes `panels` as a grid with `cols` columns (rows as needed) into one
-/// SVG at `path`; each panel is 900×600 scaled to fit a width of at most
-/// 1800 px. Errors if any panel is invalid, `panels` is empty or `cols` is 0.
-pub fn write_panels_svg(panels: &[LinePlot], cols: usize, path: &Path) -> Result<(), PlotError> {
+/// `panels` as a grid with `cols` columns (rows as needed) in one SVG; each panel is 900×600
+/// scaled to fit a width of at most 1800 px. Errors if any panel is invalid, `panels` is
+/// empty or `cols` is 0.
+pub fn render_panels_svg(panels: &[LinePlot], cols: usize) -> Result<String, PlotError> {
     if panels.is_empty() || cols == 0 {
         return Err(PlotError::InvalidGrid { panels: panels.len(), cols });
     }
@@ -272,138 +240,12 @@ pub fn write_panels_svg(panels: &[LinePlot], cols: usize, path: &Path) -> Result
     let (pw, ph) = if cols <= 2 { PLOT_SIZE } else { (1800 / cols as u32, 1200 / cols as u32) };
     let size = (pw * cols as u32, ph * rows as u32);
     let title = panels.first().map_or("", |p| p.title.as_str());
-    let svg = render(size, title, |root| {
+    render(size, title, |root| {
         for (area, plot) in root.split_evenly((rows, cols)).iter().zip(panels) {
             draw_plot(area, plot)?;
         }
         Ok(())
-    })?;
-    write_atomic(path, &svg)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn tmp(name: &str) -> PathBuf {
-        let dir = std::env::temp_dir().join(format!("cosserat-plot-{}-{name}", std::process::id()));
-        let _ = std::fs::create_dir_all(&dir);
-        dir.join(format!("{name}.svg"))
-    }
-
-    fn series(label: &str, f: impl Fn(f64) -> f64) -> Series {
-        let x: Vec<f64> = (0..50).map(|i| i as f64 * 0.1).collect();
-        Series { label: label.into(), y: x.iter().map(|&v| f(v)).collect(), x }
-    }
-
-    fn plot(series: Vec<Series>) -> LinePlot {
-        LinePlot {
-            title: "Tip deflection".into(),
-            x_label: "time [s]".into(),
-            y_label: "y(L) [m]".into(),
-            series,
-            ..Default::default()
-        }
-    }
-
-    fn no_tmp_left(path: &Path) -> bool {
-        let dir = path.parent().expect("dir");
-        std::fs::read_dir(dir)
-            .expect("read_dir")
-            .all(|e| !e.expect("entry").file_name().to_string_lossy().ends_with(".tmp"))
-    }
-
-    #[test]
-    fn writes_svg_with_labels() {
-        let path = tmp("basic");
-        let mut s2 = series("constant", |_| 3.0);
-        s2.y[7] = f64::NAN;
-        s2.x[8] = f64::INFINITY;
-        write_svg(&plot(vec![series("rust", |x| x.sin()), s2]), &path).unwrap();
-        let svg = std::fs::read_to_string(&path).unwrap();
-        for text in ["Tip deflection", "time [s]", "y(L) [m]", "rust", "constant", "width=\"900\"", "height=\"600\""] {
-            assert!(svg.contains(text), "missing {text}");
-        }
-        assert!(no_tmp_left(&path));
-        // Only a constant series: zero range must still work.
-        write_svg(&plot(vec![series("flat", |_| 0.0)]), &path).unwrap();
-        let _ = std::fs::remove_dir_all(path.parent().expect("dir"));
-    }
-
-    #[test]
-    fn log_axes() {
-        let path = tmp("log");
-        let mut p = plot(vec![series("err", |x| 10f64.powf(-x)), series("with zero", |x| x)]);
-        p.log_y = true;
-        p.log_x = true; // x = 0 is dropped
-        write_svg(&p, &path).unwrap();
-        let svg = std::fs::read_to_string(&path).unwrap();
-        assert!(svg.contains("err") && svg.contains("with zero"));
-        let all_negative = LinePlot { log_y: true, ..plot(vec![series("neg", |x| -1.0 - x)]) };
-        assert!(matches!(
-            write_svg(&all_negative, &path.with_file_name("neg.svg")),
-            Err(PlotError::NoPlottablePoints { log_y: true, .. })
-        ));
-        let _ = std::fs::remove_dir_all(path.parent().expect("dir"));
-    }
-
-    #[test]
-    fn bad_input_errors() {
-        let path = tmp("bad");
-        let empty = plot(vec![Series { label: "nothing".into(), x: vec![], y: vec![] }]);
-        let e = write_svg(&empty, &path).unwrap_err();
-        assert!(matches!(e, PlotError::EmptySeries { .. }));
-        assert!(e.to_string().contains("'nothing'") && e.to_string().contains("empty"), "{e}");
-        assert!(matches!(write_svg(&plot(vec![]), &path), Err(PlotError::NoSeries { .. })));
-        let mismatch = plot(vec![Series { label: "m".into(), x: vec![1.0, 2.0], y: vec![1.0] }]);
-        assert!(matches!(write_svg(&mismatch, &path), Err(PlotError::LengthMismatch { x_len: 2, y_len: 1, .. })));
-        assert!(!path.exists());
-        assert!(matches!(write_panels_svg(&[], 2, &path), Err(PlotError::InvalidGrid { .. })));
-        assert!(matches!(
-            write_panels_svg(&[plot(vec![series("a", |x| x)])], 0, &path),
-            Err(PlotError::InvalidGrid { .. })
-        ));
-        // Unwritable destination: an Io error naming the path, no temp file left.
-        let missing =
-            std::env::temp_dir().join(format!("cosserat-plot-{}-no-such-dir", std::process::id())).join("x.svg");
-        let e = write_svg(&plot(vec![series("a", |x| x)]), &missing).unwrap_err();
-        assert!(matches!(e, PlotError::Io { .. }) && e.to_string().contains("no-such-dir"), "{e}");
-        let _ = std::fs::remove_dir_all(path.parent().expect("dir"));
-    }
-
-    #[test]
-    fn tick_format() {
-        assert_eq!(format_tick(1e-5), "1e-5");
-        assert_eq!(format_tick(-2.5e6), "-2.5e6");
-        assert_eq!(format_tick(0.25), "0.25");
-        assert_eq!(format_tick(0.0), "0");
-        assert_eq!(format_tick(3.0), "3");
-    }
-
-    #[test]
-    fn panels_grid() {
-        let path = tmp("panels");
-        let names = ["position", "kappa_1", "kappa_2", "kappa_3"];
-        let panels: Vec<LinePlot> = names
-            .iter()
-            .enumerate()
-            .map(|(i, n)| LinePlot {
-                title: n.to_string(),
-                x_label: "s [m]".into(),
-                y_label: format!("{n} [1/m]"),
-                series: vec![series(&format!("rust {n}"), move |x| (x * i as f64).cos()), series("freefem", |x| x)],
-                ..Default::default()
-            })
-            .collect();
-        write_panels_svg(&panels, 2, &path).unwrap();
-        let svg = std::fs::read_to_string(&path).unwrap();
-        for n in names {
-            assert!(svg.contains(n) && svg.contains(&format!("rust {n}")), "{n}");
-        }
-        assert!(svg.contains("width=\"1800\"") && svg.contains("height=\"1200\""));
-        assert!(no_tmp_left(&path));
-        let _ = std::fs::remove_dir_all(path.parent().expect("dir"));
-    }
+    })
 }
 
 /// A value field over a regular grid drawn as coloured cells (a kymograph): `values[i][j]` at
@@ -426,8 +268,8 @@ fn diverging(v: f64, limit: f64) -> RGBColor {
     RGBColor((r * 255.0) as u8, (g * 255.0) as u8, (b * 255.0) as u8)
 }
 
-/// Writes heatmaps side by side (one row) into one SVG at `path`.
-pub fn write_heatmaps_svg(maps: &[Heatmap], path: &Path) -> Result<(), PlotError> {
+/// Heatmaps side by side (one row) in one SVG.
+pub fn render_heatmaps_svg(maps: &[Heatmap]) -> Result<String, PlotError> {
     if maps.is_empty() {
         return Err(PlotError::InvalidGrid { panels: 0, cols: 0 });
     }
@@ -447,7 +289,7 @@ pub fn write_heatmaps_svg(maps: &[Heatmap], path: &Path) -> Result<(), PlotError
     }
     let size = (PLOT_SIZE.0 * maps.len() as u32, PLOT_SIZE.1);
     let title = maps[0].title.clone();
-    let svg = render(size, &title, |root| {
+    render(size, &title, |root| {
         for (m, area) in maps.iter().zip(root.split_evenly((1, maps.len()))) {
             let (x0, x1) = (m.x[0], m.x[m.x.len() - 1]);
             let (y0, y1) = (m.y[0], m.y[m.y.len() - 1]);
@@ -478,6 +320,92 @@ pub fn write_heatmaps_svg(maps: &[Heatmap], path: &Path) -> Result<(), PlotError
             chart.draw_series(cells).map_err(|e| draw_err(&m.title, e))?;
         }
         Ok(())
-    })?;
-    write_atomic(path, &svg)
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn series(label: &str, f: impl Fn(f64) -> f64) -> Series {
+        let x: Vec<f64> = (0..50).map(|i| i as f64 * 0.1).collect();
+        Series { label: label.into(), y: x.iter().map(|&v| f(v)).collect(), x }
+    }
+
+    fn plot(series: Vec<Series>) -> LinePlot {
+        LinePlot {
+            title: "Tip deflection".into(),
+            x_label: "time [s]".into(),
+            y_label: "y(L) [m]".into(),
+            series,
+            ..Default::default()
+        }
+    }
+
+    #[test]
+    fn renders_svg_with_labels() {
+        let mut s2 = series("constant", |_| 3.0);
+        s2.y[7] = f64::NAN;
+        s2.x[8] = f64::INFINITY;
+        let svg = render_svg(&plot(vec![series("rust", |x| x.sin()), s2])).unwrap();
+        for text in ["Tip deflection", "time [s]", "y(L) [m]", "rust", "constant", "width=\"900\"", "height=\"600\""] {
+            assert!(svg.contains(text), "missing {text}");
+        }
+        // Only a constant series: zero range must still work.
+        render_svg(&plot(vec![series("flat", |_| 0.0)])).unwrap();
+    }
+
+    #[test]
+    fn log_axes() {
+        let mut p = plot(vec![series("err", |x| 10f64.powf(-x)), series("with zero", |x| x)]);
+        p.log_y = true;
+        p.log_x = true; // x = 0 is dropped
+        let svg = render_svg(&p).unwrap();
+        assert!(svg.contains("err") && svg.contains("with zero"));
+        let all_negative = LinePlot { log_y: true, ..plot(vec![series("neg", |x| -1.0 - x)]) };
+        assert!(matches!(render_svg(&all_negative), Err(PlotError::NoPlottablePoints { log_y: true, .. })));
+    }
+
+    #[test]
+    fn bad_input_errors() {
+        let empty = plot(vec![Series { label: "nothing".into(), x: vec![], y: vec![] }]);
+        let e = render_svg(&empty).unwrap_err();
+        assert!(matches!(e, PlotError::EmptySeries { .. }));
+        assert!(e.to_string().contains("'nothing'") && e.to_string().contains("empty"), "{e}");
+        assert!(matches!(render_svg(&plot(vec![])), Err(PlotError::NoSeries { .. })));
+        let mismatch = plot(vec![Series { label: "m".into(), x: vec![1.0, 2.0], y: vec![1.0] }]);
+        assert!(matches!(render_svg(&mismatch), Err(PlotError::LengthMismatch { x_len: 2, y_len: 1, .. })));
+        assert!(matches!(render_panels_svg(&[], 2), Err(PlotError::InvalidGrid { .. })));
+        assert!(matches!(render_panels_svg(&[plot(vec![series("a", |x| x)])], 0), Err(PlotError::InvalidGrid { .. })));
+    }
+
+    #[test]
+    fn tick_format() {
+        assert_eq!(format_tick(1e-5), "1e-5");
+        assert_eq!(format_tick(-2.5e6), "-2.5e6");
+        assert_eq!(format_tick(0.25), "0.25");
+        assert_eq!(format_tick(0.0), "0");
+        assert_eq!(format_tick(3.0), "3");
+    }
+
+    #[test]
+    fn panels_grid() {
+        let names = ["position", "kappa_1", "kappa_2", "kappa_3"];
+        let panels: Vec<LinePlot> = names
+            .iter()
+            .enumerate()
+            .map(|(i, n)| LinePlot {
+                title: n.to_string(),
+                x_label: "s [m]".into(),
+                y_label: format!("{n} [1/m]"),
+                series: vec![series(&format!("rust {n}"), move |x| (x * i as f64).cos()), series("freefem", |x| x)],
+                ..Default::default()
+            })
+            .collect();
+        let svg = render_panels_svg(&panels, 2).unwrap();
+        for n in names {
+            assert!(svg.contains(n) && svg.contains(&format!("rust {n}")), "{n}");
+        }
+        assert!(svg.contains("width=\"1800\"") && svg.contains("height=\"1200\""));
+    }
 }

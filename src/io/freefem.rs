@@ -8,13 +8,15 @@ use std::process::Command;
 
 use nalgebra::Vector3;
 
-use crate::case::{Analysis, Case, InverseMethod, StaticMethod};
-use crate::loads::LoadFrame;
-use crate::mesh::QuadratureScheme;
-use crate::run::{Engine, InverseOutput, NodalState, RunResult, SolverStats};
+use super::files::{csv_reader, InputError};
+use crate::case::{Analysis, Case};
+use crate::model::chart::Chart;
+use crate::model::loads::LoadFrame;
+use crate::model::mesh::Rule;
+use crate::run::{angles_known, Engine, InverseOutput, NodalState, RunResult, SolverStats};
 use crate::solve::dynamics::TipRecord;
-use crate::solve::inverse::{InverseRecord, ObjectiveTerms};
-use crate::solve::statics::IterationRecord;
+use crate::solve::inverse::{InverseMethod, InverseRecord, ObjectiveTerms};
+use crate::solve::statics::{IterationRecord, Method};
 
 /// Environment variable pointing at the `freefem/` script directory (default: the crate's).
 pub const SCRIPT_DIR_ENV: &str = "COSSERAT_FREEFEM_DIR";
@@ -30,14 +32,22 @@ pub enum FreeFemError {
     NotInstalled,
     #[error("FreeFEM script directory {0} does not contain forward.edp (set {SCRIPT_DIR_ENV})")]
     MissingScripts(PathBuf),
-    #[error("I/O error on {path}: {source}")]
-    Io { path: PathBuf, source: std::io::Error },
+    #[error("I/O error on {path}")]
+    Io {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
     #[error("FreeFEM failed (exit status {status}) in {workdir}:\n{output}")]
     Failed { status: i32, workdir: PathBuf, output: String },
     #[error("{0}")]
     Unsupported(&'static str),
-    #[error("cannot read FreeFEM output {path}: {reason}")]
+    #[error("case `{0}` is not an inverse case")]
+    NotInverse(String),
+    #[error("FreeFEM output {path}: {reason}")]
     BadOutput { path: PathBuf, reason: String },
+    #[error("cannot read FreeFEM output")]
+    Read(#[from] InputError),
 }
 
 /// Directory holding `forward.edp` and `rotation.idp`.
@@ -55,6 +65,15 @@ pub fn find_executable() -> Result<PathBuf, FreeFemError> {
 
 fn num(v: f64) -> String {
     format!("{v:e}")
+}
+
+/// FreeFEM name of a quadrature rule (`qf1pE`: midpoint, `qf2pE`: 2-point Gauss).
+fn rule_name(rule: &Rule) -> &'static str {
+    if rule.points.len() == 1 {
+        "qf1pE"
+    } else {
+        "qf2pE"
+    }
 }
 
 /// FreeFEM names of the case constants: identifiers there cannot hold `_`, so constants are
@@ -88,31 +107,26 @@ pub fn include_file(case: &Case) -> String {
     for (k, v) in &case.constants {
         let _ = writeln!(o, "real {} = {}; // constant `{k}`", names[k], num(*v));
     }
-    let scheme: QuadratureScheme = case.quadrature;
-    let _ = writeln!(o, "macro QFS {} //", QuadratureScheme::freefem_name(&scheme.stretch_shear()));
-    let _ = writeln!(o, "macro QFB {} //", QuadratureScheme::freefem_name(&scheme.bending()));
-    let _ = writeln!(o, "macro QFL {} //", QuadratureScheme::freefem_name(&scheme.loads()));
+    let scheme = case.quadrature;
+    let _ = writeln!(o, "macro QFS {} //", rule_name(&scheme.stretch_shear()));
+    let _ = writeln!(o, "macro QFB {} //", rule_name(&scheme.bending()));
+    let _ = writeln!(o, "macro QFL {} //", rule_name(&scheme.loads()));
     let groups = [("F", "(S,T)"), ("L", "(S,T)"), ("FE", "(T)"), ("LE", "(T)")];
     for (g, (prefix, args)) in groups.iter().enumerate() {
         for k in 0..3 {
             let _ = writeln!(o, "macro {prefix}{}{args} ({}) //", k + 1, case.loads.exprs[g][k].to_freefem(&rename));
         }
     }
-    let (dynamic, method, relax, tol, maxit, tend, steps, cont) = match case.analysis.clone() {
-        Analysis::Static { method, tolerance, max_iterations, continuation_steps } => match method {
-            StaticMethod::FixedPoint { relaxation } => {
-                (0, 0, relaxation, tolerance, max_iterations, 0.0, 0, continuation_steps)
+    let (dynamic, method, relax, tol, maxit, tend, steps, cont) = match &case.analysis {
+        Analysis::Static(p) => match p.method {
+            Method::FixedPoint { relaxation } => {
+                (0, 0, relaxation, p.tolerance, p.max_iterations, 0.0, 0, p.continuation_steps)
             }
-            StaticMethod::Newton => (0, 1, 1.0, tolerance, max_iterations, 0.0, 0, continuation_steps),
+            Method::Newton => (0, 1, 1.0, p.tolerance, p.max_iterations, 0.0, 0, p.continuation_steps),
         },
-        Analysis::Dynamic { end_time_s, steps, tolerance, max_iterations } => {
-            (1, 1, 1.0, tolerance, max_iterations, end_time_s, steps, 1)
-        }
+        Analysis::Dynamic(p) => (1, 1, 1.0, p.newton_tolerance, p.newton_max_iterations, p.end_time_s, p.steps, 1),
         Analysis::Inverse(inv) => {
-            let relax = match inv.method {
-                InverseMethod::FixedPoint { relaxation } | InverseMethod::Newton { relaxation, .. } => relaxation,
-            };
-            (0, 0, relax, inv.tolerance, inv.max_iterations, 0.0, 0, 1)
+            (0, 0, inv.params.relaxation, inv.params.tolerance, inv.params.max_iterations, 0.0, 0, 1)
         }
     };
     let local = i32::from(case.loads.frame == LoadFrame::Local);
@@ -133,7 +147,7 @@ pub fn include_file(case: &Case) -> String {
         num(tol)
     );
     if let Analysis::Inverse(inv) = &case.analysis {
-        let w = &inv.weights;
+        let (p, w) = (&inv.params, &inv.params.weights);
         let _ = writeln!(o, "// inverse problem (docs/inverse.md): weights of eq. (41), first frame");
         let _ = writeln!(
             o,
@@ -160,9 +174,9 @@ pub fn include_file(case: &Case) -> String {
         let _ = writeln!(
             o,
             "real dt = {};\nint firstFrame = 1;\nreal alpha0 = {};\nreal stab = {};",
-            num(inv.frame_interval_s),
-            num(inv.alpha0_rad),
-            num(inv.stabilisation)
+            num(p.frame_interval_s),
+            num(p.alpha0_rad),
+            num(p.stabilisation)
         );
     }
     o
@@ -171,11 +185,8 @@ pub fn include_file(case: &Case) -> String {
 /// Run `freefem/inverse.edp` on an inverse case with the data file `data_path` (copied into
 /// `workdir` as `data.csv` unless it is already there). `data` is the parsed content of that file.
 pub fn run_inverse(case: &Case, data: NodalState, data_path: &Path, workdir: &Path) -> Result<RunResult, FreeFemError> {
-    let inv = case.inverse().ok_or_else(|| FreeFemError::BadOutput {
-        path: data_path.to_path_buf(),
-        reason: format!("case `{}` is not an inverse case", case.name),
-    })?;
-    if matches!(inv.method, InverseMethod::Newton { .. }) {
+    let inv = case.inverse().ok_or_else(|| FreeFemError::NotInverse(case.name.clone()))?;
+    if matches!(inv.params.method, InverseMethod::Newton { .. }) {
         return Err(FreeFemError::Unsupported(
             "the FreeFEM engine mirrors the paper's fixed point only (solver.method = \"fixed_point\")",
         ));
@@ -210,7 +221,7 @@ pub fn run_inverse(case: &Case, data: NodalState, data_path: &Path, workdir: &Pa
         s: rows.iter().map(|r| r[0]).collect(),
         x: rows.iter().map(|r| v3(r, 1)).collect(),
         alpha: rows.iter().map(|r| v3(r, 4)).collect(),
-        chart: Default::default(),
+        chart: Chart::default(),
     };
     let mut hist_header = vec!["iteration", "rel_change", "x_err_rel", "tangent_misfit"];
     hist_header.extend(ObjectiveTerms::NAMES);
@@ -240,7 +251,7 @@ pub fn run_inverse(case: &Case, data: NodalState, data_path: &Path, workdir: &Pa
         max_newton_iterations: None,
         wall_time_s: info.get("wall_time_s").copied().unwrap_or(f64::NAN),
     };
-    let w = inv.weights;
+    let w = inv.params.weights;
     Ok(RunResult {
         engine: Engine::Freefem,
         nodes,
@@ -249,7 +260,7 @@ pub fn run_inverse(case: &Case, data: NodalState, data_path: &Path, workdir: &Pa
         stats,
         inverse: Some(InverseOutput {
             data,
-            angles_known: crate::run::angles_known(case),
+            angles_known: angles_known(case),
             xhat: rows.iter().map(|r| v3(r, 7)).collect(),
             ahat: rows.iter().map(|r| v3(r, 10)).collect(),
             history,
@@ -302,12 +313,11 @@ fn execute(case: &Case, workdir: &Path, script: &str, outputs: &[&str]) -> Resul
 }
 
 fn read_info(info_path: &Path) -> Result<BTreeMap<String, f64>, FreeFemError> {
-    let bad = |reason: String| FreeFemError::BadOutput { path: info_path.to_path_buf(), reason };
+    let csv_err = |source| InputError::Csv { path: info_path.to_path_buf(), source };
     let mut info = BTreeMap::new();
-    let mut rdr =
-        csv::ReaderBuilder::new().trim(csv::Trim::All).from_path(info_path).map_err(|e| bad(e.to_string()))?;
+    let mut rdr = csv::ReaderBuilder::new().trim(csv::Trim::All).from_path(info_path).map_err(csv_err)?;
     for rec in rdr.records() {
-        let rec = rec.map_err(|e| bad(e.to_string()))?;
+        let rec = rec.map_err(csv_err)?;
         if let (Some(k), Some(v)) = (rec.get(0), rec.get(1).and_then(|v| v.parse::<f64>().ok())) {
             info.insert(k.to_string(), v);
         }
@@ -317,14 +327,10 @@ fn read_info(info_path: &Path) -> Result<BTreeMap<String, f64>, FreeFemError> {
 
 fn read_table(path: &Path, expected: &[&str]) -> Result<Vec<Vec<f64>>, FreeFemError> {
     let bad = |reason: String| FreeFemError::BadOutput { path: path.to_path_buf(), reason };
-    let mut rdr = csv::ReaderBuilder::new().trim(csv::Trim::All).from_path(path).map_err(|e| bad(e.to_string()))?;
-    let headers: Vec<String> = rdr.headers().map_err(|e| bad(e.to_string()))?.iter().map(String::from).collect();
-    if headers != expected {
-        return Err(bad(format!("header {headers:?}, expected {expected:?}")));
-    }
+    let mut rdr = csv_reader(path, expected)?;
     let mut rows = Vec::new();
     for (i, rec) in rdr.records().enumerate() {
-        let rec = rec.map_err(|e| bad(e.to_string()))?;
+        let rec = rec.map_err(|source| InputError::Csv { path: path.to_path_buf(), source })?;
         let row: Result<Vec<f64>, _> = rec.iter().map(|v| v.parse::<f64>()).collect();
         let row = row.map_err(|e| bad(format!("row {}: {e}", i + 1)))?;
         if row.iter().any(|v| !v.is_finite()) {
@@ -348,7 +354,7 @@ fn read_outputs(case: &Case, dir: &Path) -> Result<RunResult, FreeFemError> {
         s: rows.iter().map(|r| r[0]).collect(),
         x: rows.iter().map(|r| Vector3::new(r[1], r[2], r[3])).collect(),
         alpha: rows.iter().map(|r| Vector3::new(r[4], r[5], r[6])).collect(),
-        chart: Default::default(),
+        chart: Chart::default(),
     };
     let info = read_info(&dir.join("ff_info.csv"))?;
     let get = |k: &str| info.get(k).copied();

@@ -13,9 +13,7 @@
 //! is an error that says what was found; no value is guessed or converted.
 use std::path::Path;
 
-use crate::output::write_atomic;
-
-use super::ClipError;
+use super::files::{write_atomic, InputError, OutputError};
 
 const MAGIC: &[u8] = b"\x93NUMPY";
 
@@ -29,21 +27,21 @@ pub struct NpyArray {
 }
 
 /// Read a little-endian float64, C-order `.npy` file.
-pub fn read_npy(path: &Path) -> Result<NpyArray, ClipError> {
-    let bytes = std::fs::read(path).map_err(|e| ClipError::Read { path: path.to_path_buf(), reason: e.to_string() })?;
-    parse_npy(&bytes).map_err(|reason| ClipError::Npy { path: path.to_path_buf(), reason })
+pub fn read_npy(path: &Path) -> Result<NpyArray, InputError> {
+    let bytes = std::fs::read(path).map_err(|source| InputError::Open { path: path.to_path_buf(), source })?;
+    parse_npy(&bytes).map_err(|reason| InputError::Npy { path: path.to_path_buf(), reason })
 }
 
 /// Write `data` (C order) with the given shape as a version 1.0 `.npy` file, atomically.
-pub fn write_npy(path: &Path, shape: &[usize], data: &[f64]) -> Result<(), ClipError> {
+pub fn write_npy(path: &Path, shape: &[usize], data: &[f64]) -> Result<(), OutputError> {
     let count: usize = shape.iter().product();
     if count != data.len() {
-        return Err(ClipError::Shape {
+        return Err(OutputError::Invalid {
             path: path.to_path_buf(),
             reason: format!("shape {shape:?} holds {count} values, but {} were given", data.len()),
         });
     }
-    Ok(write_atomic(path, &npy_bytes(shape, data))?)
+    write_atomic(path, &npy_bytes(shape, data))
 }
 
 /// Bytes of a version 1.0 `.npy` file (header padded so that the data start at a multiple of 64).

@@ -1,12 +1,12 @@
 //! ParaView output: one VTK XML PolyData file (`.vtp`) per frame holding the centreline as a
 //! polyline with per-node vectors (directors, controls) and scalars, and a `.pvd` collection
-//! that lists the frames with their times. Written atomically (`output::write_atomic`).
+//! that lists the frames with their times. Written atomically (`io::files::write_atomic`).
 use std::fmt::Write as _;
 use std::path::Path;
 
 use nalgebra::Vector3;
 
-use crate::output::{write_atomic, OutputError};
+use super::files::{write_atomic, OutputError};
 
 /// Per-node fields of one frame.
 pub struct PolylineFields<'a> {

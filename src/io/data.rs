@@ -4,29 +4,17 @@
 //! Format: CSV, header `s_m,x_m,y_m,z_m,alpha_rad,beta_rad,gamma_rad`, one row per mesh node in
 //! order of the reference arc length `s` [m]; positions [m], angles of eq. (1) [rad]; every
 //! value written with 17 significant digits so that the file round-trips `f64` exactly.
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use nalgebra::Vector3;
 
-use crate::mesh::Mesh;
-use crate::output::{write_atomic, OutputError};
+use super::files::{csv_reader, write_atomic, InputError, OutputError};
+use crate::model::chart::Chart;
+use crate::model::mesh::Mesh;
 use crate::run::NodalState;
 
 /// Column names of `data.csv`.
 pub const DATA_HEADER: [&str; 7] = ["s_m", "x_m", "y_m", "z_m", "alpha_rad", "beta_rad", "gamma_rad"];
-
-/// Errors reading data files; each names the file and the row.
-#[derive(Debug, thiserror::Error)]
-pub enum DataError {
-    #[error("cannot read data file {path}: {reason}")]
-    Read { path: PathBuf, reason: String },
-    #[error("data file {path}, row {row}: {reason}")]
-    Row { path: PathBuf, row: usize, reason: String },
-    #[error("data file {path}: {reason}")]
-    Shape { path: PathBuf, reason: String },
-    #[error(transparent)]
-    Write(#[from] OutputError),
-}
 
 /// Text of `data.csv` for nodal fields (exact round trip).
 pub fn data_csv_text(nodes: &NodalState) -> String {
@@ -42,23 +30,18 @@ pub fn data_csv_text(nodes: &NodalState) -> String {
 }
 
 /// Write `data.csv` atomically.
-pub fn write_data(path: &Path, nodes: &NodalState) -> Result<(), DataError> {
-    Ok(write_atomic(path, data_csv_text(nodes).as_bytes())?)
+pub fn write_data(path: &Path, nodes: &NodalState) -> Result<(), OutputError> {
+    write_atomic(path, data_csv_text(nodes).as_bytes())
 }
 
 /// Read `data.csv` and check it against the mesh: one row per node, `s` at the node positions
 /// (to 1e-9 L), every value finite.
-pub fn read_data(path: &Path, mesh: &Mesh) -> Result<NodalState, DataError> {
-    let read = |reason: String| DataError::Read { path: path.to_path_buf(), reason };
-    let mut rdr = csv::ReaderBuilder::new().trim(csv::Trim::All).from_path(path).map_err(|e| read(e.to_string()))?;
-    let headers: Vec<String> = rdr.headers().map_err(|e| read(e.to_string()))?.iter().map(String::from).collect();
-    if headers != DATA_HEADER {
-        return Err(read(format!("header {headers:?}, expected {DATA_HEADER:?}")));
-    }
-    let mut nodes = NodalState { s: Vec::new(), x: Vec::new(), alpha: Vec::new(), chart: Default::default() };
+pub fn read_data(path: &Path, mesh: &Mesh) -> Result<NodalState, InputError> {
+    let mut rdr = csv_reader(path, &DATA_HEADER)?;
+    let mut nodes = NodalState { s: Vec::new(), x: Vec::new(), alpha: Vec::new(), chart: Chart::default() };
     for (i, rec) in rdr.records().enumerate() {
         let row = i + 1;
-        let bad = |reason: String| DataError::Row { path: path.to_path_buf(), row, reason };
+        let bad = |reason: String| InputError::Row { path: path.to_path_buf(), row, reason };
         let rec = rec.map_err(|e| bad(e.to_string()))?;
         let v: Vec<f64> =
             rec.iter().map(|t| t.parse::<f64>().map_err(|e| bad(format!("`{t}`: {e}")))).collect::<Result<_, _>>()?;
@@ -72,13 +55,13 @@ pub fn read_data(path: &Path, mesh: &Mesh) -> Result<NodalState, DataError> {
         nodes.x.push(Vector3::new(v[1], v[2], v[3]));
         nodes.alpha.push(Vector3::new(v[4], v[5], v[6]));
     }
-    let shape = |reason: String| DataError::Shape { path: path.to_path_buf(), reason };
+    let shape = |reason: String| InputError::Shape { path: path.to_path_buf(), reason };
     if nodes.s.len() != mesh.nodes() {
         return Err(shape(format!("{} node rows, but the case's mesh has {} nodes", nodes.s.len(), mesh.nodes())));
     }
     for (i, &s) in nodes.s.iter().enumerate() {
         if (s - mesh.node_s(i)).abs() > 1e-9 * mesh.length_m {
-            return Err(DataError::Row {
+            return Err(InputError::Row {
                 path: path.to_path_buf(),
                 row: i + 1,
                 reason: format!("s = {s} m, but mesh node {i} is at {} m", mesh.node_s(i)),
@@ -98,7 +81,7 @@ mod tests {
             s: (0..n).map(|i| mesh.node_s(i)).collect(),
             x: (0..n).map(|i| Vector3::new(0.1 / 3.0 * i as f64, (i as f64).sin() * 1e-4, mesh.node_s(i))).collect(),
             alpha: (0..n).map(|i| Vector3::new(std::f64::consts::PI / 7.0, -0.3 * i as f64, 0.25)).collect(),
-            chart: Default::default(),
+            chart: Chart::default(),
         }
     }
 
@@ -119,7 +102,7 @@ mod tests {
         let p = dir.path().join("data.csv");
         let good = data_csv_text(&sample(&mesh));
         std::fs::write(&p, good.replacen("e-4,", "e-4x,", 1)).unwrap();
-        assert!(matches!(read_data(&p, &mesh), Err(DataError::Row { row: 2, .. })), "{:?}", read_data(&p, &mesh));
+        assert!(matches!(read_data(&p, &mesh), Err(InputError::Row { row: 2, .. })), "{:?}", read_data(&p, &mesh));
         let lines: Vec<&str> = good.lines().collect();
         std::fs::write(&p, lines[..3].join("\n")).unwrap();
         let e = read_data(&p, &mesh).unwrap_err().to_string();
@@ -127,6 +110,6 @@ mod tests {
         std::fs::write(&p, good.replace("2.5000000000000000e-1", "NaN")).unwrap();
         let e = read_data(&p, &mesh).unwrap_err().to_string();
         assert!(e.contains("gamma_rad is not finite"), "{e}");
-        assert!(matches!(read_data(&dir.path().join("missing.csv"), &mesh), Err(DataError::Read { .. })));
+        assert!(matches!(read_data(&dir.path().join("missing.csv"), &mesh), Err(InputError::Csv { .. })));
     }
 }

@@ -11,20 +11,21 @@
 //!   momentum:       δx · ρA ẋ + δα · Qᵀ I A α̇                                  eqs. (7), (27), (40)
 //!   loads:          δx · f + δα · l                                             eq. (40)
 //! ```
-#![allow(non_snake_case)]
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 
-use crate::material::RodProperties;
-use crate::mesh::{QuadratureScheme, Rule};
-use crate::rotation::{rotation, rotation_derivatives, skew, PointFrame};
+use super::material::RodProperties;
+use super::mesh::{DofMap, Field, QuadratureScheme, Rule};
+use super::rotation::{curvature, rotation, rotation_derivatives, skew, PointFrame};
 
 /// Local element vector (12 entries).
 pub type LocalVec = SVector<f64, 12>;
 /// Local element matrix (12 × 12).
 pub type LocalMat = SMatrix<f64, 12, 12>;
 
-const X: [usize; 2] = [0, 6];
-const ALPHA: [usize; 2] = [3, 9];
+/// Layout of an element vector (two nodes of the forward layout).
+const LOCAL: DofMap = DofMap::forward(2);
+const X: [usize; 2] = [LOCAL.local(0, Field::X, 0), LOCAL.local(1, Field::X, 0)];
+const ALPHA: [usize; 2] = [LOCAL.local(0, Field::Alpha, 0), LOCAL.local(1, Field::Alpha, 0)];
 
 /// Fields interpolated at one point of an element.
 #[derive(Clone, Copy, Debug)]
@@ -43,8 +44,11 @@ pub struct PointState {
 pub fn interpolate(u: &LocalVec, h: f64, xi: f64) -> PointState {
     let n = [1.0 - xi, xi];
     let dn = [-1.0 / h, 1.0 / h];
-    let node = |k: usize, off: usize| Vector3::new(u[k * 6 + off], u[k * 6 + off + 1], u[k * 6 + off + 2]);
-    let (xa, xb, aa, ab) = (node(0, 0), node(1, 0), node(0, 3), node(1, 3));
+    let node = |a: usize, field: Field| {
+        let i = LOCAL.local(a, field, 0);
+        Vector3::new(u[i], u[i + 1], u[i + 2])
+    };
+    let (xa, xb, aa, ab) = (node(0, Field::X), node(1, Field::X), node(0, Field::Alpha), node(1, Field::Alpha));
     PointState {
         n,
         dn,
@@ -73,6 +77,7 @@ fn columns(c: [Vector3<f64>; 3]) -> Matrix3<f64> {
 
 /// Internal force `G(u)` of one element (D3, with the quadrature split of D4) and, if asked,
 /// its exact tangent `∂G/∂u`.
+#[allow(non_snake_case)] // paper symbols K, J, Q, A, S, C, Bk, H, I
 pub fn internal_force(
     props: &RodProperties,
     scheme: QuadratureScheme,
@@ -135,6 +140,7 @@ pub fn internal_force(
 /// The frozen-coefficient linear operator of the paper's fixed point (§4, D5) on one element:
 /// returns `(L, b)` with `L(u_k) û = b(u_k)` (loads excluded from `b`), where `Q_k, A_k, B_k,
 /// q3_k` come from the iterate `u_k`. At a fixed point `L u − b = G(u)`.
+#[allow(non_snake_case)] // paper symbols K, J, Q, A, S, C, Bk, H, I
 pub fn frozen_operator(props: &RodProperties, scheme: QuadratureScheme, h: f64, uk: &LocalVec) -> (LocalMat, LocalVec) {
     let K = Matrix3::from_diagonal(&props.shear_stretch_n);
     let J = Matrix3::from_diagonal(&props.bend_twist_nm2);
@@ -170,6 +176,7 @@ pub fn frozen_operator(props: &RodProperties, scheme: QuadratureScheme, h: f64, 
 
 /// Momentum functional `P(u, u̇)` of one element (D6, 2-point Gauss) and optionally its
 /// derivatives with respect to `u` and `u̇`.
+#[allow(non_snake_case)] // paper symbols K, J, Q, A, S, C, Bk, H, I
 pub fn momentum(
     props: &RodProperties,
     scheme: QuadratureScheme,
@@ -242,6 +249,7 @@ pub fn distributed_load(
 /// Follower (local-frame) distributed loads of one element: `∫ N_a Qᵀ(α) fˡ`, `∫ N_a Qᵀ(α) lˡ`
 /// (eq. 4: `vᵍ = Qᵀ vˡ`), load rule of D4, and optionally their derivative with respect to the
 /// local unknowns `∂/∂u` added into `tangent`.
+#[allow(non_snake_case)] // paper symbols K, J, Q, A, S, C, Bk, H, I
 pub fn follower_load(
     scheme: QuadratureScheme,
     h: f64,
@@ -274,6 +282,20 @@ pub fn follower_load(
     r
 }
 
+/// Curvature `κˡ = A(α_m) ∂sα` [1/m] (eq. 28) at the midpoint of every element of a nodal
+/// field of angles `alpha` at the arc lengths `s` [m], with the midpoint arc length [m]:
+/// `α_m = (α_e + α_{e+1})/2`, `∂sα = (α_{e+1} − α_e)/(s_{e+1} − s_e)`. The one curvature of
+/// every output and error measure of the crate.
+pub fn midpoint_curvatures(s: &[f64], alpha: &[Vector3<f64>]) -> Vec<(f64, Vector3<f64>)> {
+    (0..s.len().saturating_sub(1))
+        .map(|e| {
+            let h = s[e + 1] - s[e];
+            let mid = (alpha[e] + alpha[e + 1]) * 0.5;
+            ((s[e] + s[e + 1]) * 0.5, curvature(&mid, &((alpha[e + 1] - alpha[e]) / h)))
+        })
+        .collect()
+}
+
 fn for_each_point(rule: &Rule, h: f64, u: &LocalVec, mut f: impl FnMut(&PointState, f64)) {
     for (xi, w) in rule.points.iter().zip(rule.weights) {
         let p = interpolate(u, h, *xi);
@@ -284,7 +306,7 @@ fn for_each_point(rule: &Rule, h: f64, u: &LocalVec, mut f: impl FnMut(&PointSta
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::material::{CrossSection, Material, RodProperties};
+    use crate::model::material::{CrossSection, Material, RodProperties};
 
     fn props() -> RodProperties {
         let mat = Material {
@@ -377,7 +399,7 @@ mod tests {
         assert!(g.amax() < 1e-6, "{g}");
         // Rigid rotation: x' = d3(α) with constant α → also stress free.
         let a = Vector3::new(0.3, 0.4, -0.2);
-        let d3 = crate::rotation::d3(&a);
+        let d3 = crate::model::rotation::d3(&a);
         let mut u = LocalVec::zeros();
         for k in 0..3 {
             u[6 + k] = h * d3[k];

@@ -1,0 +1,366 @@
+//! Case files: TOML → serde structs ([`raw`], `deny_unknown_fields`) → one validated, typed
+//! [`Case`] ([`validate`]) that holds the solvers' own params types.
+//!
+//! Numbers may be written as TOML numbers or as strings holding an expression of the case's
+//! `[constants]` (e.g. `radius_m = "L/40"`); load components are expressions of the reference
+//! arc length `s` [m], time `t` [s] and the constants (see `crate::expr`). Solvers never see
+//! TOML: they receive the params built here. A sweep sets a value in the case file's tables
+//! and validates the whole case again ([`sweep`]), so every setting has one validator and one
+//! translation to its solver.
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use nalgebra::{Matrix3, Vector3};
+
+mod raw;
+pub mod sweep;
+mod validate;
+
+use crate::clip::synthetic::{RollClipParams, TimeMapping};
+use crate::clip::{ClipPlane, KymogramParams};
+use crate::model::loads::Loads;
+use crate::model::material::{CrossSection, Material, RodProperties};
+use crate::model::mesh::{Mesh, QuadratureScheme};
+use crate::solve::dynamics::DynamicParams;
+use crate::solve::inverse::InverseParams;
+use crate::solve::sequence::{FrameStart, RotationTreatment, SequenceParams};
+use crate::solve::statics::StaticParams;
+use crate::solve::Problem;
+use validate::Validator;
+
+/// Errors at the case-file boundary. Every variant names the file; `Invalid` names the key.
+#[derive(Debug, thiserror::Error)]
+pub enum CaseError {
+    #[error("cannot read case file {path}")]
+    Io {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("{path}: {message}")]
+    Syntax { path: PathBuf, message: String },
+    #[error("{path}: key `{key}`: {reason}")]
+    Invalid { path: PathBuf, key: String, reason: String },
+}
+
+/// Where the centreline data of an inverse case come from.
+#[derive(Clone, Debug, PartialEq)]
+pub enum DataSource {
+    /// a static forward solve of the case's own `[loads]` (synthetic data, I7)
+    Forward(StaticParams),
+    /// a recorded or synthetic clip (`[clip]`), solved frame by frame
+    Clip(ClipSource),
+}
+
+/// The `roll_3d` settings of a synthetic clip (`crate::clip::synthetic`); its nodes, length
+/// and Δt are the mesh's and the clip's.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SyntheticClip {
+    pub frames: usize,
+    pub roll_total_rad: f64,
+    pub twist_per_m: f64,
+    pub time_mapping: TimeMapping,
+    pub substeps: usize,
+}
+
+impl SyntheticClip {
+    /// The generator's parameters on `mesh` with frame interval `dt_s` [s].
+    pub fn params(&self, mesh: &Mesh, dt_s: f64) -> RollClipParams {
+        RollClipParams {
+            length_m: mesh.length_m,
+            nodes: mesh.nodes(),
+            frames: self.frames,
+            dt_s,
+            roll_total_rad: self.roll_total_rad,
+            twist_per_m: self.twist_per_m,
+            time_mapping: self.time_mapping,
+            substeps: self.substeps,
+        }
+    }
+}
+
+/// File format of a clip.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ClipKind {
+    /// joint-angle kymogram (.npy, frames × joint angles [rad]) of the `elegansbot` package,
+    /// turned into a spline centreline of the rod's length with `elements + 1` nodes, placed
+    /// in the `plane`
+    Kymogram,
+    /// positions: CSV `frame,node,x_m,y_m,z_m` or NPY frames × nodes × 3 [m]
+    Recording,
+    /// the 3D ground-truth clip built from a kymogram's curvature with a rolling bending plane
+    /// and a twist (`crate::clip::synthetic`); `file` is the omega-turn kymogram
+    Roll3d(SyntheticClip),
+}
+
+/// A clip and how its frames are solved.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ClipSource {
+    pub kind: ClipKind,
+    /// resolved against the case file's directory
+    pub file: PathBuf,
+    /// `[first, end)` frame range, all frames if `None`
+    pub frames: Option<(usize, usize)>,
+    /// chart guard: stop when |cos β| < this at any node (`solve::sequence`)
+    pub min_cos_beta: f64,
+    /// initial iterate of the frames after the first (D13)
+    pub start: FrameStart,
+    /// angle chart per frame (`docs/rotation.md`)
+    pub rotation: RotationTreatment,
+    /// plane of a kymogram's placement (`crate::clip`)
+    pub plane: ClipPlane,
+    /// rigid rotation applied to every frame after the placement (`clip.orientation`, a
+    /// rotation vector [rad]; identity if absent)
+    pub orientation: Matrix3<f64>,
+    /// unit gauge vector of the first frame in space coordinates (R7): `clip.gauge` rotated by
+    /// `orientation`; default the placement plane's normal (e2 for x–z, e3 for x–y)
+    pub gauge: Vector3<f64>,
+}
+
+/// An inverse analysis (Problem 2, eq. 61): the solver's params and the data.
+#[derive(Clone, Debug, PartialEq)]
+pub struct InverseSettings {
+    pub params: InverseParams,
+    pub data: DataSource,
+}
+
+/// What is solved.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Analysis {
+    /// Static solve; `continuation_steps` ≥ 1: all loads ramped by k/steps, each step solved
+    /// from the last.
+    Static(StaticParams),
+    /// Appendix A time stepping (D6), Newton per step.
+    Dynamic(DynamicParams),
+    /// Recover α, f, l from a centreline: a forward solution of the case's `[loads]`, or a clip.
+    Inverse(InverseSettings),
+}
+
+/// Rust–FreeFEM comparison tolerances (D8).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CompareTolerances {
+    /// max node-wise |Δ(x − x0)| / max |x − x0|
+    pub displacement_rel: f64,
+    /// max node-wise |Δα| / max |α|
+    pub angles_rel: f64,
+    /// scalar metrics: |Δ| ≤ metric_rel·|rust| + metric_abs
+    pub metric_rel: f64,
+    pub metric_abs: f64,
+    /// allowed difference of iteration counts
+    pub iterations_abs: f64,
+    /// inverse cases: max node-wise |Δ(x̂, α̂)| / max |(x̂, α̂)| (per field)
+    pub adjoint_rel: f64,
+}
+
+/// Independent theory a case is checked against (metrics `*_rel_error` in `metrics.json`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Reference {
+    /// Eq. (63), the Kirchhoff elastica and the planar Reissner rod for a dead end force of
+    /// magnitude `force_n` [N] along −e2 (see `run::metrics`).
+    TipLoadedCantilever { force_n: f64 },
+}
+
+/// A validated case.
+#[derive(Clone, Debug)]
+pub struct Case {
+    pub name: String,
+    pub description: String,
+    pub source: Option<PathBuf>,
+    pub constants: BTreeMap<String, f64>,
+    pub mesh: Mesh,
+    pub material: Material,
+    pub section: CrossSection,
+    pub props: RodProperties,
+    pub quadrature: QuadratureScheme,
+    pub loads: Loads,
+    pub analysis: Analysis,
+    pub compare: CompareTolerances,
+    pub reference: Option<Reference>,
+    /// the case file's tables and the path it was validated with, for [`sweep`]'s overrides
+    raw: Option<(toml::Table, PathBuf)>,
+}
+
+impl Case {
+    /// Read and validate a case file.
+    pub fn from_file(path: &Path) -> Result<Case, CaseError> {
+        let text =
+            std::fs::read_to_string(path).map_err(|source| CaseError::Io { path: path.to_path_buf(), source })?;
+        let name = path.file_stem().and_then(|s| s.to_str()).unwrap_or("case").to_string();
+        let mut case = Case::from_toml(&text, &name, path)?;
+        case.source = Some(path.to_path_buf());
+        Ok(case)
+    }
+
+    /// Parse and validate TOML text; `path` names the file in messages and resolves relative
+    /// clip files.
+    pub fn from_toml(text: &str, name: &str, path: &Path) -> Result<Case, CaseError> {
+        let syntax = |e: toml::de::Error| CaseError::Syntax { path: path.to_path_buf(), message: e.to_string() };
+        let raw: raw::RawCase = toml::from_str(text).map_err(syntax)?;
+        let mut case = Validator::new(path).case(raw, name)?;
+        case.raw = Some((toml::from_str(text).map_err(syntax)?, path.to_path_buf()));
+        Ok(case)
+    }
+
+    /// The discrete forward problem of the case (`[rod]`, `[material]`, `[cross_section]`,
+    /// `[loads]`, `solver.quadrature`).
+    pub fn problem(&self) -> Problem<'_> {
+        Problem::new(self.mesh, self.props, self.quadrature, &self.loads)
+    }
+
+    /// The same dynamic case cut to its first `steps` time steps (same Δt): the short but real
+    /// subset that `cargo test` runs through FreeFEM. Other cases are returned unchanged.
+    pub fn time_prefix(&self, steps: usize) -> Case {
+        let mut c = self.clone();
+        if let Analysis::Dynamic(p) = &mut c.analysis {
+            let k = steps.min(p.steps).max(1);
+            p.end_time_s = p.end_time_s * k as f64 / p.steps as f64;
+            p.steps = k;
+        }
+        c
+    }
+
+    /// Is this a dynamic case?
+    pub fn is_dynamic(&self) -> bool {
+        matches!(self.analysis, Analysis::Dynamic(_))
+    }
+
+    /// The settings of an inverse case.
+    pub fn inverse(&self) -> Option<&InverseSettings> {
+        match &self.analysis {
+            Analysis::Inverse(s) => Some(s),
+            _ => None,
+        }
+    }
+
+    /// The clip of a clip case.
+    pub fn clip(&self) -> Option<&ClipSource> {
+        match &self.inverse()?.data {
+            DataSource::Clip(c) => Some(c),
+            DataSource::Forward(_) => None,
+        }
+    }
+
+    /// The static forward case that generates an inverse case's data (same rod and loads).
+    pub fn data_case(&self) -> Option<Case> {
+        let DataSource::Forward(d) = self.inverse()?.data else { return None };
+        let mut c = self.clone();
+        c.analysis = Analysis::Static(d);
+        Some(c)
+    }
+
+    /// How a kymogram clip becomes centrelines on this case's mesh.
+    pub fn kymogram_params(&self) -> Option<KymogramParams> {
+        let (inv, clip) = (self.inverse()?, self.clip()?);
+        Some(KymogramParams {
+            length_m: self.mesh.length_m,
+            nodes: self.mesh.nodes(),
+            dt_s: inv.params.frame_interval_s,
+            plane: clip.plane,
+            scale_to_length: true,
+        })
+    }
+
+    /// The generator's parameters of a `roll_3d` clip on this case's mesh.
+    pub fn roll_clip_params(&self) -> Option<RollClipParams> {
+        let (inv, clip) = (self.inverse()?, self.clip()?);
+        match &clip.kind {
+            ClipKind::Roll3d(s) => Some(s.params(&self.mesh, inv.params.frame_interval_s)),
+            _ => None,
+        }
+    }
+
+    /// The clip solver's settings of a clip case.
+    pub fn sequence_params(&self) -> Option<SequenceParams> {
+        let (inv, clip) = (self.inverse()?, self.clip()?);
+        Some(SequenceParams {
+            inverse: inv.params,
+            min_cos_beta: clip.min_cos_beta,
+            frame_offset: clip.frames.map(|f| f.0).unwrap_or(0),
+            start: clip.start,
+            rotation: clip.rotation,
+            gauge: clip.gauge,
+        })
+    }
+}
+
+/// All `*.toml` files of a directory, sorted by name.
+pub fn case_files(dir: &Path) -> std::io::Result<Vec<PathBuf>> {
+    let mut v: Vec<PathBuf> = std::fs::read_dir(dir)?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().map(|x| x == "toml").unwrap_or(false))
+        .collect();
+    v.sort();
+    Ok(v)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::solve::statics::Method;
+
+    const GOOD: &str = r#"
+description = "test"
+[constants]
+F = 1e-8
+L0 = 1e-3
+[rod]
+length_m = "L0"
+elements = 10
+[material]
+young_modulus_pa = 1.1e5
+shear_modulus_pa = 5e4
+shear_correction = "4/3"
+[cross_section]
+shape = "circle"
+radius_m = "L0/40"
+[loads]
+end_force_n = [0, "-F", 0]
+[solver]
+analysis = "static"
+relaxation = 0.5
+tolerance = 1e-10
+max_iterations = 100
+[compare]
+displacement_rel = 1e-6
+angles_rel = 1e-6
+metric_rel = 1e-6
+"#;
+
+    fn parse(text: &str) -> Result<Case, CaseError> {
+        Case::from_toml(text, "t", Path::new("t.toml"))
+    }
+
+    #[test]
+    fn good_case_parses() {
+        let c = parse(GOOD).unwrap();
+        assert_eq!(c.mesh.elements, 10);
+        assert!((c.mesh.length_m - 1e-3).abs() < 1e-18);
+        assert!((c.material.shear_correction - 4.0 / 3.0).abs() < 1e-15);
+        assert!(
+            matches!(c.analysis, Analysis::Static(StaticParams { method: Method::FixedPoint { relaxation }, .. }) if relaxation == 0.5)
+        );
+    }
+
+    fn expect_key(text: &str, key: &str) {
+        match parse(text) {
+            Err(CaseError::Invalid { key: k, .. }) => assert_eq!(k, key),
+            other => panic!("expected invalid {key}, got {other:?}"),
+        }
+    }
+
+    #[test]
+    fn bad_values_name_the_key() {
+        expect_key(&GOOD.replace("elements = 10", "elements = 1"), "rod.elements");
+        expect_key(&GOOD.replace("young_modulus_pa = 1.1e5", "young_modulus_pa = -1"), "material.young_modulus_pa");
+        expect_key(&GOOD.replace("\"-F\"", "\"-G*s\""), "loads.end_force_n[1]");
+        expect_key(&GOOD.replace("relaxation = 0.5", "relaxation = 1.5"), "solver.relaxation");
+        expect_key(&GOOD.replace("radius_m = \"L0/40\"", "radius_m = \"L0/(\""), "cross_section.radius_m");
+        expect_key(&GOOD.replace("analysis = \"static\"", "analysis = \"dynamic\""), "material.density_kg_m3");
+    }
+
+    #[test]
+    fn unknown_keys_are_rejected() {
+        let e = parse(&GOOD.replace("elements = 10", "elements = 10\nelement = 3")).unwrap_err();
+        assert!(e.to_string().contains("unknown field `element`"), "{e}");
+    }
+}

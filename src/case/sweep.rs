@@ -1,0 +1,299 @@
+//! Parameter sweeps (`cosserat sweep`): `--set key=v1,v2,…` specifications and their
+//! cartesian product of cases. Each value is written into the case file's own table (e.g.
+//! `lambda_d` → `inverse.lambda_d`, `elements` → `rod.elements`) and the whole case is
+//! validated again, so a swept value meets exactly the rules, and reaches the solvers by
+//! exactly the path, of a value written in the file.
+use super::raw::RawCase;
+use super::validate::Validator;
+use super::{Analysis, Case, CaseError};
+
+/// Errors of sweep specifications.
+#[derive(Debug, thiserror::Error)]
+pub enum SweepError {
+    #[error("--set `{0}`: expected key=value[,value…]")]
+    Syntax(String),
+    #[error("--set {key}: `{value}` is not a number")]
+    NotANumber { key: String, value: String },
+    #[error("--set {key}: {reason}")]
+    Invalid { key: String, reason: String },
+    #[error("--set {key}: unknown parameter for case `{case}` (known: {known})")]
+    UnknownKey { key: String, case: String, known: String },
+    #[error("--set {0} given twice")]
+    Duplicate(String),
+}
+
+/// One swept parameter and its values.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SweepParam {
+    pub key: String,
+    pub values: Vec<f64>,
+}
+
+/// A parameter a sweep can set: its name on the command line, its table and key in the case
+/// file (`index`: the entry of an array), and whether it is a count.
+struct Key {
+    name: &'static str,
+    table: &'static str,
+    key: &'static str,
+    index: Option<usize>,
+    count: bool,
+}
+
+const fn key(name: &'static str, table: &'static str, key: &'static str) -> Key {
+    Key { name, table, key, index: None, count: false }
+}
+const fn count(name: &'static str, table: &'static str, key: &'static str) -> Key {
+    Key { name, table, key, index: None, count: true }
+}
+const fn entry(name: &'static str, key: &'static str, index: usize) -> Key {
+    Key { name, table: "inverse", key, index: Some(index), count: false }
+}
+
+const INVERSE_KEYS: &[Key] = &[
+    key("lambda_g", "inverse", "lambda_g"),
+    key("lambda_f", "inverse", "lambda_f"),
+    key("lambda_l", "inverse", "lambda_l"),
+    key("lambda_d", "inverse", "lambda_d"),
+    entry("lambda_kappa1", "lambda_kappa", 0),
+    entry("lambda_kappa2", "lambda_kappa", 1),
+    entry("lambda_kappa3", "lambda_kappa", 2),
+    entry("lambda_omega1", "lambda_omega", 0),
+    entry("lambda_omega2", "lambda_omega", 1),
+    entry("lambda_omega3", "lambda_omega", 2),
+    key("relaxation", "solver", "relaxation"),
+    key("warm_start_tolerance", "solver", "warm_start_tolerance"),
+    key("tolerance", "solver", "tolerance"),
+    count("max_iterations", "solver", "max_iterations"),
+    count("elements", "rod", "elements"),
+    key("stabilisation", "inverse", "stabilisation"),
+];
+const STATIC_KEYS: &[Key] = &[
+    key("relaxation", "solver", "relaxation"),
+    key("tolerance", "solver", "tolerance"),
+    count("max_iterations", "solver", "max_iterations"),
+    count("continuation_steps", "solver", "continuation_steps"),
+    count("elements", "rod", "elements"),
+];
+const DYNAMIC_KEYS: &[Key] = &[
+    key("tolerance", "solver", "tolerance"),
+    count("max_iterations", "solver", "max_iterations"),
+    count("steps", "time", "steps"),
+    count("elements", "rod", "elements"),
+];
+
+fn keys(case: &Case) -> &'static [Key] {
+    match case.analysis {
+        Analysis::Inverse(_) => INVERSE_KEYS,
+        Analysis::Static(_) => STATIC_KEYS,
+        Analysis::Dynamic(_) => DYNAMIC_KEYS,
+    }
+}
+
+/// Parameters a sweep can set on `case`.
+pub fn known_keys(case: &Case) -> Vec<&'static str> {
+    keys(case).iter().map(|k| k.name).collect()
+}
+
+/// Parse `key=v1,v2,…`.
+pub fn parse_set(spec: &str) -> Result<SweepParam, SweepError> {
+    let (key, values) = spec.split_once('=').ok_or_else(|| SweepError::Syntax(spec.into()))?;
+    let key = key.trim().to_string();
+    if key.is_empty() || values.trim().is_empty() {
+        return Err(SweepError::Syntax(spec.into()));
+    }
+    let values = values
+        .split(',')
+        .map(|v| {
+            let v = v.trim();
+            v.parse::<f64>()
+                .ok()
+                .filter(|x| x.is_finite())
+                .ok_or_else(|| SweepError::NotANumber { key: key.clone(), value: v.into() })
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok(SweepParam { key, values })
+}
+
+impl Case {
+    /// The case with the given parameters set (command-line names, see [`known_keys`]),
+    /// validated again as a whole.
+    pub fn with_values(&self, values: &[(&str, f64)]) -> Result<Case, SweepError> {
+        let (mut table, path) = self.raw.clone().ok_or_else(|| SweepError::Invalid {
+            key: values.first().map(|v| v.0.to_string()).unwrap_or_default(),
+            reason: format!("case `{}` was not read from TOML", self.name),
+        })?;
+        for &(name, v) in values {
+            let k = keys(self).iter().find(|k| k.name == name).ok_or_else(|| SweepError::UnknownKey {
+                key: name.into(),
+                case: self.name.clone(),
+                known: known_keys(self).join(", "),
+            })?;
+            set(&mut table, k, v)?;
+        }
+        let invalid = |reason: String| SweepError::Invalid {
+            key: values.iter().map(|v| v.0).collect::<Vec<_>>().join(", "),
+            reason,
+        };
+        let raw: RawCase =
+            toml::Value::Table(table.clone()).try_into().map_err(|e: toml::de::Error| invalid(e.to_string()))?;
+        let mut case = Validator::new(&path).case(raw, &self.name).map_err(|e| match e {
+            CaseError::Invalid { key, reason, .. } => invalid(format!("{reason} (case file key `{key}`)")),
+            other => invalid(other.to_string()),
+        })?;
+        case.source = self.source.clone();
+        case.raw = Some((table, path));
+        Ok(case)
+    }
+}
+
+/// Write `v` at `k` in the case file's tables (an integer for a count).
+fn set(table: &mut toml::Table, k: &Key, v: f64) -> Result<(), SweepError> {
+    let value = if k.count {
+        if !(v >= 1.0 && v.fract() == 0.0 && v < 1e9) {
+            return Err(SweepError::Invalid {
+                key: k.name.into(),
+                reason: format!("must be a positive integer, got {v}"),
+            });
+        }
+        toml::Value::Integer(v as i64)
+    } else {
+        toml::Value::Float(v)
+    };
+    let t =
+        table.entry(k.table).or_insert_with(|| toml::Value::Table(toml::Table::new())).as_table_mut().ok_or_else(
+            || SweepError::Invalid { key: k.name.into(), reason: format!("[{}] is not a table", k.table) },
+        )?;
+    match k.index {
+        None => {
+            t.insert(k.key.into(), value);
+        }
+        Some(i) => {
+            let zeros = || toml::Value::Array(vec![toml::Value::Float(0.0); 3]);
+            let a = t.entry(k.key).or_insert_with(zeros).as_array_mut().ok_or_else(|| SweepError::Invalid {
+                key: k.name.into(),
+                reason: format!("{}.{} is not an array", k.table, k.key),
+            })?;
+            match a.get_mut(i) {
+                Some(slot) => *slot = value,
+                None => {
+                    return Err(SweepError::Invalid {
+                        key: k.name.into(),
+                        reason: format!("{}.{} has no entry {i}", k.table, k.key),
+                    })
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// One point of the cartesian product: `(key, value)` in the order of the `--set` options.
+pub type Point = Vec<(String, f64)>;
+
+/// The cartesian product of the specifications (first key varies slowest), each point
+/// applied to `case` and validated.
+pub fn product(case: &Case, params: &[SweepParam]) -> Result<Vec<(Point, Case)>, SweepError> {
+    for (i, p) in params.iter().enumerate() {
+        if params[..i].iter().any(|q| q.key == p.key) {
+            return Err(SweepError::Duplicate(p.key.clone()));
+        }
+        if !known_keys(case).contains(&p.key.as_str()) {
+            return Err(SweepError::UnknownKey {
+                key: p.key.clone(),
+                case: case.name.clone(),
+                known: known_keys(case).join(", "),
+            });
+        }
+    }
+    let mut points: Vec<Point> = vec![Vec::new()];
+    for p in params {
+        points = points
+            .into_iter()
+            .flat_map(|pt| {
+                p.values.iter().map(move |&v| {
+                    let mut q = pt.clone();
+                    q.push((p.key.clone(), v));
+                    q
+                })
+            })
+            .collect();
+    }
+    points
+        .into_iter()
+        .map(|pt| {
+            let values: Vec<(&str, f64)> = pt.iter().map(|(k, v)| (k.as_str(), *v)).collect();
+            let mut c = case.with_values(&values)?;
+            c.name = run_name(case, &pt);
+            Ok((pt, c))
+        })
+        .collect()
+}
+
+/// Folder name of a run: `<key>=<value>` joined with `_`, e.g. `lambda_l=1e-20`.
+pub fn run_name(case: &Case, point: &Point) -> String {
+    if point.is_empty() {
+        return case.name.clone();
+    }
+    point.iter().map(|(k, v)| format!("{k}={}", fmt_value(*v))).collect::<Vec<_>>().join("_")
+}
+
+/// Shortest exact decimal of a value (`1e-20`, `0.5`, `100`).
+pub fn fmt_value(v: f64) -> String {
+    let plain = format!("{v}");
+    let sci = format!("{v:e}");
+    if sci.len() < plain.len() {
+        sci
+    } else {
+        plain
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::Path;
+
+    fn case(name: &str) -> Case {
+        Case::from_file(&Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("cases/{name}.toml"))).expect("case")
+    }
+
+    #[test]
+    fn product_is_cartesian_and_applied() {
+        let params = vec![parse_set("lambda_l=1e-20,1e3").unwrap(), parse_set("lambda_kappa3=0,1e-10,1").unwrap()];
+        let pts = product(&case("inverse_bend"), &params).unwrap();
+        assert_eq!(pts.len(), 6);
+        assert_eq!(pts[0].1.name, "lambda_l=1e-20_lambda_kappa3=0");
+        let Analysis::Inverse(ref s) = pts[5].1.analysis else { panic!() };
+        let w = s.params.weights;
+        assert_eq!((w.lambda_l, w.lambda_kappa[2], w.lambda_kappa[1]), (1e3, 1.0, 0.0));
+    }
+
+    /// A swept value takes the path of a value in the file: the whole case is derived again.
+    #[test]
+    fn swept_values_are_validated_and_derived_like_the_file() {
+        let c = case("worm_roll_3d");
+        let (_, c63) = product(&c, &[parse_set("elements=63").unwrap()]).unwrap().remove(0);
+        assert_eq!((c63.mesh.nodes(), c63.roll_clip_params().unwrap().nodes), (64, 64));
+        let (_, d) = product(&case("cantilever_dynamic"), &[parse_set("steps=10").unwrap()]).unwrap().remove(0);
+        let Analysis::Dynamic(p) = d.analysis else { panic!() };
+        assert_eq!(p.steps, 10);
+    }
+
+    #[test]
+    fn bad_specifications_are_errors() {
+        assert!(matches!(parse_set("lambda_l"), Err(SweepError::Syntax(_))));
+        assert!(matches!(parse_set("lambda_l=1,x"), Err(SweepError::NotANumber { .. })));
+        assert!(matches!(parse_set("lambda_l=nan"), Err(SweepError::NotANumber { .. })));
+        let c = case("inverse_bend");
+        assert!(matches!(product(&c, &[parse_set("lambda_q=1").unwrap()]), Err(SweepError::UnknownKey { .. })));
+        let e = product(&c, &[parse_set("lambda_f=0").unwrap()]).unwrap_err();
+        assert!(e.to_string().contains("must be > 0, got 0") && e.to_string().contains("inverse.lambda_f"), "{e}");
+        assert!(matches!(product(&c, &[parse_set("elements=2.5").unwrap()]), Err(SweepError::Invalid { .. })));
+        assert!(matches!(
+            product(&c, &[parse_set("warm_start_tolerance=1e-3").unwrap()]),
+            Err(SweepError::Invalid { .. })
+        ));
+        let twice = [parse_set("lambda_f=1").unwrap(), parse_set("lambda_f=2").unwrap()];
+        assert!(matches!(product(&c, &twice), Err(SweepError::Duplicate(_))));
+    }
+}

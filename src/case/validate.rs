@@ -1,0 +1,561 @@
+//! Raw case tables → the typed [`Case`]: one function per table, each building the solver's
+//! own params type directly, every rule in one place (a sweep's values go through these same
+//! functions, `case::overrides`). Errors name the file and the key.
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use nalgebra::{Rotation3, Vector3};
+
+use super::raw::*;
+use super::{
+    Analysis, Case, CaseError, ClipKind, ClipSource, CompareTolerances, DataSource, InverseSettings, Reference,
+    SyntheticClip,
+};
+use crate::clip::synthetic::RollClipParams;
+use crate::clip::ClipPlane;
+use crate::expr::Expr;
+use crate::model::loads::{LoadFrame, Loads};
+use crate::model::material::{CrossSection, Material, RodProperties};
+use crate::model::mesh::{Mesh, QuadratureScheme};
+use crate::solve::dynamics::DynamicParams;
+use crate::solve::inverse::{InverseMethod, InverseParams, Weights};
+use crate::solve::sequence::{FrameStart, RotationTreatment};
+use crate::solve::statics::{Method, StaticParams};
+
+/// The validator of one case file: its path (for messages) and its evaluated constants.
+pub(super) struct Validator<'a> {
+    pub(super) path: &'a Path,
+    constants: BTreeMap<String, f64>,
+}
+
+impl<'a> Validator<'a> {
+    pub(super) fn new(path: &'a Path) -> Self {
+        Validator { path, constants: BTreeMap::new() }
+    }
+
+    fn err(&self, key: &str, reason: impl Into<String>) -> CaseError {
+        CaseError::Invalid { path: self.path.to_path_buf(), key: key.to_string(), reason: reason.into() }
+    }
+
+    /// A finite number (a TOML number or an expression of the constants).
+    fn scalar(&self, key: &str, v: &Scalar) -> Result<f64, CaseError> {
+        let x = match v {
+            Scalar::Number(x) => *x,
+            Scalar::Text(s) => crate::expr::eval_const(s, &self.constants).map_err(|e| self.err(key, e.to_string()))?,
+        };
+        if !x.is_finite() {
+            return Err(self.err(key, format!("value is not finite ({x})")));
+        }
+        Ok(x)
+    }
+
+    fn positive(&self, key: &str, v: &Scalar) -> Result<f64, CaseError> {
+        let x = self.scalar(key, v)?;
+        if x <= 0.0 {
+            return Err(self.err(key, format!("must be > 0, got {x}")));
+        }
+        Ok(x)
+    }
+
+    fn nonnegative(&self, key: &str, v: &Scalar) -> Result<f64, CaseError> {
+        let x = self.scalar(key, v)?;
+        if x < 0.0 {
+            return Err(self.err(key, format!("must be ≥ 0, got {x}")));
+        }
+        Ok(x)
+    }
+
+    /// A tolerance or other number in (0, 1).
+    fn unit_open(&self, key: &str, v: f64) -> Result<f64, CaseError> {
+        if !(v > 0.0 && v < 1.0) {
+            return Err(self.err(key, format!("must lie in (0, 1), got {v}")));
+        }
+        Ok(v)
+    }
+
+    /// A count ≥ 1.
+    fn count(&self, key: &str, v: usize) -> Result<usize, CaseError> {
+        if v == 0 {
+            return Err(self.err(key, "must be ≥ 1"));
+        }
+        Ok(v)
+    }
+
+    /// The whole case.
+    pub(super) fn case(mut self, mut raw: RawCase, name: &str) -> Result<Case, CaseError> {
+        self.constants(std::mem::take(&mut raw.constants))?;
+        let mesh = self.mesh(&raw.rod)?;
+        let kind = raw.solver.analysis;
+        let material = self.material(&raw.material, kind)?;
+        let section = self.section(&raw.cross_section)?;
+        let loads = self.loads(&raw.loads, kind)?;
+        self.tables_of_other_analyses(&raw, kind)?;
+        let quadrature = match raw.solver.quadrature {
+            RawQuadrature::Selective => QuadratureScheme::Selective,
+            RawQuadrature::Full => QuadratureScheme::Full,
+            RawQuadrature::Reduced => QuadratureScheme::Reduced,
+        };
+        let analysis = match kind {
+            RawAnalysis::Static => Analysis::Static(self.static_solve("solver", &raw.solver)?),
+            RawAnalysis::Dynamic => Analysis::Dynamic(self.dynamic(&raw.solver, raw.time.as_ref())?),
+            RawAnalysis::Inverse => Analysis::Inverse(self.inverse(&raw, &mesh)?),
+        };
+        let compare = self.compare(&raw.compare, kind)?;
+        let reference = self.reference(raw.reference.as_ref(), kind)?;
+        Ok(Case {
+            reference,
+            name: name.to_string(),
+            description: raw.description,
+            source: None,
+            constants: self.constants,
+            mesh,
+            material,
+            section,
+            props: RodProperties::new(&material, &section),
+            quadrature,
+            loads,
+            analysis,
+            compare,
+            raw: None,
+        })
+    }
+
+    /// `[constants]`: each may use the others, in any order (evaluated until no progress).
+    fn constants(&mut self, raw: BTreeMap<String, Scalar>) -> Result<(), CaseError> {
+        let mut pending: Vec<(String, Scalar)> = raw.into_iter().collect();
+        for (k, _) in &pending {
+            if matches!(k.as_str(), "s" | "t" | "pi")
+                || Expr::parse(k).map(|e| e.variables().len() != 1).unwrap_or(true)
+            {
+                return Err(
+                    self.err(&format!("constants.{k}"), "not a valid constant name (identifier other than s, t, pi)")
+                );
+            }
+        }
+        while !pending.is_empty() {
+            let before = pending.len();
+            let mut rest = Vec::new();
+            for (k, v) in pending {
+                match self.scalar(&format!("constants.{k}"), &v) {
+                    Ok(x) => {
+                        self.constants.insert(k, x);
+                    }
+                    Err(e) => rest.push((k, v, e)),
+                }
+            }
+            if rest.len() == before {
+                return Err(rest.into_iter().next().map(|(_, _, e)| e).expect("non-empty"));
+            }
+            pending = rest.into_iter().map(|(k, v, _)| (k, v)).collect();
+        }
+        Ok(())
+    }
+
+    /// `[rod]`.
+    fn mesh(&self, rod: &RawRod) -> Result<Mesh, CaseError> {
+        let length = self.positive("rod.length_m", &rod.length_m)?;
+        if rod.elements < 2 {
+            return Err(self.err("rod.elements", format!("need at least 2 elements, got {}", rod.elements)));
+        }
+        Ok(Mesh::new(length, rod.elements))
+    }
+
+    /// `[material]`; the density is required by a dynamic analysis only.
+    fn material(&self, m: &RawMaterial, kind: RawAnalysis) -> Result<Material, CaseError> {
+        let density = match (&m.density_kg_m3, kind) {
+            (Some(d), _) => self.positive("material.density_kg_m3", d)?,
+            (None, RawAnalysis::Static | RawAnalysis::Inverse) => 1.0,
+            (None, RawAnalysis::Dynamic) => {
+                return Err(self.err("material.density_kg_m3", "required for a dynamic analysis"))
+            }
+        };
+        Ok(Material {
+            young_modulus_pa: self.positive("material.young_modulus_pa", &m.young_modulus_pa)?,
+            shear_modulus_pa: self.positive("material.shear_modulus_pa", &m.shear_modulus_pa)?,
+            density_kg_m3: density,
+            shear_correction: self.positive("material.shear_correction", &m.shear_correction)?,
+        })
+    }
+
+    /// `[cross_section]`.
+    fn section(&self, s: &RawSection) -> Result<CrossSection, CaseError> {
+        Ok(match s {
+            RawSection::Circle { radius_m } => {
+                CrossSection::Circle { radius_m: self.positive("cross_section.radius_m", radius_m)? }
+            }
+            RawSection::Rectangle { width_m, height_m } => CrossSection::Rectangle {
+                width_m: self.positive("cross_section.width_m", width_m)?,
+                height_m: self.positive("cross_section.height_m", height_m)?,
+            },
+        })
+    }
+
+    fn expr(&self, key: &str, v: &Scalar, allowed: &[&str]) -> Result<Expr, CaseError> {
+        let text = match v {
+            Scalar::Number(x) => format!("{x:e}"),
+            Scalar::Text(s) => s.clone(),
+        };
+        let e = Expr::parse(&text).map_err(|e| self.err(key, format!("cannot parse `{text}`: {e}")))?;
+        for var in e.variables() {
+            if !allowed.contains(&var.as_str()) && !self.constants.contains_key(&var) {
+                return Err(self.err(
+                    key,
+                    format!(
+                        "unknown name `{var}` in `{text}` (allowed: {}, or a [constants] entry)",
+                        allowed.join(", ")
+                    ),
+                ));
+            }
+        }
+        Ok(e)
+    }
+
+    fn vector(&self, key: &str, v: &Option<[Scalar; 3]>, allowed: &[&str]) -> Result<[Expr; 3], CaseError> {
+        let zero = Scalar::Number(0.0);
+        let items = v.clone().unwrap_or([zero.clone(), zero.clone(), zero]);
+        let mut out = Vec::with_capacity(3);
+        for (i, item) in items.iter().enumerate() {
+            out.push(self.expr(&format!("{key}[{i}]"), item, allowed)?);
+        }
+        Ok([out[0].clone(), out[1].clone(), out[2].clone()])
+    }
+
+    /// `[loads]`: expressions of `s` (and `t` in a dynamic analysis) and the constants.
+    fn loads(&self, l: &RawLoads, kind: RawAnalysis) -> Result<Loads, CaseError> {
+        let (vars, end_vars): (&[&str], &[&str]) = match kind {
+            RawAnalysis::Static | RawAnalysis::Inverse => (&["s"], &[]),
+            RawAnalysis::Dynamic => (&["s", "t"], &["t"]),
+        };
+        let frame = match l.frame {
+            RawFrame::Global => LoadFrame::Global,
+            RawFrame::Local => LoadFrame::Local,
+        };
+        Loads::new(
+            frame,
+            self.vector("loads.force_n_per_m", &l.force_n_per_m, vars)?,
+            self.vector("loads.torque_nm_per_m", &l.torque_nm_per_m, vars)?,
+            self.vector("loads.end_force_n", &l.end_force_n, end_vars)?,
+            self.vector("loads.end_torque_nm", &l.end_torque_nm, end_vars)?,
+            &self.constants,
+        )
+        .map_err(|e| self.err("loads", e.to_string()))
+    }
+
+    /// Tables and `[solver]` keys that belong to another analysis are refused.
+    fn tables_of_other_analyses(&self, raw: &RawCase, kind: RawAnalysis) -> Result<(), CaseError> {
+        let s = &raw.solver;
+        self.unit_open("solver.tolerance", s.tolerance)?;
+        self.count("solver.max_iterations", s.max_iterations)?;
+        if kind != RawAnalysis::Inverse {
+            for (present, key) in
+                [(raw.data.is_some(), "data"), (raw.clip.is_some(), "clip"), (raw.inverse.is_some(), "inverse")]
+            {
+                if present {
+                    return Err(self.err(key, "only allowed when solver.analysis = \"inverse\""));
+                }
+            }
+            if s.warm_start_tolerance.is_some() {
+                return Err(self.err("solver.warm_start_tolerance", "only used by an inverse analysis"));
+            }
+        }
+        if kind != RawAnalysis::Dynamic && raw.time.is_some() {
+            return Err(self.err("time", "only allowed when solver.analysis = \"dynamic\""));
+        }
+        Ok(())
+    }
+
+    /// `method` (+ `relaxation`) of a static solve in table `table`.
+    fn static_method(&self, table: &str, method: RawMethod, relaxation: Option<f64>) -> Result<Method, CaseError> {
+        match method {
+            RawMethod::FixedPoint => Ok(Method::FixedPoint { relaxation: self.relaxation(table, relaxation)? }),
+            RawMethod::Newton => {
+                if relaxation.is_some() {
+                    return Err(self.err(&format!("{table}.relaxation"), "not used by method = \"newton\""));
+                }
+                Ok(Method::Newton)
+            }
+        }
+    }
+
+    /// `relaxation` of table `table`, required, in (0, 1].
+    fn relaxation(&self, table: &str, relaxation: Option<f64>) -> Result<f64, CaseError> {
+        let key = format!("{table}.relaxation");
+        let w = relaxation.ok_or_else(|| self.err(&key, "required by method = \"fixed_point\""))?;
+        if !(w > 0.0 && w <= 1.0) {
+            return Err(self.err(&key, format!("must lie in (0, 1], got {w}")));
+        }
+        Ok(w)
+    }
+
+    /// A static solve: `[solver]` of a static analysis (`table = "solver"`), or `[data]`.
+    fn static_solve(&self, table: &str, s: &RawSolver) -> Result<StaticParams, CaseError> {
+        Ok(StaticParams {
+            method: self.static_method(table, s.method, s.relaxation)?,
+            tolerance: self.unit_open(&format!("{table}.tolerance"), s.tolerance)?,
+            max_iterations: self.count(&format!("{table}.max_iterations"), s.max_iterations)?,
+            continuation_steps: self.count(&format!("{table}.continuation_steps"), s.continuation_steps)?,
+        })
+    }
+
+    /// `[solver]` and `[time]` of a dynamic analysis.
+    fn dynamic(&self, s: &RawSolver, time: Option<&RawTime>) -> Result<DynamicParams, CaseError> {
+        if s.method != RawMethod::Newton {
+            return Err(self.err("solver.method", "a dynamic analysis is solved by \"newton\" per step (D6)"));
+        }
+        if s.relaxation.is_some() {
+            return Err(self.err("solver.relaxation", "not used by a dynamic analysis"));
+        }
+        if s.continuation_steps != 1 {
+            return Err(self.err("solver.continuation_steps", "only for a static analysis"));
+        }
+        let t = time.ok_or_else(|| self.err("time", "required when solver.analysis = \"dynamic\""))?;
+        Ok(DynamicParams {
+            end_time_s: self.positive("time.end_s", &t.end_s)?,
+            steps: self.count("time.steps", t.steps)?,
+            newton_tolerance: s.tolerance,
+            newton_max_iterations: s.max_iterations,
+        })
+    }
+
+    /// `[solver]`, `[inverse]` and `[data]` or `[clip]` of an inverse analysis.
+    fn inverse(&self, raw: &RawCase, mesh: &Mesh) -> Result<InverseSettings, CaseError> {
+        let s = &raw.solver;
+        // Both methods need the relaxation: Newton starts from the fixed point (I8).
+        let relaxation = self.relaxation("solver", s.relaxation)?;
+        let method = match s.method {
+            RawMethod::FixedPoint => {
+                if s.warm_start_tolerance.is_some() {
+                    return Err(self.err("solver.warm_start_tolerance", "only used by method = \"newton\""));
+                }
+                InverseMethod::FixedPoint
+            }
+            RawMethod::Newton => {
+                let w = s.warm_start_tolerance.ok_or_else(|| {
+                    self.err(
+                        "solver.warm_start_tolerance",
+                        "required by method = \"newton\" (Newton starts from the fixed point's iterate at this relative change, I8)",
+                    )
+                })?;
+                InverseMethod::Newton { warm_start_tolerance: self.unit_open("solver.warm_start_tolerance", w)? }
+            }
+        };
+        if s.continuation_steps != 1 {
+            return Err(self.err("solver.continuation_steps", "not used by an inverse analysis"));
+        }
+        let data = match (&raw.data, &raw.clip) {
+            (Some(d), None) => DataSource::Forward(self.data(d)?),
+            (None, Some(cl)) => DataSource::Clip(self.clip(cl, mesh)?),
+            (Some(_), Some(_)) => {
+                return Err(self.err("clip", "give either [data] (synthetic) or [clip] (recorded), not both"))
+            }
+            (None, None) => return Err(self.err(
+                "data",
+                "an inverse case needs [data] (a forward solve generating the centreline) or [clip] (a recorded clip)",
+            )),
+        };
+        let inv = raw.inverse.as_ref().ok_or_else(|| {
+            self.err("inverse", "required when solver.analysis = \"inverse\" (the weights of eq. 41)")
+        })?;
+        let weights = self.weights(inv)?;
+        let frame_interval_s = match (&inv.frame_interval_s, &raw.clip) {
+            (Some(_), Some(_)) => {
+                return Err(self.err("inverse.frame_interval_s", "a clip case takes Δt from clip.frame_interval_s"))
+            }
+            (Some(v), None) => self.positive("inverse.frame_interval_s", v)?,
+            (None, Some(cl)) => self.positive("clip.frame_interval_s", &cl.frame_interval_s)?,
+            (None, None) if weights.lambda_omega.iter().any(|&w| w > 0.0) => {
+                return Err(self.err("inverse.frame_interval_s", "required when lambda_omega is non-zero"));
+            }
+            (None, None) => 1.0,
+        };
+        let alpha0_rad =
+            inv.alpha0_rad.as_ref().map(|v| self.scalar("inverse.alpha0_rad", v)).transpose()?.unwrap_or(0.0);
+        let stabilisation = match &inv.stabilisation {
+            Some(v) => {
+                let e = self.scalar("inverse.stabilisation", v)?;
+                if !(0.0..=1.0).contains(&e) {
+                    return Err(self.err("inverse.stabilisation", format!("must lie in [0, 1], got {e}")));
+                }
+                e
+            }
+            None => 0.0,
+        };
+        let params = InverseParams {
+            weights,
+            frame_interval_s,
+            alpha0_rad,
+            stabilisation,
+            relaxation,
+            method,
+            tolerance: s.tolerance,
+            max_iterations: s.max_iterations,
+        };
+        Ok(InverseSettings { params, data })
+    }
+
+    /// `[inverse]`: the weights of eq. (41).
+    fn weights(&self, inv: &RawInverse) -> Result<Weights, CaseError> {
+        let diag = |key: &str, v: &Option<[Scalar; 3]>| -> Result<Vector3<f64>, CaseError> {
+            let mut out = Vector3::zeros();
+            for (i, item) in v.iter().flatten().enumerate() {
+                out[i] = self.nonnegative(&format!("{key}[{i}]"), item)?;
+            }
+            Ok(out)
+        };
+        Ok(Weights {
+            lambda_g: self.positive("inverse.lambda_g", &inv.lambda_g)?,
+            lambda_f: self.positive("inverse.lambda_f", &inv.lambda_f)?,
+            lambda_l: self.positive("inverse.lambda_l", &inv.lambda_l)?,
+            lambda_d: self.nonnegative("inverse.lambda_d", &inv.lambda_d)?,
+            lambda_kappa: diag("inverse.lambda_kappa", &Some(inv.lambda_kappa.clone()))?,
+            lambda_omega: diag("inverse.lambda_omega", &inv.lambda_omega)?,
+        })
+    }
+
+    /// `[data]`: the static forward solve that generates an inverse case's data (I7).
+    fn data(&self, d: &RawData) -> Result<StaticParams, CaseError> {
+        if d.max_iterations == 0 || d.continuation_steps == 0 {
+            return Err(self.err("data.max_iterations", "max_iterations and continuation_steps must be ≥ 1"));
+        }
+        Ok(StaticParams {
+            method: self.static_method("data", d.method, d.relaxation)?,
+            tolerance: self.unit_open("data.tolerance", d.tolerance)?,
+            max_iterations: d.max_iterations,
+            continuation_steps: d.continuation_steps,
+        })
+    }
+
+    /// `[clip]`: a recorded or synthetic clip.
+    fn clip(&self, cl: &RawClip, mesh: &Mesh) -> Result<ClipSource, CaseError> {
+        let base = self.path.parent().unwrap_or(Path::new(""));
+        let frames = match cl.frames {
+            Some([a, b]) if a < b => Some((a, b)),
+            Some([a, b]) => {
+                return Err(self.err("clip.frames", format!("expected [first, end) with first < end, got [{a}, {b}]")))
+            }
+            None => None,
+        };
+        if !(cl.min_cos_beta >= 0.0 && cl.min_cos_beta < 1.0) {
+            return Err(self.err("clip.min_cos_beta", format!("must lie in [0, 1), got {}", cl.min_cos_beta)));
+        }
+        let plane = match cl.plane {
+            RawPlane::Xz => ClipPlane::Xz,
+            RawPlane::Xy => ClipPlane::Xy,
+        };
+        if let Some(v) = cl.orientation.iter().flatten().find(|v| !v.is_finite()) {
+            return Err(self.err("clip.orientation", format!("must be a finite rotation vector [rad], got {v}")));
+        }
+        let orientation = Rotation3::new(Vector3::from(cl.orientation.unwrap_or([0.0; 3]))).into_inner();
+        let gauge = match cl.gauge {
+            Some(g) => Vector3::from(g)
+                .try_normalize(1e-12)
+                .filter(|v| v.iter().all(|c| c.is_finite()))
+                .ok_or_else(|| self.err("clip.gauge", format!("must be a finite non-zero vector, got {g:?}")))?,
+            None => match plane {
+                ClipPlane::Xz => Vector3::y(),
+                ClipPlane::Xy => Vector3::z(),
+            },
+        };
+        let frame_interval_s = self.positive("clip.frame_interval_s", &cl.frame_interval_s)?;
+        let kind = match cl.kind {
+            RawClipKind::Kymogram => ClipKind::Kymogram,
+            RawClipKind::Recording => ClipKind::Recording,
+            RawClipKind::Roll3d => ClipKind::Roll3d(self.synthetic(cl, mesh, frame_interval_s)?),
+        };
+        if !matches!(kind, ClipKind::Roll3d(_))
+            && (cl.roll_total_rad.is_some()
+                || cl.twist_per_m.is_some()
+                || cl.clip_frames.is_some()
+                || cl.substeps.is_some())
+        {
+            return Err(self.err(
+                "clip",
+                "roll_total_rad, twist_per_m, clip_frames and substeps apply to kind = \"roll_3d\" only",
+            ));
+        }
+        Ok(ClipSource {
+            kind,
+            file: base.join(&cl.file),
+            frames,
+            min_cos_beta: cl.min_cos_beta,
+            start: match cl.start {
+                RawStart::PreviousFrame => FrameStart::PreviousFrame,
+                RawStart::DataGuess => FrameStart::DataGuess,
+            },
+            rotation: match cl.rotation {
+                RawRotation::Rebased => RotationTreatment::Rebased,
+                RawRotation::GlobalEuler => RotationTreatment::GlobalEuler,
+            },
+            plane,
+            orientation,
+            gauge: orientation * gauge,
+        })
+    }
+
+    /// The `roll_3d` keys of `[clip]` (nodes, length and Δt are the mesh's and the clip's).
+    fn synthetic(&self, cl: &RawClip, mesh: &Mesh, dt_s: f64) -> Result<SyntheticClip, CaseError> {
+        let d = RollClipParams::default();
+        let synthetic = SyntheticClip {
+            frames: cl.clip_frames.unwrap_or(d.frames),
+            roll_total_rad: cl
+                .roll_total_rad
+                .as_ref()
+                .map(|v| self.scalar("clip.roll_total_rad", v))
+                .transpose()?
+                .unwrap_or(d.roll_total_rad),
+            twist_per_m: cl
+                .twist_per_m
+                .as_ref()
+                .map(|v| self.scalar("clip.twist_per_m", v))
+                .transpose()?
+                .unwrap_or(d.twist_per_m),
+            time_mapping: d.time_mapping,
+            substeps: cl.substeps.unwrap_or(d.substeps),
+        };
+        synthetic.params(mesh, dt_s).validate().map_err(|e| self.err("clip", e.to_string()))?;
+        Ok(synthetic)
+    }
+
+    /// `[compare]`: the Rust–FreeFEM tolerances (D8).
+    fn compare(&self, rc: &RawCompare, kind: RawAnalysis) -> Result<CompareTolerances, CaseError> {
+        if kind == RawAnalysis::Inverse && rc.adjoint_rel.is_none() {
+            return Err(self.err("compare.adjoint_rel", "required for an inverse case (tolerance on the adjoint x̂, α̂)"));
+        }
+        for (k, v) in [
+            ("compare.displacement_rel", rc.displacement_rel),
+            ("compare.angles_rel", rc.angles_rel),
+            ("compare.metric_rel", rc.metric_rel),
+            ("compare.adjoint_rel", rc.adjoint_rel.unwrap_or(1.0)),
+        ] {
+            if !(v > 0.0 && v.is_finite()) {
+                return Err(self.err(k, format!("must be > 0, got {v}")));
+            }
+        }
+        for (k, v) in [("compare.metric_abs", rc.metric_abs), ("compare.iterations_abs", rc.iterations_abs)] {
+            if !(v >= 0.0 && v.is_finite()) {
+                return Err(self.err(k, format!("must be ≥ 0, got {v}")));
+            }
+        }
+        Ok(CompareTolerances {
+            displacement_rel: rc.displacement_rel,
+            angles_rel: rc.angles_rel,
+            metric_rel: rc.metric_rel,
+            metric_abs: rc.metric_abs,
+            iterations_abs: rc.iterations_abs,
+            adjoint_rel: rc.adjoint_rel.unwrap_or(f64::INFINITY),
+        })
+    }
+
+    /// `[reference]`: the theory a static case is checked against.
+    fn reference(&self, r: Option<&RawReference>, kind: RawAnalysis) -> Result<Option<Reference>, CaseError> {
+        match r {
+            None => Ok(None),
+            Some(RawReference::TipLoadedCantilever { force_n }) => {
+                if kind != RawAnalysis::Static {
+                    return Err(self.err("reference.kind", "\"tip_loaded_cantilever\" needs a static analysis"));
+                }
+                Ok(Some(Reference::TipLoadedCantilever { force_n: self.positive("reference.force_n", force_n)? }))
+            }
+        }
+    }
+}

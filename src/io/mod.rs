@@ -1,0 +1,18 @@
+//! Everything that touches files or other programs: atomic writes and CSV ([`files`]), the
+//! forward data file `data.csv` ([`data`]), clip files ([`clip_files`], [`npy`]), the outputs of
+//! a run ([`run_files`]) and of a clip ([`clip_output`], [`vtk`]), SVG figures ([`plot`]), the
+//! FreeFEM engine ([`freefem`]), a case in either engine from its files ([`engine`]) and the
+//! files of a sweep ([`sweep`]).
+pub mod clip_files;
+pub mod clip_output;
+pub mod data;
+pub mod engine;
+pub mod files;
+pub mod freefem;
+pub mod npy;
+pub mod plot;
+pub mod run_files;
+pub mod sweep;
+pub mod vtk;
+
+pub use files::{write_atomic, InputError, OutputError};

@@ -1,0 +1,228 @@
+//! A clip case frame by frame in the Rust engine (`solve::sequence`), every converged frame
+//! handed to a [`FrameSink`] (which `crate::io` implements with the streamed files) on a
+//! second thread while the next frame is solved.
+use std::time::Instant;
+
+use nalgebra::{Matrix3, Vector3};
+
+use super::metrics::INNER_SKIP_ELEMENTS;
+use super::{NodalState, RunError};
+use crate::case::Case;
+use crate::clip::synthetic::{compare_frame, FrameComparison, GroundTruth, RecoveredFrame};
+use crate::clip::Clip;
+use crate::model::mesh::Field;
+use crate::solve::sequence::{solve_sequence, FrameReport};
+
+/// Nodes skipped at each end when scoring curvature against a ground truth (the curvature of
+/// the inverse solution is least reliable at the free ends; as `metrics::INNER_SKIP_ELEMENTS`).
+pub const TRUTH_SKIP_NODES: usize = INNER_SKIP_ELEMENTS;
+
+/// One converged frame of a clip, in space coordinates.
+#[derive(Clone, Debug)]
+pub struct ClipFrame {
+    pub report: FrameReport,
+    /// frame time [s]
+    pub time_s: f64,
+    /// the recovered state (angles in the frame's chart)
+    pub nodes: NodalState,
+    /// controls f = x̂/λf [N/m] and l = α̂/λl [N m/m] per node (eq. 54)
+    pub force: Vec<Vector3<f64>>,
+    pub torque: Vec<Vector3<f64>>,
+    /// the frame's data positions [m]
+    pub data: Vec<Vector3<f64>>,
+    /// sign alternation of the recovered κ2 and of the data's planar curvature
+    pub roughness: (f64, f64),
+    /// synthetic clips: the frame against its ground truth
+    pub truth: Option<TruthFrame>,
+}
+
+/// A frame of a synthetic clip against its ground truth.
+#[derive(Clone, Debug)]
+pub struct TruthFrame {
+    /// true roll ψ of the bending plane [rad]
+    pub roll_rad: f64,
+    /// true twist κ3, mean over the nodes [rad/m]
+    pub twist_per_m: f64,
+    pub comparison: FrameComparison,
+}
+
+/// Where the frames of a clip go (`crate::io::clip_files::ClipWriter` streams them to disk).
+/// Called from a second thread, in frame order.
+pub trait FrameSink: Send {
+    type Error: std::error::Error + Send + Sync + 'static;
+    /// One converged frame.
+    fn frame(&mut self, frame: &ClipFrame) -> Result<(), Self::Error>;
+    /// After the last frame handed over (also when the clip stopped early).
+    fn finish(&mut self) -> Result<(), Self::Error>;
+}
+
+/// Summary of a clip run.
+#[derive(Clone, Debug)]
+pub struct ClipRun {
+    pub reports: Vec<FrameReport>,
+    /// per frame: sign alternation of the recovered κ2 and of the data's planar curvature
+    /// ([`sign_alternation`])
+    pub roughness: Vec<(f64, f64)>,
+    /// per frame: recovered κ2 at element midpoints and the data's planar curvature at the
+    /// interior nodes [1/m] (x–z clips: the bending curvature; [`planar_xz_curvature`])
+    pub kappa2: Vec<Vec<f64>>,
+    pub data_kappa: Vec<Vec<f64>>,
+    /// synthetic clips: per frame the errors against the ground truth (end nodes skipped:
+    /// [`TRUTH_SKIP_NODES`]), and the true and recovered bending `κ1² + κ2²` [1/m²] per node
+    pub truth: Option<TruthRun>,
+    pub wall_time_s: f64,
+    pub source: String,
+}
+
+/// Ground-truth scores of a synthetic clip run.
+#[derive(Clone, Debug, Default)]
+pub struct TruthRun {
+    pub comparisons: Vec<FrameComparison>,
+    /// true roll ψ of the bending plane per frame [rad]
+    pub roll_rad: Vec<f64>,
+    /// true twist κ3 per frame (mean over nodes) [rad/m]
+    pub twist_per_m: Vec<f64>,
+    pub bending_true: Vec<Vec<f64>>,
+    pub bending_recovered: Vec<Vec<f64>>,
+}
+
+/// Curvature at the nodes from element-midpoint values: the mean of the adjacent elements
+/// (the end element at the ends).
+pub fn nodal_curvature(kappa: &[(f64, Vector3<f64>)]) -> Vec<Vector3<f64>> {
+    let m = kappa.len();
+    (0..=m).map(|i| (kappa[i.saturating_sub(1).min(m - 1)].1 + kappa[i.min(m - 1)].1) * 0.5).collect()
+}
+
+/// Planar curvature of a centreline in the x–z plane at interior nodes [1/m]:
+/// `(θ_e − θ_{e−1})/h`, θ the tangent angle from e3 towards e1. For a frame with α = β = 0 this
+/// is κ2 of eq. (28) (κ = A ∂sα with A(0) gives κ2 = −∂sγ = ∂sθ).
+pub fn planar_xz_curvature(x: &[Vector3<f64>], h: f64) -> Vec<f64> {
+    let theta: Vec<f64> = x.windows(2).map(|w| (w[1][0] - w[0][0]).atan2(w[1][2] - w[0][2])).collect();
+    theta
+        .windows(2)
+        .map(|t| {
+            let d = t[1] - t[0];
+            let d = (d + std::f64::consts::PI).rem_euclid(2.0 * std::f64::consts::PI) - std::f64::consts::PI;
+            d / h
+        })
+        .collect()
+}
+
+/// Roughness of a sequence: the fraction of interior points where the first difference changes
+/// sign (a local extremum). A smooth curvature profile of a worm has a handful of extrema; a
+/// nodal zig-zag has one at almost every point (roughness → 1).
+pub fn sign_alternation(k: &[f64]) -> f64 {
+    if k.len() < 3 {
+        return 0.0;
+    }
+    let d: Vec<f64> = k.windows(2).map(|w| w[1] - w[0]).collect();
+    let flips = d.windows(2).filter(|w| w[0] * w[1] < 0.0).count();
+    flips as f64 / (k.len() - 2) as f64
+}
+
+/// Solve the clip `clip` of a clip case frame by frame in the Rust engine, handing every
+/// converged frame to `sink` (on a second thread, while the next frame is solved); `truth`:
+/// the ground truth of a synthetic clip, frame for frame. On failure the sink has every
+/// converged frame and the error names the frame; a sink error stops the clip at the next
+/// frame and is reported in its place.
+pub fn run_clip<S: FrameSink>(
+    case: &Case,
+    clip: &Clip,
+    truth: Option<&GroundTruth>,
+    mut sink: S,
+    mut progress: impl FnMut(usize, usize),
+) -> Result<ClipRun, RunError> {
+    let sp = case.sequence_params().ok_or_else(|| RunError::Kind { case: case.name.clone(), what: "a clip case" })?;
+    let problem = case.problem();
+    let dofs = problem.dofs();
+    let w8 = sp.inverse.weights;
+    let first_frame = sp.frame_offset;
+    let total = clip.frame_count();
+    let h = case.mesh.h();
+    let start = Instant::now();
+    let mut rough = Vec::new();
+    let (mut kappa2, mut data_kappa) = (Vec::new(), Vec::new());
+    let mut truth_run = truth.map(|_| TruthRun::default());
+    let (tx, rx) = std::sync::mpsc::sync_channel::<ClipFrame>(8);
+    let (result, written) = std::thread::scope(|scope| {
+        let io = scope.spawn(move || -> Result<(), S::Error> {
+            for frame in rx {
+                sink.frame(&frame)?;
+            }
+            sink.finish()
+        });
+        let result = solve_sequence(
+            &problem,
+            &sp,
+            &clip.frames,
+            None,
+            |_, _| {},
+            |rep, frame| {
+                let sol = frame.solution;
+                let nodes = NodalState { chart: frame.chart, ..NodalState::from_vector(&case.mesh, &sol.u) };
+                let (force, torque): (Vec<_>, Vec<_>) = (0..nodes.s.len())
+                    .map(|i| {
+                        let (xh, ah) = (dofs.get(&sol.adjoint, i, Field::X), dofs.get(&sol.adjoint, i, Field::Alpha));
+                        (xh / w8.lambda_f, ah / w8.lambda_l)
+                    })
+                    .unzip();
+                let data = &clip.frames[rep.frame - first_frame];
+                let kappa = nodes.element_curvature();
+                let k2: Vec<f64> = kappa.iter().map(|(_, k)| k[1]).collect();
+                // The data's curvature in the plane normal to the chart's axis (exactly the x–z
+                // curvature for an x–z clip; rotates with the data, R5).
+                let in_chart: Vec<Vector3<f64>> = data.iter().map(|x| frame.chart.to_chart(x)).collect();
+                let kd = planar_xz_curvature(&in_chart, h);
+                let mut truth_frame = None;
+                if let (Some(t), Some(tr)) = (truth, &mut truth_run) {
+                    let ft = &t.frames[rep.frame - first_frame];
+                    let q: Vec<Matrix3<f64>> = nodes.alpha.iter().map(|a| nodes.chart.rotation(a)).collect();
+                    let kn = nodal_curvature(&kappa);
+                    let c =
+                        compare_frame(data, ft, &RecoveredFrame { x: &nodes.x, q: &q, kappa: &kn }, TRUTH_SKIP_NODES)
+                            .map_err(|e| e.to_string())?;
+                    let twist = ft.kappa.iter().map(|k| k.z).sum::<f64>() / ft.kappa.len() as f64;
+                    let bend = |k: &Vector3<f64>| k.x * k.x + k.y * k.y;
+                    tr.comparisons.push(c.clone());
+                    tr.roll_rad.push(ft.roll_rad);
+                    tr.twist_per_m.push(twist);
+                    tr.bending_true.push(ft.kappa.iter().map(bend).collect());
+                    tr.bending_recovered.push(kn.iter().map(bend).collect());
+                    truth_frame = Some(TruthFrame { roll_rad: ft.roll_rad, twist_per_m: twist, comparison: c });
+                }
+                let roughness = (sign_alternation(&k2), sign_alternation(&kd));
+                rough.push(roughness);
+                kappa2.push(k2);
+                data_kappa.push(kd);
+                let frame = ClipFrame {
+                    report: *rep,
+                    time_s: rep.frame as f64 * clip.dt_s,
+                    nodes,
+                    force,
+                    torque,
+                    data: data.clone(),
+                    roughness,
+                    truth: truth_frame,
+                };
+                tx.send(frame).map_err(|_| "the output thread stopped (see the write error)".to_string())?;
+                progress(rep.frame - first_frame + 1, total);
+                Ok(())
+            },
+        );
+        drop(tx);
+        let written = io.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+        (result, written)
+    });
+    // A write error explains a stopped clip better than the stop itself.
+    written.map_err(|e| RunError::Sink(Box::new(e)))?;
+    let reports = result?;
+    Ok(ClipRun {
+        reports,
+        roughness: rough,
+        kappa2,
+        data_kappa,
+        truth: truth_run,
+        wall_time_s: start.elapsed().as_secs_f64(),
+        source: clip.source.clone(),
+    })
+}

@@ -1,0 +1,180 @@
+//! Running a case in the Rust engine on data in memory: a forward case, the forward data of a
+//! synthetic inverse case, one inverse frame ([`run_inverse`]) or a whole clip
+//! ([`clip::run_clip`]), each producing the engine-agnostic [`RunResult`] of [`result`].
+//! Files (case data, clips, outputs) and the FreeFEM engine are `crate::io`'s.
+pub mod clip;
+pub mod metrics;
+pub mod result;
+
+use std::time::Instant;
+
+use nalgebra::{DVector, Vector3};
+
+pub use result::{Engine, InverseOutput, NodalState, RunResult, SolverStats};
+
+use crate::case::{Analysis, Case, DataSource};
+use crate::clip::ClipError;
+use crate::model::mesh::Field;
+use crate::solve::inverse::{Frame, FrameSolver, InverseRecord, Start};
+use crate::solve::sequence::SequenceError;
+use crate::solve::{dynamics, statics, SolveError};
+use metrics::INNER_SKIP_ELEMENTS;
+
+/// Errors of running a case.
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    #[error("rust engine")]
+    Solve(#[from] SolveError),
+    #[error("clip")]
+    Clip(#[from] ClipError),
+    #[error("clip")]
+    Sequence(#[from] SequenceError),
+    #[error("case `{case}` is not {what}")]
+    Kind { case: String, what: &'static str },
+    #[error("writing the clip")]
+    Sink(#[source] Box<dyn std::error::Error + Send + Sync>),
+    /// The solver stopped without meeting its rule; `partial` holds the last iterate and the
+    /// history up to there (sweeps keep it so that non-converging values still show).
+    #[error("rust engine stopped after {} iterations without meeting its stopping rule", .partial.stats.iterations)]
+    Incomplete {
+        #[source]
+        source: SolveError,
+        partial: Box<RunResult>,
+    },
+}
+
+impl RunError {
+    fn kind(case: &Case, what: &'static str) -> Self {
+        RunError::Kind { case: case.name.clone(), what }
+    }
+}
+
+/// Run a forward (static or dynamic) case in the Rust engine; `progress(done, total)` per
+/// iteration or time step.
+pub fn run_forward(case: &Case, mut progress: impl FnMut(usize, usize)) -> Result<RunResult, RunError> {
+    let problem = case.problem();
+    let start = Instant::now();
+    match &case.analysis {
+        Analysis::Static(params) => {
+            let sol = statics::solve(&problem, params, |r| progress(r.iteration, params.max_iterations))?;
+            let result = RunResult {
+                engine: Engine::Rust,
+                nodes: NodalState::from_vector(&case.mesh, &sol.u),
+                history: sol.history.clone(),
+                tip: Vec::new(),
+                stats: SolverStats {
+                    iterations: sol.iterations,
+                    last_change: Some(sol.last_change),
+                    residual: Some(sol.residual),
+                    max_newton_iterations: None,
+                    wall_time_s: start.elapsed().as_secs_f64(),
+                },
+                inverse: None,
+            };
+            match sol.converged() {
+                Ok(_) => Ok(result),
+                Err(source) => Err(RunError::Incomplete { source, partial: Box::new(result) }),
+            }
+        }
+        Analysis::Dynamic(params) => {
+            let sol = dynamics::solve(&problem, params, &mut progress)?;
+            Ok(RunResult {
+                engine: Engine::Rust,
+                nodes: NodalState::from_vector(&case.mesh, &sol.u),
+                history: Vec::new(),
+                tip: sol.tip,
+                stats: SolverStats {
+                    iterations: sol.total_newton_iterations,
+                    last_change: None,
+                    residual: None,
+                    max_newton_iterations: Some(sol.max_newton_iterations),
+                    wall_time_s: start.elapsed().as_secs_f64(),
+                },
+                inverse: None,
+            })
+        }
+        Analysis::Inverse(_) => Err(RunError::kind(case, "a forward case")),
+    }
+}
+
+/// The data of a synthetic inverse case: the Rust forward engine on [`Case::data_case`] (I7).
+pub fn forward_data(case: &Case) -> Result<NodalState, RunError> {
+    let data_case = case.data_case().ok_or_else(|| RunError::kind(case, "an inverse case with [data]"))?;
+    match run_forward(&data_case, |_, _| {}) {
+        Ok(r) => Ok(r.nodes),
+        Err(RunError::Incomplete { source, .. }) => Err(source.into()),
+        Err(e) => Err(e),
+    }
+}
+
+/// Does the data source of an inverse case carry the true angles (synthetic forward data)?
+pub fn angles_known(case: &Case) -> bool {
+    matches!(case.inverse().map(|i| &i.data), Some(DataSource::Forward(_)))
+}
+
+/// Solve the inverse case `case` as one first frame (Remark 6) in the Rust engine on the data
+/// `data` (its positions; for synthetic data also the true angles, for the curvature errors).
+pub fn run_inverse(
+    case: &Case,
+    data: &NodalState,
+    mut progress: impl FnMut(usize, usize),
+) -> Result<RunResult, RunError> {
+    let settings = case.inverse().ok_or_else(|| RunError::kind(case, "an inverse case"))?;
+    let params = settings.params;
+    let problem = case.problem();
+    let start = Instant::now();
+    let known = angles_known(case);
+    let truth: Vec<Vector3<f64>> = data.element_curvature().into_iter().map(|(_, k)| k).collect();
+    let mut kappa_err = Vec::new();
+    let observer = |r: &InverseRecord, u: &DVector<f64>, _: &DVector<f64>| {
+        if known {
+            let k: Vec<Vector3<f64>> =
+                NodalState::from_vector(&case.mesh, u).element_curvature().into_iter().map(|(_, k)| k).collect();
+            kappa_err.push([
+                metrics::relative_error(&k, &truth, 0),
+                metrics::relative_error(&k, &truth, INNER_SKIP_ELEMENTS),
+            ]);
+        }
+        progress(r.iteration, params.max_iterations)
+    };
+    let frame = Frame { index: 0, x_g: &data.x, previous: None };
+    let sol = FrameSolver::new(&problem, params).solve(&frame, &problem.reference_state(), Start::Guess, observer)?;
+    let dofs = problem.dofs();
+    let result = RunResult {
+        engine: Engine::Rust,
+        nodes: NodalState::from_vector(&case.mesh, &sol.u),
+        history: Vec::new(),
+        tip: Vec::new(),
+        stats: SolverStats {
+            iterations: sol.history.len(),
+            last_change: sol.history.last().map(|h| h.rel_change),
+            residual: None,
+            max_newton_iterations: None,
+            wall_time_s: start.elapsed().as_secs_f64(),
+        },
+        inverse: Some(InverseOutput {
+            data: data.clone(),
+            angles_known: known,
+            xhat: dofs.field(&sol.adjoint, Field::X),
+            ahat: dofs.field(&sol.adjoint, Field::Alpha),
+            history: sol.history.clone(),
+            kappa_err,
+            lambda_f: params.weights.lambda_f,
+            lambda_l: params.weights.lambda_l,
+        }),
+    };
+    match sol.converged(0) {
+        Ok(_) => Ok(result),
+        Err(source) => Err(RunError::Incomplete { source, partial: Box::new(result) }),
+    }
+}
+
+/// Run `case` in the Rust engine from memory: a forward case, or a synthetic inverse case on
+/// its forward data generated here (identical to what `data.csv` holds: the file round-trips
+/// `f64` exactly). Clips are read from files: `crate::io::engine`.
+pub fn run_rust(case: &Case, progress: impl FnMut(usize, usize)) -> Result<RunResult, RunError> {
+    match &case.analysis {
+        Analysis::Inverse(_) => run_inverse(case, &forward_data(case)?, progress),
+        _ => run_forward(case, progress),
+    }
+}

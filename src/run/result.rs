@@ -1,0 +1,134 @@
+//! What a run produces, the same for both engines: [`RunResult`] with its nodal state, the
+//! histories and, for inverse runs, the data and controls.
+use nalgebra::{DVector, Vector3};
+
+use crate::model::chart::Chart;
+use crate::model::element::midpoint_curvatures;
+use crate::model::mesh::{Field, Mesh};
+use crate::solve::dynamics::TipRecord;
+use crate::solve::inverse::InverseRecord;
+use crate::solve::statics::IterationRecord;
+
+/// Which implementation produced a result.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Engine {
+    Rust,
+    Freefem,
+}
+
+impl std::fmt::Display for Engine {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Engine::Rust => "rust",
+            Engine::Freefem => "freefem",
+        })
+    }
+}
+
+/// Nodal fields of a state.
+#[derive(Clone, Debug, PartialEq)]
+pub struct NodalState {
+    /// reference arc length [m]
+    pub s: Vec<f64>,
+    /// position [m]
+    pub x: Vec<Vector3<f64>>,
+    /// angles (α, β, γ) [rad] in `chart`
+    pub alpha: Vec<Vector3<f64>>,
+    /// the angles' chart (`crate::model::chart`; the paper's global chart unless a clip was
+    /// rebased)
+    pub chart: Chart,
+}
+
+impl NodalState {
+    /// The nodal fields of a state `u` (forward layout) on `mesh`, in the global chart.
+    pub fn from_vector(mesh: &Mesh, u: &DVector<f64>) -> Self {
+        let dofs = mesh.dofs();
+        NodalState {
+            s: (0..mesh.nodes()).map(|i| mesh.node_s(i)).collect(),
+            x: dofs.field(u, Field::X),
+            alpha: dofs.field(u, Field::Alpha),
+            chart: Chart::default(),
+        }
+    }
+    /// Element-midpoint curvature `κˡ = A(α) ∂s α` [1/m] with the midpoint arc length [m]
+    /// (eq. 28, [`midpoint_curvatures`]).
+    pub fn element_curvature(&self) -> Vec<(f64, Vector3<f64>)> {
+        midpoint_curvatures(&self.s, &self.alpha)
+    }
+    /// Directors `d1, d2, d3` per node (rows of Q, eq. 2).
+    pub fn directors(&self) -> Vec<[Vector3<f64>; 3]> {
+        self.alpha
+            .iter()
+            .map(|a| {
+                let q = self.chart.rotation(a);
+                [q.row(0).transpose(), q.row(1).transpose(), q.row(2).transpose()]
+            })
+            .collect()
+    }
+    /// Displacement from the reference configuration `(0, 0, s)` [m].
+    pub fn displacement(&self) -> Vec<Vector3<f64>> {
+        self.x.iter().zip(&self.s).map(|(x, s)| x - Vector3::new(0.0, 0.0, *s)).collect()
+    }
+}
+
+/// Solver statistics.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SolverStats {
+    /// static: iterations of the nonlinear solver; dynamic: total Newton iterations
+    pub iterations: usize,
+    /// static: last relative change (fixed point) or increment (Newton)
+    pub last_change: Option<f64>,
+    /// static: ‖R‖∞/‖F‖∞ at the solution
+    pub residual: Option<f64>,
+    /// dynamic: largest Newton iteration count of a step
+    pub max_newton_iterations: Option<usize>,
+    /// wall-clock time of the solve (engine-internal) [s]
+    pub wall_time_s: f64,
+}
+
+/// Result of running a case in one engine.
+#[derive(Clone, Debug)]
+pub struct RunResult {
+    pub engine: Engine,
+    /// final state; for an inverse case the recovered `(x, α)`
+    pub nodes: NodalState,
+    /// static iteration history
+    pub history: Vec<IterationRecord>,
+    /// dynamic tip history (including t = 0)
+    pub tip: Vec<TipRecord>,
+    pub stats: SolverStats,
+    /// inverse cases: data, adjoint (controls) and per-iteration history
+    pub inverse: Option<InverseOutput>,
+}
+
+/// What an inverse run adds to its [`RunResult`].
+#[derive(Clone, Debug)]
+pub struct InverseOutput {
+    /// the data read from `data.csv` (x_g and the forward angles α_f, I7)
+    pub data: NodalState,
+    /// whether `data.alpha` holds true angles (synthetic data) or zeros (a recorded clip,
+    /// whose frame is unknown): curvature errors are only reported in the first case
+    pub angles_known: bool,
+    /// adjoint x̂ per node; the force control is f = x̂/λf [N/m] (eq. 54)
+    pub xhat: Vec<Vector3<f64>>,
+    /// adjoint α̂ per node; the torque control is l = α̂/λl [N] (eq. 54)
+    pub ahat: Vec<Vector3<f64>>,
+    /// one record per iteration (relative change, fit measures, objective terms of (41))
+    pub history: Vec<InverseRecord>,
+    /// per iteration: curvature error against the data's `[all elements, inner]`
+    /// (`metrics::inverse_metrics`); empty when the engine does not report it (FreeFEM)
+    pub kappa_err: Vec<[f64; 2]>,
+    pub lambda_f: f64,
+    pub lambda_l: f64,
+}
+
+impl InverseOutput {
+    /// Force control f = x̂/λf per node [N/m].
+    pub fn force(&self) -> Vec<Vector3<f64>> {
+        self.xhat.iter().map(|v| v / self.lambda_f).collect()
+    }
+    /// Torque control l = α̂/λl per node [N·m/m].
+    pub fn torque(&self) -> Vec<Vector3<f64>> {
+        self.ahat.iter().map(|v| v / self.lambda_l).collect()
+    }
+}

@@ -1,0 +1,268 @@
+//! The KKT system of the fixed point (`docs/inverse.md`, I4) element by element, and the
+//! boundary conditions of I5. Element vectors and matrices have the KKT layout of two nodes,
+//! `[x, α, x̂, α̂]` per node (24 unknowns).
+use nalgebra::{DVector, Matrix3, SMatrix, SVector, Vector3};
+
+use super::{Frame, InverseParams};
+use crate::assemble::{assemble, Tangent};
+use crate::linalg::Pattern;
+use crate::model::element::{frozen_operator, interpolate, LocalVec};
+use crate::model::mesh::{DofMap, Field, GAUSS2};
+use crate::model::rotation::{a_matrix, d3, rotation_derivatives};
+use crate::solve::Problem;
+
+/// Element matrix of the KKT system (24 × 24).
+pub type KktMat = SMatrix<f64, 24, 24>;
+/// Element vector of the KKT system (24).
+pub type KktVec = SVector<f64, 24>;
+
+/// Layout of a KKT element vector and of a forward element vector.
+pub(crate) const LOCAL: DofMap = DofMap::kkt(2);
+const FORWARD: DofMap = DofMap::forward(2);
+/// Offsets of the fields of the element's two nodes in a KKT element vector.
+pub(crate) const X: [usize; 2] = [LOCAL.local(0, Field::X, 0), LOCAL.local(1, Field::X, 0)];
+pub(crate) const AL: [usize; 2] = [LOCAL.local(0, Field::Alpha, 0), LOCAL.local(1, Field::Alpha, 0)];
+const XH: [usize; 2] = [LOCAL.local(0, Field::XHat, 0), LOCAL.local(1, Field::XHat, 0)];
+const ALH: [usize; 2] = [LOCAL.local(0, Field::AlphaHat, 0), LOCAL.local(1, Field::AlphaHat, 0)];
+
+/// The KKT element index of forward element index `i` (`[x_a, α_a, x_b, α_b]`); `hat` selects
+/// the adjoint copy (x → x̂, α → α̂).
+#[inline]
+pub(crate) fn kkt(i: usize, hat: bool) -> usize {
+    if hat {
+        KKT_HAT[i]
+    } else {
+        KKT_STATE[i]
+    }
+}
+
+const fn kkt_index(i: usize, hat: bool) -> usize {
+    let position = i % FORWARD.block() < 3;
+    let field = match (position, hat) {
+        (true, false) => Field::X,
+        (true, true) => Field::XHat,
+        (false, false) => Field::Alpha,
+        (false, true) => Field::AlphaHat,
+    };
+    LOCAL.local(i / FORWARD.block(), field, i % 3)
+}
+
+const fn kkt_table(hat: bool) -> [usize; 12] {
+    let mut t = [0; 12];
+    let mut i = 0;
+    while i < 12 {
+        t[i] = kkt_index(i, hat);
+        i += 1;
+    }
+    t
+}
+
+const KKT_STATE: [usize; 12] = kkt_table(false);
+const KKT_HAT: [usize; 12] = kkt_table(true);
+
+/// The state part (`hat = false`) or the adjoint part of a KKT element vector, in the forward
+/// element layout.
+pub(crate) fn element_part(ue: &KktVec, hat: bool) -> LocalVec {
+    LocalVec::from_fn(|i, _| ue[kkt(i, hat)])
+}
+
+/// Points `(ξ, w)` of the λd term's rule (I11): `(1 − ε)` times the stretch–shear rule of the
+/// scheme plus `ε` times 2-point Gauss (at most 2 + 2 points, no allocation).
+#[derive(Clone, Copy, Debug)]
+pub struct PointRule {
+    points: [(f64, f64); 4],
+    len: usize,
+}
+
+impl PointRule {
+    /// The λd rule of `problem`'s scheme with stabilisation `eps`.
+    pub fn tangent(problem: &Problem, eps: f64) -> Self {
+        let base = problem.scheme.stretch_shear();
+        let mut rule = PointRule { points: [(0.0, 0.0); 4], len: 0 };
+        let mut push = |x: f64, w: f64| {
+            if w != 0.0 {
+                rule.points[rule.len] = (x, w);
+                rule.len += 1;
+            }
+        };
+        for (x, w) in base.iter() {
+            push(x, w * (1.0 - eps));
+        }
+        if eps > 0.0 {
+            for (x, w) in GAUSS2.iter() {
+                push(x, w * eps);
+            }
+        }
+        rule
+    }
+
+    pub fn iter(&self) -> impl Iterator<Item = (f64, f64)> + Clone + '_ {
+        self.points[..self.len].iter().copied()
+    }
+}
+
+/// `∂d3/∂α = [0 | d_β | d_γ]` (eqs. 56–58).
+pub(crate) fn d3_jacobian(alpha: &Vector3<f64>) -> Matrix3<f64> {
+    let dq = rotation_derivatives(alpha);
+    Matrix3::from_columns(&[dq[0].row(2).transpose(), dq[1].row(2).transpose(), dq[2].row(2).transpose()])
+}
+
+/// Add a 3 × 3 block at `(ro, co)`.
+pub(crate) fn add3(m: &mut KktMat, ro: usize, co: usize, blk: &Matrix3<f64>) {
+    for i in 0..3 {
+        for j in 0..3 {
+            m[(ro + i, co + j)] += blk[(i, j)];
+        }
+    }
+}
+
+/// Local KKT matrix and right-hand side of one element (I4), coefficients frozen at the
+/// element's state `uk`; `xg`, `alpha_prev`: the data and the previous frame's angles at its
+/// nodes (`first_frame`: no Λω term).
+#[allow(non_snake_case)] // paper symbols W, D, A, Kk
+pub(crate) fn element_system(
+    problem: &Problem,
+    p: &InverseParams,
+    first_frame: bool,
+    uk: &LocalVec,
+    xg: [Vector3<f64>; 2],
+    alpha_prev: [Vector3<f64>; 2],
+) -> (KktMat, KktVec) {
+    let h = problem.mesh.h();
+    let w8 = &p.weights;
+    let mut m = KktMat::zeros();
+    let mut r = KktVec::zeros();
+    // Frozen operator: primal rows (hat test) × state columns, and its transpose.
+    let (l, b) = frozen_operator(&problem.props, problem.scheme, h, uk);
+    for i in 0..12 {
+        r[kkt(i, true)] += b[i];
+        for j in 0..12 {
+            m[(kkt(i, true), kkt(j, false))] += l[(i, j)];
+            m[(kkt(j, false), kkt(i, true))] += l[(i, j)];
+        }
+    }
+    let omega_on = !first_frame && w8.lambda_omega.amax() > 0.0;
+    let dt = p.frame_interval_s;
+    // Mass-type terms (load rule): tracking, control costs, Λω.
+    for (xi, w) in GAUSS2.iter() {
+        let q = interpolate(uk, h, xi);
+        let n = q.n;
+        let wh = w * h;
+        let xg_q = xg[0] * n[0] + xg[1] * n[1];
+        let ap_q = alpha_prev[0] * n[0] + alpha_prev[1] * n[1];
+        let W = if omega_on {
+            let A = a_matrix(&q.alpha);
+            A.transpose() * Matrix3::from_diagonal(&w8.lambda_omega) * A / (dt * dt)
+        } else {
+            Matrix3::zeros()
+        };
+        for a in 0..2 {
+            for i in 0..3 {
+                r[X[a] + i] += wh * n[a] * w8.lambda_g * xg_q[i];
+            }
+            let wa = W * ap_q * (wh * n[a]);
+            for i in 0..3 {
+                r[AL[a] + i] += wa[i];
+            }
+            for c in 0..2 {
+                let nn = wh * n[a] * n[c];
+                add3(&mut m, X[a], X[c], &(Matrix3::identity() * (w8.lambda_g * nn)));
+                add3(&mut m, XH[a], XH[c], &(Matrix3::identity() * (-nn / w8.lambda_f)));
+                add3(&mut m, ALH[a], ALH[c], &(Matrix3::identity() * (-nn / w8.lambda_l)));
+                add3(&mut m, AL[a], AL[c], &(W * nn));
+            }
+        }
+    }
+    // λd term (its rule, I11): λd ∫ (∂sδx − D δα)·(∂s x − D α − d3^k + D α_k).
+    for (xi, w) in PointRule::tangent(problem, p.stabilisation).iter() {
+        let q = interpolate(uk, h, xi);
+        let wh = w * h * w8.lambda_d;
+        let D = d3_jacobian(&q.alpha);
+        let c = d3(&q.alpha) - D * q.alpha;
+        for a in 0..2 {
+            let ta = [Matrix3::identity() * q.dn[a], -D * q.n[a]]; // test operator blocks (x, α)
+            for i in 0..3 {
+                r[X[a] + i] += wh * (ta[0].transpose() * c)[i];
+                r[AL[a] + i] += wh * (ta[1].transpose() * c)[i];
+            }
+            for cc in 0..2 {
+                let tc = [Matrix3::identity() * q.dn[cc], -D * q.n[cc]];
+                for (ra, ro) in [(0, X[a]), (1, AL[a])] {
+                    for (ca, co) in [(0, X[cc]), (1, AL[cc])] {
+                        add3(&mut m, ro, co, &(ta[ra].transpose() * tc[ca] * wh));
+                    }
+                }
+            }
+        }
+    }
+    // Λκ term (bending rule): ∫ ∂sδα · Aᵀ Λκ A ∂sα.
+    if w8.lambda_kappa.amax() > 0.0 {
+        for (xi, w) in problem.scheme.bending().iter() {
+            let q = interpolate(uk, h, xi);
+            let A = a_matrix(&q.alpha);
+            let Kk = A.transpose() * Matrix3::from_diagonal(&w8.lambda_kappa) * A * (w * h);
+            for a in 0..2 {
+                for c in 0..2 {
+                    add3(&mut m, AL[a], AL[c], &(Kk * (q.dn[a] * q.dn[c])));
+                }
+            }
+        }
+    }
+    (m, r)
+}
+
+/// Dirichlet unknowns of I5 (KKT layout) with their values: `x = x_g` and `x̂ = α̂ = 0` at
+/// both ends, and on the first frame `α(0) = α0` (first angle only, Remark 6).
+pub fn dirichlet(dofs: &DofMap, alpha0: f64, frame: &Frame) -> Vec<(usize, f64)> {
+    let mut fixed = Vec::new();
+    dirichlet_into(dofs, alpha0, frame, &mut fixed);
+    fixed
+}
+
+/// [`dirichlet`] into a reused vector (cleared first).
+pub(crate) fn dirichlet_into(dofs: &DofMap, alpha0: f64, frame: &Frame, fixed: &mut Vec<(usize, f64)>) {
+    fixed.clear();
+    let last = frame.x_g.len() - 1;
+    for node in [0, last] {
+        for k in 0..3 {
+            fixed.push((dofs.index(node, Field::X, k), frame.x_g[node][k]));
+        }
+        for field in [Field::XHat, Field::AlphaHat] {
+            for k in 0..3 {
+                fixed.push((dofs.index(node, field, k), 0.0));
+            }
+        }
+    }
+    if frame.is_first() {
+        fixed.push((dofs.index(0, Field::Alpha, 0), alpha0));
+    }
+}
+
+/// Assemble the KKT matrix (into `values`, zeroed first) and right-hand side of I4 with the
+/// coefficients frozen at the state `u` (forward layout); boundary conditions not applied.
+#[allow(clippy::too_many_arguments)]
+pub fn assemble_system(
+    problem: &Problem,
+    p: &InverseParams,
+    first_frame: bool,
+    pattern: &Pattern,
+    values: &mut [f64],
+    u: &DVector<f64>,
+    x_g: &[Vector3<f64>],
+    alpha_prev: &[Vector3<f64>],
+) -> DVector<f64> {
+    let fwd = problem.dofs();
+    let kkt_dofs = problem.mesh.kkt_dofs();
+    values.iter_mut().for_each(|v| *v = 0.0);
+    let mut rhs = kkt_dofs.zeros();
+    assemble(&kkt_dofs, &mut rhs, Some(Tangent::new(pattern, values, 1.0)), |e, t| {
+        let uk: LocalVec = fwd.gather(u, e);
+        let (m, r) =
+            element_system(problem, p, first_frame, &uk, [x_g[e], x_g[e + 1]], [alpha_prev[e], alpha_prev[e + 1]]);
+        if let Some(t) = t {
+            *t = m;
+        }
+        r
+    });
+    rhs
+}

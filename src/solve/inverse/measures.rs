@@ -1,0 +1,94 @@
+//! What a frame's iterate is measured by (`docs/inverse.md`, I2): the fit to the data and the
+//! terms of the objective (41), each one pass of [`integrate`] over the mesh.
+use nalgebra::{DVector, Vector3};
+
+use super::kkt::PointRule;
+use super::{Frame, InverseParams, InverseRecord, ObjectiveTerms};
+use crate::assemble::integrate;
+use crate::model::element::{interpolate, LocalVec};
+use crate::model::mesh::GAUSS2;
+use crate::model::rotation::{a_matrix, curvature, d3};
+use crate::solve::Problem;
+
+/// `(‖x − x_g‖/‖x_g‖, ‖∂s x − d3‖)` with the integration rules of I2 (the misfit with the λd
+/// term's rule, I11).
+pub fn fit_measures(problem: &Problem, p: &InverseParams, u: &DVector<f64>, x_g: &[Vector3<f64>]) -> (f64, f64) {
+    let (mesh, dofs) = (&problem.mesh, problem.dofs());
+    let h = mesh.h();
+    let (mut e2, mut g2, mut t2) = (0.0, 0.0, 0.0);
+    integrate(mesh, GAUSS2.iter(), |e, xi, w| {
+        let q = interpolate(&dofs.gather(u, e), h, xi);
+        let xg = x_g[e] * q.n[0] + x_g[e + 1] * q.n[1];
+        e2 += w * h * (q.x - xg).norm_squared();
+        g2 += w * h * xg.norm_squared();
+    });
+    let rule = PointRule::tangent(problem, p.stabilisation);
+    integrate(mesh, rule.iter(), |e, xi, w| {
+        let q = interpolate(&dofs.gather(u, e), h, xi);
+        t2 += w * h * (q.dx - d3(&q.alpha)).norm_squared();
+    });
+    ((e2 / g2).sqrt(), t2.sqrt())
+}
+
+/// The terms of the objective (41) at the state `u` with the adjoint `adjoint` (forward
+/// layout each), integrated with the rules of I2; `alpha_prev`: the previous frame's angles
+/// (the Λω term is off on the first frame).
+pub fn objective_terms(
+    problem: &Problem,
+    p: &InverseParams,
+    first_frame: bool,
+    u: &DVector<f64>,
+    adjoint: &DVector<f64>,
+    x_g: &[Vector3<f64>],
+    alpha_prev: &[Vector3<f64>],
+) -> ObjectiveTerms {
+    let (mesh, dofs) = (&problem.mesh, problem.dofs());
+    let h = mesh.h();
+    let w8 = &p.weights;
+    let mut t = ObjectiveTerms::default();
+    let state = |e: usize, xi: f64| interpolate(&dofs.gather::<12>(u, e), h, xi);
+    integrate(mesh, GAUSS2.iter(), |e, xi, w| {
+        let q = state(e, xi);
+        let ae: LocalVec = dofs.gather(adjoint, e);
+        let qa = interpolate(&ae, h, xi);
+        let wh = 0.5 * w * h;
+        let xg = x_g[e] * q.n[0] + x_g[e + 1] * q.n[1];
+        t.tracking += wh * w8.lambda_g * (q.x - xg).norm_squared();
+        t.force += wh * qa.x.norm_squared() / w8.lambda_f;
+        t.torque += wh * qa.alpha.norm_squared() / w8.lambda_l;
+        if !first_frame {
+            let ap = alpha_prev[e] * q.n[0] + alpha_prev[e + 1] * q.n[1];
+            let om = a_matrix(&q.alpha) * (q.alpha - ap) / p.frame_interval_s;
+            t.angular += wh * om.component_mul(&om).dot(&w8.lambda_omega);
+        }
+    });
+    integrate(mesh, PointRule::tangent(problem, p.stabilisation).iter(), |e, xi, w| {
+        let q = state(e, xi);
+        t.shear += 0.5 * w * h * w8.lambda_d * (q.dx - d3(&q.alpha)).norm_squared();
+    });
+    integrate(mesh, problem.scheme.bending().iter(), |e, xi, w| {
+        let q = state(e, xi);
+        let k = curvature(&q.alpha, &q.dalpha);
+        t.bending += 0.5 * w * h * k.component_mul(&k).dot(&w8.lambda_kappa);
+    });
+    t
+}
+
+/// The per-iteration record of `frame` at the state `u` with the adjoint `adjoint` (fit
+/// measures and the objective terms of (41)).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn record(
+    problem: &Problem,
+    p: &InverseParams,
+    frame: &Frame,
+    alpha_prev: &[Vector3<f64>],
+    iteration: usize,
+    rel_change: f64,
+    u: &DVector<f64>,
+    adjoint: &DVector<f64>,
+    residual: Option<f64>,
+) -> InverseRecord {
+    let (x_err_rel, tangent_misfit) = fit_measures(problem, p, u, frame.x_g);
+    let objective = objective_terms(problem, p, frame.is_first(), u, adjoint, frame.x_g, alpha_prev);
+    InverseRecord { iteration, rel_change, x_err_rel, tangent_misfit, objective, residual }
+}

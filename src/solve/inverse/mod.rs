@@ -1,0 +1,310 @@
+//! Inverse problem of one frame: Problem 1 (41)–(43) solved by the monolithic scheme of
+//! Problem 2, eq. (61), with the corrections and readings of `docs/inverse.md` (I1–I11).
+//!
+//! ```text
+//!   ⎡ H_k   L_kᵀ ⎤ ⎡u⎤   ⎡h_k⎤     u = (x, α) state, û = (x̂, α̂) adjoint,
+//!   ⎣ L_k   −C   ⎦ ⎣û⎦ = ⎣b_k⎦     f = x̂/λf, l = α̂/λl (eq. 54)
+//! ```
+//! `L_k`, `b_k`: the frozen operator of the forward fixed point (D5). `H_k`: the objective's
+//! second-order terms with `d3` linearised as in (60) and the corrected sign of the λd term.
+//! `C`: control mass matrices `(1/λf) M`, `(1/λl) M`.
+//!
+//! One entry point, [`FrameSolver`]: made once per mesh (it owns the KKT pattern, the LU
+//! storage and the scratch, reused for every frame of a clip), it solves a [`Frame`] with the
+//! method of its [`InverseParams`]:
+//! - [`InverseMethod::FixedPoint`]: the paper's scheme, the state relaxed with w (Remark 10),
+//!   [`fixed_point`];
+//! - [`InverseMethod::Newton`]: Newton on the same discrete equations with the exact Jacobian
+//!   (I8), [`newton`], started by the fixed point from a guess or directly from a start close
+//!   to the solution ([`Start`]).
+//!
+//! Files: [`kkt`] (the element system of I4 and the boundary conditions of I5), [`measures`]
+//! (fit and objective (41), I2), [`fixed_point`], [`newton`].
+//!
+//! ## References
+//! 1. Wang et al., Comput. Mech. 71 (2023), §3–4, eqs. (41), (52)–(61), Remark 6, Remark 10.
+pub mod fixed_point;
+pub mod kkt;
+pub mod measures;
+pub mod newton;
+
+use nalgebra::{DVector, Vector3};
+
+use super::{Problem, SolveError, Stop};
+use crate::linalg::{LinearSolver, Pattern};
+use crate::model::mesh::DofMap;
+use crate::model::rotation::Angles;
+
+/// Regularisation weights of eq. (41).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Weights {
+    /// λg: weight of the tracking term ½λg ∫|x − x_g|²
+    pub lambda_g: f64,
+    /// λf: weight of the force control ½λf ∫|f|²
+    pub lambda_f: f64,
+    /// λl: weight of the torque control ½λl ∫|l|²
+    pub lambda_l: f64,
+    /// λd: weight of the shear–stretch penalty ½λd ∫|∂s x − d3|²
+    pub lambda_d: f64,
+    /// Λκ diagonal (bending and twist)
+    pub lambda_kappa: Vector3<f64>,
+    /// Λω diagonal (angular velocity; frames after the first only, Remark 6)
+    pub lambda_omega: Vector3<f64>,
+}
+
+/// Nonlinear solver of one frame (`docs/inverse.md`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum InverseMethod {
+    /// The paper's relaxed fixed point (eq. 61, Remark 10).
+    FixedPoint,
+    /// Newton on the same discrete equations (I8). From a guess it starts at the fixed point's
+    /// iterate whose relative change is ≤ `warm_start_tolerance`.
+    Newton { warm_start_tolerance: f64 },
+}
+
+/// Settings of the inverse solver, the same for every frame of a clip.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct InverseParams {
+    pub weights: Weights,
+    /// Δt between frames [s] (the Λω term)
+    pub frame_interval_s: f64,
+    /// Dirichlet value of the first angle α at s = 0 on the first frame [rad]; 0 in Remark 6,
+    /// the rotation angle about e3 when the data are rotated rigidly about e3 (invariance)
+    pub alpha0_rad: f64,
+    /// weight ε ∈ [0, 1] of the two-point rule in the λd term (I11): the term is integrated
+    /// with (1 − ε)·(the stretch–shear rule, D4) + ε·(2-point Gauss). 0 is the paper's element;
+    /// ε > 0 penalises the nodal zig-zag of the angles that the one-point rule cannot see.
+    pub stabilisation: f64,
+    /// relaxation w ∈ (0, 1] of the fixed point (Remark 10); Newton's warm start uses it too
+    pub relaxation: f64,
+    pub method: InverseMethod,
+    /// stopping rule: relative change of (x, α) (D5) ≤ tolerance
+    pub tolerance: f64,
+    /// iterations per frame (fixed point and Newton together)
+    pub max_iterations: usize,
+}
+
+/// The data of one frame.
+#[derive(Clone, Copy, Debug)]
+pub struct Frame<'a> {
+    /// frame number, in records and errors
+    pub index: usize,
+    /// data positions x_g per node [m]
+    pub x_g: &'a [Vector3<f64>],
+    /// the previous frame's angles per node (the Λω term), or `None` on the first frame, which
+    /// has α(0) = α0 instead and no Λω term (Remark 6)
+    pub previous: Option<&'a [Angles]>,
+}
+
+impl Frame<'_> {
+    pub fn is_first(&self) -> bool {
+        self.previous.is_none()
+    }
+}
+
+/// Where a frame's solve starts from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Start {
+    /// a guess (the reference state, the data guess): Newton is warm-started by the fixed point
+    Guess,
+    /// an iterate close to the solution (the previous frame's): Newton runs directly
+    Near,
+}
+
+/// Per-iteration record (`docs/inverse.md`): relative change of (x, α) (D5),
+/// ‖x − x_g‖/‖x_g‖ and ‖∂s x − d3‖ [L² norm, m^½] at the relaxed iterate, and the terms of
+/// the objective (41) at that iterate with the controls of the last solve.
+#[derive(Clone, Copy, Debug)]
+pub struct InverseRecord {
+    pub iteration: usize,
+    pub rel_change: f64,
+    pub x_err_rel: f64,
+    pub tangent_misfit: f64,
+    pub objective: ObjectiveTerms,
+    /// Newton only (`docs/inverse.md`, I8): equilibrated KKT residual `‖D_r R(U)‖₂` after the
+    /// step, relative to its value at the start of Newton; `None` for the fixed point
+    pub residual: Option<f64>,
+}
+
+/// The six terms of the objective (41), each with its weight and the ½, with the
+/// integration rules of I2.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ObjectiveTerms {
+    /// λg/2 ∫|x − x_g|²
+    pub tracking: f64,
+    /// λf/2 ∫|f|², f = x̂/λf (eq. 54)
+    pub force: f64,
+    /// λl/2 ∫|l|², l = α̂/λl (eq. 54)
+    pub torque: f64,
+    /// λd/2 ∫|∂s x − d3|²
+    pub shear: f64,
+    /// ½ ∫ κᵀ Λκ κ, κ = A ∂sα (eq. 28)
+    pub bending: f64,
+    /// ½ ∫ ωᵀ Λω ω, ω = A (α − α_{n−1})/Δt (eq. 27, backward difference; 0 on the first frame)
+    pub angular: f64,
+}
+
+impl ObjectiveTerms {
+    pub fn total(&self) -> f64 {
+        self.tracking + self.force + self.torque + self.shear + self.bending + self.angular
+    }
+    /// Names in CSV order, with units (J = the objective's unit).
+    pub const NAMES: [&'static str; 7] =
+        ["j_tracking", "j_force", "j_torque", "j_shear", "j_bending", "j_angular", "j_total"];
+    pub fn values(&self) -> [f64; 7] {
+        [self.tracking, self.force, self.torque, self.shear, self.bending, self.angular, self.total()]
+    }
+}
+
+/// The result of one frame: the last iterate, its history and why it stopped.
+#[derive(Clone, Debug)]
+pub struct InverseSolution {
+    /// state `(x, α)` (forward layout)
+    pub u: DVector<f64>,
+    /// adjoint `(x̂, α̂)` (forward layout) of the last solve
+    pub adjoint: DVector<f64>,
+    pub history: Vec<InverseRecord>,
+    /// [`Stop::MaxIterations`]: `u` is the last iterate (see [`InverseSolution::converged`])
+    pub stop: Stop,
+}
+
+impl InverseSolution {
+    /// The solution if it met the stopping rule, else the error of frame `frame` with the
+    /// iterations and the last relative change (fixed point) or Newton residual.
+    pub fn converged(self, frame: usize) -> Result<Self, SolveError> {
+        if self.stop == Stop::Converged {
+            return Ok(self);
+        }
+        let iterations = self.history.len();
+        let last = self.history.last();
+        Err(match last.and_then(|r| r.residual) {
+            Some(residual) => SolveError::InverseNewtonNotConverged { frame, iterations, residual },
+            None => SolveError::InverseNotConverged {
+                frame,
+                iterations,
+                rel_change: last.map(|r| r.rel_change).unwrap_or(f64::NAN),
+            },
+        })
+    }
+}
+
+/// The one entry point of the inverse problem of a frame: the method of its params, and what
+/// every frame of a clip reuses (built once per mesh): the KKT sparsity pattern
+/// ([`DofMap::kkt`] layout, block tridiagonal), the banded LU's storage and scratch
+/// ([`LinearSolver`]), the value arrays of the Jacobian and the line search, and the Dirichlet
+/// rows of I5 (refilled per frame: the positions depend only on whether the frame is the
+/// first, the values on its data).
+///
+/// ```ignore
+/// let mut solver = FrameSolver::new(&problem, params);   // once per clip
+/// for frame in frames {
+///     let sol = solver.solve(&frame, &u0, Start::Near, |_, _, _| {})?.converged(frame.index)?;
+/// }
+/// ```
+pub struct FrameSolver<'p> {
+    pub(crate) problem: &'p Problem<'p>,
+    pub(crate) params: InverseParams,
+    pub(crate) dofs: DofMap,
+    pub(crate) pattern: Pattern,
+    pub(crate) solver: LinearSolver,
+    /// Dirichlet unknowns of I5 and their values (KKT numbering)
+    pub(crate) fixed: Vec<(usize, f64)>,
+    pub(crate) rows: Vec<usize>,
+    /// system values (pattern order)
+    pub(crate) values: Vec<f64>,
+    /// Newton: the residual merit's row weights (Ruiz row factors of the first Jacobian)
+    pub(crate) merit_weights: Vec<f64>,
+    /// zero angles: the `α_{n−1}` of a first frame (its Λω term is off)
+    pub(crate) no_previous: Vec<Angles>,
+}
+
+impl<'p> FrameSolver<'p> {
+    /// A solver for the mesh of `problem`.
+    pub fn new(problem: &'p Problem<'p>, params: InverseParams) -> Self {
+        let dofs = problem.mesh.kkt_dofs();
+        let pattern = dofs.pattern();
+        let solver = LinearSolver::new(&pattern);
+        let values = vec![0.0; pattern.nnz()];
+        FrameSolver {
+            problem,
+            params,
+            dofs,
+            pattern,
+            solver,
+            fixed: Vec::new(),
+            rows: Vec::new(),
+            values,
+            merit_weights: Vec::new(),
+            no_previous: vec![Vector3::zeros(); problem.mesh.nodes()],
+        }
+    }
+
+    pub fn params(&self) -> &InverseParams {
+        &self.params
+    }
+
+    /// Solve one frame from the state `u0` (forward layout) by the method of the params (see
+    /// [`Start`]). `observer` sees every iteration's record, state and adjoint. Hitting the
+    /// iteration limit is not an error here: the solution says [`Stop::MaxIterations`].
+    pub fn solve(
+        &mut self,
+        frame: &Frame,
+        u0: &DVector<f64>,
+        start: Start,
+        mut observer: impl FnMut(&InverseRecord, &DVector<f64>, &DVector<f64>),
+    ) -> Result<InverseSolution, SolveError> {
+        let expected = self.problem.mesh.nodes();
+        let fwd = self.problem.dofs();
+        for (what, nodes) in [
+            ("data x_g", frame.x_g.len()),
+            ("previous frame's angles", frame.previous.map_or(expected, <[Angles]>::len)),
+            ("initial state", u0.len() / fwd.block()),
+        ] {
+            if nodes != expected {
+                return Err(SolveError::NodeCount { what, nodes, expected });
+            }
+        }
+        self.set_dirichlet(frame);
+        let params = self.params;
+        match (params.method, start) {
+            (InverseMethod::FixedPoint, _) => fixed_point::solve(self, &params, frame, u0, &mut observer),
+            (InverseMethod::Newton { .. }, Start::Near) => newton::solve(self, &params, frame, u0, &mut observer),
+            (InverseMethod::Newton { warm_start_tolerance }, Start::Guess) => {
+                newton::solve_warm(self, warm_start_tolerance, frame, u0, &mut observer)
+            }
+        }
+    }
+
+    /// Dirichlet rows and values of I5 for the frame.
+    fn set_dirichlet(&mut self, frame: &Frame) {
+        kkt::dirichlet_into(&self.dofs, self.params.alpha0_rad, frame, &mut self.fixed);
+        self.rows.clear();
+        self.rows.extend(self.fixed.iter().map(|f| f.0));
+    }
+
+    /// Solve `K(u) U = r(u)` of I4 with the boundary conditions of I5 (equilibrated, I6); `U`
+    /// has the KKT layout.
+    pub(crate) fn solve_linearised(
+        &mut self,
+        params: &InverseParams,
+        frame: &Frame,
+        u: &DVector<f64>,
+    ) -> Result<DVector<f64>, SolveError> {
+        let previous = frame.previous.unwrap_or(&self.no_previous);
+        let mut rhs = kkt::assemble_system(
+            self.problem,
+            params,
+            frame.is_first(),
+            &self.pattern,
+            &mut self.values,
+            u,
+            frame.x_g,
+            previous,
+        );
+        for &(d, v) in &self.fixed {
+            rhs[d] = v;
+        }
+        self.pattern.set_identity_rows(&mut self.values, &self.rows);
+        Ok(self.solver.solve_equilibrated(&self.values, &rhs)?)
+    }
+}

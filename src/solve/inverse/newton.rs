@@ -1,0 +1,288 @@
+//! Newton mode of the inverse problem of one frame (`docs/inverse.md`, I8): Newton on the
+//! discrete equations whose fixed point [`super::fixed_point`] seeks, eq. (61) with the
+//! readings I3–I5.
+//!
+//! ```text
+//!   R(U) = K(u) U − r(u),     U = (u, û),  u = (x, α) the state part of U
+//!   J(U) = K(u) + ∂/∂u [K(u) V − r(u)]|_{V = U}
+//! ```
+//! `K`, `r` are the fixed point's KKT matrix and right-hand side (I4) with every coefficient
+//! (Q, A, B, q3, d3, D = [0 | d_β | d_γ]) at the current state; the Dirichlet rows of I5 are
+//! `U_d − v_d`. The coefficient derivative is exact: on the primal rows it is `∂G/∂u − L(u)`
+//! (the forward tangent of `element::internal_force` minus the frozen operator, since
+//! `L(u) u − b(u) = G(u)`), on the adjoint rows it is the derivative of `L(u)ᵀ û` and of the
+//! λd, Λκ and Λω terms (`coefficient_derivative`). A zero of `R` is a fixed point of the
+//! paper's scheme, so both modes converge to the same discrete solution. Remark 8's variant
+//! (an adjoint that also varies Q, A, B) is a different problem and is not used.
+//!
+//! Steps are damped by backtracking on the equilibrated residual norm `‖D_r R‖₂` (D_r: Ruiz
+//! row factors of the first Jacobian, I6). Stop when the full Newton step has
+//! `relative_change(x, α) ≤ tol` (D5); that step is taken without line search.
+//!
+//! ## References
+//! 1. Wang et al., Comput. Mech. 71 (2023), §3–4, eqs. (52)–(61), Remark 8, Remark 10.
+use nalgebra::{DVector, Matrix3, Vector3};
+
+use super::kkt::{add3, element_part, element_system, kkt, KktMat, KktVec, PointRule, AL, X};
+use super::measures::record;
+use super::{Frame, FrameSolver, InverseParams, InverseRecord, InverseSolution};
+use crate::assemble::{assemble, Tangent};
+use crate::linalg::Pattern;
+use crate::model::element::{frozen_operator, internal_force, interpolate, LocalMat};
+use crate::model::mesh::GAUSS2;
+use crate::model::rotation::{
+    a_matrix, a_matrix_derivatives, d3, d3_second_derivatives, rotation, rotation_derivatives, skew, PointFrame,
+};
+use crate::solve::statics::relative_change;
+use crate::solve::{Problem, SolveError, Stop};
+
+/// Smallest step fraction of the backtracking line search (2⁻¹⁰).
+const MIN_STEP: f64 = 1.0 / 1024.0;
+/// Armijo constant of the line search: accept `t` if `φ(U + t δ) ≤ (1 − c t) φ(U)`.
+const ARMIJO: f64 = 1e-4;
+
+/// `∂/∂u [K_e(u) V − r_e(u)]` at `V = U_e` for one element (24 × 24, KKT numbering; only the
+/// state columns are non-zero): the derivative of the frozen coefficients of I4.
+///
+/// ```text
+///   primal rows:   ∂G/∂u − L(u)                                   (G(u) = L(u) u − b(u), D5)
+///   adjoint rows:  ∂/∂u [L(u)ᵀ û]:  ∫ ∂sδx · S(α) (∂s x̂ + ∂s x × α̂),  S = QᵀKQ   (stretch–shear rule)
+///                                   ∫ ∂sδα · (QᵀJA)ᵀ ∂s α̂                    (bending rule)
+///                  λd:  −λd ∫ δα · [v·∂²d3/∂α_i∂α_j] δα,  v = ∂s x − d3            (stretch–shear rule)
+///                  Λκ:  ∫ ∂sδα · ∂_α(AᵀΛκA) ∂sα                                    (bending rule)
+///                  Λω:  ∫ δα · ∂_α(AᵀΛωA) (α − α_{n−1}) / Δt²                      (load rule)
+/// ```
+#[allow(non_snake_case)] // paper symbols K, J, Q, A, S, H2, Lk, Lw
+fn coefficient_derivative(
+    problem: &Problem,
+    p: &InverseParams,
+    first_frame: bool,
+    ue: &KktVec,
+    alpha_prev: [Vector3<f64>; 2],
+) -> KktMat {
+    let h = problem.mesh.h();
+    let props = &problem.props;
+    let w8 = &p.weights;
+    let (state, adj) = (element_part(ue, false), element_part(ue, true));
+    let mut e = KktMat::zeros();
+    // Primal rows: ∂G/∂u − L(u).
+    let mut t = LocalMat::zeros();
+    internal_force(props, problem.scheme, h, &state, Some(&mut t));
+    let (l, _) = frozen_operator(props, problem.scheme, h, &state);
+    for i in 0..12 {
+        for j in 0..12 {
+            e[(kkt(i, true), kkt(j, false))] = t[(i, j)] - l[(i, j)];
+        }
+    }
+    let columns = |c: [Vector3<f64>; 3]| Matrix3::from_columns(&c);
+    let K = Matrix3::from_diagonal(&props.shear_stretch_n);
+    let Jm = Matrix3::from_diagonal(&props.bend_twist_nm2);
+    // Stretch–shear rule: L(u)ᵀ û on the x rows, and the λd term.
+    for (xi, w) in problem.scheme.stretch_shear().iter() {
+        let (q, qa) = (interpolate(&state, h, xi), interpolate(&adj, h, xi));
+        let wh = w * h;
+        let Q = rotation(&q.alpha);
+        let dQ = rotation_derivatives(&q.alpha);
+        let S = Q.transpose() * K * Q;
+        let v = qa.dx + q.dx.cross(&qa.alpha);
+        let dS_v = columns([0, 1, 2].map(|j| (dQ[j].transpose() * K * Q + Q.transpose() * K * dQ[j]) * v));
+        let dS_dx = -S * skew(&qa.alpha);
+        for c in 0..2 {
+            for b in 0..2 {
+                add3(&mut e, X[c], AL[b], &(dS_v * (wh * q.dn[c] * q.n[b])));
+                add3(&mut e, X[c], X[b], &(dS_dx * (wh * q.dn[c] * q.dn[b])));
+            }
+        }
+    }
+    // The λd term's rule (I11): the second derivative of d3 in −λd ∫ δα·D(α)ᵀ(∂s x − d3).
+    for (xi, w) in PointRule::tangent(problem, p.stabilisation).iter() {
+        let q = interpolate(&state, h, xi);
+        let wh = w * h;
+        let dd = d3_second_derivatives(&q.alpha);
+        let mis = q.dx - d3(&q.alpha);
+        let H2 = Matrix3::from_fn(|i, j| mis.dot(&dd[i][j])) * (-w8.lambda_d);
+        for c in 0..2 {
+            for b in 0..2 {
+                add3(&mut e, AL[c], AL[b], &(H2 * (wh * q.n[c] * q.n[b])));
+            }
+        }
+    }
+    // Bending rule: L(u)ᵀ û on the α rows, and the Λκ term.
+    let kappa_on = w8.lambda_kappa.amax() > 0.0;
+    let Lk = Matrix3::from_diagonal(&w8.lambda_kappa);
+    for (xi, w) in problem.scheme.bending().iter() {
+        let (q, qa) = (interpolate(&state, h, xi), interpolate(&adj, h, xi));
+        let wh = w * h;
+        let f = PointFrame::new(&q.alpha, true);
+        let (Q, A, dQ, dA) = (f.q, f.a, f.dq, f.da);
+        let mut blk = columns(
+            [0, 1, 2].map(|j| (dQ[j].transpose() * Jm * A + Q.transpose() * Jm * dA[j]).transpose() * qa.dalpha),
+        );
+        if kappa_on {
+            blk += columns([0, 1, 2].map(|j| (dA[j].transpose() * Lk * A + A.transpose() * Lk * dA[j]) * q.dalpha));
+        }
+        for c in 0..2 {
+            for b in 0..2 {
+                add3(&mut e, AL[c], AL[b], &(blk * (wh * q.dn[c] * q.n[b])));
+            }
+        }
+    }
+    // Load rule: the Λω term (as in `element_system`).
+    if !first_frame && w8.lambda_omega.amax() > 0.0 {
+        let dt = p.frame_interval_s;
+        let Lw = Matrix3::from_diagonal(&w8.lambda_omega) / (dt * dt);
+        for (xi, w) in GAUSS2.iter() {
+            let q = interpolate(&state, h, xi);
+            let wh = w * h;
+            let A = a_matrix(&q.alpha);
+            let dA = a_matrix_derivatives(&q.alpha);
+            let da = q.alpha - (alpha_prev[0] * q.n[0] + alpha_prev[1] * q.n[1]);
+            let blk = columns([0, 1, 2].map(|j| (dA[j].transpose() * Lw * A + A.transpose() * Lw * dA[j]) * da));
+            for c in 0..2 {
+                for b in 0..2 {
+                    add3(&mut e, AL[c], AL[b], &(blk * (wh * q.n[c] * q.n[b])));
+                }
+            }
+        }
+    }
+    e
+}
+
+/// Newton residual `R(U) = K(u) U − r(u)` of I8 (KKT layout, Dirichlet rows `U_d − v_d` of
+/// `fixed`, I5) and, when `jacobian = Some((pattern, values, rows))`, its exact Jacobian `J(U)`
+/// into `values` (the Dirichlet `rows` identity). One pass of the element loop; without the
+/// Jacobian the same element sums in the same order, so the same residual.
+#[allow(clippy::too_many_arguments)]
+pub fn assemble_residual(
+    problem: &Problem,
+    p: &InverseParams,
+    frame: &Frame,
+    alpha_prev: &[Vector3<f64>],
+    big: &DVector<f64>,
+    fixed: &[(usize, f64)],
+    jacobian: Option<(&Pattern, &mut [f64], &[usize])>,
+) -> DVector<f64> {
+    let dofs = problem.mesh.kkt_dofs();
+    let first = frame.is_first();
+    let x_g = frame.x_g;
+    let kernel = |e: usize, t: Option<&mut KktMat>| {
+        let ue: KktVec = dofs.gather(big, e);
+        let uk = element_part(&ue, false);
+        let ap = [alpha_prev[e], alpha_prev[e + 1]];
+        let (m, rhs) = element_system(problem, p, first, &uk, [x_g[e], x_g[e + 1]], ap);
+        if let Some(t) = t {
+            *t = m + coefficient_derivative(problem, p, first, &ue, ap);
+        }
+        m * ue - rhs
+    };
+    let mut r = dofs.zeros();
+    match jacobian {
+        Some((pattern, values, rows)) => {
+            values.iter_mut().for_each(|v| *v = 0.0);
+            assemble(&dofs, &mut r, Some(Tangent::new(pattern, &mut *values, 1.0)), kernel);
+            pattern.set_identity_rows(values, rows);
+        }
+        None => assemble(&dofs, &mut r, None, kernel),
+    }
+    for &(d, v) in fixed {
+        r[d] = big[d] - v;
+    }
+    r
+}
+
+/// Newton of one frame (I8) from the state `u0` (forward layout) with `params`; the solver's
+/// Dirichlet rows must be those of the frame. The adjoint is started consistently by one
+/// linear solve of the fixed point, `K(u0) U = r(u0)` (I4). `params.relaxation` is not used;
+/// `params.tolerance` bounds the relative change of `(x, α)` of a full Newton step (D5), and
+/// each record carries the equilibrated residual relative to its start value.
+pub(crate) fn solve(
+    s: &mut FrameSolver,
+    params: &InverseParams,
+    frame: &Frame,
+    u0: &DVector<f64>,
+    observer: &mut impl FnMut(&InverseRecord, &DVector<f64>, &DVector<f64>),
+) -> Result<InverseSolution, SolveError> {
+    // Consistent start: one linear solve of the fixed point at u0.
+    let mut big = s.solve_linearised(params, frame, u0)?;
+    let problem = s.problem;
+    let fwd = problem.dofs();
+    let FrameSolver { dofs, pattern, solver, fixed, rows, values, merit_weights, no_previous, .. } = s;
+    let previous = frame.previous.unwrap_or(no_previous.as_slice());
+    let mut history = Vec::new();
+    let mut phi0 = f64::NAN;
+    let mut adjoint = fwd.zeros();
+    let mut u = dofs.kkt_state(&big);
+    for k in 1..=params.max_iterations {
+        let jacobian = Some((&*pattern, values.as_mut_slice(), rows.as_slice()));
+        let r = assemble_residual(problem, params, frame, previous, &big, fixed, jacobian);
+        let delta = solver.solve_equilibrated(values, &(-&r))?;
+        if k == 1 {
+            // the Ruiz row factors of the first Jacobian weigh the merit of the whole frame
+            merit_weights.clear();
+            merit_weights.extend_from_slice(solver.row_factors());
+        }
+        let merit =
+            |r: &DVector<f64>| r.iter().zip(merit_weights.iter()).map(|(a, b)| (a * b).powi(2)).sum::<f64>().sqrt();
+        let phi = merit(&r);
+        if k == 1 {
+            phi0 = phi;
+        }
+        // A full step whose relative change is within the tolerance is taken without the
+        // line search: the merit is then at its round-off floor and cannot decrease reliably.
+        let full = relative_change(&fwd, &dofs.kkt_state(&(&big + &delta)), &dofs.kkt_state(&big)) <= params.tolerance;
+        let mut t = 1.0;
+        let (mut trial, mut phi_t);
+        loop {
+            trial = &big + &delta * t;
+            phi_t = merit(&assemble_residual(problem, params, frame, previous, &trial, fixed, None));
+            if full || phi_t <= (1.0 - ARMIJO * t) * phi || t <= MIN_STEP {
+                break;
+            }
+            t *= 0.5;
+        }
+        let u_old = dofs.kkt_state(&big);
+        u = dofs.kkt_state(&trial);
+        let rel_change = relative_change(&fwd, &u, &u_old);
+        big = trial;
+        if !rel_change.is_finite() || !phi_t.is_finite() || big.iter().any(|v| !v.is_finite()) {
+            return Err(SolveError::InverseNonFinite { frame: frame.index, iteration: k });
+        }
+        adjoint = dofs.kkt_adjoint(&big);
+        let rec = record(problem, params, frame, previous, k, rel_change, &u, &adjoint, Some(phi_t / phi0));
+        observer(&rec, &u, &adjoint);
+        history.push(rec);
+        if full {
+            return Ok(InverseSolution { u, adjoint, history, stop: Stop::Converged });
+        }
+    }
+    Ok(InverseSolution { u, adjoint, history, stop: Stop::MaxIterations })
+}
+
+/// Newton started from the paper's fixed point (I8): the fixed point (relaxation
+/// `relaxation` of the solver's params) runs from `u0` until its relative change is
+/// ≤ `warm_start_tolerance`, then [`solve`] continues from its state until the tolerance. One
+/// history (the Newton records continue the iteration count and carry `residual`);
+/// `max_iterations` bounds the two phases together. From the straight reference state Newton
+/// alone can reach a spurious root (I8), hence the warm start.
+pub(crate) fn solve_warm(
+    s: &mut FrameSolver,
+    warm_start_tolerance: f64,
+    frame: &Frame,
+    u0: &DVector<f64>,
+    observer: &mut impl FnMut(&InverseRecord, &DVector<f64>, &DVector<f64>),
+) -> Result<InverseSolution, SolveError> {
+    let p = s.params;
+    let warm = InverseParams { tolerance: warm_start_tolerance.max(p.tolerance), ..p };
+    let start = super::fixed_point::solve(s, &warm, frame, u0, observer)?;
+    if start.stop != Stop::Converged {
+        return Ok(start);
+    }
+    let done = start.history.len();
+    let rest = InverseParams { max_iterations: p.max_iterations.saturating_sub(done).max(1), ..p };
+    let newton = solve(s, &rest, frame, &start.u, &mut |r, u, a| {
+        observer(&InverseRecord { iteration: r.iteration + done, ..*r }, u, a);
+    })?;
+    let mut history = start.history;
+    history.extend(newton.history.into_iter().map(|r| InverseRecord { iteration: r.iteration + done, ..r }));
+    Ok(InverseSolution { history, ..newton })
+}
