@@ -124,9 +124,15 @@ fn chart_guard_names_frame_and_node() {
         rotation: RotationTreatment::GlobalEuler,
         gauge: Vector3::y(),
     };
-    let err =
-        solve_sequence(&p, &sp, &[x_g.clone()], Some(&DVector::from(p.reference_state())), |_, _| {}, |_, _| Ok(()))
-            .expect_err("the guard must fire");
+    let err = solve_sequence(
+        &p,
+        &sp,
+        std::slice::from_ref(&x_g),
+        Some(&DVector::from(p.reference_state())),
+        |_, _| {},
+        |_, _| Ok(()),
+    )
+    .expect_err("the guard must fire");
     eprintln!("{err}");
     match err {
         SequenceError::SingularChart { frame, node, cos_beta, .. } => {
@@ -140,7 +146,8 @@ fn chart_guard_names_frame_and_node() {
     // β = 0: the same frame converges, far from the singular set.
     for gauge in [Vector3::x(), -Vector3::x()] {
         let sp = SequenceParams { rotation: RotationTreatment::Rebased, gauge, ..sp };
-        let reports = solve_sequence(&p, &sp, &[x_g.clone()], None, |_, _| {}, |_, _| Ok(())).expect("rebased chart");
+        let reports =
+            solve_sequence(&p, &sp, std::slice::from_ref(&x_g), None, |_, _| {}, |_, _| Ok(())).expect("rebased chart");
         eprintln!(
             "rebased, gauge {gauge:?}: {} iterations, x error {:.2e}, min |cos β| {}",
             reports[0].iterations, reports[0].x_err_rel, reports[0].min_cos_beta

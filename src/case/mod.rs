@@ -49,7 +49,7 @@ pub enum DataSource {
     /// a static forward solve of the case's own `[loads]` (synthetic data, I7)
     Forward(StaticParams),
     /// a recorded or synthetic clip (`[clip]`), solved frame by frame
-    Clip(ClipSource),
+    Clip(Box<ClipSource>),
 }
 
 /// The `roll_3d` settings of a synthetic clip (`crate::clip::synthetic`); its nodes, length

@@ -344,7 +344,7 @@ impl<'a> Validator<'a> {
         }
         let data = match (&raw.data, &raw.clip) {
             (Some(d), None) => DataSource::Forward(self.data(d)?),
-            (None, Some(cl)) => DataSource::Clip(self.clip(cl, mesh)?),
+            (None, Some(cl)) => DataSource::Clip(Box::new(self.clip(cl, mesh)?)),
             (Some(_), Some(_)) => {
                 return Err(self.err("clip", "give either [data] (synthetic) or [clip] (recorded), not both"))
             }

@@ -115,8 +115,8 @@ impl ClipWriter {
             let mut v = vec![nodes.s[i]];
             v.extend(nodes.x[i].iter());
             v.extend(nodes.alpha[i].iter());
-            for k in 0..3 {
-                v.extend(d[i][k].iter());
+            for dk in &d[i] {
+                v.extend(dk.iter());
             }
             v.extend(force[i].iter());
             v.extend(torque[i].iter());

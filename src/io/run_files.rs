@@ -102,8 +102,8 @@ fn write_inverse(
         let mut row = vec![r.nodes.s[i]];
         row.extend(r.nodes.x[i].iter());
         row.extend(r.nodes.alpha[i].iter());
-        for k in 0..3 {
-            row.extend(d[i][k].iter());
+        for dk in &d[i] {
+            row.extend(dk.iter());
         }
         row.extend(f[i].iter());
         row.extend(l[i].iter());

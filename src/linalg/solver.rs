@@ -141,7 +141,7 @@ fn row_col_max(r: &mut [f64], a: &[f64]) -> f64 {
 /// the accumulated row and column factors in `dr`, `dc` (`r`, `c`, `r_next`: scratch). Each pass takes
 /// the row and column maxima of `a`, then scales `a_ij ← a_ij (1/√r_i)(1/√c_j)`; the scaling
 /// of one pass and the maxima of the next share one sweep over the values.
-#[allow(clippy::too_many_arguments, clippy::needless_range_loop)] // j indexes columns of a, c, dc and col_ptr together
+#[allow(clippy::too_many_arguments)] // the CSC arrays, the values and the scratch of one solver
 fn ruiz(
     col_ptr: &[usize],
     row_idx: &[usize],
@@ -202,7 +202,6 @@ mod tests {
 
     /// The Ruiz scaling as first written (two sweeps per pass, `f64::max`, factors per entry):
     /// the reference for the fused, branch-free version.
-    #[allow(clippy::needless_range_loop)]
     fn ruiz_reference(p: &Pattern, values: &[f64]) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
         let n = p.ndofs();
         let mut a = values.to_vec();

@@ -183,7 +183,7 @@ pub fn run_clip<S: FrameSink>(
                             .map_err(|e| e.to_string())?;
                     let twist = ft.kappa.iter().map(|k| k.z).sum::<f64>() / ft.kappa.len() as f64;
                     let bend = |k: &Vector3<f64>| k.x * k.x + k.y * k.y;
-                    tr.comparisons.push(c.clone());
+                    tr.comparisons.push(c);
                     tr.roll_rad.push(ft.roll_rad);
                     tr.twist_per_m.push(twist);
                     tr.bending_true.push(ft.kappa.iter().map(bend).collect());

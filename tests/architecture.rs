@@ -1,0 +1,351 @@
+//! The module structure of `src/` (see the layers in `src/lib.rs`): every `crate::`, `super::`
+//! and (in `main.rs`) `cosserat::` path is resolved to the module it names; the resulting graph
+//! has no cycle, no module imports a module of a higher layer, and no source file is longer
+//! than 600 lines. `cargo test --test architecture -- --nocapture` prints the graph's size.
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::{Path, PathBuf};
+
+/// Layers, lowest first; a module may use its own top-level module and those of lower layers.
+const LAYERS: &[&[&str]] = &[
+    &["expr", "linalg", "reference"],
+    &["model"],
+    &["assemble"],
+    &["solve"],
+    &["clip"],
+    &["case"],
+    &["run"],
+    &["io"],
+    &["main"],
+];
+
+/// Longest source file allowed [lines].
+const MAX_LINES: usize = 600;
+
+fn layer(module: &str) -> usize {
+    let top = module.split("::").next().unwrap_or(module);
+    LAYERS.iter().position(|l| l.contains(&top)).unwrap_or_else(|| panic!("module `{module}` is in no layer"))
+}
+
+/// Module path of a source file: `src/a/b.rs` and `src/a/b/mod.rs` are `a::b`; `main.rs` is `main`.
+fn module_of(src: &Path, file: &Path) -> String {
+    let rel = file.strip_prefix(src).expect("under src");
+    let mut parts: Vec<String> = rel.iter().map(|p| p.to_string_lossy().into_owned()).collect();
+    let last = parts.pop().expect("file name");
+    let stem = last.trim_end_matches(".rs");
+    if stem != "mod" && stem != "lib" {
+        parts.push(stem.to_string());
+    }
+    parts.join("::")
+}
+
+fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    for entry in std::fs::read_dir(dir).expect("read_dir") {
+        let p = entry.expect("entry").path();
+        if p.is_dir() {
+            rust_files(&p, out);
+        } else if p.extension().is_some_and(|e| e == "rs") {
+            out.push(p);
+        }
+    }
+}
+
+/// The code of a Rust file without comments and string literals (paths in docs and messages
+/// are not imports).
+fn code_only(text: &str) -> String {
+    let b: Vec<char> = text.chars().collect();
+    let mut out = String::with_capacity(text.len());
+    let mut i = 0;
+    while i < b.len() {
+        if b[i] == '/' && b.get(i + 1) == Some(&'/') {
+            while i < b.len() && b[i] != '\n' {
+                i += 1;
+            }
+        } else if b[i] == '/' && b.get(i + 1) == Some(&'*') {
+            i += 2;
+            while i + 1 < b.len() && !(b[i] == '*' && b[i + 1] == '/') {
+                i += 1;
+            }
+            i += 2;
+        } else if b[i] == '"' {
+            i += 1;
+            while i < b.len() && b[i] != '"' {
+                i += if b[i] == '\\' { 2 } else { 1 };
+            }
+            i += 1;
+            out.push_str("\"\"");
+        } else if b[i] == '\'' && b.get(i + 2) == Some(&'\'') {
+            i += 3; // a char literal such as '"'
+        } else {
+            out.push(b[i]);
+            i += 1;
+        }
+    }
+    out
+}
+
+/// Every path that starts with `crate`, `super`, `self` or `cosserat` in `code`, with `use`
+/// groups `a::{b, c::d}` expanded.
+fn paths(code: &str) -> Vec<Vec<String>> {
+    let chars: Vec<char> = code.chars().collect();
+    let mut out = Vec::new();
+    let ident = |c: char| c.is_alphanumeric() || c == '_';
+    let mut i = 0;
+    while i < chars.len() {
+        if ident(chars[i]) && (i == 0 || !(ident(chars[i - 1]) || chars[i - 1] == ':')) {
+            let start = i;
+            while i < chars.len() && ident(chars[i]) {
+                i += 1;
+            }
+            let word: String = chars[start..i].iter().collect();
+            if matches!(word.as_str(), "crate" | "super" | "self" | "cosserat") && chars.get(i) == Some(&':') {
+                let mut prefix = vec![word];
+                i = read_path(&chars, i, &mut prefix, &mut out);
+            }
+        } else {
+            i += 1;
+        }
+    }
+    out
+}
+
+/// Continue a path after `prefix` at `i` (which points at `::`), pushing complete paths.
+fn read_path(chars: &[char], mut i: usize, prefix: &mut Vec<String>, out: &mut Vec<Vec<String>>) -> usize {
+    let ident = |c: char| c.is_alphanumeric() || c == '_';
+    while chars.get(i) == Some(&':') && chars.get(i + 1) == Some(&':') {
+        i += 2;
+        while chars.get(i).is_some_and(|c| c.is_whitespace()) {
+            i += 1;
+        }
+        if chars.get(i) == Some(&'{') {
+            i += 1;
+            loop {
+                while chars.get(i).is_some_and(|c| c.is_whitespace() || *c == ',') {
+                    i += 1;
+                }
+                match chars.get(i) {
+                    None => return i,
+                    Some('}') => return i + 1,
+                    _ => {}
+                }
+                let start = i;
+                while chars.get(i).is_some_and(|c| ident(*c) || *c == '*') {
+                    i += 1;
+                }
+                let mut p = prefix.clone();
+                p.push(chars[start..i].iter().collect());
+                i = read_path(chars, i, &mut p, out);
+                // skip `as name`
+                while chars.get(i).is_some_and(|c| *c != ',' && *c != '}') {
+                    i += 1;
+                }
+            }
+        }
+        let start = i;
+        while chars.get(i).is_some_and(|c| ident(*c) || *c == '*') {
+            i += 1;
+        }
+        if start == i {
+            break;
+        }
+        prefix.push(chars[start..i].iter().collect());
+    }
+    out.push(prefix.clone());
+    i
+}
+
+/// The module a path in `from` refers to: the longest prefix that is a known module.
+fn resolve(from: &str, path: &[String], modules: &BTreeSet<String>) -> Option<String> {
+    let mut base: Vec<String> = match path[0].as_str() {
+        "crate" | "cosserat" => Vec::new(),
+        "self" | "super" => {
+            // `self` is the file's module, `super` its parent (inline `mod tests` blocks use
+            // `super` for their file: an edge to the parent, which is not counted)
+            let mut b: Vec<String> =
+                if from.is_empty() { Vec::new() } else { from.split("::").map(String::from).collect() };
+            if path[0] == "super" {
+                b.pop();
+            }
+            b
+        }
+        _ => return None,
+    };
+    let mut rest = &path[1..];
+    while rest.first().is_some_and(|s| s == "super") {
+        base.pop();
+        rest = &rest[1..];
+    }
+    let mut best = None;
+    let mut cur = base.clone();
+    if !cur.is_empty() && modules.contains(&cur.join("::")) {
+        best = Some(cur.join("::"));
+    }
+    for seg in rest {
+        cur.push(seg.clone());
+        let name = cur.join("::");
+        if modules.contains(&name) {
+            best = Some(name);
+        }
+    }
+    best
+}
+
+/// Strongly connected components with more than one module (Tarjan).
+fn cycles(graph: &BTreeMap<String, BTreeSet<String>>) -> Vec<Vec<String>> {
+    struct T<'a> {
+        g: &'a BTreeMap<String, BTreeSet<String>>,
+        index: BTreeMap<&'a str, usize>,
+        low: BTreeMap<&'a str, usize>,
+        stack: Vec<&'a str>,
+        on: BTreeSet<&'a str>,
+        next: usize,
+        out: Vec<Vec<String>>,
+    }
+    fn visit<'a>(t: &mut T<'a>, v: &'a str) {
+        t.index.insert(v, t.next);
+        t.low.insert(v, t.next);
+        t.next += 1;
+        t.stack.push(v);
+        t.on.insert(v);
+        for w in t.g.get(v).into_iter().flatten() {
+            let w = w.as_str();
+            if !t.index.contains_key(w) {
+                visit(t, w);
+                let lw = t.low[w];
+                let lv = t.low.get_mut(v).expect("low");
+                *lv = (*lv).min(lw);
+            } else if t.on.contains(w) {
+                let iw = t.index[w];
+                let lv = t.low.get_mut(v).expect("low");
+                *lv = (*lv).min(iw);
+            }
+        }
+        if t.low[v] == t.index[v] {
+            let mut comp = Vec::new();
+            while let Some(w) = t.stack.pop() {
+                t.on.remove(w);
+                comp.push(w.to_string());
+                if w == v {
+                    break;
+                }
+            }
+            if comp.len() > 1 {
+                comp.sort();
+                t.out.push(comp);
+            }
+        }
+    }
+    let mut t = T {
+        g: graph,
+        index: BTreeMap::new(),
+        low: BTreeMap::new(),
+        stack: Vec::new(),
+        on: BTreeSet::new(),
+        next: 0,
+        out: Vec::new(),
+    };
+    for v in graph.keys() {
+        if !t.index.contains_key(v.as_str()) {
+            visit(&mut t, v);
+        }
+    }
+    t.out
+}
+
+#[test]
+fn layers_are_imported_downward_only_without_cycles_and_files_are_short() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let src = root.join("src");
+    let mut files = Vec::new();
+    rust_files(&src, &mut files);
+    files.sort();
+    let modules: BTreeSet<String> =
+        files.iter().map(|f| module_of(&src, f)).filter(|m| !m.is_empty() && m != "main").collect();
+    let mut graph: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
+    let mut upward = Vec::new();
+    let mut long = Vec::new();
+    for f in &files {
+        let text = std::fs::read_to_string(f).expect("source");
+        let from = module_of(&src, f);
+        if text.lines().count() > MAX_LINES {
+            long.push(format!("{} ({} lines)", f.display(), text.lines().count()));
+        }
+        if from.is_empty() {
+            continue; // lib.rs declares the modules
+        }
+        for p in paths(&code_only(&text)) {
+            let Some(to) = resolve(&from, &p, &modules) else { continue };
+            if to == from || to.starts_with(&format!("{from}::")) || from.starts_with(&format!("{to}::")) {
+                continue; // a module and its own submodules
+            }
+            graph.entry(from.clone()).or_default().insert(to.clone());
+            if layer(&to) > layer(&from) {
+                upward.push(format!("{from} → {to} ({})", p.join("::")));
+            }
+        }
+    }
+    for m in &modules {
+        graph.entry(m.clone()).or_default();
+    }
+    let edges: usize = graph.values().map(BTreeSet::len).sum();
+    let cyc = cycles(&graph);
+    let largest = files
+        .iter()
+        .map(|f| (std::fs::read_to_string(f).map(|t| t.lines().count()).unwrap_or(0), f))
+        .max()
+        .map(|(n, f)| format!("{} ({n} lines)", f.strip_prefix(root).unwrap_or(f).display()))
+        .unwrap_or_default();
+    println!(
+        "{} modules, {edges} imports between modules, {} cycles, {} upward imports; largest file {largest}",
+        modules.len() + 1,
+        cyc.len(),
+        upward.len()
+    );
+    assert!(cyc.is_empty(), "import cycles: {cyc:?}");
+    assert!(upward.is_empty(), "imports from a lower layer to a higher one:\n{}", upward.join("\n"));
+    let mut test_files = Vec::new();
+    rust_files(&root.join("tests"), &mut test_files);
+    rust_files(&root.join("examples"), &mut test_files);
+    for f in test_files {
+        let n = std::fs::read_to_string(&f).expect("source").lines().count();
+        if n > MAX_LINES {
+            long.push(format!("{} ({n} lines)", f.display()));
+        }
+    }
+    assert!(long.is_empty(), "files over {MAX_LINES} lines: {long:?}");
+}
+
+/// The checker itself: it finds a cycle and an upward import when there is one, and reads
+/// grouped imports, `super` and paths inside code but not inside comments or strings.
+#[test]
+fn the_checker_sees_imports_and_cycles() {
+    let code = code_only(
+        "use crate::io::{files::write_atomic, plot::{render_svg, Series}};\n// crate::run::X\nlet s = \"crate::case\"; super::kkt::X; crate::model::mesh::Field::X",
+    );
+    let p = paths(&code);
+    let modules: BTreeSet<String> = [
+        "io",
+        "io::files",
+        "io::plot",
+        "model",
+        "model::mesh",
+        "run",
+        "case",
+        "solve",
+        "solve::inverse",
+        "solve::inverse::kkt",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
+    let resolved: BTreeSet<String> = p.iter().filter_map(|p| resolve("solve::inverse::newton", p, &modules)).collect();
+    let expected: BTreeSet<String> =
+        ["io::files", "io::plot", "solve::inverse::kkt", "model::mesh"].iter().map(|s| s.to_string()).collect();
+    assert_eq!(resolved, expected, "{p:?}");
+    let mut g: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
+    g.entry("a".into()).or_default().insert("b".into());
+    g.entry("b".into()).or_default().insert("c".into());
+    g.entry("c".into()).or_default().insert("a".into());
+    g.entry("d".into()).or_default().insert("a".into());
+    assert_eq!(cycles(&g), vec![vec!["a".to_string(), "b".to_string(), "c".to_string()]]);
+    assert!(layer("io::files") > layer("run::clip") && layer("model::mesh") < layer("assemble"));
+}
