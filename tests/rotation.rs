@@ -7,7 +7,10 @@
 mod common;
 
 use common::{case_from, case_text, edit, worm_data_present};
+use cosserat::case::Case;
+use cosserat::io::engine::run_case;
 use cosserat::io::engine::{run_clip_case, EngineError};
+use cosserat::run::Engine;
 use cosserat::run::RunError;
 use cosserat::solve::sequence::SequenceError;
 use nalgebra::{Matrix3, Rotation3, Vector3};
@@ -27,15 +30,20 @@ fn parse(path: &Path) -> Vec<Vec<f64>> {
     text.lines().skip(1).map(|l| l.split(',').map(|v| v.parse::<f64>().expect("number")).collect()).collect()
 }
 
-/// The omega/delta Newton case (λd = 1) with extra `[clip]` lines, run into a temporary folder.
-fn run(name: &str, clip_lines: &str, frames: Option<usize>) -> Result<Recovered, EngineError> {
+/// The omega/delta Newton case (λd = 1) with extra `[clip]` lines.
+fn clip_case(name: &str, clip_lines: &str, frames: Option<usize>) -> Case {
     let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/elegansbot");
     let mut text = edit(&case_text(name), "file = \"../data/elegansbot/", &format!("file = \"{}/", data.display()));
     text = edit(&text, "start = \"data_guess\"", &format!("start = \"data_guess\"\n{clip_lines}"));
     if let Some(n) = frames {
         text = edit(&text, "min_cos_beta = 1e-3", &format!("min_cos_beta = 1e-3\nframes = [0, {n}]"));
     }
-    let case = case_from(&text, name);
+    case_from(&text, name)
+}
+
+/// [`clip_case`] run into a temporary folder.
+fn run(name: &str, clip_lines: &str, frames: Option<usize>) -> Result<Recovered, EngineError> {
+    let case = clip_case(name, clip_lines, frames);
     let dir = tempfile::tempdir().expect("tempdir");
     let r = run_clip_case(&case, dir.path(), |_, _| {})?;
     let frames_csv = parse(&dir.path().join("frames.csv"));
@@ -153,4 +161,35 @@ fn delta_turn_in_any_orientation() {
     if worm_data_present("delta_turn_in_any_orientation") {
         check_clip("worm_delta_turn_ld1", std::env::var("COSSERAT_TEST_FRAMES").ok().and_then(|v| v.parse().ok()));
     }
+}
+
+/// `compare` and `sweep` on a clip case solve its first frame alone, in the paper's chart
+/// from the straight reference state (both engines). A clip whose first frame the clip driver
+/// solves in a rotated chart is refused by both engines with an error naming the keys, instead
+/// of its `clip.rotation`, `clip.gauge` or `clip.orientation` being ignored; the x–z
+/// placement (axis e2) runs as before.
+#[test]
+fn the_single_frame_path_refuses_a_rotated_first_chart() {
+    if !worm_data_present("the_single_frame_path_refuses_a_rotated_first_chart") {
+        return;
+    }
+    let dir = tempfile::tempdir().expect("tempdir");
+    let solve =
+        |lines: &str, engine| run_case(&clip_case("worm_omega_turn_ld1", lines, None), engine, dir.path(), |_, _| {});
+    let turned = "orientation = [0.9, -2.1, 1.3]";
+    for engine in [Engine::Rust, Engine::Freefem] {
+        match solve(turned, engine) {
+            Err(EngineError::Run(e @ RunError::Chart { .. })) => {
+                let text = e.to_string();
+                assert!(text.contains("clip.rotation") && text.contains("cosserat run"), "{text}");
+            }
+            other => panic!("{engine}: the rotated first chart must be refused, got {:?}", other.map(|r| r.stats)),
+        }
+    }
+    let plain = solve("", Engine::Rust).expect("x–z placement");
+    let fit = plain.inverse.as_ref().and_then(|i| i.history.last()).map(|h| h.x_err_rel).expect("history");
+    assert!(plain.nodes.chart.is_identity() && fit < 1e-5, "{fit:e}");
+    // the same rotated clip in the paper's chart is accepted (a single frame need not reach
+    // the singular set)
+    assert!(solve(&format!("{turned}\nrotation = \"global_euler\""), Engine::Rust).is_ok());
 }

@@ -83,6 +83,7 @@ pub fn run_inverse_on(
     workdir: &Path,
     progress: impl FnMut(usize, usize),
 ) -> Result<RunResult, EngineError> {
+    run::check_single_frame(case)?;
     let data = read_data(data_path, &case.mesh)?;
     match engine {
         Engine::Rust => Ok(run::run_inverse(case, &data, progress)?),

@@ -44,6 +44,7 @@ pub enum FreeFemError {
     Unsupported(&'static str),
     #[error("case `{0}` is not an inverse case")]
     NotInverse(String),
+
     #[error("FreeFEM output {path}: {reason}")]
     BadOutput { path: PathBuf, reason: String },
     #[error("cannot read FreeFEM output")]
@@ -186,6 +187,7 @@ pub fn include_file(case: &Case) -> String {
 /// `workdir` as `data.csv` unless it is already there). `data` is the parsed content of that file.
 pub fn run_inverse(case: &Case, data: NodalState, data_path: &Path, workdir: &Path) -> Result<RunResult, FreeFemError> {
     let inv = case.inverse().ok_or_else(|| FreeFemError::NotInverse(case.name.clone()))?;
+
     if matches!(inv.params.method, InverseMethod::Newton { .. }) {
         return Err(FreeFemError::Unsupported(
             "the FreeFEM engine mirrors the paper's fixed point only (solver.method = \"fixed_point\")",

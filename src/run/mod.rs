@@ -16,7 +16,7 @@ use crate::case::{Analysis, Case, DataSource};
 use crate::clip::ClipError;
 use crate::model::mesh::Field;
 use crate::solve::inverse::{Frame, FrameSolver, InverseRecord, Start};
-use crate::solve::sequence::SequenceError;
+use crate::solve::sequence::{first_chart, SequenceError};
 use crate::solve::{dynamics, statics, SolveError};
 use metrics::INNER_SKIP_ELEMENTS;
 
@@ -31,6 +31,10 @@ pub enum RunError {
     Sequence(#[from] SequenceError),
     #[error("case `{case}` is not {what}")]
     Kind { case: String, what: &'static str },
+    #[error(
+        "case `{case}`: `compare` and `sweep` solve a clip's first frame alone, in the paper's angle chart (eq. 1) from the straight reference state, but this clip's first frame is solved in the rebased chart with singular axis ({:.3}, {:.3}, {:.3}) (clip.rotation = \"rebased\" with clip.gauge or clip.orientation away from e2). `cosserat run` solves the whole clip in its charts; to compare the first frame, set clip.rotation = \"global_euler\" or a gauge along e2", axis[0], axis[1], axis[2]
+    )]
+    Chart { case: String, axis: [f64; 3] },
     #[error("writing the clip")]
     Sink(#[source] Box<dyn std::error::Error + Send + Sync>),
     /// The solver stopped without meeting its rule; `partial` holds the last iterate and the
@@ -112,14 +116,31 @@ pub fn angles_known(case: &Case) -> bool {
     matches!(case.inverse().map(|i| &i.data), Some(DataSource::Forward(_)))
 }
 
+/// The single-frame path (`run_inverse`: `compare` and `sweep` on a clip case) solves a clip's
+/// first frame in the paper's chart from the straight reference state, as the FreeFEM engine
+/// does. A clip whose first frame the clip driver solves in another chart (`clip.rotation =
+/// "rebased"` with `clip.gauge` or `clip.orientation` away from e2) is refused: from the straight
+/// state in a rotated chart the scheme reaches a spurious root, and in the paper's chart the
+/// settings would be ignored.
+pub fn check_single_frame(case: &Case) -> Result<(), RunError> {
+    match case.sequence_params().map(|sp| first_chart(&sp)) {
+        Some(chart) if !chart.is_identity() => {
+            Err(RunError::Chart { case: case.name.clone(), axis: chart.axis().into() })
+        }
+        _ => Ok(()),
+    }
+}
+
 /// Solve the inverse case `case` as one first frame (Remark 6) in the Rust engine on the data
-/// `data` (its positions; for synthetic data also the true angles, for the curvature errors).
+/// `data` (its positions; for synthetic data also the true angles, for the curvature errors),
+/// from the straight reference state in the paper's chart ([`check_single_frame`]).
 pub fn run_inverse(
     case: &Case,
     data: &NodalState,
     mut progress: impl FnMut(usize, usize),
 ) -> Result<RunResult, RunError> {
     let settings = case.inverse().ok_or_else(|| RunError::kind(case, "an inverse case"))?;
+    check_single_frame(case)?;
     let params = settings.params;
     let problem = case.problem();
     let start = Instant::now();

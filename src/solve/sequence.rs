@@ -92,6 +92,15 @@ pub enum SequenceError {
     Callback { frame: usize, message: String },
 }
 
+/// The chart of a clip's first frame: the paper's global chart, or the rebased chart whose
+/// singular axis is the gauge (R7).
+pub fn first_chart(sp: &SequenceParams) -> Chart {
+    match sp.rotation {
+        RotationTreatment::GlobalEuler => Chart::identity(),
+        RotationTreatment::Rebased => Chart::with_axis(&sp.gauge),
+    }
+}
+
 /// Smallest |cos β| over the nodes of a state (forward layout `dofs`) and its node.
 pub fn min_cos_beta(dofs: &DofMap, u: &DVector<f64>) -> (f64, usize) {
     (0..dofs.nodes()).map(|i| (dofs.get(u, i, Field::Alpha)[1].cos().abs(), i)).fold((f64::INFINITY, 0), |a, b| {
@@ -198,8 +207,7 @@ pub fn solve_sequence(
         let k = i + sp.frame_offset;
         let start = std::time::Instant::now();
         let chart = match (sp.rotation, &prev) {
-            (RotationTreatment::GlobalEuler, _) => Chart::identity(),
-            (RotationTreatment::Rebased, None) => Chart::with_axis(&sp.gauge),
+            (RotationTreatment::GlobalEuler, _) | (_, None) => first_chart(sp),
             (RotationTreatment::Rebased, Some((c, _))) => Chart::with_axis(&frame_axis(x_space, Some(&c.axis()))),
         };
         let x_g: Vec<Vector3<f64>> =
