@@ -60,10 +60,12 @@ enum Command {
     Sweep {
         /// Case file (TOML)
         case: PathBuf,
-        /// Parameter and values, e.g. `--set lambda_l=1e-20,1e-10,1,1e3`; repeat for a
-        /// cartesian product. Inverse cases: lambda_g, lambda_f, lambda_l, lambda_d,
-        /// lambda_kappa1..3, lambda_omega1..3, relaxation, warm_start_tolerance, tolerance,
-        /// max_iterations, elements, stabilisation
+        /// Parameter and values, e.g. `--set lambda_d=1e-6,1e-4`; repeat for a cartesian
+        /// product. Each value is set in the case file's table and the case validated again.
+        /// Inverse cases: lambda_g, lambda_f, lambda_l, lambda_d, lambda_kappa1..3,
+        /// lambda_omega1..3, relaxation, warm_start_tolerance, tolerance, max_iterations,
+        /// elements, stabilisation. Static: relaxation, tolerance, max_iterations,
+        /// continuation_steps, elements. Dynamic: tolerance, max_iterations, steps, elements
         #[arg(long = "set", value_name = "KEY=V1,V2,...", required = true)]
         set: Vec<String>,
         /// Output directory [default: out/<case name>/sweep]

@@ -203,6 +203,21 @@ pub const TRUTH_COLUMNS: [&str; 10] = [
     "roll_offset_rad",
 ];
 
+/// The frame numbers of a clip run as the x axis of its per-frame figures.
+struct FrameAxis(Vec<f64>);
+
+impl FrameAxis {
+    fn new(reports: &[FrameReport]) -> Self {
+        FrameAxis(reports.iter().map(|r| r.frame as f64).collect())
+    }
+    fn series(&self, label: &str, y: Vec<f64>) -> Series {
+        Series { label: label.into(), x: self.0.clone(), y }
+    }
+    fn plot(title: String, y_label: &str, series: Vec<Series>, log_y: bool) -> LinePlot {
+        LinePlot { title, x_label: "frame".into(), y_label: y_label.into(), series, log_x: false, log_y }
+    }
+}
+
 /// Recovered vs true for a synthetic clip (`truth.svg`): bending κ1² + κ2² kymographs (true,
 /// recovered) and per frame the errors, the roll offset against the true roll, and κ3.
 pub fn write_truth_plot(case: &Case, run: &ClipRun, path: &Path) -> Result<(), OutputError> {
@@ -211,16 +226,8 @@ pub fn write_truth_plot(case: &Case, run: &ClipRun, path: &Path) -> Result<(), O
     if nf < 2 {
         return Ok(());
     }
-    let f: Vec<f64> = run.reports.iter().map(|r| r.frame as f64).collect();
-    let s = |label: &str, y: Vec<f64>| Series { label: label.into(), x: f.clone(), y };
-    let plot = |title: String, yl: &str, series: Vec<Series>, log_y: bool| LinePlot {
-        title,
-        x_label: "frame".into(),
-        y_label: yl.into(),
-        series,
-        log_x: false,
-        log_y,
-    };
+    let axis = FrameAxis::new(&run.reports);
+    let (s, plot) = (|l: &str, y| axis.series(l, y), FrameAxis::plot);
     let c = &t.comparisons;
     let panels = vec![
         plot(
@@ -301,16 +308,8 @@ pub fn write_clip_plot(
     if reports.is_empty() {
         return Ok(());
     }
-    let f: Vec<f64> = reports.iter().map(|r| r.frame as f64).collect();
-    let s = |label: &str, y: Vec<f64>| Series { label: label.into(), x: f.clone(), y };
-    let plot = |title: String, yl: &str, series: Vec<Series>, log_y: bool| LinePlot {
-        title,
-        x_label: "frame".into(),
-        y_label: yl.into(),
-        series,
-        log_x: false,
-        log_y,
-    };
+    let axis = FrameAxis::new(reports);
+    let (s, plot) = (|l: &str, y| axis.series(l, y), FrameAxis::plot);
     let panels = vec![
         plot(
             format!("{}: iterations per frame", case.name),

@@ -116,9 +116,9 @@ pub(crate) fn add3(m: &mut KktMat, ro: usize, co: usize, blk: &Matrix3<f64>) {
     }
 }
 
-/// Local KKT matrix and right-hand side of one element (I4), coefficients frozen at the
-/// element's state `uk`; `xg`, `alpha_prev`: the data and the previous frame's angles at its
-/// nodes (`first_frame`: no Λω term).
+/// Local KKT matrix (added into `m`, which the caller zeroes) and right-hand side (returned)
+/// of one element (I4), coefficients frozen at the element's state `uk`; `xg`, `alpha_prev`:
+/// the data and the previous frame's angles at its nodes (`first_frame`: no Λω term).
 #[allow(non_snake_case)] // paper symbols W, D, A, Kk
 pub(crate) fn element_system(
     problem: &Problem,
@@ -127,10 +127,10 @@ pub(crate) fn element_system(
     uk: &LocalVec,
     xg: [Vector3<f64>; 2],
     alpha_prev: [Vector3<f64>; 2],
-) -> (KktMat, KktVec) {
+    m: &mut KktMat,
+) -> KktVec {
     let h = problem.mesh.h();
     let w8 = &p.weights;
-    let mut m = KktMat::zeros();
     let mut r = KktVec::zeros();
     // Frozen operator: primal rows (hat test) × state columns, and its transpose.
     let (l, b) = frozen_operator(&problem.props, problem.scheme, h, uk);
@@ -166,10 +166,10 @@ pub(crate) fn element_system(
             }
             for c in 0..2 {
                 let nn = wh * n[a] * n[c];
-                add3(&mut m, X[a], X[c], &(Matrix3::identity() * (w8.lambda_g * nn)));
-                add3(&mut m, XH[a], XH[c], &(Matrix3::identity() * (-nn / w8.lambda_f)));
-                add3(&mut m, ALH[a], ALH[c], &(Matrix3::identity() * (-nn / w8.lambda_l)));
-                add3(&mut m, AL[a], AL[c], &(W * nn));
+                add3(m, X[a], X[c], &(Matrix3::identity() * (w8.lambda_g * nn)));
+                add3(m, XH[a], XH[c], &(Matrix3::identity() * (-nn / w8.lambda_f)));
+                add3(m, ALH[a], ALH[c], &(Matrix3::identity() * (-nn / w8.lambda_l)));
+                add3(m, AL[a], AL[c], &(W * nn));
             }
         }
     }
@@ -189,7 +189,7 @@ pub(crate) fn element_system(
                 let tc = [Matrix3::identity() * q.dn[cc], -D * q.n[cc]];
                 for (ra, ro) in [(0, X[a]), (1, AL[a])] {
                     for (ca, co) in [(0, X[cc]), (1, AL[cc])] {
-                        add3(&mut m, ro, co, &(ta[ra].transpose() * tc[ca] * wh));
+                        add3(m, ro, co, &(ta[ra].transpose() * tc[ca] * wh));
                     }
                 }
             }
@@ -203,12 +203,12 @@ pub(crate) fn element_system(
             let Kk = A.transpose() * Matrix3::from_diagonal(&w8.lambda_kappa) * A * (w * h);
             for a in 0..2 {
                 for c in 0..2 {
-                    add3(&mut m, AL[a], AL[c], &(Kk * (q.dn[a] * q.dn[c])));
+                    add3(m, AL[a], AL[c], &(Kk * (q.dn[a] * q.dn[c])));
                 }
             }
         }
     }
-    (m, r)
+    r
 }
 
 /// Dirichlet unknowns of I5 (KKT layout) with their values: `x = x_g` and `x̂ = α̂ = 0` at
@@ -255,14 +255,11 @@ pub fn assemble_system(
     let kkt_dofs = problem.mesh.kkt_dofs();
     values.iter_mut().for_each(|v| *v = 0.0);
     let mut rhs = kkt_dofs.zeros();
+    let mut scratch = KktMat::zeros();
     assemble(&kkt_dofs, &mut rhs, Some(Tangent::new(pattern, values, 1.0)), |e, t| {
         let uk: LocalVec = fwd.gather(u, e);
-        let (m, r) =
-            element_system(problem, p, first_frame, &uk, [x_g[e], x_g[e + 1]], [alpha_prev[e], alpha_prev[e + 1]]);
-        if let Some(t) = t {
-            *t = m;
-        }
-        r
+        let m = t.unwrap_or(&mut scratch);
+        element_system(problem, p, first_frame, &uk, [x_g[e], x_g[e + 1]], [alpha_prev[e], alpha_prev[e + 1]], m)
     });
     rhs
 }

@@ -258,7 +258,7 @@ impl<'p> FrameSolver<'p> {
         for (what, nodes) in [
             ("data x_g", frame.x_g.len()),
             ("previous frame's angles", frame.previous.map_or(expected, <[Angles]>::len)),
-            ("initial state", u0.len() / fwd.block()),
+            ("initial state", if u0.len() == fwd.len() { expected } else { u0.len() / fwd.block() }),
         ] {
             if nodes != expected {
                 return Err(SolveError::NodeCount { what, nodes, expected });

@@ -165,15 +165,22 @@ pub fn assemble_residual(
     let dofs = problem.mesh.kkt_dofs();
     let first = frame.is_first();
     let x_g = frame.x_g;
+    let mut scratch = KktMat::zeros();
     let kernel = |e: usize, t: Option<&mut KktMat>| {
         let ue: KktVec = dofs.gather(big, e);
         let uk = element_part(&ue, false);
         let ap = [alpha_prev[e], alpha_prev[e + 1]];
-        let (m, rhs) = element_system(problem, p, first, &uk, [x_g[e], x_g[e + 1]], ap);
-        if let Some(t) = t {
-            *t = m + coefficient_derivative(problem, p, first, &ue, ap);
+        let jacobian = t.is_some();
+        let m = t.unwrap_or_else(|| {
+            scratch.fill(0.0);
+            &mut scratch
+        });
+        let rhs = element_system(problem, p, first, &uk, [x_g[e], x_g[e + 1]], ap, m);
+        let r = *m * ue - rhs;
+        if jacobian {
+            *m += coefficient_derivative(problem, p, first, &ue, ap);
         }
-        m * ue - rhs
+        r
     };
     let mut r = dofs.zeros();
     match jacobian {
