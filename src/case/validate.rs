@@ -1,6 +1,6 @@
 //! Raw case tables → the typed [`Case`]: one function per table, each building the solver's
 //! own params type directly, every rule in one place (a sweep's values go through these same
-//! functions, `case::overrides`). Errors name the file and the key.
+//! functions, `case::sweep`). Errors name the file and the key.
 use std::collections::BTreeMap;
 use std::path::Path;
 
