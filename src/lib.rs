@@ -11,7 +11,7 @@
 //! `α = (α, β, γ)` of the frame `Q = Rz(α) Rx(β) Ry(γ)` (eq. 1). Balance laws (5), (6) with the
 //! constitutive laws (11), (15), in weak form (40) with `j = 1`. Every reading of an ambiguous
 //! or misprinted part of the paper is in `docs/decisions.md` (D1–D14), `docs/inverse.md`
-//! (I1–I11) and `docs/rotation.md` (R1–R8).
+//! (I1–I12) and `docs/rotation.md` (R1–R8).
 //!
 //! ## Layers
 //! Each layer imports only the layers above it in this list (checked by

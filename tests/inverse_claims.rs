@@ -21,7 +21,7 @@ use cosserat::solve::Problem;
 use nalgebra::{DVector, Matrix3, Rotation3, Unit, Vector3};
 use rayon::prelude::*;
 
-/// Iteration cap of the sweeps: the base run stops after 363 iterations.
+/// Iteration cap of the sweeps: the base run stops after 361 iterations.
 const CAP: usize = 600;
 
 /// Forward data of eq. (64): the Newton solution (truth) and its nodal positions x_g.
@@ -148,29 +148,26 @@ fn spread(a: &[f64], b: &[f64]) -> f64 {
 /// Finding (2): "vary λl from 1e-20 to 1e3 … these convergence curves are exactly the same …
 /// l = α̂/λl always has a magnitude of 1e-7".
 ///
-/// **Reproduced only for λl ∈ [1e-12, 1e-6]; roughly up to 1e-3; not at 1e-20, 1 or 1e3**
-/// (Λκ3 = 1e-10 here, the paper's Fig. 9 used 1e-20). Measured (100 elements, stop 3e-6,
-/// cap 600; κ error: all elements (without 5 end elements)):
+/// **Reproduced for λl ∈ [1e-20, 1e-3]; not at 1 or 1e3** (Λκ3 = 1e-10 here, the paper's Fig. 9
+/// used 1e-20). Measured (100 elements, stop 3e-6, cap 600; κ error: all elements (without 5
+/// end elements)):
 ///
-/// | λl    | its  | ‖x−x_g‖/‖x_g‖ | κ error         | ‖l‖ [L²]           |
-/// |-------|------|---------------|-----------------|--------------------|
-/// | 1e-20 | 600✗ | 7.05e-5       | 278 (272)       | 2.5e-3 (noise)     |
-/// | 1e-12 | 379  | 8.02e-5       | 0.085 (0.019)   | 2.42e-8            |
-/// | 1e-10 | 363  | 8.17e-5       | 0.086 (0.018)   | 2.28e-8            |
-/// | 1e-6  | 364  | 8.16e-5       | 0.086 (0.018)   | 2.27e-8            |
-/// | 1e-3  | 378  | 8.01e-5       | 0.080 (0.018)   | 2.18e-8            |
-/// | 1     | 552  | 7.22e-5       | 0.027 (0.009)   | 7.5e-9             |
-/// | 1e3   | 600✗ | 1.81e-2       | 6.6 (6.1)       | 1.28e-7            |
+/// | λl    | its  | ‖x−x_g‖/‖x_g‖ | κ error         | ‖l‖ [L²]   |
+/// |-------|------|---------------|-----------------|------------|
+/// | 1e-20 | 361  | 8.20e-5       | 0.086 (0.018)   | 2.28e-8    |
+/// | 1e-12 | 361  | 8.20e-5       | 0.086 (0.018)   | 2.28e-8    |
+/// | 1e-10 | 361  | 8.20e-5       | 0.086 (0.018)   | 2.28e-8    |
+/// | 1e-6  | 361  | 8.20e-5       | 0.086 (0.018)   | 2.28e-8    |
+/// | 1e-3  | 373  | 8.07e-5       | 0.080 (0.018)   | 2.12e-8    |
+/// | 1     | 551  | 7.17e-5       | 0.027 (0.009)   | 7.5e-9     |
+/// | 1e3   | 600✗ | 1.81e-2       | 6.6 (6.1)       | 1.28e-7    |
 ///
-/// Max relative spread of the histories against λl = 1e-10 (common iterations): 1e-12: x
-/// 1.3e-10, κ 5.7e-3, inner κ 9.9e-2; 1e-6: 1.3e-6, 2.8e-3, 7.8e-3; 1e-3: 1.7e-3, 0.68
-/// (transient; 7.7e-2 from iteration 100), 0.58. So "the same curves" and ‖l‖ ≈ 2.3e-8
-/// constant (not 1e-7) hold for 1e-12 … 1e-6. At 1e-20 the x-error curve is still the same
-/// (spread 3.4e-9), but the angles are not determined: the relative change stays O(1) and κ
-/// wanders (a side run: 1e-14 converges with κ error 0.33, 1e-16 does not converge). λl = 1
-/// converges more slowly to a *better* κ; at 1e3 the torque is too costly and x is not fitted.
-/// A side run with the paper's Λκ3 = 1e-20 gives the same picture (1e-10: 364 its, κ 0.086;
-/// 1e-20: no convergence, κ error 1e5; 1e3: no convergence, x 1.8e-2).
+/// Max relative spread of the histories against λl = 1e-10 (common iterations): 1e-20 and
+/// 1e-12: x 1.1e-10, κ 3.0e-8; 1e-6: x 1.0e-6, κ 3.0e-4; 1e-3: x 1.6e-3, κ 0.63 (transient;
+/// 6.3e-2 from iteration 100). So "exactly the same curves" and ‖l‖ ≈ 2.3e-8 constant (the
+/// paper: ~1e-7) hold for 1e-20 … 1e-6. λl = 1 converges more slowly to a *better* κ; at 1e3
+/// the torque is too costly and x is not fitted. (With the one-point λd rule and the 2-point Λκ
+/// rule, 1e-20 did not converge: change O(1), κ error 278; docs/audit.md.)
 #[test]
 fn lambda_l_sweep() {
     let (_, b) = base();
@@ -183,32 +180,25 @@ fn lambda_l_sweep() {
         line("lambda_l", *l, get(*l), *l);
     }
     // 1e-12 and 1e-6: the same curves as 1e-10, and the same ‖l‖.
-    for l in [1e-12, 1e-6, 1e-3] {
+    for l in [1e-20, 1e-12, 1e-6, 1e-3] {
         let r = get(l);
         let (sx, sk, ski) =
             (spread(&xh(r), &xh(b)), spread(&kh(r, false), &kh(b, false)), spread(&kh(r, true), &kh(b, true)));
         let late = spread(&kh(r, false)[100..], &kh(b, false)[100..]);
         let ln = r.torque_norm(l) / b.torque_norm(1e-10);
         eprintln!("  lambda_l {l:e} vs 1e-10: spread x {sx:.2e}, kappa {sk:.2e} (from iteration 100: {late:.2e}), inner kappa {ski:.2e}; |l| ratio {ln:.3}");
-        // 363–418 iterations: where the plateau's 3e-6 stop falls is set by round-off (I9)
-        assert!(r.converged && r.iterations() <= 450, "{l}: {}", r.iterations());
+        // 361–373 iterations
+        assert!(r.converged && r.iterations() <= 400, "{l}: {}", r.iterations());
         assert!((ln - 1.0).abs() < 0.1, "{l}: {ln}");
         if l < 1e-3 {
-            // measured: x 1.3e-10 / 1.3e-6, κ 5.7e-3 / 2.8e-3, inner κ 9.9e-2 / 7.8e-3
-            let inner_bound = if l == 1e-12 { 0.15 } else { 0.02 };
-            assert!(sx < 1e-5 && sk < 0.02 && ski < inner_bound, "{l}: {sx} {sk} {ski}");
+            // measured: x ≤ 1.0e-6, κ ≤ 3.0e-4, inner κ ≤ 6.3e-4
+            assert!(sx < 1e-5 && sk < 3e-3 && ski < 6e-3, "{l}: {sx} {sk} {ski}");
         } else {
             // 1e-3: x still the same curve; κ differs in the transient, agrees later.
             assert!(sx < 5e-3 && sk > 0.3 && late < 0.1, "{l}: {sx} {sk} {late}");
         }
     }
     assert!(b.converged && (b.torque_norm(1e-10) - 2.28e-8).abs() < 0.1e-8, "{}", b.torque_norm(1e-10));
-    // 1e-20: x follows the same curve, the angles do not settle.
-    let r = get(1e-20);
-    let sx = spread(&xh(r), &xh(b));
-    eprintln!("  lambda_l 1e-20 vs 1e-10: spread x {sx:.2e}; final kappa error {:.1}", r.kappa.last().unwrap().0);
-    assert!(!r.converged && sx < 1e-7, "{sx}");
-    assert!(r.kappa[100..].iter().all(|k| k.0 > 1.0), "kappa error of 1e-20 should stay O(1)+");
     // 1: converges, later, to a smaller curvature error.
     let r = get(1.0);
     assert!(r.converged && (500..=600).contains(&r.iterations()), "{}", r.iterations());
@@ -221,46 +211,43 @@ fn lambda_l_sweep() {
 
 /// Finding (3): "converge stably with λd varying from 1e1 to 1e-10".
 ///
-/// **Reproduced for 1e-2 … 1e-10, not for 1e1.** Measured (stop 3e-6; κ error all elements
-/// (without 5 end elements)):
+/// **Reproduced** with the stabilised λd rule (ε = 1e-3, I11) and the midpoint rule for the Λκ
+/// term (I12). Measured (stop 3e-6; κ error all elements (without 5 end elements)):
 ///
-/// | λd    | its    | ‖x−x_g‖/‖x_g‖ | κ error       | ‖l‖     | J tracking / shear / total |
-/// |-------|--------|---------------|---------------|---------|----------------------------|
-/// | 1e1   | 600✗   | 1.37e-4       | 369 (360)     | 7.4e-4  | 1.5e-9 / 3.5e-9 / 5.4e-9   |
-/// | 1e-2  | 2827   | 1.36e-4       | 0.119 (0.081) | 8.8e-8  | 1.5e-9 / 4.8e-12 / 2.1e-9  |
-/// | 1e-6  | 363    | 8.17e-5       | 0.086 (0.018) | 2.3e-8  | 5.4e-10 / 5.1e-16 / 1.1e-9 |
-/// | 1e-10 | 364    | 8.16e-5       | 0.086 (0.018) | 2.3e-8  | 5.3e-10 / 5.1e-20 / 1.1e-9 |
+/// | λd    | its | ‖x−x_g‖/‖x_g‖ | κ error       | J tracking / shear / total   |
+/// |-------|-----|---------------|---------------|------------------------------|
+/// | 1e1   | 375 | 1.42e-4       | 0.086 (0.019) | 1.6e-9 / 4.0e-9 / 6.0e-9     |
+/// | 1e-2  | 361 | 8.20e-5       | 0.086 (0.018) | 5.4e-10 / 5.6e-12 / 1.1e-9   |
+/// | 1e-6  | 361 | 8.20e-5       | 0.086 (0.018) | 5.4e-10 / 5.6e-16 / 1.1e-9   |
+/// | 1e-10 | 361 | 8.20e-5       | 0.086 (0.018) | 5.4e-10 / 5.6e-20 / 1.1e-9   |
 ///
-/// At 1e1 the relative change stays at 5e-2 … 0.6 (also over 1500 iterations in a side run)
-/// while x is fitted: the angles zig-zag. 1e-2 converges, more slowly, with a worse κ. How
-/// slowly is set by round-off: with faer's sparse LU it stopped after 682 iterations (x 6.98e-5,
-/// κ 0.170), with the banded LU (issue 5) after 2827 (row above). Only the 1e-6 and 1e-10
-/// rows are insensitive to it.
-/// A side run with the paper's Λκ3 = 1e-20 for λd = 1e1: no convergence either (change 0.44
-/// at 600, κ error 760).
+/// With the one-point λd rule (ε = 0, the selective element's stretch–shear rule) 1e-2 needed
+/// 2827 iterations and 1e1 did not converge (change 0.05–0.6, κ error 369): the one-point rule
+/// cannot see the nodal zig-zag of the angles (docs/audit.md).
 #[test]
 fn lambda_d_sweep() {
     let (d, b) = base();
     let p = d.problem();
-    let set = |l: f64| InverseParams {
-        max_iterations: if l == 1e-2 { 3000 } else { CAP },
-        ..with_weights(&paper(), |w| w.lambda_d = l)
-    };
+    let set = |l: f64| with_weights(&paper(), |w| w.lambda_d = l);
     let runs = sweep(&[1e1, 1e-2, 1e-6, 1e-10], set, 1e-6, false);
     let get = |l: f64| runs.iter().find(|(v, _)| *v == l).map(|(_, r)| r.as_ref().unwrap_or(b)).expect("value");
     for (l, _) in &runs {
         line("lambda_d", *l, get(*l), 1e-10);
     }
     let kappa = |r: &Run| curvature_error(&p.mesh, &r.u, &d.truth, 0);
-    let r = get(1e-10);
-    assert!(r.converged && r.iterations().abs_diff(b.iterations()) <= 3);
-    assert!((kappa(r) / kappa(b) - 1.0).abs() < 0.01 && (r.last().x_err_rel / b.last().x_err_rel - 1.0).abs() < 0.01);
-    let r = get(1e-2);
-    assert!(r.converged && 2 * r.iterations() > 3 * b.iterations(), "{}", r.iterations());
-    assert!(r.last().x_err_rel < 2e-4 && kappa(r) > 1.2 * kappa(b), "{}", kappa(r));
+    for l in [1e-2, 1e-10] {
+        let r = get(l);
+        assert!(r.converged && r.iterations().abs_diff(b.iterations()) <= 3, "{l}: {}", r.iterations());
+        assert!(
+            (kappa(r) / kappa(b) - 1.0).abs() < 0.01 && (r.last().x_err_rel / b.last().x_err_rel - 1.0).abs() < 0.01
+        );
+    }
+    // 1e1: converges a few iterations later; x is fitted less tightly (the λd term pulls ∂s x
+    // towards d3), κ as well as at 1e-6.
     let r = get(1e1);
-    assert!(!r.converged && r.last().rel_change > 1e-3 && kappa(r) > 10.0, "{} {}", r.last().rel_change, kappa(r));
-    assert!(r.last().x_err_rel < 1e-3, "{}", r.last().x_err_rel);
+    assert!(r.converged && r.iterations() <= b.iterations() + 30, "{}", r.iterations());
+    assert!(r.last().x_err_rel < 2e-4 && r.last().x_err_rel > 1.5 * b.last().x_err_rel, "{}", r.last().x_err_rel);
+    assert!((kappa(r) / kappa(b) - 1.0).abs() < 0.05, "{}", kappa(r));
 }
 
 /// Finding (4): "converges for λf from 1e-10 to 1e6 … λf must be sufficiently small for the
@@ -369,20 +356,19 @@ fn equivariance_error(
 /// although it is the obvious candidate.
 ///
 /// Measured (x rel., max |Q′ − L Q Rᵀ|, κ rel., max angle change), after 1 | 20 iterations:
-/// - translation c:           2.0e-15, 3.4e-6, 2.5e-4 | 2.8e-9, 9.4e-6, 2.0e-4
-/// - relabelling Rz(0.7) + c: 2.0e-15, 5.8e-6, 3.3e-4 | 8.9e-7, 4.9e-5, 5.0e-4 (α + 0.7)
-/// - spatial Ry(0.6) + c:     1.4e-15, 4.6e-6, 2.6e-4 | 1.7e-6, 7.5e-5, 9.7e-4 (γ − 0.6)
-/// - spatial Rz(0.7) + c:     1.0e-15, 4.4e-2, 0.16   | 1.7e-2, 0.38, 2.8
-/// - general R + c:           1.9e-15, 4.2e-2, 0.13   | 6.1e-2, 2.0, 71
+/// - translation c:           1.7e-15, 7.5e-13, 5.2e-11 | 2.7e-7, 1.8e-5, 3.1e-4
+/// - relabelling Rz(0.7) + c: 1.6e-15, 6.2e-13, 3.7e-11 | 1.4e-7, 2.2e-5, 4.6e-4 (α + 0.7)
+/// - spatial Ry(0.6) + c:     1.2e-15, 6.7e-13, 3.9e-11 | 3.0e-6, 1.5e-4, 1.7e-3 (γ − 0.6)
+/// - spatial Rz(0.7) + c:     1.7e-15, 4.4e-2, 0.16     | 4.2e-4, 8.9e-3, 7.1e-2
+/// - general R + c:           2.8e-15, 4.2e-2, 0.12     | 2.1e-2, 1.9, 1.0e3
 ///
 /// (general R: axis (1, 2, 3), 0.5 rad; α0 from the chart of `Q(α_orig(0)) Rᵀ` — the product
-/// `R Q` is the relabelling, not a spatial rotation, in this convention.) Not 1e-9 even for a
-/// pure translation: the angles are this sensitive to round-off (a side run: a 1e-15 relative
-/// perturbation of x_g alone moves them by 6.5e-6 after one iteration); the symmetric cases sit
-/// at that level after one iteration, the others 4 orders above. The rotated non-symmetric
-/// runs do not even converge (side run: relative change 3.6e-4 / 1.2e-4 after 1000
-/// iterations, ‖x−x_g‖/‖x_g‖ 5e-3 / 4e-3, against 428 iterations unrotated): this is not
-/// discretisation error — the Euler chart makes the scheme orientation dependent.
+/// `R Q` is the relabelling, not a spatial rotation, in this convention.) After one iteration
+/// the symmetric cases agree to round-off; over 20 iterations the round-off differences grow
+/// (the near-null β zig-zag of I8, now held by the stabilised λd rule at ε = 1e-3: with ε = 0
+/// they were 3.5e-6 in Q after one iteration). The rotated non-symmetric runs are 40–1e4 times
+/// further apart: this is not discretisation error — the Euler chart makes the scheme
+/// orientation dependent.
 #[test]
 fn rigid_motions() {
     let d = Data::new(50);
@@ -424,15 +410,13 @@ fn rigid_motions() {
         errs
     };
     // One iteration from the straight state: x is linear in the data for all five; the
-    // frames agree at round-off sensitivity for the symmetries and to 4e-2 otherwise.
+    // frames agree to round-off for the symmetries and to 4e-2 otherwise.
     let errs = errors(1);
     for e in &errs {
         assert!(e[0] < 1e-14, "{e:?}");
     }
-    // (measured up to 1.2e-5 in Q: a 1e-15 change of the data moves the angles by 6.5e-6, and
-    // the LU's elimination order changes the round-off by as much)
     for e in &errs[..3] {
-        assert!(e[1] < 3e-5 && e[2] < 3e-3, "{e:?}");
+        assert!(e[1] < 1e-10 && e[2] < 1e-8, "{e:?}");
     }
     for e in &errs[3..] {
         assert!(e[1] > 1e-2 && e[2] > 0.05, "{e:?}");
@@ -442,8 +426,8 @@ fn rigid_motions() {
     for e in &errs[..3] {
         assert!(e[0] < 1e-5 && e[1] < 3e-4 && e[2] < 3e-3, "{e:?}");
     }
-    // Not exact: O(1) differences in the frames.
+    // Not exact: 40 times the symmetric differences and more.
     for e in &errs[3..] {
-        assert!(e[0] > 1e-3 && e[1] > 0.1 && e[2] > 1.0, "{e:?}");
+        assert!(e[0] > 1e-4 && e[1] > 5e-3 && e[2] > 0.05, "{e:?}");
     }
 }

@@ -4,7 +4,7 @@ mod common;
 
 use common::{case_from, case_text, edit, with_weights};
 use cosserat::model::mesh::{DofMap, Field};
-use cosserat::solve::inverse::{InverseMethod, InverseParams, Weights};
+use cosserat::solve::inverse::{InverseMethod, InverseParams, Weights, DEFAULT_STABILISATION};
 use cosserat::solve::sequence::{solve_sequence, FrameStart, RotationTreatment, SequenceError, SequenceParams};
 use cosserat::solve::statics::{self, Method, StaticParams};
 use cosserat::solve::Problem;
@@ -22,7 +22,7 @@ fn params() -> InverseParams {
         },
         frame_interval_s: 0.04,
         alpha0_rad: 0.0,
-        stabilisation: 0.0,
+        stabilisation: DEFAULT_STABILISATION,
         relaxation: 0.5,
         method: InverseMethod::FixedPoint,
         tolerance: 1e-5,

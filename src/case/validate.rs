@@ -18,7 +18,7 @@ use crate::model::loads::{LoadFrame, Loads};
 use crate::model::material::{CrossSection, Material, RodProperties};
 use crate::model::mesh::{Mesh, QuadratureScheme};
 use crate::solve::dynamics::DynamicParams;
-use crate::solve::inverse::{InverseMethod, InverseParams, Weights};
+use crate::solve::inverse::{InverseMethod, InverseParams, Weights, DEFAULT_STABILISATION};
 use crate::solve::sequence::{FrameStart, RotationTreatment};
 use crate::solve::statics::{Method, StaticParams};
 
@@ -378,7 +378,7 @@ impl<'a> Validator<'a> {
                 }
                 e
             }
-            None => 0.0,
+            None => DEFAULT_STABILISATION,
         };
         let params = InverseParams {
             weights,

@@ -10,7 +10,7 @@
 //! used (errata: (Δt²/2) F_n and M_{n−2}; see PAPER-NOTES and `docs/decisions.md`).
 use nalgebra::{DVector, Vector3};
 
-use super::{Problem, SolveError};
+use super::{divergence, Problem, SolveError};
 use crate::assemble::Tangent;
 use crate::linalg::LinearSolver;
 use crate::model::loads::LoadFrame;
@@ -101,8 +101,8 @@ pub fn solve(
             let du = solver.solve(&values, &(-r))?;
             u += &du;
             increment = problem.increment_measure(&du);
-            if !increment.is_finite() {
-                return Err(SolveError::NonFinite { step: Some(n), iteration: it });
+            if let Some((quantity, value)) = divergence(problem, &u, increment) {
+                return Err(SolveError::Diverged { step: Some(n), iteration: it, quantity, value });
             }
             if increment <= params.newton_tolerance {
                 converged = Some(it);

@@ -14,6 +14,7 @@ pub mod statics;
 pub use problem::Problem;
 
 use crate::linalg::LinearError;
+use crate::model;
 
 /// Why an iteration stopped with a usable iterate.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -34,8 +35,10 @@ pub enum SolveError {
     #[error("Newton did not converge after {iterations} iterations (last increment {increment:e}){}", step_text(*.step))]
     /// `step`: time step (dynamic) or continuation step (static)
     NewtonNotConverged { step: Option<usize>, iterations: usize, increment: f64 },
-    #[error("non-finite value in iteration {iteration}{}", step_text(*.step))]
-    NonFinite { step: Option<usize>, iteration: usize },
+    #[error("diverged in iteration {iteration}{}: {quantity} = {value:e}", step_text(*.step))]
+    /// `quantity` named with its limit (a non-finite value or one beyond [`DIVERGED_LENGTHS`],
+    /// [`DIVERGED_ANGLE_RAD`]); the iterate is not returned.
+    Diverged { step: Option<usize>, iteration: usize, quantity: &'static str, value: f64 },
     #[error(
         "inverse fixed point of frame {frame} did not converge after {iterations} iterations (last relative change of (x, α) {rel_change:e})"
     )]
@@ -44,12 +47,50 @@ pub enum SolveError {
         "inverse Newton of frame {frame} did not converge after {iterations} iterations (last residual ‖R‖/‖R₀‖ {residual:e})"
     )]
     InverseNewtonNotConverged { frame: usize, iterations: usize, residual: f64 },
-    #[error("non-finite value in iteration {iteration} of inverse frame {frame}")]
-    InverseNonFinite { frame: usize, iteration: usize },
+    #[error("inverse frame {frame} diverged in iteration {iteration}: {quantity} = {value:e}")]
+    /// `quantity` named with its limit (a non-finite value, or the misfit beyond
+    /// [`inverse::DIVERGED_X_ERR`]); the iterate is not returned.
+    InverseDiverged { frame: usize, iteration: usize, quantity: &'static str, value: f64 },
     #[error("{what}: {nodes} nodes, but the mesh has {expected}")]
     NodeCount { what: &'static str, nodes: usize, expected: usize },
     #[error(transparent)]
     Linear(#[from] LinearError),
+}
+
+/// A forward iterate whose centreline lies farther than this many rod lengths from the
+/// reference configuration has diverged (a converging static or dynamic solve of a rod of
+/// length L stays within L of its clamp).
+pub const DIVERGED_LENGTHS: f64 = 1e3;
+/// A forward iterate with an angle beyond this [rad] (≈ 160 turns) has diverged.
+pub const DIVERGED_ANGLE_RAD: f64 = 1e3;
+
+/// The first sign of divergence of a forward iterate `u` after a step measured by `change`:
+/// `(quantity with its limit, value)`, or `None` when every unknown is finite and within
+/// [`DIVERGED_LENGTHS`] and [`DIVERGED_ANGLE_RAD`].
+pub(crate) fn divergence(problem: &Problem, u: &nalgebra::DVector<f64>, change: f64) -> Option<(&'static str, f64)> {
+    if !change.is_finite() {
+        return Some(("the relative change (non-finite)", change));
+    }
+    if let Some(v) = u.iter().find(|v| !v.is_finite()) {
+        return Some(("an unknown of the iterate (non-finite)", *v));
+    }
+    let dofs = problem.dofs();
+    let reference = problem.reference_state();
+    let length = problem.mesh.length_m;
+    let far = dofs
+        .field(u, model::mesh::Field::X)
+        .iter()
+        .zip(dofs.field(&reference, model::mesh::Field::X))
+        .map(|(x, x0)| (x - x0).amax() / length)
+        .fold(0.0, f64::max);
+    if far > DIVERGED_LENGTHS {
+        return Some(("max |x − x_ref| / L (limit 1e3)", far));
+    }
+    let angle = dofs.field(u, model::mesh::Field::Alpha).iter().map(|a| a.amax()).fold(0.0, f64::max);
+    if angle > DIVERGED_ANGLE_RAD {
+        return Some(("max |α| [rad] (limit 1e3)", angle));
+    }
+    None
 }
 
 fn step_text(step: Option<usize>) -> String {

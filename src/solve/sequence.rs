@@ -248,7 +248,7 @@ pub fn solve_sequence(
             Err(
                 SolveError::InverseNotConverged { .. }
                 | SolveError::InverseNewtonNotConverged { .. }
-                | SolveError::InverseNonFinite { .. },
+                | SolveError::InverseDiverged { .. },
             ) if from_previous => (solve(&guess(), Start::Guess)?, true),
             Err(e) => return Err(e.into()),
         };

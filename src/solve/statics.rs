@@ -12,7 +12,7 @@
 //! 1. Wang et al., Comput. Mech. 71 (2023), §4, eqs. (52), (61), Remark 10.
 use nalgebra::DVector;
 
-use super::{Problem, SolveError, Stop};
+use super::{divergence, Problem, SolveError, Stop};
 use crate::assemble::{assemble, Tangent};
 use crate::linalg::{LinearSolver, Pattern};
 use crate::model::element::frozen_operator;
@@ -163,8 +163,8 @@ fn solve_step(
                 problem.increment_measure(&du)
             }
         };
-        if !change.is_finite() || u.iter().any(|v| !v.is_finite()) {
-            return Err(SolveError::NonFinite { step: Some(step), iteration: k });
+        if let Some((quantity, value)) = divergence(problem, &u, change) {
+            return Err(SolveError::Diverged { step: Some(step), iteration: k, quantity, value });
         }
         let rec = IterationRecord { step, iteration: k, change };
         progress(&rec);

@@ -6,6 +6,7 @@ use cosserat::case::Case;
 use cosserat::model::mesh::Field;
 use cosserat::solve::inverse::{
     Frame, FrameSolver, InverseMethod, InverseParams, InverseRecord, InverseSolution, Start, Weights,
+    DEFAULT_STABILISATION,
 };
 use cosserat::solve::{Problem, SolveError};
 use nalgebra::{DVector, Vector3};
@@ -90,7 +91,7 @@ pub fn paper_params_64() -> InverseParams {
         },
         frame_interval_s: 1.0,
         alpha0_rad: 0.0,
-        stabilisation: 0.0,
+        stabilisation: DEFAULT_STABILISATION,
         relaxation: 0.5,
         method: InverseMethod::FixedPoint,
         tolerance: 3e-6,

@@ -35,11 +35,9 @@ pub(crate) fn solve(
         let u_next = &u_new * params.relaxation + &u * (1.0 - params.relaxation);
         let rel_change = relative_change(&fwd, &u_next, &u);
         u = u_next;
-        if !rel_change.is_finite() || u.iter().chain(adjoint.iter()).any(|v| !v.is_finite()) {
-            return Err(SolveError::InverseNonFinite { frame: frame.index, iteration: k });
-        }
         let previous = frame.previous.unwrap_or(&s.no_previous);
         let rec = record(s.problem, params, frame, previous, k, rel_change, &u, &adjoint, None);
+        rec.divergence(frame.index, &u, &adjoint)?;
         observer(&rec, &u, &adjoint);
         history.push(rec);
         if rel_change <= params.tolerance {

@@ -2,7 +2,7 @@
 //! terms of the objective (41), each one pass of [`integrate`] over the mesh.
 use nalgebra::{DVector, Vector3};
 
-use super::kkt::PointRule;
+use super::kkt::{PointRule, KAPPA_RULE};
 use super::{Frame, InverseParams, InverseRecord, ObjectiveTerms};
 use crate::assemble::integrate;
 use crate::model::element::{interpolate, LocalVec};
@@ -66,7 +66,7 @@ pub fn objective_terms(
         let q = state(e, xi);
         t.shear += 0.5 * w * h * w8.lambda_d * (q.dx - d3(&q.alpha)).norm_squared();
     });
-    integrate(mesh, problem.scheme.bending().iter(), |e, xi, w| {
+    integrate(mesh, KAPPA_RULE.iter(), |e, xi, w| {
         let q = state(e, xi);
         let k = curvature(&q.alpha, &q.dalpha);
         t.bending += 0.5 * w * h * k.component_mul(&k).dot(&w8.lambda_kappa);

@@ -23,7 +23,7 @@
 //! 1. Wang et al., Comput. Mech. 71 (2023), §3–4, eqs. (52)–(61), Remark 8, Remark 10.
 use nalgebra::{DVector, Matrix3, Vector3};
 
-use super::kkt::{add3, element_part, element_system, kkt, KktMat, KktVec, PointRule, AL, X};
+use super::kkt::{add3, element_part, element_system, kkt, KktMat, KktVec, PointRule, AL, KAPPA_RULE, X};
 use super::measures::record;
 use super::{Frame, FrameSolver, InverseParams, InverseRecord, InverseSolution};
 use crate::assemble::{assemble, Tangent};
@@ -49,7 +49,7 @@ const ARMIJO: f64 = 1e-4;
 ///   adjoint rows:  ∂/∂u [L(u)ᵀ û]:  ∫ ∂sδx · S(α) (∂s x̂ + ∂s x × α̂),  S = QᵀKQ   (stretch–shear rule)
 ///                                   ∫ ∂sδα · (QᵀJA)ᵀ ∂s α̂                    (bending rule)
 ///                  λd:  −λd ∫ δα · [v·∂²d3/∂α_i∂α_j] δα,  v = ∂s x − d3            (stretch–shear rule)
-///                  Λκ:  ∫ ∂sδα · ∂_α(AᵀΛκA) ∂sα                                    (bending rule)
+///                  Λκ:  ∫ ∂sδα · ∂_α(AᵀΛκA) ∂sα                                    (Λκ rule, I12)
 ///                  Λω:  ∫ δα · ∂_α(AᵀΛωA) (α − α_{n−1}) / Δt²                      (load rule)
 /// ```
 #[allow(non_snake_case)] // paper symbols K, J, Q, A, S, H2, Lk, Lw
@@ -107,23 +107,32 @@ fn coefficient_derivative(
             }
         }
     }
-    // Bending rule: L(u)ᵀ û on the α rows, and the Λκ term.
-    let kappa_on = w8.lambda_kappa.amax() > 0.0;
-    let Lk = Matrix3::from_diagonal(&w8.lambda_kappa);
+    // Bending rule: L(u)ᵀ û on the α rows.
     for (xi, w) in problem.scheme.bending().iter() {
         let (q, qa) = (interpolate(&state, h, xi), interpolate(&adj, h, xi));
         let wh = w * h;
         let f = PointFrame::new(&q.alpha, true);
         let (Q, A, dQ, dA) = (f.q, f.a, f.dq, f.da);
-        let mut blk = columns(
+        let blk = columns(
             [0, 1, 2].map(|j| (dQ[j].transpose() * Jm * A + Q.transpose() * Jm * dA[j]).transpose() * qa.dalpha),
         );
-        if kappa_on {
-            blk += columns([0, 1, 2].map(|j| (dA[j].transpose() * Lk * A + A.transpose() * Lk * dA[j]) * q.dalpha));
-        }
         for c in 0..2 {
             for b in 0..2 {
                 add3(&mut e, AL[c], AL[b], &(blk * (wh * q.dn[c] * q.n[b])));
+            }
+        }
+    }
+    // The Λκ term's rule (I12).
+    if w8.lambda_kappa.amax() > 0.0 {
+        let Lk = Matrix3::from_diagonal(&w8.lambda_kappa);
+        for (xi, w) in KAPPA_RULE.iter() {
+            let q = interpolate(&state, h, xi);
+            let (A, dA) = (a_matrix(&q.alpha), a_matrix_derivatives(&q.alpha));
+            let blk = columns([0, 1, 2].map(|j| (dA[j].transpose() * Lk * A + A.transpose() * Lk * dA[j]) * q.dalpha));
+            for c in 0..2 {
+                for b in 0..2 {
+                    add3(&mut e, AL[c], AL[b], &(blk * (w * h * q.dn[c] * q.n[b])));
+                }
             }
         }
     }
@@ -251,11 +260,9 @@ pub(crate) fn solve(
         u = dofs.kkt_state(&trial);
         let rel_change = relative_change(&fwd, &u, &u_old);
         big = trial;
-        if !rel_change.is_finite() || !phi_t.is_finite() || big.iter().any(|v| !v.is_finite()) {
-            return Err(SolveError::InverseNonFinite { frame: frame.index, iteration: k });
-        }
         adjoint = dofs.kkt_adjoint(&big);
         let rec = record(problem, params, frame, previous, k, rel_change, &u, &adjoint, Some(phi_t / phi0));
+        rec.divergence(frame.index, &u, &adjoint)?;
         observer(&rec, &u, &adjoint);
         history.push(rec);
         if full {
