@@ -25,7 +25,9 @@
 //! 5. [`clip`]: clips of centrelines (kymogram geometry, the synthetic 3D clip);
 //! 6. [`case`]: case files, validated into the solvers' params;
 //! 7. [`run`]: running a case in the Rust engine, results and metrics;
-//! 8. [`io`]: files, figures, the FreeFEM engine; then the `cosserat` binary (CLI).
+//! 8. [`io`]: files, figures, the FreeFEM engine;
+//! 9. [`audit`]: the audit of the paper's §5–6 (specs, checks, figures, report); then the
+//!    `cosserat` binary (CLI).
 //!
 //! ## Notation
 //! | symbol | Rust name | unit |
@@ -52,6 +54,7 @@
 //! 3. [R3] K. E. Bisshopp, D. C. Drucker, *Large deflection of cantilever beams*, Q. Appl. Math.
 //!    3 (1945) — elastica reference values.
 pub mod assemble;
+pub mod audit;
 pub mod case;
 pub mod clip;
 pub mod expr;

@@ -7,11 +7,10 @@ use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use cosserat::case::{case_files, Case};
-use cosserat::io::clip_output::{write_clip_kymographs, write_clip_plot, write_truth_plot};
 use cosserat::io::data::write_data;
-use cosserat::io::engine::{load_data, run_case, run_clip_case, run_inverse_on};
+use cosserat::io::engine::{load_data, run_case, run_clip_case, run_inverse_on, write_clip_figures};
 use cosserat::io::run_files::{write_convergence_plot, write_run};
-use cosserat::io::sweep::{run_point, summary_csv, RunStatus, SummaryRow};
+use cosserat::io::sweep::{run_point, summary_csv, RunStatus, SummaryRow, CLIP_SUMMARY_METRICS, SUMMARY_METRICS};
 use cosserat::io::write_atomic;
 use cosserat::run::metrics::{all_metrics, compare};
 use cosserat::run::{Engine, RunResult};
@@ -55,8 +54,10 @@ enum Command {
     /// values, status, iterations, recovery errors, objective, wall time, error message) and
     /// `convergence.svg` (log-log histories, one curve per run; Figs. 9-11 of the paper). A run
     /// that reaches its iteration limit is `not_converged`: its folder holds the last iterate
-    /// and FAILED.txt, and its curve is plotted. Exit status 1 if any run failed or did not
-    /// converge (after writing everything).
+    /// and FAILED.txt, and its curve is plotted. A clip case solves its whole clip for every
+    /// point (the folder holds the files of `run` on the clip; the summary has one row per
+    /// point: frames, iterations, worst fit, tangent misfit, |j - 1|, objective). Exit status 1
+    /// if any run failed or did not converge (after writing everything).
     Sweep {
         /// Case file (TOML)
         case: PathBuf,
@@ -69,6 +70,31 @@ enum Command {
         #[arg(long = "set", value_name = "KEY=V1,V2,...", required = true)]
         set: Vec<String>,
         /// Output directory [default: out/<case name>/sweep]
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Parallel runs [default: number of cores]
+        #[arg(long)]
+        jobs: Option<usize>,
+        /// Do not show a progress bar
+        #[arg(long)]
+        quiet: bool,
+    },
+    /// Audit the paper: regenerate its figures and judge its claims (§5-6).
+    ///
+    /// Reads the audit specs (default: every *.toml of cases/paper/), runs every point of every
+    /// run in parallel (one folder per point, the files of `run`/`sweep`), draws the paper's
+    /// figures and writes REPORT.md (one row per claim: the paper's words and number, ours, the
+    /// verdict - reproduced, differs, refuted, not computable here - and its cause) and
+    /// report.csv. `--quick` runs the specs' short grids and clip excerpts (the subset asserted by
+    /// `cargo test`). Exit status 1 if a claim's verdict is not the one its spec expects (the
+    /// report is written first).
+    Audit {
+        /// Audit specs (TOML) or folders of them [default: cases/paper]
+        specs: Vec<PathBuf>,
+        /// Short grids and clip excerpts (`quick_grid`, `quick_set` of the specs)
+        #[arg(long)]
+        quick: bool,
+        /// Output directory [default: out/audit, out/audit-quick with --quick]; replaced whole
         #[arg(long)]
         out: Option<PathBuf>,
         /// Parallel runs [default: number of cores]
@@ -110,6 +136,7 @@ fn dispatch(cli: Cli) -> Result<ExitCode> {
         Command::Run { case, engine, out, quiet } => cmd_run(&case, engine, out, quiet),
         Command::Compare { case, out } => cmd_compare(&case, out),
         Command::Sweep { case, set, out, jobs, quiet } => cmd_sweep(&case, &set, out, jobs, quiet),
+        Command::Audit { specs, quick, out, jobs, quiet } => cmd_audit(&specs, quick, out, jobs, quiet),
         Command::List { dir } => cmd_list(&dir),
         Command::Modes { case, count } => cmd_modes(&case, count),
     }
@@ -213,9 +240,7 @@ fn cmd_run_clip(case: &Case, engine: Engine, dir: &Path, quiet: bool) -> Result<
             return Err(e);
         }
     };
-    write_clip_plot(case, &run.reports, &run.roughness, &dir.join("plot.svg"))?;
-    write_clip_kymographs(case, &run, &dir.join("kymograph.svg"))?;
-    write_truth_plot(case, &run, &dir.join("truth.svg"))?;
+    write_clip_figures(case, &run, dir)?;
     if let Some(t) = &run.truth {
         let max = |f: &dyn Fn(&cosserat::clip::synthetic::FrameComparison) -> f64| {
             t.comparisons.iter().map(f).fold(0.0, f64::max)
@@ -324,7 +349,8 @@ fn cmd_sweep(path: &Path, set: &[String], out: Option<PathBuf>, jobs: Option<usi
         })
         .collect();
     let summary = dir.join("summary.csv");
-    write_atomic(&summary, summary_csv(&keys, &rows)?.as_bytes())?;
+    let columns: &[&str] = if case.clip().is_some() { &CLIP_SUMMARY_METRICS } else { &SUMMARY_METRICS };
+    write_atomic(&summary, summary_csv(&keys, columns, &rows)?.as_bytes())?;
     let curves: Vec<(&String, &RunResult)> =
         results.iter().filter_map(|(_, name, o)| o.run.as_ref().map(|run| (name, run))).collect();
     if !curves.is_empty() {
@@ -345,6 +371,60 @@ fn cmd_sweep(path: &Path, set: &[String], out: Option<PathBuf>, jobs: Option<usi
         }
     }
     Ok(if failed == 0 { ExitCode::SUCCESS } else { ExitCode::from(1) })
+}
+
+fn cmd_audit(
+    paths: &[PathBuf],
+    quick: bool,
+    out: Option<PathBuf>,
+    jobs: Option<usize>,
+    quiet: bool,
+) -> Result<ExitCode> {
+    use cosserat::audit::{run_audit, spec::read_spec, spec_files, AuditOptions, Verdict};
+    let default = [PathBuf::from("cases/paper")];
+    let mut files = Vec::new();
+    for p in if paths.is_empty() { &default[..] } else { paths } {
+        if p.is_dir() {
+            files.extend(spec_files(p)?);
+        } else {
+            files.push(p.clone());
+        }
+    }
+    if files.is_empty() {
+        anyhow::bail!("no audit specs (*.toml) given or found");
+    }
+    let specs = files.iter().map(|f| read_spec(f, quick)).collect::<Result<Vec<_>, _>>()?;
+    let out = out.unwrap_or_else(|| PathBuf::from(if quick { "out/audit-quick" } else { "out/audit" }));
+    let pb = progress_bar(quiet, if quick { "audit (quick)" } else { "audit" });
+    let opts = AuditOptions { out: out.clone(), jobs: jobs.unwrap_or(0) };
+    let report = run_audit(&specs, quick, &opts, |done, total| {
+        pb.set_length(total as u64);
+        pb.set_position(done as u64);
+    })?;
+    pb.finish_and_clear();
+    let counts = report.counts();
+    let summary: Vec<String> = Verdict::ALL.iter().zip(counts).map(|(v, n)| format!("{n} {}", v.as_str())).collect();
+    println!(
+        "{} claims of {} specs: {}; {} figures; {:.0} s; wrote {}",
+        report.claims.len(),
+        specs.len(),
+        summary.join(", "),
+        report.figures.len(),
+        report.wall_time_s,
+        out.join("REPORT.md").display()
+    );
+    let unexpected: Vec<_> = report.claims.iter().filter(|c| c.verdict != c.claim.expect).collect();
+    for c in &unexpected {
+        eprintln!(
+            "  {} ({}): {} where the spec expects {}; ours: {}",
+            c.claim.id,
+            c.spec,
+            c.verdict.as_str(),
+            c.claim.expect.as_str(),
+            c.ours
+        );
+    }
+    Ok(if unexpected.is_empty() { ExitCode::SUCCESS } else { ExitCode::from(1) })
 }
 
 fn cmd_list(dir: &Path) -> Result<ExitCode> {

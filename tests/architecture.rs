@@ -15,6 +15,7 @@ const LAYERS: &[&[&str]] = &[
     &["case"],
     &["run"],
     &["io"],
+    &["audit"],
     &["main"],
 ];
 

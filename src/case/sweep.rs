@@ -118,22 +118,62 @@ impl Case {
     /// The case with the given parameters set (command-line names, see [`known_keys`]),
     /// validated again as a whole.
     pub fn with_values(&self, values: &[(&str, f64)]) -> Result<Case, SweepError> {
+        let label = values.iter().map(|v| v.0).collect::<Vec<_>>().join(", ");
+        self.revalidated(&label, |table| {
+            for &(name, v) in values {
+                let k = keys(self).iter().find(|k| k.name == name).ok_or_else(|| SweepError::UnknownKey {
+                    key: name.into(),
+                    case: self.name.clone(),
+                    known: known_keys(self).join(", "),
+                })?;
+                set(table, k, v)?;
+            }
+            Ok(())
+        })
+    }
+
+    /// The case with any keys of its file set, by dotted path (`"clip.frames"`,
+    /// `"inverse.lambda_omega"`, `"solver.max_iterations"`) to TOML values, validated again
+    /// as a whole. Missing tables are created; a path through a non-table is an error.
+    pub fn with_overrides(&self, overrides: &[(String, toml::Value)]) -> Result<Case, SweepError> {
+        let label = overrides.iter().map(|o| o.0.as_str()).collect::<Vec<_>>().join(", ");
+        self.revalidated(&label, |table| {
+            for (path, value) in overrides {
+                let parts: Vec<&str> = path.split('.').collect();
+                let (last, tables) = parts
+                    .split_last()
+                    .filter(|(l, _)| !l.is_empty())
+                    .ok_or_else(|| SweepError::Invalid { key: path.clone(), reason: "empty key".into() })?;
+                let mut t = &mut *table;
+                for part in tables {
+                    t = t
+                        .entry(part.to_string())
+                        .or_insert_with(|| toml::Value::Table(toml::Table::new()))
+                        .as_table_mut()
+                        .ok_or_else(|| SweepError::Invalid {
+                            key: path.clone(),
+                            reason: format!("`{part}` is not a table"),
+                        })?;
+                }
+                t.insert(last.to_string(), value.clone());
+            }
+            Ok(())
+        })
+    }
+
+    /// Apply `edit` to a copy of the case file's tables and validate the result (errors name
+    /// `label`).
+    fn revalidated(
+        &self,
+        label: &str,
+        edit: impl FnOnce(&mut toml::Table) -> Result<(), SweepError>,
+    ) -> Result<Case, SweepError> {
         let (mut table, path) = self.raw.clone().ok_or_else(|| SweepError::Invalid {
-            key: values.first().map(|v| v.0.to_string()).unwrap_or_default(),
+            key: label.to_string(),
             reason: format!("case `{}` was not read from TOML", self.name),
         })?;
-        for &(name, v) in values {
-            let k = keys(self).iter().find(|k| k.name == name).ok_or_else(|| SweepError::UnknownKey {
-                key: name.into(),
-                case: self.name.clone(),
-                known: known_keys(self).join(", "),
-            })?;
-            set(&mut table, k, v)?;
-        }
-        let invalid = |reason: String| SweepError::Invalid {
-            key: values.iter().map(|v| v.0).collect::<Vec<_>>().join(", "),
-            reason,
-        };
+        edit(&mut table)?;
+        let invalid = |reason: String| SweepError::Invalid { key: label.to_string(), reason };
         let raw: RawCase =
             toml::Value::Table(table.clone()).try_into().map_err(|e: toml::de::Error| invalid(e.to_string()))?;
         let mut case = Validator::new(&path).case(raw, &self.name).map_err(|e| match e {
@@ -277,6 +317,21 @@ mod tests {
         let (_, d) = product(&case("cantilever_dynamic"), &[parse_set("steps=10").unwrap()]).unwrap().remove(0);
         let Analysis::Dynamic(p) = d.analysis else { panic!() };
         assert_eq!(p.steps, 10);
+    }
+
+    /// Dotted overrides reach the same validator: a clip's frame range and a weight vector.
+    #[test]
+    fn overrides_by_dotted_path() {
+        let c = case("inverse_bend_twist");
+        let v = |x: f64| toml::Value::Float(x);
+        let o = c
+            .with_overrides(&[("inverse.lambda_kappa".into(), toml::Value::Array(vec![v(0.0), v(1e-3), v(2.0)]))])
+            .unwrap();
+        assert_eq!(o.inverse().unwrap().params.weights.lambda_kappa, nalgebra::Vector3::new(0.0, 1e-3, 2.0));
+        let e = c.with_overrides(&[("inverse.lambda_kappa".into(), v(1.0))]).unwrap_err();
+        assert!(e.to_string().contains("inverse.lambda_kappa"), "{e}");
+        let e = c.with_overrides(&[("description.x".into(), v(1.0))]).unwrap_err();
+        assert!(e.to_string().contains("not a table"), "{e}");
     }
 
     #[test]

@@ -1,9 +1,11 @@
 //! The files of a clip run: `frames.csv`, `fields.csv`, `curvature.csv`, `truth.csv`
 //! (synthetic clips), ParaView `vtk/frame_NNNNN.vtp` + `clip.pvd` streamed frame by frame
 //! ([`ClipWriter`], the [`FrameSink`] of `run::clip`), and the summary figures written at the
-//! end (`plot.svg`, `kymograph.svg`, `truth.svg`, `truth_errors.svg`).
+//! end (`plot.svg`, `kymograph.svg`, `omega.svg`, `truth.svg`, `truth_errors.svg`).
 use std::io::Write;
 use std::path::{Path, PathBuf};
+
+use nalgebra::Vector3;
 
 use super::files::{write_plot, OutputError};
 use super::plot::{render_heatmaps_svg, render_panels_svg, Heatmap, LinePlot, Series};
@@ -27,8 +29,10 @@ pub struct ClipWriter {
 
 /// Columns of `frames.csv`.
 /// `min_abs_cos_beta` is the chart's (the angles of `fields.csv` are in the frame's chart
-/// `Q = Q_E(α) B`, whose singular axis `n = Bᵀ e2` is `chart_axis_*`; `docs/rotation.md`).
-pub const CLIP_FRAME_COLUMNS: [&str; 22] = [
+/// `Q = Q_E(α) B`, whose singular axis `n = Bᵀ e2` is `chart_axis_*`; `docs/rotation.md`);
+/// `max_abs_omega_rad_per_s` is the largest |ωˡ| over the nodes [rad/s] (eq. 27, 0 on the
+/// first frame; `run::clip::ClipFrame::omega`).
+pub const CLIP_FRAME_COLUMNS: [&str; 23] = [
     "frame",
     "time_s",
     "iterations",
@@ -51,6 +55,44 @@ pub const CLIP_FRAME_COLUMNS: [&str; 22] = [
     "chart_axis_x",
     "chart_axis_y",
     "chart_axis_z",
+    "max_abs_omega_rad_per_s",
+];
+
+/// Columns of `fields.csv`, one row per frame and node: position [m], the angles [rad] in the
+/// frame's chart, the directors d1–d3 (rows of Q, eq. 2), the controls f [N/m] and l [N m/m]
+/// (eq. 54), the data position [m] and the angular velocity ωˡ [rad/s] in the local frame
+/// (eq. 27, as κ; 0 on the first frame; `run::clip::ClipFrame::omega`).
+pub const CLIP_FIELD_COLUMNS: [&str; 30] = [
+    "frame",
+    "node",
+    "s_m",
+    "x_m",
+    "y_m",
+    "z_m",
+    "alpha_rad",
+    "beta_rad",
+    "gamma_rad",
+    "d1_x",
+    "d1_y",
+    "d1_z",
+    "d2_x",
+    "d2_y",
+    "d2_z",
+    "d3_x",
+    "d3_y",
+    "d3_z",
+    "f_x_n_per_m",
+    "f_y_n_per_m",
+    "f_z_n_per_m",
+    "l_x_nm_per_m",
+    "l_y_nm_per_m",
+    "l_z_nm_per_m",
+    "data_x_m",
+    "data_y_m",
+    "data_z_m",
+    "omega1_rad_per_s",
+    "omega2_rad_per_s",
+    "omega3_rad_per_s",
 ];
 
 impl ClipWriter {
@@ -64,23 +106,10 @@ impl ClipWriter {
             writeln!(f, "{header}").map_err(err(p))?;
             Ok(f)
         };
-        let mut fields_header = vec!["frame", "node", "s_m", "x_m", "y_m", "z_m", "alpha_rad", "beta_rad", "gamma_rad"];
-        fields_header.extend(["d1_x", "d1_y", "d1_z", "d2_x", "d2_y", "d2_z", "d3_x", "d3_y", "d3_z"]);
-        fields_header.extend([
-            "f_x_n_per_m",
-            "f_y_n_per_m",
-            "f_z_n_per_m",
-            "l_x_nm_per_m",
-            "l_y_nm_per_m",
-            "l_z_nm_per_m",
-            "data_x_m",
-            "data_y_m",
-            "data_z_m",
-        ]);
         Ok(ClipWriter {
             dir: dir.to_path_buf(),
             frames: open("frames.csv", &CLIP_FRAME_COLUMNS.join(","))?,
-            fields: open("fields.csv", &fields_header.join(","))?,
+            fields: open("fields.csv", &CLIP_FIELD_COLUMNS.join(","))?,
             curvature: open("curvature.csv", "frame,s_mid_m,kappa1_per_m,kappa2_per_m,kappa3_per_m")?,
             truth: if truth { Some(open("truth.csv", &TRUTH_COLUMNS.join(","))?) } else { None },
             pvd: Vec::new(),
@@ -90,7 +119,8 @@ impl ClipWriter {
     /// Append one converged frame: its report row, nodal fields, element curvature, truth row
     /// and VTK file.
     pub fn write_frame(&mut self, frame: &ClipFrame) -> Result<(), OutputError> {
-        let ClipFrame { report, time_s, nodes, force, torque, data, roughness, .. } = frame;
+        let ClipFrame { report, time_s, nodes, force, torque, data, omega, roughness, .. } = frame;
+        let omega = omega.clone().unwrap_or_else(|| vec![Vector3::zeros(); nodes.s.len()]);
         let (time_s, roughness) = (*time_s, *roughness);
         let err = |name: &str| {
             let p = self.dir.join(name);
@@ -108,6 +138,7 @@ impl ClipWriter {
             f64::from(u8::from(r.restarted)),
         ]);
         row.extend(r.chart_axis.iter());
+        row.push(omega.iter().map(|w| w.norm()).fold(0.0, f64::max));
         let line: Vec<String> = row.iter().map(|v| format!("{v:.10e}")).collect();
         writeln!(self.frames, "{}", line.join(",")).and_then(|_| self.frames.flush()).map_err(err("frames.csv"))?;
         let d = nodes.directors();
@@ -121,6 +152,7 @@ impl ClipWriter {
             v.extend(force[i].iter());
             v.extend(torque[i].iter());
             v.extend(data[i].iter());
+            v.extend(omega[i].iter());
             let text: Vec<String> = v.iter().map(|x| format!("{x:.10e}")).collect();
             writeln!(self.fields, "{},{i},{}", r.frame, text.join(",")).map_err(err("fields.csv"))?;
         }
@@ -147,6 +179,7 @@ impl ClipWriter {
                     ("l_nm_per_m", torque),
                     ("kappa_per_m", &kn),
                     ("data_position_m", data),
+                    ("omega_rad_per_s", &omega),
                 ],
                 scalars: vec![],
             },
@@ -375,9 +408,7 @@ pub fn write_clip_kymographs(case: &Case, run: &ClipRun, path: &Path) -> Result<
         let values: Vec<Vec<f64>> = frames.iter().map(|&i| cols.iter().map(|&j| field[i][j]).collect()).collect();
         (y, values)
     };
-    let mut all: Vec<f64> = run.data_kappa.iter().flatten().map(|v| v.abs()).filter(|v| v.is_finite()).collect();
-    all.sort_by(f64::total_cmp);
-    let limit = all.get((all.len() as f64 * 0.99) as usize).copied().unwrap_or(1.0);
+    let limit = abs_percentile_99(run.data_kappa.iter().flatten().copied());
     let (yd, vd) = grid(&run.data_kappa, &|j| (j + 1) as f64 * h);
     let (yr, vr) = grid(&run.kappa2, &|j| (j as f64 + 0.5) * h);
     let map = |title: String, y: Vec<f64>, values: Vec<Vec<f64>>| Heatmap {
@@ -396,4 +427,45 @@ pub fn write_clip_kymographs(case: &Case, run: &ClipRun, path: &Path) -> Result<
             map("recovered kappa_2 [1/m]".into(), yr, vr),
         ]),
     )
+}
+
+/// The 99th percentile of |v| over the finite values (1 if there are none): the colour limit
+/// of a kymograph.
+pub(crate) fn abs_percentile_99(values: impl Iterator<Item = f64>) -> f64 {
+    let mut all: Vec<f64> = values.map(f64::abs).filter(|v| v.is_finite()).collect();
+    all.sort_by(f64::total_cmp);
+    all.get((all.len() as f64 * 0.99) as usize).copied().unwrap_or(1.0)
+}
+
+/// Kymographs of the angular velocity (Fig. 24 style, `omega.svg`): ω1, ω2, ω3 [rad/s] in the
+/// local frame (eq. 27, [`ClipRun::omega`]) over frames (x) and the nodes' arc length (y), each
+/// on its own colour scale (±the 99th percentile of its |ω| over the frames after the first,
+/// which has none). Strided as [`write_clip_kymographs`]; nothing is written for fewer than two
+/// frames.
+pub fn write_omega_kymographs(case: &Case, run: &ClipRun, path: &Path) -> Result<(), OutputError> {
+    let nf = run.omega.len().min(run.reports.len());
+    if nf < 2 {
+        return Ok(());
+    }
+    let frames: Vec<usize> = (0..nf).step_by(nf.div_ceil(150)).collect();
+    let x: Vec<f64> = frames.iter().map(|&i| run.reports[i].frame as f64).collect();
+    let m = run.omega[0].len();
+    let cols: Vec<usize> = (0..m).step_by(m.div_ceil(64).max(1)).collect();
+    let y: Vec<f64> = cols.iter().map(|&j| case.mesh.node_s(j) * 1e3).collect();
+    let maps: Vec<Heatmap> = (0..3)
+        .map(|k| {
+            let limit = abs_percentile_99(run.omega[1..nf].iter().flatten().map(|w| w[k]));
+            let name = if k == 0 { format!("{}: ", case.name) } else { String::new() };
+            Heatmap {
+                title: format!("{name}omega_{} [rad/s], colour ±{limit:.3e}", k + 1),
+                x_label: "frame".into(),
+                y_label: "s [mm]".into(),
+                x: x.clone(),
+                y: y.clone(),
+                values: frames.iter().map(|&i| cols.iter().map(|&j| run.omega[i][j][k]).collect()).collect(),
+                limit,
+            }
+        })
+        .collect();
+    write_plot(path, render_heatmaps_svg(&maps))
 }

@@ -7,13 +7,15 @@ use std::path::Path;
 use nalgebra::Vector3;
 
 use super::clip_files::{load_clip, ClipFileError};
-use super::clip_output::ClipWriter;
+use super::clip_output::{
+    write_clip_kymographs, write_clip_plot, write_omega_kymographs, write_truth_plot, ClipWriter,
+};
 use super::data::{read_data, write_data};
 use super::files::{InputError, OutputError};
 use super::freefem::{self, FreeFemError};
 use crate::case::{Case, DataSource};
 use crate::model::chart::Chart;
-use crate::run::clip::{run_clip, ClipRun};
+use crate::run::clip::{run_clip, ClipFrame, ClipRun, FrameSink};
 use crate::run::{self, Engine, NodalState, RunError, RunResult};
 
 /// Errors of running a case from files.
@@ -93,9 +95,47 @@ pub fn run_inverse_on(
 
 /// Solve the clip of a clip case frame by frame in the Rust engine, streaming every converged
 /// frame into `dir` ([`ClipWriter`]); on failure the converged frames stay there and the error
-/// names the frame. The summary figures are the caller's (`io::clip_output`).
+/// names the frame. The summary figures are the caller's ([`write_clip_figures`]).
 pub fn run_clip_case(case: &Case, dir: &Path, progress: impl FnMut(usize, usize)) -> Result<ClipRun, EngineError> {
+    run_clip_case_observed(case, dir, |_| {}, progress)
+}
+
+/// [`run_clip_case`] with `observer` called on every converged frame, in order, after it was
+/// written (on the output thread).
+pub fn run_clip_case_observed(
+    case: &Case,
+    dir: &Path,
+    observer: impl FnMut(&ClipFrame) + Send,
+    progress: impl FnMut(usize, usize),
+) -> Result<ClipRun, EngineError> {
     let (clip, truth) = load_clip(case)?;
-    let writer = ClipWriter::create(dir, truth.is_some())?;
+    let writer = Observed { sink: ClipWriter::create(dir, truth.is_some())?, observer };
     Ok(run_clip(case, &clip, truth.as_ref(), writer, progress)?)
+}
+
+/// A [`FrameSink`] that writes each frame and then shows it to an observer.
+struct Observed<F> {
+    sink: ClipWriter,
+    observer: F,
+}
+
+impl<F: FnMut(&ClipFrame) + Send> FrameSink for Observed<F> {
+    type Error = OutputError;
+    fn frame(&mut self, frame: &ClipFrame) -> Result<(), OutputError> {
+        self.sink.frame(frame)?;
+        (self.observer)(frame);
+        Ok(())
+    }
+    fn finish(&mut self) -> Result<(), OutputError> {
+        self.sink.finish()
+    }
+}
+
+/// The summary figures of a clip run in `dir`: `plot.svg` (per frame: iterations, fit, chart,
+/// objective, roughness), `kymograph.svg` and, for synthetic clips, `truth.svg`.
+pub fn write_clip_figures(case: &Case, run: &ClipRun, dir: &Path) -> Result<(), OutputError> {
+    write_clip_plot(case, &run.reports, &run.roughness, &dir.join("plot.svg"))?;
+    write_clip_kymographs(case, run, &dir.join("kymograph.svg"))?;
+    write_omega_kymographs(case, run, &dir.join("omega.svg"))?;
+    write_truth_plot(case, run, &dir.join("truth.svg"))
 }

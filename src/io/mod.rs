@@ -11,6 +11,7 @@ pub mod files;
 pub mod freefem;
 pub mod npy;
 pub mod plot;
+pub mod posture;
 pub mod run_files;
 pub mod sweep;
 pub mod vtk;

@@ -176,7 +176,7 @@ where
 }
 
 /// Compact tick labels: plain decimals for moderate magnitudes, else `1.5e-3`.
-fn format_tick(v: f64) -> String {
+pub(crate) fn format_tick(v: f64) -> String {
     let a = v.abs();
     if a == 0.0 {
         "0".to_string()

@@ -1,14 +1,17 @@
 //! The files of a parameter sweep: one folder per grid point (the files of `run`, or of the
 //! last iterate with `FAILED.txt` when the point did not converge) and `summary.csv`. The
-//! grid itself is `case::sweep`'s.
+//! grid itself is `case::sweep`'s. A point of a clip case solves the whole clip (the frames
+//! of `run` on a clip, its row the metrics of `run::clip_metrics`).
 use std::path::Path;
 
 use super::data::write_data;
-use super::engine::{load_data, run_inverse_on, EngineError};
+use super::engine::{load_data, run_clip_case_observed, run_inverse_on, write_clip_figures, EngineError};
 use super::files::write_atomic;
 use super::run_files::write_run;
 use crate::case::sweep::{fmt_value, Point};
 use crate::case::Case;
+use crate::run::clip::{ClipFrame, ClipRun};
+use crate::run::clip_metrics::clip_metrics;
 use crate::run::metrics::{all_metrics, Metrics};
 use crate::run::{run_forward, RunError, RunResult};
 
@@ -56,20 +59,35 @@ impl RunStatus {
     }
 }
 
+/// Columns of the summary table of a clip case after the swept keys (`run::clip_metrics`).
+pub const CLIP_SUMMARY_METRICS: [&str; 11] = [
+    "frames",
+    "iterations_mean",
+    "iterations_max",
+    "x_err_rel_max",
+    "tangent_misfit_rel_max",
+    "max_abs_j_minus_1",
+    "shear_share_median",
+    "j_total_median",
+    "min_abs_cos_beta",
+    "truth_x_err_rel_max",
+    "wall_time_s",
+];
+
 /// CSV text of the summary (header: swept keys, `status` (`ok`, `not_converged`, `failed`),
-/// [`SUMMARY_METRICS`], `error`).
-pub fn summary_csv(keys: &[String], rows: &[SummaryRow]) -> Result<String, csv::Error> {
+/// `columns` ([`SUMMARY_METRICS`], or [`CLIP_SUMMARY_METRICS`] for a clip case), `error`).
+pub fn summary_csv(keys: &[String], columns: &[&str], rows: &[SummaryRow]) -> Result<String, csv::Error> {
     let mut w = csv::Writer::from_writer(Vec::new());
     let mut header: Vec<String> = keys.to_vec();
     header.push("status".into());
-    header.extend(SUMMARY_METRICS.iter().map(|s| s.to_string()));
+    header.extend(columns.iter().map(|s| s.to_string()));
     header.push("error".into());
     w.write_record(&header)?;
     for r in rows {
         let mut rec: Vec<String> = r.point.iter().map(|(_, v)| fmt_value(*v)).collect();
         rec.push(r.status.as_str().into());
         rec.extend(
-            SUMMARY_METRICS
+            columns
                 .iter()
                 .map(|k| r.metrics.as_ref().and_then(|m| m.get(*k)).map(|v| format!("{v:.10e}")).unwrap_or_default()),
         );
@@ -80,21 +98,27 @@ pub fn summary_csv(keys: &[String], rows: &[SummaryRow]) -> Result<String, csv::
     Ok(String::from_utf8_lossy(&bytes).into_owned())
 }
 
-/// What one run of a sweep produced.
+/// What one run of a sweep produced: a single-frame or forward run (`run`) or a clip (`clip`).
 pub struct SweepOutcome {
     pub status: RunStatus,
     pub metrics: Option<Metrics>,
     pub run: Option<RunResult>,
+    pub clip: Option<ClipRun>,
     pub error: Option<String>,
 }
 
 /// One point of a sweep in the Rust engine, writing its folder `dir`. A run that stops at its
 /// iteration limit still writes the files of its last iterate, plus `FAILED.txt` with the error.
+/// A clip case solves its whole clip ([`run_clip_point`]).
 pub fn run_point(case: &Case, dir: &Path) -> SweepOutcome {
+    if case.clip().is_some() {
+        return run_clip_point(case, dir, |_| {});
+    }
     let failed = |e: &dyn std::fmt::Display| SweepOutcome {
         status: RunStatus::Failed,
         metrics: None,
         run: None,
+        clip: None,
         error: Some(e.to_string()),
     };
     let outcome: Result<RunResult, EngineError> = if case.inverse().is_some() {
@@ -123,9 +147,31 @@ pub fn run_point(case: &Case, dir: &Path) -> SweepOutcome {
         Ok(m)
     };
     match write() {
-        Ok(m) => SweepOutcome { status, metrics: Some(m), run: Some(r), error },
+        Ok(m) => SweepOutcome { status, metrics: Some(m), run: Some(r), clip: None, error },
         Err(e) => failed(&e),
     }
+}
+
+/// The whole clip of a clip case in the Rust engine, frames streamed to `dir` and shown to
+/// `observer`, then the clip's figures. A clip that stops at a frame keeps the converged frames
+/// and writes `FAILED.txt` naming the frame; its status is `failed`.
+pub fn run_clip_point(case: &Case, dir: &Path, observer: impl FnMut(&ClipFrame) + Send) -> SweepOutcome {
+    let failed = |e: String| {
+        let _ = write_atomic(
+            &dir.join("FAILED.txt"),
+            format!("{e}\nThe converged frames before it are in this folder.\n").as_bytes(),
+        );
+        SweepOutcome { status: RunStatus::Failed, metrics: None, run: None, clip: None, error: Some(e) }
+    };
+    let run = match run_clip_case_observed(case, dir, observer, |_, _| {}) {
+        Ok(r) => r,
+        Err(e) => return failed(format!("case {}: {}", case.name, chain(&e))),
+    };
+    if let Err(e) = write_clip_figures(case, &run, dir) {
+        return failed(format!("case {}: {}", case.name, chain(&e)));
+    }
+    let m = clip_metrics(case, &run);
+    SweepOutcome { status: RunStatus::Ok, metrics: Some(m), run: None, clip: Some(run), error: None }
 }
 
 /// An error and its sources, `a: b: c` (as `anyhow`'s `{:#}`).
@@ -168,7 +214,7 @@ mod tests {
                 error: Some("bad".into()),
             },
         ];
-        let text = summary_csv(&["lambda_l".into()], &rows).unwrap();
+        let text = summary_csv(&["lambda_l".into()], &SUMMARY_METRICS, &rows).unwrap();
         let lines: Vec<&str> = text.lines().collect();
         assert!(lines[0].starts_with("lambda_l,status,iterations,x_err_rel"));
         assert!(lines[1].starts_with("1e-20,ok,1.2000000000e1"));

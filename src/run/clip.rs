@@ -11,6 +11,7 @@ use crate::case::Case;
 use crate::clip::synthetic::{compare_frame, FrameComparison, GroundTruth, RecoveredFrame};
 use crate::clip::Clip;
 use crate::model::mesh::Field;
+use crate::solve::inverse::measures::angular_velocity;
 use crate::solve::sequence::{solve_sequence, FrameReport};
 
 /// Nodes skipped at each end when scoring curvature against a ground truth (the curvature of
@@ -30,6 +31,11 @@ pub struct ClipFrame {
     pub torque: Vec<Vector3<f64>>,
     /// the frame's data positions [m]
     pub data: Vec<Vector3<f64>>,
+    /// angular velocity ωˡ = A(α)(α − α_{n−1})/Δt per node [rad/s], components in the local
+    /// frame (d1, d2, d3) as κ (eq. 27; [`angular_velocity`]): exactly what the Λω term of (41)
+    /// penalised, α_{n−1} the previous frame's angles in this frame's chart. `None` on the
+    /// first frame, which has no previous frame (Remark 6)
+    pub omega: Option<Vec<Vector3<f64>>>,
     /// sign alternation of the recovered κ2 and of the data's planar curvature
     pub roughness: (f64, f64),
     /// synthetic clips: the frame against its ground truth
@@ -67,6 +73,9 @@ pub struct ClipRun {
     /// interior nodes [1/m] (x–z clips: the bending curvature; [`planar_xz_curvature`])
     pub kappa2: Vec<Vec<f64>>,
     pub data_kappa: Vec<Vec<f64>>,
+    /// per frame: the angular velocity ωˡ per node [rad/s] ([`ClipFrame::omega`]); zeros on the
+    /// first frame
+    pub omega: Vec<Vec<Vector3<f64>>>,
     /// synthetic clips: per frame the errors against the ground truth (end nodes skipped:
     /// [`TRUTH_SKIP_NODES`]), and the true and recovered bending `κ1² + κ2²` [1/m²] per node
     pub truth: Option<TruthRun>,
@@ -141,7 +150,8 @@ pub fn run_clip<S: FrameSink>(
     let h = case.mesh.h();
     let start = Instant::now();
     let mut rough = Vec::new();
-    let (mut kappa2, mut data_kappa) = (Vec::new(), Vec::new());
+    let (mut kappa2, mut data_kappa, mut omega_rows) = (Vec::new(), Vec::new(), Vec::new());
+    let dt = sp.inverse.frame_interval_s;
     let mut truth_run = truth.map(|_| TruthRun::default());
     let (tx, rx) = std::sync::mpsc::sync_channel::<ClipFrame>(8);
     let (result, written) = std::thread::scope(|scope| {
@@ -190,6 +200,10 @@ pub fn run_clip<S: FrameSink>(
                     tr.bending_recovered.push(kn.iter().map(bend).collect());
                     truth_frame = Some(TruthFrame { roll_rad: ft.roll_rad, twist_per_m: twist, comparison: c });
                 }
+                let omega: Option<Vec<Vector3<f64>>> = frame
+                    .previous
+                    .map(|prev| nodes.alpha.iter().zip(prev).map(|(a, p)| angular_velocity(a, p, dt)).collect());
+                omega_rows.push(omega.clone().unwrap_or_else(|| vec![Vector3::zeros(); nodes.alpha.len()]));
                 let roughness = (sign_alternation(&k2), sign_alternation(&kd));
                 rough.push(roughness);
                 kappa2.push(k2);
@@ -201,6 +215,7 @@ pub fn run_clip<S: FrameSink>(
                     force,
                     torque,
                     data: data.clone(),
+                    omega,
                     roughness,
                     truth: truth_frame,
                 };
@@ -221,6 +236,7 @@ pub fn run_clip<S: FrameSink>(
         roughness: rough,
         kappa2,
         data_kappa,
+        omega: omega_rows,
         truth: truth_run,
         wall_time_s: start.elapsed().as_secs_f64(),
         source: clip.source.clone(),

@@ -3,6 +3,7 @@
 //! ([`clip::run_clip`]), each producing the engine-agnostic [`RunResult`] of [`result`].
 //! Files (case data, clips, outputs) and the FreeFEM engine are `crate::io`'s.
 pub mod clip;
+pub mod clip_metrics;
 pub mod metrics;
 pub mod result;
 

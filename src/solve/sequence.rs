@@ -177,6 +177,11 @@ pub fn data_frame_guess(x_g: &[Vector3<f64>]) -> DVector<f64> {
 pub struct FrameSolution<'a> {
     pub solution: &'a InverseSolution,
     pub chart: Chart,
+    /// the previous frame's angles α_{n−1} [rad] per node in this frame's chart, exactly as the
+    /// Λω term of (41) used them (re-expressed and unwrapped, R6); `None` on the first frame
+    /// (Remark 6). With the solution's angles they give the frame's angular velocity
+    /// (`inverse::measures::angular_velocity`, eq. 27).
+    pub previous: Option<&'a [Angles]>,
 }
 
 /// Solve every frame of `frames` (positions per node, the mesh's nodes) in order. `u0` is the
@@ -282,8 +287,8 @@ pub fn solve_sequence(
             wall_time_s: start.elapsed().as_secs_f64(),
         };
         let in_space = if chart.is_identity() { None } else { Some(to_space(&dofs, &chart, &sol)) };
-        on_frame(&rep, &FrameSolution { solution: in_space.as_ref().unwrap_or(&sol), chart })
-            .map_err(|message| SequenceError::Callback { frame: k, message })?;
+        let solution = FrameSolution { solution: in_space.as_ref().unwrap_or(&sol), chart, previous: frame.previous };
+        on_frame(&rep, &solution).map_err(|message| SequenceError::Callback { frame: k, message })?;
         prev2 = prev.take();
         prev = Some((chart, sol.u));
         reports.push(rep);

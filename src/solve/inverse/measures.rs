@@ -7,8 +7,17 @@ use super::{Frame, InverseParams, InverseRecord, ObjectiveTerms};
 use crate::assemble::integrate;
 use crate::model::element::{interpolate, LocalVec};
 use crate::model::mesh::GAUSS2;
-use crate::model::rotation::{a_matrix, curvature, d3};
+use crate::model::rotation::{a_matrix, curvature, d3, Angles};
 use crate::solve::Problem;
+
+/// The angular velocity that the Λω term of (41) penalises: eq. (27), `ωˡ = A(α) ∂t α`, with
+/// the backward difference `∂t α ≈ (α − α_{n−1})/Δt` [rad/s], components in the local frame
+/// (d1, d2, d3) as κˡ (eq. 28). `alpha_prev` must be in the chart of `alpha` (on a rebased
+/// clip, the previous frame's angles re-expressed in this frame's chart, as
+/// `solve::sequence` hands them to the solver); `dt_s`: the frame interval Δt [s].
+pub fn angular_velocity(alpha: &Angles, alpha_prev: &Angles, dt_s: f64) -> Vector3<f64> {
+    a_matrix(alpha) * (alpha - alpha_prev) / dt_s
+}
 
 /// `(‖x − x_g‖/‖x_g‖, ‖∂s x − d3‖)` with the integration rules of I2 (the misfit with the λd
 /// term's rule, I11).
@@ -58,7 +67,7 @@ pub fn objective_terms(
         t.torque += wh * qa.alpha.norm_squared() / w8.lambda_l;
         if !first_frame {
             let ap = alpha_prev[e] * q.n[0] + alpha_prev[e + 1] * q.n[1];
-            let om = a_matrix(&q.alpha) * (q.alpha - ap) / p.frame_interval_s;
+            let om = angular_velocity(&q.alpha, &ap, p.frame_interval_s);
             t.angular += wh * om.component_mul(&om).dot(&w8.lambda_omega);
         }
     });

@@ -1,0 +1,280 @@
+//! Numbers a claim of the paper needs beyond a run's own metrics, each from an independent
+//! reference or a definition written here:
+//! - `eq63_curve_rel_error` (tip-loaded cantilevers, Fig. 7): `max_s |y(s) − y₆₃(s)| / |y₆₃(L)|`
+//!   against eq. (63) along the whole rod;
+//! - `modal_tip_rel_error` (dynamic runs, Fig. 5): the tip history against the exact-in-time
+//!   response of the linearised discrete model (`solve::modes`) to the same load, sampled
+//!   twice per time step and linear in between;
+//! - `kappa3_max_abs_per_m` (inverse runs): max |κ3| without the end elements (eq. 65,
+//!   finding (4): "a too large κ3 could be generated");
+//! - `force_to_design_l2`, `torque_to_design_l2` (synthetic inverse runs, Fig. 15): ‖f‖/‖f_design‖
+//!   and ‖l‖/‖l_design‖, L² norms over the rod, the design the loads of the `[data]` solve, and
+//!   `force_to_design_orders`, `torque_to_design_orders`: |log10| of those ratios (orders of
+//!   magnitude apart);
+//! - clip runs ([`ClipSeries`]): RMS of the recovered κ1, κ2, κ3 and of the bending
+//!   `√(κ1² + κ2²)` over frames and inner elements [1/m] (Figs. 17, 23, 25), and the lag in
+//!   frames of the bending wave between s = L/4 and 3L/4 (> 0: from s = 0 towards s = L).
+use nalgebra::{DVector, Vector3};
+
+use crate::case::{Analysis, Case, Reference};
+use crate::model::mesh::Field;
+use crate::reference::timoshenko_deflection;
+use crate::run::clip::ClipFrame;
+use crate::run::metrics::{Metrics, INNER_SKIP_ELEMENTS};
+use crate::run::RunResult;
+use crate::solve::modes::modal_model;
+
+/// Per-frame series of a clip run kept for the audit's measures and figures.
+#[derive(Clone, Debug, Default)]
+pub struct ClipSeries {
+    /// frame numbers
+    pub frames: Vec<usize>,
+    /// element midpoints [m]
+    pub s_mid: Vec<f64>,
+    /// per frame: element-midpoint curvature κ = A ∂sα [1/m] (eq. 28)
+    pub kappa: Vec<Vec<Vector3<f64>>>,
+    /// per frame: max over the nodes of |ω| [rad/s] (eq. 27 between frames; 0 on the first)
+    pub omega_max: Vec<f64>,
+    /// the frames asked for (posture figures)
+    pub kept: Vec<ClipFrame>,
+    /// the last frame solved
+    pub last: Option<ClipFrame>,
+}
+
+/// Collects a [`ClipSeries`] frame by frame (the observer of a clip run).
+pub struct ClipRecorder {
+    keep: Vec<usize>,
+    series: ClipSeries,
+}
+
+impl ClipRecorder {
+    pub fn new(keep: &[usize]) -> Self {
+        ClipRecorder { keep: keep.to_vec(), series: ClipSeries::default() }
+    }
+    pub fn record(&mut self, frame: &ClipFrame) {
+        let kappa = frame.nodes.element_curvature();
+        if self.series.s_mid.is_empty() {
+            self.series.s_mid = kappa.iter().map(|(s, _)| *s).collect();
+        }
+        self.series.frames.push(frame.report.frame);
+        self.series.kappa.push(kappa.into_iter().map(|(_, k)| k).collect());
+        self.series
+            .omega_max
+            .push(frame.omega.as_ref().map_or(0.0, |w| w.iter().map(|v| v.norm()).fold(0.0, f64::max)));
+        if self.keep.contains(&frame.report.frame) {
+            self.series.kept.push(frame.clone());
+        }
+        self.series.last = Some(frame.clone());
+    }
+    pub fn finish(self) -> ClipSeries {
+        self.series
+    }
+}
+
+/// The derived metrics of a point (see the module documentation); absent where they do not
+/// apply.
+pub fn derived_metrics(case: &Case, run: Option<&RunResult>, series: Option<&ClipSeries>) -> Metrics {
+    let mut m = Metrics::new();
+    if let Some(r) = run {
+        if let Some(Reference::TipLoadedCantilever { force_n }) = case.reference {
+            let (l, kga, ei) = (case.mesh.length_m, case.props.shear_stretch_n[0], case.props.bend_twist_nm2[0]);
+            let tip = timoshenko_deflection(l, force_n, l, kga, ei).abs();
+            let worst = r
+                .nodes
+                .s
+                .iter()
+                .zip(&r.nodes.x)
+                .map(|(s, x)| (x[1] - timoshenko_deflection(*s, force_n, l, kga, ei)).abs())
+                .fold(0.0, f64::max);
+            m.insert("eq63_curve_rel_error".into(), worst / tip);
+        }
+        if let Some(e) = modal_tip_error(case, r) {
+            m.insert("modal_tip_rel_error".into(), e);
+        }
+        if r.inverse.is_some() {
+            let k = r.nodes.element_curvature();
+            let n = k.len();
+            let inner = k.iter().skip(INNER_SKIP_ELEMENTS).take(n.saturating_sub(2 * INNER_SKIP_ELEMENTS));
+            m.insert("kappa3_max_abs_per_m".into(), inner.map(|(_, k)| k[2].abs()).fold(0.0, f64::max));
+            let own = crate::run::metrics::inverse_metrics(r);
+            let (fc, lc) = (own.get("force_l2_n_per_m05"), own.get("torque_l2_n_m05"));
+            if let (Some((f, l)), Some(fc), Some(lc)) = (design_norms(case), fc, lc) {
+                m.insert("force_to_design_l2".into(), fc / f);
+                m.insert("torque_to_design_l2".into(), lc / l);
+                m.insert("force_to_design_orders".into(), (fc / f).log10().abs());
+                m.insert("torque_to_design_orders".into(), (lc / l).log10().abs());
+            }
+        }
+    }
+    if let Some(s) = series {
+        m.extend(clip_series_metrics(s));
+    }
+    m
+}
+
+/// `(‖f_design‖, ‖l_design‖)` [N/m · m^½, N m/m · m^½]: L² norms over the rod of the
+/// distributed loads of a synthetic inverse case's `[data]` solve (|f| does not depend on the
+/// frame the load is given in), by the 2-point rule per element.
+fn design_norms(case: &Case) -> Option<(f64, f64)> {
+    let data = case.data_case()?;
+    let h = data.mesh.h();
+    let (mut f2, mut l2) = (0.0, 0.0);
+    for e in 0..data.mesh.elements {
+        for (xi, w) in crate::model::mesh::GAUSS2.iter() {
+            let s = (e as f64 + xi) * h;
+            let (f, l) = data.loads.distributed(s, 0.0);
+            f2 += w * h * f.norm_squared();
+            l2 += w * h * l.norm_squared();
+        }
+    }
+    Some((f2.sqrt(), l2.sqrt()))
+}
+
+/// Max over the time steps and the tip's x, y of |x_tip − x_modal| / max |x_modal| for a
+/// dynamic run; `None` for other runs or when the modal model cannot be built.
+fn modal_tip_error(case: &Case, r: &RunResult) -> Option<f64> {
+    let modal = modal_tip_history(case, r)?;
+    let (mut err, mut scale) = (0.0f64, 0.0f64);
+    for (rec, m) in r.tip.iter().zip(&modal) {
+        for comp in 0..2 {
+            scale = scale.max(m[comp].abs());
+            err = err.max((rec.position_m[comp] - m[comp]).abs());
+        }
+    }
+    (scale > 0.0).then_some(err / scale)
+}
+
+/// The tip's x, y [m] at the times of a dynamic run's tip records, from the exact-in-time
+/// response of the linearised discrete model (all modes) to the case's load, sampled twice per
+/// time step and linear in between; `None` for other runs.
+pub fn modal_tip_history(case: &Case, r: &RunResult) -> Option<Vec<[f64; 2]>> {
+    let Analysis::Dynamic(p) = &case.analysis else { return None };
+    if r.tip.is_empty() {
+        return None;
+    }
+    let problem = case.problem();
+    let model = modal_model(&problem).ok()?;
+    let dt = p.end_time_s / p.steps as f64;
+    const SUB: usize = 2;
+    let ds = dt / SUB as f64;
+    let nm = model.omegas.len();
+    let last = case.mesh.nodes() - 1;
+    let dofs = case.mesh.dofs();
+    let (mut q, mut v) = (DVector::<f64>::zeros(nm), DVector::<f64>::zeros(nm));
+    let mut g0 = model.project(&problem.external_force(0.0));
+    let mut out = Vec::with_capacity(r.tip.len());
+    let mut step = 0usize;
+    for rec in &r.tip {
+        // the record's step number (records at t = 0 included)
+        let target = (rec.time_s / dt).round();
+        if target < step as f64 || (rec.time_s - target * dt).abs() > 1e-9 * dt.max(rec.time_s) {
+            return None;
+        }
+        for n in step..target as usize {
+            for k in 0..SUB {
+                let t1 = (n * SUB + k + 1) as f64 * ds;
+                let g1 = model.project(&problem.external_force(t1));
+                for i in 0..nm {
+                    // q'' + ω² q = g0 + (g1 − g0) τ/ds on [0, ds], exactly.
+                    let w = model.omegas[i];
+                    let rate = (g1[i] - g0[i]) / ds;
+                    let (c, s) = ((w * ds).cos(), (w * ds).sin());
+                    let a = q[i] - g0[i] / (w * w);
+                    let b = (v[i] - rate / (w * w)) / w;
+                    q[i] = g1[i] / (w * w) + a * c + b * s;
+                    v[i] = rate / (w * w) - a * w * s + b * w * c;
+                }
+                g0 = g1;
+            }
+        }
+        step = target as usize;
+        out.push([0, 1].map(|comp| model.displacement(dofs.index(last, Field::X, comp), &q)));
+    }
+    Some(out)
+}
+
+/// RMS of the recovered curvature components over the frames and the inner elements, and the
+/// lag of the bending wave (see the module documentation).
+fn clip_series_metrics(s: &ClipSeries) -> Metrics {
+    let mut m = Metrics::new();
+    let ne = s.s_mid.len();
+    if s.kappa.is_empty() || ne <= 2 * INNER_SKIP_ELEMENTS {
+        return m;
+    }
+    let inner = INNER_SKIP_ELEMENTS..ne - INNER_SKIP_ELEMENTS;
+    let count = (s.kappa.len() * inner.len()) as f64;
+    let rms = |f: &dyn Fn(&Vector3<f64>) -> f64| {
+        (s.kappa.iter().flat_map(|k| k[inner.clone()].iter().map(f)).sum::<f64>() / count).sqrt()
+    };
+    m.insert("kappa1_rms_per_m".into(), rms(&|k| k[0] * k[0]));
+    m.insert("kappa2_rms_per_m".into(), rms(&|k| k[1] * k[1]));
+    m.insert("kappa3_rms_per_m".into(), rms(&|k| k[2] * k[2]));
+    m.insert("bending_rms_per_m".into(), rms(&|k| k[0] * k[0] + k[1] * k[1]));
+    m.insert("omega_max_rad_per_s".into(), s.omega_max.iter().copied().fold(0.0, f64::max));
+    if let Some(lag) = bending_wave_lag(s) {
+        m.insert("bending_wave_lag_frames".into(), lag as f64);
+    }
+    m
+}
+
+/// The lag τ (frames) maximising `|Σ_t z_a(t) conj(z_b(t + τ))|` with `z = κ1 + i κ2` at the
+/// elements nearest s = L/4 (a) and 3L/4 (b), |τ| ≤ a quarter of the clip: positive when the
+/// bending travels from s = 0 towards s = L. A roll of the material frame multiplies both
+/// signals by the same phase and does not change the magnitude.
+fn bending_wave_lag(s: &ClipSeries) -> Option<i64> {
+    let nf = s.kappa.len();
+    if nf < 8 {
+        return None;
+    }
+    let ne = s.s_mid.len();
+    let (a, b) = (ne / 4, 3 * ne / 4);
+    let z = |f: usize, e: usize| (s.kappa[f][e][0], s.kappa[f][e][1]);
+    let max_lag = (nf / 4) as i64;
+    let mut best = (0i64, -1.0f64);
+    for tau in -max_lag..=max_lag {
+        let (mut re, mut im) = (0.0, 0.0);
+        for t in 0..nf as i64 {
+            let u = t + tau;
+            if u < 0 || u >= nf as i64 {
+                continue;
+            }
+            let (x, y) = (z(t as usize, a), z(u as usize, b));
+            // x · conj(y)
+            re += x.0 * y.0 + x.1 * y.1;
+            im += x.1 * y.0 - x.0 * y.1;
+        }
+        let mag = (re * re + im * im).sqrt() / (nf as i64 - tau.abs()) as f64;
+        if mag > best.1 {
+            best = (tau, mag);
+        }
+    }
+    Some(best.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A pulse of bending travels towards s = L at 0.01 body lengths per frame: the probes at
+    /// L/4 and 3L/4 see it 50 frames apart; played backwards, −50.
+    #[test]
+    fn wave_lag_sign_and_size() {
+        let (ne, nf) = (100, 400);
+        let s_mid: Vec<f64> = (0..ne).map(|e| (e as f64 + 0.5) / ne as f64).collect();
+        let kappa: Vec<Vec<Vector3<f64>>> = (0..nf)
+            .map(|t| {
+                s_mid
+                    .iter()
+                    .map(|s| {
+                        let u = (s - 0.01 * t as f64 + 1.0) / 0.1;
+                        Vector3::new((-u * u).exp(), 0.5 * (-u * u).exp(), 3.0)
+                    })
+                    .collect()
+            })
+            .collect();
+        let series = ClipSeries { frames: (0..nf).collect(), s_mid, kappa, ..Default::default() };
+        assert_eq!(bending_wave_lag(&series), Some(50));
+        let back = ClipSeries { kappa: series.kappa.iter().rev().cloned().collect(), ..series.clone() };
+        assert_eq!(bending_wave_lag(&back), Some(-50));
+    }
+}

@@ -1,0 +1,297 @@
+//! The audit of the paper (`cosserat audit`): every figure, table and claim of §5–6 that can
+//! be computed here, regenerated from the specs of `cases/paper/` ([`spec`]) and judged with
+//! numbers ([`check`]): *reproduced*, *differs*, *refuted* or *not computable here*. Runs go
+//! through the same path as `cosserat sweep` (`io::sweep::run_point`), one folder per point;
+//! [`measures`] adds the numbers a claim needs beyond a run's metrics, [`figures`] draws the
+//! paper's panels and [`report`] writes `REPORT.md` and `report.csv`.
+pub mod check;
+pub mod figures;
+pub mod measures;
+pub mod report;
+pub mod spec;
+
+use std::path::{Path, PathBuf};
+
+use rayon::prelude::*;
+use serde::Deserialize;
+
+use crate::case::sweep::{product, Point, SweepError};
+use crate::io::sweep::{run_clip_point, run_point, RunStatus, SweepOutcome};
+use measures::{derived_metrics, ClipRecorder, ClipSeries};
+use spec::{Claim, RunSpec, Spec};
+
+/// The judgement of one claim.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Verdict {
+    /// our numbers satisfy the paper's statement
+    Reproduced,
+    /// our numbers satisfy it in part, or with different numbers (the cause is given)
+    Differs,
+    /// our numbers contradict it, for a cause shown in `docs/audit.md`
+    Refuted,
+    /// the paper's data or setting is not available; the check ran on a substitute
+    NotComputable,
+}
+
+impl Verdict {
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            Verdict::Reproduced => "reproduced",
+            Verdict::Differs => "differs",
+            Verdict::Refuted => "refuted",
+            Verdict::NotComputable => "not computable here",
+        }
+    }
+    pub const ALL: [Verdict; 4] = [Verdict::Reproduced, Verdict::Differs, Verdict::Refuted, Verdict::NotComputable];
+}
+
+/// Errors of an audit (before any run: the runs' own failures are results).
+#[derive(Debug, thiserror::Error)]
+pub enum AuditError {
+    #[error(transparent)]
+    Spec(#[from] spec::SpecError),
+    #[error("spec {spec}: run `{run}`")]
+    Grid {
+        spec: String,
+        run: String,
+        #[source]
+        source: SweepError,
+    },
+    #[error("spec {spec}: figure {file}")]
+    Figure {
+        spec: String,
+        file: String,
+        #[source]
+        source: Box<crate::io::OutputError>,
+    },
+    #[error("writing the report")]
+    Output(#[from] crate::io::OutputError),
+    #[error("writing the report")]
+    Csv(#[from] csv::Error),
+    #[error("{path} exists and is not an audit folder (no {MARKER}); choose another --out")]
+    Foreign { path: PathBuf },
+    #[error("cannot prepare the audit folder {path}")]
+    Folder {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("cannot list audit specs in {path}")]
+    List {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+}
+
+/// One point of a run with what it produced.
+pub struct PointResult {
+    /// grid values (empty for a run without a grid)
+    pub point: Point,
+    /// folder name of the point
+    pub label: String,
+    pub outcome: SweepOutcome,
+    /// clip runs: per-frame series the figures and measures need beyond `frames.csv`
+    pub series: Option<ClipSeries>,
+}
+
+impl PointResult {
+    pub fn converged(&self) -> bool {
+        self.outcome.status == RunStatus::Ok
+    }
+    /// A metric of the point (its run's metrics with [`measures::derived_metrics`]).
+    pub fn metric(&self, name: &str) -> Option<f64> {
+        self.outcome.metrics.as_ref().and_then(|m| m.get(name)).copied()
+    }
+    /// Does the point have these grid values?
+    pub fn matches(&self, at: &spec::Selector) -> bool {
+        at.iter().all(|(k, v)| self.point.iter().any(|(pk, pv)| pk == k && (pv - v).abs() <= 1e-12 * v.abs()))
+    }
+}
+
+/// The points of one run of a spec.
+pub struct RunResults {
+    pub name: String,
+    pub points: Vec<PointResult>,
+    /// the case's description (for the report)
+    pub case_name: String,
+}
+
+impl RunResults {
+    /// The selected points (`at` empty: all).
+    pub fn select(&self, at: &spec::Selector) -> impl Iterator<Item = &PointResult> + '_ {
+        let at = at.clone();
+        self.points.iter().filter(move |p| p.matches(&at))
+    }
+}
+
+/// A judged claim.
+#[derive(Clone, Debug)]
+pub struct ClaimResult {
+    pub spec: String,
+    pub claim: Claim,
+    pub verdict: Verdict,
+    /// our numbers, two significant digits
+    pub ours: String,
+    /// the figure illustrating the claim, relative to the audit folder
+    pub figure: Option<String>,
+}
+
+/// Everything an audit produced.
+pub struct AuditReport {
+    pub claims: Vec<ClaimResult>,
+    /// figures written, relative to the audit folder
+    pub figures: Vec<String>,
+    pub quick: bool,
+    pub wall_time_s: f64,
+}
+
+impl AuditReport {
+    /// Claims per verdict, in the order of [`Verdict::ALL`].
+    pub fn counts(&self) -> [usize; 4] {
+        Verdict::ALL.map(|v| self.claims.iter().filter(|c| c.verdict == v).count())
+    }
+}
+
+/// Settings of an audit.
+#[derive(Clone, Debug)]
+pub struct AuditOptions {
+    /// output folder (one subfolder per spec, `REPORT.md`, `report.csv`)
+    pub out: PathBuf,
+    /// parallel runs (0: one per core)
+    pub jobs: usize,
+}
+
+/// The spec files of a folder (`*.toml`, sorted).
+pub fn spec_files(dir: &Path) -> Result<Vec<PathBuf>, AuditError> {
+    let list = |source| AuditError::List { path: dir.to_path_buf(), source };
+    let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map_err(list)?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .collect();
+    files.sort();
+    Ok(files)
+}
+
+/// The file that marks a folder as an audit's output (so that a new audit may replace it).
+pub const MARKER: &str = ".cosserat-audit";
+
+/// Empty `out` for a new audit: a previous audit's folder (it holds [`MARKER`]) is removed
+/// whole, so that no point of an older audit survives next to the new ones; any other
+/// non-empty folder is refused.
+fn prepare_folder(out: &Path) -> Result<(), AuditError> {
+    let io = |source| AuditError::Folder { path: out.to_path_buf(), source };
+    if out.exists() {
+        let empty = std::fs::read_dir(out).map_err(io)?.next().is_none();
+        if !empty && !out.join(MARKER).exists() {
+            return Err(AuditError::Foreign { path: out.to_path_buf() });
+        }
+        std::fs::remove_dir_all(out).map_err(io)?;
+    }
+    std::fs::create_dir_all(out).map_err(io)?;
+    std::fs::write(out.join(MARKER), "written by `cosserat audit`; replaced whole by the next audit\n").map_err(io)
+}
+
+/// One job of the audit: a point of a run of a spec.
+struct Job<'a> {
+    spec: usize,
+    run: &'a RunSpec,
+    point: Point,
+    case: crate::case::Case,
+    dir: PathBuf,
+}
+
+/// Run every point of every run of `specs` in parallel (clip runs first: they are the longest),
+/// judge every claim, draw every figure and write `REPORT.md` and `report.csv` into
+/// `opts.out`. `progress(done, total)` after each point.
+pub fn run_audit(
+    specs: &[Spec],
+    quick: bool,
+    opts: &AuditOptions,
+    progress: impl Fn(usize, usize) + Sync,
+) -> Result<AuditReport, AuditError> {
+    let start = std::time::Instant::now();
+    let mut jobs: Vec<Job> = Vec::new();
+    for (i, spec) in specs.iter().enumerate() {
+        for run in &spec.runs {
+            let grid_err = |source| AuditError::Grid { spec: spec.name.clone(), run: run.name.clone(), source };
+            let points = product(&run.case, &run.grid).map_err(grid_err)?;
+            for (point, case) in points {
+                let label = if point.is_empty() { "run".to_string() } else { case.name.clone() };
+                let dir = opts.out.join(&spec.name).join(&run.name).join(&label);
+                jobs.push(Job { spec: i, run, point, case, dir });
+            }
+        }
+    }
+    prepare_folder(&opts.out)?;
+    jobs.sort_by_key(|j| j.case.clip().is_none());
+    let total = jobs.len();
+    let done = std::sync::atomic::AtomicUsize::new(0);
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(opts.jobs).build().ok();
+    let work = || -> Vec<(usize, String, PointResult)> {
+        jobs.par_iter()
+            .map(|j| {
+                let r = run_job(j);
+                progress(done.fetch_add(1, std::sync::atomic::Ordering::SeqCst) + 1, total);
+                (j.spec, j.run.name.clone(), r)
+            })
+            .collect()
+    };
+    let finished = match &pool {
+        Some(p) => p.install(work),
+        None => work(),
+    };
+    // Regroup by spec and run, in the specs' order.
+    let mut results: Vec<Vec<RunResults>> = specs
+        .iter()
+        .map(|s| {
+            s.runs
+                .iter()
+                .map(|r| RunResults { name: r.name.clone(), points: Vec::new(), case_name: r.case.name.clone() })
+                .collect()
+        })
+        .collect();
+    for (spec, run, r) in finished {
+        if let Some(rr) = results[spec].iter_mut().find(|x| x.name == run) {
+            rr.points.push(r);
+        }
+    }
+    let mut claims = Vec::new();
+    let mut figures = Vec::new();
+    for (spec, runs) in specs.iter().zip(&results) {
+        let written = figures::write_figures(spec, runs, &opts.out.join(&spec.name))
+            .map_err(|(file, source)| AuditError::Figure { spec: spec.name.clone(), file, source: Box::new(source) })?;
+        figures.extend(written.iter().map(|f| format!("{}/{f}", spec.name)));
+        for claim in &spec.claims {
+            claims.push(check::judge(spec, claim, runs));
+        }
+    }
+    let report = AuditReport { claims, figures, quick, wall_time_s: start.elapsed().as_secs_f64() };
+    report::write_report(&report, &opts.out)?;
+    Ok(report)
+}
+
+/// Run one point: a clip case solves its clip (recording the series the figures need), any
+/// other case runs as in `cosserat sweep`; then the derived metrics of [`measures`].
+fn run_job(j: &Job) -> PointResult {
+    let label = j.dir.file_name().map(|f| f.to_string_lossy().into_owned()).unwrap_or_default();
+    let (mut outcome, series) = if j.case.clip().is_some() {
+        let recorder = ClipRecorder::new(&j.run.keep_frames);
+        let shared = std::sync::Mutex::new(recorder);
+        let outcome = run_clip_point(&j.case, &j.dir, |frame| {
+            if let Ok(mut r) = shared.lock() {
+                r.record(frame);
+            }
+        });
+        let series = shared.into_inner().ok().map(|r| r.finish());
+        (outcome, series)
+    } else {
+        (run_point(&j.case, &j.dir), None)
+    };
+    if let Some(m) = outcome.metrics.as_mut() {
+        m.extend(derived_metrics(&j.case, outcome.run.as_ref(), series.as_ref()));
+    }
+    PointResult { point: j.point.clone(), label, outcome, series }
+}

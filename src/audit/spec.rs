@@ -1,0 +1,411 @@
+//! Audit specs (`cases/paper/*.toml`): TOML → serde structs (`deny_unknown_fields`) → one
+//! validated [`Spec`] whose runs hold validated cases. One spec per figure, table or group of
+//! claims of §5–6 of the paper:
+//!
+//! ```toml
+//! title = "Findings (1)-(5) of §5.2 on the data of eq. (64)"
+//! section = "§5.2"
+//! paper_figures = "Figs. 9-11"
+//!
+//! [runs.ld]                                   # a run: a case, fixed overrides, a grid
+//! case = "../inverse_bend.toml"               # relative to this file
+//! set = { "solver.max_iterations" = 3000 }    # dotted keys of the case file
+//! grid = { lambda_d = [1e-10, 1e-6, 1e-2, 1, 10] }   # `cosserat sweep --set` keys
+//! quick_grid = { lambda_d = [1e-2, 10] }      # `--quick` (default: grid)
+//! quick_set = { "clip.frames" = [0, 40] }     # `--quick` only, after `set`
+//!
+//! [[claims]]
+//! id = "eq64-3"
+//! where = "§5.2 (64), finding (3); Fig. 10"
+//! statement = "converge stably with the regularisation parameter λd varying from 10¹ to 10⁻¹⁰"
+//! paper = "converges for λd = 1e-10 … 1e1"
+//! check = { kind = "converges", run = "ld" }
+//! expect = "reproduced"
+//! cause = "…"                                 # shown with any other verdict
+//!
+//! [[figures]]
+//! file = "fig10.svg"
+//! title = "Fig. 10: convergence against λd"
+//! show = { kind = "convergence", run = "ld" }
+//! ```
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use serde::Deserialize;
+
+use super::Verdict;
+use crate::case::sweep::{known_keys, SweepParam};
+use crate::case::Case;
+
+/// Errors at the spec-file boundary; each names the file.
+#[derive(Debug, thiserror::Error)]
+pub enum SpecError {
+    #[error("cannot read audit spec {path}")]
+    Io {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("{path}: {message}")]
+    Syntax { path: PathBuf, message: String },
+    #[error("{path}: {what}: {reason}")]
+    Invalid { path: PathBuf, what: String, reason: String },
+    #[error("{path}: run `{run}`: case {case}")]
+    Case {
+        path: PathBuf,
+        run: String,
+        case: PathBuf,
+        #[source]
+        source: Box<dyn std::error::Error + Send + Sync>,
+    },
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawSpec {
+    title: String,
+    section: String,
+    #[serde(default)]
+    paper_figures: String,
+    runs: BTreeMap<String, RawRun>,
+    claims: Vec<RawClaim>,
+    #[serde(default)]
+    figures: Vec<PlotSpec>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawRun {
+    case: PathBuf,
+    #[serde(default)]
+    set: toml::Table,
+    #[serde(default)]
+    quick_set: toml::Table,
+    #[serde(default)]
+    grid: BTreeMap<String, Vec<f64>>,
+    quick_grid: Option<BTreeMap<String, Vec<f64>>>,
+    /// frames of a clip run kept in memory for posture figures
+    #[serde(default)]
+    keep_frames: Vec<usize>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawClaim {
+    id: String,
+    #[serde(rename = "where")]
+    location: String,
+    statement: String,
+    paper: String,
+    check: Check,
+    expect: Verdict,
+    #[serde(default)]
+    if_fails: Option<Verdict>,
+    cause: Option<String>,
+    not_computable: Option<String>,
+    substitute: Option<String>,
+    figure: Option<String>,
+}
+
+/// A grid point by its values (`{ lambda_d = 1e-2 }`); empty: the run's only point.
+pub type Selector = BTreeMap<String, f64>;
+
+/// A run's point, or every point of the run when `at` is empty.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Ref {
+    pub run: String,
+    #[serde(default)]
+    pub at: Selector,
+}
+
+/// The relation a claim checks on the runs' metrics.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum Check {
+    /// every point of `run` meets its stopping rule (partly: some points do)
+    Converges { run: String },
+    /// no point of `run` converges (the paper says the scheme fails there)
+    DoesNotConverge { run: String },
+    /// `metric ≤ limit` at every selected point
+    Below {
+        run: String,
+        metric: String,
+        limit: f64,
+        #[serde(default)]
+        at: Selector,
+    },
+    /// `metric ≥ limit` at every selected point
+    Above {
+        run: String,
+        metric: String,
+        limit: f64,
+        #[serde(default)]
+        at: Selector,
+    },
+    /// `metric` increases (strictly) along the run's single grid key
+    Increasing { run: String, metric: String },
+    /// `metric(numerator) / metric(denominator) ≥ limit`
+    RatioAbove { metric: String, numerator: Ref, denominator: Ref, limit: f64 },
+    /// `metric(numerator) / metric(denominator) ≤ limit`
+    RatioBelow { metric: String, numerator: Ref, denominator: Ref, limit: f64 },
+    /// `max / min` of `metric` over the points of `run` and of the runs `with` ≤ `factor`
+    /// (the same value everywhere); at least two points
+    WithinFactor {
+        run: String,
+        metric: String,
+        factor: f64,
+        #[serde(default)]
+        with: Vec<String>,
+    },
+    /// the histories of `history` (an inverse run's per-iteration record) agree with the
+    /// reference point's to a relative spread ≤ `limit` over their common iterations
+    SameHistories { run: String, history: String, reference: Selector, limit: f64 },
+}
+
+impl Check {
+    /// The runs the check reads.
+    pub fn runs(&self) -> Vec<&str> {
+        match self {
+            Check::Converges { run }
+            | Check::DoesNotConverge { run }
+            | Check::Below { run, .. }
+            | Check::Above { run, .. }
+            | Check::Increasing { run, .. }
+            | Check::SameHistories { run, .. } => vec![run],
+            Check::WithinFactor { run, with, .. } => std::iter::once(run).chain(with).map(|s| s.as_str()).collect(),
+            Check::RatioAbove { numerator, denominator, .. } | Check::RatioBelow { numerator, denominator, .. } => {
+                vec![&numerator.run, &denominator.run]
+            }
+        }
+    }
+}
+
+/// A figure of the audit, laid out like the paper's panels.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct PlotSpec {
+    /// file name in the spec's output folder (`.svg`)
+    pub file: String,
+    pub title: String,
+    pub show: PlotKind,
+}
+
+/// What a figure shows.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum PlotKind {
+    /// log-log histories of every point of an inverse run (Figs. 9–11, 13)
+    Convergence { run: String },
+    /// recovered x and κ against the data along the rod (Figs. 8, 12, 14)
+    Recovered {
+        run: String,
+        #[serde(default)]
+        at: Selector,
+    },
+    /// the controls f and l along the rod against the loads that made the data (Fig. 15)
+    Controls {
+        run: String,
+        #[serde(default)]
+        at: Selector,
+    },
+    /// tip history of a dynamic run with the modal solution overlaid (Fig. 5)
+    TipHistory { run: String },
+    /// tip-loaded cantilevers against eq. (63), the elastica and the Reissner rod (Fig. 7)
+    Deflection { runs: Vec<String> },
+    /// κ1, κ2, κ3 of a clip run over frames and arc length (Figs. 17, 23, 25)
+    Kymograph {
+        run: String,
+        #[serde(default)]
+        at: Selector,
+    },
+    /// the objective's terms per frame, one curve per point of each run (Figs. 18–20)
+    Objectives { runs: Vec<String> },
+    /// the angular velocity ω per frame, max over the body, one curve per point of each run
+    /// (Fig. 24)
+    Omega { runs: Vec<String> },
+    /// rendered postures of chosen frames (among the run's `keep_frames`) of a clip run
+    /// (Figs. 16, 21, 22)
+    Postures {
+        run: String,
+        frames: Vec<usize>,
+        #[serde(default)]
+        at: Selector,
+    },
+}
+
+impl PlotKind {
+    /// The runs the figure reads.
+    pub fn runs(&self) -> Vec<&str> {
+        match self {
+            PlotKind::Convergence { run }
+            | PlotKind::Recovered { run, .. }
+            | PlotKind::Controls { run, .. }
+            | PlotKind::TipHistory { run }
+            | PlotKind::Kymograph { run, .. }
+            | PlotKind::Postures { run, .. } => vec![run],
+            PlotKind::Deflection { runs } | PlotKind::Objectives { runs } | PlotKind::Omega { runs } => {
+                runs.iter().map(|s| s.as_str()).collect()
+            }
+        }
+    }
+}
+
+/// A run of a spec: a validated case and its grid.
+#[derive(Clone, Debug)]
+pub struct RunSpec {
+    pub name: String,
+    /// the case with `set` applied (and `quick_set` in quick mode)
+    pub case: Case,
+    /// the grid (`quick_grid` in quick mode); empty: one point
+    pub grid: Vec<SweepParam>,
+    /// clip runs: frames kept for posture figures
+    pub keep_frames: Vec<usize>,
+}
+
+/// One claim of the paper and how it is judged.
+#[derive(Clone, Debug)]
+pub struct Claim {
+    pub id: String,
+    /// section, equation, figure
+    pub location: String,
+    /// the paper's words (a short quote)
+    pub statement: String,
+    /// the paper's number or range
+    pub paper: String,
+    pub check: Check,
+    /// the verdict this project established (asserted by the quick audit in `cargo test`)
+    pub expect: Verdict,
+    /// the verdict when the check fails outright (default: differs)
+    pub if_fails: Verdict,
+    /// why our number differs (reported with any verdict but reproduced)
+    pub cause: Option<String>,
+    /// what of the paper is not available here (its data, its code): the check runs on the
+    /// `substitute` and the verdict is "not computable here" when it holds there
+    pub not_computable: Option<String>,
+    /// the data the check runs on when it is not the paper's
+    pub substitute: Option<String>,
+    /// a figure file of the spec illustrating the claim
+    pub figure: Option<String>,
+}
+
+/// A validated audit spec.
+#[derive(Clone, Debug)]
+pub struct Spec {
+    /// file stem (output folder name)
+    pub name: String,
+    pub path: PathBuf,
+    pub title: String,
+    pub section: String,
+    /// the paper's figures and tables the spec covers
+    pub paper_figures: String,
+    pub runs: Vec<RunSpec>,
+    pub claims: Vec<Claim>,
+    pub plots: Vec<PlotSpec>,
+}
+
+impl Spec {
+    /// The run named `name`.
+    pub fn run(&self, name: &str) -> Option<&RunSpec> {
+        self.runs.iter().find(|r| r.name == name)
+    }
+}
+
+/// Read and validate a spec; `quick`: apply the runs' `quick_set` and `quick_grid`.
+pub fn read_spec(path: &Path, quick: bool) -> Result<Spec, SpecError> {
+    let text = std::fs::read_to_string(path).map_err(|source| SpecError::Io { path: path.to_path_buf(), source })?;
+    let raw: RawSpec =
+        toml::from_str(&text).map_err(|e| SpecError::Syntax { path: path.to_path_buf(), message: e.to_string() })?;
+    let invalid = |what: String, reason: String| SpecError::Invalid { path: path.to_path_buf(), what, reason };
+    let dir = path.parent().unwrap_or(Path::new("."));
+    let mut runs = Vec::new();
+    for (name, r) in raw.runs {
+        let case_path = dir.join(&r.case);
+        let boxed = |e: Box<dyn std::error::Error + Send + Sync>| SpecError::Case {
+            path: path.to_path_buf(),
+            run: name.clone(),
+            case: case_path.clone(),
+            source: e,
+        };
+        let mut case = Case::from_file(&case_path).map_err(|e| boxed(Box::new(e)))?;
+        let mut set: Vec<(String, toml::Value)> = r.set.into_iter().collect();
+        if quick {
+            set.extend(r.quick_set);
+        }
+        if !set.is_empty() {
+            case = case.with_overrides(&set).map_err(|e| boxed(Box::new(e)))?;
+        }
+        let grid_table = if quick { r.quick_grid.unwrap_or(r.grid) } else { r.grid };
+        let known = known_keys(&case);
+        let mut grid = Vec::new();
+        for (key, values) in grid_table {
+            if !known.contains(&key.as_str()) {
+                return Err(invalid(
+                    format!("run `{name}` grid"),
+                    format!("unknown key `{key}` (known: {})", known.join(", ")),
+                ));
+            }
+            if values.is_empty() || values.iter().any(|v| !v.is_finite()) {
+                return Err(invalid(format!("run `{name}` grid `{key}`"), "needs finite values".into()));
+            }
+            grid.push(SweepParam { key, values });
+        }
+        if !r.keep_frames.is_empty() && case.clip().is_none() {
+            return Err(invalid(format!("run `{name}`"), "keep_frames needs a clip case".into()));
+        }
+        runs.push(RunSpec { name, case, grid, keep_frames: r.keep_frames });
+    }
+    let spec_runs = |names: Vec<&str>, what: String| -> Result<(), SpecError> {
+        match names.iter().find(|n| !runs.iter().any(|r| r.name == **n)) {
+            Some(n) => Err(invalid(what, format!("names no run `{n}`"))),
+            None => Ok(()),
+        }
+    };
+    let mut claims: Vec<Claim> = Vec::new();
+    for c in raw.claims {
+        spec_runs(c.check.runs(), format!("claim `{}`", c.id))?;
+        if claims.iter().any(|o| o.id == c.id) {
+            return Err(invalid(format!("claim `{}`", c.id), "id given twice".into()));
+        }
+        if !matches!(c.expect, Verdict::Reproduced | Verdict::NotComputable) && c.cause.is_none() {
+            return Err(invalid(format!("claim `{}`", c.id), "a verdict other than reproduced needs a cause".into()));
+        }
+        if c.expect == Verdict::NotComputable && (c.not_computable.is_none() || c.substitute.is_none()) {
+            return Err(invalid(
+                format!("claim `{}`", c.id),
+                "expect = \"not_computable\" needs not_computable = \"<what is missing>\" and substitute = \"<what ran instead>\""
+                    .into(),
+            ));
+        }
+        claims.push(Claim {
+            id: c.id,
+            location: c.location,
+            statement: c.statement,
+            paper: c.paper,
+            check: c.check,
+            expect: c.expect,
+            if_fails: c.if_fails.unwrap_or(Verdict::Differs),
+            cause: c.cause,
+            not_computable: c.not_computable,
+            substitute: c.substitute,
+            figure: c.figure,
+        });
+    }
+    for p in &raw.figures {
+        spec_runs(p.show.runs(), format!("figure `{}`", p.file))?;
+        if !p.file.ends_with(".svg") || p.file.contains('/') {
+            return Err(invalid(format!("figure `{}`", p.file), "must be a file name ending in .svg".into()));
+        }
+    }
+    let name = path.file_stem().and_then(|s| s.to_str()).unwrap_or("spec").to_string();
+    Ok(Spec {
+        name,
+        path: path.to_path_buf(),
+        title: raw.title,
+        section: raw.section,
+        paper_figures: raw.paper_figures,
+        runs,
+        claims,
+        plots: raw.figures,
+    })
+}
