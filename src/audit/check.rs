@@ -135,10 +135,13 @@ fn iterations_range(pts: &[&PointResult], metric: &str) -> String {
         return String::new();
     }
     let (lo, hi) = v.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| (a.min(*x), b.max(*x)));
+    // frames are counted exactly; iterations to two digits (they may move by one between
+    // machines)
+    let f = |x: f64| if metric == "frames" { format!("{x}") } else { sig2(x) };
     if lo == hi {
-        format!(" ({} {metric})", sig2(lo))
+        format!(" ({} {metric})", f(lo))
     } else {
-        format!(" ({}–{} {metric})", sig2(lo), sig2(hi))
+        format!(" ({}–{} {metric})", f(lo), f(hi))
     }
 }
 
