@@ -375,8 +375,8 @@ fn points_of<'a>(runs: &'a [RunResults], names: &[String]) -> Vec<((String, Stri
 }
 
 /// Figs. 16, 21, 22: the kept frames of a clip run, three projections each, with the directors
-/// d1 (ticks), d3 (arrows) and the tangent, the centreline coloured by |κ| (node average of the
-/// element curvatures).
+/// d1 (ticks), d3 (arrows) and the tangent, the centreline coloured by |κ| (the node average of
+/// the element curvatures, `run::clip::nodal_curvature`).
 fn postures(title: &str, p: &PointResult, frames: &[usize]) -> Option<Svg> {
     let s = p.series.as_ref()?;
     let mut shown: Vec<&crate::run::clip::ClipFrame> =
@@ -389,14 +389,7 @@ fn postures(title: &str, p: &PointResult, frames: &[usize]) -> Option<Svg> {
         .into_iter()
         .map(|k| {
             let d = k.nodes.directors();
-            let kappa = k.nodes.element_curvature();
-            let n = k.nodes.x.len();
-            let colour = (0..n)
-                .map(|i| {
-                    let (a, b) = (i.saturating_sub(1), i.min(kappa.len() - 1));
-                    0.5 * (kappa[a].1.norm() + kappa[b].1.norm())
-                })
-                .collect();
+            let colour = crate::run::clip::nodal_curvature(&k.kappa).iter().map(|v| v.norm()).collect();
             PosturePanel {
                 label: format!("frame {}", k.report.frame),
                 x: k.nodes.x.clone(),

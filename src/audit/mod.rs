@@ -278,15 +278,9 @@ pub fn run_audit(
 fn run_job(j: &Job) -> PointResult {
     let label = j.dir.file_name().map(|f| f.to_string_lossy().into_owned()).unwrap_or_default();
     let (mut outcome, series) = if j.case.clip().is_some() {
-        let recorder = ClipRecorder::new(&j.run.keep_frames);
-        let shared = std::sync::Mutex::new(recorder);
-        let outcome = run_clip_point(&j.case, &j.dir, |frame| {
-            if let Ok(mut r) = shared.lock() {
-                r.record(frame);
-            }
-        });
-        let series = shared.into_inner().ok().map(|r| r.finish());
-        (outcome, series)
+        let mut recorder = ClipRecorder::new(&j.run.keep_frames);
+        let outcome = run_clip_point(&j.case, &j.dir, |frame| recorder.record(frame));
+        (outcome, Some(recorder.finish()))
     } else {
         (run_point(&j.case, &j.dir), None)
     };

@@ -119,7 +119,7 @@ impl ClipWriter {
     /// Append one converged frame: its report row, nodal fields, element curvature, truth row
     /// and VTK file.
     pub fn write_frame(&mut self, frame: &ClipFrame) -> Result<(), OutputError> {
-        let ClipFrame { report, time_s, nodes, force, torque, data, omega, roughness, .. } = frame;
+        let ClipFrame { report, time_s, nodes, force, torque, data, omega, kappa, roughness, .. } = frame;
         let omega = omega.clone().unwrap_or_else(|| vec![Vector3::zeros(); nodes.s.len()]);
         let (time_s, roughness) = (*time_s, *roughness);
         let err = |name: &str| {
@@ -157,15 +157,14 @@ impl ClipWriter {
             writeln!(self.fields, "{},{i},{}", r.frame, text.join(",")).map_err(err("fields.csv"))?;
         }
         self.fields.flush().map_err(err("fields.csv"))?;
-        let kappa = nodes.element_curvature();
-        for (s, k) in &kappa {
+        for (s, k) in kappa {
             writeln!(self.curvature, "{},{s:.10e},{:.10e},{:.10e},{:.10e}", r.frame, k[0], k[1], k[2])
                 .map_err(err("curvature.csv"))?;
         }
         self.curvature.flush().map_err(err("curvature.csv"))?;
         let (d1, d2, d3): (Vec<_>, Vec<_>, Vec<_>) =
             (d.iter().map(|x| x[0]).collect(), d.iter().map(|x| x[1]).collect(), d.iter().map(|x| x[2]).collect());
-        let kn = nodal_curvature(&kappa);
+        let kn = nodal_curvature(kappa);
         let name = format!("frame_{:05}.vtp", r.frame);
         write_vtp(
             &self.dir.join("vtk").join(&name),

@@ -40,6 +40,13 @@ pub struct SummaryRow {
     pub error: Option<String>,
 }
 
+impl SweepOutcome {
+    /// A point that produced no result, with its error.
+    fn failed(error: String) -> Self {
+        SweepOutcome { status: RunStatus::Failed, metrics: None, run: None, clip: None, error: Some(error) }
+    }
+}
+
 /// Outcome of one run of a sweep.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum RunStatus {
@@ -114,13 +121,7 @@ pub fn run_point(case: &Case, dir: &Path) -> SweepOutcome {
     if case.clip().is_some() {
         return run_clip_point(case, dir, |_| {});
     }
-    let failed = |e: &dyn std::fmt::Display| SweepOutcome {
-        status: RunStatus::Failed,
-        metrics: None,
-        run: None,
-        clip: None,
-        error: Some(e.to_string()),
-    };
+    let failed = |e: &dyn std::fmt::Display| SweepOutcome::failed(e.to_string());
     let outcome: Result<RunResult, EngineError> = if case.inverse().is_some() {
         let path = dir.join("data.csv");
         match load_data(case).and_then(|d| Ok(write_data(&path, &d)?)) {
@@ -161,7 +162,7 @@ pub fn run_clip_point(case: &Case, dir: &Path, observer: impl FnMut(&ClipFrame) 
             &dir.join("FAILED.txt"),
             format!("{e}\nThe converged frames before it are in this folder.\n").as_bytes(),
         );
-        SweepOutcome { status: RunStatus::Failed, metrics: None, run: None, clip: None, error: Some(e) }
+        SweepOutcome::failed(e)
     };
     let run = match run_clip_case_observed(case, dir, observer, |_, _| {}) {
         Ok(r) => r,

@@ -36,6 +36,9 @@ pub struct ClipFrame {
     /// penalised, α_{n−1} the previous frame's angles in this frame's chart. `None` on the
     /// first frame, which has no previous frame (Remark 6)
     pub omega: Option<Vec<Vector3<f64>>>,
+    /// element-midpoint curvature `(s [m], κ = A ∂sα [1/m])` (eq. 28), computed once for every
+    /// consumer of the frame
+    pub kappa: Vec<(f64, Vector3<f64>)>,
     /// sign alternation of the recovered κ2 and of the data's planar curvature
     pub roughness: (f64, f64),
     /// synthetic clips: the frame against its ground truth
@@ -216,6 +219,7 @@ pub fn run_clip<S: FrameSink>(
                     torque,
                     data: data.clone(),
                     omega,
+                    kappa,
                     roughness,
                     truth: truth_frame,
                 };
