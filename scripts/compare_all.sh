@@ -1,22 +1,25 @@
 #!/usr/bin/env bash
-# The main job: every case of cases/ through both engines, full length (the dynamic cantilever
-# takes ~4-5 minutes in FreeFEM), writing out/<case>/{rust,freefem}/ and a comparison table
-# per case (inverse cases: ~50 s of FreeFEM each; inverse Newton cases run in Rust only; worm
-# clips: first frame in both engines, then the whole clip in Rust, 3 minutes for the omega turn).
-# Exit status 1 if any comparison fails.
+# The full comparison: every case of cases/ through both engines, whole runs (the dynamic
+# cantilever's 1000 steps take ~5 minutes in FreeFEM; each inverse fixed point ~1 minute), the
+# first 10 frames of each clip, then one whole clip in both engines (CLIP, default
+# worm_delta_turn_ld1) with the time of each engine, then a batch of generated cases
+# (GENERATED, default 24). Writes out/full/<case>/ and a table per case; exit status 1 if any
+# comparison fails.
 set -uo pipefail
 cd "$(dirname "$0")/.."
 cargo build --release -q || exit 1
 bin=target/release/cosserat
+clip=${CLIP:-worm_delta_turn_ld1}
 status=0
-mkdir -p out
+mkdir -p out/full
 for c in cases/*.toml; do
   name=$(basename "$c" .toml)
   echo "== $name"
-  $bin compare "$c" --out "out/$name" | tee "out/$name.compare.txt" || status=1
-  # Clip cases: compare checks their first frame in both engines; the whole clip runs in Rust.
-  if grep -q '^\[clip\]' "$c"; then
-    $bin run "$c" --out "out/$name/clip" || status=1
-  fi
+  $bin compare "$c" --out "out/full/$name" | tee "out/full/$name.txt" || status=1
 done
+echo "== whole clip: $clip"
+$bin compare "cases/$clip.toml" --frames all --out "out/full/${clip}_all" | tee "out/full/${clip}_all.txt" || status=1
+echo "== generated cases"
+COSSERAT_GENERATED_CASES=${GENERATED:-24} cargo test --release -q --test generated_cases -- --nocapture 2>&1 \
+  | tee out/full/generated.txt | grep -E "^gen|passed|FAIL|panicked" || status=1
 exit $status

@@ -12,7 +12,7 @@ use cosserat::io::engine::{load_data, run_case, run_clip_case, run_inverse_on, w
 use cosserat::io::run_files::{write_convergence_plot, write_run};
 use cosserat::io::sweep::{run_point, summary_csv, RunStatus, SummaryRow, CLIP_SUMMARY_METRICS, SUMMARY_METRICS};
 use cosserat::io::write_atomic;
-use cosserat::run::metrics::{all_metrics, compare};
+use cosserat::run::metrics::all_metrics;
 use cosserat::run::{Engine, RunResult};
 use cosserat::solve::modes::modal_model;
 
@@ -40,13 +40,28 @@ enum Command {
         #[arg(long)]
         quiet: bool,
     },
-    /// Run both engines and compare their metrics; exit status 1 if any row fails.
+    /// Run both engines and compare them; exit status 1 if any row fails.
+    ///
+    /// Newton runs are compared at their roots, an inverse fixed point at the same iteration
+    /// (FreeFEM runs exactly the iterations Rust needed), a clip frame by frame over its first
+    /// frames. Each tolerance is derived from the case's conditioning: the Rust engine runs the
+    /// case again with its input perturbed by 1e-13 (relative), and a row passes when the
+    /// engines differ by less than 10 x (that change + the solver tolerance) + 1e-12. Values in
+    /// the case's [compare] table override them (with a `reason`). Writes compare.csv, the
+    /// engines' outputs (single runs) and FreeFEM's work folder to --out.
     Compare {
         /// Case file (TOML)
         case: PathBuf,
         /// Directory for both engines' outputs [default: out/<case name>]
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Short horizon: 200 time steps, 40 fixed-point iterations, 3 clip frames
+        #[arg(long)]
+        short: bool,
+        /// Clip cases: frames to compare, a number or `all` [default: the case's
+        /// `[compare] frames`, 10]
+        #[arg(long, value_parser = parse_frames)]
+        frames: Option<usize>,
     },
     /// Run a case for every point of a parameter grid (in parallel) and summarise.
     ///
@@ -134,7 +149,7 @@ fn main() -> ExitCode {
 fn dispatch(cli: Cli) -> Result<ExitCode> {
     match cli.command {
         Command::Run { case, engine, out, quiet } => cmd_run(&case, engine, out, quiet),
-        Command::Compare { case, out } => cmd_compare(&case, out),
+        Command::Compare { case, out, short, frames } => cmd_compare(&case, out, short, frames),
         Command::Sweep { case, set, out, jobs, quiet } => cmd_sweep(&case, &set, out, jobs, quiet),
         Command::Audit { specs, quick, out, jobs, quiet } => cmd_audit(&specs, quick, out, jobs, quiet),
         Command::List { dir } => cmd_list(&dir),
@@ -274,46 +289,59 @@ fn cmd_run_clip(case: &Case, engine: Engine, dir: &Path, quiet: bool) -> Result<
     Ok(ExitCode::SUCCESS)
 }
 
-fn cmd_compare(path: &Path, out: Option<PathBuf>) -> Result<ExitCode> {
-    let case = load(path)?;
-    let dir = out.unwrap_or_else(|| PathBuf::from("out").join(&case.name));
-    let data = prepare_data(&case, &dir)?;
-    let rust = run_engine(&case, Engine::Rust, &dir.join("rust"), data.as_deref(), false)?;
-    write_run(&case, &rust, &all_metrics(&case, &rust)?, &dir.join("rust"))?;
-    if matches!(case.inverse().map(|i| i.params.method), Some(cosserat::solve::inverse::InverseMethod::Newton { .. })) {
-        println!(
-            "{}: inverse Newton runs in the Rust engine only (FreeFEM mirrors the paper's fixed point); wrote {} ({} iterations, {:.3} s). Compare its fixed-point twin instead.",
-            case.name,
-            dir.join("rust").display(),
-            rust.stats.iterations,
-            rust.stats.wall_time_s
-        );
-        return Ok(ExitCode::SUCCESS);
+/// `--frames`: a positive count or `all`.
+fn parse_frames(s: &str) -> Result<usize, String> {
+    if s == "all" {
+        return Ok(usize::MAX);
     }
-    let ff = run_engine(&case, Engine::Freefem, &dir.join("freefem"), data.as_deref(), false)?;
-    write_run(&case, &ff, &all_metrics(&case, &ff)?, &dir.join("freefem"))?;
-    let rows = compare(&case, &rust, &ff);
-    println!("{:<34} {:>15} {:>15} {:>11} {:>11}  result", "metric", "rust", "freefem", "|diff|", "tolerance");
-    let mut failed = 0;
-    for r in &rows {
-        let verdict = if r.passed() { "PASS" } else { "FAIL" };
-        failed += usize::from(!r.passed());
+    match s.parse::<usize>() {
+        Ok(n) if n > 0 => Ok(n),
+        _ => Err(format!("expected a number of frames >= 1 or `all`, got `{s}`")),
+    }
+}
+
+fn cmd_compare(path: &Path, out: Option<PathBuf>, short: bool, frames: Option<usize>) -> Result<ExitCode> {
+    use cosserat::io::compare::{compare_case, default_dir, report_csv, CompareOptions, Horizon};
+    let case = load(path)?;
+    let dir = out.unwrap_or_else(|| default_dir(&case));
+    let opts = CompareOptions { horizon: if short { Horizon::Short } else { Horizon::Full }, frames };
+    eprintln!(
+        "{}: rust engine (twice: as given and with its input perturbed by 1e-13), then FreeFEM in {}",
+        case.name,
+        dir.join("freefem_work").display()
+    );
+    let report = compare_case(&case, &dir, &opts).with_context(|| format!("case {}", case.name))?;
+    if let Some((rust, ff)) = &report.runs {
+        write_run(&case, rust, &all_metrics(&case, rust)?, &dir.join("rust"))?;
+        write_run(&case, ff, &all_metrics(&case, ff)?, &dir.join("freefem"))?;
+    }
+    write_atomic(&dir.join("compare.csv"), report_csv(&report).as_bytes())?;
+    println!("{}: {}", case.name, report.what);
+    println!("{:<34} {:>15} {:>15} {:>11} {:>11}  result  tolerance from", "quantity", "rust", "freefem", "|diff|", "tolerance");
+    for r in &report.rows {
         let v = |x: Option<f64>| x.map(|x| format!("{x:.8e}")).unwrap_or_else(|| "-".into());
         println!(
-            "{:<34} {:>15} {:>15} {:>11.3e} {:>11.3e}  {verdict}",
+            "{:<34} {:>15} {:>15} {:>11.3e} {:>11.3e}  {:<6}  {}",
             r.name,
             v(r.rust),
             v(r.freefem),
             r.difference,
-            r.tolerance
+            r.tolerance,
+            if r.passed() { "PASS" } else { "FAIL" },
+            r.basis
         );
     }
     println!(
-        "wall time: rust {:.3} s, freefem {:.3} s (ratio freefem/rust {:.1})",
-        rust.stats.wall_time_s,
-        ff.stats.wall_time_s,
-        ff.stats.wall_time_s / rust.stats.wall_time_s
+        "wall time: rust {:.3} s, freefem {:.3} s (ratio freefem/rust {:.1}); wrote {}",
+        report.rust_wall_s,
+        report.freefem_wall_s,
+        report.freefem_wall_s / report.rust_wall_s,
+        dir.join("compare.csv").display()
     );
+    let failed = report.failed();
+    if failed > 0 {
+        eprintln!("{}: {failed} of {} rows FAILED", case.name, report.rows.len());
+    }
     Ok(if failed == 0 { ExitCode::SUCCESS } else { ExitCode::from(1) })
 }
 

@@ -136,21 +136,37 @@ pub enum Analysis {
     Inverse(InverseSettings),
 }
 
-/// Rust–FreeFEM comparison tolerances (D8).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct CompareTolerances {
-    /// max node-wise |Δ(x − x0)| / max |x − x0|
-    pub displacement_rel: f64,
-    /// max node-wise |Δα| / max |α|
-    pub angles_rel: f64,
-    /// scalar metrics: |Δ| ≤ metric_rel·|rust| + metric_abs
-    pub metric_rel: f64,
-    pub metric_abs: f64,
-    /// allowed difference of iteration counts
-    pub iterations_abs: f64,
-    /// inverse cases: max node-wise |Δ(x̂, α̂)| / max |(x̂, α̂)| (per field)
-    pub adjoint_rel: f64,
+/// The Rust–FreeFEM comparison of a case (`[compare]`, docs/decisions.md D14). Tolerances are
+/// derived from the case's measured conditioning; a value here overrides the derived one for
+/// its group of rows and needs a `reason`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CompareSpec {
+    /// clip cases: frames compared by default (`--frames` overrides)
+    pub frames: usize,
+    pub overrides: CompareOverrides,
+    /// why the overrides are there (required with any of them)
+    pub reason: Option<String>,
 }
+
+/// Tolerances that replace the derived ones (D14), each for its group of rows.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct CompareOverrides {
+    /// max node-wise |Δ(x − x0)| / max |x − x0|, and the tip history
+    pub displacement_rel: Option<f64>,
+    /// max node-wise |Δα| / max |α|
+    pub angles_rel: Option<f64>,
+    /// scalar metrics: |Δ| ≤ metric_rel·|rust| + metric_abs
+    pub metric_rel: Option<f64>,
+    pub metric_abs: Option<f64>,
+    /// allowed difference of iteration counts
+    pub iterations_abs: Option<f64>,
+    /// inverse cases: max node-wise |Δ(x̂, α̂)| / max |(x̂, α̂)| (per field)
+    pub adjoint_rel: Option<f64>,
+}
+
+/// Clip frames compared when neither `[compare] frames` nor `--frames` says: enough for the
+/// warm start, its linear predictor and a change of chart to be exercised.
+pub const DEFAULT_COMPARE_FRAMES: usize = 10;
 
 /// Independent theory a case is checked against (metrics `*_rel_error` in `metrics.json`).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -174,7 +190,7 @@ pub struct Case {
     pub quadrature: QuadratureScheme,
     pub loads: Loads,
     pub analysis: Analysis,
-    pub compare: CompareTolerances,
+    pub compare: CompareSpec,
     pub reference: Option<Reference>,
     /// the case file's tables and the path it was validated with, for [`sweep`]'s overrides
     raw: Option<(toml::Table, PathBuf)>,
@@ -321,9 +337,7 @@ relaxation = 0.5
 tolerance = 1e-10
 max_iterations = 100
 [compare]
-displacement_rel = 1e-6
-angles_rel = 1e-6
-metric_rel = 1e-6
+frames = 4
 "#;
 
     fn parse(text: &str) -> Result<Case, CaseError> {
@@ -339,6 +353,18 @@ metric_rel = 1e-6
         assert!(
             matches!(c.analysis, Analysis::Static(StaticParams { method: Method::FixedPoint { relaxation }, .. }) if relaxation == 0.5)
         );
+        assert_eq!(c.compare.frames, 4);
+        assert_eq!(c.compare.overrides, CompareOverrides::default());
+    }
+
+    #[test]
+    fn compare_overrides_need_a_reason() {
+        let text = GOOD.replace("frames = 4", "frames = 4\nangles_rel = 1e-6");
+        expect_key(&text, "compare.angles_rel");
+        let ok = parse(&text.replace("frames = 4", "frames = 4\nreason = \"measured: the twist is held by 1e-10 only\""));
+        assert_eq!(ok.unwrap().compare.overrides.angles_rel, Some(1e-6));
+        expect_key(&GOOD.replace("frames = 4", "frames = 0"), "compare.frames");
+        expect_key(&GOOD.replace("frames = 4", "metric_abs = -1\nreason = \"x\""), "compare.metric_abs");
     }
 
     fn expect_key(text: &str, key: &str) {

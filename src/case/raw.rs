@@ -26,6 +26,7 @@ pub(super) struct RawCase {
     pub(super) loads: RawLoads,
     pub(super) solver: RawSolver,
     pub(super) time: Option<RawTime>,
+    #[serde(default)]
     pub(super) compare: RawCompare,
     pub(super) reference: Option<RawReference>,
     /// inverse cases: the forward solve that generates the data from `[loads]`
@@ -238,15 +239,15 @@ pub(super) struct RawTime {
     pub(super) steps: usize,
 }
 
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct RawCompare {
-    pub(super) displacement_rel: f64,
-    pub(super) angles_rel: f64,
-    pub(super) metric_rel: f64,
-    #[serde(default)]
-    pub(super) metric_abs: f64,
-    #[serde(default)]
-    pub(super) iterations_abs: f64,
+    pub(super) frames: Option<usize>,
+    pub(super) displacement_rel: Option<f64>,
+    pub(super) angles_rel: Option<f64>,
+    pub(super) metric_rel: Option<f64>,
+    pub(super) metric_abs: Option<f64>,
+    pub(super) iterations_abs: Option<f64>,
     pub(super) adjoint_rel: Option<f64>,
+    pub(super) reason: Option<String>,
 }

@@ -8,7 +8,7 @@ use nalgebra::{Rotation3, Vector3};
 
 use super::raw::*;
 use super::{
-    Analysis, Case, CaseError, ClipKind, ClipSource, CompareTolerances, DataSource, InverseSettings, Reference,
+    Analysis, Case, CaseError, ClipKind, ClipSource, CompareOverrides, CompareSpec, DataSource, DEFAULT_COMPARE_FRAMES, InverseSettings, Reference,
     SyntheticClip,
 };
 use crate::clip::synthetic::RollClipParams;
@@ -100,7 +100,7 @@ impl<'a> Validator<'a> {
             RawAnalysis::Dynamic => Analysis::Dynamic(self.dynamic(&raw.solver, raw.time.as_ref())?),
             RawAnalysis::Inverse => Analysis::Inverse(self.inverse(&raw, &mesh)?),
         };
-        let compare = self.compare(&raw.compare, kind)?;
+        let compare = self.compare(&raw.compare)?;
         let reference = self.reference(raw.reference.as_ref(), kind)?;
         Ok(Case {
             reference,
@@ -516,34 +516,44 @@ impl<'a> Validator<'a> {
         Ok(synthetic)
     }
 
-    /// `[compare]`: the Rust–FreeFEM tolerances (D8).
-    fn compare(&self, rc: &RawCompare, kind: RawAnalysis) -> Result<CompareTolerances, CaseError> {
-        if kind == RawAnalysis::Inverse && rc.adjoint_rel.is_none() {
-            return Err(self.err("compare.adjoint_rel", "required for an inverse case (tolerance on the adjoint x̂, α̂)"));
-        }
-        for (k, v) in [
-            ("compare.displacement_rel", rc.displacement_rel),
-            ("compare.angles_rel", rc.angles_rel),
-            ("compare.metric_rel", rc.metric_rel),
-            ("compare.adjoint_rel", rc.adjoint_rel.unwrap_or(1.0)),
-        ] {
-            if !(v > 0.0 && v.is_finite()) {
-                return Err(self.err(k, format!("must be > 0, got {v}")));
-            }
-        }
-        for (k, v) in [("compare.metric_abs", rc.metric_abs), ("compare.iterations_abs", rc.iterations_abs)] {
-            if !(v >= 0.0 && v.is_finite()) {
-                return Err(self.err(k, format!("must be ≥ 0, got {v}")));
-            }
-        }
-        Ok(CompareTolerances {
+    /// `[compare]`: the frames of a clip comparison and the overrides of the derived
+    /// tolerances (D14), each with the `reason` they need.
+    fn compare(&self, rc: &RawCompare) -> Result<CompareSpec, CaseError> {
+        let o = CompareOverrides {
             displacement_rel: rc.displacement_rel,
             angles_rel: rc.angles_rel,
             metric_rel: rc.metric_rel,
             metric_abs: rc.metric_abs,
             iterations_abs: rc.iterations_abs,
-            adjoint_rel: rc.adjoint_rel.unwrap_or(f64::INFINITY),
-        })
+            adjoint_rel: rc.adjoint_rel,
+        };
+        let given = [
+            ("compare.displacement_rel", o.displacement_rel),
+            ("compare.angles_rel", o.angles_rel),
+            ("compare.metric_rel", o.metric_rel),
+            ("compare.metric_abs", o.metric_abs),
+            ("compare.iterations_abs", o.iterations_abs),
+            ("compare.adjoint_rel", o.adjoint_rel),
+        ];
+        for (k, v) in given {
+            if let Some(v) = v {
+                if !(v >= 0.0 && v.is_finite()) {
+                    return Err(self.err(k, format!("must be a finite number ≥ 0, got {v}")));
+                }
+            }
+        }
+        let reason = rc.reason.as_ref().map(|r| r.trim().to_string()).filter(|r| !r.is_empty());
+        if let (Some((k, _)), None) = (given.iter().find(|(_, v)| v.is_some()), &reason) {
+            return Err(self.err(
+                k,
+                "overrides the tolerance derived from the case's conditioning (docs/decisions.md D14): say why in compare.reason = \"…\", or remove it",
+            ));
+        }
+        let frames = rc.frames.unwrap_or(DEFAULT_COMPARE_FRAMES);
+        if frames == 0 {
+            return Err(self.err("compare.frames", "must be ≥ 1"));
+        }
+        Ok(CompareSpec { frames, overrides: o, reason })
     }
 
     /// `[reference]`: the theory a static case is checked against.

@@ -89,7 +89,7 @@ pub fn run_inverse_on(
     let data = read_data(data_path, &case.mesh)?;
     match engine {
         Engine::Rust => Ok(run::run_inverse(case, &data, progress)?),
-        Engine::Freefem => Ok(freefem::run_inverse(case, data, data_path, workdir)?),
+        Engine::Freefem => Ok(freefem::run_inverse(case, data, data_path, workdir, &Default::default())?),
     }
 }
 

@@ -83,8 +83,28 @@ fn constant_names(constants: &BTreeMap<String, f64>) -> BTreeMap<String, String>
     constants.keys().enumerate().map(|(i, k)| (k.clone(), format!("cst{i}"))).collect()
 }
 
+/// How a FreeFEM run departs from the case's own stopping rule, and the clip it solves.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct RunOptions {
+    /// inverse fixed point: run exactly this many iterations (`exactIters`), the tolerance
+    /// ignored, so that both engines are compared at the same iterate (docs/decisions.md D14)
+    pub exact_iterations: Option<usize>,
+    /// clip driver (`freefem/clip.edp`): its frames
+    pub clip: Option<ClipInclude>,
+}
+
+/// The clip keys of `case.idp` for `freefem/clip.edp`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ClipInclude {
+    pub frames: usize,
+    pub frame_offset: usize,
+    /// 0: previous frame's solution (restart from the data guess on failure), 1: data guess
+    pub start_data_guess: bool,
+    pub min_cos_beta: f64,
+}
+
 /// The include file `case.idp` of the FreeFEM contract (see `freefem/forward.edp`).
-pub fn include_file(case: &Case) -> String {
+pub fn include_file(case: &Case, opts: &RunOptions) -> String {
     let p = &case.props;
     let names = constant_names(&case.constants);
     let rename = |v: &str| match v {
@@ -179,20 +199,41 @@ pub fn include_file(case: &Case) -> String {
             num(p.alpha0_rad),
             num(p.stabilisation)
         );
+        let (method, warm) = match p.method {
+            InverseMethod::FixedPoint => (0, 0.0),
+            InverseMethod::Newton { warm_start_tolerance } => (1, warm_start_tolerance),
+        };
+        let _ = writeln!(
+            o,
+            "// solver (I8): 0 fixed point, 1 Newton warm-started by the fixed point down to max(warmTol, tol)\nint invMethod = {method};\nreal warmTol = {};\nint exactIters = {}; // > 0: exactly this many iterations, tol ignored",
+            num(warm),
+            opts.exact_iterations.unwrap_or(0)
+        );
+        if let Some(c) = &opts.clip {
+            let _ = writeln!(
+                o,
+                "// clip driver (freefem/clip.edp)\nint nframes = {};\nint frameOffset = {};\nint clipStart = {}; // 0 previous_frame, 1 data_guess\nreal minCosBeta = {};",
+                c.frames,
+                c.frame_offset,
+                i32::from(c.start_data_guess),
+                num(c.min_cos_beta)
+            );
+        }
     }
     o
 }
 
 /// Run `freefem/inverse.edp` on an inverse case with the data file `data_path` (copied into
 /// `workdir` as `data.csv` unless it is already there). `data` is the parsed content of that file.
-pub fn run_inverse(case: &Case, data: NodalState, data_path: &Path, workdir: &Path) -> Result<RunResult, FreeFemError> {
+pub fn run_inverse(
+    case: &Case,
+    data: NodalState,
+    data_path: &Path,
+    workdir: &Path,
+    opts: &RunOptions,
+) -> Result<RunResult, FreeFemError> {
     let inv = case.inverse().ok_or_else(|| FreeFemError::NotInverse(case.name.clone()))?;
 
-    if matches!(inv.params.method, InverseMethod::Newton { .. }) {
-        return Err(FreeFemError::Unsupported(
-            "the FreeFEM engine mirrors the paper's fixed point only (solver.method = \"fixed_point\")",
-        ));
-    }
     let io = |path: &Path| {
         let path = path.to_path_buf();
         move |source| FreeFemError::Io { path, source }
@@ -207,7 +248,7 @@ pub fn run_inverse(case: &Case, data: NodalState, data_path: &Path, workdir: &Pa
     if !same {
         std::fs::copy(data_path, &target).map_err(io(&target))?;
     }
-    execute(case, workdir, "inverse.edp", &["ff_inverse_nodes.csv", "ff_inverse_history.csv", "ff_info.csv"])?;
+    execute(case, workdir, "inverse.edp", &["ff_inverse_nodes.csv", "ff_inverse_history.csv", "ff_info.csv"], opts)?;
     let nodes_path = workdir.join("ff_inverse_nodes.csv");
     let mut header = vec!["s_m", "x_m", "y_m", "z_m", "alpha_rad", "beta_rad", "gamma_rad"];
     header.extend(["xhat_1", "xhat_2", "xhat_3", "ahat_1", "ahat_2", "ahat_3"]);
@@ -227,6 +268,7 @@ pub fn run_inverse(case: &Case, data: NodalState, data_path: &Path, workdir: &Pa
     };
     let mut hist_header = vec!["iteration", "rel_change", "x_err_rel", "tangent_misfit"];
     hist_header.extend(ObjectiveTerms::NAMES);
+    hist_header.push("newton_residual");
     let history = read_table(&workdir.join("ff_inverse_history.csv"), &hist_header)?
         .into_iter()
         .map(|r| InverseRecord {
@@ -242,7 +284,8 @@ pub fn run_inverse(case: &Case, data: NodalState, data_path: &Path, workdir: &Pa
                 bending: r[8],
                 angular: r[9],
             },
-            residual: None,
+            // −1 marks a fixed-point iteration (no Newton residual)
+            residual: (r[11] >= 0.0).then_some(r[11]),
         })
         .collect();
     let info = read_info(&workdir.join("ff_info.csv"))?;
@@ -275,12 +318,24 @@ pub fn run_inverse(case: &Case, data: NodalState, data_path: &Path, workdir: &Pa
 
 /// Run the FreeFEM engine on `case` inside `workdir` (created if needed).
 pub fn run(case: &Case, workdir: &Path) -> Result<RunResult, FreeFemError> {
-    execute(case, workdir, "forward.edp", &["ff_nodes.csv", "ff_info.csv", "ff_history.csv", "ff_tip.csv"])?;
+    execute(
+        case,
+        workdir,
+        "forward.edp",
+        &["ff_nodes.csv", "ff_info.csv", "ff_history.csv", "ff_tip.csv"],
+        &RunOptions::default(),
+    )?;
     read_outputs(case, workdir)
 }
 
 /// Write `case.idp` into `workdir`, remove stale `outputs`, run `script` headless there.
-fn execute(case: &Case, workdir: &Path, script: &str, outputs: &[&str]) -> Result<(), FreeFemError> {
+pub(super) fn execute(
+    case: &Case,
+    workdir: &Path,
+    script: &str,
+    outputs: &[&str],
+    opts: &RunOptions,
+) -> Result<(), FreeFemError> {
     let exe = find_executable()?;
     let scripts = script_dir();
     let script = scripts.join(script);
@@ -293,7 +348,7 @@ fn execute(case: &Case, workdir: &Path, script: &str, outputs: &[&str]) -> Resul
     };
     std::fs::create_dir_all(workdir).map_err(io(workdir))?;
     let include = workdir.join("case.idp");
-    std::fs::write(&include, include_file(case)).map_err(io(&include))?;
+    std::fs::write(&include, include_file(case, opts)).map_err(io(&include))?;
     for stale in outputs {
         let _ = std::fs::remove_file(workdir.join(stale));
     }
@@ -314,7 +369,7 @@ fn execute(case: &Case, workdir: &Path, script: &str, outputs: &[&str]) -> Resul
     Ok(())
 }
 
-fn read_info(info_path: &Path) -> Result<BTreeMap<String, f64>, FreeFemError> {
+pub(super) fn read_info(info_path: &Path) -> Result<BTreeMap<String, f64>, FreeFemError> {
     let csv_err = |source| InputError::Csv { path: info_path.to_path_buf(), source };
     let mut info = BTreeMap::new();
     let mut rdr = csv::ReaderBuilder::new().trim(csv::Trim::All).from_path(info_path).map_err(csv_err)?;
@@ -327,7 +382,7 @@ fn read_info(info_path: &Path) -> Result<BTreeMap<String, f64>, FreeFemError> {
     Ok(info)
 }
 
-fn read_table(path: &Path, expected: &[&str]) -> Result<Vec<Vec<f64>>, FreeFemError> {
+pub(super) fn read_table(path: &Path, expected: &[&str]) -> Result<Vec<Vec<f64>>, FreeFemError> {
     let bad = |reason: String| FreeFemError::BadOutput { path: path.to_path_buf(), reason };
     let mut rdr = csv_reader(path, expected)?;
     let mut rows = Vec::new();

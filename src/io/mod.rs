@@ -5,10 +5,12 @@
 //! files of a sweep ([`sweep`]).
 pub mod clip_files;
 pub mod clip_output;
+pub mod compare;
 pub mod data;
 pub mod engine;
 pub mod files;
 pub mod freefem;
+pub mod freefem_clip;
 pub mod npy;
 pub mod plot;
 pub mod posture;

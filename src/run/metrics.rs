@@ -5,11 +5,10 @@ use std::collections::BTreeMap;
 use nalgebra::{DVector, Vector3};
 
 use super::{NodalState, RunResult};
-use crate::case::{Analysis, Case, CompareTolerances, Reference};
+use crate::case::{Case, Reference};
 use crate::model::mesh::Mesh;
 use crate::reference::{timoshenko_tip_deflection, tip_loaded_cantilever, PlanarRod, ReferenceError};
 use crate::solve::inverse::ObjectiveTerms;
-use crate::solve::statics::{Method, StaticParams};
 
 /// Flat map metric name → value (`metrics.json`). Names carry SI units.
 pub type Metrics = BTreeMap<String, f64>;
@@ -141,6 +140,99 @@ pub fn all_metrics(case: &Case, r: &RunResult) -> Result<Metrics, ReferenceError
     Ok(m)
 }
 
+/// Which tolerance of a case's `[compare]` table a comparison row falls under (overrides,
+/// docs/decisions.md D14).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Group {
+    /// node-wise displacement and the tip history (`displacement_rel`)
+    Displacement,
+    /// node-wise angles (`angles_rel`)
+    Angles,
+    /// node-wise adjoints x̂, α̂ (`adjoint_rel`)
+    Adjoint,
+    /// scalar metrics (`metric_rel`, `metric_abs`)
+    Metric,
+    /// iteration counts (`iterations_abs`)
+    Iterations,
+}
+
+/// One compared quantity of two runs: a field difference (relative, D8), a scalar metric of
+/// each (absolute difference) or an iteration count.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Difference {
+    pub name: String,
+    pub group: Group,
+    /// the two runs' values (`None` for field rows)
+    pub a: Option<f64>,
+    pub b: Option<f64>,
+    /// field rows: max node-wise |Δ| / max |field|; metrics and counts: |a − b| (∞ if either
+    /// is missing or not finite)
+    pub difference: f64,
+}
+
+/// The quantities two runs of the same case are compared on: node-wise displacement, angles
+/// and (inverse) adjoints, the tip history of a dynamic run, the physical metrics, the recovery
+/// errors and, with `iterations`, the iteration counts.
+pub fn differences(a: &RunResult, b: &RunResult, iterations: bool) -> Vec<Difference> {
+    let mut rows = Vec::new();
+    let field = |name: &str, group: Group, difference: f64| Difference {
+        name: name.into(),
+        group,
+        a: None,
+        b: None,
+        difference: if difference.is_nan() { f64::INFINITY } else { difference },
+    };
+    let scalar = |name: &str, group: Group, x: Option<f64>, y: Option<f64>| {
+        let d = match (x, y) {
+            (Some(x), Some(y)) => (x - y).abs(),
+            _ => f64::INFINITY,
+        };
+        Difference { name: name.into(), group, a: x, b: y, difference: if d.is_nan() { f64::INFINITY } else { d } }
+    };
+    let nodes_match = a.nodes.s.len() == b.nodes.s.len();
+    if nodes_match {
+        rows.push(field(
+            "nodewise_rel_diff_displacement",
+            Group::Displacement,
+            max_relative_difference(&a.nodes.displacement(), &b.nodes.displacement()),
+        ));
+        rows.push(field(
+            "nodewise_rel_diff_angles",
+            Group::Angles,
+            max_relative_difference(&a.nodes.alpha, &b.nodes.alpha),
+        ));
+    } else {
+        rows.push(field("node_count", Group::Displacement, f64::INFINITY));
+    }
+    let (ma, mb) = (physical_metrics(a), physical_metrics(b));
+    for (name, &x) in &ma {
+        rows.push(scalar(name, Group::Metric, Some(x), mb.get(name).copied()));
+    }
+    if a.tip.len() == b.tip.len() && !a.tip.is_empty() {
+        let p: Vec<_> = a.tip.iter().map(|t| t.position_m - a.tip[0].position_m).collect();
+        let q: Vec<_> = b.tip.iter().map(|t| t.position_m - b.tip[0].position_m).collect();
+        rows.push(field("tip_history_rel_diff", Group::Displacement, max_relative_difference(&p, &q)));
+    } else if a.tip.len() != b.tip.len() {
+        rows.push(field("tip_history_length", Group::Displacement, f64::INFINITY));
+    }
+    if let (Some(x), Some(y)) = (&a.inverse, &b.inverse) {
+        if nodes_match {
+            rows.push(field("nodewise_rel_diff_xhat", Group::Adjoint, max_relative_difference(&x.xhat, &y.xhat)));
+            rows.push(field("nodewise_rel_diff_ahat", Group::Adjoint, max_relative_difference(&x.ahat, &y.ahat)));
+        }
+        // Recovery errors (κ amplifies angle differences by ~1/h).
+        let (ma, mb) = (inverse_metrics(a), inverse_metrics(b));
+        for name in ["x_err_rel", "kappa_err_rel", "kappa_err_rel_inner"].into_iter().filter(|n| ma.contains_key(*n)) {
+            rows.push(scalar(name, Group::Metric, ma.get(name).copied(), mb.get(name).copied()));
+        }
+    }
+    if iterations {
+        let (x, y) = (a.stats.iterations as f64, b.stats.iterations as f64);
+        rows.push(scalar("iterations", Group::Iterations, Some(x), Some(y)));
+    }
+    rows
+}
+
 /// One row of `cosserat compare`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ComparisonRow {
@@ -150,6 +242,8 @@ pub struct ComparisonRow {
     pub freefem: Option<f64>,
     pub difference: f64,
     pub tolerance: f64,
+    /// how the tolerance was found (derived from the perturbed run, or the case's override)
+    pub basis: String,
 }
 
 impl ComparisonRow {
@@ -162,90 +256,13 @@ impl ComparisonRow {
 pub fn max_relative_difference(a: &[nalgebra::Vector3<f64>], b: &[nalgebra::Vector3<f64>]) -> f64 {
     let scale = a.iter().fold(0.0_f64, |m, v| m.max(v.amax()));
     let diff = a.iter().zip(b).fold(0.0_f64, |m, (u, v)| m.max((u - v).amax()));
-    if diff == 0.0 {
+    if a.len() != b.len() {
+        f64::INFINITY
+    } else if diff == 0.0 {
         0.0
     } else if scale == 0.0 {
         f64::INFINITY
     } else {
         diff / scale
     }
-}
-
-/// Rows comparing a Rust and a FreeFEM run of the same case.
-pub fn compare(case: &Case, rust: &RunResult, ff: &RunResult) -> Vec<ComparisonRow> {
-    let tol: &CompareTolerances = &case.compare;
-    let mut rows = Vec::new();
-    let nodes_match = rust.nodes.s.len() == ff.nodes.s.len();
-    let field = |name: &str, value: f64, tolerance: f64| ComparisonRow {
-        name: name.into(),
-        rust: None,
-        freefem: None,
-        difference: value,
-        tolerance,
-    };
-    if nodes_match {
-        rows.push(field(
-            "nodewise_rel_diff_displacement",
-            max_relative_difference(&rust.nodes.displacement(), &ff.nodes.displacement()),
-            tol.displacement_rel,
-        ));
-        rows.push(field(
-            "nodewise_rel_diff_angles",
-            max_relative_difference(&rust.nodes.alpha, &ff.nodes.alpha),
-            tol.angles_rel,
-        ));
-    } else {
-        rows.push(field("node_count", f64::INFINITY, 0.0));
-    }
-    let (mr, mf) = (physical_metrics(rust), physical_metrics(ff));
-    for (name, &a) in &mr {
-        let b = mf.get(name).copied().unwrap_or(f64::NAN);
-        let d = (a - b).abs();
-        rows.push(ComparisonRow {
-            name: name.clone(),
-            rust: Some(a),
-            freefem: Some(b),
-            difference: if d.is_nan() { f64::INFINITY } else { d },
-            tolerance: tol.metric_rel * a.abs() + tol.metric_abs,
-        });
-    }
-    if rust.tip.len() == ff.tip.len() && !rust.tip.is_empty() {
-        let a: Vec<_> = rust.tip.iter().map(|t| t.position_m).collect();
-        let b: Vec<_> = ff.tip.iter().map(|t| t.position_m).collect();
-        let a0: Vec<_> = a.iter().map(|p| p - a[0]).collect();
-        let b0: Vec<_> = b.iter().map(|p| p - b[0]).collect();
-        rows.push(field("tip_history_rel_diff", max_relative_difference(&a0, &b0), tol.displacement_rel));
-    }
-    if let (Some(a), Some(b)) = (&rust.inverse, &ff.inverse) {
-        if nodes_match {
-            rows.push(field("nodewise_rel_diff_xhat", max_relative_difference(&a.xhat, &b.xhat), tol.adjoint_rel));
-            rows.push(field("nodewise_rel_diff_ahat", max_relative_difference(&a.ahat, &b.ahat), tol.adjoint_rel));
-        }
-        // Recovery errors (κ amplifies angle differences by ~1/h), compared relatively.
-        let (ma, mb) = (inverse_metrics(rust), inverse_metrics(ff));
-        for name in ["x_err_rel", "kappa_err_rel", "kappa_err_rel_inner"].into_iter().filter(|n| ma.contains_key(*n)) {
-            let (x, y) = (ma.get(name).copied().unwrap_or(f64::NAN), mb.get(name).copied().unwrap_or(f64::NAN));
-            let d = (x - y).abs();
-            rows.push(ComparisonRow {
-                name: name.into(),
-                rust: Some(x),
-                freefem: Some(y),
-                difference: if d.is_nan() { f64::INFINITY } else { d },
-                tolerance: tol.metric_rel * x.abs(),
-            });
-        }
-    }
-    // Both engines run the identical fixed point (D5), so their iteration counts are compared.
-    let fixed_point = matches!(case.analysis, Analysis::Static(StaticParams { method: Method::FixedPoint { .. }, .. }));
-    if fixed_point || matches!(case.analysis, Analysis::Inverse(_)) {
-        let (a, b) = (rust.stats.iterations as f64, ff.stats.iterations as f64);
-        rows.push(ComparisonRow {
-            name: "iterations".into(),
-            rust: Some(a),
-            freefem: Some(b),
-            difference: (a - b).abs(),
-            tolerance: tol.iterations_abs,
-        });
-    }
-    rows
 }

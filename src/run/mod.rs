@@ -4,6 +4,7 @@
 //! Files (case data, clips, outputs) and the FreeFEM engine are `crate::io`'s.
 pub mod clip;
 pub mod clip_metrics;
+pub mod frames;
 pub mod metrics;
 pub mod result;
 

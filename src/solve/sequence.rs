@@ -101,6 +101,28 @@ pub fn first_chart(sp: &SequenceParams) -> Chart {
     }
 }
 
+/// The chart of a frame with data `x_space` (space coordinates) after a frame in chart `prev`
+/// (`None`: the clip's first frame): [`first_chart`] for the first frame and for the global
+/// chart, else the chart whose axis is [`frame_axis`] of the data, signed against `prev`'s
+/// (R4). It depends on the data only, so [`clip_charts`] gives every frame's chart up front.
+pub fn frame_chart(sp: &SequenceParams, prev: Option<&Chart>, x_space: &[Vector3<f64>]) -> Chart {
+    match (sp.rotation, prev) {
+        (RotationTreatment::GlobalEuler, _) | (_, None) => first_chart(sp),
+        (RotationTreatment::Rebased, Some(c)) => Chart::with_axis(&frame_axis(x_space, Some(&c.axis()))),
+    }
+}
+
+/// The chart of every frame of a clip, in order ([`frame_chart`]): what [`solve_sequence`]
+/// uses, for an engine that is handed the charts (the FreeFEM clip driver).
+pub fn clip_charts(sp: &SequenceParams, frames: &[Vec<Vector3<f64>>]) -> Vec<Chart> {
+    let mut charts: Vec<Chart> = Vec::with_capacity(frames.len());
+    for x in frames {
+        let c = frame_chart(sp, charts.last(), x);
+        charts.push(c);
+    }
+    charts
+}
+
 /// Smallest |cos β| over the nodes of a state (forward layout `dofs`) and its node.
 pub fn min_cos_beta(dofs: &DofMap, u: &DVector<f64>) -> (f64, usize) {
     (0..dofs.nodes()).map(|i| (dofs.get(u, i, Field::Alpha)[1].cos().abs(), i)).fold((f64::INFINITY, 0), |a, b| {
@@ -211,10 +233,7 @@ pub fn solve_sequence(
     for (i, x_space) in frames.iter().enumerate() {
         let k = i + sp.frame_offset;
         let start = std::time::Instant::now();
-        let chart = match (sp.rotation, &prev) {
-            (RotationTreatment::GlobalEuler, _) | (_, None) => first_chart(sp),
-            (RotationTreatment::Rebased, Some((c, _))) => Chart::with_axis(&frame_axis(x_space, Some(&c.axis()))),
-        };
+        let chart = frame_chart(sp, prev.as_ref().map(|(c, _)| c), x_space);
         let x_g: Vec<Vector3<f64>> =
             if chart.is_identity() { x_space.clone() } else { x_space.iter().map(|x| chart.to_chart(x)).collect() };
         let guess = || data_frame_guess(&x_g);

@@ -3,6 +3,8 @@
 use std::path::{Path, PathBuf};
 
 use cosserat::case::Case;
+use cosserat::io::compare::CompareReport;
+use cosserat::io::freefem::{find_executable, INSTALL_HINT};
 use cosserat::model::mesh::Field;
 use cosserat::solve::inverse::{
     Frame, FrameSolver, InverseMethod, InverseParams, InverseRecord, InverseSolution, Start, Weights,
@@ -154,4 +156,50 @@ pub fn solve_newton(
 ) -> Result<InverseSolution, SolveError> {
     let newton = InverseParams { method: InverseMethod::Newton { warm_start_tolerance: 1e-3 }, ..*params };
     solve_frame(p, &newton, x_g, previous, u0, Start::Near, on)
+}
+
+/// Is FreeFEM there? Panics if not, unless `COSSERAT_SKIP_FREEFEM` is set (local work only;
+/// CI never sets it), in which case it says so and returns false.
+pub fn freefem_required() -> bool {
+    if std::env::var_os("COSSERAT_SKIP_FREEFEM").is_some() {
+        eprintln!("COSSERAT_SKIP_FREEFEM is set: skipping the FreeFEM cross-check");
+        return false;
+    }
+    if find_executable().is_err() {
+        panic!("FreeFem++ is not installed; {INSTALL_HINT} (or set COSSERAT_SKIP_FREEFEM=1 for local work)");
+    }
+    true
+}
+
+/// Print a comparison's rows and push one line per failed row to `failures`.
+pub fn report_failures(report: &CompareReport, failures: &mut Vec<String>) {
+    eprintln!(
+        "{}: {}; rust {:.3} s, freefem {:.3} s",
+        report.case, report.what, report.rust_wall_s, report.freefem_wall_s
+    );
+    for row in &report.rows {
+        eprintln!(
+            "  {:<32} |diff| {:.3e}  tol {:.3e}  {}  {}",
+            row.name,
+            row.difference,
+            row.tolerance,
+            if row.passed() { "PASS" } else { "FAIL" },
+            row.basis
+        );
+        if !row.passed() {
+            failures.push(format!("{}: {} differs by {:e} > {:e}", report.case, row.name, row.difference, row.tolerance));
+        }
+    }
+}
+
+/// An error with its sources, for the failure list.
+pub fn error_chain(e: &dyn std::error::Error) -> String {
+    let mut s = e.to_string();
+    let mut src = e.source();
+    while let Some(c) = src {
+        s.push_str(": ");
+        s.push_str(&c.to_string());
+        src = c.source();
+    }
+    s
 }
