@@ -317,7 +317,10 @@ fn cmd_compare(path: &Path, out: Option<PathBuf>, short: bool, frames: Option<us
     }
     write_atomic(&dir.join("compare.csv"), report_csv(&report).as_bytes())?;
     println!("{}: {}", case.name, report.what);
-    println!("{:<34} {:>15} {:>15} {:>11} {:>11}  result  tolerance from", "quantity", "rust", "freefem", "|diff|", "tolerance");
+    println!(
+        "{:<34} {:>15} {:>15} {:>11} {:>11}  result  tolerance from",
+        "quantity", "rust", "freefem", "|diff|", "tolerance"
+    );
     for r in &report.rows {
         let v = |x: Option<f64>| x.map(|x| format!("{x:.8e}")).unwrap_or_else(|| "-".into());
         println!(

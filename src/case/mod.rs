@@ -361,7 +361,8 @@ frames = 4
     fn compare_overrides_need_a_reason() {
         let text = GOOD.replace("frames = 4", "frames = 4\nangles_rel = 1e-6");
         expect_key(&text, "compare.angles_rel");
-        let ok = parse(&text.replace("frames = 4", "frames = 4\nreason = \"measured: the twist is held by 1e-10 only\""));
+        let ok =
+            parse(&text.replace("frames = 4", "frames = 4\nreason = \"measured: the twist is held by 1e-10 only\""));
         assert_eq!(ok.unwrap().compare.overrides.angles_rel, Some(1e-6));
         expect_key(&GOOD.replace("frames = 4", "frames = 0"), "compare.frames");
         expect_key(&GOOD.replace("frames = 4", "metric_abs = -1\nreason = \"x\""), "compare.metric_abs");

@@ -8,8 +8,8 @@ use nalgebra::{Rotation3, Vector3};
 
 use super::raw::*;
 use super::{
-    Analysis, Case, CaseError, ClipKind, ClipSource, CompareOverrides, CompareSpec, DataSource, DEFAULT_COMPARE_FRAMES, InverseSettings, Reference,
-    SyntheticClip,
+    Analysis, Case, CaseError, ClipKind, ClipSource, CompareOverrides, CompareSpec, DataSource, InverseSettings,
+    Reference, SyntheticClip, DEFAULT_COMPARE_FRAMES,
 };
 use crate::clip::synthetic::RollClipParams;
 use crate::clip::ClipPlane;

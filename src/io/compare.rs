@@ -175,8 +175,8 @@ fn is_fixed_point_inverse(case: &Case) -> bool {
     matches!(case.inverse().map(|i| i.params.method), Some(InverseMethod::FixedPoint))
 }
 
-/// The tolerance of one row and how it was found.
-fn tolerance(d: &Difference, sens: Option<&Difference>, tau: f64, case: &Case) -> (f64, String) {
+/// The tolerance of one row and how it was found; `sens` the perturbed run's differences.
+fn tolerance(d: &Difference, sens: &[Difference], tau: f64, case: &Case) -> (f64, String) {
     let o: &CompareOverrides = &case.compare.overrides;
     let reason = || format!("override: {}", case.compare.reason.as_deref().unwrap_or(""));
     let value = d.a.unwrap_or(0.0).abs();
@@ -193,7 +193,18 @@ fn tolerance(d: &Difference, sens: Option<&Difference>, tau: f64, case: &Case) -
     if let Some(t) = over {
         return (t, reason());
     }
-    let sigma = sens.map(|s| s.difference).filter(|s| s.is_finite()).unwrap_or(f64::INFINITY);
+    let own = sens.iter().find(|s| s.name == d.name).map(|s| s.difference).filter(|s| s.is_finite());
+    // A single perturbation can leave one scalar nearly unchanged by chance: the field row
+    // that bounds it (a maximum over every node) gives the floor of its sensitivity.
+    let via_field = d.bound.and_then(|(group, scale)| {
+        let f = sens.iter().filter(|s| s.group == group && s.a.is_none()).map(|s| s.difference).fold(0.0, f64::max);
+        (f * scale).is_finite().then_some(f * scale)
+    });
+    let sigma = match (own, via_field) {
+        (Some(a), Some(b)) => a.max(b),
+        (Some(a), None) | (None, Some(a)) => a,
+        (None, None) => f64::INFINITY,
+    };
     let t = match d.group {
         Group::Iterations => 1.0 + SAFETY * sigma,
         Group::Metric => {
@@ -216,7 +227,7 @@ fn rows(case: &Case, tau: f64, diffs: &[Difference], sens: &[Difference]) -> Vec
     diffs
         .iter()
         .map(|d| {
-            let (tol, basis) = tolerance(d, sens.iter().find(|s| s.name == d.name), tau, case);
+            let (tol, basis) = tolerance(d, sens, tau, case);
             ComparisonRow {
                 name: d.name.clone(),
                 rust: d.a,
@@ -260,7 +271,8 @@ fn compare_single(case: &Case, dir: &Path, opts: &CompareOptions) -> Result<Comp
         let pert = NodalState { x: perturb_positions(&data.x, 11), ..data.clone() };
         let fixed_point = is_fixed_point_inverse(&case);
         let (rust, perturbed, exact) = if fixed_point {
-            let rust = if short { rust_exact(&case, &data, SHORT_ITERATIONS)? } else { run_inverse(&case, &data, |_, _| {})? };
+            let rust =
+                if short { rust_exact(&case, &data, SHORT_ITERATIONS)? } else { run_inverse(&case, &data, |_, _| {})? };
             let n = rust.stats.iterations;
             let p = rust_exact(&case, &pert, n).map_err(|e| CompareError::Perturbed(e.into()))?;
             (rust, p, Some(n))
@@ -300,6 +312,7 @@ fn compare_single(case: &Case, dir: &Path, opts: &CompareOptions) -> Result<Comp
             a: Some(n as f64),
             b: Some(f as f64),
             difference: (n as f64 - f as f64).abs(),
+            bound: None,
         };
         let s = Difference { difference: (n as f64 - p as f64).abs(), ..d.clone() };
         out.extend(rows(&case, tau, &[d], &[s]));
@@ -329,8 +342,8 @@ fn compare_clip(case: &Case, dir: &Path, opts: &CompareOptions) -> Result<Compar
     let pert: Vec<Vec<Vector3<f64>>> =
         frames.iter().enumerate().map(|(f, x)| perturb_positions(x, 1000 + f as u64)).collect();
     let perturbed = solve_frames(case, &pert).map_err(|e| CompareError::Perturbed(e.into()))?;
-    let exact: Option<Vec<usize>> =
-        fixed_point.then(|| rust.frames.iter().map(|f| f.result.stats.iterations).collect());
+    let exact: Option<Vec<(usize, bool)>> =
+        fixed_point.then(|| rust.frames.iter().map(|f| (f.result.stats.iterations, f.restarted)).collect());
     let work = dir.join("freefem_work");
     let ff = run_clip(case, frames, exact.as_deref(), &work).map_err(EngineError::from)?;
     let mut out = Vec::new();

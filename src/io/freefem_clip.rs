@@ -28,14 +28,16 @@ pub struct FreeFemFrames {
 }
 
 /// Run `freefem/clip.edp` on `frames` (space coordinates, from the clip's first frame) of the
-/// clip case `case` in `workdir`. `exact_iterations`: per frame, the number of fixed-point
-/// iterations to run instead of the tolerance (0: the tolerance), for a comparison at the same
-/// iterates. A failing frame is not an error here: the frames before it are returned with the
-/// message.
+/// clip case `case` in `workdir`. `follow`: per frame, the number of fixed-point iterations to
+/// run instead of the tolerance (0: the tolerance) and whether to solve it from its data guess
+/// as a restart, for a comparison at the same iterates as another engine's run (a fixed point
+/// stopped at an equal count cannot see that the other engine's attempt from the previous
+/// frame failed). A failing frame is not an error here: the frames before it are returned with
+/// the message.
 pub fn run_clip(
     case: &Case,
     frames: &[Vec<Vector3<f64>>],
-    exact_iterations: Option<&[usize]>,
+    follow: Option<&[(usize, bool)]>,
     workdir: &Path,
 ) -> Result<FreeFemFrames, FreeFemError> {
     let sp = case.sequence_params().ok_or_else(|| FreeFemError::NotInverse(case.name.clone()))?;
@@ -48,10 +50,11 @@ pub fn run_clip(
     let mut data = String::from("frame,s_m,x_m,y_m,z_m\n");
     for (f, x) in frames.iter().enumerate() {
         for (i, p) in x.iter().enumerate() {
-            let _ = writeln!(data, "{},{:e},{:e},{:e},{:e}", f + sp.frame_offset, case.mesh.node_s(i), p[0], p[1], p[2]);
+            let _ =
+                writeln!(data, "{},{:e},{:e},{:e},{:e}", f + sp.frame_offset, case.mesh.node_s(i), p[0], p[1], p[2]);
         }
     }
-    let mut bases = String::from("frame,b11,b12,b13,b21,b22,b23,b31,b32,b33,exact_iterations\n");
+    let mut bases = String::from("frame,b11,b12,b13,b21,b22,b23,b31,b32,b33,exact_iterations,restarted\n");
     for (f, c) in charts.iter().enumerate() {
         let b = c.base;
         let _ = write!(bases, "{}", f + sp.frame_offset);
@@ -60,7 +63,8 @@ pub fn run_clip(
                 let _ = write!(bases, ",{:e}", b[(i, j)]);
             }
         }
-        let _ = writeln!(bases, ",{}", exact_iterations.and_then(|e| e.get(f)).copied().unwrap_or(0));
+        let (n, restart) = follow.and_then(|e| e.get(f)).copied().unwrap_or((0, false));
+        let _ = writeln!(bases, ",{n},{}", u8::from(restart));
     }
     for (name, text) in [("clip_data.csv", &data), ("clip_charts.csv", &bases)] {
         let path = workdir.join(name);

@@ -168,6 +168,10 @@ pub struct Difference {
     /// field rows: max node-wise |Δ| / max |field|; metrics and counts: |a − b| (∞ if either
     /// is missing or not finite)
     pub difference: f64,
+    /// scalar metrics: the field row (group) whose relative difference σ bounds this metric's,
+    /// `|Δq| ≲ σ · scale`: a tip position by the displacement (scale max |x − x0|), a tip angle
+    /// by the angles (max |α|), the recovery errors by the state they are computed from
+    pub bound: Option<(Group, f64)>,
 }
 
 /// The quantities two runs of the same case are compared on: node-wise displacement, angles
@@ -181,14 +185,25 @@ pub fn differences(a: &RunResult, b: &RunResult, iterations: bool) -> Vec<Differ
         a: None,
         b: None,
         difference: if difference.is_nan() { f64::INFINITY } else { difference },
+        bound: None,
     };
-    let scalar = |name: &str, group: Group, x: Option<f64>, y: Option<f64>| {
+    let scalar = |name: &str, group: Group, x: Option<f64>, y: Option<f64>, bound: Option<(Group, f64)>| {
         let d = match (x, y) {
             (Some(x), Some(y)) => (x - y).abs(),
             _ => f64::INFINITY,
         };
-        Difference { name: name.into(), group, a: x, b: y, difference: if d.is_nan() { f64::INFINITY } else { d } }
+        Difference {
+            name: name.into(),
+            group,
+            a: x,
+            b: y,
+            difference: if d.is_nan() { f64::INFINITY } else { d },
+            bound,
+        }
     };
+    let amax = |v: &[Vector3<f64>]| v.iter().fold(0.0_f64, |m, v| m.max(v.amax()));
+    let disp_scale = amax(&a.nodes.displacement()).max(amax(&a.tip.iter().map(|t| t.position_m).collect::<Vec<_>>()));
+    let angle_scale = amax(&a.nodes.alpha).max(amax(&a.tip.iter().map(|t| t.angles_rad).collect::<Vec<_>>()));
     let nodes_match = a.nodes.s.len() == b.nodes.s.len();
     if nodes_match {
         rows.push(field(
@@ -206,7 +221,9 @@ pub fn differences(a: &RunResult, b: &RunResult, iterations: bool) -> Vec<Differ
     }
     let (ma, mb) = (physical_metrics(a), physical_metrics(b));
     for (name, &x) in &ma {
-        rows.push(scalar(name, Group::Metric, Some(x), mb.get(name).copied()));
+        let bound =
+            if name.ends_with("_rad") { (Group::Angles, angle_scale) } else { (Group::Displacement, disp_scale) };
+        rows.push(scalar(name, Group::Metric, Some(x), mb.get(name).copied(), Some(bound)));
     }
     if a.tip.len() == b.tip.len() && !a.tip.is_empty() {
         let p: Vec<_> = a.tip.iter().map(|t| t.position_m - a.tip[0].position_m).collect();
@@ -221,14 +238,24 @@ pub fn differences(a: &RunResult, b: &RunResult, iterations: bool) -> Vec<Differ
             rows.push(field("nodewise_rel_diff_ahat", Group::Adjoint, max_relative_difference(&x.ahat, &y.ahat)));
         }
         // Recovery errors (κ amplifies angle differences by ~1/h).
+        // x_err_rel moves with the displacement relative to the data's size (scale 1); the
+        // curvature errors with ∂sα: 2 max|Δα|/h against the data's rms curvature.
         let (ma, mb) = (inverse_metrics(a), inverse_metrics(b));
+        let kf: Vec<f64> = x.data.element_curvature().iter().map(|(_, k)| k.norm_squared()).collect();
+        let k_rms = (kf.iter().sum::<f64>() / kf.len().max(1) as f64).sqrt();
+        let h = a.nodes.s.get(1).copied().unwrap_or(1.0) - a.nodes.s.first().copied().unwrap_or(0.0);
         for name in ["x_err_rel", "kappa_err_rel", "kappa_err_rel_inner"].into_iter().filter(|n| ma.contains_key(*n)) {
-            rows.push(scalar(name, Group::Metric, ma.get(name).copied(), mb.get(name).copied()));
+            let bound = if name == "x_err_rel" {
+                (Group::Displacement, 1.0)
+            } else {
+                (Group::Angles, 2.0 * angle_scale / (h * k_rms))
+            };
+            rows.push(scalar(name, Group::Metric, ma.get(name).copied(), mb.get(name).copied(), Some(bound)));
         }
     }
     if iterations {
         let (x, y) = (a.stats.iterations as f64, b.stats.iterations as f64);
-        rows.push(scalar("iterations", Group::Iterations, Some(x), Some(y)));
+        rows.push(scalar("iterations", Group::Iterations, Some(x), Some(y), None));
     }
     rows
 }

@@ -187,7 +187,8 @@ pub fn report_failures(report: &CompareReport, failures: &mut Vec<String>) {
             row.basis
         );
         if !row.passed() {
-            failures.push(format!("{}: {} differs by {:e} > {:e}", report.case, row.name, row.difference, row.tolerance));
+            failures
+                .push(format!("{}: {} differs by {:e} > {:e}", report.case, row.name, row.difference, row.tolerance));
         }
     }
 }

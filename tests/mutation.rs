@@ -1,0 +1,107 @@
+//! A comparison that cannot fail proves nothing: copies of the FreeFEM scripts with one sign
+//! flipped in one term (through the test-only script directory `COSSERAT_FREEFEM_DIR`) must make
+//! `compare` fail, by rows beyond their derived tolerances or by a FreeFEM failure, while the
+//! intact scripts pass the same comparison (`cross_engine.rs`).
+//!
+//! One test function: the script directory is process-wide state.
+mod common;
+
+use std::path::Path;
+
+use cosserat::case::Case;
+use cosserat::io::compare::{compare_case, CompareOptions, Horizon};
+use cosserat::io::freefem::{script_dir, SCRIPT_DIR_ENV};
+
+/// One mutation: a script of `freefem/`, the exact text replaced (it must occur once), its
+/// replacement, the case and horizon it is run on, and the rows that must fail.
+struct Mutation {
+    what: &'static str,
+    file: &'static str,
+    from: &'static str,
+    to: &'static str,
+    case: &'static str,
+    horizon: Horizon,
+    /// rows that must fail when FreeFEM still converges
+    rows: &'static [&'static str],
+}
+
+const MUTATIONS: &[Mutation] = &[
+    Mutation {
+        what: "inverse: the lambda_d right-hand side (linearised d3 of eq. 60) with the wrong sign",
+        file: "inverse_core.idp",
+        from: "+ (1. - stab)*lambdaD*(TMS1(uc,te)*TMR1(uc)",
+        to: "- (1. - stab)*lambdaD*(TMS1(uc,te)*TMR1(uc)",
+        case: "inverse_bend_twist",
+        horizon: Horizon::Short,
+        rows: &["nodewise_rel_diff_angles", "nodewise_rel_diff_xhat", "x_err_rel"],
+    },
+    Mutation {
+        what: "forward: the follower load's f2 term (f^g = Q^T f^l) with the wrong sign",
+        file: "forward.edp",
+        from: "macro FLG2(P,T) (Qp(12,P)*F1(x,T) + Qp(22,P)*F2(x,T)",
+        to: "macro FLG2(P,T) (Qp(12,P)*F1(x,T) - Qp(22,P)*F2(x,T)",
+        case: "follower_bend_64",
+        horizon: Horizon::Full,
+        rows: &["nodewise_rel_diff_displacement", "tip_y_m"],
+    },
+    Mutation {
+        what: "forward: the third component of d_s x cross n (eq. 35) with the wrong sign",
+        file: "kinematics.idp",
+        from: "macro XN3(P) (dx(P#1)*NG2(P) - dx(P#2)*NG1(P)) //",
+        to: "macro XN3(P) (dx(P#1)*NG2(P) + dx(P#2)*NG1(P)) //",
+        case: "follower_bend_twist_65",
+        horizon: Horizon::Full,
+        rows: &["nodewise_rel_diff_displacement"],
+    },
+];
+
+fn copy_scripts(to: &Path) {
+    for e in std::fs::read_dir(script_dir()).expect("freefem/") {
+        let p = e.expect("entry").path();
+        if p.is_file() {
+            std::fs::copy(&p, to.join(p.file_name().expect("name"))).expect("copy");
+        }
+    }
+}
+
+#[test]
+fn broken_freefem_scripts_make_compare_fail() {
+    if !common::freefem_required() {
+        return;
+    }
+    let mut survived = Vec::new();
+    for m in MUTATIONS {
+        let dir = tempfile::tempdir().expect("tempdir");
+        copy_scripts(dir.path());
+        let path = dir.path().join(m.file);
+        let text = std::fs::read_to_string(&path).expect("script");
+        assert_eq!(text.matches(m.from).count(), 1, "{}: `{}` must occur once in {}", m.what, m.from, m.file);
+        std::fs::write(&path, text.replacen(m.from, m.to, 1)).expect("write");
+        std::env::set_var(SCRIPT_DIR_ENV, dir.path());
+        let case = Case::from_file(&common::cases_dir().join(format!("{}.toml", m.case))).expect("case");
+        let out = tempfile::tempdir().expect("tempdir");
+        let result = compare_case(&case, out.path(), &CompareOptions { horizon: m.horizon, frames: None });
+        std::env::remove_var(SCRIPT_DIR_ENV);
+        match result {
+            Err(e) => eprintln!("{} on {}: compare FAILED with an error: {}", m.what, m.case, common::error_chain(&e)),
+            Ok(report) => {
+                let failed: Vec<&str> = report.rows.iter().filter(|r| !r.passed()).map(|r| r.name.as_str()).collect();
+                eprintln!(
+                    "{} on {}: {} of {} rows FAILED: {failed:?}",
+                    m.what,
+                    m.case,
+                    failed.len(),
+                    report.rows.len()
+                );
+                for r in &report.rows {
+                    eprintln!("  {:<32} |diff| {:.3e}  tol {:.3e}", r.name, r.difference, r.tolerance);
+                }
+                let missing: Vec<_> = m.rows.iter().filter(|n| !failed.contains(n)).collect();
+                if !missing.is_empty() {
+                    survived.push(format!("{} on {}: rows {missing:?} passed", m.what, m.case));
+                }
+            }
+        }
+    }
+    assert!(survived.is_empty(), "mutations the comparison did not catch: {survived:#?}");
+}
