@@ -234,7 +234,7 @@ fn cmd_run(path: &Path, engine: Engine, out: Option<PathBuf>, quiet: bool) -> Re
 fn cmd_run_clip(case: &Case, engine: Engine, dir: &Path, quiet: bool) -> Result<ExitCode> {
     if engine != Engine::Rust {
         anyhow::bail!(
-            "case {}: clips run in the Rust engine (`--engine rust`); FreeFEM cross-checks a prefix in the tests",
+            "case {}: `run` solves clips in the Rust engine (`--engine rust`); to run a clip in FreeFEM against it, use `cosserat compare CASE --frames N` (or `--frames all`)",
             case.name
         );
     }
@@ -301,7 +301,7 @@ fn parse_frames(s: &str) -> Result<usize, String> {
 }
 
 fn cmd_compare(path: &Path, out: Option<PathBuf>, short: bool, frames: Option<usize>) -> Result<ExitCode> {
-    use cosserat::io::compare::{compare_case, default_dir, report_csv, CompareOptions, Horizon};
+    use cosserat::io::compare::{compare_case, default_dir, frames_csv, report_csv, CompareOptions, Horizon};
     let case = load(path)?;
     let dir = out.unwrap_or_else(|| default_dir(&case));
     let opts = CompareOptions { horizon: if short { Horizon::Short } else { Horizon::Full }, frames };
@@ -333,6 +333,20 @@ fn cmd_compare(path: &Path, out: Option<PathBuf>, short: bool, frames: Option<us
             if r.passed() { "PASS" } else { "FAIL" },
             r.basis
         );
+    }
+    if !report.frame_times.is_empty() {
+        let t = &report.frame_times;
+        let n = t.len() as f64;
+        let (r, f) = (t.iter().map(|t| t.rust_s).sum::<f64>(), t.iter().map(|t| t.freefem_s).sum::<f64>());
+        println!(
+            "per frame: rust {:.1} ms, freefem {:.2} s (ratio {:.0}); iterations per frame rust {:.2}, freefem {:.2}",
+            1e3 * r / n,
+            f / n,
+            f / r,
+            t.iter().map(|t| t.rust_iterations).sum::<usize>() as f64 / n,
+            t.iter().map(|t| t.freefem_iterations).sum::<usize>() as f64 / n
+        );
+        write_atomic(&dir.join("compare_frames.csv"), frames_csv(&report).as_bytes())?;
     }
     println!(
         "wall time: rust {:.3} s, freefem {:.3} s (ratio freefem/rust {:.1}); wrote {}",

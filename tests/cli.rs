@@ -180,3 +180,32 @@ fn sweep_writes_one_folder_per_run_a_summary_and_a_convergence_plot() {
         .code(1)
         .stderr(predicate::str::contains("unknown parameter"));
 }
+
+#[test]
+fn compare_on_a_clip_checks_consecutive_frames_in_both_engines() {
+    if std::env::var_os("COSSERAT_SKIP_FREEFEM").is_some()
+        || !std::path::Path::new("data/elegansbot/kymogram_omega-turn.npy").is_file()
+    {
+        return;
+    }
+    cosserat()
+        .args(["compare", "cases/worm_roll_3d.toml", "--frames", "0"])
+        .assert()
+        .failure()
+        .stderr(predicate::str::contains("expected a number of frames >= 1 or `all`"));
+    let dir = tempfile::tempdir().expect("tempdir");
+    cosserat()
+        .args(["compare", "cases/worm_roll_3d.toml", "--frames", "2", "--out"])
+        .arg(dir.path())
+        .assert()
+        .success()
+        .stdout(
+            predicate::str::contains("clip frames 0-1 (2 frames)")
+                .and(predicate::str::contains("frames_solved"))
+                .and(predicate::str::contains("per frame: rust"))
+                .and(predicate::str::contains("FAIL").not()),
+        );
+    let frames = std::fs::read_to_string(dir.path().join("compare_frames.csv")).expect("compare_frames.csv");
+    assert_eq!(frames.lines().count(), 3, "{frames}");
+    assert!(std::fs::read_to_string(dir.path().join("compare.csv")).expect("compare.csv").contains("derived"));
+}

@@ -163,7 +163,7 @@ fn delta_turn_in_any_orientation() {
     }
 }
 
-/// `compare` and `sweep` on a clip case solve its first frame alone, in the paper's chart
+/// The single-frame inverse path on a clip case solves its first frame alone, in the paper's chart
 /// from the straight reference state (both engines). A clip whose first frame the clip driver
 /// solves in a rotated chart is refused by both engines with an error naming the keys, instead
 /// of its `clip.rotation`, `clip.gauge` or `clip.orientation` being ignored; the x–z

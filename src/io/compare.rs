@@ -69,6 +69,18 @@ pub struct CompareOptions {
     pub frames: Option<usize>,
 }
 
+/// One clip frame's cost in both engines.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrameTime {
+    pub frame: usize,
+    /// wall time of the frame's solve [s]
+    pub rust_s: f64,
+    /// FreeFEM's CPU time of the frame [s]
+    pub freefem_s: f64,
+    pub rust_iterations: usize,
+    pub freefem_iterations: usize,
+}
+
 /// The outcome of a comparison.
 #[derive(Debug)]
 pub struct CompareReport {
@@ -78,8 +90,8 @@ pub struct CompareReport {
     pub what: String,
     pub rust_wall_s: f64,
     pub freefem_wall_s: f64,
-    /// clip comparisons: per frame `(frame, rust s, freefem s, rust iterations, freefem iterations)`
-    pub frame_times: Vec<(usize, f64, f64, usize, usize)>,
+    /// clip comparisons: per frame, both engines' time and iterations
+    pub frame_times: Vec<FrameTime>,
     /// single runs: both results (for their output folders)
     pub runs: Option<(RunResult, RunResult)>,
 }
@@ -364,13 +376,13 @@ fn compare_clip(case: &Case, dir: &Path, opts: &CompareOptions) -> Result<Compar
             }
         }
         restarts += f64::from(u8::from(r.restarted != f.restarted));
-        frame_times.push((
-            r.frame,
-            r.result.stats.wall_time_s,
-            f.result.stats.wall_time_s,
-            r.result.stats.iterations,
-            f.result.stats.iterations,
-        ));
+        frame_times.push(FrameTime {
+            frame: r.frame,
+            rust_s: r.result.stats.wall_time_s,
+            freefem_s: f.result.stats.wall_time_s,
+            rust_iterations: r.result.stats.iterations,
+            freefem_iterations: f.result.stats.iterations,
+        });
     }
     for (mut row, frame, _) in worst {
         row.basis = format!("{} (worst: frame {frame})", row.basis);
@@ -439,6 +451,18 @@ pub fn report_csv(report: &CompareReport) -> String {
         ));
     }
     s
+}
+
+/// `compare_frames.csv` of a clip comparison: per frame, both engines' time and iterations.
+pub fn frames_csv(report: &CompareReport) -> String {
+    let mut csv = String::from("frame,rust_wall_s,freefem_wall_s,rust_iterations,freefem_iterations\n");
+    for t in &report.frame_times {
+        csv.push_str(&format!(
+            "{},{:e},{:e},{},{}\n",
+            t.frame, t.rust_s, t.freefem_s, t.rust_iterations, t.freefem_iterations
+        ));
+    }
+    csv
 }
 
 /// Where a comparison writes (`out/<case>` unless given).

@@ -34,7 +34,7 @@ pub enum RunError {
     #[error("case `{case}` is not {what}")]
     Kind { case: String, what: &'static str },
     #[error(
-        "case `{case}`: `compare` and `sweep` solve a clip's first frame alone, in the paper's angle chart (eq. 1) from the straight reference state, but this clip's first frame is solved in the rebased chart with singular axis ({:.3}, {:.3}, {:.3}) (clip.rotation = \"rebased\" with clip.gauge or clip.orientation away from e2). `cosserat run` solves the whole clip in its charts; to compare the first frame, set clip.rotation = \"global_euler\" or a gauge along e2", axis[0], axis[1], axis[2]
+        "case `{case}`: the single-frame inverse path solves a clip's first frame alone, in the paper's angle chart (eq. 1) from the straight reference state, but this clip's first frame is solved in the rebased chart with singular axis ({:.3}, {:.3}, {:.3}) (clip.rotation = \"rebased\" with clip.gauge or clip.orientation away from e2). `cosserat run` and `cosserat compare` solve the clip frame by frame in its charts; for the single-frame path set clip.rotation = \"global_euler\" or a gauge along e2", axis[0], axis[1], axis[2]
     )]
     Chart { case: String, axis: [f64; 3] },
     #[error("writing the clip")]

@@ -41,7 +41,7 @@ pub struct SequenceParams {
 /// Angle chart of each frame (`docs/rotation.md`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum RotationTreatment {
-    /// the paper's chart of eq. (1) for every frame (the one FreeFEM mirrors)
+    /// the paper's chart of eq. (1) for every frame
     GlobalEuler,
     /// per frame the chart `Q = Q_E(α) B` whose singular axis is [`frame_axis`] of the frame's
     /// data (the gauge on the first frame), R1–R7
