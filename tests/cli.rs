@@ -209,3 +209,13 @@ fn compare_on_a_clip_checks_consecutive_frames_in_both_engines() {
     assert_eq!(frames.lines().count(), 3, "{frames}");
     assert!(std::fs::read_to_string(dir.path().join("compare.csv")).expect("compare.csv").contains("derived"));
 }
+
+#[test]
+fn compare_refuses_frames_on_a_case_without_a_clip() {
+    cosserat()
+        .args(["compare", "cases/timoshenko_5pct.toml", "--frames", "3", "--out"])
+        .arg(tempfile::tempdir().expect("tempdir").path())
+        .assert()
+        .failure()
+        .stderr(predicate::str::contains("`--frames` applies to clips only"));
+}

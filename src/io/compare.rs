@@ -109,6 +109,8 @@ pub enum CompareError {
     Engine(#[from] EngineError),
     #[error("rust engine on the perturbed input (conditioning run)")]
     Perturbed(#[source] EngineError),
+    #[error("case `{0}` is not a clip case: `--frames` applies to clips only")]
+    FramesWithoutClip(String),
 }
 
 impl From<RunError> for CompareError {
@@ -121,6 +123,8 @@ impl From<RunError> for CompareError {
 pub fn compare_case(case: &Case, dir: &Path, opts: &CompareOptions) -> Result<CompareReport, CompareError> {
     if case.clip().is_some() {
         compare_clip(case, dir, opts)
+    } else if opts.frames.is_some() {
+        Err(CompareError::FramesWithoutClip(case.name.clone()))
     } else {
         compare_single(case, dir, opts)
     }
