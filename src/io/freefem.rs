@@ -51,6 +51,12 @@ pub enum FreeFemError {
     Read(#[from] InputError),
 }
 
+/// The I/O error on `path`, for `map_err`.
+pub(super) fn io(path: &Path) -> impl FnOnce(std::io::Error) -> FreeFemError {
+    let path = path.to_path_buf();
+    move |source| FreeFemError::Io { path, source }
+}
+
 /// Directory holding `forward.edp` and `rotation.idp`.
 pub fn script_dir() -> PathBuf {
     std::env::var_os(SCRIPT_DIR_ENV)
@@ -234,10 +240,6 @@ pub fn run_inverse(
 ) -> Result<RunResult, FreeFemError> {
     let inv = case.inverse().ok_or_else(|| FreeFemError::NotInverse(case.name.clone()))?;
 
-    let io = |path: &Path| {
-        let path = path.to_path_buf();
-        move |source| FreeFemError::Io { path, source }
-    };
     std::fs::create_dir_all(workdir).map_err(io(workdir))?;
     let target = workdir.join("data.csv");
     let same = std::fs::canonicalize(data_path)
@@ -342,10 +344,6 @@ pub(super) fn execute(
     if !script.is_file() {
         return Err(FreeFemError::MissingScripts(scripts));
     }
-    let io = |path: &Path| {
-        let path = path.to_path_buf();
-        move |source| FreeFemError::Io { path, source }
-    };
     std::fs::create_dir_all(workdir).map_err(io(workdir))?;
     let include = workdir.join("case.idp");
     std::fs::write(&include, include_file(case, opts)).map_err(io(&include))?;

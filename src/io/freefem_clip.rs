@@ -9,7 +9,7 @@ use std::path::Path;
 
 use nalgebra::Vector3;
 
-use super::freefem::{execute, read_info, read_table, ClipInclude, FreeFemError, RunOptions};
+use super::freefem::{execute, io, read_info, read_table, ClipInclude, FreeFemError, RunOptions};
 use crate::case::Case;
 use crate::model::chart::Chart;
 use crate::run::frames::{frame_result, SolvedFrame};
@@ -41,10 +41,6 @@ pub fn run_clip(
     workdir: &Path,
 ) -> Result<FreeFemFrames, FreeFemError> {
     let sp = case.sequence_params().ok_or_else(|| FreeFemError::NotInverse(case.name.clone()))?;
-    let io = |path: &Path| {
-        let path = path.to_path_buf();
-        move |source| FreeFemError::Io { path, source }
-    };
     std::fs::create_dir_all(workdir).map_err(io(workdir))?;
     let charts = clip_charts(&sp, frames);
     let mut data = String::from("frame,s_m,x_m,y_m,z_m\n");
@@ -87,7 +83,7 @@ pub fn run_clip(
         ),
         Err(e) => return Err(e),
     };
-    let frames_out = read_frames(case, frames, &charts, workdir)?;
+    let frames_out = read_frames(case, sp.frame_offset, frames, &charts, workdir)?;
     let wall_time_s = read_info(&workdir.join("ff_info.csv"))
         .ok()
         .and_then(|i| i.get("wall_time_s").copied())
@@ -105,12 +101,12 @@ fn frame_header() -> Vec<&'static str> {
 
 fn read_frames(
     case: &Case,
+    offset: usize,
     frames: &[Vec<Vector3<f64>>],
     charts: &[Chart],
     workdir: &Path,
 ) -> Result<Vec<SolvedFrame>, FreeFemError> {
     let n = case.mesh.nodes();
-    let offset = case.sequence_params().map_or(0, |sp| sp.frame_offset);
     let frames_path = workdir.join("ff_clip_frames.csv");
     let nodes_path = workdir.join("ff_clip_nodes.csv");
     if !frames_path.is_file() {
