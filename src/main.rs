@@ -7,13 +7,14 @@ use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use cosserat::case::{case_files, Case};
-use cosserat::io::data::write_data;
-use cosserat::io::engine::{load_data, run_case, run_clip_case, run_inverse_on, write_clip_figures};
-use cosserat::io::run_files::{write_convergence_plot, write_run};
-use cosserat::io::sweep::{run_point, summary_csv, RunStatus, SummaryRow, CLIP_SUMMARY_METRICS, SUMMARY_METRICS};
+use cosserat::io::job::{run_into, run_manifest, JobEnd};
+use cosserat::io::run_files::write_run;
+use cosserat::io::run_folder::{input_file, Manifest, Mode, RunFolder, Status};
+use cosserat::io::sweep::RunStatus;
 use cosserat::io::write_atomic;
+use cosserat::run::budget::{self, default_limit_bytes, Footprint, GIB};
 use cosserat::run::metrics::all_metrics;
-use cosserat::run::{Engine, RunResult};
+use cosserat::run::Engine;
 use cosserat::solve::modes::modal_model;
 
 /// Forward Cosserat rods after Wang et al. (Comput. Mech. 71, 2023), in Rust and FreeFEM.
@@ -33,9 +34,20 @@ enum Command {
         /// Which engine to run
         #[arg(long, value_enum, default_value_t = Engine::Rust)]
         engine: Engine,
-        /// Output directory [default: out/<case name>/<engine>]
+        /// Output directory [default: out/<case name>/<engine>]. The run writes into a staging
+        /// folder beside it that replaces it whole at the end; run.json says what it holds
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Replace the output directory even if it holds files but no run.json
+        #[arg(long)]
+        force: bool,
+        /// Continue the interrupted or failed clip in the output directory from its last
+        /// converged frame (same case file and clip file); the CSVs are then byte for byte those
+        /// of an uninterrupted run
+        #[arg(long, conflicts_with = "force")]
+        resume: bool,
+        #[command(flatten)]
+        limits: Limits,
         /// Do not show a progress bar
         #[arg(long)]
         quiet: bool,
@@ -62,6 +74,11 @@ enum Command {
         /// `[compare] frames`, 10]
         #[arg(long, value_parser = parse_frames)]
         frames: Option<usize>,
+        /// Replace the output directory even if it holds files but no run.json
+        #[arg(long)]
+        force: bool,
+        #[command(flatten)]
+        limits: Limits,
     },
     /// Run a case for every point of a parameter grid (in parallel) and summarise.
     ///
@@ -87,6 +104,11 @@ enum Command {
         /// Output directory [default: out/<case name>/sweep]
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Replace the output directory even if it holds files but no run.json
+        #[arg(long)]
+        force: bool,
+        #[command(flatten)]
+        limits: Limits,
         /// Parallel runs [default: number of cores]
         #[arg(long)]
         jobs: Option<usize>,
@@ -112,6 +134,9 @@ enum Command {
         /// Output directory [default: out/audit, out/audit-quick with --quick]; replaced whole
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Replace the output directory even if it holds files but no run.json
+        #[arg(long)]
+        force: bool,
         /// Parallel runs [default: number of cores]
         #[arg(long)]
         jobs: Option<usize>,
@@ -132,11 +157,42 @@ enum Command {
         /// How many modes to print
         #[arg(long, default_value_t = 10)]
         count: usize,
+        #[command(flatten)]
+        limits: Limits,
     },
+}
+
+/// Resource limits of a run.
+#[derive(clap::Args, Debug, Clone, Copy)]
+struct Limits {
+    /// Refuse a run whose estimated memory exceeds this [GiB] [default: half the machine's
+    /// memory]
+    #[arg(long, value_name = "GIB")]
+    max_memory_gib: Option<f64>,
+}
+
+/// Exit status of a run stopped by SIGINT/SIGTERM (128 + SIGINT, the shell's convention).
+const EXIT_INTERRUPTED: u8 = 130;
+
+/// SIGINT/SIGTERM/SIGHUP: the first asks the running loops to stop after the current frame
+/// (time step, iteration) so that the files stay consistent; a second one exits at once.
+fn install_signal_handler() {
+    let result = ctrlc::set_handler(|| {
+        if cosserat::interrupt::requested() {
+            eprintln!("\nsecond signal: exiting at once (the output folder keeps its previous state)");
+            std::process::exit(i32::from(EXIT_INTERRUPTED));
+        }
+        cosserat::interrupt::request();
+        eprintln!("\nsignal received: stopping after the current frame / step (again to exit at once)");
+    });
+    if let Err(e) = result {
+        eprintln!("warning: cannot handle SIGINT/SIGTERM ({e}); an interrupted run will not be marked");
+    }
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    install_signal_handler();
     match dispatch(cli) {
         Ok(code) => code,
         Err(e) => {
@@ -148,12 +204,19 @@ fn main() -> ExitCode {
 
 fn dispatch(cli: Cli) -> Result<ExitCode> {
     match cli.command {
-        Command::Run { case, engine, out, quiet } => cmd_run(&case, engine, out, quiet),
-        Command::Compare { case, out, short, frames } => cmd_compare(&case, out, short, frames),
-        Command::Sweep { case, set, out, jobs, quiet } => cmd_sweep(&case, &set, out, jobs, quiet),
-        Command::Audit { specs, quick, out, jobs, quiet } => cmd_audit(&specs, quick, out, jobs, quiet),
+        Command::Run { case, engine, out, force, resume, limits, quiet } => {
+            let mode = if resume { Mode::Resume } else { Mode::Fresh { force } };
+            cmd_run(&case, engine, out, mode, limits, quiet)
+        }
+        Command::Compare { case, out, short, frames, force, limits } => {
+            cmd_compare(&case, out, short, frames, force, limits)
+        }
+        Command::Sweep { case, set, out, force, limits, jobs, quiet } => {
+            cmd_sweep(&case, &set, out, force, limits, jobs, quiet)
+        }
+        Command::Audit { specs, quick, out, force, jobs, quiet } => cmd_audit(&specs, quick, out, force, jobs, quiet),
         Command::List { dir } => cmd_list(&dir),
-        Command::Modes { case, count } => cmd_modes(&case, count),
+        Command::Modes { case, count, limits } => cmd_modes(&case, count, limits),
     }
 }
 
@@ -175,87 +238,82 @@ fn progress_bar(quiet: bool, label: &str) -> ProgressBar {
     pb
 }
 
-/// For an inverse case: generate its data with the Rust forward engine into `dir/data.csv`
-/// (I7), the file every engine's inverse run then reads.
-fn prepare_data(case: &Case, dir: &Path) -> Result<Option<PathBuf>> {
-    if case.inverse().is_none() {
-        return Ok(None);
-    }
-    let path = dir.join("data.csv");
-    let data = load_data(case).with_context(|| format!("case {}: generating the forward data", case.name))?;
-    write_data(&path, &data)?;
-    Ok(Some(path))
+/// Refuse a run whose estimated memory exceeds the limit (`--max-memory-gib`).
+fn check_memory(case: &Case, what: Footprint, limits: Limits) -> Result<()> {
+    let limit = limits.max_memory_gib.map(|g| g * GIB).unwrap_or_else(default_limit_bytes);
+    Ok(budget::check(case, what, limit)?)
 }
 
-fn run_engine(case: &Case, engine: Engine, dir: &Path, data: Option<&Path>, quiet: bool) -> Result<RunResult> {
-    let pb = progress_bar(quiet || engine == Engine::Freefem, &format!("{} [{engine}]", case.name));
+fn cmd_run(
+    path: &Path,
+    engine: Engine,
+    out: Option<PathBuf>,
+    mode: Mode,
+    limits: Limits,
+    quiet: bool,
+) -> Result<ExitCode> {
+    let case = load(path)?;
+    check_memory(&case, Footprint::Run, limits)?;
+    let dir = out.unwrap_or_else(|| PathBuf::from("out").join(&case.name).join(engine.to_string()));
+    let label = if case.clip().is_some() { "frames" } else { "" };
+    let pb = progress_bar(quiet || engine == Engine::Freefem, &format!("{} [{engine}] {label}", case.name));
     if engine == Engine::Freefem && !quiet {
-        eprintln!("{} [freefem]: running FreeFEM in {}", case.name, dir.display());
+        eprintln!("{} [freefem]: running FreeFEM in a staging folder beside {}", case.name, dir.display());
     }
-    let progress = |done: usize, total: usize| {
+    let end = run_into(&case, engine, &dir, mode, |done, total| {
         pb.set_length(total as u64);
         pb.set_position(done as u64);
-    };
-    let work = dir.join("freefem_work");
-    let result = match data {
-        Some(path) => run_inverse_on(case, engine, path, &work, progress),
-        None => run_case(case, engine, &work, progress),
-    };
+    })
+    .with_context(|| format!("case {}: output folder {}", case.name, dir.display()))?;
     pb.finish_and_clear();
-    result.with_context(|| format!("case {}", case.name))
-}
-
-fn cmd_run(path: &Path, engine: Engine, out: Option<PathBuf>, quiet: bool) -> Result<ExitCode> {
-    let case = load(path)?;
-    let dir = out.unwrap_or_else(|| PathBuf::from("out").join(&case.name).join(engine.to_string()));
-    if case.clip().is_some() {
-        return cmd_run_clip(&case, engine, &dir, quiet);
+    for n in &end.notes {
+        eprintln!("note: {n}");
     }
-    let data = prepare_data(&case, &dir)?;
-    let r = run_engine(&case, engine, &dir, data.as_deref(), quiet)?;
-    let m = all_metrics(&case, &r)?;
-    let written = write_run(&case, &r, &m, &dir)?;
-    let tip = r.nodes.x.last().copied().unwrap_or_default();
-    println!(
-        "{} [{engine}]: tip = ({:.6e}, {:.6e}, {:.6e}) m, {} iterations, {:.3} s; wrote {} files to {}",
-        case.name,
-        tip[0],
-        tip[1],
-        tip[2],
-        r.stats.iterations,
-        r.stats.wall_time_s,
-        written.len(),
-        dir.display()
-    );
+    match end.status {
+        Status::Complete => print_run(&case, engine, &end),
+        Status::Interrupted => {
+            let kept = match end.frames {
+                Some((n, _)) => format!(
+                    "kept {n} converged frames (CSV, VTK, clip.pvd and figures cover exactly them); continue with `cosserat run {} --out {} --resume`",
+                    path.display(),
+                    dir.display()
+                ),
+                None => "a single run keeps no partial result".into(),
+            };
+            eprintln!("{}: interrupted; {kept}; run.json in {} says interrupted", case.name, dir.display());
+            return Ok(ExitCode::from(EXIT_INTERRUPTED));
+        }
+        Status::Failed | Status::Running => {
+            let kept = match end.frames {
+                Some((n, _)) if n > 0 => format!(
+                    "\nThe {n} converged frames before it are in {} (run.json says failed); after a fix that does not change the case, `--resume` continues from them",
+                    dir.display()
+                ),
+                _ => format!("\n{} holds run.json saying failed", dir.display()),
+            };
+            anyhow::bail!("{}{kept}", end.message.unwrap_or_default());
+        }
+    }
     Ok(ExitCode::SUCCESS)
 }
 
-/// A clip case: frames solved in order and streamed to `dir`; a summary plot at the end.
-fn cmd_run_clip(case: &Case, engine: Engine, dir: &Path, quiet: bool) -> Result<ExitCode> {
-    if engine != Engine::Rust {
-        anyhow::bail!(
-            "case {}: `run` solves clips in the Rust engine (`--engine rust`); to run a clip in FreeFEM against it, use `cosserat compare CASE --frames N` (or `--frames all`)",
-            case.name
+/// The summary line(s) of a complete run.
+fn print_run(case: &Case, engine: Engine, end: &JobEnd) {
+    if let Some(r) = &end.single {
+        let tip = r.nodes.x.last().copied().unwrap_or_default();
+        println!(
+            "{} [{engine}]: tip = ({:.6e}, {:.6e}, {:.6e}) m, {} iterations, {:.3} s; wrote {} files to {}",
+            case.name,
+            tip[0],
+            tip[1],
+            tip[2],
+            r.stats.iterations,
+            r.stats.wall_time_s,
+            end.files,
+            end.dir.display()
         );
     }
-    let pb = progress_bar(quiet, &format!("{} [frames]", case.name));
-    let result = run_clip_case(case, dir, |done, total| {
-        pb.set_length(total as u64);
-        pb.set_position(done as u64);
-    });
-    pb.finish_and_clear();
-    let run = match result {
-        Ok(r) => r,
-        Err(e) => {
-            let e = anyhow::Error::from(e).context(format!("case {}", case.name));
-            let _ = write_atomic(
-                &dir.join("FAILED.txt"),
-                format!("{e:#}\nThe converged frames before it are in this folder.\n").as_bytes(),
-            );
-            return Err(e);
-        }
-    };
-    write_clip_figures(case, &run, dir)?;
+    let Some(run) = &end.clip else { return };
     if let Some(t) = &run.truth {
         let max = |f: &dyn Fn(&cosserat::clip::synthetic::FrameComparison) -> f64| {
             t.comparisons.iter().map(f).fold(0.0, f64::max)
@@ -284,9 +342,8 @@ fn cmd_run_clip(case: &Case, engine: Engine, dir: &Path, quiet: bool) -> Result<
         its.iter().min().copied().unwrap_or(0),
         its.iter().sum::<usize>() as f64 / n.max(1) as f64,
         its.iter().max().copied().unwrap_or(0),
-        dir.display()
+        end.dir.display()
     );
-    Ok(ExitCode::SUCCESS)
 }
 
 /// `--frames`: a positive count or `all`.
@@ -300,16 +357,53 @@ fn parse_frames(s: &str) -> Result<usize, String> {
     }
 }
 
-fn cmd_compare(path: &Path, out: Option<PathBuf>, short: bool, frames: Option<usize>) -> Result<ExitCode> {
-    use cosserat::io::compare::{compare_case, default_dir, frames_csv, report_csv, CompareOptions, Horizon};
+fn cmd_compare(
+    path: &Path,
+    out: Option<PathBuf>,
+    short: bool,
+    frames: Option<usize>,
+    force: bool,
+    limits: Limits,
+) -> Result<ExitCode> {
+    use cosserat::io::compare::default_dir;
     let case = load(path)?;
-    let dir = out.unwrap_or_else(|| default_dir(&case));
+    check_memory(&case, Footprint::Run, limits)?;
+    let target = out.unwrap_or_else(|| default_dir(&case));
+    let mut manifest = run_manifest(&case, Engine::Rust)?;
+    manifest.command = "compare".into();
+    manifest.engine = Some("rust and freefem".into());
+    let folder = RunFolder::begin(&target, manifest, Mode::Fresh { force })
+        .with_context(|| format!("case {}: output folder {}", case.name, target.display()))?;
+    for n in &folder.notes {
+        eprintln!("note: {n}");
+    }
+    let result = compare_into(&case, folder.dir(), short, frames);
+    let (status, message) = match &result {
+        Ok(_) => (Status::Complete, None),
+        Err(_) if cosserat::interrupt::requested() => (Status::Interrupted, Some("interrupted by a signal".into())),
+        Err(e) => (Status::Failed, Some(format!("{e:#}"))),
+    };
+    folder.finish(status, message)?;
+    match (status, result) {
+        (Status::Interrupted, _) => {
+            eprintln!("{}: interrupted; {} holds run.json saying interrupted", case.name, target.display());
+            Ok(ExitCode::from(EXIT_INTERRUPTED))
+        }
+        (_, Err(e)) => Err(e.context(format!("{} holds run.json saying failed", target.display()))),
+        (_, Ok(code)) => Ok(code),
+    }
+}
+
+/// Both engines on `case` and their comparison, written into `dir` (the staging folder).
+fn compare_into(case: &Case, dir: &Path, short: bool, frames: Option<usize>) -> Result<ExitCode> {
+    use cosserat::io::compare::{compare_case, frames_csv, report_csv, CompareOptions, Horizon};
     let opts = CompareOptions { horizon: if short { Horizon::Short } else { Horizon::Full }, frames };
     eprintln!(
         "{}: rust engine (twice: as given and with its input perturbed by 1e-13), then FreeFEM in {}",
         case.name,
         dir.join("freefem_work").display()
     );
+    let (case, dir) = (case.clone(), dir.to_path_buf());
     let report = compare_case(&case, &dir, &opts).with_context(|| format!("case {}", case.name))?;
     if let Some((rust, ff)) = &report.runs {
         write_run(&case, rust, &all_metrics(&case, rust)?, &dir.join("rust"))?;
@@ -362,66 +456,85 @@ fn cmd_compare(path: &Path, out: Option<PathBuf>, short: bool, frames: Option<us
     Ok(if failed == 0 { ExitCode::SUCCESS } else { ExitCode::from(1) })
 }
 
-fn cmd_sweep(path: &Path, set: &[String], out: Option<PathBuf>, jobs: Option<usize>, quiet: bool) -> Result<ExitCode> {
+#[allow(clippy::too_many_arguments)]
+fn cmd_sweep(
+    path: &Path,
+    set: &[String],
+    out: Option<PathBuf>,
+    force: bool,
+    limits: Limits,
+    jobs: Option<usize>,
+    quiet: bool,
+) -> Result<ExitCode> {
     use cosserat::case::sweep::{parse_set, product};
-    use rayon::prelude::*;
+    use cosserat::io::sweep::sweep_into;
     let case = load(path)?;
     let params = set.iter().map(|s| parse_set(s)).collect::<Result<Vec<_>, _>>()?;
     let points = product(&case, &params)?;
-    let dir = out.unwrap_or_else(|| PathBuf::from("out").join(&case.name).join("sweep"));
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(jobs.unwrap_or(0)).build().context("thread pool")?;
+    for (_, c) in &points {
+        check_memory(c, Footprint::Run, limits).with_context(|| format!("sweep point {}", c.name))?;
+    }
+    let target = out.unwrap_or_else(|| PathBuf::from("out").join(&case.name).join("sweep"));
+    let mut manifest = run_manifest(&case, Engine::Rust)?;
+    manifest.command = "sweep".into();
+    let folder = RunFolder::begin(&target, manifest, Mode::Fresh { force })
+        .with_context(|| format!("case {}: output folder {}", case.name, target.display()))?;
+    for n in &folder.notes {
+        eprintln!("note: {n}");
+    }
     let pb = progress_bar(quiet, &format!("{} sweep", case.name));
     pb.set_length(points.len() as u64);
-    let results: Vec<_> = pool.install(|| {
-        points
-            .par_iter()
-            .map(|(point, c)| {
-                let r = run_point(c, &dir.join(&c.name));
-                pb.inc(1);
-                (point.clone(), c.name.clone(), r)
-            })
-            .collect()
-    });
-    pb.finish_and_clear();
     let keys: Vec<String> = params.iter().map(|p| p.key.clone()).collect();
-    let rows: Vec<SummaryRow> = results
-        .iter()
-        .map(|(point, _, o)| SummaryRow {
-            point: point.clone(),
-            status: o.status,
-            metrics: o.metrics.clone(),
-            error: o.error.clone(),
-        })
-        .collect();
-    let summary = dir.join("summary.csv");
-    let columns: &[&str] = if case.clip().is_some() { &CLIP_SUMMARY_METRICS } else { &SUMMARY_METRICS };
-    write_atomic(&summary, summary_csv(&keys, columns, &rows)?.as_bytes())?;
-    let curves: Vec<(&String, &RunResult)> =
-        results.iter().filter_map(|(_, name, o)| o.run.as_ref().map(|run| (name, run))).collect();
-    if !curves.is_empty() {
-        write_convergence_plot(&curves, &dir.join("convergence.svg"))?;
-    }
-    let failed = rows.iter().filter(|r| r.status != RunStatus::Ok).count();
+    let result = sweep_into(&case, &keys, &points, folder.dir(), jobs.unwrap_or(0), || pb.inc(1));
+    pb.finish_and_clear();
+    let rows = match result {
+        Ok(rows) => rows,
+        Err(e) => {
+            let message = cosserat::io::sweep::chain(&e);
+            folder.finish(Status::Failed, Some(message.clone()))?;
+            anyhow::bail!("case {}: sweep: {message}; {} holds run.json saying failed", case.name, target.display());
+        }
+    };
+    let count = |s: RunStatus| rows.iter().filter(|r| r.status == s).count();
+    let (interrupted, failed) = (count(RunStatus::Interrupted), rows.len() - count(RunStatus::Ok));
+    let status = if interrupted > 0 {
+        Status::Interrupted
+    } else if failed > 0 {
+        Status::Failed
+    } else {
+        Status::Complete
+    };
+    let message = (failed > 0).then(|| {
+        format!("{failed} of {} points failed, did not converge or were interrupted (summary.csv)", rows.len())
+    });
+    folder.finish(status, message)?;
     println!(
-        "{}: {} runs, {} failed or not converged; wrote {} and one folder per run to {}",
+        "{}: {} runs, {} failed or not converged, {interrupted} interrupted; wrote {} and one folder per run to {}",
         case.name,
         rows.len(),
-        failed,
-        summary.display(),
-        dir.display()
+        failed - interrupted,
+        target.join("summary.csv").display(),
+        target.display()
     );
-    for (_, name, o) in &results {
-        if let Some(e) = &o.error {
-            eprintln!("  {name}: {}: {e}", o.status.as_str());
+    for r in &rows {
+        if let Some(e) = &r.error {
+            eprintln!("  {}: {}: {e}", r.name, r.status.as_str());
         }
     }
-    Ok(if failed == 0 { ExitCode::SUCCESS } else { ExitCode::from(1) })
+    Ok(if interrupted > 0 {
+        ExitCode::from(EXIT_INTERRUPTED)
+    } else if failed == 0 {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    })
 }
 
 fn cmd_audit(
     paths: &[PathBuf],
     quick: bool,
     out: Option<PathBuf>,
+    force: bool,
     jobs: Option<usize>,
     quiet: bool,
 ) -> Result<ExitCode> {
@@ -440,13 +553,36 @@ fn cmd_audit(
     }
     let specs = files.iter().map(|f| read_spec(f, quick)).collect::<Result<Vec<_>, _>>()?;
     let out = out.unwrap_or_else(|| PathBuf::from(if quick { "out/audit-quick" } else { "out/audit" }));
+    // an audit folder of an older version carries the audit's marker instead of run.json
+    let force = force || out.join(cosserat::audit::MARKER).is_file();
+    let mut manifest = Manifest::new("audit");
+    manifest.inputs = files.iter().map(|f| input_file(f)).collect::<Result<_, _>>()?;
+    manifest.settings.insert("quick".into(), f64::from(u8::from(quick)));
+    let folder = RunFolder::begin(&out, manifest, Mode::Fresh { force })
+        .with_context(|| format!("audit: output folder {}", out.display()))?;
     let pb = progress_bar(quiet, if quick { "audit (quick)" } else { "audit" });
-    let opts = AuditOptions { out: out.clone(), jobs: jobs.unwrap_or(0) };
+    let opts = AuditOptions { out: folder.dir().to_path_buf(), jobs: jobs.unwrap_or(0) };
     let report = run_audit(&specs, quick, &opts, |done, total| {
         pb.set_length(total as u64);
         pb.set_position(done as u64);
-    })?;
+    });
     pb.finish_and_clear();
+    let report = match report {
+        Ok(r) if !cosserat::interrupt::requested() => {
+            folder.finish(Status::Complete, None)?;
+            r
+        }
+        Ok(_) => {
+            folder.finish(Status::Interrupted, Some("interrupted by a signal: points not run".into()))?;
+            eprintln!("audit interrupted; {} holds run.json saying interrupted", out.display());
+            return Ok(ExitCode::from(EXIT_INTERRUPTED));
+        }
+        Err(e) => {
+            let message = format!("{:#}", anyhow::Error::from(e));
+            folder.finish(Status::Failed, Some(message.clone()))?;
+            anyhow::bail!("audit: {message}; {} holds run.json saying failed", out.display());
+        }
+    };
     let counts = report.counts();
     let summary: Vec<String> = Verdict::ALL.iter().zip(counts).map(|(v, n)| format!("{n} {}", v.as_str())).collect();
     println!(
@@ -477,20 +613,29 @@ fn cmd_list(dir: &Path) -> Result<ExitCode> {
     if files.is_empty() {
         anyhow::bail!("no *.toml case files in {}", dir.display());
     }
+    let mut invalid = 0;
     for f in files {
         match Case::from_file(&f) {
             Ok(c) => println!("{:<24} {}", c.name, c.description),
-            Err(e) => println!(
-                "{:<24} INVALID: {e}",
-                f.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default()
-            ),
+            Err(e) => {
+                invalid += 1;
+                println!(
+                    "{:<24} INVALID: {e}",
+                    f.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default()
+                )
+            }
         }
+    }
+    if invalid > 0 {
+        eprintln!("error: {invalid} invalid case file(s) in {} (marked INVALID above)", dir.display());
+        return Ok(ExitCode::from(1));
     }
     Ok(ExitCode::SUCCESS)
 }
 
-fn cmd_modes(path: &Path, count: usize) -> Result<ExitCode> {
+fn cmd_modes(path: &Path, count: usize, limits: Limits) -> Result<ExitCode> {
     let case = load(path)?;
+    check_memory(&case, Footprint::Modes, limits)?;
     let model = modal_model(&case.problem())?;
     println!(
         "{}: natural frequencies of the linearised rod (clamped at s = 0, {} elements)",

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 /// Layers, lowest first; a module may use its own top-level module and those of lower layers.
 const LAYERS: &[&[&str]] = &[
-    &["expr", "linalg", "reference"],
+    &["expr", "linalg", "reference", "interrupt"],
     &["model"],
     &["assemble"],
     &["solve"],

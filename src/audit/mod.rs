@@ -16,7 +16,7 @@ use rayon::prelude::*;
 use serde::Deserialize;
 
 use crate::case::sweep::{product, Point, SweepError};
-use crate::io::sweep::{run_clip_point, run_point, RunStatus, SweepOutcome};
+use crate::io::sweep::{point_manifest, run_clip_point, run_point, RunStatus, SweepOutcome};
 use measures::{derived_metrics, ClipRecorder, ClipSeries};
 use spec::{Claim, RunSpec, Spec};
 
@@ -184,7 +184,15 @@ pub const MARKER: &str = ".cosserat-audit";
 fn prepare_folder(out: &Path) -> Result<(), AuditError> {
     let io = |source| AuditError::Folder { path: out.to_path_buf(), source };
     if out.exists() {
-        let empty = std::fs::read_dir(out).map_err(io)?.next().is_none();
+        // empty, or a staging folder of the output-folder contract (`io::run_folder`) holding
+        // only its run.json
+        let empty = std::fs::read_dir(out)
+            .map_err(io)?
+            .filter_map(Result::ok)
+            .all(|e| e.file_name() == crate::io::run_folder::MANIFEST);
+        if empty {
+            return std::fs::write(out.join(MARKER), "written by `cosserat audit`\n").map_err(io);
+        }
         if !empty && !out.join(MARKER).exists() {
             return Err(AuditError::Foreign { path: out.to_path_buf() });
         }
@@ -277,12 +285,13 @@ pub fn run_audit(
 /// other case runs as in `cosserat sweep`; then the derived metrics of [`measures`].
 fn run_job(j: &Job) -> PointResult {
     let label = j.dir.file_name().map(|f| f.to_string_lossy().into_owned()).unwrap_or_default();
+    let template = point_manifest("audit point", &j.case, &j.point);
     let (mut outcome, series) = if j.case.clip().is_some() {
         let mut recorder = ClipRecorder::new(&j.run.keep_frames);
-        let outcome = run_clip_point(&j.case, &j.dir, |frame| recorder.record(frame));
+        let outcome = run_clip_point(&j.case, &j.dir, &template, |frame| recorder.record(frame));
         (outcome, Some(recorder.finish()))
     } else {
-        (run_point(&j.case, &j.dir), None)
+        (run_point(&j.case, &j.dir, &template), None)
     };
     if let Some(m) = outcome.metrics.as_mut() {
         m.extend(derived_metrics(&j.case, outcome.run.as_ref(), series.as_ref()));

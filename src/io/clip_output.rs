@@ -2,12 +2,13 @@
 //! (synthetic clips), ParaView `vtk/frame_NNNNN.vtp` + `clip.pvd` streamed frame by frame
 //! ([`ClipWriter`], the [`FrameSink`] of `run::clip`), and the summary figures written at the
 //! end (`plot.svg`, `kymograph.svg`, `omega.svg`, `truth.svg`, `truth_errors.svg`).
-use std::io::Write;
+use std::io::{Seek, Write};
 use std::path::{Path, PathBuf};
 
 use nalgebra::Vector3;
 
 use super::files::{write_plot, OutputError};
+use super::journal::{Entry, Journal, Offsets, JOURNAL};
 use super::plot::{render_heatmaps_svg, render_panels_svg, Heatmap, LinePlot, Series};
 use super::vtk::{write_pvd, write_vtp, PolylineFields};
 use crate::case::Case;
@@ -25,6 +26,8 @@ pub struct ClipWriter {
     /// `truth.csv` of a synthetic clip
     truth: Option<std::io::BufWriter<std::fs::File>>,
     pvd: Vec<(f64, String)>,
+    /// the resume journal, if kept
+    journal: Option<Journal>,
 }
 
 /// Columns of `frames.csv`.
@@ -96,14 +99,15 @@ pub const CLIP_FIELD_COLUMNS: [&str; 30] = [
 ];
 
 impl ClipWriter {
-    /// Create the streamed files in `dir` (headers written); `truth`: also `truth.csv`.
-    pub fn create(dir: &Path, truth: bool) -> Result<Self, OutputError> {
+    /// Create the streamed files in `dir` (headers written); `truth`: also `truth.csv`;
+    /// `journal`: also the resume journal (`super::journal`).
+    pub fn create(dir: &Path, truth: bool, journal: bool) -> Result<Self, OutputError> {
         let err = |path: PathBuf| move |source| OutputError::Io { path: path.clone(), source };
         std::fs::create_dir_all(dir.join("vtk")).map_err(err(dir.join("vtk")))?;
         let open = |name: &str, header: &str| -> Result<std::io::BufWriter<std::fs::File>, OutputError> {
             let p = dir.join(name);
             let mut f = std::io::BufWriter::new(std::fs::File::create(&p).map_err(err(p.clone()))?);
-            writeln!(f, "{header}").map_err(err(p))?;
+            writeln!(f, "{header}").and_then(|_| f.flush()).map_err(err(p))?;
             Ok(f)
         };
         Ok(ClipWriter {
@@ -113,6 +117,69 @@ impl ClipWriter {
             curvature: open("curvature.csv", "frame,s_mid_m,kappa1_per_m,kappa2_per_m,kappa3_per_m")?,
             truth: if truth { Some(open("truth.csv", &TRUTH_COLUMNS.join(","))?) } else { None },
             pvd: Vec::new(),
+            journal: if journal { Some(Journal::create(dir)?) } else { None },
+        })
+    }
+
+    /// Reopen the streamed files of an earlier run in `dir` after the frames of `entries` (its
+    /// journal's complete lines, `journal_bytes` long): every CSV cut back to its length after
+    /// the last of them, the VTK files of later frames removed, the journal continued.
+    pub fn resume(dir: &Path, truth: bool, entries: &[Entry], journal_bytes: u64) -> Result<Self, OutputError> {
+        let Some(last) = entries.last() else { return Self::create(dir, truth, true) };
+        let err = |path: PathBuf| move |source| OutputError::Io { path: path.clone(), source };
+        let reopen = |name: &str, len: u64| -> Result<std::io::BufWriter<std::fs::File>, OutputError> {
+            let p = dir.join(name);
+            let f = std::fs::OpenOptions::new().append(true).open(&p).map_err(err(p.clone()))?;
+            f.set_len(len).map_err(err(p))?;
+            Ok(std::io::BufWriter::new(f))
+        };
+        let o = last.offsets;
+        let truth = match (truth, o.truth) {
+            (true, Some(len)) => Some(reopen("truth.csv", len)?),
+            (false, None) => None,
+            _ => {
+                return Err(OutputError::Invalid {
+                    path: dir.join(JOURNAL),
+                    reason: "the journal and the case disagree on a ground truth (truth.csv)".into(),
+                })
+            }
+        };
+        let kept: std::collections::BTreeSet<String> =
+            entries.iter().map(|e| format!("frame_{:05}.vtp", e.record.report.frame)).collect();
+        let vtk = dir.join("vtk");
+        for entry in std::fs::read_dir(&vtk).map_err(err(vtk.clone()))? {
+            let name = entry.map_err(err(vtk.clone()))?.file_name().to_string_lossy().into_owned();
+            if !kept.contains(&name) {
+                std::fs::remove_file(vtk.join(&name)).map_err(err(vtk.join(&name)))?;
+            }
+        }
+        Ok(ClipWriter {
+            dir: dir.to_path_buf(),
+            frames: reopen("frames.csv", o.frames)?,
+            fields: reopen("fields.csv", o.fields)?,
+            curvature: reopen("curvature.csv", o.curvature)?,
+            truth,
+            pvd: entries.iter().map(|e| (e.time_s, format!("vtk/frame_{:05}.vtp", e.record.report.frame))).collect(),
+            journal: Some(Journal::reopen(dir, journal_bytes)?),
+        })
+    }
+
+    /// Lengths of the streamed CSVs now (every line flushed).
+    fn offsets(&mut self) -> Result<Offsets, OutputError> {
+        let dir = &self.dir;
+        let len = |name: &str, f: &mut std::io::BufWriter<std::fs::File>| {
+            f.flush()
+                .and_then(|_| f.get_mut().stream_position())
+                .map_err(|source| OutputError::Io { path: dir.join(name), source })
+        };
+        Ok(Offsets {
+            frames: len("frames.csv", &mut self.frames)?,
+            fields: len("fields.csv", &mut self.fields)?,
+            curvature: len("curvature.csv", &mut self.curvature)?,
+            truth: match &mut self.truth {
+                Some(f) => Some(len("truth.csv", f)?),
+                None => None,
+            },
         })
     }
 
@@ -199,6 +266,12 @@ impl ClipWriter {
             ];
             let text: Vec<String> = v.iter().map(|x| format!("{x:.10e}")).collect();
             writeln!(file, "{},{}", r.frame, text.join(",")).and_then(|_| file.flush()).map_err(err("truth.csv"))?;
+        }
+        if self.journal.is_some() {
+            let offsets = self.offsets()?;
+            if let Some(j) = &mut self.journal {
+                j.append(&Entry { time_s, offsets, record: frame.record.clone() })?;
+            }
         }
         Ok(())
     }

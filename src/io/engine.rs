@@ -13,9 +13,10 @@ use super::clip_output::{
 use super::data::{read_data, write_data};
 use super::files::{InputError, OutputError};
 use super::freefem::{self, FreeFemError};
+use super::journal::{read_journal, JournalError};
 use crate::case::{Case, DataSource};
 use crate::model::chart::Chart;
-use crate::run::clip::{run_clip, ClipFrame, ClipRun, FrameSink};
+use crate::run::clip::{run_clip, ClipFrame, ClipOutcome, ClipRun, FrameSink};
 use crate::run::{self, Engine, NodalState, RunError, RunResult};
 
 /// Errors of running a case from files.
@@ -33,6 +34,8 @@ pub enum EngineError {
     Clip(#[from] ClipFileError),
     #[error("case `{0}` is not an inverse case")]
     NotInverse(String),
+    #[error(transparent)]
+    Journal(#[from] JournalError),
 }
 
 /// The data of an inverse case: the Rust forward engine on its `[data]` solve (I7), or the
@@ -108,9 +111,43 @@ pub fn run_clip_case_observed(
     observer: impl FnMut(&ClipFrame) + Send,
     progress: impl FnMut(usize, usize),
 ) -> Result<ClipRun, EngineError> {
+    let out = run_clip_to(case, dir, ClipOptions::default(), observer, progress)?;
+    match out.stopped {
+        Some(e) => Err(e.into()),
+        None => Ok(out.run),
+    }
+}
+
+/// How [`run_clip_to`] treats the folder.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct ClipOptions {
+    /// keep the resume journal (`super::journal`) while the clip runs
+    pub journal: bool,
+    /// continue the run whose journal `dir` holds, after its last complete frame
+    pub resume: bool,
+}
+
+/// The clip of a clip case in the Rust engine, streamed into `dir` (as [`run_clip_case`]), fresh
+/// or resumed after the frames of the journal in `dir` ([`ClipOptions`]). `Err`: the clip could
+/// not be started; otherwise the outcome's summary covers every frame in `dir` (resumed ones
+/// included) and `stopped` says why it ended early, if it did.
+pub fn run_clip_to(
+    case: &Case,
+    dir: &Path,
+    opts: ClipOptions,
+    observer: impl FnMut(&ClipFrame) + Send,
+    progress: impl FnMut(usize, usize),
+) -> Result<ClipOutcome, EngineError> {
     let (clip, truth) = load_clip(case)?;
-    let writer = Observed { sink: ClipWriter::create(dir, truth.is_some())?, observer };
-    Ok(run_clip(case, &clip, truth.as_ref(), writer, progress)?)
+    let (records, sink) = if opts.resume {
+        let (entries, bytes) = read_journal(dir)?;
+        let sink = ClipWriter::resume(dir, truth.is_some(), &entries, bytes)?;
+        (entries.into_iter().map(|e| e.record).collect(), sink)
+    } else {
+        (Vec::new(), ClipWriter::create(dir, truth.is_some(), opts.journal)?)
+    };
+    let writer = Observed { sink, observer };
+    Ok(run_clip(case, &clip, truth.as_ref(), &records, writer, progress)?)
 }
 
 /// A [`FrameSink`] that writes each frame and then shows it to an observer.

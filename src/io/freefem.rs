@@ -45,6 +45,8 @@ pub enum FreeFemError {
     #[error("case `{0}` is not an inverse case")]
     NotInverse(String),
 
+    #[error("FreeFEM was stopped by a signal (interrupted) in {workdir}")]
+    Interrupted { workdir: PathBuf },
     #[error("FreeFEM output {path}: {reason}")]
     BadOutput { path: PathBuf, reason: String },
     #[error("cannot read FreeFEM output")]
@@ -355,16 +357,41 @@ pub(super) fn execute(
     if std::env::var_os("FF_LOADPATH").is_none() {
         cmd.env("FF_LOADPATH", "/usr/lib/freefem++");
     }
-    let out = cmd.output().map_err(io(&script))?;
-    let text = format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
-    if !out.status.success() {
+    // Output to a file (no pipe to drain), the child polled so that a requested stop
+    // (`crate::interrupt`) kills it instead of waiting for it.
+    let log = workdir.join("freefem_output.txt");
+    let log_file = std::fs::File::create(&log).map_err(io(&log))?;
+    cmd.stdout(log_file.try_clone().map_err(io(&log))?).stderr(log_file);
+    let mut child = cmd.spawn().map_err(io(&script))?;
+    let status = loop {
+        if let Some(status) = child.try_wait().map_err(io(&script))? {
+            break status;
+        }
+        if crate::interrupt::requested() {
+            let _ = child.kill();
+            let _ = child.wait();
+            return Err(FreeFemError::Interrupted { workdir: workdir.to_path_buf() });
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    };
+    if !status.success() {
+        if crate::interrupt::requested() {
+            return Err(FreeFemError::Interrupted { workdir: workdir.to_path_buf() });
+        }
         return Err(FreeFemError::Failed {
-            status: out.status.code().unwrap_or(-1),
+            status: status.code().unwrap_or(-1),
             workdir: workdir.to_path_buf(),
-            output: text,
+            output: std::fs::read_to_string(&log).unwrap_or_default(),
         });
     }
     Ok(())
+}
+
+impl FreeFemError {
+    /// Was FreeFEM stopped because a stop was requested?
+    pub fn is_interrupted(&self) -> bool {
+        matches!(self, FreeFemError::Interrupted { .. })
+    }
 }
 
 pub(super) fn read_info(info_path: &Path) -> Result<BTreeMap<String, f64>, FreeFemError> {

@@ -1,6 +1,6 @@
 //! Everything that touches files or other programs: atomic writes and CSV ([`files`]), the
 //! forward data file `data.csv` ([`data`]), clip files ([`clip_files`], [`npy`]), the outputs of
-//! a run ([`run_files`]) and of a clip ([`clip_output`], [`vtk`]), SVG figures ([`plot`]), the
+//! a run ([`run_files`]) and of a clip ([`clip_output`], [`vtk`], the resume [`journal`]), SVG figures ([`plot`]), the
 //! FreeFEM engine ([`freefem`]), a case in either engine from its files ([`engine`]) and the
 //! files of a sweep ([`sweep`]).
 pub mod clip_files;
@@ -11,10 +11,13 @@ pub mod engine;
 pub mod files;
 pub mod freefem;
 pub mod freefem_clip;
+pub mod job;
+pub mod journal;
 pub mod npy;
 pub mod plot;
 pub mod posture;
 pub mod run_files;
+pub mod run_folder;
 pub mod sweep;
 pub mod vtk;
 

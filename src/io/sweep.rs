@@ -1,13 +1,15 @@
 //! The files of a parameter sweep: one folder per grid point (the files of `run`, or of the
-//! last iterate with `FAILED.txt` when the point did not converge) and `summary.csv`. The
+//! last iterate when the point did not converge, and the point's `run.json` saying which) and
+//! `summary.csv`. The
 //! grid itself is `case::sweep`'s. A point of a clip case solves the whole clip (the frames
 //! of `run` on a clip, its row the metrics of `run::clip_metrics`).
 use std::path::Path;
 
 use super::data::write_data;
-use super::engine::{load_data, run_clip_case_observed, run_inverse_on, write_clip_figures, EngineError};
-use super::files::write_atomic;
+use super::engine::{load_data, run_clip_to, run_inverse_on, write_clip_figures, ClipOptions, EngineError};
+use super::files::OutputError;
 use super::run_files::write_run;
+use super::run_folder::{input_file, Manifest, Status};
 use crate::case::sweep::{fmt_value, Point};
 use crate::case::Case;
 use crate::run::clip::{ClipFrame, ClipRun};
@@ -34,6 +36,8 @@ pub const SUMMARY_METRICS: [&str; 11] = [
 /// of a run that did not converge) and its error message.
 #[derive(Clone, Debug)]
 pub struct SummaryRow {
+    /// the point's folder name
+    pub name: String,
     pub point: Point,
     pub status: RunStatus,
     pub metrics: Option<Metrics>,
@@ -45,6 +49,17 @@ impl SweepOutcome {
     fn failed(error: String) -> Self {
         SweepOutcome { status: RunStatus::Failed, metrics: None, run: None, clip: None, error: Some(error) }
     }
+
+    /// A point stopped (or not started) by a signal.
+    fn interrupted() -> Self {
+        SweepOutcome {
+            status: RunStatus::Interrupted,
+            metrics: None,
+            run: None,
+            clip: None,
+            error: Some("interrupted by a signal".into()),
+        }
+    }
 }
 
 /// Outcome of one run of a sweep.
@@ -54,6 +69,8 @@ pub enum RunStatus {
     /// iteration limit reached; the metrics are those of the last iterate
     NotConverged,
     Failed,
+    /// stopped by a signal (or not started because of one)
+    Interrupted,
 }
 
 impl RunStatus {
@@ -62,6 +79,16 @@ impl RunStatus {
             RunStatus::Ok => "ok",
             RunStatus::NotConverged => "not_converged",
             RunStatus::Failed => "failed",
+            RunStatus::Interrupted => "interrupted",
+        }
+    }
+
+    /// The status of the point's folder (`run.json`).
+    pub fn folder_status(&self) -> Status {
+        match self {
+            RunStatus::Ok => Status::Complete,
+            RunStatus::NotConverged | RunStatus::Failed => Status::Failed,
+            RunStatus::Interrupted => Status::Interrupted,
         }
     }
 }
@@ -114,13 +141,63 @@ pub struct SweepOutcome {
     pub error: Option<String>,
 }
 
-/// One point of a sweep in the Rust engine, writing its folder `dir`. A run that stops at its
-/// iteration limit still writes the files of its last iterate, plus `FAILED.txt` with the error.
-/// A clip case solves its whole clip ([`run_clip_point`]).
-pub fn run_point(case: &Case, dir: &Path) -> SweepOutcome {
-    if case.clip().is_some() {
-        return run_clip_point(case, dir, |_| {});
+/// One point of a sweep in the Rust engine, writing its folder `dir` and its `run.json`
+/// (`template` with the point's status and message). A run that stops at its iteration limit
+/// still writes the files of its last iterate (its `run.json` says failed). A clip case solves
+/// its whole clip ([`run_clip_point`]). A point reached after a stop was requested
+/// (`crate::interrupt`) is not started and writes nothing.
+pub fn run_point(case: &Case, dir: &Path, template: &Manifest) -> SweepOutcome {
+    if crate::interrupt::requested() {
+        return SweepOutcome::interrupted();
     }
+    let outcome = if case.clip().is_some() { clip_point(case, dir, |_| {}) } else { single_point(case, dir) };
+    finish_point(dir, template, outcome)
+}
+
+/// The whole clip of a clip case in the Rust engine as a point of a sweep or audit, frames
+/// streamed to `dir` and shown to `observer`, then the clip's figures (over the frames solved,
+/// also when it stopped early) and its `run.json`. A clip that stops at a frame keeps the
+/// converged frames; its status is `failed` (or `interrupted`).
+pub fn run_clip_point(
+    case: &Case,
+    dir: &Path,
+    template: &Manifest,
+    observer: impl FnMut(&ClipFrame) + Send,
+) -> SweepOutcome {
+    if crate::interrupt::requested() {
+        return SweepOutcome::interrupted();
+    }
+    finish_point(dir, template, clip_point(case, dir, observer))
+}
+
+/// The `run.json` of a point of `command` (a sweep, an audit): the case and its file's hash,
+/// the point's settings, the Rust engine.
+pub fn point_manifest(command: &str, case: &Case, point: &Point) -> Manifest {
+    let mut m = Manifest::new(command);
+    m.case_name = Some(case.name.clone());
+    m.case = case.source.as_deref().and_then(|p| input_file(p).ok());
+    m.inputs = case.clip().and_then(|c| input_file(&c.file).ok()).into_iter().collect();
+    m.settings = point.iter().cloned().collect();
+    m.engine = Some("rust".into());
+    m
+}
+
+/// The point's `run.json`: `template` with the case's name, the point's status and message.
+fn finish_point(dir: &Path, template: &Manifest, outcome: SweepOutcome) -> SweepOutcome {
+    if !dir.is_dir() {
+        return outcome;
+    }
+    let mut m = template.clone();
+    if let Some(c) = &outcome.clip {
+        m.frames_done = Some(c.reports.len());
+    }
+    match m.finish(dir, outcome.status.folder_status(), outcome.error.clone()) {
+        Ok(()) => outcome,
+        Err(e) => SweepOutcome::failed(chain(&e)),
+    }
+}
+
+fn single_point(case: &Case, dir: &Path) -> SweepOutcome {
     let failed = |e: &dyn std::fmt::Display| SweepOutcome::failed(e.to_string());
     let outcome: Result<RunResult, EngineError> = if case.inverse().is_some() {
         let path = dir.join("data.csv");
@@ -133,18 +210,15 @@ pub fn run_point(case: &Case, dir: &Path) -> SweepOutcome {
     };
     let (status, r, error) = match outcome {
         Ok(r) => (RunStatus::Ok, r, None),
+        Err(EngineError::Run(e)) if e.is_interrupted() => return SweepOutcome::interrupted(),
         Err(EngineError::Run(RunError::Incomplete { source, partial })) => {
-            (RunStatus::NotConverged, *partial, Some(source.to_string()))
+            (RunStatus::NotConverged, *partial, Some(format!("{source}; the files here hold the last iterate")))
         }
         Err(e) => return failed(&format_args!("case {}: {}", case.name, chain(&e))),
     };
     let write = || -> Result<Metrics, String> {
         let m = all_metrics(case, &r).map_err(|e| chain(&e))?;
         write_run(case, &r, &m, dir).map_err(|e| chain(&e))?;
-        if let Some(e) = &error {
-            write_atomic(&dir.join("FAILED.txt"), format!("{e}\nThe files here hold the last iterate.\n").as_bytes())
-                .map_err(|e| chain(&e))?;
-        }
         Ok(m)
     };
     match write() {
@@ -153,26 +227,85 @@ pub fn run_point(case: &Case, dir: &Path) -> SweepOutcome {
     }
 }
 
-/// The whole clip of a clip case in the Rust engine, frames streamed to `dir` and shown to
-/// `observer`, then the clip's figures. A clip that stops at a frame keeps the converged frames
-/// and writes `FAILED.txt` naming the frame; its status is `failed`.
-pub fn run_clip_point(case: &Case, dir: &Path, observer: impl FnMut(&ClipFrame) + Send) -> SweepOutcome {
-    let failed = |e: String| {
-        let _ = write_atomic(
-            &dir.join("FAILED.txt"),
-            format!("{e}\nThe converged frames before it are in this folder.\n").as_bytes(),
-        );
-        SweepOutcome::failed(e)
+fn clip_point(case: &Case, dir: &Path, observer: impl FnMut(&ClipFrame) + Send) -> SweepOutcome {
+    let out = match run_clip_to(case, dir, ClipOptions::default(), observer, |_, _| {}) {
+        Ok(out) => out,
+        Err(e) => return SweepOutcome::failed(format!("case {}: {}", case.name, chain(&e))),
     };
-    let run = match run_clip_case_observed(case, dir, observer, |_, _| {}) {
-        Ok(r) => r,
-        Err(e) => return failed(format!("case {}: {}", case.name, chain(&e))),
+    let (status, error) = match &out.stopped {
+        None => (RunStatus::Ok, None),
+        Some(e) if e.is_interrupted() => (RunStatus::Interrupted, Some(chain(e))),
+        Some(e) => (
+            RunStatus::Failed,
+            Some(format!("case {}: {}; the converged frames before it are in this folder", case.name, chain(e))),
+        ),
     };
-    if let Err(e) = write_clip_figures(case, &run, dir) {
-        return failed(format!("case {}: {}", case.name, chain(&e)));
+    if !out.run.reports.is_empty() {
+        if let Err(e) = write_clip_figures(case, &out.run, dir) {
+            return SweepOutcome::failed(format!("case {}: {}", case.name, chain(&e)));
+        }
     }
-    let m = clip_metrics(case, &run);
-    SweepOutcome { status: RunStatus::Ok, metrics: Some(m), run: None, clip: Some(run), error: None }
+    let m = (status == RunStatus::Ok).then(|| clip_metrics(case, &out.run));
+    SweepOutcome { status, metrics: m, run: None, clip: Some(out.run), error }
+}
+
+/// Run every point of a sweep of `case` (`points`: the grid of `case::sweep::product`, swept
+/// `keys`) in parallel on `jobs` threads (0: one per core), each into its folder under `dir`
+/// ([`run_point`]), then write `summary.csv` and `convergence.svg`; `tick` after each point.
+/// Two points with the same folder name are refused (they would write into one folder).
+pub fn sweep_into(
+    case: &Case,
+    keys: &[String],
+    points: &[(Point, Case)],
+    dir: &Path,
+    jobs: usize,
+    tick: impl Fn() + Sync,
+) -> Result<Vec<SummaryRow>, OutputError> {
+    use rayon::prelude::*;
+    let mut names = std::collections::BTreeSet::new();
+    for (_, c) in points {
+        if !names.insert(c.name.as_str()) {
+            return Err(OutputError::Invalid {
+                path: dir.join(&c.name),
+                reason: "two points of the sweep have this folder (a value given twice?)".into(),
+            });
+        }
+    }
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(jobs).build().map_err(|e| OutputError::Invalid {
+        path: dir.to_path_buf(),
+        reason: format!("cannot start the thread pool: {e}"),
+    })?;
+    let results: Vec<(String, Point, SweepOutcome)> = pool.install(|| {
+        points
+            .par_iter()
+            .map(|(point, c)| {
+                let template = point_manifest("sweep point", c, point);
+                let r = run_point(c, &dir.join(&c.name), &template);
+                tick();
+                (c.name.clone(), point.clone(), r)
+            })
+            .collect()
+    });
+    let rows: Vec<SummaryRow> = results
+        .iter()
+        .map(|(name, point, o)| SummaryRow {
+            name: name.clone(),
+            point: point.clone(),
+            status: o.status,
+            metrics: o.metrics.clone(),
+            error: o.error.clone(),
+        })
+        .collect();
+    let columns: &[&str] = if case.clip().is_some() { &CLIP_SUMMARY_METRICS } else { &SUMMARY_METRICS };
+    let text = summary_csv(keys, columns, &rows)
+        .map_err(|e| OutputError::Invalid { path: dir.join("summary.csv"), reason: e.to_string() })?;
+    super::files::write_atomic(&dir.join("summary.csv"), text.as_bytes())?;
+    let curves: Vec<(&String, &RunResult)> =
+        results.iter().filter_map(|(name, _, o)| o.run.as_ref().map(|run| (name, run))).collect();
+    if !curves.is_empty() {
+        super::run_files::write_convergence_plot(&curves, &dir.join("convergence.svg"))?;
+    }
+    Ok(rows)
 }
 
 /// An error and its sources, `a: b: c` (as `anyhow`'s `{:#}`).
@@ -197,18 +330,21 @@ mod tests {
         m.insert("iterations".into(), 12.0);
         let rows = vec![
             SummaryRow {
+                name: String::new(),
                 point: vec![("lambda_l".into(), 1e-20)],
                 status: RunStatus::Ok,
                 metrics: Some(m.clone()),
                 error: None,
             },
             SummaryRow {
+                name: String::new(),
                 point: vec![("lambda_l".into(), 1e3)],
                 status: RunStatus::NotConverged,
                 metrics: Some(m),
                 error: Some("did not converge,\nat all".into()),
             },
             SummaryRow {
+                name: String::new(),
                 point: vec![("lambda_l".into(), 1.0)],
                 status: RunStatus::Failed,
                 metrics: None,

@@ -20,7 +20,7 @@ use std::f64::consts::PI;
 use super::rotation::{angles_from_rotation, rotation, Angles};
 
 /// A chart `Q = Q_E(α) B` of eq. (1) composed with a constant base rotation `B` (R1).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Chart {
     /// `B`: maps space coordinates to chart coordinates (`x̃ = B x`)
     pub base: Matrix3<f64>,

@@ -3,16 +3,20 @@
 //! second thread while the next frame is solved.
 use std::time::Instant;
 
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::{DVector, Matrix3, Vector3};
 
 use super::metrics::INNER_SKIP_ELEMENTS;
 use super::{NodalState, RunError};
 use crate::case::Case;
 use crate::clip::synthetic::{compare_frame, FrameComparison, GroundTruth, RecoveredFrame};
 use crate::clip::Clip;
+use crate::model::chart::Chart;
 use crate::model::mesh::Field;
+use crate::model::rotation::Angles;
 use crate::solve::inverse::measures::angular_velocity;
-use crate::solve::sequence::{solve_sequence, FrameReport};
+use crate::solve::inverse::InverseSolution;
+use crate::solve::sequence::{solve_sequence_from, vector_to_space, FrameReport, FrameSolution, ResumeFrom};
+use crate::solve::Stop;
 
 /// Nodes skipped at each end when scoring curvature against a ground truth (the curvature of
 /// the inverse solution is least reliable at the free ends; as `metrics::INNER_SKIP_ELEMENTS`).
@@ -39,10 +43,16 @@ pub struct ClipFrame {
     /// element-midpoint curvature `(s [m], κ = A ∂sα [1/m])` (eq. 28), computed once for every
     /// consumer of the frame
     pub kappa: Vec<(f64, Vector3<f64>)>,
+    /// recovered κ2 at the element midpoints and the data's planar curvature at the interior
+    /// nodes [1/m] ([`ClipRun::kappa2`], [`ClipRun::data_kappa`])
+    pub kappa2: Vec<f64>,
+    pub data_kappa: Vec<f64>,
     /// sign alternation of the recovered κ2 and of the data's planar curvature
     pub roughness: (f64, f64),
     /// synthetic clips: the frame against its ground truth
     pub truth: Option<TruthFrame>,
+    /// what the frame is derived from (the resume journal)
+    pub record: FrameRecord,
 }
 
 /// A frame of a synthetic clip against its ground truth.
@@ -53,6 +63,9 @@ pub struct TruthFrame {
     /// true twist κ3, mean over the nodes [rad/m]
     pub twist_per_m: f64,
     pub comparison: FrameComparison,
+    /// true and recovered bending `κ1² + κ2²` per node [1/m²]
+    pub bending_true: Vec<f64>,
+    pub bending_recovered: Vec<f64>,
 }
 
 /// Where the frames of a clip go (`crate::io::clip_files::ClipWriter` streams them to disk).
@@ -132,18 +145,48 @@ pub fn sign_alternation(k: &[f64]) -> f64 {
     flips as f64 / (k.len() - 2) as f64
 }
 
+/// Everything a converged frame of a clip is derived from, exactly (the resume journal of
+/// `crate::io` stores one per frame): with the records of frames `0..n` a clip resumes at frame
+/// `n` and continues bit for bit as the uninterrupted solve (`solve::sequence::ResumeFrom`),
+/// and the summary of frames `0..n` is derived again from them without solving.
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+pub struct FrameRecord {
+    pub report: FrameReport,
+    pub chart: Chart,
+    /// the state `(x, α)` in the frame's chart (forward layout)
+    pub state: DVector<f64>,
+    /// the adjoint `(x̂, α̂)` in space coordinates (forward layout)
+    pub adjoint: DVector<f64>,
+    /// the previous frame's angles in this frame's chart (`None` on the first frame)
+    pub previous: Option<Vec<Angles>>,
+}
+
+/// How a clip run ended: its summary over the frames it solved (all of them, or those before
+/// it stopped) and, if it stopped early, why (a frame's error, a write error, or an interrupt:
+/// [`RunError::is_interrupted`]).
+#[derive(Debug)]
+pub struct ClipOutcome {
+    pub run: ClipRun,
+    pub stopped: Option<RunError>,
+    /// frames of the clip
+    pub total: usize,
+}
+
 /// Solve the clip `clip` of a clip case frame by frame in the Rust engine, handing every
 /// converged frame to `sink` (on a second thread, while the next frame is solved); `truth`:
-/// the ground truth of a synthetic clip, frame for frame. On failure the sink has every
-/// converged frame and the error names the frame; a sink error stops the clip at the next
-/// frame and is reported in its place.
+/// the ground truth of a synthetic clip, frame for frame. `resume`: the records of the frames
+/// `0..n` of an earlier run of the same case ([`FrameRecord`]; empty: from the first frame);
+/// they are not handed to the sink again, the summary covers them. On failure or interrupt the
+/// sink has every converged frame and the outcome says why it stopped; a sink error stops the
+/// clip at the next frame and is reported in its place.
 pub fn run_clip<S: FrameSink>(
     case: &Case,
     clip: &Clip,
     truth: Option<&GroundTruth>,
+    resume: &[FrameRecord],
     mut sink: S,
     mut progress: impl FnMut(usize, usize),
-) -> Result<ClipRun, RunError> {
+) -> Result<ClipOutcome, RunError> {
     let sp = case.sequence_params().ok_or_else(|| RunError::Kind { case: case.name.clone(), what: "a clip case" })?;
     let problem = case.problem();
     let dofs = problem.dofs();
@@ -152,10 +195,98 @@ pub fn run_clip<S: FrameSink>(
     let total = clip.frame_count();
     let h = case.mesh.h();
     let start = Instant::now();
-    let mut rough = Vec::new();
-    let (mut kappa2, mut data_kappa, mut omega_rows) = (Vec::new(), Vec::new(), Vec::new());
     let dt = sp.inverse.frame_interval_s;
-    let mut truth_run = truth.map(|_| TruthRun::default());
+    let mut summary = Summary::new(truth.is_some());
+    // A converged frame in space coordinates with everything its consumers need.
+    let derive = |rep: &FrameReport, frame: &FrameSolution| -> Result<ClipFrame, String> {
+        let sol = frame.solution;
+        let nodes = NodalState { chart: frame.chart, ..NodalState::from_vector(&case.mesh, &sol.u) };
+        let (force, torque): (Vec<_>, Vec<_>) = (0..nodes.s.len())
+            .map(|i| {
+                let (xh, ah) = (dofs.get(&sol.adjoint, i, Field::X), dofs.get(&sol.adjoint, i, Field::Alpha));
+                (xh / w8.lambda_f, ah / w8.lambda_l)
+            })
+            .unzip();
+        let index = rep.frame.checked_sub(first_frame).filter(|i| *i < clip.frames.len());
+        let index = index.ok_or_else(|| format!("frame {} is outside the clip", rep.frame))?;
+        let data = &clip.frames[index];
+        let kappa = nodes.element_curvature();
+        let k2: Vec<f64> = kappa.iter().map(|(_, k)| k[1]).collect();
+        // The data's curvature in the plane normal to the chart's axis (exactly the x–z
+        // curvature for an x–z clip; rotates with the data, R5).
+        let in_chart: Vec<Vector3<f64>> = data.iter().map(|x| frame.chart.to_chart(x)).collect();
+        let kd = planar_xz_curvature(&in_chart, h);
+        let mut truth_frame = None;
+        if let Some(t) = truth {
+            let ft = &t.frames[index];
+            let q: Vec<Matrix3<f64>> = nodes.alpha.iter().map(|a| nodes.chart.rotation(a)).collect();
+            let kn = nodal_curvature(&kappa);
+            let c = compare_frame(data, ft, &RecoveredFrame { x: &nodes.x, q: &q, kappa: &kn }, TRUTH_SKIP_NODES)
+                .map_err(|e| e.to_string())?;
+            let twist = ft.kappa.iter().map(|k| k.z).sum::<f64>() / ft.kappa.len() as f64;
+            let bend = |k: &Vector3<f64>| k.x * k.x + k.y * k.y;
+            truth_frame = Some(TruthFrame {
+                roll_rad: ft.roll_rad,
+                twist_per_m: twist,
+                comparison: c,
+                bending_true: ft.kappa.iter().map(bend).collect(),
+                bending_recovered: kn.iter().map(bend).collect(),
+            });
+        }
+        let omega: Option<Vec<Vector3<f64>>> =
+            frame.previous.map(|prev| nodes.alpha.iter().zip(prev).map(|(a, p)| angular_velocity(a, p, dt)).collect());
+        let roughness = (sign_alternation(&k2), sign_alternation(&kd));
+        Ok(ClipFrame {
+            report: *rep,
+            time_s: rep.frame as f64 * clip.dt_s,
+            nodes,
+            force,
+            torque,
+            data: data.clone(),
+            omega,
+            kappa,
+            kappa2: k2,
+            data_kappa: kd,
+            roughness,
+            truth: truth_frame,
+            record: FrameRecord {
+                report: *rep,
+                chart: frame.chart,
+                state: frame.state.clone(),
+                adjoint: sol.adjoint.clone(),
+                previous: frame.previous.map(<[Angles]>::to_vec),
+            },
+        })
+    };
+    // The frames of an earlier run: their summary again, from their records.
+    for (i, r) in resume.iter().enumerate() {
+        if r.report.frame != first_frame + i || r.state.len() != dofs.len() || r.adjoint.len() != dofs.len() {
+            return Err(RunError::Resume(format!(
+                "record {i} is frame {} with {} unknowns; expected frame {} with {}",
+                r.report.frame,
+                r.state.len(),
+                first_frame + i,
+                dofs.len()
+            )));
+        }
+        let sol = InverseSolution {
+            u: vector_to_space(&dofs, &r.chart, &r.state, false),
+            adjoint: r.adjoint.clone(),
+            history: Vec::new(),
+            stop: Stop::Converged,
+        };
+        let fs = FrameSolution { solution: &sol, chart: r.chart, previous: r.previous.as_deref(), state: &r.state };
+        summary.push(&derive(&r.report, &fs).map_err(RunError::Resume)?);
+    }
+    let from = match resume {
+        [] => None,
+        [.., a, b] => Some(ResumeFrom {
+            next: resume.len(),
+            prev: (b.chart, b.state.clone()),
+            prev2: Some((a.chart, a.state.clone())),
+        }),
+        [b] => Some(ResumeFrom { next: 1, prev: (b.chart, b.state.clone()), prev2: None }),
+    };
     let (tx, rx) = std::sync::mpsc::sync_channel::<ClipFrame>(8);
     let (result, written) = std::thread::scope(|scope| {
         let io = scope.spawn(move || -> Result<(), S::Error> {
@@ -164,65 +295,16 @@ pub fn run_clip<S: FrameSink>(
             }
             sink.finish()
         });
-        let result = solve_sequence(
+        let result = solve_sequence_from(
             &problem,
             &sp,
             &clip.frames,
             None,
+            from,
             |_, _| {},
             |rep, frame| {
-                let sol = frame.solution;
-                let nodes = NodalState { chart: frame.chart, ..NodalState::from_vector(&case.mesh, &sol.u) };
-                let (force, torque): (Vec<_>, Vec<_>) = (0..nodes.s.len())
-                    .map(|i| {
-                        let (xh, ah) = (dofs.get(&sol.adjoint, i, Field::X), dofs.get(&sol.adjoint, i, Field::Alpha));
-                        (xh / w8.lambda_f, ah / w8.lambda_l)
-                    })
-                    .unzip();
-                let data = &clip.frames[rep.frame - first_frame];
-                let kappa = nodes.element_curvature();
-                let k2: Vec<f64> = kappa.iter().map(|(_, k)| k[1]).collect();
-                // The data's curvature in the plane normal to the chart's axis (exactly the x–z
-                // curvature for an x–z clip; rotates with the data, R5).
-                let in_chart: Vec<Vector3<f64>> = data.iter().map(|x| frame.chart.to_chart(x)).collect();
-                let kd = planar_xz_curvature(&in_chart, h);
-                let mut truth_frame = None;
-                if let (Some(t), Some(tr)) = (truth, &mut truth_run) {
-                    let ft = &t.frames[rep.frame - first_frame];
-                    let q: Vec<Matrix3<f64>> = nodes.alpha.iter().map(|a| nodes.chart.rotation(a)).collect();
-                    let kn = nodal_curvature(&kappa);
-                    let c =
-                        compare_frame(data, ft, &RecoveredFrame { x: &nodes.x, q: &q, kappa: &kn }, TRUTH_SKIP_NODES)
-                            .map_err(|e| e.to_string())?;
-                    let twist = ft.kappa.iter().map(|k| k.z).sum::<f64>() / ft.kappa.len() as f64;
-                    let bend = |k: &Vector3<f64>| k.x * k.x + k.y * k.y;
-                    tr.comparisons.push(c);
-                    tr.roll_rad.push(ft.roll_rad);
-                    tr.twist_per_m.push(twist);
-                    tr.bending_true.push(ft.kappa.iter().map(bend).collect());
-                    tr.bending_recovered.push(kn.iter().map(bend).collect());
-                    truth_frame = Some(TruthFrame { roll_rad: ft.roll_rad, twist_per_m: twist, comparison: c });
-                }
-                let omega: Option<Vec<Vector3<f64>>> = frame
-                    .previous
-                    .map(|prev| nodes.alpha.iter().zip(prev).map(|(a, p)| angular_velocity(a, p, dt)).collect());
-                omega_rows.push(omega.clone().unwrap_or_else(|| vec![Vector3::zeros(); nodes.alpha.len()]));
-                let roughness = (sign_alternation(&k2), sign_alternation(&kd));
-                rough.push(roughness);
-                kappa2.push(k2);
-                data_kappa.push(kd);
-                let frame = ClipFrame {
-                    report: *rep,
-                    time_s: rep.frame as f64 * clip.dt_s,
-                    nodes,
-                    force,
-                    torque,
-                    data: data.clone(),
-                    omega,
-                    kappa,
-                    roughness,
-                    truth: truth_frame,
-                };
+                let frame = derive(rep, frame)?;
+                summary.push(&frame);
                 tx.send(frame).map_err(|_| "the output thread stopped (see the write error)".to_string())?;
                 progress(rep.frame - first_frame + 1, total);
                 Ok(())
@@ -233,16 +315,54 @@ pub fn run_clip<S: FrameSink>(
         (result, written)
     });
     // A write error explains a stopped clip better than the stop itself.
-    written.map_err(|e| RunError::Sink(Box::new(e)))?;
-    let reports = result?;
-    Ok(ClipRun {
-        reports,
-        roughness: rough,
-        kappa2,
-        data_kappa,
-        omega: omega_rows,
-        truth: truth_run,
-        wall_time_s: start.elapsed().as_secs_f64(),
-        source: clip.source.clone(),
-    })
+    let stopped = match (written, result) {
+        (Err(e), _) => Some(RunError::Sink(Box::new(e))),
+        (Ok(()), Err(e)) => Some(RunError::from(e)),
+        (Ok(()), Ok(_)) => None,
+    };
+    Ok(ClipOutcome { run: summary.finish(start.elapsed().as_secs_f64(), clip.source.clone()), stopped, total })
+}
+
+/// The per-frame summary of a clip run, frame by frame.
+struct Summary {
+    run: ClipRun,
+}
+
+impl Summary {
+    fn new(truth: bool) -> Self {
+        Summary {
+            run: ClipRun {
+                reports: Vec::new(),
+                roughness: Vec::new(),
+                kappa2: Vec::new(),
+                data_kappa: Vec::new(),
+                omega: Vec::new(),
+                truth: truth.then(TruthRun::default),
+                wall_time_s: 0.0,
+                source: String::new(),
+            },
+        }
+    }
+
+    fn push(&mut self, f: &ClipFrame) {
+        let r = &mut self.run;
+        r.reports.push(f.report);
+        r.roughness.push(f.roughness);
+        r.kappa2.push(f.kappa2.clone());
+        r.data_kappa.push(f.data_kappa.clone());
+        r.omega.push(f.omega.clone().unwrap_or_else(|| vec![Vector3::zeros(); f.nodes.alpha.len()]));
+        if let (Some(tr), Some(t)) = (&mut r.truth, &f.truth) {
+            tr.comparisons.push(t.comparison);
+            tr.roll_rad.push(t.roll_rad);
+            tr.twist_per_m.push(t.twist_per_m);
+            tr.bending_true.push(t.bending_true.clone());
+            tr.bending_recovered.push(t.bending_recovered.clone());
+        }
+    }
+
+    fn finish(mut self, wall_time_s: f64, source: String) -> ClipRun {
+        self.run.wall_time_s = wall_time_s;
+        self.run.source = source;
+        self.run
+    }
 }

@@ -2,6 +2,7 @@
 //! synthetic inverse case, one inverse frame ([`run_inverse`]) or a whole clip
 //! ([`clip::run_clip`]), each producing the engine-agnostic [`RunResult`] of [`result`].
 //! Files (case data, clips, outputs) and the FreeFEM engine are `crate::io`'s.
+pub mod budget;
 pub mod clip;
 pub mod clip_metrics;
 pub mod frames;
@@ -39,6 +40,8 @@ pub enum RunError {
     Chart { case: String, axis: [f64; 3] },
     #[error("writing the clip")]
     Sink(#[source] Box<dyn std::error::Error + Send + Sync>),
+    #[error("resuming the clip: {0}")]
+    Resume(String),
     /// The solver stopped without meeting its rule; `partial` holds the last iterate and the
     /// history up to there (sweeps keep it so that non-converging values still show).
     #[error("rust engine stopped after {} iterations without meeting its stopping rule", .partial.stats.iterations)]
@@ -50,6 +53,15 @@ pub enum RunError {
 }
 
 impl RunError {
+    /// Did the run stop because a stop was requested (`crate::interrupt`)?
+    pub fn is_interrupted(&self) -> bool {
+        match self {
+            RunError::Solve(e) | RunError::Incomplete { source: e, .. } => matches!(e, SolveError::Interrupted { .. }),
+            RunError::Sequence(SequenceError::Solve(e)) => matches!(e, SolveError::Interrupted { .. }),
+            _ => false,
+        }
+    }
+
     fn kind(case: &Case, what: &'static str) -> Self {
         RunError::Kind { case: case.name.clone(), what }
     }

@@ -10,7 +10,7 @@
 //! used (errata: (Δt²/2) F_n and M_{n−2}; see PAPER-NOTES and `docs/decisions.md`).
 use nalgebra::{DVector, Vector3};
 
-use super::{divergence, Problem, SolveError};
+use super::{divergence, Problem, SolveError, Step};
 use crate::assemble::Tangent;
 use crate::linalg::LinearSolver;
 use crate::model::loads::LoadFrame;
@@ -73,6 +73,9 @@ pub fn solve(
     let state_free_loads = !(problem.loads.has_distributed() && matches!(problem.loads.frame, LoadFrame::Local));
 
     for n in 1..=params.steps {
+        if crate::interrupt::requested() {
+            return Err(SolveError::Interrupted { what: "time steps", done: n - 1, total: params.steps });
+        }
         let t = n as f64 * dt;
         let mut u = &u_prev + &v_prev * dt;
         let mut converged = None;
@@ -102,7 +105,7 @@ pub fn solve(
             u += &du;
             increment = problem.increment_measure(&du);
             if let Some((quantity, value)) = divergence(problem, &u, increment) {
-                return Err(SolveError::Diverged { step: Some(n), iteration: it, quantity, value });
+                return Err(SolveError::Diverged { step: Some(Step::Time(n)), iteration: it, quantity, value });
             }
             if increment <= params.newton_tolerance {
                 converged = Some(it);
@@ -110,7 +113,7 @@ pub fn solve(
             }
         }
         let it = converged.ok_or(SolveError::NewtonNotConverged {
-            step: Some(n),
+            step: Some(Step::Time(n)),
             iterations: params.newton_max_iterations,
             increment,
         })?;

@@ -34,11 +34,14 @@ pub enum SolveError {
     FixedPointNotConverged { step: usize, iterations: usize, rel_change: f64 },
     #[error("Newton did not converge after {iterations} iterations (last increment {increment:e}){}", step_text(*.step))]
     /// `step`: time step (dynamic) or continuation step (static)
-    NewtonNotConverged { step: Option<usize>, iterations: usize, increment: f64 },
+    NewtonNotConverged { step: Option<Step>, iterations: usize, increment: f64 },
     #[error("diverged in iteration {iteration}{}: {quantity} = {value:e}", step_text(*.step))]
     /// `quantity` named with its limit (a non-finite value or one beyond [`DIVERGED_LENGTHS`],
     /// [`DIVERGED_ANGLE_RAD`]); the iterate is not returned.
-    Diverged { step: Option<usize>, iteration: usize, quantity: &'static str, value: f64 },
+    Diverged { step: Option<Step>, iteration: usize, quantity: &'static str, value: f64 },
+    /// A stop was requested (`crate::interrupt`, SIGINT/SIGTERM) before `done + 1` of `total`.
+    #[error("interrupted by a signal after {done} of {total} {what}")]
+    Interrupted { what: &'static str, done: usize, total: usize },
     #[error(
         "inverse fixed point of frame {frame} did not converge after {iterations} iterations (last relative change of (x, α) {rel_change:e})"
     )]
@@ -93,6 +96,18 @@ pub(crate) fn divergence(problem: &Problem, u: &nalgebra::DVector<f64>, change: 
     None
 }
 
-fn step_text(step: Option<usize>) -> String {
-    step.map(|s| format!(" at time step {s}")).unwrap_or_default()
+/// Where a forward solve was when it stopped: a time step (dynamic) or a load-continuation
+/// step (static).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Step {
+    Time(usize),
+    Continuation(usize),
+}
+
+fn step_text(step: Option<Step>) -> String {
+    match step {
+        Some(Step::Time(n)) => format!(" at time step {n}"),
+        Some(Step::Continuation(n)) => format!(" of load-continuation step {n}"),
+        None => String::new(),
+    }
 }

@@ -59,7 +59,7 @@ pub enum FrameStart {
 }
 
 /// Per-frame report.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, serde::Serialize, serde::Deserialize)]
 pub struct FrameReport {
     pub frame: usize,
     pub iterations: usize,
@@ -204,6 +204,9 @@ pub struct FrameSolution<'a> {
     /// (Remark 6). With the solution's angles they give the frame's angular velocity
     /// (`inverse::measures::angular_velocity`, eq. 27).
     pub previous: Option<&'a [Angles]>,
+    /// the state `(x, α)` in the frame's chart: what the next frames start from
+    /// ([`ResumeFrom`])
+    pub state: &'a DVector<f64>,
 }
 
 /// Solve every frame of `frames` (positions per node, the mesh's nodes) in order. `u0` is the
@@ -218,19 +221,52 @@ pub fn solve_sequence(
     sp: &SequenceParams,
     frames: &[Vec<Vector3<f64>>],
     u0: Option<&DVector<f64>>,
+    on_iteration: impl FnMut(usize, &InverseRecord),
+    on_frame: impl FnMut(&FrameReport, &FrameSolution) -> Result<(), String>,
+) -> Result<Vec<FrameReport>, SequenceError> {
+    solve_sequence_from(problem, sp, frames, u0, None, on_iteration, on_frame)
+}
+
+/// Where a clip solve resumes: the number of frames already solved (≥ 1) and the states of
+/// the last two of them in their charts, exactly as [`FrameSolution::state`] gave them. A clip
+/// resumed from the states of its frames `next − 2` and `next − 1` continues bit for bit as the
+/// uninterrupted solve would (every frame's solve depends on those two states, its data and
+/// its chart only).
+#[derive(Clone, Debug)]
+pub struct ResumeFrom {
+    pub next: usize,
+    pub prev: (Chart, DVector<f64>),
+    pub prev2: Option<(Chart, DVector<f64>)>,
+}
+
+/// [`solve_sequence`], optionally resumed after the frames of `resume`; the reports returned
+/// are those of the frames solved here. Before each frame it checks for a requested stop
+/// (`crate::interrupt`): the clip then ends with [`SolveError::Interrupted`], every frame before
+/// it handed to `on_frame`.
+pub fn solve_sequence_from(
+    problem: &Problem,
+    sp: &SequenceParams,
+    frames: &[Vec<Vector3<f64>>],
+    u0: Option<&DVector<f64>>,
+    resume: Option<ResumeFrom>,
     mut on_iteration: impl FnMut(usize, &InverseRecord),
     mut on_frame: impl FnMut(&FrameReport, &FrameSolution) -> Result<(), String>,
 ) -> Result<Vec<FrameReport>, SequenceError> {
     let dofs = problem.dofs();
     let h = problem.mesh.h();
     let mut reports = Vec::with_capacity(frames.len());
-    // the previous frame: its chart and its state in that chart
-    let mut prev: Option<(Chart, DVector<f64>)> = None;
-    // the frame before that, for the linear predictor of a warm start
-    let mut prev2: Option<(Chart, DVector<f64>)> = None;
+    // the previous frame: its chart and its state in that chart; the frame before that, for
+    // the linear predictor of a warm start
+    let (first, mut prev, mut prev2) = match resume {
+        Some(r) => (r.next, Some(r.prev), r.prev2),
+        None => (0, None, None),
+    };
     // pattern, LU storage and scratch once per clip, reused by every frame
     let mut solver = FrameSolver::new(problem, sp.inverse);
-    for (i, x_space) in frames.iter().enumerate() {
+    for (i, x_space) in frames.iter().enumerate().skip(first) {
+        if crate::interrupt::requested() {
+            return Err(SolveError::Interrupted { what: "frames", done: i, total: frames.len() }.into());
+        }
         let k = i + sp.frame_offset;
         let start = std::time::Instant::now();
         let chart = frame_chart(sp, prev.as_ref().map(|(c, _)| c), x_space);
@@ -306,7 +342,12 @@ pub fn solve_sequence(
             wall_time_s: start.elapsed().as_secs_f64(),
         };
         let in_space = if chart.is_identity() { None } else { Some(to_space(&dofs, &chart, &sol)) };
-        let solution = FrameSolution { solution: in_space.as_ref().unwrap_or(&sol), chart, previous: frame.previous };
+        let solution = FrameSolution {
+            solution: in_space.as_ref().unwrap_or(&sol),
+            chart,
+            previous: frame.previous,
+            state: &sol.u,
+        };
         on_frame(&rep, &solution).map_err(|message| SequenceError::Callback { frame: k, message })?;
         prev2 = prev.take();
         prev = Some((chart, sol.u));
@@ -335,20 +376,27 @@ fn carry_state(dofs: &DofMap, to: &Chart, from: &Chart, u: &DVector<f64>, near: 
 
 /// The solution with positions and adjoints in space coordinates (R3); angles unchanged.
 fn to_space(dofs: &DofMap, chart: &Chart, sol: &InverseSolution) -> InverseSolution {
-    let rotate = |v: &DVector<f64>, both: bool| {
-        let mut out = v.clone();
-        for j in 0..dofs.nodes() {
-            let (a, b) = (dofs.get(v, j, Field::X), dofs.get(v, j, Field::Alpha));
-            let (a, b) = (chart.to_space(&a), if both { chart.to_space(&b) } else { b });
-            dofs.set(&mut out, j, Field::X, &a);
-            dofs.set(&mut out, j, Field::Alpha, &b);
-        }
-        out
-    };
     InverseSolution {
-        u: rotate(&sol.u, false),
-        adjoint: rotate(&sol.adjoint, true),
+        u: vector_to_space(dofs, chart, &sol.u, false),
+        adjoint: vector_to_space(dofs, chart, &sol.adjoint, true),
         history: sol.history.clone(),
         stop: sol.stop,
     }
+}
+
+/// A forward-layout vector of chart `chart` in space coordinates (R3): the position block
+/// rotated, the angle block rotated too if `both` (an adjoint), else unchanged (angles stay the
+/// chart's). What [`FrameSolution::solution`] holds, from the chart's state and adjoint.
+pub fn vector_to_space(dofs: &DofMap, chart: &Chart, v: &DVector<f64>, both: bool) -> DVector<f64> {
+    if chart.is_identity() {
+        return v.clone();
+    }
+    let mut out = v.clone();
+    for j in 0..dofs.nodes() {
+        let (a, b) = (dofs.get(v, j, Field::X), dofs.get(v, j, Field::Alpha));
+        let (a, b) = (chart.to_space(&a), if both { chart.to_space(&b) } else { b });
+        dofs.set(&mut out, j, Field::X, &a);
+        dofs.set(&mut out, j, Field::Alpha, &b);
+    }
+    out
 }

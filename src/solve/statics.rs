@@ -12,7 +12,7 @@
 //! 1. Wang et al., Comput. Mech. 71 (2023), §4, eqs. (52), (61), Remark 10.
 use nalgebra::DVector;
 
-use super::{divergence, Problem, SolveError, Stop};
+use super::{divergence, Problem, SolveError, Step, Stop};
 use crate::assemble::{assemble, Tangent};
 use crate::linalg::{LinearSolver, Pattern};
 use crate::model::element::frozen_operator;
@@ -75,7 +75,9 @@ impl StaticSolution {
             last.map(|r| (r.step, r.iteration, r.change)).unwrap_or((1, self.iterations, f64::NAN));
         Err(match self.method {
             Method::FixedPoint { .. } => SolveError::FixedPointNotConverged { step, iterations, rel_change: change },
-            Method::Newton => SolveError::NewtonNotConverged { step: Some(step), iterations, increment: change },
+            Method::Newton => {
+                SolveError::NewtonNotConverged { step: Some(Step::Continuation(step)), iterations, increment: change }
+            }
         })
     }
 }
@@ -130,6 +132,13 @@ fn solve_step(
     let h = problem.mesh.h();
     let mut last = f64::NAN;
     for k in 1..=params.max_iterations {
+        if crate::interrupt::requested() {
+            return Err(SolveError::Interrupted {
+                what: "iterations",
+                done: history.len(),
+                total: params.max_iterations,
+            });
+        }
         values.iter_mut().for_each(|v| *v = 0.0);
         let change = match params.method {
             Method::FixedPoint { relaxation } => {
@@ -164,7 +173,7 @@ fn solve_step(
             }
         };
         if let Some((quantity, value)) = divergence(problem, &u, change) {
-            return Err(SolveError::Diverged { step: Some(step), iteration: k, quantity, value });
+            return Err(SolveError::Diverged { step: Some(Step::Continuation(step)), iteration: k, quantity, value });
         }
         let rec = IterationRecord { step, iteration: k, change };
         progress(&rec);

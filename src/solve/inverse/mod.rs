@@ -171,7 +171,7 @@ impl InverseRecord {
 
 /// The six terms of the objective (41), each with its weight and the ½, with the
 /// integration rules of I2.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ObjectiveTerms {
     /// λg/2 ∫|x − x_g|²
     pub tracking: f64,

@@ -1,0 +1,401 @@
+//! The output-folder contract. Every command that writes results (`run`, `sweep`, `compare`,
+//! `audit`) writes them into a staging folder beside its output folder, `.NAME.staging-PID`,
+//! and `run.json` there says what the folder is: the command, the case and the SHA-256 of its
+//! file and inputs, the engine, the program version, the status (`running`, `complete`,
+//! `failed`, `interrupted`), the frames done and the files written. When the run ends — complete,
+//! failed or interrupted — the staging folder replaces the output folder whole (two renames in
+//! one parent), so a folder never mixes two runs and never holds stale files, and a run killed
+//! outright leaves the previous folder untouched (its staging folder is removed, or resumed, by
+//! the next run). A folder holding files but no `run.json` is not replaced unless `--force`.
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use sha2::{Digest, Sha256};
+
+use super::files::write_atomic;
+
+/// File name of the manifest in an output folder.
+pub const MANIFEST: &str = "run.json";
+
+/// The state of a run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Status {
+    Running,
+    Complete,
+    Failed,
+    Interrupted,
+}
+
+impl Status {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Status::Running => "running",
+            Status::Complete => "complete",
+            Status::Failed => "failed",
+            Status::Interrupted => "interrupted",
+        }
+    }
+}
+
+/// An input file of a run and its SHA-256.
+#[derive(Clone, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct InputFile {
+    pub path: String,
+    pub sha256: String,
+}
+
+/// `run.json`.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Manifest {
+    /// "cosserat"
+    pub program: String,
+    /// the program's version (Cargo.toml)
+    pub version: String,
+    /// the subcommand: run, sweep, compare, audit
+    pub command: String,
+    /// the case's name and file (with its SHA-256), where the command has one
+    pub case_name: Option<String>,
+    pub case: Option<InputFile>,
+    /// other inputs the results depend on (a clip's recording or kymogram)
+    pub inputs: Vec<InputFile>,
+    /// settings that differ from the case file (a sweep point)
+    pub settings: BTreeMap<String, f64>,
+    pub engine: Option<String>,
+    pub status: Status,
+    /// clips: converged frames written, and frames of the clip
+    pub frames_done: Option<usize>,
+    pub frames_total: Option<usize>,
+    /// why the run failed or stopped
+    pub message: Option<String>,
+    /// the process that wrote the folder
+    pub pid: u32,
+    /// seconds since the Unix epoch
+    pub started_unix_s: u64,
+    pub finished_unix_s: Option<u64>,
+    /// every file of the folder (relative paths, `/`-separated), `run.json` excepted
+    pub files: Vec<String>,
+}
+
+/// Errors of the output-folder contract; each names the folder.
+#[derive(Debug, thiserror::Error)]
+pub enum FolderError {
+    #[error("{path} is not a folder")]
+    NotAFolder { path: PathBuf },
+    #[error(
+        "{path} holds files ({examples}) but no run.json: it was not written by a cosserat run (or by an older version). Choose another --out, or pass --force to replace it whole"
+    )]
+    Foreign { path: PathBuf, examples: String },
+    #[error("{path}: refusing to replace the working folder, one of its parents or the root; choose a folder for the results")]
+    Dangerous { path: PathBuf },
+    #[error("{path} is being written by another cosserat process (pid {pid}, run.json status running)")]
+    Busy { path: PathBuf, pid: u32 },
+    #[error("{path}: cannot resume: {reason}")]
+    CannotResume { path: PathBuf, reason: String },
+    #[error("{path}")]
+    Io {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("{path}: {reason}")]
+    Manifest { path: PathBuf, reason: String },
+}
+
+fn io_err(path: &Path) -> impl Fn(std::io::Error) -> FolderError + '_ {
+    move |source| FolderError::Io { path: path.to_path_buf(), source }
+}
+
+/// SHA-256 of a file's bytes (hex), streamed.
+pub fn sha256_file(path: &Path) -> std::io::Result<String> {
+    let mut f = std::fs::File::open(path)?;
+    let mut hasher = Sha256::new();
+    std::io::copy(&mut f, &mut hasher)?;
+    Ok(hasher.finalize().iter().map(|b| format!("{b:02x}")).collect())
+}
+
+/// An input file with its hash.
+pub fn input_file(path: &Path) -> Result<InputFile, FolderError> {
+    Ok(InputFile { path: path.display().to_string(), sha256: sha256_file(path).map_err(io_err(path))? })
+}
+
+fn now_unix_s() -> u64 {
+    std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map(|d| d.as_secs()).unwrap_or(0)
+}
+
+impl Manifest {
+    /// A running manifest of `command` in this process.
+    pub fn new(command: &str) -> Self {
+        Manifest {
+            program: "cosserat".into(),
+            version: env!("CARGO_PKG_VERSION").into(),
+            command: command.into(),
+            case_name: None,
+            case: None,
+            inputs: Vec::new(),
+            settings: BTreeMap::new(),
+            engine: None,
+            status: Status::Running,
+            frames_done: None,
+            frames_total: None,
+            message: None,
+            pid: std::process::id(),
+            started_unix_s: now_unix_s(),
+            finished_unix_s: None,
+            files: Vec::new(),
+        }
+    }
+
+    /// Read `dir/run.json`; `Ok(None)` if there is none.
+    pub fn read(dir: &Path) -> Result<Option<Manifest>, FolderError> {
+        let path = dir.join(MANIFEST);
+        match std::fs::read(&path) {
+            Ok(bytes) => serde_json::from_slice(&bytes)
+                .map(Some)
+                .map_err(|e| FolderError::Manifest { path, reason: format!("not a cosserat run.json: {e}") }),
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
+            Err(source) => Err(FolderError::Io { path, source }),
+        }
+    }
+
+    /// Write `dir/run.json` (atomically).
+    pub fn write(&self, dir: &Path) -> Result<(), FolderError> {
+        let path = dir.join(MANIFEST);
+        let text = serde_json::to_string_pretty(self)
+            .map_err(|e| FolderError::Manifest { path: path.clone(), reason: e.to_string() })?;
+        write_atomic(&path, format!("{text}\n").as_bytes())
+            .map_err(|e| FolderError::Manifest { path, reason: super::sweep::chain(&e) })
+    }
+
+    /// End the run as `status` (with `message`), listing the files of `dir`, and write it there.
+    pub fn finish(&mut self, dir: &Path, status: Status, message: Option<String>) -> Result<(), FolderError> {
+        self.status = status;
+        self.message = message;
+        self.finished_unix_s = Some(now_unix_s());
+        self.files = list_files(dir)?;
+        self.write(dir)
+    }
+}
+
+/// The files under `dir` (relative, sorted, `/`-separated), `run.json` and the hidden
+/// temporaries of atomic writes excepted.
+pub fn list_files(dir: &Path) -> Result<Vec<String>, FolderError> {
+    fn walk(root: &Path, dir: &Path, out: &mut Vec<String>) -> Result<(), FolderError> {
+        for entry in std::fs::read_dir(dir).map_err(io_err(dir))? {
+            let entry = entry.map_err(io_err(dir))?;
+            let p = entry.path();
+            let name = entry.file_name().to_string_lossy().into_owned();
+            if entry.file_type().map_err(io_err(&p))?.is_dir() {
+                walk(root, &p, out)?;
+            } else {
+                let skip = (dir == root && name == MANIFEST) || (name.starts_with('.') && name.ends_with(".tmp"));
+                if skip {
+                    continue;
+                }
+                let rel = p.strip_prefix(root).unwrap_or(&p);
+                out.push(rel.iter().map(|c| c.to_string_lossy()).collect::<Vec<_>>().join("/"));
+            }
+        }
+        Ok(())
+    }
+    let mut out = Vec::new();
+    walk(dir, dir, &mut out)?;
+    out.sort();
+    Ok(out)
+}
+
+/// How a run treats its output folder.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Mode {
+    /// a new run; `force`: also replace a folder that holds files but no `run.json`
+    Fresh { force: bool },
+    /// continue the interrupted or failed run of the folder (same case and inputs)
+    Resume,
+}
+
+/// An output folder being written: the run writes into [`RunFolder::dir`] (the staging folder)
+/// and [`RunFolder::finish`] puts it in place.
+#[derive(Debug)]
+pub struct RunFolder {
+    target: PathBuf,
+    staging: PathBuf,
+    pub manifest: Manifest,
+    /// the manifest of the run being resumed
+    pub resumed: Option<Manifest>,
+    /// what was done to the folder's surroundings (stale staging folders removed), for the user
+    pub notes: Vec<String>,
+}
+
+fn pid_alive(pid: u32) -> bool {
+    pid == std::process::id() || Path::new(&format!("/proc/{pid}")).exists()
+}
+
+/// Is `path` the working folder, one of its parents, or the root?
+fn dangerous(path: &Path) -> bool {
+    let Ok(abs) = std::fs::canonicalize(path) else { return false };
+    let cwd = std::env::current_dir().ok().and_then(|c| std::fs::canonicalize(c).ok());
+    abs.parent().is_none() || cwd.is_some_and(|c| c.starts_with(&abs))
+}
+
+impl RunFolder {
+    /// Start a run whose results go to `target`, described by `manifest` (status running).
+    pub fn begin(target: &Path, mut manifest: Manifest, mode: Mode) -> Result<RunFolder, FolderError> {
+        let name = target
+            .file_name()
+            .filter(|n| !n.is_empty() && *n != "..")
+            .ok_or_else(|| FolderError::Dangerous { path: target.to_path_buf() })?
+            .to_string_lossy()
+            .into_owned();
+        let parent = match target.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+            _ => PathBuf::from("."),
+        };
+        if target.exists() && !target.is_dir() {
+            return Err(FolderError::NotAFolder { path: target.to_path_buf() });
+        }
+        std::fs::create_dir_all(&parent).map_err(io_err(&parent))?;
+        let staging = parent.join(format!(".{name}.staging-{}", std::process::id()));
+        let mut notes = Vec::new();
+        // Staging folders of runs that were killed: the newest may be resumed, the rest go.
+        let prefix = format!(".{name}.staging-");
+        let mut stale: Vec<(std::time::SystemTime, PathBuf)> = Vec::new();
+        for entry in std::fs::read_dir(&parent).map_err(io_err(&parent))? {
+            let entry = entry.map_err(io_err(&parent))?;
+            let n = entry.file_name().to_string_lossy().into_owned();
+            if let Some(pid) = n.strip_prefix(&prefix).and_then(|p| p.parse::<u32>().ok()) {
+                if !pid_alive(pid) {
+                    let t = entry.metadata().and_then(|m| m.modified()).unwrap_or(std::time::UNIX_EPOCH);
+                    stale.push((t, entry.path()));
+                }
+            }
+        }
+        stale.sort();
+        let old = Manifest::read(target)?;
+        if let Some(m) = &old {
+            if m.status == Status::Running && pid_alive(m.pid) {
+                return Err(FolderError::Busy { path: target.to_path_buf(), pid: m.pid });
+            }
+        }
+        let resumed = match mode {
+            Mode::Fresh { force } => {
+                let files = if target.is_dir() { list_entries(target)? } else { Vec::new() };
+                if old.is_none() && !files.is_empty() {
+                    if !force {
+                        let examples = files.iter().take(3).cloned().collect::<Vec<_>>().join(", ");
+                        return Err(FolderError::Foreign { path: target.to_path_buf(), examples });
+                    }
+                    if dangerous(target) {
+                        return Err(FolderError::Dangerous { path: target.to_path_buf() });
+                    }
+                }
+                None
+            }
+            Mode::Resume => {
+                // the run to continue: a killed run's staging folder, else the folder itself
+                let (source, previous) = match stale.pop() {
+                    Some((_, dir)) => {
+                        let m = Manifest::read(&dir)?;
+                        notes.push(format!("resuming the run that was stopped while writing {}", dir.display()));
+                        (dir, m)
+                    }
+                    None => (target.to_path_buf(), old.clone()),
+                };
+                let cannot = |reason: String| FolderError::CannotResume { path: target.to_path_buf(), reason };
+                let previous = previous.ok_or_else(|| cannot("it holds no run.json (no run to resume)".into()))?;
+                check_resumable(&previous, &manifest).map_err(cannot)?;
+                std::fs::rename(&source, &staging).map_err(io_err(&source))?;
+                manifest.started_unix_s = previous.started_unix_s;
+                Some(previous)
+            }
+        };
+        for (_, dir) in stale {
+            std::fs::remove_dir_all(&dir).map_err(io_err(&dir))?;
+            notes.push(format!("removed {}, left by a run that was killed", dir.display()));
+        }
+        if resumed.is_none() {
+            if staging.exists() {
+                std::fs::remove_dir_all(&staging).map_err(io_err(&staging))?;
+            }
+            std::fs::create_dir_all(&staging).map_err(io_err(&staging))?;
+        }
+        manifest.status = Status::Running;
+        manifest.write(&staging)?;
+        Ok(RunFolder { target: target.to_path_buf(), staging, manifest, resumed, notes })
+    }
+
+    /// Where the run writes (the staging folder).
+    pub fn dir(&self) -> &Path {
+        &self.staging
+    }
+
+    /// The output folder (where the results will be once the run ends).
+    pub fn target(&self) -> &Path {
+        &self.target
+    }
+
+    /// End the run as `status`: `run.json` written with the files, then the staging folder put
+    /// in place of the output folder (the previous one removed). Returns the output folder.
+    pub fn finish(mut self, status: Status, message: Option<String>) -> Result<PathBuf, FolderError> {
+        self.manifest.finish(&self.staging, status, message)?;
+        let parent = self.staging.parent().unwrap_or(Path::new(".")).to_path_buf();
+        let old = parent.join(format!(
+            ".{}.old-{}",
+            self.target.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default(),
+            std::process::id()
+        ));
+        let had_old = self.target.exists();
+        if had_old {
+            std::fs::rename(&self.target, &old).map_err(io_err(&self.target))?;
+        }
+        if let Err(source) = std::fs::rename(&self.staging, &self.target) {
+            if had_old {
+                let _ = std::fs::rename(&old, &self.target);
+            }
+            return Err(FolderError::Io { path: self.staging.clone(), source });
+        }
+        if had_old {
+            std::fs::remove_dir_all(&old).map_err(io_err(&old))?;
+        }
+        Ok(self.target.clone())
+    }
+}
+
+/// The names in a folder.
+fn list_entries(dir: &Path) -> Result<Vec<String>, FolderError> {
+    let mut out = Vec::new();
+    for entry in std::fs::read_dir(dir).map_err(io_err(dir))? {
+        out.push(entry.map_err(io_err(dir))?.file_name().to_string_lossy().into_owned());
+    }
+    out.sort();
+    Ok(out)
+}
+
+/// Can the run of `previous` be continued by the run described by `new`? The same command
+/// (`run`) on the same case file and inputs, a clip, not complete.
+fn check_resumable(previous: &Manifest, new: &Manifest) -> Result<(), String> {
+    if previous.command != "run" || previous.frames_done.is_none() {
+        return Err(format!("it holds a `{}` run, not a clip run (only clips resume)", previous.command));
+    }
+    if previous.status == Status::Complete {
+        return Err("its run is complete; nothing to resume".into());
+    }
+    if previous.version != new.version {
+        return Err(format!("it was written by cosserat {}, this is {}", previous.version, new.version));
+    }
+    let hash = |f: &Option<InputFile>| f.as_ref().map(|f| f.sha256.clone());
+    if hash(&previous.case) != hash(&new.case) {
+        return Err(format!(
+            "its case file had SHA-256 {}, the case given now has {}: a resumed clip must be the same case",
+            hash(&previous.case).unwrap_or_default(),
+            hash(&new.case).unwrap_or_default()
+        ));
+    }
+    let hashes = |m: &Manifest| m.inputs.iter().map(|f| f.sha256.clone()).collect::<Vec<_>>();
+    if hashes(previous) != hashes(new) {
+        return Err("its clip file has changed since (SHA-256 differs)".into());
+    }
+    if previous.engine != new.engine {
+        return Err(format!("it was run by the {} engine", previous.engine.clone().unwrap_or_default()));
+    }
+    Ok(())
+}

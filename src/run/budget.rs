@@ -1,0 +1,126 @@
+//! The memory a run will need, estimated from the case before anything is allocated, and the
+//! refusal of a run above a limit (`cosserat … --max-memory-gib`). The estimate counts the
+//! arrays the solvers allocate: per forward unknown the band LU (`linalg::band`, `2 kl + ku + 1`
+//! rows, `kl = ku = 2 b − 1` for blocks of `b` unknowns per node), per element the pattern's
+//! values, scaled copy and slots (`linalg::pattern`), a few dozen work vectors; a clip's frames
+//! and per-frame summary (`run::clip::ClipRun`); the dense matrices of the modal model
+//! (`solve::modes`, about ten `n × n`). Checked against the peak resident size of real runs in
+//! `docs/results.md`: it errs high, never low by more than the process's fixed few MB.
+use crate::case::{Analysis, Case, ClipKind};
+
+/// Bytes in a GiB.
+pub const GIB: f64 = 1024.0 * 1024.0 * 1024.0;
+
+/// What part of the program will run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Footprint {
+    /// `run`, `sweep` points, `compare`: the case's solver
+    Run,
+    /// `modes`: the dense modal model
+    Modes,
+}
+
+/// A run refused before it started.
+#[derive(Debug, thiserror::Error)]
+#[error(
+    "case `{case}`: {what} would need about {:.1} GiB of memory (estimated from {basis}), above the limit of {:.1} GiB; reduce {key} or raise the limit with --max-memory-gib",
+    .bytes / GIB,
+    .limit / GIB
+)]
+pub struct BudgetError {
+    pub case: String,
+    pub what: &'static str,
+    pub bytes: f64,
+    pub limit: f64,
+    pub basis: String,
+    pub key: &'static str,
+}
+
+/// Fixed cost of a process [bytes] (binary, allocator, thread stacks).
+const FIXED_BYTES: f64 = 32.0 * 1024.0 * 1024.0;
+
+/// Bytes per element of a banded solve with `b` unknowns per node: band LU over `b` unknowns
+/// (`ld = 3 kl + 1`... with pivots), pattern values + equilibrated copy + slots of the two
+/// nodes' `(2b)²` entries, and about 40 work vectors of `b` entries.
+fn banded_bytes_per_element(b: f64) -> f64 {
+    let kl = 2.0 * b - 1.0;
+    let band = (3.0 * kl + 1.0) * b * 8.0 + b * 8.0;
+    let pattern = (2.0 * b).powi(2) * (8.0 + 8.0 + 8.0);
+    let vectors = 40.0 * b * 8.0;
+    band + pattern + vectors
+}
+
+/// Frames and node-frames of a clip case, from its settings or the size of its file.
+fn clip_node_frames(case: &Case) -> Option<(f64, String)> {
+    let c = case.clip()?;
+    let nodes = case.mesh.nodes() as f64;
+    let frames = match (&c.kind, c.frames) {
+        (_, Some((a, b))) => Some(b.saturating_sub(a) as f64),
+        (ClipKind::Roll3d(s), None) => Some(s.frames as f64),
+        _ => None,
+    };
+    match frames {
+        Some(f) => Some((f * nodes, format!("{f} frames × {nodes} nodes"))),
+        None => {
+            // a recording or kymogram: its numbers are at least 8 bytes each in the file, and
+            // every node-frame takes at least 3 of them (or 1 joint angle)
+            let size = std::fs::metadata(&c.file).map(|m| m.len() as f64).unwrap_or(0.0);
+            let per = if matches!(c.kind, ClipKind::Kymogram) { 8.0 } else { 24.0 };
+            Some((
+                size / per * if matches!(c.kind, ClipKind::Kymogram) { nodes } else { 1.0 },
+                format!("{} ({:.0} MB)", c.file.display(), size / 1e6),
+            ))
+        }
+    }
+}
+
+/// Estimated peak memory [bytes] of `what` on `case`, with what it was estimated from and the
+/// key that scales it.
+pub fn estimate(case: &Case, what: Footprint) -> (f64, String, &'static str) {
+    let e = case.mesh.elements as f64;
+    let n_forward = 6.0 * (e + 1.0);
+    match what {
+        Footprint::Modes => (
+            FIXED_BYTES + 10.0 * n_forward * n_forward * 8.0,
+            format!("{e} elements, dense modal model"),
+            "rod.elements",
+        ),
+        Footprint::Run => match &case.analysis {
+            Analysis::Static(_) | Analysis::Dynamic(_) => {
+                (FIXED_BYTES + e * banded_bytes_per_element(6.0), format!("{e} elements"), "rod.elements")
+            }
+            Analysis::Inverse(_) => {
+                // the KKT system (12 unknowns per node), the forward data solve beside it
+                let mut bytes = FIXED_BYTES + e * (banded_bytes_per_element(12.0) + banded_bytes_per_element(6.0));
+                let mut basis = format!("{e} elements");
+                if let Some((node_frames, what)) = clip_node_frames(case) {
+                    // positions (3) + κ2, data κ, ω (3), truth (2) + frame files per node-frame
+                    bytes += node_frames * 12.0 * 8.0;
+                    basis = format!("{basis}, clip {what}");
+                }
+                (bytes, basis, "rod.elements or the clip's frames")
+            }
+        },
+    }
+}
+
+/// Refuse `what` on `case` if its estimate exceeds `limit_bytes`.
+pub fn check(case: &Case, what: Footprint, limit_bytes: f64) -> Result<(), BudgetError> {
+    let (bytes, basis, key) = estimate(case, what);
+    if bytes > limit_bytes {
+        let what = match what {
+            Footprint::Run => "the run",
+            Footprint::Modes => "the modal model",
+        };
+        return Err(BudgetError { case: case.name.clone(), what, bytes, limit: limit_bytes, basis, key });
+    }
+    Ok(())
+}
+
+/// The default limit: half of the machine's memory (`/proc/meminfo`), 4 GiB where unknown.
+pub fn default_limit_bytes() -> f64 {
+    let total_kib = std::fs::read_to_string("/proc/meminfo").ok().and_then(|s| {
+        s.lines().find(|l| l.starts_with("MemTotal:")).and_then(|l| l.split_whitespace().nth(1)?.parse::<f64>().ok())
+    });
+    total_kib.map(|k| k * 1024.0 / 2.0).unwrap_or(4.0 * GIB)
+}
