@@ -7,13 +7,10 @@ use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use cosserat::case::{case_files, Case};
-use cosserat::io::job::{run_into, run_manifest, JobEnd};
-use cosserat::io::run_files::write_run;
+use cosserat::io::job::{run_into, run_manifest};
 use cosserat::io::run_folder::{input_file, Manifest, Mode, RunFolder, Status};
 use cosserat::io::sweep::RunStatus;
-use cosserat::io::write_atomic;
 use cosserat::run::budget::{self, default_limit_bytes, Footprint, GIB};
-use cosserat::run::metrics::all_metrics;
 use cosserat::run::Engine;
 use cosserat::solve::modes::modal_model;
 
@@ -270,7 +267,7 @@ fn cmd_run(
         eprintln!("note: {n}");
     }
     match end.status {
-        Status::Complete => print_run(&case, engine, &end),
+        Status::Complete => print!("{}", end.summary(&case.name, engine)),
         Status::Interrupted => {
             let kept = match end.frames {
                 Some((n, _)) => format!(
@@ -295,55 +292,6 @@ fn cmd_run(
         }
     }
     Ok(ExitCode::SUCCESS)
-}
-
-/// The summary line(s) of a complete run.
-fn print_run(case: &Case, engine: Engine, end: &JobEnd) {
-    if let Some(r) = &end.single {
-        let tip = r.nodes.x.last().copied().unwrap_or_default();
-        println!(
-            "{} [{engine}]: tip = ({:.6e}, {:.6e}, {:.6e}) m, {} iterations, {:.3} s; wrote {} files to {}",
-            case.name,
-            tip[0],
-            tip[1],
-            tip[2],
-            r.stats.iterations,
-            r.stats.wall_time_s,
-            end.files,
-            end.dir.display()
-        );
-    }
-    let Some(run) = &end.clip else { return };
-    if let Some(t) = &run.truth {
-        let max = |f: &dyn Fn(&cosserat::clip::synthetic::FrameComparison) -> f64| {
-            t.comparisons.iter().map(f).fold(0.0, f64::max)
-        };
-        println!(
-            "{} ground truth (all frames, max): |x - x_true|/|x_true| {:.2e}; bending k1^2+k2^2 rel. L2 {:.2e}; angle(d3, true d3) {:.2e} rad; |roll offset| {:.3} rad; kappa_3 rms error {:.1} rad/m (true twist {:.1} rad/m); see truth.csv, truth.svg, truth_errors.svg",
-            case.name,
-            max(&|c| c.position_rel_l2),
-            max(&|c| c.bending_rel_l2),
-            max(&|c| c.max_tangent_angle_rad),
-            max(&|c| c.roll_offset_rad.abs()),
-            max(&|c| c.twist_rms_error_per_m),
-            t.twist_per_m.first().copied().unwrap_or(0.0)
-        );
-    }
-    let n = run.reports.len();
-    let its: Vec<usize> = run.reports.iter().map(|r| r.iterations).collect();
-    let worst = run.reports.iter().map(|r| r.x_err_rel).fold(0.0, f64::max);
-    let jmax = run.reports.iter().map(|r| r.max_stretch_deviation).fold(0.0, f64::max);
-    println!(
-        "{} [rust]: {n} frames in {:.2} s ({:.1} frames/s; solving {:.2} s); iterations per frame min {} / mean {:.1} / max {}; max |x - x_g|/|x_g| {worst:.3e}; max |j - 1| {jmax:.3e}; wrote {}",
-        case.name,
-        run.wall_time_s,
-        n as f64 / run.wall_time_s,
-        run.reports.iter().map(|r| r.wall_time_s).sum::<f64>(),
-        its.iter().min().copied().unwrap_or(0),
-        its.iter().sum::<usize>() as f64 / n.max(1) as f64,
-        its.iter().max().copied().unwrap_or(0),
-        end.dir.display()
-    );
 }
 
 /// `--frames`: a positive count or `all`.
@@ -377,7 +325,7 @@ fn cmd_compare(
     for n in &folder.notes {
         eprintln!("note: {n}");
     }
-    let result = compare_into(&case, folder.dir(), short, frames);
+    let result = compare_into(&case, folder.dir(), &target, short, frames);
     let (status, message) = match &result {
         Ok(_) => (Status::Complete, None),
         Err(_) if cosserat::interrupt::requested() => (Status::Interrupted, Some("interrupted by a signal".into())),
@@ -395,60 +343,18 @@ fn cmd_compare(
 }
 
 /// Both engines on `case` and their comparison, written into `dir` (the staging folder).
-fn compare_into(case: &Case, dir: &Path, short: bool, frames: Option<usize>) -> Result<ExitCode> {
-    use cosserat::io::compare::{compare_case, frames_csv, report_csv, CompareOptions, Horizon};
+fn compare_into(case: &Case, dir: &Path, target: &Path, short: bool, frames: Option<usize>) -> Result<ExitCode> {
+    use cosserat::io::compare::{compare_case, report_table, write_compare, CompareOptions, Horizon};
     let opts = CompareOptions { horizon: if short { Horizon::Short } else { Horizon::Full }, frames };
     eprintln!(
         "{}: rust engine (twice: as given and with its input perturbed by 1e-13), then FreeFEM in {}",
         case.name,
-        dir.join("freefem_work").display()
+        target.join("freefem_work").display()
     );
-    let (case, dir) = (case.clone(), dir.to_path_buf());
-    let report = compare_case(&case, &dir, &opts).with_context(|| format!("case {}", case.name))?;
-    if let Some((rust, ff)) = &report.runs {
-        write_run(&case, rust, &all_metrics(&case, rust)?, &dir.join("rust"))?;
-        write_run(&case, ff, &all_metrics(&case, ff)?, &dir.join("freefem"))?;
-    }
-    write_atomic(&dir.join("compare.csv"), report_csv(&report).as_bytes())?;
-    println!("{}: {}", case.name, report.what);
-    println!(
-        "{:<34} {:>15} {:>15} {:>11} {:>11}  result  tolerance from",
-        "quantity", "rust", "freefem", "|diff|", "tolerance"
-    );
-    for r in &report.rows {
-        let v = |x: Option<f64>| x.map(|x| format!("{x:.8e}")).unwrap_or_else(|| "-".into());
-        println!(
-            "{:<34} {:>15} {:>15} {:>11.3e} {:>11.3e}  {:<6}  {}",
-            r.name,
-            v(r.rust),
-            v(r.freefem),
-            r.difference,
-            r.tolerance,
-            if r.passed() { "PASS" } else { "FAIL" },
-            r.basis
-        );
-    }
-    if !report.frame_times.is_empty() {
-        let t = &report.frame_times;
-        let n = t.len() as f64;
-        let (r, f) = (t.iter().map(|t| t.rust_s).sum::<f64>(), t.iter().map(|t| t.freefem_s).sum::<f64>());
-        println!(
-            "per frame: rust {:.1} ms, freefem {:.2} s (ratio {:.0}); iterations per frame rust {:.2}, freefem {:.2}",
-            1e3 * r / n,
-            f / n,
-            f / r,
-            t.iter().map(|t| t.rust_iterations).sum::<usize>() as f64 / n,
-            t.iter().map(|t| t.freefem_iterations).sum::<usize>() as f64 / n
-        );
-        write_atomic(&dir.join("compare_frames.csv"), frames_csv(&report).as_bytes())?;
-    }
-    println!(
-        "wall time: rust {:.3} s, freefem {:.3} s (ratio freefem/rust {:.1}); wrote {}",
-        report.rust_wall_s,
-        report.freefem_wall_s,
-        report.freefem_wall_s / report.rust_wall_s,
-        dir.join("compare.csv").display()
-    );
+    let report = compare_case(case, dir, &opts).with_context(|| format!("case {}", case.name))?;
+    write_compare(case, &report, dir)?;
+    print!("{}", report_table(case, &report));
+    println!("wrote {}", target.join("compare.csv").display());
     let failed = report.failed();
     if failed > 0 {
         eprintln!("{}: {failed} of {} rows FAILED", case.name, report.rows.len());

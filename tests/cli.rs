@@ -163,9 +163,10 @@ fn sweep_writes_one_folder_per_run_a_summary_and_a_convergence_plot() {
     let summary = std::fs::read_to_string(dir.path().join("fail/summary.csv")).expect("summary");
     assert!(summary.lines().nth(1).expect("row").starts_with("3,not_converged,3.0000000000e0,"), "{summary}");
     // The last iterate is kept, labelled, and its history plotted.
-    assert!(std::fs::read_to_string(dir.path().join("fail/max_iterations=3/FAILED.txt"))
-        .expect("FAILED.txt")
-        .contains("did not converge"));
+    let manifest = std::fs::read_to_string(dir.path().join("fail/max_iterations=3/run.json")).expect("run.json");
+    assert!(manifest.contains("\"status\": \"failed\"") && manifest.contains("did not converge"), "{manifest}");
+    let sweep = std::fs::read_to_string(dir.path().join("fail/run.json")).expect("sweep run.json");
+    assert!(sweep.contains("\"status\": \"failed\"") && sweep.contains("1 of 1 points"), "{sweep}");
     assert_eq!(
         std::fs::read_to_string(dir.path().join("fail/max_iterations=3/inverse_history.csv"))
             .expect("history")

@@ -26,11 +26,13 @@ use nalgebra::Vector3;
 use super::clip_files::load_clip;
 use super::data::write_data;
 use super::engine::{load_data, EngineError};
+use super::files::{write_atomic, OutputError};
 use super::freefem::{self, RunOptions};
 use super::freefem_clip::run_clip;
+use super::run_files::write_run;
 use crate::case::{Analysis, Case, CompareOverrides};
 use crate::run::frames::{solve_frames, SolvedFrame};
-use crate::run::metrics::{differences, ComparisonRow, Difference, Group};
+use crate::run::metrics::{all_metrics, differences, ComparisonRow, Difference, Group};
 use crate::run::{run_forward, run_inverse, NodalState, RunError, RunResult};
 use crate::solve::inverse::InverseMethod;
 use crate::solve::statics::Method;
@@ -472,4 +474,64 @@ pub fn frames_csv(report: &CompareReport) -> String {
 /// Where a comparison writes (`out/<case>` unless given).
 pub fn default_dir(case: &Case) -> PathBuf {
     PathBuf::from("out").join(&case.name)
+}
+
+/// Write what `cosserat compare` keeps in `dir`: both engines' outputs (single runs),
+/// `compare.csv` and, for clips, `compare_frames.csv`.
+pub fn write_compare(case: &Case, report: &CompareReport, dir: &Path) -> Result<(), OutputError> {
+    if let Some((rust, ff)) = &report.runs {
+        let metrics = |r: &RunResult| {
+            all_metrics(case, r).map_err(|e| OutputError::Invalid { path: dir.to_path_buf(), reason: e.to_string() })
+        };
+        write_run(case, rust, &metrics(rust)?, &dir.join("rust"))?;
+        write_run(case, ff, &metrics(ff)?, &dir.join("freefem"))?;
+    }
+    write_atomic(&dir.join("compare.csv"), report_csv(report).as_bytes())?;
+    if !report.frame_times.is_empty() {
+        write_atomic(&dir.join("compare_frames.csv"), frames_csv(report).as_bytes())?;
+    }
+    Ok(())
+}
+
+/// The comparison as a table for the terminal: one line per row (values, difference,
+/// tolerance, verdict, where the tolerance comes from), per-frame times of a clip, wall times.
+pub fn report_table(case: &Case, report: &CompareReport) -> String {
+    let mut out = format!("{}: {}\n", case.name, report.what);
+    out += &format!(
+        "{:<34} {:>15} {:>15} {:>11} {:>11}  result  tolerance from\n",
+        "quantity", "rust", "freefem", "|diff|", "tolerance"
+    );
+    for r in &report.rows {
+        let v = |x: Option<f64>| x.map(|x| format!("{x:.8e}")).unwrap_or_else(|| "-".into());
+        out += &format!(
+            "{:<34} {:>15} {:>15} {:>11.3e} {:>11.3e}  {:<6}  {}\n",
+            r.name,
+            v(r.rust),
+            v(r.freefem),
+            r.difference,
+            r.tolerance,
+            if r.passed() { "PASS" } else { "FAIL" },
+            r.basis
+        );
+    }
+    if !report.frame_times.is_empty() {
+        let t = &report.frame_times;
+        let n = t.len() as f64;
+        let (r, f) = (t.iter().map(|t| t.rust_s).sum::<f64>(), t.iter().map(|t| t.freefem_s).sum::<f64>());
+        out += &format!(
+            "per frame: rust {:.1} ms, freefem {:.2} s (ratio {:.0}); iterations per frame rust {:.2}, freefem {:.2}\n",
+            1e3 * r / n,
+            f / n,
+            f / r,
+            t.iter().map(|t| t.rust_iterations).sum::<usize>() as f64 / n,
+            t.iter().map(|t| t.freefem_iterations).sum::<usize>() as f64 / n
+        );
+    }
+    out += &format!(
+        "wall time: rust {:.3} s, freefem {:.3} s (ratio freefem/rust {:.1})\n",
+        report.rust_wall_s,
+        report.freefem_wall_s,
+        report.freefem_wall_s / report.rust_wall_s
+    );
+    out
 }

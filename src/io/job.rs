@@ -38,12 +38,65 @@ pub struct JobEnd {
     pub notes: Vec<String>,
 }
 
+impl JobEnd {
+    /// The summary of a complete run for the terminal: the tip and iterations of a single
+    /// run; frames, iterations, fit (and ground-truth errors) of a clip.
+    pub fn summary(&self, name: &str, engine: Engine) -> String {
+        let mut out = String::new();
+        if let Some(r) = &self.single {
+            let tip = r.nodes.x.last().copied().unwrap_or_default();
+            out += &format!(
+                "{name} [{engine}]: tip = ({:.6e}, {:.6e}, {:.6e}) m, {} iterations, {:.3} s; wrote {} files to {}\n",
+                tip[0],
+                tip[1],
+                tip[2],
+                r.stats.iterations,
+                r.stats.wall_time_s,
+                self.files,
+                self.dir.display()
+            );
+        }
+        let Some(run) = &self.clip else { return out };
+        if let Some(t) = &run.truth {
+            let max = |f: &dyn Fn(&crate::clip::synthetic::FrameComparison) -> f64| {
+                t.comparisons.iter().map(f).fold(0.0, f64::max)
+            };
+            out += &format!(
+                "{name} ground truth (all frames, max): |x - x_true|/|x_true| {:.2e}; bending k1^2+k2^2 rel. L2 {:.2e}; angle(d3, true d3) {:.2e} rad; |roll offset| {:.3} rad; kappa_3 rms error {:.1} rad/m (true twist {:.1} rad/m); see truth.csv, truth.svg, truth_errors.svg\n",
+                max(&|c| c.position_rel_l2),
+                max(&|c| c.bending_rel_l2),
+                max(&|c| c.max_tangent_angle_rad),
+                max(&|c| c.roll_offset_rad.abs()),
+                max(&|c| c.twist_rms_error_per_m),
+                t.twist_per_m.first().copied().unwrap_or(0.0)
+            );
+        }
+        let n = run.reports.len();
+        let its: Vec<usize> = run.reports.iter().map(|r| r.iterations).collect();
+        let worst = run.reports.iter().map(|r| r.x_err_rel).fold(0.0, f64::max);
+        let jmax = run.reports.iter().map(|r| r.max_stretch_deviation).fold(0.0, f64::max);
+        out += &format!(
+            "{name} [rust]: {n} frames in {:.2} s ({:.1} frames/s; solving {:.2} s); iterations per frame min {} / mean {:.1} / max {}; max |x - x_g|/|x_g| {worst:.3e}; max |j - 1| {jmax:.3e}; wrote {}\n",
+            run.wall_time_s,
+            n as f64 / run.wall_time_s,
+            run.reports.iter().map(|r| r.wall_time_s).sum::<f64>(),
+            its.iter().min().copied().unwrap_or(0),
+            its.iter().sum::<usize>() as f64 / n.max(1) as f64,
+            its.iter().max().copied().unwrap_or(0),
+            self.dir.display()
+        );
+        out
+    }
+}
+
 /// The `run.json` of `cosserat run` on `case` in `engine`.
 pub fn run_manifest(case: &Case, engine: Engine) -> Result<Manifest, FolderError> {
     let mut m = Manifest::new("run");
     m.case_name = Some(case.name.clone());
     m.case = case.source.as_deref().map(input_file).transpose()?;
     if let Some(c) = case.clip() {
+        // a clip's folder counts frames from the start (what makes it resumable)
+        m.frames_done = Some(0);
         if c.file.is_file() {
             m.inputs.push(input_file(&c.file)?);
         }

@@ -163,8 +163,10 @@ impl Manifest {
         let path = dir.join(MANIFEST);
         let text = serde_json::to_string_pretty(self)
             .map_err(|e| FolderError::Manifest { path: path.clone(), reason: e.to_string() })?;
-        write_atomic(&path, format!("{text}\n").as_bytes())
-            .map_err(|e| FolderError::Manifest { path, reason: super::sweep::chain(&e) })
+        write_atomic(&path, format!("{text}\n").as_bytes()).map_err(|e| {
+            let cause = std::error::Error::source(&e).map(|c| format!(": {c}")).unwrap_or_default();
+            FolderError::Manifest { path, reason: format!("{e}{cause}") }
+        })
     }
 
     /// End the run as `status` (with `message`), listing the files of `dir`, and write it there.

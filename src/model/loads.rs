@@ -73,6 +73,28 @@ impl Loads {
         (self.eval3(2, 0.0, t), self.eval3(3, 0.0, t))
     }
 
+    /// Case-file keys of the load groups, in the order of [`Loads::exprs`].
+    pub const KEYS: [&'static str; 4] =
+        ["loads.force_n_per_m", "loads.torque_nm_per_m", "loads.end_force_n", "loads.end_torque_nm"];
+
+    /// The load component of largest magnitude over the arc lengths `s` [m] at time `t` [s]:
+    /// its key and component (`loads.end_force_n[1]`), expression and value.
+    pub fn largest(&self, s: &[f64], t: f64) -> Option<(String, String, f64)> {
+        let mut best: Option<(String, String, f64)> = None;
+        for (g, key) in Self::KEYS.iter().enumerate() {
+            let at: Vec<f64> = if g < 2 { s.to_vec() } else { vec![0.0] };
+            for c in 0..3 {
+                for &si in &at {
+                    let v = self.eval3(g, si, t)[c];
+                    if best.as_ref().is_none_or(|b| v.abs() > b.2.abs() || (v.is_nan() && !b.2.is_nan())) {
+                        best = Some((format!("{key}[{c}]"), self.exprs[g][c].to_string(), v));
+                    }
+                }
+            }
+        }
+        best
+    }
+
     /// True when all distributed components are the literal zero (skip their quadrature).
     pub fn has_distributed(&self) -> bool {
         let zero = |e: &Expr| e.variables().is_empty() && e.eval(&|_| None).map(|v| v == 0.0).unwrap_or(false);

@@ -42,6 +42,10 @@ pub enum RunError {
     Sink(#[source] Box<dyn std::error::Error + Send + Sync>),
     #[error("resuming the clip: {0}")]
     Resume(String),
+    /// A forward solve diverged: the error, with the largest load of the case named (a load
+    /// far beyond the rod's stiffness is the usual cause).
+    #[error("rust engine: the solve could not follow the loads, the largest of which is {key} = \"{expr}\" = {value:e} (check its magnitude and units, or raise solver.continuation_steps of a static case)")]
+    Diverged { source: SolveError, key: String, expr: String, value: f64 },
     /// The solver stopped without meeting its rule; `partial` holds the last iterate and the
     /// history up to there (sweeps keep it so that non-converging values still show).
     #[error("rust engine stopped after {} iterations without meeting its stopping rule", .partial.stats.iterations)]
@@ -56,7 +60,9 @@ impl RunError {
     /// Did the run stop because a stop was requested (`crate::interrupt`)?
     pub fn is_interrupted(&self) -> bool {
         match self {
-            RunError::Solve(e) | RunError::Incomplete { source: e, .. } => matches!(e, SolveError::Interrupted { .. }),
+            RunError::Solve(e) | RunError::Incomplete { source: e, .. } | RunError::Diverged { source: e, .. } => {
+                matches!(e, SolveError::Interrupted { .. })
+            }
             RunError::Sequence(SequenceError::Solve(e)) => matches!(e, SolveError::Interrupted { .. }),
             _ => false,
         }
@@ -68,8 +74,29 @@ impl RunError {
 }
 
 /// Run a forward (static or dynamic) case in the Rust engine; `progress(done, total)` per
-/// iteration or time step.
-pub fn run_forward(case: &Case, mut progress: impl FnMut(usize, usize)) -> Result<RunResult, RunError> {
+/// iteration or time step. A diverged solve names the case's largest load.
+pub fn run_forward(case: &Case, progress: impl FnMut(usize, usize)) -> Result<RunResult, RunError> {
+    run_forward_solve(case, progress).map_err(|e| match e {
+        RunError::Solve(source @ SolveError::Diverged { .. }) => {
+            let s: Vec<f64> = (0..case.mesh.nodes()).map(|i| case.mesh.node_s(i)).collect();
+            let end = match &case.analysis {
+                Analysis::Dynamic(p) => p.end_time_s,
+                _ => 0.0,
+            };
+            let big = [0.0, end]
+                .iter()
+                .filter_map(|&t| case.loads.largest(&s, t))
+                .max_by(|a, b| a.2.abs().total_cmp(&b.2.abs()));
+            match big {
+                Some((key, expr, value)) => RunError::Diverged { source, key, expr, value },
+                None => RunError::Solve(source),
+            }
+        }
+        e => e,
+    })
+}
+
+fn run_forward_solve(case: &Case, mut progress: impl FnMut(usize, usize)) -> Result<RunResult, RunError> {
     let problem = case.problem();
     let start = Instant::now();
     match &case.analysis {
