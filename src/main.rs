@@ -151,8 +151,8 @@ enum Command {
     Modes {
         /// Case file (TOML); loads and time settings are ignored
         case: PathBuf,
-        /// How many modes to print
-        #[arg(long, default_value_t = 10)]
+        /// How many modes to print (at least 1)
+        #[arg(long, default_value_t = 10, allow_hyphen_values = true, value_parser = parse_count)]
         count: usize,
         #[command(flatten)]
         limits: Limits,
@@ -292,6 +292,14 @@ fn cmd_run(
         }
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// `--count`: a positive number.
+fn parse_count(s: &str) -> Result<usize, String> {
+    match s.parse::<usize>() {
+        Ok(n) if n > 0 => Ok(n),
+        _ => Err(format!("expected a number of modes >= 1, got `{s}`")),
+    }
 }
 
 /// `--frames`: a positive count or `all`.
@@ -455,7 +463,11 @@ fn cmd_audit(
         }
     }
     if files.is_empty() {
-        anyhow::bail!("no audit specs (*.toml) given or found");
+        let given: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
+        anyhow::bail!(
+            "no audit specs (*.toml) in {}",
+            if given.is_empty() { "cases/paper".to_string() } else { given.join(", ") }
+        );
     }
     let specs = files.iter().map(|f| read_spec(f, quick)).collect::<Result<Vec<_>, _>>()?;
     let out = out.unwrap_or_else(|| PathBuf::from(if quick { "out/audit-quick" } else { "out/audit" }));

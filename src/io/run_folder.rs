@@ -252,8 +252,11 @@ impl RunFolder {
             Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
             _ => PathBuf::from("."),
         };
-        if target.exists() && !target.is_dir() {
-            return Err(FolderError::NotAFolder { path: target.to_path_buf() });
+        // the folder, or the first of its parents that exists, must be a folder
+        if let Some(existing) = target.ancestors().find(|a| !a.as_os_str().is_empty() && a.exists()) {
+            if !existing.is_dir() {
+                return Err(FolderError::NotAFolder { path: existing.to_path_buf() });
+            }
         }
         std::fs::create_dir_all(&parent).map_err(io_err(&parent))?;
         let staging = parent.join(format!(".{name}.staging-{}", std::process::id()));

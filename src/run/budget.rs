@@ -23,11 +23,12 @@ pub enum Footprint {
 /// A run refused before it started.
 #[derive(Debug, thiserror::Error)]
 #[error(
-    "case `{case}`: {what} would need about {:.1} GiB of memory (estimated from {basis}), above the limit of {:.1} GiB; reduce {key} or raise the limit with --max-memory-gib",
+    "{case}: {what} would need about {:.3e} GiB of memory (estimated from {basis}), above the limit of {:.1} GiB; reduce {key} or raise the limit with --max-memory-gib",
     .bytes / GIB,
     .limit / GIB
 )]
 pub struct BudgetError {
+    /// the case file (or the case's name)
     pub case: String,
     pub what: &'static str,
     pub bytes: f64,
@@ -50,53 +51,65 @@ fn banded_bytes_per_element(b: f64) -> f64 {
     band + pattern + vectors
 }
 
-/// Frames and node-frames of a clip case, from its settings or the size of its file.
+/// Node-frames of a clip case, from its settings or the size of its file, and what they were
+/// estimated from.
 fn clip_node_frames(case: &Case) -> Option<(f64, String)> {
     let c = case.clip()?;
     let nodes = case.mesh.nodes() as f64;
     let frames = match (&c.kind, c.frames) {
-        (_, Some((a, b))) => Some(b.saturating_sub(a) as f64),
-        (ClipKind::Roll3d(s), None) => Some(s.frames as f64),
+        (_, Some((a, b))) => Some((b.saturating_sub(a) as f64, format!("clip.frames = [{a}, {b}]"))),
+        (ClipKind::Roll3d(s), None) => Some((s.frames as f64, format!("clip.clip_frames = {}", s.frames))),
         _ => None,
     };
     match frames {
-        Some(f) => Some((f * nodes, format!("{f} frames × {nodes} nodes"))),
+        Some((f, key)) => Some((f * nodes, format!("{key} × {nodes} nodes"))),
         None => {
-            // a recording or kymogram: its numbers are at least 8 bytes each in the file, and
-            // every node-frame takes at least 3 of them (or 1 joint angle)
+            // a recording or kymogram: every number takes at least 8 bytes in the file; a
+            // node-frame of a recording 3 numbers, a kymogram's frame of `nodes` nodes one
+            // angle per joint
             let size = std::fs::metadata(&c.file).map(|m| m.len() as f64).unwrap_or(0.0);
-            let per = if matches!(c.kind, ClipKind::Kymogram) { 8.0 } else { 24.0 };
-            Some((
-                size / per * if matches!(c.kind, ClipKind::Kymogram) { nodes } else { 1.0 },
-                format!("{} ({:.0} MB)", c.file.display(), size / 1e6),
-            ))
+            let node_frames = match c.kind {
+                ClipKind::Kymogram => size / 8.0 * nodes,
+                _ => size / 24.0,
+            };
+            Some((node_frames, format!("{} ({:.0} MB)", c.file.display(), size / 1e6)))
         }
     }
 }
 
+/// Bytes per time step of a dynamic run's tip history (`solve::dynamics::TipRecord` and its
+/// row in `tip_history.csv`).
+const TIP_RECORD_BYTES: f64 = 64.0;
+
 /// Estimated peak memory [bytes] of `what` on `case`, with what it was estimated from and the
-/// key that scales it.
+/// keys that scale it.
 pub fn estimate(case: &Case, what: Footprint) -> (f64, String, &'static str) {
-    let e = case.mesh.elements as f64;
+    let elements = case.mesh.elements;
+    let e = elements as f64;
     let n_forward = 6.0 * (e + 1.0);
+    let basis = format!("rod.elements = {elements}");
     match what {
         Footprint::Modes => (
             FIXED_BYTES + 10.0 * n_forward * n_forward * 8.0,
-            format!("{e} elements, dense modal model"),
+            format!("{basis}: a dense modal model of {n_forward} unknowns"),
             "rod.elements",
         ),
         Footprint::Run => match &case.analysis {
-            Analysis::Static(_) | Analysis::Dynamic(_) => {
-                (FIXED_BYTES + e * banded_bytes_per_element(6.0), format!("{e} elements"), "rod.elements")
-            }
+            Analysis::Static(_) => (FIXED_BYTES + e * banded_bytes_per_element(6.0), basis, "rod.elements"),
+            Analysis::Dynamic(p) => (
+                FIXED_BYTES + e * banded_bytes_per_element(6.0) + (p.steps as f64 + 1.0) * TIP_RECORD_BYTES,
+                format!("{basis}, time.steps = {}", p.steps),
+                "rod.elements or time.steps",
+            ),
             Analysis::Inverse(_) => {
                 // the KKT system (12 unknowns per node), the forward data solve beside it
                 let mut bytes = FIXED_BYTES + e * (banded_bytes_per_element(12.0) + banded_bytes_per_element(6.0));
-                let mut basis = format!("{e} elements");
+                let mut basis = basis;
                 if let Some((node_frames, what)) = clip_node_frames(case) {
-                    // positions (3) + κ2, data κ, ω (3), truth (2) + frame files per node-frame
+                    // positions (3) + κ2, data κ, ω (3), truth (2) per node-frame, twice over
+                    // while it is read
                     bytes += node_frames * 12.0 * 8.0;
-                    basis = format!("{basis}, clip {what}");
+                    basis = format!("{basis}, {what}");
                 }
                 (bytes, basis, "rod.elements or the clip's frames")
             }
@@ -112,7 +125,8 @@ pub fn check(case: &Case, what: Footprint, limit_bytes: f64) -> Result<(), Budge
             Footprint::Run => "the run",
             Footprint::Modes => "the modal model",
         };
-        return Err(BudgetError { case: case.name.clone(), what, bytes, limit: limit_bytes, basis, key });
+        let case = case.source.as_ref().map(|p| p.display().to_string()).unwrap_or_else(|| case.name.clone());
+        return Err(BudgetError { case, what, bytes, limit: limit_bytes, basis, key });
     }
     Ok(())
 }
