@@ -7,7 +7,7 @@ use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use cosserat::case::{case_files, Case};
-use cosserat::io::job::{run_into, run_manifest};
+use cosserat::io::job::{case_label, run_into, run_manifest};
 use cosserat::io::run_folder::{input_file, Manifest, Mode, RunFolder, Status};
 use cosserat::io::sweep::RunStatus;
 use cosserat::run::budget::{self, default_limit_bytes, Footprint, GIB};
@@ -261,7 +261,7 @@ fn cmd_run(
         pb.set_length(total as u64);
         pb.set_position(done as u64);
     })
-    .with_context(|| format!("case {}: output folder {}", case.name, dir.display()))?;
+    .with_context(|| format!("{}: output folder {}", case_label(&case), dir.display()))?;
     pb.finish_and_clear();
     for n in &end.notes {
         eprintln!("note: {n}");
@@ -329,7 +329,7 @@ fn cmd_compare(
     manifest.command = "compare".into();
     manifest.engine = Some("rust and freefem".into());
     let folder = RunFolder::begin(&target, manifest, Mode::Fresh { force })
-        .with_context(|| format!("case {}: output folder {}", case.name, target.display()))?;
+        .with_context(|| format!("{}: output folder {}", case_label(&case), target.display()))?;
     for n in &folder.notes {
         eprintln!("note: {n}");
     }
@@ -359,7 +359,7 @@ fn compare_into(case: &Case, dir: &Path, target: &Path, short: bool, frames: Opt
         case.name,
         target.join("freefem_work").display()
     );
-    let report = compare_case(case, dir, &opts).with_context(|| format!("case {}", case.name))?;
+    let report = compare_case(case, dir, &opts).with_context(|| case_label(case))?;
     write_compare(case, &report, dir)?;
     print!("{}", report_table(case, &report));
     println!("wrote {}", target.join("compare.csv").display());
@@ -392,7 +392,7 @@ fn cmd_sweep(
     let mut manifest = run_manifest(&case, Engine::Rust)?;
     manifest.command = "sweep".into();
     let folder = RunFolder::begin(&target, manifest, Mode::Fresh { force })
-        .with_context(|| format!("case {}: output folder {}", case.name, target.display()))?;
+        .with_context(|| format!("{}: output folder {}", case_label(&case), target.display()))?;
     for n in &folder.notes {
         eprintln!("note: {n}");
     }
@@ -406,7 +406,7 @@ fn cmd_sweep(
         Err(e) => {
             let message = cosserat::io::sweep::chain(&e);
             folder.finish(Status::Failed, Some(message.clone()))?;
-            anyhow::bail!("case {}: sweep: {message}; {} holds run.json saying failed", case.name, target.display());
+            anyhow::bail!("{}: sweep: {message}; {} holds run.json saying failed", case_label(&case), target.display());
         }
     };
     let count = |s: RunStatus| rows.iter().filter(|r| r.status == s).count();
@@ -537,10 +537,9 @@ fn cmd_list(dir: &Path) -> Result<ExitCode> {
             Ok(c) => println!("{:<24} {}", c.name, c.description),
             Err(e) => {
                 invalid += 1;
-                println!(
-                    "{:<24} INVALID: {e}",
-                    f.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default()
-                )
+                let stem = f.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+                println!("{stem:<24} INVALID (see below)");
+                eprintln!("INVALID {}: {e}", f.display());
             }
         }
     }

@@ -229,7 +229,7 @@ fn a_folder_not_written_by_cosserat_is_refused_unless_forced() {
         .arg(&file)
         .assert()
         .code(1)
-        .stderr(predicate::str::contains("file.txt is not a folder"));
+        .stderr(predicate::str::contains("file.txt is a file, not a folder"));
 }
 
 #[test]

@@ -89,6 +89,14 @@ impl JobEnd {
     }
 }
 
+/// How messages name a case: `case NAME (FILE)`, or `case NAME` for a case not read from a file.
+pub fn case_label(case: &Case) -> String {
+    match &case.source {
+        Some(p) => format!("case {} ({})", case.name, p.display()),
+        None => format!("case {}", case.name),
+    }
+}
+
 /// The `run.json` of `cosserat run` on `case` in `engine`.
 pub fn run_manifest(case: &Case, engine: Engine) -> Result<Manifest, FolderError> {
     let mut m = Manifest::new("run");
@@ -160,7 +168,7 @@ fn single_job(case: &Case, engine: Engine, dir: &Path, progress: impl FnMut(usiz
     let (r, failure) = match result {
         Ok(r) => (r, None),
         Err(super::engine::EngineError::Run(RunError::Incomplete { source, partial })) => {
-            (*partial, Some(format!("case {}: {source}; the files here hold the last iterate", case.name)))
+            (*partial, Some(format!("{}: {source}; the files here hold the last iterate", case_label(case))))
         }
         Err(e) => {
             let interrupted = match &e {
@@ -169,7 +177,7 @@ fn single_job(case: &Case, engine: Engine, dir: &Path, progress: impl FnMut(usiz
                 _ => false,
             };
             end.status = if interrupted { Status::Interrupted } else { Status::Failed };
-            end.message = Some(format!("case {}: {}", case.name, chain(&e)));
+            end.message = Some(format!("{}: {}", case_label(case), chain(&e)));
             return;
         }
     };
@@ -179,7 +187,7 @@ fn single_job(case: &Case, engine: Engine, dir: &Path, progress: impl FnMut(usiz
     });
     if let Err(e) = written {
         end.status = Status::Failed;
-        end.message = Some(format!("case {}: {e}", case.name));
+        end.message = Some(format!("{}: {e}", case_label(case)));
         return;
     }
     if let Some(f) = failure {
@@ -200,8 +208,8 @@ fn clip_job(
     if engine != Engine::Rust {
         end.status = Status::Failed;
         end.message = Some(format!(
-            "case {}: `run` solves clips in the Rust engine (`--engine rust`); to run a clip in FreeFEM against it, use `cosserat compare CASE --frames N` (or `--frames all`)",
-            case.name
+            "{}: `run` solves clips in the Rust engine (`--engine rust`); to run a clip in FreeFEM against it, use `cosserat compare CASE --frames N` (or `--frames all`)",
+            case_label(case)
         ));
         return;
     }
@@ -209,19 +217,19 @@ fn clip_job(
         Ok(out) => out,
         Err(e) => {
             end.status = Status::Failed;
-            end.message = Some(format!("case {}: {}", case.name, chain(&e)));
+            end.message = Some(format!("{}: {}", case_label(case), chain(&e)));
             return;
         }
     };
     let (done, total) = (out.run.reports.len(), out.total);
     if let Some(e) = &out.stopped {
         end.status = status_of(e);
-        end.message = Some(format!("case {}: {}", case.name, chain(e)));
+        end.message = Some(format!("{}: {}", case_label(case), chain(e)));
     }
     if done > 0 {
         if let Err(e) = write_clip_figures(case, &out.run, dir) {
             end.status = Status::Failed;
-            end.message = Some(format!("case {}: {}", case.name, chain(&e)));
+            end.message = Some(format!("{}: {}", case_label(case), chain(&e)));
         }
     }
     if end.status == Status::Complete {

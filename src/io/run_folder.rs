@@ -80,7 +80,7 @@ pub struct Manifest {
 /// Errors of the output-folder contract; each names the folder.
 #[derive(Debug, thiserror::Error)]
 pub enum FolderError {
-    #[error("{path} is not a folder")]
+    #[error("{path} is a file, not a folder")]
     NotAFolder { path: PathBuf },
     #[error(
         "{path} holds files ({examples}) but no run.json: it was not written by a cosserat run (or by an older version). Choose another --out, or pass --force to replace it whole"

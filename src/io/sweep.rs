@@ -8,6 +8,7 @@ use std::path::Path;
 use super::data::write_data;
 use super::engine::{load_data, run_clip_to, run_inverse_on, write_clip_figures, ClipOptions, EngineError};
 use super::files::OutputError;
+use super::job::case_label;
 use super::run_files::write_run;
 use super::run_folder::{input_file, Manifest, Status};
 use crate::case::sweep::{fmt_value, Point};
@@ -203,7 +204,7 @@ fn single_point(case: &Case, dir: &Path) -> SweepOutcome {
         let path = dir.join("data.csv");
         match load_data(case).and_then(|d| Ok(write_data(&path, &d)?)) {
             Ok(()) => run_inverse_on(case, crate::run::Engine::Rust, &path, &dir.join("freefem_work"), |_, _| {}),
-            Err(e) => return failed(&format_args!("case {}: generating the forward data: {}", case.name, chain(&e))),
+            Err(e) => return failed(&format_args!("{}: generating the forward data: {}", case_label(case), chain(&e))),
         }
     } else {
         run_forward(case, |_, _| {}).map_err(EngineError::from)
@@ -214,7 +215,7 @@ fn single_point(case: &Case, dir: &Path) -> SweepOutcome {
         Err(EngineError::Run(RunError::Incomplete { source, partial })) => {
             (RunStatus::NotConverged, *partial, Some(format!("{source}; the files here hold the last iterate")))
         }
-        Err(e) => return failed(&format_args!("case {}: {}", case.name, chain(&e))),
+        Err(e) => return failed(&format_args!("{}: {}", case_label(case), chain(&e))),
     };
     let write = || -> Result<Metrics, String> {
         let m = all_metrics(case, &r).map_err(|e| chain(&e))?;
@@ -230,19 +231,19 @@ fn single_point(case: &Case, dir: &Path) -> SweepOutcome {
 fn clip_point(case: &Case, dir: &Path, observer: impl FnMut(&ClipFrame) + Send) -> SweepOutcome {
     let out = match run_clip_to(case, dir, ClipOptions::default(), observer, |_, _| {}) {
         Ok(out) => out,
-        Err(e) => return SweepOutcome::failed(format!("case {}: {}", case.name, chain(&e))),
+        Err(e) => return SweepOutcome::failed(format!("{}: {}", case_label(case), chain(&e))),
     };
     let (status, error) = match &out.stopped {
         None => (RunStatus::Ok, None),
         Some(e) if e.is_interrupted() => (RunStatus::Interrupted, Some(chain(e))),
         Some(e) => (
             RunStatus::Failed,
-            Some(format!("case {}: {}; the converged frames before it are in this folder", case.name, chain(e))),
+            Some(format!("{}: {}; the converged frames before it are in this folder", case_label(case), chain(e))),
         ),
     };
     if !out.run.reports.is_empty() {
         if let Err(e) = write_clip_figures(case, &out.run, dir) {
-            return SweepOutcome::failed(format!("case {}: {}", case.name, chain(&e)));
+            return SweepOutcome::failed(format!("{}: {}", case_label(case), chain(&e)));
         }
     }
     let m = (status == RunStatus::Ok).then(|| clip_metrics(case, &out.run));

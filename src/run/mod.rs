@@ -77,7 +77,7 @@ impl RunError {
 /// iteration or time step. A diverged solve names the case's largest load.
 pub fn run_forward(case: &Case, progress: impl FnMut(usize, usize)) -> Result<RunResult, RunError> {
     run_forward_solve(case, progress).map_err(|e| match e {
-        RunError::Solve(source @ SolveError::Diverged { .. }) => {
+        RunError::Solve(source @ (SolveError::Diverged { .. } | SolveError::Linear(_))) => {
             let s: Vec<f64> = (0..case.mesh.nodes()).map(|i| case.mesh.node_s(i)).collect();
             let end = match &case.analysis {
                 Analysis::Dynamic(p) => p.end_time_s,
