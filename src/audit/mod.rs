@@ -65,6 +65,10 @@ pub enum AuditError {
         #[source]
         source: Box<crate::io::OutputError>,
     },
+    #[error(
+        "{path}: claim `{claim}`: unknown metric `{metric}`: no point of run `{run}` reports it (its points report: {known})"
+    )]
+    UnknownMetric { path: PathBuf, claim: String, metric: String, run: String, known: String },
     #[error("writing the report")]
     Output(#[from] crate::io::OutputError),
     #[error("writing the report")]
@@ -266,6 +270,7 @@ pub fn run_audit(
             rr.points.push(r);
         }
     }
+    check_metric_names(specs, &results)?;
     let mut claims = Vec::new();
     let mut figures = Vec::new();
     for (spec, runs) in specs.iter().zip(&results) {
@@ -279,6 +284,34 @@ pub fn run_audit(
     let report = AuditReport { claims, figures, quick, wall_time_s: start.elapsed().as_secs_f64() };
     report::write_report(&report, &opts.out)?;
     Ok(report)
+}
+
+/// Every metric a claim reads is reported by some point of its runs that has metrics (a typo
+/// in a spec is an error naming it, not a claim judged on a missing number).
+fn check_metric_names(specs: &[Spec], results: &[Vec<RunResults>]) -> Result<(), AuditError> {
+    for (spec, runs) in specs.iter().zip(results) {
+        for claim in &spec.claims {
+            let Some(metric) = claim.check.metric() else { continue };
+            for run in claim.check.runs() {
+                let Some(rr) = runs.iter().find(|r| r.name == run) else { continue };
+                let reported: Vec<&crate::run::metrics::Metrics> =
+                    rr.points.iter().filter_map(|p| p.outcome.metrics.as_ref()).collect();
+                if reported.is_empty() || reported.iter().any(|m| m.contains_key(metric)) {
+                    continue;
+                }
+                let known: std::collections::BTreeSet<&str> =
+                    reported.iter().flat_map(|m| m.keys().map(String::as_str)).collect();
+                return Err(AuditError::UnknownMetric {
+                    path: spec.path.clone(),
+                    claim: claim.id.clone(),
+                    metric: metric.to_string(),
+                    run: run.to_string(),
+                    known: known.into_iter().collect::<Vec<_>>().join(", "),
+                });
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Run one point: a clip case solves its clip (recording the series the figures need), any

@@ -164,6 +164,19 @@ pub enum Check {
 }
 
 impl Check {
+    /// The metric the check reads, if any.
+    pub fn metric(&self) -> Option<&str> {
+        match self {
+            Check::Below { metric, .. }
+            | Check::Above { metric, .. }
+            | Check::Increasing { metric, .. }
+            | Check::RatioAbove { metric, .. }
+            | Check::RatioBelow { metric, .. }
+            | Check::WithinFactor { metric, .. } => Some(metric),
+            Check::Converges { .. } | Check::DoesNotConverge { .. } | Check::SameHistories { .. } => None,
+        }
+    }
+
     /// The runs the check reads.
     pub fn runs(&self) -> Vec<&str> {
         match self {
