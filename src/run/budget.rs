@@ -4,7 +4,7 @@
 //! rows, `kl = ku = 2 b − 1` for blocks of `b` unknowns per node), per element the pattern's
 //! values, scaled copy and slots (`linalg::pattern`), a few dozen work vectors; a clip's frames
 //! and per-frame summary (`run::clip::ClipRun`); the dense matrices of the modal model
-//! (`solve::modes`, about ten `n × n`). Checked against the peak resident size of real runs in
+//! (`solve::modes`, about twelve `n × n`). Checked against the peak resident size of real runs in
 //! `docs/results.md`: it errs high, never low by more than the process's fixed few MB.
 use crate::case::{Analysis, Case, ClipKind};
 
@@ -90,7 +90,7 @@ pub fn estimate(case: &Case, what: Footprint) -> (f64, String, &'static str) {
     let basis = format!("rod.elements = {elements}");
     match what {
         Footprint::Modes => (
-            FIXED_BYTES + 10.0 * n_forward * n_forward * 8.0,
+            FIXED_BYTES + 12.0 * n_forward * n_forward * 8.0,
             format!("{basis}: a dense modal model of {n_forward} unknowns"),
             "rod.elements",
         ),
