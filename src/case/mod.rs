@@ -533,9 +533,14 @@ frames = 4
         let c = parse(&GOOD.replace("F = 1e-8", "F = 1e-8\nza = 2\nyb = \"za*2\"\nxc = \"yb*2\"")).unwrap();
         assert_eq!(c.constants["xc"], 8.0);
         let e = reason(&GOOD.replace("F = 1e-8", "F = \"G\"\nG = \"2*F\""));
+        let cycle = "refer to themselves or to one another in a cycle";
+        assert_eq!(e, format!("t.toml: key `constants.F`: cannot be evaluated: the constants F, G {cycle}"));
+        let e = reason(&GOOD.replace("F = 1e-8", "F = \"2*F\""));
+        assert_eq!(e, format!("t.toml: key `constants.F`: cannot be evaluated: the constants F {cycle}"));
+        let e = reason(&GOOD.replace("F = 1e-8", "F = 1e-8\nk = \"x*2\""));
         assert_eq!(
             e,
-            "t.toml: key `constants.F`: cannot be evaluated: the constants F, G refer to one another in a cycle"
+            "t.toml: key `constants.k`: unknown name `x` in `x*2`; allowed names: pi and the [constants] F, L0, k"
         );
         for name in ["\"(a)\"", "\"-a\"", "sin", "pi", "s"] {
             let e = reason(&GOOD.replace("F = 1e-8", &format!("F = 1e-8\n{name} = 1")));

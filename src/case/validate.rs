@@ -33,11 +33,13 @@ pub const MAX_ELEMENTS: usize = 1_000_000;
 pub(super) struct Validator<'a> {
     pub(super) path: &'a Path,
     constants: BTreeMap<String, f64>,
+    /// the names of `[constants]` (known before they are evaluated, for messages)
+    constant_names: BTreeSet<String>,
 }
 
 impl<'a> Validator<'a> {
     pub(super) fn new(path: &'a Path) -> Self {
-        Validator { path, constants: BTreeMap::new() }
+        Validator { path, constants: BTreeMap::new(), constant_names: BTreeSet::new() }
     }
 
     fn err(&self, key: &str, reason: impl Into<String>) -> CaseError {
@@ -144,6 +146,7 @@ impl<'a> Validator<'a> {
                 );
             }
         }
+        self.constant_names = raw.keys().cloned().collect();
         // Dependencies on other constants (a text that does not parse has none: its evaluation
         // reports the parse error).
         let deps: BTreeMap<&str, BTreeSet<String>> = raw
@@ -153,7 +156,7 @@ impl<'a> Validator<'a> {
                     Scalar::Text(t) => Expr::parse(t).map(|e| e.variables()).unwrap_or_default(),
                     Scalar::Number(_) => BTreeSet::new(),
                 };
-                (k.as_str(), vars.into_iter().filter(|d| raw.contains_key(d) && d != k).collect())
+                (k.as_str(), vars.into_iter().filter(|d| raw.contains_key(d)).collect())
             })
             .collect();
         let mut users: BTreeMap<&str, Vec<&str>> = BTreeMap::new();
@@ -181,7 +184,10 @@ impl<'a> Validator<'a> {
             let cycle: Vec<&str> = waiting.keys().copied().collect();
             return Err(self.err(
                 &format!("constants.{k}"),
-                format!("cannot be evaluated: the constants {} refer to one another in a cycle", cycle.join(", ")),
+                format!(
+                    "cannot be evaluated: the constants {} refer to themselves or to one another in a cycle",
+                    cycle.join(", ")
+                ),
             ));
         }
         Ok(())

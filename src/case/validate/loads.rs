@@ -42,10 +42,10 @@ impl Validator<'_> {
     /// The names an expression of the variables `vars` may use: `vars`, `pi` and the constants.
     pub(super) fn allowed_names(&self, vars: &[&str]) -> String {
         let names: Vec<&str> = vars.iter().copied().chain(["pi"]).collect();
-        if self.constants.is_empty() {
+        if self.constant_names.is_empty() {
             format!("{} (no [constants] are defined)", names.join(", "))
         } else {
-            let constants: Vec<&str> = self.constants.keys().map(String::as_str).collect();
+            let constants: Vec<&str> = self.constant_names.iter().map(String::as_str).collect();
             format!("{} and the [constants] {}", names.join(", "), constants.join(", "))
         }
     }
