@@ -36,16 +36,17 @@ use serde::Deserialize;
 use super::Verdict;
 use crate::case::sweep::{known_keys, SweepParam};
 use crate::case::Case;
+use crate::io::files::{read_capped_text, InputError};
+
+/// Largest audit spec read [bytes]: 1 MiB, as a case file (`case::CASE_FILE_CAP_BYTES`); the
+/// committed specs are 7–11 KiB.
+pub const SPEC_FILE_CAP_BYTES: u64 = 1 << 20;
 
 /// Errors at the spec-file boundary; each names the file.
 #[derive(Debug, thiserror::Error)]
 pub enum SpecError {
-    #[error("cannot read audit spec {path}")]
-    Io {
-        path: PathBuf,
-        #[source]
-        source: std::io::Error,
-    },
+    #[error(transparent)]
+    Input(#[from] InputError),
     #[error("{path}: {message}")]
     Syntax { path: PathBuf, message: String },
     #[error("{path}: {what}: {reason}")]
@@ -326,7 +327,7 @@ impl Spec {
 
 /// Read and validate a spec; `quick`: apply the runs' `quick_set` and `quick_grid`.
 pub fn read_spec(path: &Path, quick: bool) -> Result<Spec, SpecError> {
-    let text = std::fs::read_to_string(path).map_err(|source| SpecError::Io { path: path.to_path_buf(), source })?;
+    let text = read_capped_text(path, SPEC_FILE_CAP_BYTES, "audit spec")?;
     let raw: RawSpec =
         toml::from_str(&text).map_err(|e| SpecError::Syntax { path: path.to_path_buf(), message: e.to_string() })?;
     let invalid = |what: String, reason: String| SpecError::Invalid { path: path.to_path_buf(), what, reason };

@@ -27,6 +27,7 @@ use crate::solve::sequence::{FrameStart, RotationTreatment, SequenceParams};
 use crate::solve::statics::StaticParams;
 use crate::solve::Problem;
 use validate::Validator;
+pub use validate::MAX_ELEMENTS;
 
 /// Errors at the case-file boundary. Every variant names the file; `Invalid` names the key.
 #[derive(Debug, thiserror::Error)]
@@ -41,7 +42,18 @@ pub enum CaseError {
     Syntax { path: PathBuf, message: String },
     #[error("{path}: key `{key}`: {reason}")]
     Invalid { path: PathBuf, key: String, reason: String },
+    #[error("{path}: case file {}", too_large_text(*.size))]
+    TooLarge {
+        path: PathBuf,
+        /// the size of a regular file; `None`: more than the cap was read from a stream
+        size: Option<u64>,
+    },
 }
+
+/// Largest case file read [bytes]: 1 MiB. The committed cases and audit specs are 1–11 KiB
+/// (the largest, `cases/paper/sec6_worm.toml`, 11 037 bytes), so the cap is ~100× above any
+/// real case and stops `cosserat run /dev/zero` at once instead of reading forever.
+pub const CASE_FILE_CAP_BYTES: u64 = 1 << 20;
 
 /// Where the centreline data of an inverse case come from.
 #[derive(Clone, Debug, PartialEq)]
@@ -197,10 +209,9 @@ pub struct Case {
 }
 
 impl Case {
-    /// Read and validate a case file.
+    /// Read and validate a case file (at most [`CASE_FILE_CAP_BYTES`]).
     pub fn from_file(path: &Path) -> Result<Case, CaseError> {
-        let text =
-            std::fs::read_to_string(path).map_err(|source| CaseError::Io { path: path.to_path_buf(), source })?;
+        let text = read_case_file(path)?;
         let name = path.file_stem().and_then(|s| s.to_str()).unwrap_or("case").to_string();
         let mut case = Case::from_toml(&text, &name, path)?;
         case.source = Some(path.to_path_buf());
@@ -299,6 +310,38 @@ impl Case {
     }
 }
 
+/// The message of `CaseError::TooLarge` (worded as `crate::io::InputError::TooLarge`).
+fn too_large_text(size: Option<u64>) -> String {
+    let cap = format!("{CASE_FILE_CAP_BYTES} bytes (1 MiB), the cap for case files");
+    match size {
+        Some(n) => format!("of {n} bytes is larger than {cap}"),
+        None => format!("is not a regular file and did not end within {cap}: reading stopped there"),
+    }
+}
+
+/// The text of a case file, refused above [`CASE_FILE_CAP_BYTES`]: a regular file by its size,
+/// anything else (a device, a pipe) after reading one byte more than the cap. The same rule as
+/// `crate::io::files::read_capped`, which this layer cannot import (`tests/architecture.rs`).
+fn read_case_file(path: &Path) -> Result<String, CaseError> {
+    use std::io::Read;
+    let io = |source| CaseError::Io { path: path.to_path_buf(), source };
+    let too_large = |size| CaseError::TooLarge { path: path.to_path_buf(), size };
+    let file = std::fs::File::open(path).map_err(io)?;
+    let meta = file.metadata().map_err(io)?;
+    if meta.is_file() && meta.len() > CASE_FILE_CAP_BYTES {
+        return Err(too_large(Some(meta.len())));
+    }
+    let mut bytes = Vec::new();
+    file.take(CASE_FILE_CAP_BYTES + 1).read_to_end(&mut bytes).map_err(io)?;
+    if bytes.len() as u64 > CASE_FILE_CAP_BYTES {
+        return Err(too_large(meta.is_file().then_some(bytes.len() as u64)));
+    }
+    String::from_utf8(bytes).map_err(|e| CaseError::Syntax {
+        path: path.to_path_buf(),
+        message: format!("not UTF-8 text (invalid byte at offset {})", e.utf8_error().valid_up_to()),
+    })
+}
+
 /// All `*.toml` files of a directory, sorted by name.
 pub fn case_files(dir: &Path) -> std::io::Result<Vec<PathBuf>> {
     let mut v: Vec<PathBuf> = std::fs::read_dir(dir)?
@@ -389,5 +432,140 @@ frames = 4
     fn unknown_keys_are_rejected() {
         let e = parse(&GOOD.replace("elements = 10", "elements = 10\nelement = 3")).unwrap_err();
         assert!(e.to_string().contains("unknown field `element`"), "{e}");
+    }
+
+    fn reason(text: &str) -> String {
+        match parse(text) {
+            Err(e @ CaseError::Invalid { .. }) => e.to_string(),
+            other => panic!("expected an invalid key, got {other:?}"),
+        }
+    }
+
+    #[test]
+    fn case_files_are_read_within_the_cap() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("big.toml");
+        std::fs::File::create(&p).unwrap().set_len(CASE_FILE_CAP_BYTES + 1).unwrap();
+        let e = Case::from_file(&p).unwrap_err().to_string();
+        let cap = "1048576 bytes (1 MiB), the cap for case files";
+        assert_eq!(e, format!("{}: case file of 1048577 bytes is larger than {cap}", p.display()));
+        if cfg!(unix) {
+            let e = Case::from_file(Path::new("/dev/zero")).unwrap_err().to_string();
+            assert_eq!(
+                e,
+                format!(
+                    "/dev/zero: case file is not a regular file and did not end within {cap}: reading stopped there"
+                )
+            );
+        }
+    }
+
+    /// A load that is not finite on the mesh (or at a time step) is refused at load, naming the
+    /// key, the expression as written, s and t.
+    #[test]
+    fn non_finite_loads_are_refused_at_load() {
+        let with_force = |f: &str| GOOD.replace("[loads]", &format!("[loads]\nforce_n_per_m = [0, \"{f}\", 0]"));
+        let tail = "a load must be finite at every node and load quadrature point of the rod";
+        assert_eq!(
+            reason(&with_force("1/(s-s)")),
+            format!("t.toml: key `loads.force_n_per_m[1]`: `1/(s-s)` is inf at s = 0 m, t = 0 s: {tail}")
+        );
+        assert_eq!(
+            reason(&with_force("1/(s - L0)")),
+            format!("t.toml: key `loads.force_n_per_m[1]`: `1/(s - L0)` is inf at s = 0.001 m, t = 0 s: {tail}")
+        );
+        // A load quadrature point, not a node: the first Gauss point of element 3.
+        let mesh = Mesh::new(1e-3, 10);
+        let s = mesh.node_s(3) + crate::model::mesh::GAUSS2.points[0] * mesh.h();
+        let e = reason(&with_force(&format!("1/(s - {s:e})")));
+        assert!(e.contains(&format!("is inf at s = {s} m, t = 0 s")), "{e}");
+        let dynamic = GOOD
+            .replace("analysis = \"static\"\nrelaxation = 0.5", "analysis = \"dynamic\"\nmethod = \"newton\"")
+            .replace("[compare]", "[time]\nend_s = 1\nsteps = 10\n[compare]")
+            .replace("shear_correction", "density_kg_m3 = 1e3\nshear_correction");
+        assert!(parse(&dynamic).is_ok());
+        let e = reason(&dynamic.replace("end_force_n = [0, \"-F\", 0]", "end_force_n = [0, \"-F*sqrt(0.35 - t)\", 0]"));
+        assert_eq!(
+            e,
+            format!(
+                "t.toml: key `loads.end_force_n[1]`: `-F*sqrt(0.35 - t)` is NaN at s = L = 0.001 m, t = 0.4 s: {tail} \
+                 and at every time step"
+            )
+        );
+        let e = reason(&dynamic.replace("[loads]", "[loads]\ntorque_nm_per_m = [\"s/(t - 0.5)\", 0, 0]"));
+        assert!(e.contains("`loads.torque_nm_per_m[0]`: `s/(t - 0.5)` is NaN at s = 0 m, t = 0.5 s"), "{e}");
+    }
+
+    /// NaN and infinity, as TOML numbers or as names, and names a key does not have.
+    #[test]
+    fn non_numbers_and_unknown_names_say_what_is_allowed() {
+        let e = reason(&GOOD.replace("end_force_n = [0, \"-F\", 0]", "end_force_n = [0, nan, 0]"));
+        assert_eq!(
+            e,
+            "t.toml: key `loads.end_force_n[1]`: NaN is not a number of the expression language (NaN and infinity \
+             are not: every load must be finite); write a finite number or an expression of pi and the [constants] \
+             F, L0"
+        );
+        let e = reason(&GOOD.replace("[loads]", "[loads]\nforce_n_per_m = [\"NaN\", 0, 0]"));
+        assert_eq!(
+            e,
+            "t.toml: key `loads.force_n_per_m[0]`: unknown name `NaN` in `NaN` (NaN and infinity are not numbers of \
+             the expression language: every value must be finite); allowed names: s, pi and the [constants] F, L0"
+        );
+        let e = reason(&GOOD.replace("\"-F\"", "\"-F*s\""));
+        assert!(
+            e.ends_with(
+                "unknown name `s` in `-F*s` (s, the arc length [m], is defined in distributed loads only: end loads \
+                 act at s = L); allowed names: pi and the [constants] F, L0"
+            ),
+            "{e}"
+        );
+        let e = reason(
+            &GOOD.replace("[constants]\nF = 1e-8\nL0 = 1e-3", "").replace("L0", "1e-3").replace("\"-F\"", "\"inf\""),
+        );
+        assert!(e.ends_with("every value must be finite); allowed names: pi (no [constants] are defined)"), "{e}");
+        let e = reason(&GOOD.replace("radius_m = \"L0/40\"", "radius_m = \"L0/t\""));
+        assert!(e.contains("`cross_section.radius_m`: unknown name `t` in `L0/t` (t, the time [s], is defined in the loads of a dynamic analysis only); allowed names: pi and the [constants] F, L0"), "{e}");
+    }
+
+    #[test]
+    fn constants_resolve_in_dependency_order_and_cycles_are_named() {
+        let c = parse(&GOOD.replace("F = 1e-8", "F = 1e-8\nza = 2\nyb = \"za*2\"\nxc = \"yb*2\"")).unwrap();
+        assert_eq!(c.constants["xc"], 8.0);
+        let e = reason(&GOOD.replace("F = 1e-8", "F = \"G\"\nG = \"2*F\""));
+        let cycle = "refer to themselves or to one another in a cycle";
+        assert_eq!(e, format!("t.toml: key `constants.F`: cannot be evaluated: the constants F, G {cycle}"));
+        let e = reason(&GOOD.replace("F = 1e-8", "F = \"2*F\""));
+        assert_eq!(e, format!("t.toml: key `constants.F`: cannot be evaluated: the constants F {cycle}"));
+        let e = reason(&GOOD.replace("F = 1e-8", "F = 1e-8\nk = \"x*2\""));
+        assert_eq!(
+            e,
+            "t.toml: key `constants.k`: unknown name `x` in `x*2`; allowed names: pi and the [constants] F, L0, k"
+        );
+        for name in ["\"(a)\"", "\"-a\"", "sin", "pi", "s"] {
+            let e = reason(&GOOD.replace("F = 1e-8", &format!("F = 1e-8\n{name} = 1")));
+            assert!(e.contains("not a valid constant name"), "{name}: {e}");
+        }
+    }
+
+    #[test]
+    fn meshes_clip_meshes_and_clip_vectors_are_bounded() {
+        let e = reason(&GOOD.replace("elements = 10", "elements = 1000001"));
+        assert_eq!(e, "t.toml: key `rod.elements`: at most 1000000 elements, got 1000001");
+        let worm =
+            std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/worm_omega_turn.toml")).unwrap();
+        let e = reason(&worm.replace("elements = 127", "elements = 2"));
+        assert_eq!(
+            e,
+            "t.toml: key `rod.elements`: a clip case needs at least 11 elements, got 2: the clip's measures leave out \
+             5 elements at each end (curvature errors, ground truth) and the roughness needs 3 curvature values"
+        );
+        assert!(parse(&worm.replace("elements = 127", "elements = 11")).is_ok());
+        let e = reason(&worm.replace("start = \"data_guess\"", "start = \"data_guess\"\ngauge = [1e308, 1e308, 0]"));
+        assert!(e.contains("key `clip.gauge`: must be a finite non-zero vector"), "{e}");
+        let e = reason(
+            &worm.replace("start = \"data_guess\"", "start = \"data_guess\"\norientation = [1e308, 1e308, 1e308]"),
+        );
+        assert!(e.contains("key `clip.orientation`: rotation vector"), "{e}");
     }
 }

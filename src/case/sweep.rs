@@ -20,6 +20,9 @@ pub enum SweepError {
     UnknownKey { key: String, case: String, known: String },
     #[error("--set {0} given twice")]
     Duplicate(String),
+    /// `value`: the value as given the second time, with the first spelling when it differs
+    #[error("--set {key}: value {value} given twice: both runs would write one folder")]
+    DuplicateValue { key: String, value: String },
 }
 
 /// One swept parameter and its values.
@@ -94,24 +97,27 @@ pub fn known_keys(case: &Case) -> Vec<&'static str> {
     keys(case).iter().map(|k| k.name).collect()
 }
 
-/// Parse `key=v1,v2,…`.
+/// Parse `key=v1,v2,…`; each value once (equal numbers, e.g. `10` and `1e1`, are one value).
 pub fn parse_set(spec: &str) -> Result<SweepParam, SweepError> {
     let (key, values) = spec.split_once('=').ok_or_else(|| SweepError::Syntax(spec.into()))?;
     let key = key.trim().to_string();
     if key.is_empty() || values.trim().is_empty() {
         return Err(SweepError::Syntax(spec.into()));
     }
-    let values = values
-        .split(',')
-        .map(|v| {
-            let v = v.trim();
-            v.parse::<f64>()
-                .ok()
-                .filter(|x| x.is_finite())
-                .ok_or_else(|| SweepError::NotANumber { key: key.clone(), value: v.into() })
-        })
-        .collect::<Result<Vec<_>, _>>()?;
-    Ok(SweepParam { key, values })
+    let mut parsed: Vec<(f64, &str)> = Vec::new();
+    for v in values.split(',').map(str::trim) {
+        let x = v
+            .parse::<f64>()
+            .ok()
+            .filter(|x| x.is_finite())
+            .ok_or_else(|| SweepError::NotANumber { key: key.clone(), value: v.into() })?;
+        if let Some(&(_, first)) = parsed.iter().find(|(y, _)| *y == x) {
+            let value = if first == v { format!("`{v}`") } else { format!("`{v}` (= `{first}`)") };
+            return Err(SweepError::DuplicateValue { key, value });
+        }
+        parsed.push((x, v));
+    }
+    Ok(SweepParam { key, values: parsed.into_iter().map(|p| p.0).collect() })
 }
 
 impl Case {
@@ -350,5 +356,18 @@ mod tests {
         ));
         let twice = [parse_set("lambda_f=1").unwrap(), parse_set("lambda_f=2").unwrap()];
         assert!(matches!(product(&c, &twice), Err(SweepError::Duplicate(_))));
+    }
+
+    /// One value twice would run two points into one folder.
+    #[test]
+    fn a_value_given_twice_is_refused() {
+        let e = parse_set("elements=10,10").unwrap_err();
+        assert_eq!(e.to_string(), "--set elements: value `10` given twice: both runs would write one folder");
+        let e = parse_set("lambda_l=1e-20, 5, 1.0e-20").unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "--set lambda_l: value `1.0e-20` (= `1e-20`) given twice: both runs would write one folder"
+        );
+        assert_eq!(parse_set("elements=10,20").unwrap().values, vec![10.0, 20.0]);
     }
 }

@@ -1,36 +1,45 @@
 //! Raw case tables → the typed [`Case`]: one function per table, each building the solver's
 //! own params type directly, every rule in one place (a sweep's values go through these same
 //! functions, `case::sweep`). Errors name the file and the key.
-use std::collections::BTreeMap;
+//!
+//! The tables of loads ([`loads`]) and of clips ([`clip`]) are validated in submodules.
+use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
 
-use nalgebra::{Rotation3, Vector3};
+use nalgebra::Vector3;
 
 use super::raw::*;
 use super::{
-    Analysis, Case, CaseError, ClipKind, ClipSource, CompareOverrides, CompareSpec, DataSource, InverseSettings,
-    Reference, SyntheticClip, DEFAULT_COMPARE_FRAMES,
+    Analysis, Case, CaseError, CompareOverrides, CompareSpec, DataSource, InverseSettings, Reference,
+    DEFAULT_COMPARE_FRAMES,
 };
-use crate::clip::synthetic::RollClipParams;
-use crate::clip::ClipPlane;
-use crate::expr::Expr;
-use crate::model::loads::{LoadFrame, Loads};
+use crate::expr::{Expr, ExprError, Node};
 use crate::model::material::{CrossSection, Material, RodProperties};
 use crate::model::mesh::{Mesh, QuadratureScheme};
 use crate::solve::dynamics::DynamicParams;
 use crate::solve::inverse::{InverseMethod, InverseParams, Weights, DEFAULT_STABILISATION};
-use crate::solve::sequence::{FrameStart, RotationTreatment};
 use crate::solve::statics::{Method, StaticParams};
+
+mod clip;
+mod loads;
+
+/// Most elements of a mesh: 10⁶. The cases use 10–400 (the Timoshenko convergence study of
+/// `cases/paper/fig07_timoshenko.toml` goes to 400); a mesh beyond this would not fit the
+/// solvers' memory (the inverse KKT system holds 12 unknowns per node in a band of 24) and a
+/// count read from a file must not decide an allocation unchecked.
+pub const MAX_ELEMENTS: usize = 1_000_000;
 
 /// The validator of one case file: its path (for messages) and its evaluated constants.
 pub(super) struct Validator<'a> {
     pub(super) path: &'a Path,
     constants: BTreeMap<String, f64>,
+    /// the names of `[constants]` (known before they are evaluated, for messages)
+    constant_names: BTreeSet<String>,
 }
 
 impl<'a> Validator<'a> {
     pub(super) fn new(path: &'a Path) -> Self {
-        Validator { path, constants: BTreeMap::new() }
+        Validator { path, constants: BTreeMap::new(), constant_names: BTreeSet::new() }
     }
 
     fn err(&self, key: &str, reason: impl Into<String>) -> CaseError {
@@ -41,7 +50,10 @@ impl<'a> Validator<'a> {
     fn scalar(&self, key: &str, v: &Scalar) -> Result<f64, CaseError> {
         let x = match v {
             Scalar::Number(x) => *x,
-            Scalar::Text(s) => crate::expr::eval_const(s, &self.constants).map_err(|e| self.err(key, e.to_string()))?,
+            Scalar::Text(s) => crate::expr::eval_const(s, &self.constants).map_err(|e| match e {
+                ExprError::UnknownVariable { name } => self.err(key, self.unknown_name(&name, s, &[])),
+                e => self.err(key, e.to_string()),
+            })?,
         };
         if !x.is_finite() {
             return Err(self.err(key, format!("value is not finite ({x})")));
@@ -88,7 +100,7 @@ impl<'a> Validator<'a> {
         let kind = raw.solver.analysis;
         let material = self.material(&raw.material, kind)?;
         let section = self.section(&raw.cross_section)?;
-        let loads = self.loads(&raw.loads, kind)?;
+        let (loads, load_texts) = self.loads(&raw.loads, kind)?;
         self.tables_of_other_analyses(&raw, kind)?;
         let quadrature = match raw.solver.quadrature {
             RawQuadrature::Selective => QuadratureScheme::Selective,
@@ -100,6 +112,7 @@ impl<'a> Validator<'a> {
             RawAnalysis::Dynamic => Analysis::Dynamic(self.dynamic(&raw.solver, raw.time.as_ref())?),
             RawAnalysis::Inverse => Analysis::Inverse(self.inverse(&raw, &mesh)?),
         };
+        self.loads_are_finite(&loads, &load_texts, &mesh, quadrature, &analysis)?;
         let compare = self.compare(&raw.compare)?;
         let reference = self.reference(raw.reference.as_ref(), kind)?;
         Ok(Case {
@@ -120,33 +133,62 @@ impl<'a> Validator<'a> {
         })
     }
 
-    /// `[constants]`: each may use the others, in any order (evaluated until no progress).
+    /// `[constants]`: each may use the others, in any order: evaluated in the order of their
+    /// dependencies (the first ready name first), so that each is evaluated once; constants
+    /// that depend on each other are refused.
     fn constants(&mut self, raw: BTreeMap<String, Scalar>) -> Result<(), CaseError> {
-        let mut pending: Vec<(String, Scalar)> = raw.into_iter().collect();
-        for (k, _) in &pending {
-            if matches!(k.as_str(), "s" | "t" | "pi")
-                || Expr::parse(k).map(|e| e.variables().len() != 1).unwrap_or(true)
+        for k in raw.keys() {
+            // A name is an identifier that parses to itself: not s, t, pi or a function.
+            if matches!(k.as_str(), "s" | "t") || Expr::parse(k).map(|e| e.root != Node::Var(k.clone())).unwrap_or(true)
             {
                 return Err(
                     self.err(&format!("constants.{k}"), "not a valid constant name (identifier other than s, t, pi)")
                 );
             }
         }
-        while !pending.is_empty() {
-            let before = pending.len();
-            let mut rest = Vec::new();
-            for (k, v) in pending {
-                match self.scalar(&format!("constants.{k}"), &v) {
-                    Ok(x) => {
-                        self.constants.insert(k, x);
+        self.constant_names = raw.keys().cloned().collect();
+        // Dependencies on other constants (a text that does not parse has none: its evaluation
+        // reports the parse error).
+        let deps: BTreeMap<&str, BTreeSet<String>> = raw
+            .iter()
+            .map(|(k, v)| {
+                let vars = match v {
+                    Scalar::Text(t) => Expr::parse(t).map(|e| e.variables()).unwrap_or_default(),
+                    Scalar::Number(_) => BTreeSet::new(),
+                };
+                (k.as_str(), vars.into_iter().filter(|d| raw.contains_key(d)).collect())
+            })
+            .collect();
+        let mut users: BTreeMap<&str, Vec<&str>> = BTreeMap::new();
+        for (k, ds) in &deps {
+            for d in ds {
+                users.entry(d.as_str()).or_default().push(k);
+            }
+        }
+        let mut waiting: BTreeMap<&str, usize> = deps.iter().map(|(k, ds)| (*k, ds.len())).collect();
+        let mut ready: BTreeSet<&str> = waiting.iter().filter(|(_, n)| **n == 0).map(|(k, _)| *k).collect();
+        while let Some(k) = ready.pop_first() {
+            waiting.remove(k);
+            let x = self.scalar(&format!("constants.{k}"), &raw[k])?;
+            self.constants.insert(k.to_string(), x);
+            for u in users.get(k).into_iter().flatten() {
+                if let Some(n) = waiting.get_mut(u) {
+                    *n -= 1;
+                    if *n == 0 {
+                        ready.insert(u);
                     }
-                    Err(e) => rest.push((k, v, e)),
                 }
             }
-            if rest.len() == before {
-                return Err(rest.into_iter().next().map(|(_, _, e)| e).expect("non-empty"));
-            }
-            pending = rest.into_iter().map(|(k, v, _)| (k, v)).collect();
+        }
+        if let Some(k) = waiting.keys().next() {
+            let cycle: Vec<&str> = waiting.keys().copied().collect();
+            return Err(self.err(
+                &format!("constants.{k}"),
+                format!(
+                    "cannot be evaluated: the constants {} refer to themselves or to one another in a cycle",
+                    cycle.join(", ")
+                ),
+            ));
         }
         Ok(())
     }
@@ -156,6 +198,9 @@ impl<'a> Validator<'a> {
         let length = self.positive("rod.length_m", &rod.length_m)?;
         if rod.elements < 2 {
             return Err(self.err("rod.elements", format!("need at least 2 elements, got {}", rod.elements)));
+        }
+        if rod.elements > MAX_ELEMENTS {
+            return Err(self.err("rod.elements", format!("at most {MAX_ELEMENTS} elements, got {}", rod.elements)));
         }
         Ok(Mesh::new(length, rod.elements))
     }
@@ -188,57 +233,6 @@ impl<'a> Validator<'a> {
                 height_m: self.positive("cross_section.height_m", height_m)?,
             },
         })
-    }
-
-    fn expr(&self, key: &str, v: &Scalar, allowed: &[&str]) -> Result<Expr, CaseError> {
-        let text = match v {
-            Scalar::Number(x) => format!("{x:e}"),
-            Scalar::Text(s) => s.clone(),
-        };
-        let e = Expr::parse(&text).map_err(|e| self.err(key, format!("cannot parse `{text}`: {e}")))?;
-        for var in e.variables() {
-            if !allowed.contains(&var.as_str()) && !self.constants.contains_key(&var) {
-                return Err(self.err(
-                    key,
-                    format!(
-                        "unknown name `{var}` in `{text}` (allowed: {}, or a [constants] entry)",
-                        allowed.join(", ")
-                    ),
-                ));
-            }
-        }
-        Ok(e)
-    }
-
-    fn vector(&self, key: &str, v: &Option<[Scalar; 3]>, allowed: &[&str]) -> Result<[Expr; 3], CaseError> {
-        let zero = Scalar::Number(0.0);
-        let items = v.clone().unwrap_or([zero.clone(), zero.clone(), zero]);
-        let mut out = Vec::with_capacity(3);
-        for (i, item) in items.iter().enumerate() {
-            out.push(self.expr(&format!("{key}[{i}]"), item, allowed)?);
-        }
-        Ok([out[0].clone(), out[1].clone(), out[2].clone()])
-    }
-
-    /// `[loads]`: expressions of `s` (and `t` in a dynamic analysis) and the constants.
-    fn loads(&self, l: &RawLoads, kind: RawAnalysis) -> Result<Loads, CaseError> {
-        let (vars, end_vars): (&[&str], &[&str]) = match kind {
-            RawAnalysis::Static | RawAnalysis::Inverse => (&["s"], &[]),
-            RawAnalysis::Dynamic => (&["s", "t"], &["t"]),
-        };
-        let frame = match l.frame {
-            RawFrame::Global => LoadFrame::Global,
-            RawFrame::Local => LoadFrame::Local,
-        };
-        Loads::new(
-            frame,
-            self.vector("loads.force_n_per_m", &l.force_n_per_m, vars)?,
-            self.vector("loads.torque_nm_per_m", &l.torque_nm_per_m, vars)?,
-            self.vector("loads.end_force_n", &l.end_force_n, end_vars)?,
-            self.vector("loads.end_torque_nm", &l.end_torque_nm, end_vars)?,
-            &self.constants,
-        )
-        .map_err(|e| self.err("loads", e.to_string()))
     }
 
     /// Tables and `[solver]` keys that belong to another analysis are refused.
@@ -423,97 +417,6 @@ impl<'a> Validator<'a> {
             max_iterations: d.max_iterations,
             continuation_steps: d.continuation_steps,
         })
-    }
-
-    /// `[clip]`: a recorded or synthetic clip.
-    fn clip(&self, cl: &RawClip, mesh: &Mesh) -> Result<ClipSource, CaseError> {
-        let base = self.path.parent().unwrap_or(Path::new(""));
-        let frames = match cl.frames {
-            Some([a, b]) if a < b => Some((a, b)),
-            Some([a, b]) => {
-                return Err(self.err("clip.frames", format!("expected [first, end) with first < end, got [{a}, {b}]")))
-            }
-            None => None,
-        };
-        if !(cl.min_cos_beta >= 0.0 && cl.min_cos_beta < 1.0) {
-            return Err(self.err("clip.min_cos_beta", format!("must lie in [0, 1), got {}", cl.min_cos_beta)));
-        }
-        let plane = match cl.plane {
-            RawPlane::Xz => ClipPlane::Xz,
-            RawPlane::Xy => ClipPlane::Xy,
-        };
-        if let Some(v) = cl.orientation.iter().flatten().find(|v| !v.is_finite()) {
-            return Err(self.err("clip.orientation", format!("must be a finite rotation vector [rad], got {v}")));
-        }
-        let orientation = Rotation3::new(Vector3::from(cl.orientation.unwrap_or([0.0; 3]))).into_inner();
-        let gauge = match cl.gauge {
-            Some(g) => Vector3::from(g)
-                .try_normalize(1e-12)
-                .filter(|v| v.iter().all(|c| c.is_finite()))
-                .ok_or_else(|| self.err("clip.gauge", format!("must be a finite non-zero vector, got {g:?}")))?,
-            None => match plane {
-                ClipPlane::Xz => Vector3::y(),
-                ClipPlane::Xy => Vector3::z(),
-            },
-        };
-        let frame_interval_s = self.positive("clip.frame_interval_s", &cl.frame_interval_s)?;
-        let kind = match cl.kind {
-            RawClipKind::Kymogram => ClipKind::Kymogram,
-            RawClipKind::Recording => ClipKind::Recording,
-            RawClipKind::Roll3d => ClipKind::Roll3d(self.synthetic(cl, mesh, frame_interval_s)?),
-        };
-        if !matches!(kind, ClipKind::Roll3d(_))
-            && (cl.roll_total_rad.is_some()
-                || cl.twist_per_m.is_some()
-                || cl.clip_frames.is_some()
-                || cl.substeps.is_some())
-        {
-            return Err(self.err(
-                "clip",
-                "roll_total_rad, twist_per_m, clip_frames and substeps apply to kind = \"roll_3d\" only",
-            ));
-        }
-        Ok(ClipSource {
-            kind,
-            file: base.join(&cl.file),
-            frames,
-            min_cos_beta: cl.min_cos_beta,
-            start: match cl.start {
-                RawStart::PreviousFrame => FrameStart::PreviousFrame,
-                RawStart::DataGuess => FrameStart::DataGuess,
-            },
-            rotation: match cl.rotation {
-                RawRotation::Rebased => RotationTreatment::Rebased,
-                RawRotation::GlobalEuler => RotationTreatment::GlobalEuler,
-            },
-            plane,
-            orientation,
-            gauge: orientation * gauge,
-        })
-    }
-
-    /// The `roll_3d` keys of `[clip]` (nodes, length and Δt are the mesh's and the clip's).
-    fn synthetic(&self, cl: &RawClip, mesh: &Mesh, dt_s: f64) -> Result<SyntheticClip, CaseError> {
-        let d = RollClipParams::default();
-        let synthetic = SyntheticClip {
-            frames: cl.clip_frames.unwrap_or(d.frames),
-            roll_total_rad: cl
-                .roll_total_rad
-                .as_ref()
-                .map(|v| self.scalar("clip.roll_total_rad", v))
-                .transpose()?
-                .unwrap_or(d.roll_total_rad),
-            twist_per_m: cl
-                .twist_per_m
-                .as_ref()
-                .map(|v| self.scalar("clip.twist_per_m", v))
-                .transpose()?
-                .unwrap_or(d.twist_per_m),
-            time_mapping: d.time_mapping,
-            substeps: cl.substeps.unwrap_or(d.substeps),
-        };
-        synthetic.params(mesh, dt_s).validate().map_err(|e| self.err("clip", e.to_string()))?;
-        Ok(synthetic)
     }
 
     /// `[compare]`: the frames of a clip comparison and the overrides of the derived

@@ -52,6 +52,38 @@ pub const KYMOGRAM_FPS: f64 = 32.0;
 /// Nodes per frame in [R1] §6.
 pub const PAPER_NODES: usize = 128;
 
+/// Elements left out at each end by the measures of a clip run: the inner curvature errors
+/// (`run::metrics::INNER_SKIP_ELEMENTS`) and the ground-truth scores (`run::clip::TRUTH_SKIP_NODES`
+/// nodes); equal to both (tested in `io::clip_files`).
+pub const CLIP_SKIP_ELEMENTS: usize = 5;
+/// Fewest elements of a clip case's mesh: the measures leave out [`CLIP_SKIP_ELEMENTS`] at
+/// each end and must keep one, and the roughness (`run::clip::sign_alternation`) of the data's
+/// curvature at the `elements − 1` interior nodes needs 3 values. A smaller mesh would run and
+/// write results without these measures.
+pub const MIN_CLIP_ELEMENTS: usize = 2 * CLIP_SKIP_ELEMENTS + 1;
+/// Most positions (frames × nodes) a clip may hold: 2²⁵ ≈ 3.4·10⁷ (768 MiB of positions). The
+/// paper's clip is 1160 × 128 = 1.5·10⁵; an hour of a recording at 30 frames/s with 128 nodes
+/// is 1.4·10⁷. A kymogram's frames and a synthetic clip's `clip_frames` are multiplied by the
+/// mesh's node count before anything is allocated.
+pub const MAX_CLIP_POSITIONS: usize = 1 << 25;
+/// Largest deviation of a recorded frame's polyline length from the rod length,
+/// `|L_frame / rod.length_m − 1|`, accepted when a recording is loaded (kymograms are scaled to
+/// the rod length by design and not checked). Measured, max over all frames of every clip case
+/// of `cases/` on its own mesh (`io::clip_files` test `length_ratios_of_the_clip_cases`):
+///
+/// | clip | frames | max deviation | without `scale_to_length` |
+/// |---|---|---|---|
+/// | worm_omega_turn(_ld1) | 600 | 3.3e-4 | 8.2e-3 |
+/// | worm_delta_turn(_ld1) | 300 | 3.6e-4 | 8.8e-3 |
+/// | worm_roll_3d (synthetic, j = 1) | 1160 | 3.1e-4 | – |
+///
+/// The band is 10 %: 11× the largest deviation measured (0.88 %, the unscaled spline), far
+/// below the errors it is there to name (a recording in mm read as m is 1000×, a wrong
+/// `rod.length_m` 0.5× or 1.2×). It is not a convergence bound: frames 100–103 of the omega
+/// turn scaled by k about the head converge for k = 1 … 1.2 with λd = 1 and Newton
+/// (`worm_omega_turn_ld1`), but not for k = 0.95 or 1.05 with Table 1's λd = 1e2.
+pub const MAX_LENGTH_DEVIATION: f64 = 0.10;
+
 /// Errors of building, cutting and scoring clips (reading their files is `crate::io`'s).
 #[derive(Debug, thiserror::Error)]
 pub enum ClipError {

@@ -17,7 +17,9 @@
 //! primary := number | ident | ident '(' expr (',' expr)? ')' | '(' expr ')'
 //! ```
 //! Functions: `sin cos tan exp log sqrt abs sinh cosh tanh atan asin acos`
-//! (one argument) and `pow atan2 min max` (two arguments). `pi` is built in.
+//! (one argument) and `pow atan2 min max` (two arguments). `pi` is built in. Numbers are
+//! finite decimal literals: `nan` and `inf` are not numbers of the language (they would be
+//! read as names). Trees are at most [`MAX_DEPTH`] deep.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::fmt;
@@ -29,6 +31,7 @@ mod parse;
 mod tests;
 
 pub use compile::Compiled;
+pub use parse::MAX_DEPTH;
 
 /// Errors from parsing, compiling or evaluating an expression. Columns are
 /// 1-based character positions in the source string.
@@ -58,6 +61,9 @@ pub enum ExprError {
     /// A free variable with no value (eval) or no slot (compile).
     #[error("unknown variable '{name}'")]
     UnknownVariable { name: String },
+    /// Operators, signs, calls or parentheses nested deeper than the parser accepts.
+    #[error("expression nested more than {limit} levels deep at column {column}")]
+    TooDeep { column: usize, limit: usize },
 }
 
 /// Binary operators.

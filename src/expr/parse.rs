@@ -1,5 +1,16 @@
-//! Lexer and recursive-descent parser of the grammar in the module docs.
+//! Lexer and recursive-descent parser of the grammar in the module docs. The depth of the
+//! syntax tree is limited to [`MAX_DEPTH`] and the parser's own recursion to
+//! [`MAX_RECURSION`], so that neither parsing nor the recursive evaluation, compilation,
+//! printing and dropping of a tree can overflow the stack, whatever the input.
 use super::{is_function, BinOp, ExprError, Node, FUNC1, FUNC2};
+
+/// Deepest syntax tree accepted: operators, signs and calls nested in one another. The load
+/// expressions of the committed cases are at most 6 deep; a sum of 200 terms is 200 deep.
+pub const MAX_DEPTH: usize = 200;
+/// Deepest recursion of the parser (`expr` and `unary` entries: parentheses, call arguments,
+/// signs). A fully parenthesised print ([`super::Expr::to_freefem`]) of a tree of depth `d`
+/// re-parses within `3d` of these (a sign inside its parentheses is the deepest: 3 per level).
+const MAX_RECURSION: usize = 4 * MAX_DEPTH;
 
 #[derive(Debug, Clone, PartialEq)]
 enum Tok {
@@ -72,7 +83,12 @@ fn lex(src: &str) -> Result<Vec<(Tok, usize)>, ExprError> {
 struct Parser {
     toks: Vec<(Tok, usize)>,
     pos: usize,
+    /// current recursion depth of `expr` and `unary`
+    recursion: usize,
 }
+
+/// A subtree and its depth (a leaf is 1 deep).
+type Tree = (Node, usize);
 
 impl Parser {
     fn peek(&self) -> &Tok {
@@ -92,58 +108,79 @@ impl Parser {
             false
         }
     }
-    fn expr(&mut self) -> Result<Node, ExprError> {
-        let mut lhs = self.term()?;
+    /// Enter `expr` or `unary`: refused beyond [`MAX_RECURSION`].
+    fn enter(&mut self) -> Result<(), ExprError> {
+        self.recursion += 1;
+        if self.recursion > MAX_RECURSION {
+            return Err(ExprError::TooDeep { column: self.column(), limit: MAX_DEPTH });
+        }
+        Ok(())
+    }
+    /// A new node over subtrees of depth `below`: refused beyond [`MAX_DEPTH`].
+    fn node(&self, node: Node, below: usize) -> Result<Tree, ExprError> {
+        if below >= MAX_DEPTH {
+            return Err(ExprError::TooDeep { column: self.column(), limit: MAX_DEPTH });
+        }
+        Ok((node, below + 1))
+    }
+    fn expr(&mut self) -> Result<Tree, ExprError> {
+        self.enter()?;
+        let (mut lhs, mut depth) = self.term()?;
         loop {
             let op = if self.eat('+') {
                 BinOp::Add
             } else if self.eat('-') {
                 BinOp::Sub
             } else {
-                return Ok(lhs);
+                self.recursion -= 1;
+                return Ok((lhs, depth));
             };
-            let rhs = self.term()?;
-            lhs = Node::Bin(op, Box::new(lhs), Box::new(rhs));
+            let (rhs, d) = self.term()?;
+            (lhs, depth) = self.node(Node::Bin(op, Box::new(lhs), Box::new(rhs)), depth.max(d))?;
         }
     }
-    fn term(&mut self) -> Result<Node, ExprError> {
-        let mut lhs = self.unary()?;
+    fn term(&mut self) -> Result<Tree, ExprError> {
+        let (mut lhs, mut depth) = self.unary()?;
         loop {
             let op = if self.eat('*') {
                 BinOp::Mul
             } else if self.eat('/') {
                 BinOp::Div
             } else {
-                return Ok(lhs);
+                return Ok((lhs, depth));
             };
-            let rhs = self.unary()?;
-            lhs = Node::Bin(op, Box::new(lhs), Box::new(rhs));
+            let (rhs, d) = self.unary()?;
+            (lhs, depth) = self.node(Node::Bin(op, Box::new(lhs), Box::new(rhs)), depth.max(d))?;
         }
     }
-    fn unary(&mut self) -> Result<Node, ExprError> {
-        if self.eat('-') {
-            Ok(Node::Neg(Box::new(self.unary()?)))
+    fn unary(&mut self) -> Result<Tree, ExprError> {
+        self.enter()?;
+        let tree = if self.eat('-') {
+            let (a, d) = self.unary()?;
+            self.node(Node::Neg(Box::new(a)), d)?
         } else if self.eat('+') {
-            self.unary()
+            self.unary()?
         } else {
-            self.power()
-        }
+            self.power()?
+        };
+        self.recursion -= 1;
+        Ok(tree)
     }
-    fn power(&mut self) -> Result<Node, ExprError> {
-        let base = self.primary()?;
+    fn power(&mut self) -> Result<Tree, ExprError> {
+        let (base, db) = self.primary()?;
         if self.eat('^') {
-            let exp = self.unary()?;
-            Ok(Node::Bin(BinOp::Pow, Box::new(base), Box::new(exp)))
+            let (exp, de) = self.unary()?;
+            self.node(Node::Bin(BinOp::Pow, Box::new(base), Box::new(exp)), db.max(de))
         } else {
-            Ok(base)
+            Ok((base, db))
         }
     }
-    fn primary(&mut self) -> Result<Node, ExprError> {
+    fn primary(&mut self) -> Result<Tree, ExprError> {
         let column = self.column();
         match self.peek().clone() {
             Tok::Num(v) => {
                 self.pos += 1;
-                Ok(Node::Num(v))
+                Ok((Node::Num(v), 1))
             }
             Tok::Op('(') => {
                 self.pos += 1;
@@ -160,15 +197,15 @@ impl Parser {
                 } else if is_function(&name) {
                     Err(ExprError::FunctionAsVariable { name, column })
                 } else if name == "pi" {
-                    Ok(Node::Pi)
+                    Ok((Node::Pi, 1))
                 } else {
-                    Ok(Node::Var(name))
+                    Ok((Node::Var(name), 1))
                 }
             }
             _ => Err(self.unexpected("a number, identifier or '('")),
         }
     }
-    fn call(&mut self, name: String, column: usize) -> Result<Node, ExprError> {
+    fn call(&mut self, name: String, column: usize) -> Result<Tree, ExprError> {
         let f1 = FUNC1.iter().find(|(n, _)| *n == name).map(|x| x.1);
         let f2 = FUNC2.iter().find(|(n, _)| *n == name).map(|x| x.1);
         if f1.is_none() && f2.is_none() {
@@ -185,12 +222,14 @@ impl Parser {
         if args.len() != expected {
             return Err(ExprError::WrongArity { name, column, expected, found: args.len() });
         }
-        let mut it = args.into_iter().map(Box::new);
-        match (f1, f2, it.next(), it.next()) {
-            (Some(f), _, Some(a), None) => Ok(Node::Call1(f, a)),
-            (_, Some(f), Some(a), Some(b)) => Ok(Node::Call2(f, a, b)),
-            _ => Err(ExprError::WrongArity { name, column, expected, found: 0 }),
-        }
+        let below = args.iter().map(|a| a.1).max().unwrap_or(0);
+        let mut it = args.into_iter().map(|a| Box::new(a.0));
+        let node = match (f1, f2, it.next(), it.next()) {
+            (Some(f), _, Some(a), None) => Node::Call1(f, a),
+            (_, Some(f), Some(a), Some(b)) => Node::Call2(f, a, b),
+            _ => return Err(ExprError::WrongArity { name, column, expected, found: 0 }),
+        };
+        self.node(node, below)
     }
 }
 
@@ -202,8 +241,8 @@ pub(super) fn parse(src: &str) -> Result<Node, ExprError> {
     if toks.len() == 1 {
         return Err(ExprError::Empty);
     }
-    let mut p = Parser { toks, pos: 0 };
-    let root = p.expr()?;
+    let mut p = Parser { toks, pos: 0, recursion: 0 };
+    let (root, _) = p.expr()?;
     if *p.peek() != Tok::End {
         return Err(p.unexpected("an operator or end of input"));
     }

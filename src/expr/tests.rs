@@ -207,3 +207,27 @@ fn freefem_emitter() {
     assert_eq!(ff("E/(2*(1+0.4))"), "(k_E/(2e0*(1e0+4e-1)))");
     assert_eq!(ff("-2^2 + atan2(s,t) + max(s, 1.5)"), "(((-pow(2e0,2e0))+atan2(S,T))+max(S,1.5e0))");
 }
+
+/// Nesting is bounded (no stack overflow on hostile input): a tree of exactly MAX_DEPTH levels
+/// parses and round-trips through its fully parenthesised print, one more level is refused.
+#[test]
+fn nesting_is_bounded() {
+    let sum = |terms: usize| vec!["1"; terms].join("+");
+    let e = Expr::parse(&sum(MAX_DEPTH)).unwrap();
+    assert_eq!(e.eval(&|_| None).unwrap(), MAX_DEPTH as f64);
+    let again = Expr::parse(&e.to_string()).unwrap();
+    assert_eq!(again, e);
+    let e = Expr::parse(&sum(MAX_DEPTH + 1)).unwrap_err();
+    assert_eq!(e.to_string(), format!("expression nested more than 200 levels deep at column {}", 2 * MAX_DEPTH + 2));
+    let signs = format!("{}1", "-".repeat(MAX_DEPTH - 1));
+    assert_eq!(Expr::parse(&signs).unwrap().eval(&|_| None).unwrap(), -1.0);
+    let neg = Expr::parse(&signs).unwrap();
+    assert_eq!(Expr::parse(&neg.to_string()).unwrap(), neg, "a sign chain's print re-parses");
+    assert!(matches!(Expr::parse(&format!("-{signs}")), Err(ExprError::TooDeep { .. })));
+    // Deep enough to overflow any stack if it were parsed recursively without a bound.
+    for hostile in [format!("{}1", "(".repeat(1_000_000)), "+".repeat(1_000_000) + "1", sum(500_000)] {
+        assert!(matches!(Expr::parse(&hostile), Err(ExprError::TooDeep { limit: MAX_DEPTH, .. })));
+    }
+    let calls = format!("{}s{}", "sin(".repeat(MAX_DEPTH), ")".repeat(MAX_DEPTH));
+    assert!(matches!(Expr::parse(&calls), Err(ExprError::TooDeep { .. })));
+}

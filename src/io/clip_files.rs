@@ -1,19 +1,28 @@
 //! Reading clips: kymograms and user recordings (`crate::clip` turns their content into
 //! centrelines), and the clip of a clip case with its frame range, orientation and, for a
 //! synthetic clip, its ground truth.
-use std::collections::BTreeMap;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use nalgebra::{Matrix3, Vector3};
 
-use super::files::{csv_reader, InputError};
+use super::files::{csv_reader_capped, InputError};
 use super::npy::read_npy;
 use crate::case::{Case, ClipKind};
 use crate::clip::synthetic::{roll_clip, GroundTruth};
-use crate::clip::{clip_from_angles, polyline_length, Clip, ClipError, KymogramParams};
+use crate::clip::{
+    clip_from_angles, polyline_length, Clip, ClipError, KymogramParams, MAX_CLIP_POSITIONS, MAX_LENGTH_DEVIATION,
+};
 
 /// Column names of a CSV recording.
 pub const RECORDING_HEADER: [&str; 5] = ["frame", "node", "x_m", "y_m", "z_m"];
+
+/// Largest CSV recording read [bytes]: 1 GiB. The paper's clip (1160 frames × 128 nodes) is
+/// about 11 MB as CSV; an hour at 30 frames/s with 128 nodes about 1 GB. (NPY recordings and
+/// kymograms: `io::npy::NPY_FILE_CAP_BYTES`.)
+pub const CSV_RECORDING_CAP_BYTES: u64 = 1 << 30;
+
+/// The folder of the `elegansbot` kymograms that `scripts/fetch_worm_data.sh` fetches.
+const FETCHED_DATA: [&str; 2] = ["data", "elegansbot"];
 
 /// Errors of reading the clip of a clip case.
 #[derive(Debug, thiserror::Error)]
@@ -24,29 +33,73 @@ pub enum ClipFileError {
     Clip(#[from] ClipError),
     #[error("case `{0}` has no [clip]")]
     NotAClip(String),
-    #[error("{path} does not exist{hint}")]
-    Missing { path: std::path::PathBuf, hint: &'static str },
+    #[error("{path} does not exist (the clip.file of case `{case}`){hint}")]
+    Missing { path: PathBuf, case: String, hint: &'static str },
     #[error("{path}: {nodes} nodes per frame, but the case's mesh has {expected} (rod.elements + 1)")]
-    NodeCount { path: std::path::PathBuf, nodes: usize, expected: usize },
+    NodeCount { path: PathBuf, nodes: usize, expected: usize },
+    #[error(
+        "{path}, frame {frame}: the centreline is {length_m:e} m long, {ratio:.4}× the rod length rod.length_m = \
+         {rod_m:e} m (allowed: within ±{:.0} %); scale the recording to metres of this rod, or set rod.length_m to \
+         the length of the recorded body",
+        100.0 * MAX_LENGTH_DEVIATION
+    )]
+    Length { path: PathBuf, frame: usize, length_m: f64, rod_m: f64, ratio: f64 },
+    #[error(
+        "{path}: {frames} frames × {nodes} nodes are {positions} positions, more than the {MAX_CLIP_POSITIONS} a clip \
+         may hold; use a shorter clip"
+    )]
+    TooManyPositions { path: PathBuf, frames: usize, nodes: usize, positions: usize },
+}
+
+/// Is `path` in the folder of the fetched kymograms (`data/elegansbot`)?
+fn is_fetched_data(path: &Path) -> bool {
+    let parts: Vec<_> = path.components().map(|c| c.as_os_str().to_string_lossy().into_owned()).collect();
+    parts.windows(2).any(|w| w[0] == FETCHED_DATA[0] && w[1] == FETCHED_DATA[1])
+}
+
+/// Refuse a clip of `frames` frames × `nodes` nodes beyond [`MAX_CLIP_POSITIONS`], before it is built.
+fn check_positions(path: &Path, frames: usize, nodes: usize) -> Result<(), ClipFileError> {
+    let positions = frames.saturating_mul(nodes);
+    if positions > MAX_CLIP_POSITIONS {
+        return Err(ClipFileError::TooManyPositions { path: path.to_path_buf(), frames, nodes, positions });
+    }
+    Ok(())
+}
+
+/// Refuse a recording frame (`first` is the file's index of `frames[0]`) whose polyline length
+/// deviates from the rod length by more than [`MAX_LENGTH_DEVIATION`].
+fn check_lengths(path: &Path, frames: &[Vec<Vector3<f64>>], first: usize, rod_m: f64) -> Result<(), ClipFileError> {
+    for (k, f) in frames.iter().enumerate() {
+        let length_m = polyline_length(f);
+        let ratio = length_m / rod_m;
+        if ratio.is_nan() || (ratio - 1.0).abs() > MAX_LENGTH_DEVIATION {
+            return Err(ClipFileError::Length { path: path.to_path_buf(), frame: first + k, length_m, rod_m, ratio });
+        }
+    }
+    Ok(())
 }
 
 /// The clip of a clip case: kymograms become spline centrelines with the mesh's node count
-/// and the rod's length in the case's plane; recordings must have that node count; a
-/// synthetic clip (`kind = "roll_3d"`) comes with its ground truth. The frame range and the
-/// orientation of the case are applied to both.
+/// and the rod's length in the case's plane; recordings must have that node count, and every
+/// frame solved the rod's length within [`MAX_LENGTH_DEVIATION`]; a synthetic clip
+/// (`kind = "roll_3d"`) comes with its ground truth. The frame range and the orientation of the
+/// case are applied to both.
 pub fn load_clip(case: &Case) -> Result<(Clip, Option<GroundTruth>), ClipFileError> {
     let src = case.clip().ok_or_else(|| ClipFileError::NotAClip(case.name.clone()))?;
-    if !src.file.is_file() {
-        let hint = match src.kind {
-            ClipKind::Recording => "",
-            _ => " (the elegansbot kymograms are fetched and checksum-verified by scripts/fetch_worm_data.sh)",
+    if !src.file.exists() {
+        let hint = if is_fetched_data(&src.file) {
+            "; the elegansbot kymograms are fetched and checksum-verified by scripts/fetch_worm_data.sh"
+        } else {
+            ""
         };
-        return Err(ClipFileError::Missing { path: src.file.clone(), hint });
+        return Err(ClipFileError::Missing { path: src.file.clone(), case: case.name.clone(), hint });
     }
     let (mut clip, mut truth) = match &src.kind {
         ClipKind::Kymogram => {
             let params = case.kymogram_params().ok_or_else(|| ClipFileError::NotAClip(case.name.clone()))?;
-            (read_kymogram(&src.file, &params)?, None)
+            let rows = kymogram_rows(&src.file)?;
+            check_positions(&src.file, rows.len(), params.nodes)?;
+            (kymogram_clip(&src.file, &rows, &params), None)
         }
         ClipKind::Recording => {
             let dt = case.inverse().map(|i| i.params.frame_interval_s).unwrap_or(f64::NAN);
@@ -71,6 +124,10 @@ pub fn load_clip(case: &Case) -> Result<(Clip, Option<GroundTruth>), ClipFileErr
         if let Some(t) = &mut truth {
             t.select(a, b);
         }
+    }
+    if src.kind == ClipKind::Recording {
+        // Kymograms are scaled to the rod length by design; a recording's length is the user's.
+        check_lengths(&src.file, &clip.frames, src.frames.map_or(0, |f| f.0), case.mesh.length_m)?;
     }
     if src.orientation != Matrix3::identity() {
         clip.rotate(&src.orientation);
@@ -103,8 +160,14 @@ pub fn kymogram_rows(path: &Path) -> Result<Vec<Vec<f64>>, InputError> {
 }
 
 /// Read a kymogram `.npy` (frames × joints, float64, angles [rad]) into a [`Clip`].
-pub fn read_kymogram(path: &Path, params: &KymogramParams) -> Result<Clip, InputError> {
+pub fn read_kymogram(path: &Path, params: &KymogramParams) -> Result<Clip, ClipFileError> {
     let rows = kymogram_rows(path)?;
+    check_positions(path, rows.len(), params.nodes)?;
+    Ok(kymogram_clip(path, &rows, params))
+}
+
+/// The clip of the (non-empty) rows of the kymogram `path`.
+fn kymogram_clip(path: &Path, rows: &[Vec<f64>], params: &KymogramParams) -> Clip {
     let (frames, joints) = (rows.len(), rows[0].len());
     let scaled = if params.scale_to_length { ", scaled to the body length" } else { "" };
     let source = format!(
@@ -113,7 +176,7 @@ pub fn read_kymogram(path: &Path, params: &KymogramParams) -> Result<Clip, Input
         params.nodes,
         params.plane
     );
-    Ok(clip_from_angles(&rows, params, source))
+    clip_from_angles(rows, params, source)
 }
 
 /// Read a user recording: `.csv` (header `frame,node,x_m,y_m,z_m`) or `.npy` (frames × nodes × 3,
@@ -159,6 +222,14 @@ fn recording_npy(path: &Path) -> Result<Vec<Vec<Vector3<f64>>>, InputError> {
     if frames == 0 || nodes < 3 {
         return Err(shape(format!("recording of shape {:?}: need at least 1 frame and 3 nodes", a.shape)));
     }
+    // frames × nodes × 3 values were read: the product does not overflow.
+    if frames * nodes > MAX_CLIP_POSITIONS {
+        return Err(shape(format!(
+            "recording of shape {:?}: {} positions, more than the {MAX_CLIP_POSITIONS} a clip may hold",
+            a.shape,
+            frames * nodes
+        )));
+    }
     let mut out = Vec::with_capacity(frames);
     for (f, frame) in a.data.chunks_exact(3 * nodes).enumerate() {
         let pts: Vec<Vector3<f64>> = frame.chunks_exact(3).map(|c| Vector3::new(c[0], c[1], c[2])).collect();
@@ -170,16 +241,29 @@ fn recording_npy(path: &Path) -> Result<Vec<Vec<Vector3<f64>>>, InputError> {
     Ok(out)
 }
 
+/// One data row of a CSV recording.
+struct RecordingRow {
+    frame: usize,
+    node: usize,
+    row: usize,
+    position: Vector3<f64>,
+}
+
+/// The frames of a CSV recording. Every index read from the file is only compared and sorted,
+/// never used to size or index an allocation: the rows are sorted by (frame, node) and must run
+/// 0, 1, … in both, so the frames built hold exactly the rows the file has.
 fn recording_csv(path: &Path) -> Result<Vec<Vec<Vector3<f64>>>, InputError> {
-    let mut rdr = csv_reader(path, &RECORDING_HEADER)?;
-    // (frame, node) → (row, position)
-    let mut rows: BTreeMap<(usize, usize), (usize, Vector3<f64>)> = BTreeMap::new();
+    let mut rdr = csv_reader_capped(path, CSV_RECORDING_CAP_BYTES, "recording", &RECORDING_HEADER)?;
+    let mut rows: Vec<RecordingRow> = Vec::new();
     for (i, rec) in rdr.records().enumerate() {
         let row = i + 1;
         let bad = |reason: String| InputError::Row { path: path.to_path_buf(), row, reason };
         let rec = rec.map_err(|e| bad(e.to_string()))?;
         if rec.len() != 5 {
             return Err(bad(format!("{} columns, expected 5", rec.len())));
+        }
+        if rows.len() == MAX_CLIP_POSITIONS {
+            return Err(bad(format!("more than {MAX_CLIP_POSITIONS} rows, the most positions a clip may hold")));
         }
         let index = |k: usize| {
             rec[k]
@@ -189,32 +273,51 @@ fn recording_csv(path: &Path) -> Result<Vec<Vec<Vector3<f64>>>, InputError> {
         let (frame, node) = (index(0)?, index(1)?);
         let coord =
             |k: usize| rec[k].parse::<f64>().map_err(|e| bad(format!("{} `{}`: {e}", RECORDING_HEADER[k], &rec[k])));
-        let p = Vector3::new(coord(2)?, coord(3)?, coord(4)?);
-        check_position(path, frame, node, &p)?;
-        if let Some(&(first_row, _)) = rows.get(&(frame, node)) {
-            return Err(InputError::DuplicateRow { path: path.to_path_buf(), row, first_row, frame, node });
-        }
-        rows.insert((frame, node), (row, p));
+        let position = Vector3::new(coord(2)?, coord(3)?, coord(4)?);
+        check_position(path, frame, node, &position)?;
+        rows.push(RecordingRow { frame, node, row, position });
     }
-    let Some(&(last_frame, _)) = rows.keys().next_back() else {
+    if rows.is_empty() {
         return Err(InputError::Shape { path: path.to_path_buf(), reason: "no data rows".into() });
-    };
-    let mut frames: Vec<Vec<Vector3<f64>>> = vec![Vec::new(); last_frame + 1];
-    for (&(frame, node), &(_, p)) in &rows {
-        if node != frames[frame].len() {
-            return Err(InputError::MissingRow { path: path.to_path_buf(), frame, node: frames[frame].len() });
-        }
-        frames[frame].push(p);
     }
+    // Stable: rows of one (frame, node) stay in file order.
+    rows.sort_by_key(|r| (r.frame, r.node));
+    // The first repeated row in file order.
+    if let Some(w) =
+        rows.windows(2).filter(|w| (w[0].frame, w[0].node) == (w[1].frame, w[1].node)).min_by_key(|w| w[1].row)
+    {
+        let (first, dup) = (&w[0], &w[1]);
+        return Err(InputError::DuplicateRow {
+            path: path.to_path_buf(),
+            row: dup.row,
+            first_row: first.row,
+            frame: dup.frame,
+            node: dup.node,
+        });
+    }
+    let missing = |frame: usize, node: usize| InputError::MissingRow { path: path.to_path_buf(), frame, node };
+    let mut frames: Vec<Vec<Vector3<f64>>> = Vec::new();
+    for r in &rows {
+        // The frame this row must belong to: the current one, or the next.
+        let current = frames.len().checked_sub(1);
+        if current != Some(r.frame) {
+            if let Some(c) = current {
+                close_frame(path, c, &frames)?;
+            }
+            let next = frames.len();
+            if r.frame != next {
+                return Err(missing(next, 0));
+            }
+            frames.push(Vec::new());
+        }
+        let pts = frames.last_mut().expect("a frame was pushed");
+        if r.node != pts.len() {
+            return Err(missing(r.frame, pts.len()));
+        }
+        pts.push(r.position);
+    }
+    close_frame(path, frames.len() - 1, &frames)?;
     let expected = frames[0].len();
-    for (frame, pts) in frames.iter().enumerate() {
-        if pts.is_empty() {
-            return Err(InputError::MissingRow { path: path.to_path_buf(), frame, node: 0 });
-        }
-        if pts.len() != expected {
-            return Err(InputError::NodeCount { path: path.to_path_buf(), frame, nodes: pts.len(), expected });
-        }
-    }
     if expected < 3 {
         return Err(InputError::Shape {
             path: path.to_path_buf(),
@@ -224,204 +327,14 @@ fn recording_csv(path: &Path) -> Result<Vec<Vec<Vector3<f64>>>, InputError> {
     Ok(frames)
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::clip::tests::{menger_curvature, planar, wave};
-    use crate::clip::{kymogram_joints, ClipPlane, Spline, WORM_LENGTH_M};
-    use crate::io::npy::{npy_bytes, write_npy};
-    use std::path::PathBuf;
-
-    fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
-        let p = dir.join(name);
-        std::fs::write(&p, text).unwrap();
-        p
+/// Frame `frame` of a CSV recording is complete: as many nodes as frame 0.
+fn close_frame(path: &Path, frame: usize, frames: &[Vec<Vector3<f64>>]) -> Result<(), InputError> {
+    let (nodes, expected) = (frames[frame].len(), frames[0].len());
+    if nodes != expected {
+        return Err(InputError::NodeCount { path: path.to_path_buf(), frame, nodes, expected });
     }
-
-    #[test]
-    fn kymogram_npy_reads_and_malformed_ones_are_named() {
-        let dir = tempfile::tempdir().unwrap();
-        let p = dir.path().join("k.npy");
-        let rows = [wave(0.0), wave(0.7)];
-        write_npy(&p, &[2, 24], &rows.concat()).unwrap();
-        let clip = read_kymogram(&p, &KymogramParams::default()).unwrap();
-        assert_eq!(clip, clip_from_angles(&rows, &KymogramParams::default(), clip.source.clone()));
-        assert!(clip.source.contains("2 frames × 24 joint angles"), "{}", clip.source);
-        let err = |shape: &[usize], data: &[f64]| {
-            write_npy(&p, shape, data).unwrap();
-            let e = read_kymogram(&p, &KymogramParams::default()).unwrap_err().to_string();
-            assert!(e.contains("k.npy"), "{e}");
-            e
-        };
-        let mut bad = rows.concat();
-        bad[24 + 5] = f64::NAN;
-        assert!(err(&[2, 24], &bad).contains("frame 1, joint 5: angle NaN is not finite"));
-        bad[24 + 5] = f64::NEG_INFINITY;
-        assert!(err(&[2, 24], &bad).contains("frame 1, joint 5: angle -inf"));
-        assert!(err(&[2, 4, 6], &rows.concat()).contains("shape [2, 4, 6], expected 2 axes"));
-        assert!(err(&[0, 24], &[]).contains("empty"));
-        std::fs::write(&p, npy_bytes(&[2, 24], &rows.concat()).replace_f8_with(">f8")).unwrap();
-        let e = read_kymogram(&p, &KymogramParams::default()).unwrap_err().to_string();
-        assert!(e.contains("k.npy") && e.contains("dtype '>f8'"), "{e}");
-        let full = npy_bytes(&[2, 24], &rows.concat());
-        std::fs::write(&p, &full[..full.len() - 8]).unwrap();
-        let e = read_kymogram(&p, &KymogramParams::default()).unwrap_err().to_string();
-        assert!(e.contains("k.npy") && e.contains("truncated"), "{e}");
-        let e = read_kymogram(&dir.path().join("missing.npy"), &KymogramParams::default()).unwrap_err();
-        assert!(matches!(e, InputError::Open { .. }), "{e}");
-    }
-
-    trait ReplaceDescr {
-        fn replace_f8_with(self, descr: &str) -> Vec<u8>;
-    }
-    impl ReplaceDescr for Vec<u8> {
-        fn replace_f8_with(mut self, descr: &str) -> Vec<u8> {
-            let at = self.windows(3).position(|w| w == b"<f8").unwrap();
-            self.splice(at..at + 3, descr.bytes());
-            self
-        }
-    }
-
-    fn csv_text(frames: &[Vec<Vector3<f64>>]) -> String {
-        let mut s = RECORDING_HEADER.join(",") + "\n";
-        for (f, pts) in frames.iter().enumerate() {
-            for (i, p) in pts.iter().enumerate() {
-                s += &format!("{f},{i},{:e},{:e},{:e}\n", p.x, p.y, p.z);
-            }
-        }
-        s
-    }
-
-    fn sample_frames() -> Vec<Vec<Vector3<f64>>> {
-        (0..3)
-            .map(|f| (0..4).map(|i| Vector3::new(1e-5 * f as f64, 2e-5 * (i as f64).sin(), 3e-4 * i as f64)).collect())
-            .collect()
-    }
-
-    #[test]
-    fn recordings_read_from_csv_and_npy() {
-        let dir = tempfile::tempdir().unwrap();
-        let frames = sample_frames();
-        let p = write(dir.path(), "rec.csv", &csv_text(&frames));
-        let clip = read_recording(&p, 0.04).unwrap();
-        assert_eq!(
-            (clip.frames.clone(), clip.dt_s, clip.frame_count(), clip.node_count()),
-            (frames.clone(), 0.04, 3, 4)
-        );
-        assert!((clip.length_m - polyline_length(&frames[0])).abs() == 0.0);
-        // Rows in any order.
-        let text = csv_text(&frames);
-        let mut lines: Vec<&str> = text.lines().collect();
-        lines[1..].reverse();
-        let p = write(dir.path(), "rev.csv", &lines.join("\n"));
-        assert_eq!(read_recording(&p, 0.04).unwrap().frames, frames);
-        let p = dir.path().join("rec.npy");
-        let flat: Vec<f64> = frames.iter().flatten().flat_map(|v| [v.x, v.y, v.z]).collect();
-        write_npy(&p, &[3, 4, 3], &flat).unwrap();
-        assert_eq!(read_recording(&p, 0.04).unwrap().frames, frames);
-    }
-
-    #[test]
-    fn malformed_recordings_name_file_frame_node_and_row() {
-        let dir = tempfile::tempdir().unwrap();
-        let good = csv_text(&sample_frames());
-        let check = |name: &str, text: &str, wanted: &str| {
-            let p = write(dir.path(), name, text);
-            let e = read_recording(&p, 0.04).unwrap_err().to_string();
-            assert!(e.contains(name) && e.contains(wanted), "expected `{wanted}` in: {e}");
-        };
-        let lines: Vec<&str> = good.lines().collect();
-        // line k + 1 of the file is data row k; row 6 is frame 1, node 1.
-        check("nan.csv", &good.replace("1,1,1e-5,", "1,1,NaN,"), "frame 1, node 1: x = NaN is not finite");
-        check("inf.csv", &good.replacen(",0e0\n", ",inf\n", 1), "frame 0, node 0: z = inf is not finite");
-        check("header.csv", &good.replace("x_m", "x"), "expected [\"frame\", \"node\", \"x_m\", \"y_m\", \"z_m\"]");
-        check("missing.csv", &[&lines[..6], &lines[7..]].concat().join("\n"), "frame 1, node 1: no row");
-        check(
-            "dup.csv",
-            &[&lines[..], &[lines[6]]].concat().join("\n"),
-            "row 13: frame 1, node 1 already given in row 6",
-        );
-        check("count.csv", &[&lines[..], &["1,4,0,0,0"]].concat().join("\n"), "frame 1: 5 nodes, but frame 0 has 4");
-        check("gap.csv", &good.replace("\n2,", "\n3,"), "frame 2, node 0: no row");
-        check("few.csv", "frame,node,x_m,y_m,z_m\n0,0,0,0,0\n0,1,0,0,1\n", "2 nodes per frame, need at least 3");
-        check("text.csv", &good.replace("\n1,2,", "\n1,two,"), "row 7: node `two` is not a non-negative integer");
-        check("cols.csv", &good.replace("\n1,2,", "\n1,2,9,"), "row 7: ");
-        check("empty.csv", "frame,node,x_m,y_m,z_m\n", "no data rows");
-        check("rec.txt", &good, "unknown extension");
-        let npy = |name: &str, shape: &[usize], data: &[f64], wanted: &str| {
-            let p = dir.path().join(name);
-            write_npy(&p, shape, data).unwrap();
-            let e = read_recording(&p, 0.04).unwrap_err().to_string();
-            assert!(e.contains(name) && e.contains(wanted), "expected `{wanted}` in: {e}");
-        };
-        npy("two.npy", &[3, 4, 2], &[0.0; 24], "shape [3, 4, 2], expected frames × nodes × 3");
-        npy("flat.npy", &[12, 3], &[0.0; 36], "expected frames × nodes × 3");
-        npy("short.npy", &[3, 2, 3], &[0.0; 18], "need at least 1 frame and 3 nodes");
-        let mut data = vec![0.0; 36];
-        data[3 * 4 + 3 * 2 + 1] = f64::NAN;
-        npy("nan.npy", &[3, 4, 3], &data, "frame 1, node 2: y = NaN is not finite");
-        let p = dir.path().join("fortran.npy");
-        let mut b = npy_bytes(&[3, 4, 3], &[0.0; 36]);
-        let at = b.windows(5).position(|w| w == b"False").unwrap();
-        b.splice(at..at + 5, b"True ".iter().copied());
-        std::fs::write(&p, b).unwrap();
-        let e = read_recording(&p, 0.04).unwrap_err().to_string();
-        assert!(e.contains("fortran.npy") && e.contains("Fortran-order"), "{e}");
-    }
-
-    /// The real clips of `scripts/fetch_worm_data.sh`; skipped with a notice when absent.
-    #[test]
-    fn elegansbot_clips_load_when_fetched() {
-        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/elegansbot");
-        if !dir.is_dir() {
-            println!("SKIPPED: {} is absent (run scripts/fetch_worm_data.sh)", dir.display());
-            return;
-        }
-        for (name, frames) in [("kymogram_omega-turn.npy", 600), ("kymogram_delta-turn.npy", 300)] {
-            let path = dir.join(name);
-            let raw = read_npy(&path).unwrap();
-            assert_eq!(raw.shape, vec![frames, 24], "{name}");
-            let max_angle = raw.data.iter().fold(0.0f64, |m, a| m.max(a.abs()));
-            let clip = read_kymogram(&path, &KymogramParams::default()).unwrap();
-            assert_eq!((clip.frame_count(), clip.node_count(), clip.dt_s), (frames, 128, 1.0 / 32.0));
-            assert!(clip.frames.iter().flatten().all(|p| p.iter().all(|v| v.is_finite()) && p.y == 0.0));
-            let (jf, jdev) = clip.max_stretch_deviation();
-            let xz = clip.frames_with_tangent_near(&Vector3::y(), 1e-3).len();
-            let xy =
-                read_kymogram(&path, &KymogramParams { plane: ClipPlane::Xy, ..KymogramParams::default() }).unwrap();
-            let xy_near = xy.frames_with_tangent_near(&Vector3::y(), 1e-3).len();
-            // elegansbot's own orientation: head segment along +e1 in every frame, no rotation.
-            let unrotated = Clip {
-                frames: raw
-                    .data
-                    .chunks_exact(24)
-                    .map(|a| Spline::through(&planar(&kymogram_joints(a, WORM_LENGTH_M))).resample_by_arc_length(128).0)
-                    .collect(),
-                ..clip.clone()
-            };
-            let unrotated_near = unrotated.frames_with_tangent_near(&Vector3::y(), 1e-3).len();
-            // Frames whose continuous tangent passes through ±e2 somewhere: the x-component of
-            // the segment tangents changes sign (x–y placements).
-            let crossing = |c: &Clip| {
-                c.frames.iter().filter(|f| f.windows(3).any(|w| (w[1].x - w[0].x) * (w[2].x - w[1].x) <= 0.0)).count()
-            };
-            println!(
-                "{name}: frames whose tangent passes through ±e2: x–y chord along +e1 {}, x–y head along +e1 {}",
-                crossing(&xy),
-                crossing(&unrotated)
-            );
-            let kappa_max = clip.frames.iter().flat_map(|f| menger_curvature(f)).fold(0.0, f64::max);
-            let scaled =
-                read_kymogram(&path, &KymogramParams { scale_to_length: true, ..KymogramParams::default() }).unwrap();
-            let (sf, sdev) = scaled.max_stretch_deviation();
-            println!("{name}: scaled to the body length: max |j − 1| {sdev:.3e} (frame {sf})");
-            assert!(sdev < 1e-3, "{name}: scaled max |j − 1| = {sdev}");
-            println!(
-                "{name}: {frames} × 24, max |a_j| {max_angle:.3} rad, max |j − 1| {jdev:.3e} (frame {jf}), max κ {kappa_max:.4e} 1/m; \
-                 frames with a tangent within 1e-3 of ±e2: x–z {xz}, x–y chord along +e1 {xy_near}, x–y head along +e1 {unrotated_near}"
-            );
-            assert_eq!(xz, 0, "{name}: x–z placement keeps tangents off ±e2");
-            assert!(jdev < 0.02, "{name}: max |j − 1| = {jdev}");
-        }
-    }
+    Ok(())
 }
+
+#[cfg(test)]
+mod tests;

@@ -8,13 +8,18 @@ use std::path::Path;
 
 use nalgebra::Vector3;
 
-use super::files::{csv_reader, write_atomic, InputError, OutputError};
+use super::files::{csv_reader_capped, write_atomic, InputError, OutputError};
 use crate::model::chart::Chart;
 use crate::model::mesh::Mesh;
 use crate::run::NodalState;
 
 /// Column names of `data.csv`.
 pub const DATA_HEADER: [&str; 7] = ["s_m", "x_m", "y_m", "z_m", "alpha_rad", "beta_rad", "gamma_rad"];
+
+/// Largest `data.csv` read [bytes]: 256 MiB. A row is at most ~170 bytes (7 values with 17
+/// significant digits), so the largest mesh a case may have (`case::MAX_ELEMENTS`, 10⁶
+/// elements) writes ~170 MB; the committed cases (100 elements) write ~17 KB.
+pub const DATA_FILE_CAP_BYTES: u64 = 256 << 20;
 
 /// Text of `data.csv` for nodal fields (exact round trip).
 pub fn data_csv_text(nodes: &NodalState) -> String {
@@ -34,15 +39,21 @@ pub fn write_data(path: &Path, nodes: &NodalState) -> Result<(), OutputError> {
     write_atomic(path, data_csv_text(nodes).as_bytes())
 }
 
-/// Read `data.csv` and check it against the mesh: one row per node, `s` at the node positions
-/// (to 1e-9 L), every value finite.
+/// Read `data.csv` (at most [`DATA_FILE_CAP_BYTES`]) and check it against the mesh: one row
+/// per node, `s` at the node positions (to 1e-9 L), every value finite. Rows beyond the mesh's
+/// node count are counted, not kept.
 pub fn read_data(path: &Path, mesh: &Mesh) -> Result<NodalState, InputError> {
-    let mut rdr = csv_reader(path, &DATA_HEADER)?;
+    let mut rdr = csv_reader_capped(path, DATA_FILE_CAP_BYTES, "data file", &DATA_HEADER)?;
     let mut nodes = NodalState { s: Vec::new(), x: Vec::new(), alpha: Vec::new(), chart: Chart::default() };
+    let mut rows = 0;
     for (i, rec) in rdr.records().enumerate() {
         let row = i + 1;
+        rows = row;
         let bad = |reason: String| InputError::Row { path: path.to_path_buf(), row, reason };
         let rec = rec.map_err(|e| bad(e.to_string()))?;
+        if nodes.s.len() == mesh.nodes() {
+            continue;
+        }
         let v: Vec<f64> =
             rec.iter().map(|t| t.parse::<f64>().map_err(|e| bad(format!("`{t}`: {e}")))).collect::<Result<_, _>>()?;
         if v.len() != 7 {
@@ -56,8 +67,8 @@ pub fn read_data(path: &Path, mesh: &Mesh) -> Result<NodalState, InputError> {
         nodes.alpha.push(Vector3::new(v[4], v[5], v[6]));
     }
     let shape = |reason: String| InputError::Shape { path: path.to_path_buf(), reason };
-    if nodes.s.len() != mesh.nodes() {
-        return Err(shape(format!("{} node rows, but the case's mesh has {} nodes", nodes.s.len(), mesh.nodes())));
+    if rows != mesh.nodes() {
+        return Err(shape(format!("{rows} node rows, but the case's mesh has {} nodes", mesh.nodes())));
     }
     for (i, &s) in nodes.s.iter().enumerate() {
         if (s - mesh.node_s(i)).abs() > 1e-9 * mesh.length_m {
@@ -110,6 +121,26 @@ mod tests {
         std::fs::write(&p, good.replace("2.5000000000000000e-1", "NaN")).unwrap();
         let e = read_data(&p, &mesh).unwrap_err().to_string();
         assert!(e.contains("gamma_rad is not finite"), "{e}");
-        assert!(matches!(read_data(&dir.path().join("missing.csv"), &mesh), Err(InputError::Csv { .. })));
+        assert!(matches!(read_data(&dir.path().join("missing.csv"), &mesh), Err(InputError::Open { .. })));
+    }
+
+    /// Rows beyond the mesh are counted, not kept; a file beyond the cap is not read.
+    #[test]
+    fn extra_rows_and_oversized_files_are_refused() {
+        let mesh = Mesh::new(1e-3, 3);
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("data.csv");
+        let good = data_csv_text(&sample(&mesh));
+        let row = good.lines().nth(1).unwrap().to_string() + "\n";
+        std::fs::write(&p, good.clone() + &row.repeat(1000)).unwrap();
+        let e = read_data(&p, &mesh).unwrap_err().to_string();
+        assert!(e.ends_with("data.csv: 1004 node rows, but the case's mesh has 4 nodes"), "{e}");
+        let f = std::fs::File::create(&p).unwrap();
+        f.set_len(DATA_FILE_CAP_BYTES + 1).unwrap();
+        let e = read_data(&p, &mesh).unwrap_err().to_string();
+        assert!(
+            e.ends_with("data.csv: data file of 268435457 bytes is larger than 268435456 bytes (256 MiB), the cap for data files"),
+            "{e}"
+        );
     }
 }

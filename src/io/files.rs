@@ -2,8 +2,10 @@
 //! reading and writing files. Every output of the crate goes through [`write_atomic`]: it is
 //! written to a temporary name in the target directory and renamed into place, so a failure
 //! never leaves a half-written file; files are created with the process's umask (readable by
-//! others where the umask says so).
-use std::io::Write;
+//! others where the umask says so). Every input file is read through [`read_capped`], which
+//! refuses a file larger than its reader's cap before reading it, and stops reading a device or
+//! pipe that never ends at the cap.
+use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 
@@ -62,6 +64,71 @@ pub enum InputError {
     MissingRow { path: PathBuf, frame: usize, node: usize },
     #[error("{path}, row {row}: frame {frame}, node {node} already given in row {first_row}")]
     DuplicateRow { path: PathBuf, row: usize, first_row: usize, frame: usize, node: usize },
+    #[error("{}", too_large_text(path, what, *.size, *.cap))]
+    TooLarge {
+        path: PathBuf,
+        what: &'static str,
+        /// the size of a regular file; `None`: more than `cap` bytes were read from a stream
+        size: Option<u64>,
+        cap: u64,
+    },
+    #[error("{path}: {what} is not UTF-8 text (invalid byte at offset {offset})")]
+    NotText { path: PathBuf, what: &'static str, offset: usize },
+}
+
+/// The message of `InputError::TooLarge`.
+fn too_large_text(path: &Path, what: &str, size: Option<u64>, cap: u64) -> String {
+    let cap_text = format!("{cap} bytes ({}), the cap for {what}s", human_bytes(cap));
+    match size {
+        Some(n) => format!("{}: {what} of {n} bytes is larger than {cap_text}", path.display()),
+        None => format!(
+            "{}: {what} is not a regular file and did not end within {cap_text}: reading stopped there",
+            path.display()
+        ),
+    }
+}
+
+/// `n` bytes in the largest binary unit that divides it (`1 MiB`, `256 MiB`, `1 GiB`).
+pub fn human_bytes(n: u64) -> String {
+    match [(30, "GiB"), (20, "MiB"), (10, "KiB")]
+        .iter()
+        .find(|(shift, _)| n >= 1 << shift && n.is_multiple_of(1 << shift))
+    {
+        Some(&(shift, unit)) => format!("{} {unit}", n >> shift),
+        None => format!("{n} bytes"),
+    }
+}
+
+/// The whole content of the input file `path` (`what` names its kind in messages: "recording",
+/// "kymogram", …), refused if it holds more than `cap` bytes. A regular file is refused by its
+/// size before it is read; anything else (a device, a pipe) is read through
+/// `Read::take(cap + 1)`, so `/dev/zero` is refused after `cap + 1` bytes instead of being
+/// read forever. The caps are chosen per reader, far above any real input of its kind.
+pub fn read_capped(path: &Path, cap: u64, what: &'static str) -> Result<Vec<u8>, InputError> {
+    let open = |source| InputError::Open { path: path.to_path_buf(), source };
+    let too_large = |size| InputError::TooLarge { path: path.to_path_buf(), what, size, cap };
+    let file = std::fs::File::open(path).map_err(open)?;
+    let meta = file.metadata().map_err(open)?;
+    if meta.is_file() && meta.len() > cap {
+        return Err(too_large(Some(meta.len())));
+    }
+    let expected = if meta.is_file() { meta.len() } else { 0 };
+    let mut bytes = Vec::with_capacity(usize::try_from(expected.min(cap)).unwrap_or(0));
+    file.take(cap.saturating_add(1)).read_to_end(&mut bytes).map_err(open)?;
+    if bytes.len() as u64 > cap {
+        // A regular file that grew while it was read has at least this many bytes.
+        return Err(too_large(meta.is_file().then_some(bytes.len() as u64)));
+    }
+    Ok(bytes)
+}
+
+/// [`read_capped`] for a text file: its content must be UTF-8.
+pub fn read_capped_text(path: &Path, cap: u64, what: &'static str) -> Result<String, InputError> {
+    String::from_utf8(read_capped(path, cap, what)?).map_err(|e| InputError::NotText {
+        path: path.to_path_buf(),
+        what,
+        offset: e.utf8_error().valid_up_to(),
+    })
 }
 
 static TMP_COUNTER: AtomicU64 = AtomicU64::new(0);
@@ -117,7 +184,26 @@ pub fn csv_text_opt(header: &[&str], rows: impl Iterator<Item = Vec<Option<f64>>
 /// A CSV reader of `path` whose header must be `expected` (fields trimmed).
 pub fn csv_reader(path: &Path, expected: &[&str]) -> Result<csv::Reader<std::fs::File>, InputError> {
     let csv_err = |source| InputError::Csv { path: path.to_path_buf(), source };
-    let mut rdr = csv::ReaderBuilder::new().trim(csv::Trim::All).from_path(path).map_err(csv_err)?;
+    let rdr = csv::ReaderBuilder::new().trim(csv::Trim::All).from_path(path).map_err(csv_err)?;
+    with_header(path, rdr, expected)
+}
+
+/// A CSV reader of the input file `path`, read whole through [`read_capped`], whose header
+/// must be `expected` (fields trimmed).
+pub fn csv_reader_capped(
+    path: &Path,
+    cap: u64,
+    what: &'static str,
+    expected: &[&str],
+) -> Result<csv::Reader<std::io::Cursor<Vec<u8>>>, InputError> {
+    let bytes = read_capped(path, cap, what)?;
+    let rdr = csv::ReaderBuilder::new().trim(csv::Trim::All).from_reader(std::io::Cursor::new(bytes));
+    with_header(path, rdr, expected)
+}
+
+/// `rdr` if its header is `expected`.
+fn with_header<R: Read>(path: &Path, mut rdr: csv::Reader<R>, expected: &[&str]) -> Result<csv::Reader<R>, InputError> {
+    let csv_err = |source| InputError::Csv { path: path.to_path_buf(), source };
     let found: Vec<String> = rdr.headers().map_err(csv_err)?.iter().map(String::from).collect();
     if found != expected {
         return Err(InputError::Header {
@@ -147,6 +233,44 @@ mod tests {
         let e = write_atomic(&dir.path().join("d"), b"x").unwrap_err();
         assert!(e.to_string().contains("/d"), "{e}");
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 2);
+    }
+
+    /// A file over the cap is refused by its size, a stream that never ends after cap + 1
+    /// bytes; at the cap it is read.
+    #[test]
+    fn capped_reads_refuse_large_files_and_endless_streams() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("r.csv");
+        std::fs::write(&p, vec![b'x'; 1024]).unwrap();
+        assert_eq!(read_capped(&p, 1024, "recording").unwrap().len(), 1024);
+        let e = read_capped(&p, 1023, "recording").unwrap_err().to_string();
+        assert_eq!(
+            e,
+            format!(
+                "{}: recording of 1024 bytes is larger than 1023 bytes (1023 bytes), the cap for recordings",
+                p.display()
+            )
+        );
+        std::fs::write(&p, [0xff, 0xfe]).unwrap();
+        let e = read_capped_text(&p, 1024, "audit spec").unwrap_err().to_string();
+        assert_eq!(e, format!("{}: audit spec is not UTF-8 text (invalid byte at offset 0)", p.display()));
+        let e = read_capped(&dir.path().join("none"), 1024, "recording").unwrap_err();
+        assert!(matches!(e, InputError::Open { .. }), "{e}");
+        assert_eq!(
+            (human_bytes(1 << 20), human_bytes(256 << 20), human_bytes(1 << 30)),
+            ("1 MiB".into(), "256 MiB".into(), "1 GiB".into())
+        );
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn dev_zero_is_refused_at_the_cap() {
+        let e = read_capped(Path::new("/dev/zero"), 1 << 20, "case file").unwrap_err().to_string();
+        assert_eq!(
+            e,
+            "/dev/zero: case file is not a regular file and did not end within 1048576 bytes (1 MiB), the cap for \
+             case files: reading stopped there"
+        );
     }
 
     #[cfg(unix)]

@@ -13,9 +13,13 @@
 //! is an error that says what was found; no value is guessed or converted.
 use std::path::Path;
 
-use super::files::{write_atomic, InputError, OutputError};
+use super::files::{read_capped, write_atomic, InputError, OutputError};
 
 const MAGIC: &[u8] = b"\x93NUMPY";
+
+/// Largest `.npy` file read [bytes]: 1 GiB. The elegansbot kymograms are 58 KB and 115 KB; the
+/// paper's clip as a recording (1160 frames × 128 nodes × 3 float64) is 3.6 MB.
+pub const NPY_FILE_CAP_BYTES: u64 = 1 << 30;
 
 /// A C-order float64 array read from an `.npy` file.
 #[derive(Debug, Clone, PartialEq)]
@@ -26,9 +30,9 @@ pub struct NpyArray {
     pub data: Vec<f64>,
 }
 
-/// Read a little-endian float64, C-order `.npy` file.
+/// Read a little-endian float64, C-order `.npy` file of at most [`NPY_FILE_CAP_BYTES`].
 pub fn read_npy(path: &Path) -> Result<NpyArray, InputError> {
-    let bytes = std::fs::read(path).map_err(|source| InputError::Open { path: path.to_path_buf(), source })?;
+    let bytes = read_capped(path, NPY_FILE_CAP_BYTES, ".npy file")?;
     parse_npy(&bytes).map_err(|reason| InputError::Npy { path: path.to_path_buf(), reason })
 }
 
@@ -65,8 +69,10 @@ pub fn npy_bytes(shape: &[usize], data: &[f64]) -> Vec<u8> {
     out
 }
 
-/// Parse the bytes of an `.npy` file; the error is the reason, without the file name.
-fn parse_npy(bytes: &[u8]) -> Result<NpyArray, String> {
+/// Parse the bytes of an `.npy` file; the error is the reason, without the file name. Every
+/// length read from the file (header length, shape) is checked against the bytes there are
+/// before anything is allocated or indexed.
+pub fn parse_npy(bytes: &[u8]) -> Result<NpyArray, String> {
     if bytes.len() < MAGIC.len() + 2 || &bytes[..MAGIC.len()] != MAGIC {
         return Err("missing the magic string \\x93NUMPY (not an .npy file, or truncated)".into());
     }
@@ -83,13 +89,14 @@ fn parse_npy(bytes: &[u8]) -> Result<NpyArray, String> {
         }
         v => return Err(format!("format version {v}.x is not supported (1.0, 2.0 or 3.0)")),
     };
-    let header = bytes
-        .get(data_start..data_start + header_len)
+    let header = data_start
+        .checked_add(header_len)
+        .and_then(|end| bytes.get(data_start..end))
         .ok_or_else(|| format!("truncated: the header is {header_len} bytes, the file ends before it does"))?;
     let header = std::str::from_utf8(header).map_err(|_| "the header is not text".to_string())?;
     let (descr, fortran, shape) = parse_header(header)?;
     if descr != "<f8" {
-        return Err(format!("dtype '{descr}', expected little-endian float64 '<f8'"));
+        return Err(format!("dtype '{}', expected little-endian float64 '<f8'", preview(&descr)));
     }
     if fortran {
         return Err("Fortran-order array (fortran_order: True); expected C order".into());
@@ -113,16 +120,21 @@ fn parse_header(header: &str) -> Result<(String, bool, Vec<usize>), String> {
         .trim()
         .strip_prefix('{')
         .and_then(|h| h.strip_suffix('}'))
-        .ok_or_else(|| format!("header {header:?} is not a dictionary"))?;
+        .ok_or_else(|| format!("header {:?} is not a dictionary", preview(header)))?;
     let (mut descr, mut fortran, mut shape) = (None, None, None);
     let mut rest = inner.trim();
+    let mut seen: Vec<&str> = Vec::new();
     while !rest.is_empty() {
-        let (key, after) =
-            quoted(rest).ok_or_else(|| format!("header {inner:?}: expected a quoted key at {rest:?}"))?;
+        let (key, after) = quoted(rest)
+            .ok_or_else(|| format!("header {:?}: expected a quoted key at {:?}", preview(inner), preview(rest)))?;
+        if seen.contains(&key) {
+            return Err(format!("header: key '{}' given twice", preview(key)));
+        }
+        seen.push(key);
         let after = after
             .trim_start()
             .strip_prefix(':')
-            .ok_or_else(|| format!("header: expected ':' after '{key}'"))?
+            .ok_or_else(|| format!("header: expected ':' after '{}'", preview(key)))?
             .trim_start();
         let after = match key {
             "descr" => {
@@ -137,7 +149,7 @@ fn parse_header(header: &str) -> Result<(String, bool, Vec<usize>), String> {
                 } else if let Some(a) = after.strip_prefix("False") {
                     (false, a)
                 } else {
-                    return Err(format!("header: 'fortran_order' is neither True nor False at {after:?}"));
+                    return Err(format!("header: 'fortran_order' is neither True nor False at {:?}", preview(after)));
                 };
                 fortran = Some(v);
                 a
@@ -145,19 +157,22 @@ fn parse_header(header: &str) -> Result<(String, bool, Vec<usize>), String> {
             "shape" => {
                 let body = after.strip_prefix('(').ok_or("header: 'shape' is not a tuple")?;
                 let close = body.find(')').ok_or("header: 'shape' tuple is not closed")?;
-                let dims = body[..close]
-                    .split(',')
-                    .map(str::trim)
-                    .filter(|t| !t.is_empty())
+                let entries: Vec<&str> =
+                    body[..close].split(',').map(str::trim).filter(|t| !t.is_empty()).take(MAX_AXES + 1).collect();
+                if entries.len() > MAX_AXES {
+                    return Err(format!("header: shape has more than {MAX_AXES} axes, the most an array has"));
+                }
+                let dims = entries
+                    .into_iter()
                     .map(|t| {
                         t.parse::<usize>()
-                            .map_err(|_| format!("header: shape entry '{t}' is not a non-negative integer"))
+                            .map_err(|_| format!("header: shape entry '{}' is not a non-negative integer", preview(t)))
                     })
                     .collect::<Result<Vec<_>, _>>()?;
                 shape = Some(dims);
                 &body[close + 1..]
             }
-            other => return Err(format!("header: unknown key '{other}'")),
+            other => return Err(format!("header: unknown key '{}'", preview(other))),
         };
         rest = after.trim_start();
         rest = rest.strip_prefix(',').unwrap_or(rest).trim_start();
@@ -167,6 +182,17 @@ fn parse_header(header: &str) -> Result<(String, bool, Vec<usize>), String> {
         fortran.ok_or("header has no 'fortran_order'")?,
         shape.ok_or("header has no 'shape'")?,
     ))
+}
+
+/// Most axes of an array (NumPy 2's `NPY_MAXDIMS`).
+const MAX_AXES: usize = 64;
+
+/// At most the first 40 characters of `s` (for messages about a malformed header).
+fn preview(s: &str) -> String {
+    match s.char_indices().nth(40) {
+        Some((end, _)) => format!("{}…", &s[..end]),
+        None => s.to_string(),
+    }
 }
 
 /// A single- or double-quoted string at the start of `s`, and the rest after it.
@@ -232,5 +258,39 @@ mod tests {
         assert!(parse_npy(&long).unwrap_err().contains("8 bytes after the data"));
         let e = parse_npy(&edit("(2, 3)", "(2,-3)")).unwrap_err();
         assert!(e.contains("'-3'"), "{e}");
+        let e = parse_npy(&edit("'fortran_order'", "'descr'        ")).unwrap_err();
+        assert_eq!(e, "header: key 'descr' given twice");
+    }
+
+    /// Lengths from the file (header length, shape) that overflow or exceed the bytes present.
+    #[test]
+    fn hostile_lengths_are_errors() {
+        let header = |h: &str, version: u8| {
+            let mut b = MAGIC.to_vec();
+            b.extend_from_slice(&[version, 0]);
+            if version == 1 {
+                b.extend_from_slice(&(h.len() as u16).to_le_bytes());
+            } else {
+                b.extend_from_slice(&(h.len() as u32).to_le_bytes());
+            }
+            b.extend_from_slice(h.as_bytes());
+            b
+        };
+        let mut b = MAGIC.to_vec();
+        b.extend_from_slice(&[2, 0, 0xff, 0xff, 0xff, 0xff]);
+        assert_eq!(
+            parse_npy(&b).unwrap_err(),
+            "truncated: the header is 4294967295 bytes, the file ends before it does"
+        );
+        let e = parse_npy(&header("{'descr': '<f8', 'fortran_order': False, 'shape': (4294967296, 4294967296, 2)}", 1));
+        assert_eq!(e.unwrap_err(), "shape overflows");
+        let e = parse_npy(&header("{'descr': '<f8', 'fortran_order': False, 'shape': (1000000000000,)}", 3));
+        assert_eq!(e.unwrap_err(), "truncated: shape [1000000000000] needs 8000000000000 data bytes, the file has 0");
+        let axes = vec!["1"; 65].join(",");
+        let e = parse_npy(&header(&format!("{{'descr': '<f8', 'fortran_order': False, 'shape': ({axes})}}"), 1));
+        assert_eq!(e.unwrap_err(), "header: shape has more than 64 axes, the most an array has");
+        let long = "x".repeat(100_000);
+        let e = parse_npy(&header(&format!("{{'descr': '{long}', 'fortran_order': False, 'shape': (1,)}}"), 2));
+        assert_eq!(e.unwrap_err(), format!("dtype '{}…', expected little-endian float64 '<f8'", "x".repeat(40)));
     }
 }

@@ -1,0 +1,137 @@
+//! `[clip]`: a recorded, kymogram or synthetic clip, on a mesh fine enough for the clip's
+//! measures.
+use std::path::Path;
+
+use nalgebra::{Rotation3, Vector3};
+
+use super::super::raw::{RawClip, RawClipKind, RawPlane, RawRotation, RawStart};
+use super::super::{CaseError, ClipKind, ClipSource, SyntheticClip};
+use super::Validator;
+use crate::clip::synthetic::RollClipParams;
+use crate::clip::{ClipPlane, CLIP_SKIP_ELEMENTS, MAX_CLIP_POSITIONS, MIN_CLIP_ELEMENTS};
+use crate::model::mesh::Mesh;
+use crate::solve::sequence::{FrameStart, RotationTreatment};
+
+impl Validator<'_> {
+    /// `[clip]`: a recorded or synthetic clip.
+    pub(super) fn clip(&self, cl: &RawClip, mesh: &Mesh) -> Result<ClipSource, CaseError> {
+        if mesh.elements < MIN_CLIP_ELEMENTS {
+            return Err(self.err(
+                "rod.elements",
+                format!(
+                    "a clip case needs at least {MIN_CLIP_ELEMENTS} elements, got {}: the clip's measures leave out \
+                     {CLIP_SKIP_ELEMENTS} elements at each end (curvature errors, ground truth) and the roughness \
+                     needs 3 curvature values",
+                    mesh.elements
+                ),
+            ));
+        }
+        let base = self.path.parent().unwrap_or(Path::new(""));
+        let frames = match cl.frames {
+            Some([a, b]) if a < b => Some((a, b)),
+            Some([a, b]) => {
+                return Err(self.err("clip.frames", format!("expected [first, end) with first < end, got [{a}, {b}]")))
+            }
+            None => None,
+        };
+        if !(cl.min_cos_beta >= 0.0 && cl.min_cos_beta < 1.0) {
+            return Err(self.err("clip.min_cos_beta", format!("must lie in [0, 1), got {}", cl.min_cos_beta)));
+        }
+        let plane = match cl.plane {
+            RawPlane::Xz => ClipPlane::Xz,
+            RawPlane::Xy => ClipPlane::Xy,
+        };
+        if let Some(v) = cl.orientation.iter().flatten().find(|v| !v.is_finite()) {
+            return Err(self.err("clip.orientation", format!("must be a finite rotation vector [rad], got {v}")));
+        }
+        let orientation = Rotation3::new(Vector3::from(cl.orientation.unwrap_or([0.0; 3]))).into_inner();
+        if orientation.iter().any(|c| !c.is_finite()) {
+            return Err(self.err(
+                "clip.orientation",
+                format!("rotation vector {:?} [rad] is too long: its angle is not finite", cl.orientation),
+            ));
+        }
+        let gauge = match cl.gauge {
+            Some(g) => {
+                let (v, norm) = (Vector3::from(g), Vector3::from(g).norm());
+                if !(norm.is_finite() && norm > 1e-12) {
+                    return Err(self.err("clip.gauge", format!("must be a finite non-zero vector, got {g:?}")));
+                }
+                v / norm
+            }
+            None => match plane {
+                ClipPlane::Xz => Vector3::y(),
+                ClipPlane::Xy => Vector3::z(),
+            },
+        };
+        let frame_interval_s = self.positive("clip.frame_interval_s", &cl.frame_interval_s)?;
+        let kind = match cl.kind {
+            RawClipKind::Kymogram => ClipKind::Kymogram,
+            RawClipKind::Recording => ClipKind::Recording,
+            RawClipKind::Roll3d => ClipKind::Roll3d(self.synthetic(cl, mesh, frame_interval_s)?),
+        };
+        if !matches!(kind, ClipKind::Roll3d(_))
+            && (cl.roll_total_rad.is_some()
+                || cl.twist_per_m.is_some()
+                || cl.clip_frames.is_some()
+                || cl.substeps.is_some())
+        {
+            return Err(self.err(
+                "clip",
+                "roll_total_rad, twist_per_m, clip_frames and substeps apply to kind = \"roll_3d\" only",
+            ));
+        }
+        Ok(ClipSource {
+            kind,
+            file: base.join(&cl.file),
+            frames,
+            min_cos_beta: cl.min_cos_beta,
+            start: match cl.start {
+                RawStart::PreviousFrame => FrameStart::PreviousFrame,
+                RawStart::DataGuess => FrameStart::DataGuess,
+            },
+            rotation: match cl.rotation {
+                RawRotation::Rebased => RotationTreatment::Rebased,
+                RawRotation::GlobalEuler => RotationTreatment::GlobalEuler,
+            },
+            plane,
+            orientation,
+            gauge: orientation * gauge,
+        })
+    }
+
+    /// The `roll_3d` keys of `[clip]` (nodes, length and Δt are the mesh's and the clip's).
+    fn synthetic(&self, cl: &RawClip, mesh: &Mesh, dt_s: f64) -> Result<SyntheticClip, CaseError> {
+        let d = RollClipParams::default();
+        let synthetic = SyntheticClip {
+            frames: cl.clip_frames.unwrap_or(d.frames),
+            roll_total_rad: cl
+                .roll_total_rad
+                .as_ref()
+                .map(|v| self.scalar("clip.roll_total_rad", v))
+                .transpose()?
+                .unwrap_or(d.roll_total_rad),
+            twist_per_m: cl
+                .twist_per_m
+                .as_ref()
+                .map(|v| self.scalar("clip.twist_per_m", v))
+                .transpose()?
+                .unwrap_or(d.twist_per_m),
+            time_mapping: d.time_mapping,
+            substeps: cl.substeps.unwrap_or(d.substeps),
+        };
+        synthetic.params(mesh, dt_s).validate().map_err(|e| self.err("clip", e.to_string()))?;
+        let positions = synthetic.frames.saturating_mul(mesh.nodes());
+        if positions > MAX_CLIP_POSITIONS {
+            return Err(self.err(
+                "clip.clip_frames",
+                format!(
+                    "{} frames × {} nodes are {positions} positions, more than the {MAX_CLIP_POSITIONS} a clip may hold",
+                    synthetic.frames,
+                    mesh.nodes()
+                ),
+            ));
+        }
+        Ok(synthetic)
+    }
+}
