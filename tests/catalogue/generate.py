@@ -179,7 +179,7 @@ BASE_INVERSE_NEWTON = BASE_INVERSE.replace(
 )
 
 
-def clip_base(description, clip, elements=9):
+def clip_base(description, clip, elements=11):
     return f'''description = "{description}"
 
 [constants]
@@ -229,11 +229,11 @@ start = "data_guess"
 
 
 BASE_RECORDING = clip_base(
-    "catalogue base: inverse problem on a recorded clip (CSV, 3 frames x 10 nodes)",
+    "catalogue base: inverse problem on a recorded clip (CSV, 3 frames x 12 nodes)",
     recording_clip("../recordings/good.csv"),
 )
 BASE_RECORDING_NPY = clip_base(
-    "catalogue base: inverse problem on a recorded clip (NPY, 3 frames x 10 nodes x 3)",
+    "catalogue base: inverse problem on a recorded clip (NPY, 3 frames x 12 nodes x 3)",
     recording_clip("../recordings/good.npy"),
 )
 BASE_KYMOGRAM = clip_base(
@@ -273,9 +273,9 @@ BASES = {
 }
 
 # ---------------------------------------------------------------------------------------------
-# Recordings: 3 frames of 10 nodes on a body of 1 mm, planar arcs of growing curvature.
+# Recordings: 3 frames of 12 nodes on a body of 1 mm, planar arcs of growing curvature.
 
-NODES = 10
+NODES = 12
 LENGTH = 1e-3
 
 
@@ -767,7 +767,7 @@ case("rec_file_is_directory", "base_recording", [('file = "../recordings/good.cs
 case("kymo_missing_file", "base_kymogram",
      [('file = "../recordings/kymogram_good.npy"', 'file = "../data/elegansbot/kymogram_omega_turn.npy"')],
      ["kymogram_omega_turn.npy", NO_FILE], "a kymogram file name with _ for -", kind="recording", file_word=False)
-case("rec_wrong_node_count", "base_recording", [("elements = 9", "elements = 11")],
+case("rec_wrong_node_count", "base_recording", [("elements = 11", "elements = 13")],
      ["good.csv", "10", "12", "nodes"], "a 10-node recording on a 12-node mesh", kind="recording", file_word=False)
 case("rec_wrong_extension_case", "base_recording", [('file = "../recordings/good.csv"', 'file = "../recordings/good.CSV"')],
      ["good.CSV", NO_FILE + "|extension"], "an upper-case extension that is not the file's", kind="recording", file_word=False)
@@ -831,7 +831,7 @@ recording("rec_length_1p2", rows_text(csv_rows(scaled(GOOD_FRAMES, 1.2))),
 three = [arc(k, n=3) for k in (400.0, 600.0, 800.0)]
 recording("rec_three_nodes", rows_text(csv_rows(three)), ["3 nodes|3 points", "too few|at least|not enough"],
           "a 3-node recording (head, middle, tail) on a matching 2-element rod",
-          extra_edits=[("elements = 9", "elements = 2")])
+          extra_edits=[("elements = 11", "elements = 2")])
 zero = [list(GOOD_FRAMES[0])] + [[(0.0, 0.0, 0.0)] * NODES] + [list(GOOD_FRAMES[2])]
 recording("rec_zero_length_frame", rows_text(csv_rows(zero)), ["frame 1", "length|coincid|same point"],
           "a frame whose points all sit at the origin (tracking lost)")
@@ -861,7 +861,7 @@ npy_rec("npy_int64", npy_bytes([3, NODES, 3], [int(v * 1e6) for v in GOOD_FLAT],
         ["<i8|int64", "<f8|float64"], "integer positions (micrometres)")
 npy_rec("npy_big_endian", npy_bytes([3, NODES, 3], GOOD_FLAT, descr=">f8", fmt=">d"), [">f8|big-endian", "<f8|little-endian"],
         "big-endian float64")
-npy_rec("npy_2d", npy_bytes([3, NODES * 3], GOOD_FLAT), ["shape", "(3, 30)|[3, 30]", "× 3|x 3|3 axes|frames"],
+npy_rec("npy_2d", npy_bytes([3, NODES * 3], GOOD_FLAT), ["shape", "(3, 36)|[3, 36]", "× 3|x 3|3 axes|frames"],
         "frames × (nodes·3): the positions flattened per frame")
 npy_rec("npy_xy_only", npy_bytes([3, NODES, 2], [c for pts in GOOD_FRAMES for p in pts for c in (p[0], p[2])]),
         ["(3, 10, 2)|[3, 10, 2]", "× 3|x 3|3 coordinates|x, y, z"], "2D positions (x, z) without y")
@@ -886,7 +886,7 @@ npy_rec("npy_trailing_bytes", npy_bytes([3, NODES, 3], GOOD_FLAT) + b"\0" * 8, [
         "8 stray bytes after the data")
 npy_rec("npy_version_9", npy_bytes([3, NODES, 3], GOOD_FLAT)[:6] + bytes([9]) + npy_bytes([3, NODES, 3], GOOD_FLAT)[7:],
         ["version"], "an unknown NPY format version")
-npy_rec("kymo_3d", npy_bytes([3, NODES, 3], GOOD_FLAT), ["2 axes|frames × joint|joint angles", "(3, 10, 3)|[3, 10, 3]"],
+npy_rec("kymo_3d", npy_bytes([3, NODES, 3], GOOD_FLAT), ["2 axes|frames × joint|joint angles", "(3, 12, 3)|[3, 12, 3]"],
         "a position recording given as a kymogram", base="base_kymogram")
 kn = [a for r in kymogram_rows() for a in r]
 kn[24 + 7] = float("nan")
