@@ -9,8 +9,8 @@
 //! shrunk, and goes into a unit test next to the code it breaks. The inputs are generated in
 //! `fuzz_inputs`.
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
-use std::sync::OnceLock;
+use std::io::Write;
+use std::path::Path;
 
 use cosserat::case::{Case, MAX_ELEMENTS};
 use cosserat::clip::MIN_CLIP_ELEMENTS;
@@ -50,20 +50,17 @@ fn says_something(e: &dyn std::error::Error) -> Result<(), TestCaseError> {
     Ok(())
 }
 
-/// A scratch directory for the readers that take a path, one file per target; in memory
-/// (`/dev/shm`) where there is one: rewriting a small file on a disk can cost milliseconds
-/// (measured: 2.8 ms per rewrite on the ext4 disk of the development machine, 30–50 s per
-/// target of 10⁴ inputs; 0.05 ms on tmpfs).
-fn scratch(name: &str) -> PathBuf {
-    static DIR: OnceLock<tempfile::TempDir> = OnceLock::new();
-    DIR.get_or_init(|| {
-        let shm = Path::new("/dev/shm");
-        let in_memory =
-            if shm.is_dir() { tempfile::Builder::new().prefix("cosserat-fuzz").tempdir_in(shm).ok() } else { None };
-        in_memory.unwrap_or_else(|| tempfile::tempdir().expect("temporary directory"))
-    })
-    .path()
-    .join(name)
+/// A scratch file holding `bytes` for the readers that take a path, named `*{suffix}` (the
+/// recording reader goes by the extension), removed when dropped. In memory (`/dev/shm`) where
+/// there is one: writing a small file on a disk can cost milliseconds (measured: 2.8 ms per
+/// rewrite on the ext4 disk of the development machine, 30–50 s per target of 10⁴ inputs;
+/// 0.05 ms on tmpfs).
+fn scratch(bytes: &[u8], suffix: &str) -> tempfile::NamedTempFile {
+    let shm = Path::new("/dev/shm");
+    let dir = if shm.is_dir() { shm.to_path_buf() } else { std::env::temp_dir() };
+    let mut f = tempfile::Builder::new().prefix("cosserat-fuzz").suffix(suffix).tempfile_in(dir).expect("scratch file");
+    f.write_all(bytes).expect("scratch file");
+    f
 }
 
 // ------------------------------------------------------------------------------ case files
@@ -201,10 +198,6 @@ proptest! {
 
 // ------------------------------------------------------------------------------ CSV readers
 
-fn write(path: &Path, bytes: &[u8]) {
-    std::fs::write(path, bytes).expect("scratch file");
-}
-
 proptest! {
     #![proptest_config(config())]
 
@@ -220,9 +213,8 @@ proptest! {
             Some(body) => format!("{}\n{body}", RECORDING_HEADER.join(",")),
             None => edited(&recording_text(frames, nodes, &order), &edits),
         };
-        let path = scratch("rec.csv");
-        write(&path, text.as_bytes());
-        match read_recording(&path, 0.04) {
+        let file = scratch(text.as_bytes(), ".csv");
+        match read_recording(file.path(), 0.04) {
             Ok(clip) => {
                 // CSV ends a record at \n, \r or both: at most this many data rows.
                 let rows = text.split(['\n', '\r']).count().saturating_sub(1);
@@ -251,9 +243,8 @@ proptest! {
             .collect::<Vec<_>>()
             .join("\n");
         let bytes = raw.unwrap_or_else(|| edited(&good, &edits).into_bytes());
-        let path = scratch("data.csv");
-        write(&path, &bytes);
-        match read_data(&path, &mesh) {
+        let file = scratch(&bytes, ".csv");
+        match read_data(file.path(), &mesh) {
             Ok(d) => {
                 prop_assert_eq!(d.s.len(), mesh.nodes());
                 prop_assert!(d.x.iter().chain(&d.alpha).all(|v| v.iter().all(|c| c.is_finite())));
@@ -285,15 +276,12 @@ proptest! {
             }
             Err(reason) => prop_assert!(!reason.is_empty()),
         }
-        let path = scratch("k.npy");
-        write(&path, &bytes);
-        match kymogram_rows(&path) {
+        let file = scratch(&bytes, ".npy");
+        match kymogram_rows(file.path()) {
             Ok(rows) => prop_assert!(rows.iter().flatten().all(|a| a.is_finite()) && !rows.is_empty()),
             Err(e) => says_something(&e)?,
         }
-        let path = scratch("rec.npy");
-        write(&path, &bytes);
-        match read_recording(&path, 0.04) {
+        match read_recording(file.path(), 0.04) {
             Ok(clip) => prop_assert!(clip.node_count() >= 3 && clip.length_m > 0.0),
             Err(e) => says_something(&e)?,
         }
