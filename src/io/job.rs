@@ -12,6 +12,7 @@ use super::engine::{load_data, run_case, run_clip_to, run_inverse_on, write_clip
 use super::journal::remove_journal;
 use super::run_files::write_run;
 use super::run_folder::{input_file, FolderError, Manifest, Mode, RunFolder, Status};
+pub use super::sweep::case_label;
 use super::sweep::chain;
 use crate::case::Case;
 use crate::run::clip::ClipRun;
@@ -86,14 +87,6 @@ impl JobEnd {
             self.dir.display()
         );
         out
-    }
-}
-
-/// How messages name a case: `case NAME (FILE)`, or `case NAME` for a case not read from a file.
-pub fn case_label(case: &Case) -> String {
-    match &case.source {
-        Some(p) => format!("case {} ({})", case.name, p.display()),
-        None => format!("case {}", case.name),
     }
 }
 

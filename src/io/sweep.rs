@@ -8,7 +8,6 @@ use std::path::Path;
 use super::data::write_data;
 use super::engine::{load_data, run_clip_to, run_inverse_on, write_clip_figures, ClipOptions, EngineError};
 use super::files::OutputError;
-use super::job::case_label;
 use super::run_files::write_run;
 use super::run_folder::{input_file, Manifest, Status};
 use crate::case::sweep::{fmt_value, Point};
@@ -307,6 +306,14 @@ pub fn sweep_into(
         super::run_files::write_convergence_plot(&curves, &dir.join("convergence.svg"))?;
     }
     Ok(rows)
+}
+
+/// How messages name a case: `case NAME (FILE)`, or `case NAME` for a case not read from a file.
+pub fn case_label(case: &Case) -> String {
+    match &case.source {
+        Some(p) => format!("case {} ({})", case.name, p.display()),
+        None => format!("case {}", case.name),
+    }
 }
 
 /// An error and its sources, `a: b: c` (as `anyhow`'s `{:#}`).
