@@ -276,6 +276,7 @@ fn resume_refuses_another_case_file() {
 fn runs_beyond_the_memory_limit_are_refused_before_allocating() {
     let dir = tempfile::tempdir().expect("tempdir");
     let case = dir.path().join("huge.toml");
+    // 10^7 elements are beyond what a case may hold at all (rod.elements <= 10^6).
     std::fs::write(&case, common::edit(&common::case_text("timoshenko_5pct"), "elements = 100", "elements = 10000000"))
         .expect("write");
     cosserat()
@@ -284,7 +285,18 @@ fn runs_beyond_the_memory_limit_are_refused_before_allocating() {
         .arg(&case)
         .assert()
         .code(1)
-        .stderr(predicate::str::contains("rod.elements").and(predicate::str::contains("--max-memory-gib")));
+        .stderr(predicate::str::contains("rod.elements").and(predicate::str::contains("10000000")));
+    assert!(!dir.path().join("o").exists());
+    // 9 * 10^5 elements are a valid case whose estimate (about 6 GiB) exceeds a 1 GiB limit.
+    std::fs::write(&case, common::edit(&common::case_text("timoshenko_5pct"), "elements = 100", "elements = 900000"))
+        .expect("write");
+    cosserat()
+        .args(["run", "--quiet", "--max-memory-gib", "1", "--out"])
+        .arg(dir.path().join("o"))
+        .arg(&case)
+        .assert()
+        .code(1)
+        .stderr(predicate::str::contains("rod.elements = 900000").and(predicate::str::contains("--max-memory-gib")));
     assert!(!dir.path().join("o").exists());
     // The estimate scales with the elements: 100 elements pass a 0.1 GiB limit, 10^5 do not.
     cosserat()
