@@ -552,6 +552,12 @@ fn cmd_list(dir: &Path) -> Result<ExitCode> {
 
 fn cmd_modes(path: &Path, count: usize, limits: Limits) -> Result<ExitCode> {
     let case = load(path)?;
+    if !case.density_given() {
+        anyhow::bail!(
+            "{}: material.density_kg_m3 [kg/m^3] is required by `modes` (the natural frequencies scale as 1/sqrt(density)) and is missing from this case",
+            path.display()
+        );
+    }
     check_memory(&case, Footprint::Modes, limits)?;
     let model = modal_model(&case.problem())?;
     println!(

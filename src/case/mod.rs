@@ -14,6 +14,7 @@ use nalgebra::{Matrix3, Vector3};
 
 mod raw;
 pub mod sweep;
+mod toml_error;
 mod validate;
 
 use crate::clip::synthetic::{RollClipParams, TimeMapping};
@@ -204,6 +205,9 @@ pub struct Case {
     pub analysis: Analysis,
     pub compare: CompareSpec,
     pub reference: Option<Reference>,
+    /// whether the case file gave `material.density_kg_m3` (static and inverse analyses run
+    /// with 1 kg/m³ when it does not: their equations never use it)
+    density_given: bool,
     /// the case file's tables and the path it was validated with, for [`sweep`]'s overrides
     raw: Option<(toml::Table, PathBuf)>,
 }
@@ -221,7 +225,10 @@ impl Case {
     /// Parse and validate TOML text; `path` names the file in messages and resolves relative
     /// clip files.
     pub fn from_toml(text: &str, name: &str, path: &Path) -> Result<Case, CaseError> {
-        let syntax = |e: toml::de::Error| CaseError::Syntax { path: path.to_path_buf(), message: e.to_string() };
+        let syntax = |e: toml::de::Error| CaseError::Syntax {
+            path: path.to_path_buf(),
+            message: toml_error::describe(text, &e),
+        };
         let raw: raw::RawCase = toml::from_str(text).map_err(syntax)?;
         let mut case = Validator::new(path).case(raw, name)?;
         case.raw = Some((toml::from_str(text).map_err(syntax)?, path.to_path_buf()));
@@ -260,6 +267,13 @@ impl Case {
     }
 
     /// The clip of a clip case.
+    /// Whether the case file gave `material.density_kg_m3` ([`Case::material`] holds 1 kg/m³
+    /// otherwise, which only a static or inverse analysis may use: their equations never
+    /// involve the density).
+    pub fn density_given(&self) -> bool {
+        self.density_given
+    }
+
     pub fn clip(&self) -> Option<&ClipSource> {
         match &self.inverse()?.data {
             DataSource::Clip(c) => Some(c),
@@ -468,17 +482,17 @@ frames = 4
         let tail = "a load must be finite at every node and load quadrature point of the rod";
         assert_eq!(
             reason(&with_force("1/(s-s)")),
-            format!("t.toml: key `loads.force_n_per_m[1]`: `1/(s-s)` is inf at s = 0 m, t = 0 s: {tail}")
+            format!("t.toml: key `loads.force_n_per_m[1]`: `1/(s-s)` is not finite (inf) at s = 0 m, t = 0 s: {tail}")
         );
         assert_eq!(
             reason(&with_force("1/(s - L0)")),
-            format!("t.toml: key `loads.force_n_per_m[1]`: `1/(s - L0)` is inf at s = 0.001 m, t = 0 s: {tail}")
+            format!("t.toml: key `loads.force_n_per_m[1]`: `1/(s - L0)` is not finite (inf) at s = 0.001 m, t = 0 s: {tail}")
         );
         // A load quadrature point, not a node: the first Gauss point of element 3.
         let mesh = Mesh::new(1e-3, 10);
         let s = mesh.node_s(3) + crate::model::mesh::GAUSS2.points[0] * mesh.h();
         let e = reason(&with_force(&format!("1/(s - {s:e})")));
-        assert!(e.contains(&format!("is inf at s = {s} m, t = 0 s")), "{e}");
+        assert!(e.contains(&format!("is not finite (inf) at s = {s} m, t = 0 s")), "{e}");
         let dynamic = GOOD
             .replace("analysis = \"static\"\nrelaxation = 0.5", "analysis = \"dynamic\"\nmethod = \"newton\"")
             .replace("[compare]", "[time]\nend_s = 1\nsteps = 10\n[compare]")
@@ -488,7 +502,7 @@ frames = 4
         assert_eq!(
             e,
             format!(
-                "t.toml: key `loads.end_force_n[1]`: `-F*sqrt(0.35 - t)` is NaN at s = L = 0.001 m, t = 0.4 s: {tail} \
+                "t.toml: key `loads.end_force_n[1]`: `-F*sqrt(0.35 - t)` is not finite (NaN) at s = L = 0.001 m, t = 0.4 s: {tail} \
                  and at every time step"
             )
         );
@@ -557,8 +571,9 @@ frames = 4
         let e = reason(&worm.replace("elements = 127", "elements = 2"));
         assert_eq!(
             e,
-            "t.toml: key `rod.elements`: a clip case needs at least 11 elements, got 2: the clip's measures leave out \
-             5 elements at each end (curvature errors, ground truth) and the roughness needs 3 curvature values"
+            "t.toml: key `rod.elements`: a clip case needs at least 11 elements (12 nodes per frame of clip.file \
+             `../data/elegansbot/kymogram_omega-turn.npy`), got 2 (3 nodes): the clip's measures leave out 5 elements at \
+             each end (curvature errors, ground truth) and the roughness needs 3 curvature values"
         );
         assert!(parse(&worm.replace("elements = 127", "elements = 11")).is_ok());
         let e = reason(&worm.replace("start = \"data_guess\"", "start = \"data_guess\"\ngauge = [1e308, 1e308, 0]"));

@@ -52,7 +52,7 @@ impl<'a> Validator<'a> {
             Scalar::Number(x) => *x,
             Scalar::Text(s) => crate::expr::eval_const(s, &self.constants).map_err(|e| match e {
                 ExprError::UnknownVariable { name } => self.err(key, self.unknown_name(&name, s, &[])),
-                e => self.err(key, e.to_string()),
+                e => self.err(key, syntax_in_words(s, &e)),
             })?,
         };
         if !x.is_finite() {
@@ -114,7 +114,7 @@ impl<'a> Validator<'a> {
         };
         self.loads_are_finite(&loads, &load_texts, &mesh, quadrature, &analysis)?;
         let compare = self.compare(&raw.compare)?;
-        let reference = self.reference(raw.reference.as_ref(), kind)?;
+        let reference = self.reference(raw.reference.as_ref(), kind, &loads)?;
         Ok(Case {
             reference,
             name: name.to_string(),
@@ -129,6 +129,7 @@ impl<'a> Validator<'a> {
             loads,
             analysis,
             compare,
+            density_given: raw.material.density_kg_m3.is_some(),
             raw: None,
         })
     }
@@ -460,15 +461,47 @@ impl<'a> Validator<'a> {
     }
 
     /// `[reference]`: the theory a static case is checked against.
-    fn reference(&self, r: Option<&RawReference>, kind: RawAnalysis) -> Result<Option<Reference>, CaseError> {
+    fn reference(
+        &self,
+        r: Option<&RawReference>,
+        kind: RawAnalysis,
+        loads: &crate::model::loads::Loads,
+    ) -> Result<Option<Reference>, CaseError> {
         match r {
             None => Ok(None),
             Some(RawReference::TipLoadedCantilever { force_n }) => {
                 if kind != RawAnalysis::Static {
                     return Err(self.err("reference.kind", "\"tip_loaded_cantilever\" needs a static analysis"));
                 }
-                Ok(Some(Reference::TipLoadedCantilever { force_n: self.positive("reference.force_n", force_n)? }))
+                let force_n = self.positive("reference.force_n", force_n)?;
+                // the theories (elastica, Reissner) are of the case's own tip force
+                let tip = loads.end(0.0).0.norm();
+                if (force_n - tip).abs() > 1e-9 * force_n.max(tip) {
+                    return Err(self.err(
+                        "reference.force_n",
+                        format!(
+                            "{force_n:e} N, but the case's tip force loads.end_force_n has magnitude {tip:e} N: the \
+                             reference solutions would be of another load (give the same force, or drop [reference])"
+                        ),
+                    ));
+                }
+                Ok(Some(Reference::TipLoadedCantilever { force_n }))
             }
         }
     }
+}
+
+/// A syntax error of the expression `text`, quoting it, with a hint for the two mistakes a
+/// number in a case file invites: a decimal comma, and a unit after the value.
+pub(super) fn syntax_in_words(text: &str, e: &ExprError) -> String {
+    let hint = match e {
+        ExprError::Unexpected { found, .. } if found.starts_with("','") || found.contains(',') => {
+            " (a decimal comma? numbers take a point: 2.5e-5)"
+        }
+        ExprError::Unexpected { found, .. } if found.starts_with("identifier") => {
+            " (a unit after the value? expressions take no units: give SI values, e.g. 1e-3 for 1 mm)"
+        }
+        _ => "",
+    };
+    format!("`{text}`: {e}{hint}")
 }

@@ -19,10 +19,13 @@ impl Validator<'_> {
             return Err(self.err(
                 "rod.elements",
                 format!(
-                    "a clip case needs at least {MIN_CLIP_ELEMENTS} elements, got {}: the clip's measures leave out \
-                     {CLIP_SKIP_ELEMENTS} elements at each end (curvature errors, ground truth) and the roughness \
-                     needs 3 curvature values",
-                    mesh.elements
+                    "a clip case needs at least {MIN_CLIP_ELEMENTS} elements ({} nodes per frame of clip.file `{}`), \
+                     got {} ({} nodes): the clip's measures leave out {CLIP_SKIP_ELEMENTS} elements at each end \
+                     (curvature errors, ground truth) and the roughness needs 3 curvature values",
+                    MIN_CLIP_ELEMENTS + 1,
+                    cl.file.display(),
+                    mesh.elements,
+                    mesh.nodes()
                 ),
             ));
         }
@@ -126,7 +129,7 @@ impl Validator<'_> {
             return Err(self.err(
                 "clip.clip_frames",
                 format!(
-                    "{} frames × {} nodes are {positions} positions, more than the {MAX_CLIP_POSITIONS} a clip may hold",
+                    "{} frames × {} nodes are {positions} positions: too many, the limit of a clip is {MAX_CLIP_POSITIONS}",
                     synthetic.frames,
                     mesh.nodes()
                 ),

@@ -67,7 +67,8 @@ impl Validator<'_> {
             Scalar::Number(x) => format!("{x:e}"),
             Scalar::Text(s) => s.clone(),
         };
-        let e = Expr::parse(&text).map_err(|e| self.err(key, format!("cannot parse `{text}`: {e}")))?;
+        let e = Expr::parse(&text)
+            .map_err(|e| self.err(key, format!("cannot parse {}", super::syntax_in_words(&text, &e))))?;
         if let Some(var) =
             e.variables().into_iter().find(|v| !allowed.contains(&v.as_str()) && !self.constants.contains_key(v))
         {
@@ -167,7 +168,7 @@ impl Validator<'_> {
                             return Err(self.err(
                                 &format!("{key}[{i}]"),
                                 format!(
-                                    "`{text}` is {v} at {s_text}, t = {t} s: a load must be finite at every node and \
+                                    "`{text}` is not finite ({v}) at {s_text}, t = {t} s: a load must be finite at every node and \
                                      load quadrature point of the rod{}",
                                     if steps.is_some() { " and at every time step" } else { "" }
                                 ),
