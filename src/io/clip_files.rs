@@ -38,12 +38,12 @@ pub enum ClipFileError {
     #[error("{path}: {nodes} nodes per frame, but the case's mesh has {expected} (rod.elements + 1)")]
     NodeCount { path: PathBuf, nodes: usize, expected: usize },
     #[error(
-        "{path}, frame {frame}: the centreline is {length_m:e} m long, {ratio:.4}× the rod length rod.length_m = \
-         {rod_m:e} m (allowed: within ±{:.0} %); scale the recording to metres of this rod, or set rod.length_m to \
-         the length of the recorded body",
+        "{path}, frame {frame}: the centreline is {length_m:e} m long, {ratio:.3}× the rod length rod.length_m = \
+         {rod_m:e} m (allowed: within ±{:.0} %){glitch}; scale the recording to metres of this rod, or set \
+         rod.length_m to the length of the recorded body",
         100.0 * MAX_LENGTH_DEVIATION
     )]
-    Length { path: PathBuf, frame: usize, length_m: f64, rod_m: f64, ratio: f64 },
+    Length { path: PathBuf, frame: usize, length_m: f64, rod_m: f64, ratio: f64, glitch: String },
     #[error(
         "{path}: {frames} frames × {nodes} nodes are {positions} positions, more than the {MAX_CLIP_POSITIONS} a clip \
          may hold; use a shorter clip"
@@ -73,10 +73,47 @@ fn check_lengths(path: &Path, frames: &[Vec<Vector3<f64>>], first: usize, rod_m:
         let length_m = polyline_length(f);
         let ratio = length_m / rod_m;
         if ratio.is_nan() || (ratio - 1.0).abs() > MAX_LENGTH_DEVIATION {
-            return Err(ClipFileError::Length { path: path.to_path_buf(), frame: first + k, length_m, rod_m, ratio });
+            let glitch = glitch(f);
+            return Err(ClipFileError::Length {
+                path: path.to_path_buf(),
+                frame: first + k,
+                length_m,
+                rod_m,
+                ratio,
+                glitch,
+            });
         }
     }
     Ok(())
+}
+
+/// A point far off its neighbours (a tracking glitch) in the frame `pts`, in words: the node
+/// whose segments are both longer than 10× the median segment (or an end node's one segment),
+/// with its distance; empty if there is none.
+fn glitch(pts: &[Vector3<f64>]) -> String {
+    let seg: Vec<f64> = pts.windows(2).map(|w| (w[1] - w[0]).norm()).collect();
+    let mut sorted = seg.clone();
+    sorted.sort_by(f64::total_cmp);
+    let Some(&median) = sorted.get(sorted.len() / 2).filter(|&&m| m > 0.0) else { return String::new() };
+    let long = |i: usize| seg.get(i).is_some_and(|&l| l > 10.0 * median);
+    let Some(i) = (0..seg.len()).filter(|&i| long(i)).max_by(|&a, &b| seg[a].total_cmp(&seg[b])) else {
+        return String::new();
+    };
+    // segment i joins nodes i and i + 1: the node shared with another long segment, else the end
+    let node = if i + 1 < seg.len() && long(i + 1) {
+        i + 1
+    } else if i > 0 && long(i - 1) {
+        i
+    } else if i == 0 {
+        0
+    } else {
+        i + 1
+    };
+    format!(
+        "; node {node} lies {:e} m from its neighbour, {:.0}× the median segment (a tracking glitch?)",
+        seg[i],
+        seg[i] / median
+    )
 }
 
 /// The clip of a clip case: kymograms become spline centrelines with the mesh's node count
@@ -156,6 +193,17 @@ pub fn kymogram_rows(path: &Path) -> Result<Vec<Vec<f64>>, InputError> {
             value: a.data[k],
         });
     }
+    // A joint angle turns one segment against the next: beyond ±π it cannot be in radians.
+    if let Some(k) = a.data.iter().position(|v| v.abs() > std::f64::consts::PI) {
+        return Err(shape(format!(
+            "frame {}, joint {}: joint angle {} is beyond ±π, so not in radians (degrees? the kymogram's angles must \
+             be radians, largest |angle| {})",
+            k / joints,
+            k % joints,
+            a.data[k],
+            a.data.iter().fold(0.0f64, |m, v| m.max(v.abs()))
+        )));
+    }
     Ok(a.data.chunks_exact(joints).map(<[f64]>::to_vec).collect())
 }
 
@@ -182,6 +230,12 @@ fn kymogram_clip(path: &Path, rows: &[Vec<f64>], params: &KymogramParams) -> Cli
 /// Read a user recording: `.csv` (header `frame,node,x_m,y_m,z_m`) or `.npy` (frames × nodes × 3,
 /// float64) [m]; `dt_s` is the time between frames [s].
 pub fn read_recording(path: &Path, dt_s: f64) -> Result<Clip, InputError> {
+    if path.is_dir() {
+        return Err(InputError::Shape {
+            path: path.to_path_buf(),
+            reason: "is a directory, not a recording file (.csv or .npy)".into(),
+        });
+    }
     let frames = match path.extension().and_then(|e| e.to_str()) {
         Some("npy") => recording_npy(path)?,
         Some("csv") => recording_csv(path)?,
@@ -306,7 +360,7 @@ fn recording_csv(path: &Path) -> Result<Vec<Vec<Vector3<f64>>>, InputError> {
             }
             let next = frames.len();
             if r.frame != next {
-                return Err(missing(next, 0));
+                return Err(InputError::FrameGap { path: path.to_path_buf(), frame: next, next: r.frame, row: r.row });
             }
             frames.push(Vec::new());
         }

@@ -62,6 +62,11 @@ pub enum InputError {
     NodeCount { path: PathBuf, frame: usize, nodes: usize, expected: usize },
     #[error("{path}, frame {frame}, node {node}: no row (frames and nodes must be contiguous from 0)")]
     MissingRow { path: PathBuf, frame: usize, node: usize },
+    #[error(
+        "{path}, row {row}: frame {next} comes where frame {frame} was expected: frame {frame} has no rows (frames \
+         must be contiguous from 0; is the frame column a timestamp, or a -1 written unsigned?)"
+    )]
+    FrameGap { path: PathBuf, frame: usize, next: usize, row: usize },
     #[error("{path}, row {row}: frame {frame}, node {node} already given in row {first_row}")]
     DuplicateRow { path: PathBuf, row: usize, first_row: usize, frame: usize, node: usize },
     #[error("{}", too_large_text(path, what, *.size, *.cap))]
