@@ -7,17 +7,13 @@
 //! `data.csv`), on non-convergence the last iterate with `run.json` saying failed.
 use std::path::{Path, PathBuf};
 
-use super::data::write_data;
-use super::engine::{load_data, run_case, run_clip_to, run_inverse_on, write_clip_figures, ClipOptions};
-use super::journal::remove_journal;
-use super::run_files::write_run;
+use super::engine::ClipOptions;
 use super::run_folder::{input_file, FolderError, Manifest, Mode, RunFolder, Status};
-pub use super::sweep::case_label;
-use super::sweep::chain;
+pub use super::solved::case_label;
+use super::solved::solve_into;
 use crate::case::Case;
 use crate::run::clip::ClipRun;
-use crate::run::metrics::all_metrics;
-use crate::run::{Engine, RunError, RunResult};
+use crate::run::{Engine, RunResult};
 
 /// How a run ended.
 #[derive(Debug)]
@@ -128,109 +124,16 @@ pub fn run_into(
         files: 0,
         notes: std::mem::take(&mut folder.notes),
     };
-    if case.clip().is_some() {
-        clip_job(case, engine, &dir, mode == Mode::Resume, progress, &mut end);
-        folder.manifest.frames_done = end.frames.map(|f| f.0);
-        folder.manifest.frames_total = end.frames.map(|f| f.1);
-    } else {
-        single_job(case, engine, &dir, progress, &mut end);
-    }
+    let clip = ClipOptions { journal: true, resume: mode == Mode::Resume };
+    let solved = solve_into(case, engine, &dir, clip, |_| {}, progress);
+    end.status = solved.status.folder_status();
+    end.message = solved.error;
+    end.single = solved.single;
+    end.clip = solved.clip;
+    end.frames = solved.frames;
+    folder.manifest.frames_done = end.frames.map(|f| f.0);
+    folder.manifest.frames_total = end.frames.map(|f| f.1);
     let target = folder.finish(end.status, end.message.clone())?;
     end.files = Manifest::read(&target)?.map(|m| m.files.len()).unwrap_or(0);
     Ok(end)
-}
-
-fn status_of(e: &RunError) -> Status {
-    if e.is_interrupted() {
-        Status::Interrupted
-    } else {
-        Status::Failed
-    }
-}
-
-fn single_job(case: &Case, engine: Engine, dir: &Path, progress: impl FnMut(usize, usize), end: &mut JobEnd) {
-    let work = dir.join("freefem_work");
-    let result = if case.inverse().is_some() {
-        let path = dir.join("data.csv");
-        load_data(case)
-            .and_then(|d| Ok(write_data(&path, &d)?))
-            .and_then(|_| run_inverse_on(case, engine, &path, &work, progress))
-    } else {
-        run_case(case, engine, &work, progress)
-    };
-    let (r, failure) = match result {
-        Ok(r) => (r, None),
-        Err(super::engine::EngineError::Run(RunError::Incomplete { source, partial })) => {
-            (*partial, Some(format!("{}: {source}; the files here hold the last iterate", case_label(case))))
-        }
-        Err(e) => {
-            let interrupted = match &e {
-                super::engine::EngineError::Run(r) => r.is_interrupted(),
-                super::engine::EngineError::FreeFem(f) => f.is_interrupted(),
-                _ => false,
-            };
-            end.status = if interrupted { Status::Interrupted } else { Status::Failed };
-            end.message = Some(format!("{}: {}", case_label(case), chain(&e)));
-            return;
-        }
-    };
-    let written = all_metrics(case, &r).map_err(|e| chain(&e)).and_then(|m| {
-        write_run(case, &r, &m, dir).map_err(|e| chain(&e))?;
-        Ok(())
-    });
-    if let Err(e) = written {
-        end.status = Status::Failed;
-        end.message = Some(format!("{}: {e}", case_label(case)));
-        return;
-    }
-    if let Some(f) = failure {
-        end.status = Status::Failed;
-        end.message = Some(f);
-    }
-    end.single = Some(r);
-}
-
-fn clip_job(
-    case: &Case,
-    engine: Engine,
-    dir: &Path,
-    resume: bool,
-    progress: impl FnMut(usize, usize),
-    end: &mut JobEnd,
-) {
-    if engine != Engine::Rust {
-        end.status = Status::Failed;
-        end.message = Some(format!(
-            "{}: `run` solves clips in the Rust engine (`--engine rust`); to run a clip in FreeFEM against it, use `cosserat compare CASE --frames N` (or `--frames all`)",
-            case_label(case)
-        ));
-        return;
-    }
-    let out = match run_clip_to(case, dir, ClipOptions { journal: true, resume }, |_| {}, progress) {
-        Ok(out) => out,
-        Err(e) => {
-            end.status = Status::Failed;
-            end.message = Some(format!("{}: {}", case_label(case), chain(&e)));
-            return;
-        }
-    };
-    let (done, total) = (out.run.reports.len(), out.total);
-    if let Some(e) = &out.stopped {
-        end.status = status_of(e);
-        end.message = Some(format!("{}: {}", case_label(case), chain(e)));
-    }
-    if done > 0 {
-        if let Err(e) = write_clip_figures(case, &out.run, dir) {
-            end.status = Status::Failed;
-            end.message = Some(format!("{}: {}", case_label(case), chain(&e)));
-        }
-    }
-    if end.status == Status::Complete {
-        if let Err(e) = remove_journal(dir) {
-            end.status = Status::Failed;
-            end.message = Some(chain(&e));
-        }
-    }
-    end.frames = Some((done, total));
-    end.clip = Some(out.run);
 }

@@ -18,6 +18,7 @@ pub mod plot;
 pub mod posture;
 pub mod run_files;
 pub mod run_folder;
+pub mod solved;
 pub mod sweep;
 pub mod vtk;
 

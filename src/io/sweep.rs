@@ -5,17 +5,16 @@
 //! of `run` on a clip, its row the metrics of `run::clip_metrics`).
 use std::path::Path;
 
-use super::data::write_data;
-use super::engine::{load_data, run_clip_to, run_inverse_on, write_clip_figures, ClipOptions, EngineError};
+use super::engine::ClipOptions;
 use super::files::OutputError;
-use super::run_files::write_run;
-use super::run_folder::{input_file, Manifest, Status};
+use super::run_folder::{input_file, Manifest};
+pub use super::solved::{case_label, chain, RunStatus, Solved as SweepOutcome};
+use super::solved::{solve_into, Solved};
 use crate::case::sweep::{fmt_value, Point};
 use crate::case::Case;
-use crate::run::clip::{ClipFrame, ClipRun};
-use crate::run::clip_metrics::clip_metrics;
-use crate::run::metrics::{all_metrics, Metrics};
-use crate::run::{run_forward, RunError, RunResult};
+use crate::run::clip::ClipFrame;
+use crate::run::metrics::Metrics;
+use crate::run::{Engine, RunResult};
 
 /// Columns of the summary table after the swept keys.
 pub const SUMMARY_METRICS: [&str; 11] = [
@@ -42,55 +41,6 @@ pub struct SummaryRow {
     pub status: RunStatus,
     pub metrics: Option<Metrics>,
     pub error: Option<String>,
-}
-
-impl SweepOutcome {
-    /// A point that produced no result, with its error.
-    fn failed(error: String) -> Self {
-        SweepOutcome { status: RunStatus::Failed, metrics: None, run: None, clip: None, error: Some(error) }
-    }
-
-    /// A point stopped (or not started) by a signal.
-    fn interrupted() -> Self {
-        SweepOutcome {
-            status: RunStatus::Interrupted,
-            metrics: None,
-            run: None,
-            clip: None,
-            error: Some("interrupted by a signal".into()),
-        }
-    }
-}
-
-/// Outcome of one run of a sweep.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum RunStatus {
-    Ok,
-    /// iteration limit reached; the metrics are those of the last iterate
-    NotConverged,
-    Failed,
-    /// stopped by a signal (or not started because of one)
-    Interrupted,
-}
-
-impl RunStatus {
-    pub fn as_str(&self) -> &'static str {
-        match self {
-            RunStatus::Ok => "ok",
-            RunStatus::NotConverged => "not_converged",
-            RunStatus::Failed => "failed",
-            RunStatus::Interrupted => "interrupted",
-        }
-    }
-
-    /// The status of the point's folder (`run.json`).
-    pub fn folder_status(&self) -> Status {
-        match self {
-            RunStatus::Ok => Status::Complete,
-            RunStatus::NotConverged | RunStatus::Failed => Status::Failed,
-            RunStatus::Interrupted => Status::Interrupted,
-        }
-    }
 }
 
 /// Columns of the summary table of a clip case after the swept keys (`run::clip_metrics`).
@@ -132,26 +82,13 @@ pub fn summary_csv(keys: &[String], columns: &[&str], rows: &[SummaryRow]) -> Re
     Ok(String::from_utf8_lossy(&bytes).into_owned())
 }
 
-/// What one run of a sweep produced: a single-frame or forward run (`run`) or a clip (`clip`).
-pub struct SweepOutcome {
-    pub status: RunStatus,
-    pub metrics: Option<Metrics>,
-    pub run: Option<RunResult>,
-    pub clip: Option<ClipRun>,
-    pub error: Option<String>,
-}
-
 /// One point of a sweep in the Rust engine, writing its folder `dir` and its `run.json`
 /// (`template` with the point's status and message). A run that stops at its iteration limit
 /// still writes the files of its last iterate (its `run.json` says failed). A clip case solves
 /// its whole clip ([`run_clip_point`]). A point reached after a stop was requested
 /// (`crate::interrupt`) is not started and writes nothing.
 pub fn run_point(case: &Case, dir: &Path, template: &Manifest) -> SweepOutcome {
-    if crate::interrupt::requested() {
-        return SweepOutcome::interrupted();
-    }
-    let outcome = if case.clip().is_some() { clip_point(case, dir, |_| {}) } else { single_point(case, dir) };
-    finish_point(dir, template, outcome)
+    finish_point(dir, template, solve_into(case, Engine::Rust, dir, ClipOptions::default(), |_| {}, |_, _| {}))
 }
 
 /// The whole clip of a clip case in the Rust engine as a point of a sweep or audit, frames
@@ -164,10 +101,7 @@ pub fn run_clip_point(
     template: &Manifest,
     observer: impl FnMut(&ClipFrame) + Send,
 ) -> SweepOutcome {
-    if crate::interrupt::requested() {
-        return SweepOutcome::interrupted();
-    }
-    finish_point(dir, template, clip_point(case, dir, observer))
+    finish_point(dir, template, solve_into(case, Engine::Rust, dir, ClipOptions::default(), observer, |_, _| {}))
 }
 
 /// The `run.json` of a point of `command` (a sweep, an audit): the case and its file's hash,
@@ -183,7 +117,7 @@ pub fn point_manifest(command: &str, case: &Case, point: &Point) -> Manifest {
 }
 
 /// The point's `run.json`: `template` with the case's name, the point's status and message.
-fn finish_point(dir: &Path, template: &Manifest, outcome: SweepOutcome) -> SweepOutcome {
+fn finish_point(dir: &Path, template: &Manifest, outcome: Solved) -> Solved {
     if !dir.is_dir() {
         return outcome;
     }
@@ -193,60 +127,8 @@ fn finish_point(dir: &Path, template: &Manifest, outcome: SweepOutcome) -> Sweep
     }
     match m.finish(dir, outcome.status.folder_status(), outcome.error.clone()) {
         Ok(()) => outcome,
-        Err(e) => SweepOutcome::failed(chain(&e)),
+        Err(e) => Solved::failed(chain(&e)),
     }
-}
-
-fn single_point(case: &Case, dir: &Path) -> SweepOutcome {
-    let failed = |e: &dyn std::fmt::Display| SweepOutcome::failed(e.to_string());
-    let outcome: Result<RunResult, EngineError> = if case.inverse().is_some() {
-        let path = dir.join("data.csv");
-        match load_data(case).and_then(|d| Ok(write_data(&path, &d)?)) {
-            Ok(()) => run_inverse_on(case, crate::run::Engine::Rust, &path, &dir.join("freefem_work"), |_, _| {}),
-            Err(e) => return failed(&format_args!("{}: generating the forward data: {}", case_label(case), chain(&e))),
-        }
-    } else {
-        run_forward(case, |_, _| {}).map_err(EngineError::from)
-    };
-    let (status, r, error) = match outcome {
-        Ok(r) => (RunStatus::Ok, r, None),
-        Err(EngineError::Run(e)) if e.is_interrupted() => return SweepOutcome::interrupted(),
-        Err(EngineError::Run(RunError::Incomplete { source, partial })) => {
-            (RunStatus::NotConverged, *partial, Some(format!("{source}; the files here hold the last iterate")))
-        }
-        Err(e) => return failed(&format_args!("{}: {}", case_label(case), chain(&e))),
-    };
-    let write = || -> Result<Metrics, String> {
-        let m = all_metrics(case, &r).map_err(|e| chain(&e))?;
-        write_run(case, &r, &m, dir).map_err(|e| chain(&e))?;
-        Ok(m)
-    };
-    match write() {
-        Ok(m) => SweepOutcome { status, metrics: Some(m), run: Some(r), clip: None, error },
-        Err(e) => failed(&e),
-    }
-}
-
-fn clip_point(case: &Case, dir: &Path, observer: impl FnMut(&ClipFrame) + Send) -> SweepOutcome {
-    let out = match run_clip_to(case, dir, ClipOptions::default(), observer, |_, _| {}) {
-        Ok(out) => out,
-        Err(e) => return SweepOutcome::failed(format!("{}: {}", case_label(case), chain(&e))),
-    };
-    let (status, error) = match &out.stopped {
-        None => (RunStatus::Ok, None),
-        Some(e) if e.is_interrupted() => (RunStatus::Interrupted, Some(chain(e))),
-        Some(e) => (
-            RunStatus::Failed,
-            Some(format!("{}: {}; the converged frames before it are in this folder", case_label(case), chain(e))),
-        ),
-    };
-    if !out.run.reports.is_empty() {
-        if let Err(e) = write_clip_figures(case, &out.run, dir) {
-            return SweepOutcome::failed(format!("{}: {}", case_label(case), chain(&e)));
-        }
-    }
-    let m = (status == RunStatus::Ok).then(|| clip_metrics(case, &out.run));
-    SweepOutcome { status, metrics: m, run: None, clip: Some(out.run), error }
 }
 
 /// Run every point of a sweep of `case` (`points`: the grid of `case::sweep::product`, swept
@@ -301,31 +183,11 @@ pub fn sweep_into(
         .map_err(|e| OutputError::Invalid { path: dir.join("summary.csv"), reason: e.to_string() })?;
     super::files::write_atomic(&dir.join("summary.csv"), text.as_bytes())?;
     let curves: Vec<(&String, &RunResult)> =
-        results.iter().filter_map(|(name, _, o)| o.run.as_ref().map(|run| (name, run))).collect();
+        results.iter().filter_map(|(name, _, o)| o.single.as_ref().map(|run| (name, run))).collect();
     if !curves.is_empty() {
         super::run_files::write_convergence_plot(&curves, &dir.join("convergence.svg"))?;
     }
     Ok(rows)
-}
-
-/// How messages name a case: `case NAME (FILE)`, or `case NAME` for a case not read from a file.
-pub fn case_label(case: &Case) -> String {
-    match &case.source {
-        Some(p) => format!("case {} ({})", case.name, p.display()),
-        None => format!("case {}", case.name),
-    }
-}
-
-/// An error and its sources, `a: b: c` (as `anyhow`'s `{:#}`).
-pub fn chain(e: &dyn std::error::Error) -> String {
-    let mut s = e.to_string();
-    let mut source = e.source();
-    while let Some(cause) = source {
-        s.push_str(": ");
-        s.push_str(&cause.to_string());
-        source = cause.source();
-    }
-    s
 }
 
 #[cfg(test)]

@@ -1,0 +1,196 @@
+//! One run of a case into a folder, the core shared by `cosserat run` ([`super::job`]), the
+//! points of a sweep or an audit ([`super::sweep`]) and a batch of recordings: a forward or
+//! single-frame inverse run writes its files (the last iterate's too, when it stops at its
+//! iteration limit), a clip streams its frames and then its figures over the frames solved.
+//! The caller owns the folder and its `run.json` ([`super::run_folder`]).
+use std::path::Path;
+
+use super::data::write_data;
+use super::engine::{load_data, run_case, run_clip_to, run_inverse_on, write_clip_figures, ClipOptions, EngineError};
+use super::journal::remove_journal;
+use super::run_files::write_run;
+use super::run_folder::Status;
+use crate::case::Case;
+use crate::run::clip::{ClipFrame, ClipRun};
+use crate::run::clip_metrics::clip_metrics;
+use crate::run::metrics::{all_metrics, Metrics};
+use crate::run::{Engine, RunError, RunResult};
+
+/// How one run ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RunStatus {
+    Ok,
+    /// iteration limit reached; the metrics are those of the last iterate
+    NotConverged,
+    Failed,
+    /// stopped by a signal (or not started because of one)
+    Interrupted,
+}
+
+impl RunStatus {
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            RunStatus::Ok => "ok",
+            RunStatus::NotConverged => "not_converged",
+            RunStatus::Failed => "failed",
+            RunStatus::Interrupted => "interrupted",
+        }
+    }
+
+    /// The status of the run's folder (`run.json`).
+    pub fn folder_status(&self) -> Status {
+        match self {
+            RunStatus::Ok => Status::Complete,
+            RunStatus::NotConverged | RunStatus::Failed => Status::Failed,
+            RunStatus::Interrupted => Status::Interrupted,
+        }
+    }
+}
+
+/// What one run left in its folder.
+pub struct Solved {
+    pub status: RunStatus,
+    /// why it failed or stopped (the error and its causes, prefixed by the case)
+    pub error: Option<String>,
+    /// the metrics of a single run (also of the last iterate of one that did not converge) or
+    /// of a complete clip (`run::clip_metrics`)
+    pub metrics: Option<Metrics>,
+    /// a single run's result
+    pub single: Option<RunResult>,
+    /// a clip's summary over the frames it holds
+    pub clip: Option<ClipRun>,
+    /// clips: frames in the folder and frames of the clip
+    pub frames: Option<(usize, usize)>,
+}
+
+impl Solved {
+    /// A run that produced nothing, with its error.
+    pub fn failed(error: String) -> Self {
+        Solved { status: RunStatus::Failed, error: Some(error), metrics: None, single: None, clip: None, frames: None }
+    }
+
+    /// A run stopped (or not started) by a signal.
+    pub fn interrupted() -> Self {
+        Solved { status: RunStatus::Interrupted, ..Solved::failed("interrupted by a signal".into()) }
+    }
+}
+
+/// Run `case` in `engine` into the folder `dir` (which the caller has claimed). A clip runs in
+/// the Rust engine only, with `clip` (journal, resume); its frames are shown to `observer`.
+/// `progress(done, total)` follows iterations, time steps or frames.
+pub fn solve_into(
+    case: &Case,
+    engine: Engine,
+    dir: &Path,
+    clip: ClipOptions,
+    observer: impl FnMut(&ClipFrame) + Send,
+    progress: impl FnMut(usize, usize),
+) -> Solved {
+    if crate::interrupt::requested() {
+        return Solved::interrupted();
+    }
+    if case.clip().is_some() {
+        solve_clip(case, engine, dir, clip, observer, progress)
+    } else {
+        solve_single(case, engine, dir, progress)
+    }
+}
+
+fn solve_single(case: &Case, engine: Engine, dir: &Path, progress: impl FnMut(usize, usize)) -> Solved {
+    let work = dir.join("freefem_work");
+    let result = if case.inverse().is_some() {
+        let path = dir.join("data.csv");
+        match load_data(case).and_then(|d| Ok(write_data(&path, &d)?)) {
+            Ok(()) => run_inverse_on(case, engine, &path, &work, progress),
+            Err(e) => return Solved::failed(format!("{}: generating the data: {}", case_label(case), chain(&e))),
+        }
+    } else {
+        run_case(case, engine, &work, progress)
+    };
+    let (status, r, error) = match result {
+        Ok(r) => (RunStatus::Ok, r, None),
+        Err(EngineError::Run(RunError::Incomplete { source, partial })) => (
+            RunStatus::NotConverged,
+            *partial,
+            Some(format!("{}: {source}; the files here hold the last iterate", case_label(case))),
+        ),
+        Err(e) => {
+            let interrupted = match &e {
+                EngineError::Run(r) => r.is_interrupted(),
+                EngineError::FreeFem(f) => f.is_interrupted(),
+                _ => false,
+            };
+            let status = if interrupted { RunStatus::Interrupted } else { RunStatus::Failed };
+            return Solved { status, ..Solved::failed(format!("{}: {}", case_label(case), chain(&e))) };
+        }
+    };
+    let written = all_metrics(case, &r).map_err(|e| chain(&e)).and_then(|m| {
+        write_run(case, &r, &m, dir).map_err(|e| chain(&e))?;
+        Ok(m)
+    });
+    match written {
+        Ok(m) => Solved { status, error, metrics: Some(m), single: Some(r), clip: None, frames: None },
+        Err(e) => Solved::failed(format!("{}: {e}", case_label(case))),
+    }
+}
+
+fn solve_clip(
+    case: &Case,
+    engine: Engine,
+    dir: &Path,
+    opts: ClipOptions,
+    observer: impl FnMut(&ClipFrame) + Send,
+    progress: impl FnMut(usize, usize),
+) -> Solved {
+    let fail = |e: &dyn std::error::Error| Solved::failed(format!("{}: {}", case_label(case), chain(e)));
+    if engine != Engine::Rust {
+        return Solved::failed(format!(
+            "{}: `run` solves clips in the Rust engine (`--engine rust`); to run a clip in FreeFEM against it, use `cosserat compare CASE --frames N` (or `--frames all`)",
+            case_label(case)
+        ));
+    }
+    let out = match run_clip_to(case, dir, opts, observer, progress) {
+        Ok(out) => out,
+        Err(e) => return fail(&e),
+    };
+    let (done, total) = (out.run.reports.len(), out.total);
+    let (status, error) = match &out.stopped {
+        None => (RunStatus::Ok, None),
+        Some(e) if e.is_interrupted() => (RunStatus::Interrupted, Some(format!("{}: {}", case_label(case), chain(e)))),
+        Some(e) => (
+            RunStatus::Failed,
+            Some(format!("{}: {}; the converged frames before it are in this folder", case_label(case), chain(e))),
+        ),
+    };
+    if done > 0 {
+        if let Err(e) = write_clip_figures(case, &out.run, dir) {
+            return fail(&e);
+        }
+    }
+    if status == RunStatus::Ok && opts.journal {
+        if let Err(e) = remove_journal(dir) {
+            return Solved::failed(chain(&e));
+        }
+    }
+    let metrics = (status == RunStatus::Ok).then(|| clip_metrics(case, &out.run));
+    Solved { status, error, metrics, single: None, clip: Some(out.run), frames: Some((done, total)) }
+}
+
+/// The case's name and file, for messages.
+pub fn case_label(case: &Case) -> String {
+    match &case.source {
+        Some(p) => format!("case {} ({})", case.name, p.display()),
+        None => format!("case {}", case.name),
+    }
+}
+
+/// An error and its causes, `: `-separated.
+pub fn chain(e: &dyn std::error::Error) -> String {
+    let mut s = e.to_string();
+    let mut src = e.source();
+    while let Some(c) = src {
+        s += &format!(": {c}");
+        src = c.source();
+    }
+    s
+}
