@@ -685,7 +685,8 @@ case("expr_huge_distributed_load", "base_newton", [('force_n_per_m = ["-2.2*Fmax
      kind="expression")
 case("expr_dynamic_overflow", "base_dynamic",
      [('force_n_per_m = ["2e3*sin(pi*s)*sin(8*omega0*t)", ', 'force_n_per_m = ["2e3*exp(1e5*t)", ')],
-     ["force_n_per_m", "t =|time|step", NOT_FINITE], "a load that overflows to inf during the run", kind="expression")
+     ["force_n_per_m", "t =|time|step", "diverged|" + NOT_FINITE],
+     "a load growing as 2e3 exp(1e5 t), to 7.5e263 N/m within the run (finite, but far beyond the rod)", kind="expression")
 case("expr_sqrt_negative", "base_static", [('radius_m = "L0/40"', 'radius_m = "sqrt(-L0)"')],
      ["radius_m", "nan|finite"], "the square root of a negative number", kind="expression")
 case("expr_log_zero", "base_static", [("shear_modulus_pa = 5.0e4", 'shear_modulus_pa = "5e4*log(0)"')],
@@ -768,13 +769,14 @@ case("kymo_missing_file", "base_kymogram",
      [('file = "../recordings/kymogram_good.npy"', 'file = "../data/elegansbot/kymogram_omega_turn.npy"')],
      ["kymogram_omega_turn.npy", NO_FILE], "a kymogram file name with _ for -", kind="recording", file_word=False)
 case("rec_wrong_node_count", "base_recording", [("elements = 11", "elements = 13")],
-     ["good.csv", "10", "12", "nodes"], "a 10-node recording on a 12-node mesh", kind="recording", file_word=False)
+     ["good.csv", str(NODES), str(NODES + 2), "nodes"], f"a {NODES}-node recording on a {NODES + 2}-node mesh",
+     kind="recording", file_word=False)
 case("rec_wrong_extension_case", "base_recording", [('file = "../recordings/good.csv"', 'file = "../recordings/good.CSV"')],
      ["good.CSV", NO_FILE + "|extension"], "an upper-case extension that is not the file's", kind="recording", file_word=False)
 
 recording("rec_missing_row", rows_text(without(GOOD_ROWS, 1, 4)), ["frame 1", "node 4", "missing|no row"],
           "one row (frame 1, node 4) missing")
-dup = GOOD_ROWS + [GOOD_ROWS[12]]
+dup = GOOD_ROWS + [GOOD_ROWS[NODES + 2]]
 recording("rec_duplicate_row", rows_text(dup), [f"row {len(dup)}|line {len(dup) + 1}", "frame 1", "node 2",
                                                 "already|duplicate|twice"], "a row given twice")
 gap = [({0: 0, 1: 2, 2: 3}[f], n, *p) for (f, n, *p) in GOOD_ROWS]
@@ -790,10 +792,10 @@ bad = [list(r) for r in GOOD_ROWS]
 bad[14][3] = ""
 recording("rec_empty_cell", rows_text(bad), [row_word(15, 16), "y_m", "empty|missing|number"], "an empty cell")
 bad = [list(r) for r in GOOD_ROWS]
-bad[13][2] = "NaN"
+bad[NODES + 3][2] = "NaN"
 recording("rec_nan", rows_text(bad), ["frame 1", "node 3", "nan"], "a NaN coordinate (lost tracking)")
 bad = [list(r) for r in GOOD_ROWS]
-bad[21][4] = "inf"
+bad[2 * NODES + 1][4] = "inf"
 recording("rec_inf", rows_text(bad), ["frame 2", "node 1", "inf"], "an infinite coordinate")
 recording("rec_frame_u64_max", rows_text(GOOD_ROWS + [(18446744073709551615, 0, 0.0, 0.0, 0.0)]),
           ["18446744073709551615", "frame"], "a frame index of 2^64 - 1 (a -1 written as unsigned)")
@@ -842,8 +844,9 @@ recording("rec_glitch_point", rows_text(csv_rows(glitch)), ["frame 2", "node 5"]
           "one tracking glitch half a metre away in frame 2")
 recording("rec_empty_file", "", ["empty|header|no data"], "an empty recording file")
 recording("rec_header_only", "frame,node,x_m,y_m,z_m\n", ["no data|no rows|empty|no frames"], "a header without rows")
-ragged = [r for r in GOOD_ROWS if not (r[0] == 2 and r[1] == 9)]
-recording("rec_ragged_frames", rows_text(ragged), ["frame 2", "9", "10"], "the last frame one node short")
+ragged = [r for r in GOOD_ROWS if not (r[0] == 2 and r[1] == NODES - 1)]
+recording("rec_ragged_frames", rows_text(ragged), ["frame 2", f"{NODES - 1} nodes", str(NODES)],
+          "the last frame one node short")
 recording("rec_txt_extension", rows_text(GOOD_ROWS), [".csv|extension"],
           "a recording saved as .txt", ext="txt")
 
@@ -864,7 +867,7 @@ npy_rec("npy_big_endian", npy_bytes([3, NODES, 3], GOOD_FLAT, descr=">f8", fmt="
 npy_rec("npy_2d", npy_bytes([3, NODES * 3], GOOD_FLAT), ["shape", "(3, 36)|[3, 36]", "× 3|x 3|3 axes|frames"],
         "frames × (nodes·3): the positions flattened per frame")
 npy_rec("npy_xy_only", npy_bytes([3, NODES, 2], [c for pts in GOOD_FRAMES for p in pts for c in (p[0], p[2])]),
-        ["(3, 10, 2)|[3, 10, 2]", "× 3|x 3|3 coordinates|x, y, z"], "2D positions (x, z) without y")
+        [f"(3, {NODES}, 2)|[3, {NODES}, 2]", "× 3|x 3|3 coordinates|x, y, z"], "2D positions (x, z) without y")
 npy_rec("npy_truncated", npy_bytes([3, NODES, 3], GOOD_FLAT)[:-100], ["truncated|short|ends"], "a truncated download")
 npy_rec("npy_huge_shape", npy_bytes([1000000000, 1000, 3], GOOD_FLAT), ["1000000000", "truncated|short|ends|bytes"],
         "a header claiming 10^9 frames over 720 bytes of data")
@@ -878,8 +881,8 @@ nan[3 * NODES + 3 * 2 + 1] = float("nan")
 npy_rec("npy_nan", npy_bytes([3, NODES, 3], nan), ["frame 1", "node 2", "nan"], "a NaN position")
 npy_rec("npy_zero_frames", npy_bytes([0, NODES, 3], []), ["0 frames|no frames|empty|at least 1 frame"],
         "an array of zero frames")
-npy_rec("npy_wrong_nodes", npy_bytes([3, 12, 3], flat([arc(k, n=12) for k in (400.0, 600.0, 800.0)])), ["12", "10"],
-        "12 nodes per frame on a 10-node mesh")
+npy_rec("npy_wrong_nodes", npy_bytes([3, 10, 3], flat([arc(k, n=10) for k in (400.0, 600.0, 800.0)])),
+        ["10", str(NODES)], f"10 nodes per frame on a {NODES}-node mesh")
 npy_rec("npy_length_1000x", npy_bytes([3, NODES, 3], flat(scaled(GOOD_FRAMES, 1000.0))), ["length_m|length", "1000|1 m"],
         "positions in mm labelled m")
 npy_rec("npy_trailing_bytes", npy_bytes([3, NODES, 3], GOOD_FLAT) + b"\0" * 8, ["bytes after|trailing|extra"],
