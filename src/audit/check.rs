@@ -312,7 +312,7 @@ fn evaluate_inner(check: &Check, runs: &[RunResults]) -> Result<(Outcome, String
 /// A per-iteration history of an inverse point: `x_err_rel`, `rel_change`, `tangent_misfit`,
 /// `j_total`, `kappa_err_rel`, `kappa_err_rel_inner`.
 pub fn history_of(p: &PointResult, name: &str) -> Option<Vec<f64>> {
-    let inv = p.outcome.run.as_ref()?.inverse.as_ref()?;
+    let inv = p.outcome.single.as_ref()?.inverse.as_ref()?;
     let h = &inv.history;
     Some(match name {
         "x_err_rel" => h.iter().map(|r| r.x_err_rel).collect(),

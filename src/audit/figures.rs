@@ -10,7 +10,7 @@ use super::spec::{PlotKind, PlotSpec, Selector, Spec};
 use super::{PointResult, RunResults};
 use crate::case::{Case, Reference};
 use crate::io::files::write_plot;
-use crate::io::plot::{render_heatmaps_svg, render_panels_svg, Heatmap, LinePlot, Series};
+use crate::io::plot::{render_heatmaps_svg, render_panels_svg, render_svg, Heatmap, LinePlot, Series};
 use crate::io::posture::{render_postures_svg, PosturePanel};
 use crate::io::OutputError;
 use crate::model::loads::LoadFrame;
@@ -28,8 +28,30 @@ pub fn write_figures(spec: &Spec, runs: &[RunResults], dir: &Path) -> Result<Vec
         };
         write_plot(&path, svg).map_err(|e| (p.file.clone(), e))?;
         written.push(p.file.clone());
+        // the numbers of a trade-off figure beside it, for tables
+        if let PlotKind::Tradeoff { run: name, metric } = &p.show {
+            let csv = path.with_extension("csv");
+            let text = run(runs, name).map(|r| tradeoff_csv(r, metric)).unwrap_or_default();
+            crate::io::files::write_atomic(&csv, text.as_bytes()).map_err(|e| (p.file.clone(), e))?;
+        }
     }
     Ok(written)
+}
+
+/// `point,status,wall_time_s,METRIC` of every point of a run (a trade-off figure's numbers).
+fn tradeoff_csv(r: &RunResults, metric: &str) -> String {
+    let num = |v: Option<f64>| v.map(|v| format!("{v:e}")).unwrap_or_default();
+    let mut out = format!("point,status,wall_time_s,{metric}\n");
+    for p in &r.points {
+        out += &format!(
+            "\"{}\",{},{},{}\n",
+            label(p),
+            p.outcome.status.as_str(),
+            num(p.metric("wall_time_s")),
+            num(p.metric(metric))
+        );
+    }
+    out
 }
 
 type Svg = Result<String, crate::io::plot::PlotError>;
@@ -39,7 +61,7 @@ fn run<'a>(runs: &'a [RunResults], name: &str) -> Option<&'a RunResults> {
 }
 
 fn first_at<'a>(runs: &'a [RunResults], name: &str, at: &Selector) -> Option<&'a PointResult> {
-    run(runs, name)?.select(at).find(|p| p.outcome.run.is_some() || p.outcome.clip.is_some())
+    run(runs, name)?.select(at).find(|p| p.outcome.single.is_some() || p.outcome.clip.is_some())
 }
 
 fn label(p: &PointResult) -> String {
@@ -84,7 +106,30 @@ fn figure(spec: &Spec, p: &PlotSpec, runs: &[RunResults]) -> Option<Svg> {
         PlotKind::Objectives { runs: names } => objectives(spec, title, names, runs),
         PlotKind::Omega { runs: names } => omega(title, names, runs),
         PlotKind::Postures { run: name, frames, at } => postures(title, first_at(runs, name, at)?, frames),
+        PlotKind::Tradeoff { run: name, metric } => tradeoff(title, run(runs, name)?, metric),
     }
+}
+
+/// Accuracy per second: `metric` against the solve's wall time over the run's converged
+/// points (sorted by time), log-log; one curve, each point a marker of its grid values.
+fn tradeoff(title: &str, r: &RunResults, metric: &str) -> Option<Svg> {
+    let mut pts: Vec<(f64, f64)> = r
+        .points
+        .iter()
+        .filter(|p| p.converged())
+        .filter_map(|p| Some((p.metric("wall_time_s")?, p.metric(metric)?)))
+        .filter(|(t, e)| *t > 0.0 && *e > 0.0)
+        .collect();
+    pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+    if pts.is_empty() {
+        return None;
+    }
+    let series = vec![Series {
+        label: format!("{metric} (grid: {})", r.points.iter().map(label).collect::<Vec<_>>().join(", ")),
+        x: pts.iter().map(|p| p.0).collect(),
+        y: pts.iter().map(|p| p.1).collect(),
+    }];
+    Some(render_svg(&line(title.to_string(), "solve wall time [s]", metric, series, (true, true))))
 }
 
 /// Figs. 9–11, 13: log-log histories of every point, one panel per measure.
@@ -116,7 +161,7 @@ fn convergence(title: &str, r: &RunResults) -> Option<Svg> {
 
 /// Figs. 8, 12, 14: the recovered centreline and curvature against the forward data.
 fn recovered(title: &str, p: &PointResult) -> Option<Svg> {
-    let r = p.outcome.run.as_ref()?;
+    let r = p.outcome.single.as_ref()?;
     let inv = r.inverse.as_ref()?;
     let s_mm: Vec<f64> = r.nodes.s.iter().map(|s| s * 1e3).collect();
     let comp = ["x", "y", "z"];
@@ -157,7 +202,7 @@ fn recovered(title: &str, p: &PointResult) -> Option<Svg> {
 
 /// Fig. 15: the controls f = x̂/λf and l = α̂/λl against the loads that made the data.
 fn controls(title: &str, case: &Case, p: &PointResult) -> Option<Svg> {
-    let r = p.outcome.run.as_ref()?;
+    let r = p.outcome.single.as_ref()?;
     let inv = r.inverse.as_ref()?;
     let data = case.data_case()?;
     let s_mm: Vec<f64> = r.nodes.s.iter().map(|s| s * 1e3).collect();
@@ -200,7 +245,7 @@ fn controls(title: &str, case: &Case, p: &PointResult) -> Option<Svg> {
 
 /// Fig. 5: the tip's x and y against time, with the modal solution of the linearised rod.
 fn tip_history(title: &str, case: &Case, p: &PointResult) -> Option<Svg> {
-    let r = p.outcome.run.as_ref()?;
+    let r = p.outcome.single.as_ref()?;
     let t: Vec<f64> = r.tip.iter().map(|k| k.time_s).collect();
     let modal = modal_tip_history(case, r);
     let mut panels = Vec::new();
@@ -229,7 +274,7 @@ fn deflection(title: &str, pts: &[(&Case, &PointResult)]) -> Option<Svg> {
     let mut series = Vec::new();
     for (case, p) in pts {
         let Some(Reference::TipLoadedCantilever { force_n }) = case.reference else { continue };
-        let Some(r) = p.outcome.run.as_ref() else { continue };
+        let Some(r) = p.outcome.single.as_ref() else { continue };
         let (l, kga, ea, ei) = (
             case.mesh.length_m,
             case.props.shear_stretch_n[0],

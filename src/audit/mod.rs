@@ -327,7 +327,7 @@ fn run_job(j: &Job) -> PointResult {
         (run_point(&j.case, &j.dir, &template), None)
     };
     if let Some(m) = outcome.metrics.as_mut() {
-        m.extend(derived_metrics(&j.case, outcome.run.as_ref(), series.as_ref()));
+        m.extend(derived_metrics(&j.case, outcome.single.as_ref(), series.as_ref()));
     }
     PointResult { point: j.point.clone(), label, outcome, series }
 }

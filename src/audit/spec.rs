@@ -238,6 +238,9 @@ pub enum PlotKind {
     /// the angular velocity ω per frame, max over the body, one curve per point of each run
     /// (Fig. 24)
     Omega { runs: Vec<String> },
+    /// accuracy per second: a metric (an error) against the solve's wall time over the grid
+    /// points of a run, log-log, each point labelled with its grid values
+    Tradeoff { run: String, metric: String },
     /// rendered postures of chosen frames (among the run's `keep_frames`) of a clip run
     /// (Figs. 16, 21, 22)
     Postures {
@@ -257,6 +260,7 @@ impl PlotKind {
             | PlotKind::Controls { run, .. }
             | PlotKind::TipHistory { run }
             | PlotKind::Kymograph { run, .. }
+            | PlotKind::Tradeoff { run, .. }
             | PlotKind::Postures { run, .. } => vec![run],
             PlotKind::Deflection { runs } | PlotKind::Objectives { runs } | PlotKind::Omega { runs } => {
                 runs.iter().map(|s| s.as_str()).collect()
