@@ -79,3 +79,28 @@ fn audit_folder_is_replaced_whole_or_refused() {
     assert!(err.to_string().contains("not an audit folder"), "{err}");
     assert!(foreign.join("thesis.tex").is_file());
 }
+
+/// The accuracy-per-second spec (`cases/bench/`): the trade-off CSV beside its figure has one
+/// row per grid point with the solve's wall time and the error, and the error falls at second
+/// order (Appendix A) from 250 to 1000 steps, as its claim says.
+#[test]
+fn tradeoff_figure_lists_every_point_with_its_time_and_error() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/bench/accuracy_per_second.toml");
+    let spec = read_spec(&path, true).expect("spec");
+    let out = tempfile::tempdir().expect("tempdir");
+    let opts = AuditOptions { out: out.path().join("aps"), jobs: 1 };
+    let report = run_audit(std::slice::from_ref(&spec), true, &opts, |_, _| {}).expect("audit");
+    assert!(report.claims.iter().all(|c| c.verdict == Verdict::Reproduced), "{:?}", report.claims[0].ours);
+    let csv = std::fs::read_to_string(opts.out.join("accuracy_per_second/accuracy_per_second.csv")).expect("csv");
+    let rows: Vec<Vec<f64>> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.rsplitn(3, ',').take(2).map(|v| v.parse::<f64>().expect("number")).collect())
+        .collect();
+    assert_eq!(csv.lines().next(), Some("point,status,wall_time_s,modal_tip_rel_error"));
+    assert_eq!(rows.len(), 2, "{csv}");
+    // rows: [error, time]; 4x the steps: more time, and the error at most 1/8
+    assert!(rows.iter().all(|r| r[0] > 0.0 && r[1] > 0.0), "{csv}");
+    assert!(rows[1][0] < rows[0][0] / 8.0, "{csv}");
+    assert!(opts.out.join("accuracy_per_second/accuracy_per_second.svg").is_file());
+}
