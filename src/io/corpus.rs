@@ -14,6 +14,9 @@ use super::truth_file::{truth_sidecar, write_truth};
 use crate::clip::synthetic::{roll_clip, RollClipParams, TimeMapping};
 use crate::clip::ClipError;
 
+/// Frames per kymogram row played.
+const ROWS_PER_FRAME_INV: usize = 2;
+
 /// The listing of a corpus: its parameters and each recording's.
 pub const LISTING: &str = "corpus.json";
 
@@ -75,7 +78,7 @@ pub struct CorpusEntry {
     pub name: String,
     pub roll_total_rad: f64,
     pub twist_per_m: f64,
-    /// first kymogram row played (one row per frame)
+    /// first kymogram row played (then one row every two frames)
     pub first_row: usize,
     /// the seed of its noise
     pub noise_seed: u64,
@@ -116,9 +119,9 @@ fn check(name: &'static str, value: f64, ok: bool, requirement: &'static str) ->
 
 /// Write the corpus of `params` into `dir` (created if needed) from the kymogram `kymogram`
 /// (the omega turn of `scripts/fetch_worm_data.sh`). Recording `k` is `roll_KKK.npy`: a
-/// `roll_3d` clip playing `frames` consecutive kymogram rows from a random first row (the
-/// whole kymogram stretched over the clip if it has fewer rows), with a random total roll and
-/// twist, plus noise. Returns the recordings written, in order.
+/// `roll_3d` clip playing consecutive kymogram rows from a random first row, one row every two
+/// frames (the whole kymogram stretched over the clip if it has fewer rows), with a random
+/// total roll and twist, plus noise. Returns the recordings written, in order.
 pub fn write_corpus(dir: &Path, kymogram: &Path, params: &CorpusParams) -> Result<Vec<CorpusEntry>, CorpusError> {
     let p = params;
     check("count", p.count as f64, p.count >= 1, "at least one recording")?;
@@ -132,7 +135,10 @@ pub fn write_corpus(dir: &Path, kymogram: &Path, params: &CorpusParams) -> Resul
     let width = (p.count - 1).to_string().len().max(3);
     let mut entries = Vec::with_capacity(p.count);
     for k in 0..p.count {
-        let span = rows.len().saturating_sub(p.frames);
+        // half a kymogram row per frame (as worm_roll_3d, ×2.48 slower than the recording): the
+        // time spline fills the frames between rows
+        let played_rows = (p.frames - 1).div_ceil(ROWS_PER_FRAME_INV) + 1;
+        let span = rows.len().saturating_sub(played_rows);
         let entry = CorpusEntry {
             name: format!("roll_{k:0width$}"),
             roll_total_rad: p.max_roll_rad * rng.uniform(),
@@ -140,7 +146,7 @@ pub fn write_corpus(dir: &Path, kymogram: &Path, params: &CorpusParams) -> Resul
             first_row: ((span + 1) as f64 * rng.uniform()) as usize,
             noise_seed: rng.next_u64(),
         };
-        let played = &rows[entry.first_row.min(span)..(entry.first_row + p.frames).min(rows.len())];
+        let played = &rows[entry.first_row.min(span)..(entry.first_row + played_rows).min(rows.len())];
         let gen = RollClipParams {
             length_m: p.length_m,
             nodes: p.nodes,
