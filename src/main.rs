@@ -14,6 +14,8 @@ use cosserat::run::budget::{self, default_limit_bytes, Footprint, GIB};
 use cosserat::run::Engine;
 use cosserat::solve::modes::modal_model;
 
+mod cli;
+
 /// Forward Cosserat rods after Wang et al. (Comput. Mech. 71, 2023), in Rust and FreeFEM.
 #[derive(Parser, Debug)]
 #[command(name = "cosserat", version, about, long_about = None)]
@@ -141,6 +143,15 @@ enum Command {
         #[arg(long)]
         quiet: bool,
     },
+    /// Run a clip case over many recordings (here, or as a Slurm job array with --slurm).
+    Batch(cli::BatchArgs),
+    /// Run one task of a batch's Slurm job array (called by the job script).
+    #[command(hide = true)]
+    BatchTask(cli::TaskArgs),
+    /// Write OUT/summary.csv from the recordings' folders of a batch (after a Slurm job array).
+    Gather { out: PathBuf },
+    /// Write a corpus of synthetic 3D recordings with their ground truth.
+    Synth(cli::SynthArgs),
     /// List the cases of a directory with their descriptions.
     List {
         /// Directory holding *.toml case files
@@ -212,6 +223,10 @@ fn dispatch(cli: Cli) -> Result<ExitCode> {
             cmd_sweep(&case, &set, out, force, limits, jobs, quiet)
         }
         Command::Audit { specs, quick, out, force, jobs, quiet } => cmd_audit(&specs, quick, out, force, jobs, quiet),
+        Command::Batch(a) => cli::cmd_batch(a),
+        Command::BatchTask(a) => cli::cmd_batch_task(a),
+        Command::Gather { out } => cli::cmd_gather(&out),
+        Command::Synth(a) => cli::cmd_synth(a),
         Command::List { dir } => cmd_list(&dir),
         Command::Modes { case, count, limits } => cmd_modes(&case, count, limits),
     }

@@ -16,7 +16,7 @@ const LAYERS: &[&[&str]] = &[
     &["run"],
     &["io"],
     &["audit"],
-    &["main"],
+    &["main", "cli"],
 ];
 
 /// Longest source file allowed [lines].

@@ -7,6 +7,7 @@ use nalgebra::{Matrix3, Vector3};
 
 use super::files::{csv_reader_capped, InputError};
 use super::npy::read_npy;
+use super::truth_file::{read_truth, truth_sidecar};
 use crate::case::{Case, ClipKind};
 use crate::clip::synthetic::{roll_clip, GroundTruth};
 use crate::clip::{
@@ -119,7 +120,8 @@ fn glitch(pts: &[Vector3<f64>]) -> String {
 /// The clip of a clip case: kymograms become spline centrelines with the mesh's node count
 /// and the rod's length in the case's plane; recordings must have that node count, and every
 /// frame solved the rod's length within [`MAX_LENGTH_DEVIATION`]; a synthetic clip
-/// (`kind = "roll_3d"`) comes with its ground truth. The frame range and the orientation of the
+/// (`kind = "roll_3d"`) comes with its ground truth, and so does a recording with a truth sidecar
+/// ([`super::truth_file`]). The frame range and the orientation of the
 /// case are applied to both.
 pub fn load_clip(case: &Case) -> Result<(Clip, Option<GroundTruth>), ClipFileError> {
     let src = case.clip().ok_or_else(|| ClipFileError::NotAClip(case.name.clone()))?;
@@ -140,7 +142,16 @@ pub fn load_clip(case: &Case) -> Result<(Clip, Option<GroundTruth>), ClipFileErr
         }
         ClipKind::Recording => {
             let dt = case.inverse().map(|i| i.params.frame_interval_s).unwrap_or(f64::NAN);
-            (read_recording(&src.file, dt)?, None)
+            let clip = read_recording(&src.file, dt)?;
+            // a synthetic recording's ground truth, when its sidecar lies next to it
+            let sidecar = truth_sidecar(&src.file);
+            let truth = if sidecar.is_file() {
+                let s: Vec<f64> = (0..clip.node_count()).map(|i| case.mesh.node_s(i)).collect();
+                Some(read_truth(&sidecar, clip.frame_count(), &s)?)
+            } else {
+                None
+            };
+            (clip, truth)
         }
         ClipKind::Roll3d(_) => {
             let params = case.roll_clip_params().ok_or_else(|| ClipFileError::NotAClip(case.name.clone()))?;

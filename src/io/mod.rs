@@ -2,10 +2,13 @@
 //! forward data file `data.csv` ([`data`]), clip files ([`clip_files`], [`npy`]), the outputs of
 //! a run ([`run_files`]) and of a clip ([`clip_output`], [`vtk`], the resume [`journal`]), SVG figures ([`plot`]), the
 //! FreeFEM engine ([`freefem`]), a case in either engine from its files ([`engine`]) and the
-//! files of a sweep ([`sweep`]).
+//! files of a sweep ([`sweep`]), a batch of recordings ([`batch`], on Slurm: [`slurm`]) and a
+//! corpus of synthetic recordings ([`corpus`]).
+pub mod batch;
 pub mod clip_files;
 pub mod clip_output;
 pub mod compare;
+pub mod corpus;
 pub mod data;
 pub mod engine;
 pub mod files;
@@ -18,8 +21,10 @@ pub mod plot;
 pub mod posture;
 pub mod run_files;
 pub mod run_folder;
+pub mod slurm;
 pub mod solved;
 pub mod sweep;
+pub mod truth_file;
 pub mod vtk;
 
 pub use files::{write_atomic, InputError, OutputError};

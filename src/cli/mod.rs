@@ -1,0 +1,199 @@
+//! The commands of many recordings: `batch` (locally or as a Slurm job array), the hidden
+//! `batch-task` of an array task, `gather` and `synth`.
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::Duration;
+
+use anyhow::{Context, Result};
+use indicatif::{ProgressBar, ProgressStyle};
+
+use cosserat::io::batch::{self, gather, list_recordings, run_batch, run_task, BatchRow, Plan, SUMMARY};
+use cosserat::io::corpus::{write_corpus, CorpusParams};
+use cosserat::io::slurm;
+
+/// `cosserat batch`.
+#[derive(clap::Args, Debug)]
+pub struct BatchArgs {
+    /// Clip case file (TOML); each recording replaces its `clip.file`
+    case: PathBuf,
+    /// A folder of recordings (*.csv, *.npy; truth sidecars *.truth.npy are read with their
+    /// recording) or a file listing one recording per line (relative to the list's folder)
+    #[arg(long)]
+    recordings: PathBuf,
+    /// Output folder: one folder per recording, summary.csv, batch.json (the plan)
+    #[arg(long)]
+    out: PathBuf,
+    /// Recordings run at once [default: number of cores]
+    #[arg(long)]
+    jobs: Option<usize>,
+    /// Submit a Slurm job array (sbatch) instead of running here; `cosserat gather OUT` then
+    /// writes summary.csv. OUT must be on a filesystem that every node sees
+    #[arg(long)]
+    slurm: bool,
+    /// Recordings per Slurm array task
+    #[arg(long, default_value_t = 1, requires = "slurm", value_parser = clap::value_parser!(u64).range(1..))]
+    per_task: u64,
+    /// Slurm partition [default: the cluster's default]
+    #[arg(long, requires = "slurm")]
+    partition: Option<String>,
+    /// Block until the job array has finished, then gather
+    #[arg(long, requires = "slurm")]
+    wait: bool,
+    /// Do not show a progress bar
+    #[arg(long)]
+    quiet: bool,
+}
+
+/// `cosserat batch-task` (run by a Slurm array task).
+#[derive(clap::Args, Debug)]
+pub struct TaskArgs {
+    /// Output folder of the batch (holds batch.json)
+    out: PathBuf,
+    /// Array task index ($SLURM_ARRAY_TASK_ID)
+    #[arg(long)]
+    index: usize,
+}
+
+/// `cosserat synth`.
+#[derive(clap::Args, Debug)]
+pub struct SynthArgs {
+    /// Output folder for the recordings (roll_KKK.npy), their truth sidecars and corpus.json
+    #[arg(long)]
+    out: PathBuf,
+    /// Number of recordings
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
+    count: u64,
+    /// Frames per recording (>= 2)
+    #[arg(long, value_parser = clap::value_parser!(u64).range(2..))]
+    frames: u64,
+    /// Seed of the rolls, twists, kymogram excerpts and noise
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Nodes per frame: the batch case's rod.elements + 1
+    #[arg(long, default_value_t = 33, value_parser = clap::value_parser!(u64).range(3..))]
+    nodes: u64,
+    /// Standard deviation of the noise added to every coordinate [m]
+    #[arg(long, default_value_t = 1e-7)]
+    noise_m: f64,
+    /// Time between frames [s]
+    #[arg(long, default_value_t = 0.04)]
+    frame_interval_s: f64,
+    /// The kymogram whose curvature the recordings play (scripts/fetch_worm_data.sh)
+    #[arg(long, default_value = "data/elegansbot/kymogram_omega-turn.npy")]
+    kymogram: PathBuf,
+}
+
+fn bar(quiet: bool, len: usize, label: &str) -> ProgressBar {
+    if quiet {
+        return ProgressBar::hidden();
+    }
+    let pb = ProgressBar::new(len as u64);
+    pb.set_style(
+        ProgressStyle::with_template("{prefix} [{bar:40}] {pos}/{len} recordings, eta {eta}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar())
+            .progress_chars("=> "),
+    );
+    pb.set_prefix(label.to_string());
+    pb
+}
+
+/// Print the outcome of `rows` (written to `out/summary.csv`): one line on stdout, one line per
+/// failure and a one-line summary on stderr; exit status 1 if any recording did not succeed.
+fn report(out: &Path, rows: &[BatchRow], skipped: usize) -> ExitCode {
+    let failed: Vec<&BatchRow> = rows.iter().filter(|r| !r.is_ok()).collect();
+    let frames: usize = rows.iter().filter_map(|r| r.frames).sum();
+    println!(
+        "{} recordings: {} ok ({skipped} already complete, skipped), {} not; {frames} frames; wrote {}",
+        rows.len(),
+        rows.len() - failed.len(),
+        failed.len(),
+        out.join(SUMMARY).display()
+    );
+    for r in &failed {
+        eprintln!("  {} ({}): {}", r.folder, r.status, r.reason.as_deref().unwrap_or(""));
+    }
+    if failed.is_empty() {
+        return ExitCode::SUCCESS;
+    }
+    let names: Vec<&str> = failed.iter().map(|r| r.folder.as_str()).collect();
+    eprintln!("error: {} of {} recordings failed: {} (see {})", failed.len(), rows.len(), names.join(", "), SUMMARY);
+    if rows.iter().any(|r| r.status == "interrupted") {
+        return ExitCode::from(crate::EXIT_INTERRUPTED);
+    }
+    ExitCode::from(1)
+}
+
+pub fn cmd_batch(a: BatchArgs) -> Result<ExitCode> {
+    let recordings = list_recordings(&a.recordings)?;
+    let per_task = if a.slurm { a.per_task as usize } else { 1 };
+    let plan = Plan::new(&a.case, &recordings, per_task);
+    // the case is read (and refused if it is not a clip case) before anything is written
+    let (case, _) = batch::plan_case(&plan).with_context(|| format!("batch of {}", a.case.display()))?;
+    plan.begin(&a.out)?;
+    let out = std::fs::canonicalize(&a.out).with_context(|| format!("output folder {}", a.out.display()))?;
+    if a.slurm {
+        let exe = std::env::current_exe().context("cannot find the cosserat executable for the job script")?;
+        let id = slurm::submit(&plan, &out, &exe, a.partition.as_deref())?;
+        eprintln!(
+            "{}: submitted Slurm job {id}: {} recordings in {} array tasks; job script {}",
+            case.name,
+            plan.recordings.len(),
+            plan.tasks(),
+            out.join(slurm::SCRIPT).display()
+        );
+        if !a.wait {
+            println!("{id}");
+            eprintln!("when it has finished: cosserat gather {}", out.display());
+            return Ok(ExitCode::SUCCESS);
+        }
+        let pb = bar(a.quiet, plan.tasks(), &format!("{} job {id}", case.name));
+        slurm::wait(&id, Duration::from_millis(500), |queued| {
+            pb.set_position((plan.tasks() - queued.min(plan.tasks())) as u64)
+        })?;
+        pb.finish_and_clear();
+        let rows = gather(&out)?;
+        return Ok(report(&out, &rows, 0));
+    }
+    let pb = bar(a.quiet, plan.recordings.len(), &case.name);
+    let ran = run_batch(&plan, &out, a.jobs.unwrap_or(0), || pb.inc(1))?;
+    pb.finish_and_clear();
+    let skipped = ran.iter().filter(|r| r.skipped).count();
+    let rows: Vec<BatchRow> = ran.into_iter().map(|r| r.row).collect();
+    Ok(report(&out, &rows, skipped))
+}
+
+pub fn cmd_batch_task(a: TaskArgs) -> Result<ExitCode> {
+    let ran = run_task(&a.out, a.index)?;
+    for r in &ran {
+        let what = if r.skipped { "already complete".into() } else { r.row.status.clone() };
+        eprintln!("{}: {what}{}", r.row.folder, r.row.reason.as_deref().map(|m| format!(": {m}")).unwrap_or_default());
+    }
+    Ok(if ran.iter().all(|r| r.row.is_ok()) { ExitCode::SUCCESS } else { ExitCode::from(1) })
+}
+
+pub fn cmd_gather(out: &Path) -> Result<ExitCode> {
+    let rows = gather(out).with_context(|| format!("gather {}", out.display()))?;
+    Ok(report(out, &rows, 0))
+}
+
+pub fn cmd_synth(a: SynthArgs) -> Result<ExitCode> {
+    let params = CorpusParams {
+        count: a.count as usize,
+        frames: a.frames as usize,
+        nodes: a.nodes as usize,
+        dt_s: a.frame_interval_s,
+        noise_m: a.noise_m,
+        seed: a.seed,
+        ..CorpusParams::default()
+    };
+    let entries =
+        write_corpus(&a.out, &a.kymogram, &params).with_context(|| format!("synth into {}", a.out.display()))?;
+    println!(
+        "wrote {} recordings ({} frames x {} nodes, with truth sidecars) and corpus.json to {}",
+        entries.len(),
+        params.frames,
+        params.nodes,
+        a.out.display()
+    );
+    Ok(ExitCode::SUCCESS)
+}
