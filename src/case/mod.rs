@@ -507,7 +507,10 @@ frames = 4
             )
         );
         let e = reason(&dynamic.replace("[loads]", "[loads]\ntorque_nm_per_m = [\"s/(t - 0.5)\", 0, 0]"));
-        assert!(e.contains("`loads.torque_nm_per_m[0]`: `s/(t - 0.5)` is not finite (NaN) at s = 0 m, t = 0.5 s"), "{e}");
+        assert!(
+            e.contains("`loads.torque_nm_per_m[0]`: `s/(t - 0.5)` is not finite (NaN) at s = 0 m, t = 0.5 s"),
+            "{e}"
+        );
     }
 
     /// NaN and infinity, as TOML numbers or as names, and names a key does not have.
