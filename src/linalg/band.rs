@@ -57,6 +57,17 @@ impl BandLu {
         self.n
     }
 
+    /// Sub-diagonals `kl` (the first `kl` stored rows of every column are the fill of the
+    /// interchanges).
+    pub fn kl(&self) -> usize {
+        self.kl
+    }
+
+    /// Stored length of a column, `2 kl + ku + 1`.
+    pub fn ld(&self) -> usize {
+        self.ld
+    }
+
     /// Set every entry (and the fill area) to zero.
     pub fn clear(&mut self) {
         self.ab.iter_mut().for_each(|v| *v = 0.0);

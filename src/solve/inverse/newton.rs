@@ -219,7 +219,7 @@ pub(crate) fn solve(
     observer: &mut impl FnMut(&InverseRecord, &DVector<f64>, &DVector<f64>),
 ) -> Result<InverseSolution, SolveError> {
     // Consistent start: one linear solve of the fixed point at u0.
-    let mut big = s.solve_linearised(params, frame, u0)?;
+    let mut big = s.solve_linearised(params, frame, u0, false)?;
     let problem = s.problem;
     let fwd = problem.dofs();
     let FrameSolver { dofs, pattern, solver, fixed, rows, values, merit_weights, no_previous, .. } = s;
@@ -231,7 +231,9 @@ pub(crate) fn solve(
     for k in 1..=params.max_iterations {
         let jacobian = Some((&*pattern, values.as_mut_slice(), rows.as_slice()));
         let r = assemble_residual(problem, params, frame, previous, &big, fixed, jacobian);
-        let delta = solver.solve_equilibrated(values, &(-&r))?;
+        // Ruiz on the first Jacobian (I6); its factors scale the later ones of the frame
+        let delta =
+            if k == 1 { solver.solve_equilibrated(values, &(-&r))? } else { solver.solve_rescaled(values, &(-&r))? };
         if k == 1 {
             // the Ruiz row factors of the first Jacobian weigh the merit of the whole frame
             merit_weights.clear();
