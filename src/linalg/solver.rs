@@ -116,6 +116,17 @@ impl LinearSolver {
         Ok(x)
     }
 
+    /// Solve `M x = b` with the factors of the last [`LinearSolver::solve`] (no copy, no
+    /// factorisation: the matrix of that solve, e.g. a chord step's frozen Jacobian).
+    pub fn solve_factored(&self, b: &DVector<f64>) -> Result<DVector<f64>, LinearError> {
+        let mut x = b.clone();
+        self.lu.solve_in_place(x.as_mut_slice());
+        if let Some(index) = x.iter().position(|v| !v.is_finite()) {
+            return Err(LinearError::NonFinite { index });
+        }
+        Ok(x)
+    }
+
     /// Copy `values` (CSC, the pattern's order) into the band, column by column: the pattern's
     /// rows (times `dr_i dc_j` if `scaled`) and zeros in the rest of the stored band (the
     /// factorisation's fill from the last matrix). The fill rows above are the factor's.
@@ -366,6 +377,7 @@ mod tests {
         let mut solver = LinearSolver::new(&p);
         let x = solver.solve(&vals, &b).unwrap();
         assert!((&dense * &x - &b).amax() < 1e-12);
+        assert_eq!(solver.solve_factored(&b).unwrap(), x);
         // Equilibration does not change the solution of a well-conditioned system.
         let xe = solver.solve_equilibrated(&vals, &b).unwrap();
         assert!((&xe - &x).amax() < 1e-12);
