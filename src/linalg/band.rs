@@ -57,6 +57,17 @@ impl BandLu {
         self.n
     }
 
+    /// Sub-diagonals `kl` (the first `kl` stored rows of every column are the fill of the
+    /// interchanges).
+    pub fn kl(&self) -> usize {
+        self.kl
+    }
+
+    /// Stored length of a column, `2 kl + ku + 1`.
+    pub fn ld(&self) -> usize {
+        self.ld
+    }
+
     /// Set every entry (and the fill area) to zero.
     pub fn clear(&mut self) {
         self.ab.iter_mut().for_each(|v| *v = 0.0);
@@ -140,18 +151,28 @@ impl BandLu {
             }
             let pivot = self.ab[col];
             let (head, tail) = self.ab.split_at_mut((j + 1) * ld);
-            let l = &mut head[col + 1..col + 1 + km];
-            for v in l.iter_mut() {
+            for v in &mut head[col + 1..col + 1 + km] {
                 *v /= pivot;
             }
-            // rank-1 update of the columns j + 1..=ju, rows j + 1..=j + km
-            for c in j + 1..=ju {
-                let base = (c - j - 1) * ld + kv + j - c;
-                let ujc = tail[base];
-                if ujc != 0.0 {
-                    let dst = &mut tail[base + 1..base + 1 + km];
-                    for (d, li) in dst.iter_mut().zip(l.iter()) {
-                        *d -= li * ujc;
+            // rank-1 update of the columns j + 1..=ju, rows j + 1..=j + km; for the usual
+            // block sizes over all kl rows below the pivot (fixed length, unrolled): the rows
+            // past j + km hold zeros in column j (outside the band's structure, or past n) and
+            // stay zero in column c
+            let span = ju - j;
+            match self.kl {
+                23 => update::<23>(head, tail, col, kv, ld, span),
+                11 => update::<11>(head, tail, col, kv, ld, span),
+                _ => {
+                    let l = &head[col + 1..col + 1 + km];
+                    for c in j + 1..=ju {
+                        let base = (c - j - 1) * ld + kv + j - c;
+                        let ujc = tail[base];
+                        if ujc != 0.0 {
+                            let dst = &mut tail[base + 1..base + 1 + km];
+                            for (d, li) in dst.iter_mut().zip(l.iter()) {
+                                *d -= li * ujc;
+                            }
+                        }
                     }
                 }
             }
@@ -190,6 +211,25 @@ impl BandLu {
                 for (bi, ui) in b[lo..j].iter_mut().zip(u) {
                     *bi -= ui * bj;
                 }
+            }
+        }
+    }
+}
+
+/// The rank-1 update of [`BandLu::factor`] over the `span` columns after the pivot column
+/// (`head` ends with it, its multipliers at `col + 1..`; `tail` holds the next columns), all `KL`
+/// rows below the pivot row.
+#[inline]
+fn update<const KL: usize>(head: &[f64], tail: &mut [f64], col: usize, kv: usize, ld: usize, span: usize) {
+    let l: &[f64; KL] = head[col + 1..col + 1 + KL].try_into().expect("KL multipliers");
+    for (t, column) in tail.chunks_exact_mut(ld).take(span).enumerate() {
+        // column c = j + 1 + t: row j at kv + j − c
+        let base = kv - 1 - t;
+        let ujc = column[base];
+        if ujc != 0.0 {
+            let dst: &mut [f64; KL] = (&mut column[base + 1..base + 1 + KL]).try_into().expect("KL rows");
+            for r in 0..KL {
+                dst[r] -= l[r] * ujc;
             }
         }
     }

@@ -1,5 +1,9 @@
 //! Direct solver of the block-tridiagonal systems ([`Pattern`]): Ruiz equilibration
 //! (`docs/inverse.md`, I6) and a banded LU with partial pivoting ([`BandLu`]).
+//!
+//! The values are copied once into the band (one pass per column: the pattern's rows, zeros
+//! around them), equilibrated there and factored in place: no intermediate copy, no pass that
+//! zeroes the whole band.
 use nalgebra::DVector;
 
 use super::{BandLu, LinearError, Pattern};
@@ -7,16 +11,24 @@ use super::{BandLu, LinearError, Pattern};
 /// Passes of Ruiz equilibration.
 const RUIZ_PASSES: usize = 5;
 
+/// Where column `j` of the pattern lives: its first row, its length and where its first entry
+/// sits in the CSC value array and in the band storage.
+#[derive(Clone, Debug)]
+struct Columns {
+    first: Vec<usize>,
+    len: Vec<usize>,
+    csc: Vec<usize>,
+    band: Vec<usize>,
+}
+
 /// Direct solver of the pattern's block-tridiagonal systems: a banded LU with partial
 /// pivoting ([`BandLu`], `kl = ku = 2 block − 1`) whose storage and scratch are allocated once
 /// per pattern; each solve copies the values into the band, factors and solves, without
 /// allocating (apart from the returned vector).
 pub struct LinearSolver {
-    col_ptr: Vec<usize>,
-    row_idx: Vec<usize>,
+    cols: Columns,
     lu: BandLu,
-    /// equilibrated values and the row/column factors (scratch of [`LinearSolver::solve_equilibrated`])
-    scaled: Vec<f64>,
+    /// row/column factors of the last equilibration, and scratch of [`ruiz`]
     dr: Vec<f64>,
     dc: Vec<f64>,
     rmax: Vec<f64>,
@@ -27,11 +39,23 @@ pub struct LinearSolver {
 impl LinearSolver {
     pub fn new(pattern: &Pattern) -> Self {
         let n = pattern.ndofs();
+        let (col_ptr, row_idx) = (pattern.col_ptr(), pattern.row_idx());
+        let lu = BandLu::block_tridiagonal(n / pattern.block(), pattern.block());
+        let first: Vec<usize> =
+            (0..n).map(|j| if col_ptr[j] < col_ptr[j + 1] { row_idx[col_ptr[j]] } else { j }).collect();
+        debug_assert!(
+            (0..n).all(|j| (col_ptr[j]..col_ptr[j + 1]).all(|k| row_idx[k] == first[j] + k - col_ptr[j])),
+            "rows of a column must be contiguous"
+        );
+        let cols = Columns {
+            len: (0..n).map(|j| col_ptr[j + 1] - col_ptr[j]).collect(),
+            csc: col_ptr[..n].to_vec(),
+            band: (0..n).map(|j| lu.index(first[j], j)).collect(),
+            first,
+        };
         LinearSolver {
-            col_ptr: pattern.col_ptr().to_vec(),
-            row_idx: pattern.row_idx().to_vec(),
-            lu: BandLu::block_tridiagonal(n / pattern.block(), pattern.block()),
-            scaled: vec![0.0; pattern.nnz()],
+            cols,
+            lu,
             dr: vec![1.0; n],
             dc: vec![1.0; n],
             rmax: vec![0.0; n],
@@ -41,18 +65,30 @@ impl LinearSolver {
     }
 
     /// Solve `M x = b` after Ruiz equilibration (`docs/inverse.md`, I6): five passes of
-    /// row/column max-norm scaling `A ← diag(1/√r) A diag(1/√c)`, then `x = D_c y`.
+    /// row/column max-norm scaling `A ← diag(1/√r) A diag(1/√c)`, then `x = D_c y`. The factors
+    /// are kept for [`LinearSolver::solve_rescaled`].
     pub fn solve_equilibrated(&mut self, values: &[f64], b: &DVector<f64>) -> Result<DVector<f64>, LinearError> {
-        let mut scaled = std::mem::take(&mut self.scaled);
-        self.equilibrate_into(values, &mut scaled);
-        let mut x = DVector::from_fn(b.len(), |i, _| b[i] * self.dr[i]);
-        let res = self.factor_and_solve(&scaled, &mut x);
-        self.scaled = scaled;
-        res?;
-        for (xi, d) in x.iter_mut().zip(&self.dc) {
-            *xi *= d;
-        }
-        Ok(x)
+        self.load(values, false);
+        ruiz(
+            &self.cols,
+            self.lu.band_mut(),
+            &mut self.dr,
+            &mut self.dc,
+            &mut self.rmax,
+            &mut self.cmax,
+            &mut self.rnext,
+        );
+        self.factor_and_solve_scaled(b)
+    }
+
+    /// Solve `M x = b` scaled by the row and column factors of the last
+    /// [`LinearSolver::solve_equilibrated`] (`D_r M D_c y = D_r b`, `x = D_c y`): one pass
+    /// instead of Ruiz's five, for a matrix close to the one they were computed for (the
+    /// Jacobians of one Newton solve). Any positive diagonal scaling leaves the solution
+    /// unchanged up to round-off; these keep the pivots as well-scaled as the equilibrated ones.
+    pub fn solve_rescaled(&mut self, values: &[f64], b: &DVector<f64>) -> Result<DVector<f64>, LinearError> {
+        self.load(values, true);
+        self.factor_and_solve_scaled(b)
     }
 
     /// Row factors `D_r` of the last [`LinearSolver::solve_equilibrated`].
@@ -63,48 +99,70 @@ impl LinearSolver {
     /// Ruiz equilibration of I6: returns `(D_r A D_c, D_r, D_c)` (values, row and column
     /// factors) after five passes of row/column max-norm scaling.
     pub fn equilibrate(&self, values: &[f64]) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
-        let n = self.col_ptr.len() - 1;
-        let mut a = vec![0.0; values.len()];
+        let n = self.cols.len.len();
+        let mut a = values.to_vec();
         let (mut dr, mut dc) = (vec![1.0; n], vec![1.0; n]);
         let (mut r, mut c, mut r_next) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
-        ruiz(&self.col_ptr, &self.row_idx, values, &mut a, &mut dr, &mut dc, &mut r, &mut c, &mut r_next);
+        let csc = Columns { band: self.cols.csc.clone(), ..self.cols.clone() };
+        ruiz(&csc, &mut a, &mut dr, &mut dc, &mut r, &mut c, &mut r_next);
         (a, dr, dc)
-    }
-
-    /// [`LinearSolver::equilibrate`] into `scaled` and the solver's own factors `self.dr`, `self.dc`.
-    fn equilibrate_into(&mut self, values: &[f64], scaled: &mut [f64]) {
-        ruiz(
-            &self.col_ptr,
-            &self.row_idx,
-            values,
-            scaled,
-            &mut self.dr,
-            &mut self.dc,
-            &mut self.rmax,
-            &mut self.cmax,
-            &mut self.rnext,
-        );
     }
 
     /// Solve `M x = b` for the matrix with the pattern's structure and the given values.
     pub fn solve(&mut self, values: &[f64], b: &DVector<f64>) -> Result<DVector<f64>, LinearError> {
         let mut x = b.clone();
-        self.factor_and_solve(values, &mut x)?;
+        self.load(values, false);
+        self.factor_and_solve(&mut x)?;
         Ok(x)
     }
 
-    /// Copy `values` into the band, factor, and overwrite `x` (the right-hand side) by the solution.
-    fn factor_and_solve(&mut self, values: &[f64], x: &mut DVector<f64>) -> Result<(), LinearError> {
-        self.lu.clear();
-        for j in 0..self.col_ptr.len() - 1 {
-            let (k0, k1) = (self.col_ptr[j], self.col_ptr[j + 1]);
-            if k0 == k1 {
-                continue;
-            }
-            // rows of a column are contiguous in the pattern and in the band
-            let start = self.lu.index(self.row_idx[k0], j);
-            self.lu.band_mut()[start..start + (k1 - k0)].copy_from_slice(&values[k0..k1]);
+    /// Solve `M x = b` with the factors of the last [`LinearSolver::solve`] (no copy, no
+    /// factorisation: the matrix of that solve, e.g. a chord step's frozen Jacobian).
+    pub fn solve_factored(&self, b: &DVector<f64>) -> Result<DVector<f64>, LinearError> {
+        let mut x = b.clone();
+        self.lu.solve_in_place(x.as_mut_slice());
+        if let Some(index) = x.iter().position(|v| !v.is_finite()) {
+            return Err(LinearError::NonFinite { index });
         }
+        Ok(x)
+    }
+
+    /// Copy `values` (CSC, the pattern's order) into the band, column by column: the pattern's
+    /// rows (times `dr_i dc_j` if `scaled`) and zeros in the rest of the stored band (the
+    /// factorisation's fill from the last matrix). The fill rows above are the factor's.
+    fn load(&mut self, values: &[f64], scaled: bool) {
+        let c = &self.cols;
+        let ld = self.lu.ld();
+        let kl = self.lu.kl();
+        for (j, col) in self.lu.band_mut().chunks_exact_mut(ld).enumerate() {
+            let (s, len, k0) = (c.band[j] - j * ld, c.len[j], c.csc[j]);
+            col[kl..s].fill(0.0);
+            let dst = &mut col[s..s + len];
+            let src = &values[k0..k0 + len];
+            if scaled {
+                let (dr, dcj) = (&self.dr[c.first[j]..c.first[j] + len], self.dc[j]);
+                for ((d, v), r) in dst.iter_mut().zip(src).zip(dr) {
+                    *d = v * (r * dcj);
+                }
+            } else {
+                dst.copy_from_slice(src);
+            }
+            col[s + len..].fill(0.0);
+        }
+    }
+
+    /// Factor the loaded (scaled) band and solve with `D_r b`, returning `D_c y`.
+    fn factor_and_solve_scaled(&mut self, b: &DVector<f64>) -> Result<DVector<f64>, LinearError> {
+        let mut x = DVector::from_fn(b.len(), |i, _| b[i] * self.dr[i]);
+        self.factor_and_solve(&mut x)?;
+        for (xi, d) in x.iter_mut().zip(&self.dc) {
+            *xi *= d;
+        }
+        Ok(x)
+    }
+
+    /// Factor the loaded band and overwrite `x` (the right-hand side) by the solution.
+    fn factor_and_solve(&mut self, x: &mut DVector<f64>) -> Result<(), LinearError> {
         self.lu.factor()?;
         self.lu.solve_in_place(x.as_mut_slice());
         if let Some(index) = x.iter().position(|v| !v.is_finite()) {
@@ -137,15 +195,13 @@ fn row_col_max(r: &mut [f64], a: &[f64]) -> f64 {
     acc[0].max(acc[1]).max(acc[2].max(acc[3]))
 }
 
-/// Five passes of Ruiz row/column max-norm scaling of the CSC values `values` into `a`, with
-/// the accumulated row and column factors in `dr`, `dc` (`r`, `c`, `r_next`: scratch). Each pass takes
-/// the row and column maxima of `a`, then scales `a_ij ← a_ij (1/√r_i)(1/√c_j)`; the scaling
-/// of one pass and the maxima of the next share one sweep over the values.
-#[allow(clippy::too_many_arguments)] // the CSC arrays, the values and the scratch of one solver
+/// Five passes of Ruiz row/column max-norm scaling of the values in `a` (column `j` of the
+/// pattern at `a[cols.band[j]..][..cols.len[j]]`, rows from `cols.first[j]`), in place, with the
+/// accumulated row and column factors in `dr`, `dc` (`r`, `c`, `r_next`: scratch). Each pass
+/// takes the row and column maxima of `a`, then scales `a_ij ← a_ij (1/√r_i)(1/√c_j)`; the
+/// scaling of one pass and the maxima of the next share one sweep over the values.
 fn ruiz(
-    col_ptr: &[usize],
-    row_idx: &[usize],
-    values: &[f64],
+    cols: &Columns,
     a: &mut [f64],
     dr: &mut [f64],
     dc: &mut [f64],
@@ -153,18 +209,12 @@ fn ruiz(
     c: &mut [f64],
     r_next: &mut [f64],
 ) {
-    let n = col_ptr.len() - 1;
-    a.copy_from_slice(values);
+    let n = cols.len.len();
     dr.iter_mut().for_each(|v| *v = 1.0);
     dc.iter_mut().for_each(|v| *v = 1.0);
-    debug_assert!(
-        (0..n).all(|j| (col_ptr[j]..col_ptr[j + 1]).all(|k| row_idx[k] == row_idx[col_ptr[j]] + k - col_ptr[j])),
-        "rows of a column must be contiguous"
-    );
     let inv_sqrt = |v: f64| if v > 0.0 { 1.0 / v.sqrt() } else { 1.0 };
     // the rows of a column are contiguous (block-tridiagonal pattern): slices, no gathers
-    let column =
-        |j: usize| (col_ptr[j], col_ptr[j + 1], if col_ptr[j] < col_ptr[j + 1] { row_idx[col_ptr[j]] } else { 0 });
+    let column = |j: usize| (cols.band[j], cols.band[j] + cols.len[j], cols.first[j]);
     // maxima of the unscaled values
     r.iter_mut().for_each(|v| *v = 0.0);
     for j in 0..n {
@@ -327,9 +377,15 @@ mod tests {
         let mut solver = LinearSolver::new(&p);
         let x = solver.solve(&vals, &b).unwrap();
         assert!((&dense * &x - &b).amax() < 1e-12);
+        assert_eq!(solver.solve_factored(&b).unwrap(), x);
         // Equilibration does not change the solution of a well-conditioned system.
         let xe = solver.solve_equilibrated(&vals, &b).unwrap();
         assert!((&xe - &x).amax() < 1e-12);
+        // Nor does the last equilibration's scaling reused for a nearby matrix.
+        let near: Vec<f64> = vals.iter().enumerate().map(|(k, v)| v * (1.0 + 1e-3 * (k as f64).sin())).collect();
+        let xn = solver.solve(&near, &b).unwrap();
+        let xr = solver.solve_rescaled(&near, &b).unwrap();
+        assert!((&xr - &xn).amax() < 1e-12);
         // Identity rows.
         p.set_identity_rows(&mut vals, &[0, 5]);
         let x = solver.solve(&vals, &b).unwrap();

@@ -14,6 +14,8 @@
 //!
 //! Every derivative used by the Newton Jacobians is here and is finite-difference checked in
 //! the tests below (see also `docs/decisions.md`, D1).
+use std::cell::Cell;
+
 use nalgebra::{Matrix3, Vector3};
 
 /// Angles `(α, β, γ)` of eq. (1) [rad].
@@ -31,12 +33,55 @@ struct Trig {
 }
 
 impl Trig {
+    /// The sines and cosines of `a`, from [`TRIG_CACHE`] if they were computed lately.
     fn new(a: &Angles) -> Self {
+        let key = [a[0].to_bits(), a[1].to_bits(), a[2].to_bits()];
+        TRIG_CACHE.with(|c| {
+            if let Some(k) = c.keys.iter().position(|k| k.get() == key) {
+                return c.values[k].get();
+            }
+            let t = Self::compute(a);
+            let k = c.next.get();
+            c.keys[k].set(key);
+            c.values[k].set(t);
+            c.next.set((k + 1) % TRIG_SLOTS);
+            t
+        })
+    }
+
+    fn compute(a: &Angles) -> Self {
         let (sa, ca) = a[0].sin_cos();
         let (sb, cb) = a[1].sin_cos();
         let (sg, cg) = a[2].sin_cos();
         Trig { ca, sa, cb, sb, cg, sg }
     }
+}
+
+/// Entries of [`TRIG_CACHE`]: the distinct quadrature points of one element (midpoint and the
+/// two Gauss points) and one more.
+const TRIG_SLOTS: usize = 4;
+
+/// The last few angle triples (by their bits) and their sines and cosines, per thread. The
+/// kernels of one element evaluate `Q`, `A`, `d3` and their derivatives at the same few points
+/// many times (the element system, the coefficient derivative, the measures): the same
+/// numbers, computed once.
+struct TrigCache {
+    keys: [Cell<[u64; 3]>; TRIG_SLOTS],
+    values: [Cell<Trig>; TRIG_SLOTS],
+    next: Cell<usize>,
+}
+
+const NO_TRIG: Trig = Trig { ca: 1.0, sa: 0.0, cb: 1.0, sb: 0.0, cg: 1.0, sg: 0.0 };
+
+thread_local! {
+    // keys start as the bits of (0, 0, 0) with the values of (0, 0, 0)
+    static TRIG_CACHE: TrigCache = const {
+        TrigCache {
+            keys: [const { Cell::new([0; 3]) }; TRIG_SLOTS],
+            values: [const { Cell::new(NO_TRIG) }; TRIG_SLOTS],
+            next: Cell::new(0),
+        }
+    };
 }
 
 fn rz(c: f64, s: f64) -> Matrix3<f64> {

@@ -6,15 +6,20 @@
 //!              + G((u_n + u_{n−1})/2) − ½ [F(t_n) + F(t_{n−1})] = 0           (68)
 //!   ∂R_n/∂u_n = (1/Δt) ∂P/∂u + (2/Δt²) ∂P/∂u̇ + ½ ∂G/∂u
 //! ```
-//! solved by Newton from the predictor `u_{n−1} + Δt u̇_{n−1}`. The printed (71)/(72) are not
+//! solved by Newton from the predictor `u_{n−1} + Δt u̇_{n−1}`, with chord steps (the last
+//! factorised Jacobian reused while the increments contract by [`CHORD_CONTRACTION`]). The printed (71)/(72) are not
 //! used (errata: (Δt²/2) F_n and M_{n−2}; see PAPER-NOTES and `docs/decisions.md`).
 use nalgebra::{DVector, Vector3};
 
 use super::{divergence, Problem, SolveError, Step};
 use crate::assemble::Tangent;
-use crate::linalg::LinearSolver;
+use crate::linalg::{LinearSolver, Pattern};
 use crate::model::loads::LoadFrame;
 use crate::model::mesh::Field;
+
+/// Largest ratio of successive increments of a time step for which a chord step (the
+/// factorisation of an earlier Jacobian) is kept; beyond it the next iteration is Newton's.
+const CHORD_CONTRACTION: f64 = 0.01;
 
 /// Time-stepping parameters.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -72,6 +77,12 @@ pub fn solve(
     // instead of once per Newton iteration and again after it (the same numbers).
     let state_free_loads = !(problem.loads.has_distributed() && matches!(problem.loads.frame, LoadFrame::Local));
 
+    // Chord steps (simplified Newton): the factorisation of the last Jacobian is reused across
+    // iterations and time steps while the increments contract; an increment larger than
+    // CHORD_CONTRACTION times the previous one of the step has the next iteration assemble and
+    // factor the Jacobian at its iterate (a Newton step). The stopping rule is unchanged.
+    let mut factored = false;
+    let mut refactor = true;
     for n in 1..=params.steps {
         if crate::interrupt::requested() {
             return Err(SolveError::Interrupted { what: "time steps", done: n - 1, total: params.steps });
@@ -80,19 +91,30 @@ pub fn solve(
         let mut u = &u_prev + &v_prev * dt;
         let mut converged = None;
         let mut increment = f64::NAN;
+        let mut previous = f64::INFINITY;
         let f_step = if state_free_loads { Some(problem.loads_at(&u, t, None)) } else { None };
         for it in 1..=params.newton_max_iterations {
             let v = (&u - &u_prev) * (2.0 / dt) - &v_prev;
             let u_mid = (&u + &u_prev) * 0.5;
-            values.iter_mut().for_each(|x| *x = 0.0);
-            let p = problem.momentum(&u, &v, Some((Tangent::new(&pattern, &mut values, 1.0 / dt), 2.0 / (dt * dt))));
-            let g = problem.internal_force(&u_mid, Some(Tangent::new(&pattern, &mut values, 0.5)));
+            let newton = refactor || !factored;
+            if newton {
+                values.iter_mut().for_each(|x| *x = 0.0);
+            }
+            fn tangent<'a>(on: bool, pattern: &'a Pattern, values: &'a mut [f64], scale: f64) -> Option<Tangent<'a>> {
+                on.then(|| Tangent::new(pattern, values, scale))
+            }
+            let p = problem.momentum(
+                &u,
+                &v,
+                tangent(newton, &pattern, &mut values, 1.0 / dt).map(|t| (t, 2.0 / (dt * dt))),
+            );
+            let g = problem.internal_force(&u_mid, tangent(newton, &pattern, &mut values, 0.5));
             // ½[F(t_n, u_n) + F(t_{n−1}, u_{n−1})]: only the first half depends on u_n.
             let f_state;
             let f_n = match &f_step {
                 Some(f) => f,
                 None => {
-                    f_state = problem.loads_at(&u, t, Some(Tangent::new(&pattern, &mut values, -0.5)));
+                    f_state = problem.loads_at(&u, t, tangent(newton, &pattern, &mut values, -0.5));
                     &f_state
                 }
             };
@@ -100,8 +122,14 @@ pub fn solve(
             for &d in &fixed {
                 r[d] = 0.0;
             }
-            pattern.set_identity_rows(&mut values, &fixed);
-            let du = solver.solve(&values, &(-r))?;
+            let du = if newton {
+                pattern.set_identity_rows(&mut values, &fixed);
+                let du = solver.solve(&values, &(-r))?;
+                (factored, refactor) = (true, false);
+                du
+            } else {
+                solver.solve_factored(&(-r))?
+            };
             u += &du;
             increment = problem.increment_measure(&du);
             if let Some((quantity, value)) = divergence(problem, &u, increment) {
@@ -111,6 +139,10 @@ pub fn solve(
                 converged = Some(it);
                 break;
             }
+            if !newton && increment > CHORD_CONTRACTION * previous {
+                refactor = true;
+            }
+            previous = increment;
         }
         let it = converged.ok_or(SolveError::NewtonNotConverged {
             step: Some(Step::Time(n)),

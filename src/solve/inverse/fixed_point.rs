@@ -29,7 +29,8 @@ pub(crate) fn solve(
     let mut adjoint = fwd.zeros();
     let mut history = Vec::new();
     for k in 1..=params.max_iterations {
-        let big = s.solve_linearised(params, frame, &u)?;
+        // Ruiz (I6) on the first iteration's matrix; its factors scale the later ones
+        let big = s.solve_linearised(params, frame, &u, k > 1)?;
         let u_new = s.dofs.kkt_state(&big);
         adjoint = s.dofs.kkt_adjoint(&big);
         let u_next = &u_new * params.relaxation + &u * (1.0 - params.relaxation);

@@ -326,12 +326,14 @@ impl<'p> FrameSolver<'p> {
     }
 
     /// Solve `K(u) U = r(u)` of I4 with the boundary conditions of I5 (equilibrated, I6); `U`
-    /// has the KKT layout.
+    /// has the KKT layout. `rescale`: scale by the factors of the last equilibration instead of
+    /// computing new ones (a matrix of the same frame; [`LinearSolver::solve_rescaled`]).
     pub(crate) fn solve_linearised(
         &mut self,
         params: &InverseParams,
         frame: &Frame,
         u: &DVector<f64>,
+        rescale: bool,
     ) -> Result<DVector<f64>, SolveError> {
         let previous = frame.previous.unwrap_or(&self.no_previous);
         let mut rhs = kkt::assemble_system(
@@ -348,6 +350,10 @@ impl<'p> FrameSolver<'p> {
             rhs[d] = v;
         }
         self.pattern.set_identity_rows(&mut self.values, &self.rows);
-        Ok(self.solver.solve_equilibrated(&self.values, &rhs)?)
+        Ok(if rescale {
+            self.solver.solve_rescaled(&self.values, &rhs)?
+        } else {
+            self.solver.solve_equilibrated(&self.values, &rhs)?
+        })
     }
 }

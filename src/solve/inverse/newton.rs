@@ -42,7 +42,7 @@ const MIN_STEP: f64 = 1.0 / 1024.0;
 const ARMIJO: f64 = 1e-4;
 
 /// `∂/∂u [K_e(u) V − r_e(u)]` at `V = U_e` for one element (24 × 24, KKT numbering; only the
-/// state columns are non-zero): the derivative of the frozen coefficients of I4.
+/// state columns are non-zero), added into `e`: the derivative of the frozen coefficients of I4.
 ///
 /// ```text
 ///   primal rows:   ∂G/∂u − L(u)                                   (G(u) = L(u) u − b(u), D5)
@@ -59,19 +59,19 @@ fn coefficient_derivative(
     first_frame: bool,
     ue: &KktVec,
     alpha_prev: [Vector3<f64>; 2],
-) -> KktMat {
+    e: &mut KktMat,
+) {
     let h = problem.mesh.h();
     let props = &problem.props;
     let w8 = &p.weights;
     let (state, adj) = (element_part(ue, false), element_part(ue, true));
-    let mut e = KktMat::zeros();
     // Primal rows: ∂G/∂u − L(u).
     let mut t = LocalMat::zeros();
     internal_force(props, problem.scheme, h, &state, Some(&mut t));
     let (l, _) = frozen_operator(props, problem.scheme, h, &state);
     for i in 0..12 {
         for j in 0..12 {
-            e[(kkt(i, true), kkt(j, false))] = t[(i, j)] - l[(i, j)];
+            e[(kkt(i, true), kkt(j, false))] += t[(i, j)] - l[(i, j)];
         }
     }
     let columns = |c: [Vector3<f64>; 3]| Matrix3::from_columns(&c);
@@ -89,8 +89,8 @@ fn coefficient_derivative(
         let dS_dx = -S * skew(&qa.alpha);
         for c in 0..2 {
             for b in 0..2 {
-                add3(&mut e, X[c], AL[b], &(dS_v * (wh * q.dn[c] * q.n[b])));
-                add3(&mut e, X[c], X[b], &(dS_dx * (wh * q.dn[c] * q.dn[b])));
+                add3(e, X[c], AL[b], &(dS_v * (wh * q.dn[c] * q.n[b])));
+                add3(e, X[c], X[b], &(dS_dx * (wh * q.dn[c] * q.dn[b])));
             }
         }
     }
@@ -103,7 +103,7 @@ fn coefficient_derivative(
         let H2 = Matrix3::from_fn(|i, j| mis.dot(&dd[i][j])) * (-w8.lambda_d);
         for c in 0..2 {
             for b in 0..2 {
-                add3(&mut e, AL[c], AL[b], &(H2 * (wh * q.n[c] * q.n[b])));
+                add3(e, AL[c], AL[b], &(H2 * (wh * q.n[c] * q.n[b])));
             }
         }
     }
@@ -118,7 +118,7 @@ fn coefficient_derivative(
         );
         for c in 0..2 {
             for b in 0..2 {
-                add3(&mut e, AL[c], AL[b], &(blk * (wh * q.dn[c] * q.n[b])));
+                add3(e, AL[c], AL[b], &(blk * (wh * q.dn[c] * q.n[b])));
             }
         }
     }
@@ -131,7 +131,7 @@ fn coefficient_derivative(
             let blk = columns([0, 1, 2].map(|j| (dA[j].transpose() * Lk * A + A.transpose() * Lk * dA[j]) * q.dalpha));
             for c in 0..2 {
                 for b in 0..2 {
-                    add3(&mut e, AL[c], AL[b], &(blk * (w * h * q.dn[c] * q.n[b])));
+                    add3(e, AL[c], AL[b], &(blk * (w * h * q.dn[c] * q.n[b])));
                 }
             }
         }
@@ -149,12 +149,11 @@ fn coefficient_derivative(
             let blk = columns([0, 1, 2].map(|j| (dA[j].transpose() * Lw * A + A.transpose() * Lw * dA[j]) * da));
             for c in 0..2 {
                 for b in 0..2 {
-                    add3(&mut e, AL[c], AL[b], &(blk * (wh * q.n[c] * q.n[b])));
+                    add3(e, AL[c], AL[b], &(blk * (wh * q.n[c] * q.n[b])));
                 }
             }
         }
     }
-    e
 }
 
 /// Newton residual `R(U) = K(u) U − r(u)` of I8 (KKT layout, Dirichlet rows `U_d − v_d` of
@@ -187,7 +186,7 @@ pub fn assemble_residual(
         let rhs = element_system(problem, p, first, &uk, [x_g[e], x_g[e + 1]], ap, m);
         let r = *m * ue - rhs;
         if jacobian {
-            *m += coefficient_derivative(problem, p, first, &ue, ap);
+            coefficient_derivative(problem, p, first, &ue, ap, m);
         }
         r
     };
@@ -219,7 +218,7 @@ pub(crate) fn solve(
     observer: &mut impl FnMut(&InverseRecord, &DVector<f64>, &DVector<f64>),
 ) -> Result<InverseSolution, SolveError> {
     // Consistent start: one linear solve of the fixed point at u0.
-    let mut big = s.solve_linearised(params, frame, u0)?;
+    let mut big = s.solve_linearised(params, frame, u0, false)?;
     let problem = s.problem;
     let fwd = problem.dofs();
     let FrameSolver { dofs, pattern, solver, fixed, rows, values, merit_weights, no_previous, .. } = s;
@@ -228,10 +227,19 @@ pub(crate) fn solve(
     let mut phi0 = f64::NAN;
     let mut adjoint = fwd.zeros();
     let mut u = dofs.kkt_state(&big);
+    // the residual at `big` when the line search already assembled it with its Jacobian
+    let mut next: Option<DVector<f64>> = None;
     for k in 1..=params.max_iterations {
-        let jacobian = Some((&*pattern, values.as_mut_slice(), rows.as_slice()));
-        let r = assemble_residual(problem, params, frame, previous, &big, fixed, jacobian);
-        let delta = solver.solve_equilibrated(values, &(-&r))?;
+        let r = match next.take() {
+            Some(r) => r,
+            None => {
+                let jacobian = Some((&*pattern, values.as_mut_slice(), rows.as_slice()));
+                assemble_residual(problem, params, frame, previous, &big, fixed, jacobian)
+            }
+        };
+        // Ruiz on the first Jacobian (I6); its factors scale the later ones of the frame
+        let delta =
+            if k == 1 { solver.solve_equilibrated(values, &(-&r))? } else { solver.solve_rescaled(values, &(-&r))? };
         if k == 1 {
             // the Ruiz row factors of the first Jacobian weigh the merit of the whole frame
             merit_weights.clear();
@@ -250,8 +258,17 @@ pub(crate) fn solve(
         let (mut trial, mut phi_t);
         loop {
             trial = &big + &delta * t;
-            phi_t = merit(&assemble_residual(problem, params, frame, previous, &trial, fixed, None));
+            // The full step of an iteration that is not the last is usually accepted: its
+            // residual comes with the Jacobian, which the next iteration then uses (the same
+            // element sums, so the same residual as assembling it there).
+            let with_jacobian = t == 1.0 && !full;
+            let jacobian = with_jacobian.then_some((&*pattern, values.as_mut_slice(), rows.as_slice()));
+            let r_t = assemble_residual(problem, params, frame, previous, &trial, fixed, jacobian);
+            phi_t = merit(&r_t);
             if full || phi_t <= (1.0 - ARMIJO * t) * phi || t <= MIN_STEP {
+                if with_jacobian {
+                    next = Some(r_t);
+                }
                 break;
             }
             t *= 0.5;
