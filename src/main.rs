@@ -7,6 +7,7 @@ use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use cosserat::case::{case_files, Case};
+use cosserat::io::compact::OutputFormat;
 use cosserat::io::job::{case_label, run_into, run_manifest};
 use cosserat::io::run_folder::{input_file, Manifest, Mode, RunFolder, Status};
 use cosserat::io::sweep::RunStatus;
@@ -43,6 +44,9 @@ enum Command {
         /// of an uninterrupted run
         #[arg(long, conflicts_with = "force")]
         resume: bool,
+        /// Clips: per-node fields as CSV + ParaView VTK, or all in one fields.npz (docs/output.md)
+        #[arg(long, value_enum, default_value_t = OutputFormat::Csv)]
+        output_format: OutputFormat,
         #[command(flatten)]
         limits: Limits,
         /// Do not show a progress bar
@@ -201,9 +205,9 @@ fn main() -> ExitCode {
 
 fn dispatch(cli: Cli) -> Result<ExitCode> {
     match cli.command {
-        Command::Run { case, engine, out, force, resume, limits, quiet } => {
+        Command::Run { case, engine, out, force, resume, output_format, limits, quiet } => {
             let mode = if resume { Mode::Resume } else { Mode::Fresh { force } };
-            cmd_run(&case, engine, out, mode, limits, quiet)
+            cmd_run(&case, engine, out, (mode, output_format), limits, quiet)
         }
         Command::Compare { case, out, short, frames, force, limits } => {
             cmd_compare(&case, out, short, frames, force, limits)
@@ -245,7 +249,7 @@ fn cmd_run(
     path: &Path,
     engine: Engine,
     out: Option<PathBuf>,
-    mode: Mode,
+    mode: (Mode, OutputFormat),
     limits: Limits,
     quiet: bool,
 ) -> Result<ExitCode> {
