@@ -35,7 +35,7 @@ pub enum OutputFormat {
     /// `fields.csv`, `curvature.csv` and ParaView `vtk/frame_NNNNN.vtp` + `clip.pvd`
     #[default]
     Csv,
-    /// one `fields.npz` (NumPy) with every per-node field at full precision, about 6x smaller
+    /// one `fields.npz` (NumPy) with every per-node field at full precision, 4-6x smaller
     Compact,
 }
 
@@ -220,8 +220,12 @@ fn unzip(b: &[u8]) -> Result<BTreeMap<String, Vec<u8>>, String> {
         let plain = match method {
             0 => data.to_vec(),
             8 => {
-                let mut d = flate2::write::DeflateDecoder::new(Vec::with_capacity(usize_));
-                d.write_all(data).and_then(|_| d.finish()).map_err(|e| format!("{name}: {e}"))?
+                // at most one byte more than the directory says: a corrupt size is refused, not
+                // inflated without bound
+                let mut plain = Vec::new();
+                let mut d = std::io::Read::take(flate2::read::DeflateDecoder::new(data), usize_ as u64 + 1);
+                std::io::Read::read_to_end(&mut d, &mut plain).map_err(|e| format!("{name}: {e}"))?;
+                plain
             }
             m => return Err(format!("{name}: compression method {m} (expected deflate)")),
         };
