@@ -10,7 +10,6 @@
 //! `curvature.f64`, which the resume journal cuts back like CSVs; `fields.npz` is written
 //! (atomically) when the clip ends, and the raw files go with the journal.
 use std::collections::BTreeMap;
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use rayon::prelude::*;
@@ -69,37 +68,73 @@ pub fn decode_column(bytes: &[u8], per: usize) -> Vec<f64> {
     words.into_iter().map(f64::from_bits).collect()
 }
 
-/// One `.npy` member of the archive: its name and the bytes of the `.npy` file.
+/// One `.npy` member of the archive: its name and the bytes of the `.npy` file, in parts
+/// (header, byte planes) that are deflated one by one.
 struct Member {
     name: String,
-    npy: Vec<u8>,
+    parts: Vec<Vec<u8>>,
 }
 
 /// The encoded column `name` of `frames` × `per` values as a `|u1` array of shape
-/// `(8, frames, per)`.
+/// `(8, frames, per)`, one part per byte plane.
 fn column_member(name: &str, values: &[f64], frames: usize, per: usize) -> Member {
-    let mut npy = npy_header("|u1", &[8, frames, per]);
-    npy.extend(encode_column(values, frames));
-    Member { name: format!("{name}.npy"), npy }
+    let mut parts = vec![npy_header("|u1", &[8, frames, per])];
+    let planes = encode_column(values, frames);
+    parts.extend(planes.chunks(values.len().max(1)).map(<[u8]>::to_vec));
+    Member { name: format!("{name}.npy"), parts }
+}
+
+/// Shannon entropy of the bytes of `b` [bits per byte].
+fn entropy(b: &[u8]) -> f64 {
+    let mut count = [0usize; 256];
+    for &x in b {
+        count[x as usize] += 1;
+    }
+    let n = b.len().max(1) as f64;
+    count.iter().filter(|&&c| c > 0).map(|&c| -(c as f64 / n) * (c as f64 / n).log2()).sum()
+}
+
+/// `data` as deflate blocks ending on a byte boundary and not final (a sync flush), so that
+/// such segments, each compressed on its own, concatenate to one deflate stream. Noise (the low
+/// mantissa bytes, more than 7.9 bits per byte) is stored rather than searched for matches.
+fn deflate_segment(data: &[u8]) -> Result<Vec<u8>, String> {
+    let level = if entropy(data) > 7.9 { flate2::Compression::none() } else { flate2::Compression::new(6) };
+    let mut c = flate2::Compress::new(level, false);
+    let mut out = Vec::with_capacity(data.len() + data.len() / 64 + 64);
+    loop {
+        if out.capacity() - out.len() < 64 {
+            out.reserve(out.capacity().max(4096));
+        }
+        let done = c.total_in() as usize;
+        c.compress_vec(&data[done..], &mut out, flate2::FlushCompress::Sync).map_err(|e| format!("deflate: {e}"))?;
+        if c.total_in() as usize == data.len() && out.len() < out.capacity() {
+            return Ok(out);
+        }
+    }
 }
 
 /// Bytes of a zip archive of `members`, each deflated (in parallel), without the 64-bit
 /// extension; `Err` when a member or the archive exceeds its 4 GiB.
 fn zip_bytes(members: &[Member]) -> Result<Vec<u8>, String> {
-    let packed: Vec<(u32, Vec<u8>)> = members
+    let packed: Vec<(u32, usize, Vec<u8>)> = members
         .par_iter()
         .map(|m| {
-            let mut e = flate2::write::DeflateEncoder::new(Vec::new(), flate2::Compression::new(6));
-            e.write_all(&m.npy).and_then(|_| e.finish()).map(|data| (crc32fast::hash(&m.npy), data))
+            let mut crc = crc32fast::Hasher::new();
+            let mut data = Vec::new();
+            for part in &m.parts {
+                crc.update(part);
+                data.extend(deflate_segment(part)?);
+            }
+            data.extend([0x03, 0x00]); // an empty final block
+            Ok((crc.finalize(), m.parts.iter().map(Vec::len).sum(), data))
         })
-        .collect::<Result<_, _>>()
-        .map_err(|e| format!("deflate: {e}"))?;
+        .collect::<Result<_, String>>()?;
     let u32_of =
         |n: usize, what: &str| u32::try_from(n).map_err(|_| format!("{what} exceeds 4 GiB (zip without Zip64)"));
     let (mut out, mut central) = (Vec::new(), Vec::new());
-    for (m, (crc, data)) in members.iter().zip(&packed) {
+    for (m, (crc, plain, data)) in members.iter().zip(&packed) {
         let offset = u32_of(out.len(), "the archive")?;
-        let (csize, usize_) = (u32_of(data.len(), &m.name)?, u32_of(m.npy.len(), &m.name)?);
+        let (csize, usize_) = (u32_of(data.len(), &m.name)?, u32_of(*plain, &m.name)?);
         // version 2.0, no flags, deflate, 1980-01-01 00:00
         let common = |out: &mut Vec<u8>| {
             for v in [20u16, 0, 8, 0, 0x21] {
@@ -149,7 +184,7 @@ pub fn write_compact(dir: &Path, frames: &[i64], field_columns: &[&str]) -> Resu
     let mut members = Vec::new();
     let mut npy = npy_header("<i8", &[nf]);
     npy.extend(frames.iter().flat_map(|f| f.to_le_bytes()));
-    members.push(Member { name: "frame.npy".into(), npy });
+    members.push(Member { name: "frame.npy".into(), parts: vec![npy] });
     for (raw, columns) in [(RAW_FIELDS, field_columns), (RAW_CURVATURE, &CURVATURE_COLUMNS[..])] {
         let values = read(raw)?;
         let (nc, rows) = (columns.len(), values.len() / columns.len().max(1));
