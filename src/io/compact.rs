@@ -192,13 +192,12 @@ pub fn write_compact(dir: &Path, frames: &[i64], field_columns: &[&str]) -> Resu
             return Err(invalid(format!("{raw} holds {} values, not {nf} frames of {nc} columns", values.len())));
         }
         let per = rows / nf;
-        let cols: Vec<Member> = (0..nc)
-            .into_par_iter()
-            .map(|c| {
-                let col: Vec<f64> = values.iter().skip(c).step_by(nc).copied().collect();
-                column_member(columns[c], &col, nf, per)
-            })
-            .collect();
+        let mut cols: Vec<Vec<f64>> = vec![Vec::with_capacity(rows); nc];
+        for (i, v) in values.into_iter().enumerate() {
+            cols[i % nc].push(v);
+        }
+        let cols: Vec<Member> =
+            cols.par_iter().zip(columns.par_iter()).map(|(col, name)| column_member(name, col, nf, per)).collect();
         members.extend(cols);
     }
     write_atomic(&path, &zip_bytes(&members).map_err(invalid)?)?;
