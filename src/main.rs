@@ -275,7 +275,7 @@ fn cmd_run(
         Status::Interrupted => {
             let kept = match end.frames {
                 Some((n, _)) => format!(
-                    "kept {n} converged frames (CSV, VTK, clip.pvd and figures cover exactly them); continue with `cosserat run {} --out {} --resume`",
+                    "kept {n} converged frames (the folder's files and figures cover exactly them); continue with `cosserat run {} --out {} --resume`",
                     path.display(),
                     dir.display()
                 ),

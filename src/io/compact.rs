@@ -96,10 +96,20 @@ fn entropy(b: &[u8]) -> f64 {
 
 /// `data` as deflate blocks ending on a byte boundary and not final (a sync flush), so that
 /// such segments, each compressed on its own, concatenate to one deflate stream. Noise (the low
-/// mantissa bytes, more than 7.9 bits per byte) is stored rather than searched for matches.
+/// mantissa bytes, more than 7.9 bits per byte) is stored; the rest is deflated at level 3.
 fn deflate_segment(data: &[u8]) -> Result<Vec<u8>, String> {
-    let level = if entropy(data) > 7.9 { flate2::Compression::none() } else { flate2::Compression::new(6) };
-    let mut c = flate2::Compress::new(level, false);
+    if entropy(data) > 7.9 {
+        // stored blocks: a header byte (not final, type 00), LEN and its complement, the bytes
+        let mut out = Vec::with_capacity(data.len() + 5 * (data.len() / 65535 + 1));
+        for block in data.chunks(65535) {
+            out.push(0);
+            out.extend((block.len() as u16).to_le_bytes());
+            out.extend((!(block.len() as u16)).to_le_bytes());
+            out.extend(block);
+        }
+        return Ok(out);
+    }
+    let mut c = flate2::Compress::new(flate2::Compression::new(3), false);
     let mut out = Vec::with_capacity(data.len() + data.len() / 64 + 64);
     loop {
         if out.capacity() - out.len() < 64 {
@@ -299,6 +309,31 @@ mod tests {
             (0..60).map(|i| (i as f64 * 0.37).sin() * 1e-3 + if i == 7 { f64::NAN } else { 0.0 }).collect();
         let back = decode_column(&encode_column(&v, 5), 12);
         assert!(v.iter().zip(&back).all(|(a, b)| a.to_bits() == b.to_bits()));
+    }
+
+    #[test]
+    fn noise_is_stored_and_reads_back() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut state = 7u64;
+        let noise: Vec<f64> = (0..3 * 70_000)
+            .map(|_| {
+                // splitmix64
+                state = state.wrapping_add(0x9e37_79b9_7f4a_7c15);
+                let z = (state ^ (state >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+                let z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+                f64::from_bits((z ^ (z >> 31)) >> 2)
+            })
+            .collect();
+        let bytes: Vec<u8> = noise.iter().flat_map(|x| x.to_le_bytes()).collect();
+        std::fs::write(dir.path().join(RAW_FIELDS), bytes).unwrap();
+        std::fs::write(dir.path().join(RAW_CURVATURE), 0.5f64.to_le_bytes().repeat(4 * 2)).unwrap();
+        assert!(entropy(&encode_column(&noise, 2)[..noise.len()]) > 7.9);
+        let p = write_compact(dir.path(), &[0, 1], &["a", "b", "c"]).unwrap();
+        let c = read_compact(&p).unwrap();
+        for (k, name) in ["a", "b", "c"].iter().enumerate() {
+            let expected: Vec<u64> = noise.iter().skip(k).step_by(3).map(|v| v.to_bits()).collect();
+            assert_eq!(c.columns[*name].1.iter().map(|v| v.to_bits()).collect::<Vec<_>>(), expected, "{name}");
+        }
     }
 
     #[test]
