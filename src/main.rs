@@ -6,7 +6,8 @@ use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 
-use cosserat::case::{case_files, Case};
+use cosserat::case::Case;
+use cosserat::io::compact::OutputFormat;
 use cosserat::io::job::{case_label, run_into, run_manifest};
 use cosserat::io::run_folder::{input_file, Manifest, Mode, RunFolder, Status};
 use cosserat::io::sweep::RunStatus;
@@ -45,6 +46,9 @@ enum Command {
         /// of an uninterrupted run
         #[arg(long, conflicts_with = "force")]
         resume: bool,
+        /// Clips: per-node fields as CSV + ParaView VTK, or all in one fields.npz (docs/output.md)
+        #[arg(long, value_enum, default_value_t = OutputFormat::Csv)]
+        output_format: OutputFormat,
         #[command(flatten)]
         limits: Limits,
         /// Do not show a progress bar
@@ -212,9 +216,9 @@ fn main() -> ExitCode {
 
 fn dispatch(cli: Cli) -> Result<ExitCode> {
     match cli.command {
-        Command::Run { case, engine, out, force, resume, limits, quiet } => {
+        Command::Run { case, engine, out, force, resume, output_format, limits, quiet } => {
             let mode = if resume { Mode::Resume } else { Mode::Fresh { force } };
-            cmd_run(&case, engine, out, mode, limits, quiet)
+            cmd_run(&case, engine, out, (mode, output_format), limits, quiet)
         }
         Command::Compare { case, out, short, frames, force, limits } => {
             cmd_compare(&case, out, short, frames, force, limits)
@@ -227,7 +231,7 @@ fn dispatch(cli: Cli) -> Result<ExitCode> {
         Command::BatchTask(a) => cli::cmd_batch_task(a),
         Command::Gather { out } => cli::cmd_gather(&out),
         Command::Synth(a) => cli::cmd_synth(a),
-        Command::List { dir } => cmd_list(&dir),
+        Command::List { dir } => cli::list::cmd_list(&dir),
         Command::Modes { case, count, limits } => cmd_modes(&case, count, limits),
     }
 }
@@ -260,7 +264,7 @@ fn cmd_run(
     path: &Path,
     engine: Engine,
     out: Option<PathBuf>,
-    mode: Mode,
+    mode: (Mode, OutputFormat),
     limits: Limits,
     quiet: bool,
 ) -> Result<ExitCode> {
@@ -286,7 +290,7 @@ fn cmd_run(
         Status::Interrupted => {
             let kept = match end.frames {
                 Some((n, _)) => format!(
-                    "kept {n} converged frames (CSV, VTK, clip.pvd and figures cover exactly them); continue with `cosserat run {} --out {} --resume`",
+                    "kept {n} converged frames (the folder's files and figures cover exactly them); continue with `cosserat run {} --out {} --resume`",
                     path.display(),
                     dir.display()
                 ),
@@ -539,30 +543,6 @@ fn cmd_audit(
         );
     }
     Ok(if unexpected.is_empty() { ExitCode::SUCCESS } else { ExitCode::from(1) })
-}
-
-fn cmd_list(dir: &Path) -> Result<ExitCode> {
-    let files = case_files(dir).with_context(|| format!("cannot list {}", dir.display()))?;
-    if files.is_empty() {
-        anyhow::bail!("no *.toml case files in {}", dir.display());
-    }
-    let mut invalid = 0;
-    for f in files {
-        match Case::from_file(&f) {
-            Ok(c) => println!("{:<24} {}", c.name, c.description),
-            Err(e) => {
-                invalid += 1;
-                let stem = f.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
-                println!("{stem:<24} INVALID (see below)");
-                eprintln!("INVALID {}: {e}", f.display());
-            }
-        }
-    }
-    if invalid > 0 {
-        eprintln!("error: {invalid} invalid case file(s) in {} (marked INVALID above)", dir.display());
-        return Ok(ExitCode::from(1));
-    }
-    Ok(ExitCode::SUCCESS)
 }
 
 fn cmd_modes(path: &Path, count: usize, limits: Limits) -> Result<ExitCode> {

@@ -1,5 +1,8 @@
-//! The commands of many recordings: `batch` (locally or as a Slurm job array), the hidden
+//! Commands beyond a single case: `list` ([`list`]), and those of many recordings: `batch`
+//! (locally or as a Slurm job array), the hidden
 //! `batch-task` of an array task, `gather` and `synth`.
+pub mod list;
+
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Duration;

@@ -14,6 +14,7 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+use super::compact::OutputFormat;
 use super::engine::ClipOptions;
 use super::files::{write_atomic, OutputError};
 use super::run_folder::{input_file, sha256_file, FolderError, InputFile, Manifest, Mode, RunFolder, Status};
@@ -343,7 +344,7 @@ pub fn run_recording(case: &Case, case_file: &InputFile, entry: &PlanEntry, out:
         Ok(f) => f,
         Err(e) => return failed(chain(&e)),
     };
-    let clip = ClipOptions { journal: true, resume: false };
+    let clip = ClipOptions { journal: true, resume: false, format: OutputFormat::Csv };
     let solved = solve_into(&case, Engine::Rust, folder.dir(), clip, |_| {}, |_, _| {});
     let metrics = solved.clip.as_ref().filter(|c| !c.reports.is_empty()).map(|c| clip_metrics(&case, c));
     let get = |k: &str| metrics.as_ref().and_then(|m| m.get(k)).copied();

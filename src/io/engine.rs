@@ -10,6 +10,7 @@ use super::clip_files::{load_clip, ClipFileError};
 use super::clip_output::{
     write_clip_kymographs, write_clip_plot, write_omega_kymographs, write_truth_plot, ClipWriter,
 };
+use super::compact::OutputFormat;
 use super::data::{read_data, write_data};
 use super::files::{InputError, OutputError};
 use super::freefem::{self, FreeFemError};
@@ -125,6 +126,8 @@ pub struct ClipOptions {
     pub journal: bool,
     /// continue the run whose journal `dir` holds, after its last complete frame
     pub resume: bool,
+    /// how the per-node fields are written (`super::compact`)
+    pub format: OutputFormat,
 }
 
 /// The clip of a clip case in the Rust engine, streamed into `dir` (as [`run_clip_case`]), fresh
@@ -141,10 +144,10 @@ pub fn run_clip_to(
     let (clip, truth) = load_clip(case)?;
     let (records, sink) = if opts.resume {
         let (entries, bytes) = read_journal(dir)?;
-        let sink = ClipWriter::resume(dir, truth.is_some(), &entries, bytes)?;
+        let sink = ClipWriter::resume(dir, truth.is_some(), &entries, bytes, opts.format)?;
         (entries.into_iter().map(|e| e.record).collect(), sink)
     } else {
-        (Vec::new(), ClipWriter::create(dir, truth.is_some(), opts.journal)?)
+        (Vec::new(), ClipWriter::create(dir, truth.is_some(), opts.journal, opts.format)?)
     };
     let writer = Observed { sink, observer };
     Ok(run_clip(case, &clip, truth.as_ref(), &records, writer, progress)?)

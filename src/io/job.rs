@@ -7,6 +7,7 @@
 //! `data.csv`), on non-convergence the last iterate with `run.json` saying failed.
 use std::path::{Path, PathBuf};
 
+use super::compact::OutputFormat;
 use super::engine::ClipOptions;
 use super::run_folder::{input_file, FolderError, Manifest, Mode, RunFolder, Status};
 pub use super::solved::case_label;
@@ -102,14 +103,14 @@ pub fn run_manifest(case: &Case, engine: Engine) -> Result<Manifest, FolderError
     Ok(m)
 }
 
-/// Run `case` in `engine` into the folder `out` ([`Mode`]: fresh, or resuming a clip).
-/// `Err`: the folder could not be claimed (nothing written); otherwise the folder holds the
-/// run, whatever its end.
+/// Run `case` in `engine` into the folder `out` ([`Mode`]: fresh, or resuming a clip; a clip's
+/// per-node fields in `format`). `Err`: the folder could not be claimed (nothing written);
+/// otherwise the folder holds the run, whatever its end.
 pub fn run_into(
     case: &Case,
     engine: Engine,
     out: &Path,
-    mode: Mode,
+    (mode, format): (Mode, OutputFormat),
     progress: impl FnMut(usize, usize),
 ) -> Result<JobEnd, FolderError> {
     let mut folder = RunFolder::begin(out, run_manifest(case, engine)?, mode)?;
@@ -124,7 +125,7 @@ pub fn run_into(
         files: 0,
         notes: std::mem::take(&mut folder.notes),
     };
-    let clip = ClipOptions { journal: true, resume: mode == Mode::Resume };
+    let clip = ClipOptions { journal: true, resume: mode == Mode::Resume, format };
     let solved = solve_into(case, engine, &dir, clip, |_| {}, progress);
     end.status = solved.status.folder_status();
     end.message = solved.error;

@@ -1,12 +1,14 @@
 //! Everything that touches files or other programs: atomic writes and CSV ([`files`]), the
 //! forward data file `data.csv` ([`data`]), clip files ([`clip_files`], [`npy`]), the outputs of
-//! a run ([`run_files`]) and of a clip ([`clip_output`], [`vtk`], the resume [`journal`]), SVG figures ([`plot`]), the
-//! FreeFEM engine ([`freefem`]), a case in either engine from its files ([`engine`]) and the
+//! a run ([`run_files`]) and of a clip ([`clip_output`], [`clip_figures`], [`vtk`], [`compact`], the resume [`journal`]),
+//! SVG figures ([`plot`]), the FreeFEM engine ([`freefem`]), a case in either engine from its files ([`engine`]) and the
 //! files of a sweep ([`sweep`]), a batch of recordings ([`batch`], on Slurm: [`slurm`]) and a
 //! corpus of synthetic recordings ([`corpus`]).
 pub mod batch;
+pub mod clip_figures;
 pub mod clip_files;
 pub mod clip_output;
+pub mod compact;
 pub mod compare;
 pub mod corpus;
 pub mod data;

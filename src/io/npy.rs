@@ -50,22 +50,30 @@ pub fn write_npy(path: &Path, shape: &[usize], data: &[f64]) -> Result<(), Outpu
 
 /// Bytes of a version 1.0 `.npy` file (header padded so that the data start at a multiple of 64).
 pub fn npy_bytes(shape: &[usize], data: &[f64]) -> Vec<u8> {
+    let mut out = npy_header("<f8", shape);
+    out.reserve(8 * data.len());
+    for v in data {
+        out.extend_from_slice(&v.to_le_bytes());
+    }
+    out
+}
+
+/// The magic string and header of a version 1.0 `.npy` file of dtype `descr` (C order), padded
+/// so that the data that follow start at a multiple of 64.
+pub fn npy_header(descr: &str, shape: &[usize]) -> Vec<u8> {
     let dims = match shape {
         [n] => format!("({n},)"),
         _ => format!("({})", shape.iter().map(|n| n.to_string()).collect::<Vec<_>>().join(", ")),
     };
-    let mut header = format!("{{'descr': '<f8', 'fortran_order': False, 'shape': {dims}, }}");
+    let mut header = format!("{{'descr': '{descr}', 'fortran_order': False, 'shape': {dims}, }}");
     let unpadded = MAGIC.len() + 2 + 2 + header.len() + 1;
     header.push_str(&" ".repeat((64 - unpadded % 64) % 64));
     header.push('\n');
-    let mut out = Vec::with_capacity(MAGIC.len() + 4 + header.len() + 8 * data.len());
+    let mut out = Vec::with_capacity(MAGIC.len() + 4 + header.len());
     out.extend_from_slice(MAGIC);
     out.extend_from_slice(&[1, 0]);
     out.extend_from_slice(&(header.len() as u16).to_le_bytes());
     out.extend_from_slice(header.as_bytes());
-    for v in data {
-        out.extend_from_slice(&v.to_le_bytes());
-    }
     out
 }
 
@@ -73,6 +81,25 @@ pub fn npy_bytes(shape: &[usize], data: &[f64]) -> Vec<u8> {
 /// length read from the file (header length, shape) is checked against the bytes there are
 /// before anything is allocated or indexed.
 pub fn parse_npy(bytes: &[u8]) -> Result<NpyArray, String> {
+    let (descr, shape, body) = npy_payload(bytes)?;
+    if descr != "<f8" {
+        return Err(format!("dtype '{}', expected little-endian float64 '<f8'", preview(&descr)));
+    }
+    let count = shape.iter().try_fold(1usize, |a, &n| a.checked_mul(n)).ok_or("shape overflows")?;
+    let expected = count.checked_mul(8).ok_or("shape overflows")?;
+    if body.len() < expected {
+        return Err(format!("truncated: shape {shape:?} needs {expected} data bytes, the file has {}", body.len()));
+    }
+    if body.len() > expected {
+        return Err(format!("{} bytes after the data of shape {shape:?} ({expected} bytes)", body.len() - expected));
+    }
+    let data = body.chunks_exact(8).map(|c| f64::from_le_bytes(c.try_into().expect("chunks of 8"))).collect();
+    Ok(NpyArray { shape, data })
+}
+
+/// The dtype, shape and data bytes of a C-order `.npy` file (the data not checked against the
+/// shape).
+pub fn npy_payload(bytes: &[u8]) -> Result<(String, Vec<usize>, &[u8]), String> {
     if bytes.len() < MAGIC.len() + 2 || &bytes[..MAGIC.len()] != MAGIC {
         return Err("missing the magic string \\x93NUMPY (not an .npy file, or truncated)".into());
     }
@@ -95,23 +122,10 @@ pub fn parse_npy(bytes: &[u8]) -> Result<NpyArray, String> {
         .ok_or_else(|| format!("truncated: the header is {header_len} bytes, the file ends before it does"))?;
     let header = std::str::from_utf8(header).map_err(|_| "the header is not text".to_string())?;
     let (descr, fortran, shape) = parse_header(header)?;
-    if descr != "<f8" {
-        return Err(format!("dtype '{}', expected little-endian float64 '<f8'", preview(&descr)));
-    }
     if fortran {
         return Err("Fortran-order array (fortran_order: True); expected C order".into());
     }
-    let count = shape.iter().try_fold(1usize, |a, &n| a.checked_mul(n)).ok_or("shape overflows")?;
-    let body = &bytes[data_start + header_len..];
-    let expected = count.checked_mul(8).ok_or("shape overflows")?;
-    if body.len() < expected {
-        return Err(format!("truncated: shape {shape:?} needs {expected} data bytes, the file has {}", body.len()));
-    }
-    if body.len() > expected {
-        return Err(format!("{} bytes after the data of shape {shape:?} ({expected} bytes)", body.len() - expected));
-    }
-    let data = body.chunks_exact(8).map(|c| f64::from_le_bytes(c.try_into().expect("chunks of 8"))).collect();
-    Ok(NpyArray { shape, data })
+    Ok((descr, shape, &bytes[data_start + header_len..]))
 }
 
 /// The three entries of the header dictionary: `descr`, `fortran_order`, `shape`.

@@ -5,6 +5,7 @@
 //! The caller owns the folder and its `run.json` ([`super::run_folder`]).
 use std::path::Path;
 
+use super::clip_output::remove_raw;
 use super::data::write_data;
 use super::engine::{load_data, run_case, run_clip_to, run_inverse_on, write_clip_figures, ClipOptions, EngineError};
 use super::journal::remove_journal;
@@ -168,7 +169,7 @@ fn solve_clip(
         }
     }
     if status == RunStatus::Ok && opts.journal {
-        if let Err(e) = remove_journal(dir) {
+        if let Err(e) = remove_journal(dir).and_then(|_| remove_raw(dir)) {
             return Solved::failed(chain(&e));
         }
     }

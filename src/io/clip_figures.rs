@@ -1,0 +1,243 @@
+//! The summary figures of a clip run, written at the end over the frames solved: `plot.svg`,
+//! `kymograph.svg`, `omega.svg`, `truth.svg` and `truth_errors.svg`.
+use std::path::Path;
+
+use super::files::{write_plot, OutputError};
+use super::plot::{render_heatmaps_svg, render_panels_svg, Heatmap, LinePlot, Series};
+use crate::case::Case;
+use crate::run::clip::ClipRun;
+use crate::solve::sequence::FrameReport;
+
+/// The frame numbers of a clip run as the x axis of its per-frame figures.
+struct FrameAxis(Vec<f64>);
+
+impl FrameAxis {
+    fn new(reports: &[FrameReport]) -> Self {
+        FrameAxis(reports.iter().map(|r| r.frame as f64).collect())
+    }
+    fn series(&self, label: &str, y: Vec<f64>) -> Series {
+        Series { label: label.into(), x: self.0.clone(), y }
+    }
+    fn plot(title: String, y_label: &str, series: Vec<Series>, log_y: bool) -> LinePlot {
+        LinePlot { title, x_label: "frame".into(), y_label: y_label.into(), series, log_x: false, log_y }
+    }
+}
+
+/// Recovered vs true for a synthetic clip (`truth.svg`): bending κ1² + κ2² kymographs (true,
+/// recovered) and per frame the errors, the roll offset against the true roll, and κ3.
+pub fn write_truth_plot(case: &Case, run: &ClipRun, path: &Path) -> Result<(), OutputError> {
+    let Some(t) = &run.truth else { return Ok(()) };
+    let nf = t.comparisons.len();
+    if nf < 2 {
+        return Ok(());
+    }
+    let axis = FrameAxis::new(&run.reports);
+    let (s, plot) = (|l: &str, y| axis.series(l, y), FrameAxis::plot);
+    let c = &t.comparisons;
+    let panels = vec![
+        plot(
+            format!("{}: errors against the ground truth", case.name),
+            "relative error / rad",
+            vec![
+                s("|x - x_true|/|x_true|", c.iter().map(|v| v.position_rel_l2).collect()),
+                s("bending k1^2+k2^2, rel. L2", c.iter().map(|v| v.bending_rel_l2).collect()),
+                s("max angle(d3, true d3) [rad]", c.iter().map(|v| v.max_tangent_angle_rad).collect()),
+            ],
+            true,
+        ),
+        plot(
+            "roll of the frame about d3".into(),
+            "angle [rad]",
+            vec![
+                s("true roll psi of the bending plane", t.roll_rad.clone()),
+                s("recovered d1 vs true d1 (offset)", c.iter().map(|v| v.roll_offset_rad).collect()),
+            ],
+            false,
+        ),
+        plot(
+            "twist kappa_3".into(),
+            "kappa_3 [rad/m]",
+            vec![
+                s("true", t.twist_per_m.clone()),
+                s("recovered (mean over inner nodes)", c.iter().map(|v| v.twist_mean_per_m).collect()),
+                s("rms error", c.iter().map(|v| v.twist_rms_error_per_m).collect()),
+            ],
+            false,
+        ),
+        plot(
+            "angle chart: min |cos beta| over the nodes".into(),
+            "|cos beta|",
+            vec![s("rebased chart", run.reports.iter().map(|r| r.min_cos_beta).collect())],
+            false,
+        ),
+    ];
+    let lines = path.with_file_name("truth_errors.svg");
+    write_plot(&lines, render_panels_svg(&panels, 2))?;
+    let fs = nf.div_ceil(150);
+    let frames: Vec<usize> = (0..nf).step_by(fs).collect();
+    let x: Vec<f64> = frames.iter().map(|&i| run.reports[i].frame as f64).collect();
+    let m = t.bending_true[0].len();
+    let cols: Vec<usize> = (0..m).step_by(m.div_ceil(64)).collect();
+    let y: Vec<f64> = cols.iter().map(|&j| j as f64 * case.mesh.h() * 1e3).collect();
+    let grid = |field: &Vec<Vec<f64>>| -> Vec<Vec<f64>> {
+        frames.iter().map(|&i| cols.iter().map(|&j| field[i][j].sqrt()).collect()).collect()
+    };
+    let mut all: Vec<f64> = t.bending_true.iter().flatten().map(|v| v.sqrt()).collect();
+    all.sort_by(f64::total_cmp);
+    let limit = all.get((all.len() as f64 * 0.99) as usize).copied().unwrap_or(1.0);
+    let map = |title: String, values: Vec<Vec<f64>>| Heatmap {
+        title,
+        x_label: "frame".into(),
+        y_label: "s [mm]".into(),
+        x: x.clone(),
+        y: y.clone(),
+        values,
+        limit,
+    };
+    write_plot(
+        path,
+        render_heatmaps_svg(&[
+            map(format!("true bending sqrt(k1^2+k2^2) [1/m], colour 0..{limit:.0}"), grid(&t.bending_true)),
+            map("recovered sqrt(k1^2+k2^2) [1/m]".into(), grid(&t.bending_recovered)),
+        ]),
+    )
+}
+
+/// Per-frame summary of a clip run: iterations, fit, chart guard and roughness against frame.
+pub fn write_clip_plot(
+    case: &Case,
+    reports: &[FrameReport],
+    roughness: &[(f64, f64)],
+    path: &Path,
+) -> Result<(), OutputError> {
+    if reports.is_empty() {
+        return Ok(());
+    }
+    let axis = FrameAxis::new(reports);
+    let (s, plot) = (|l: &str, y| axis.series(l, y), FrameAxis::plot);
+    let panels = vec![
+        plot(
+            format!("{}: iterations per frame", case.name),
+            "iterations",
+            vec![s("iterations", reports.iter().map(|r| r.iterations as f64).collect())],
+            false,
+        ),
+        plot(
+            "fit per frame".into(),
+            "value",
+            vec![
+                s("|x - x_g|/|x_g|", reports.iter().map(|r| r.x_err_rel).collect()),
+                s("|x' - d3| [m^1/2]", reports.iter().map(|r| r.tangent_misfit).collect()),
+                s("last relative change", reports.iter().map(|r| r.last_change).collect()),
+            ],
+            true,
+        ),
+        plot(
+            "angle chart: min |cos beta| over the nodes".into(),
+            "|cos beta|",
+            vec![s("min |cos beta|", reports.iter().map(|r| r.min_cos_beta).collect())],
+            false,
+        ),
+        plot(
+            "objective (41)".into(),
+            "J",
+            vec![
+                s("tracking", reports.iter().map(|r| r.objective.tracking).collect()),
+                s("total", reports.iter().map(|r| r.objective.total()).collect()),
+            ],
+            true,
+        ),
+        plot(
+            "roughness of the curvature (sign alternation of its differences)".into(),
+            "fraction of elements",
+            vec![
+                s("recovered kappa_2", roughness.iter().map(|r| r.0).collect()),
+                s("data", roughness.iter().map(|r| r.1).collect()),
+            ],
+            false,
+        ),
+    ];
+    write_plot(path, render_panels_svg(&panels, 2))
+}
+
+/// Kymographs of a planar clip (Fig. 17 style): the data's curvature and the recovered κ2 over
+/// frames (x) and arc length (y), on one colour scale (±the 99th percentile of |data|). At most
+/// ~150 frames and 64 positions are drawn (strided) to keep the SVG small.
+pub fn write_clip_kymographs(case: &Case, run: &ClipRun, path: &Path) -> Result<(), OutputError> {
+    let nf = run.kappa2.len();
+    if nf < 2 {
+        return Ok(());
+    }
+    let fs = nf.div_ceil(150);
+    let frames: Vec<usize> = (0..nf).step_by(fs).collect();
+    let x: Vec<f64> = frames.iter().map(|&i| run.reports[i].frame as f64).collect();
+    let h = case.mesh.h();
+    let grid = |field: &Vec<Vec<f64>>, s_of: &dyn Fn(usize) -> f64| {
+        let m = field[0].len();
+        let ss = m.div_ceil(64);
+        let cols: Vec<usize> = (0..m).step_by(ss).collect();
+        let y: Vec<f64> = cols.iter().map(|&j| s_of(j) * 1e3).collect();
+        let values: Vec<Vec<f64>> = frames.iter().map(|&i| cols.iter().map(|&j| field[i][j]).collect()).collect();
+        (y, values)
+    };
+    let limit = abs_percentile_99(run.data_kappa.iter().flatten().copied());
+    let (yd, vd) = grid(&run.data_kappa, &|j| (j + 1) as f64 * h);
+    let (yr, vr) = grid(&run.kappa2, &|j| (j as f64 + 0.5) * h);
+    let map = |title: String, y: Vec<f64>, values: Vec<Vec<f64>>| Heatmap {
+        title,
+        x_label: "frame".into(),
+        y_label: "s [mm]".into(),
+        x: x.clone(),
+        y,
+        values,
+        limit,
+    };
+    write_plot(
+        path,
+        render_heatmaps_svg(&[
+            map(format!("{}: data curvature [1/m], colour ±{limit:.0}", case.name), yd, vd),
+            map("recovered kappa_2 [1/m]".into(), yr, vr),
+        ]),
+    )
+}
+
+/// The 99th percentile of |v| over the finite values (1 if there are none): the colour limit
+/// of a kymograph.
+pub(crate) fn abs_percentile_99(values: impl Iterator<Item = f64>) -> f64 {
+    let mut all: Vec<f64> = values.map(f64::abs).filter(|v| v.is_finite()).collect();
+    all.sort_by(f64::total_cmp);
+    all.get((all.len() as f64 * 0.99) as usize).copied().unwrap_or(1.0)
+}
+
+/// Kymographs of the angular velocity (Fig. 24 style, `omega.svg`): ω1, ω2, ω3 [rad/s] in the
+/// local frame (eq. 27, [`ClipRun::omega`]) over frames (x) and the nodes' arc length (y), each
+/// on its own colour scale (±the 99th percentile of its |ω| over the frames after the first,
+/// which has none). Strided as [`write_clip_kymographs`]; nothing is written for fewer than two
+/// frames.
+pub fn write_omega_kymographs(case: &Case, run: &ClipRun, path: &Path) -> Result<(), OutputError> {
+    let nf = run.omega.len().min(run.reports.len());
+    if nf < 2 {
+        return Ok(());
+    }
+    let frames: Vec<usize> = (0..nf).step_by(nf.div_ceil(150)).collect();
+    let x: Vec<f64> = frames.iter().map(|&i| run.reports[i].frame as f64).collect();
+    let m = run.omega[0].len();
+    let cols: Vec<usize> = (0..m).step_by(m.div_ceil(64).max(1)).collect();
+    let y: Vec<f64> = cols.iter().map(|&j| case.mesh.node_s(j) * 1e3).collect();
+    let maps: Vec<Heatmap> = (0..3)
+        .map(|k| {
+            let limit = abs_percentile_99(run.omega[1..nf].iter().flatten().map(|w| w[k]));
+            let name = if k == 0 { format!("{}: ", case.name) } else { String::new() };
+            Heatmap {
+                title: format!("{name}omega_{} [rad/s], colour ±{limit:.3e}", k + 1),
+                x_label: "frame".into(),
+                y_label: "s [mm]".into(),
+                x: x.clone(),
+                y: y.clone(),
+                values: frames.iter().map(|&i| cols.iter().map(|&j| run.omega[i][j][k]).collect()).collect(),
+                limit,
+            }
+        })
+        .collect();
+    write_plot(path, render_heatmaps_svg(&maps))
+}
