@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Speed benchmark of issue 5, in one run on one machine (not a test: nothing here asserts).
+# Speed benchmark, in one run on one machine (not a test: nothing here asserts).
 #   1. worm_roll_3d: the full 1160-frame 3D clip in Rust (Newton warm-started from the previous
 #      frame, rebased chart): wall time (best of 3), frames/s, mean iterations per frame, peak RSS.
 #   2. FreeFEM vs Rust on the prefix FreeFEM can handle: frame 0 of worm_roll_3d (the global
@@ -8,9 +8,10 @@
 #   3. timoshenko_10pct end to end (best of 5) and cantilever_dynamic end to end (best of 3).
 # Goals (2-core machine): 3D clip <= 10 s and <= 200 MB; >= 50x FreeFEM per frame;
 # Timoshenko <= 30 ms; dynamic cantilever <= 1 s.
-#   4. issue 16: worm_roll_3d per Newton iteration (whole process / iterations, best of the 3 runs
-#      above), worm_omega_turn_ld1 whole process (best of 3).
-# Goals of issue 16: roll_3d <= 2.5 s and <= 0.6 ms per Newton iteration, omega_ld1 <= 1.8 s,
+#   4. worm_roll_3d per Newton iteration (whole process / iterations, best of the 3 runs
+#      above), worm_omega_turn_ld1 whole process (best of 3), the 3D clip's output size in both
+#      formats.
+# Second goals: roll_3d <= 2.5 s and <= 0.6 ms per Newton iteration, omega_ld1 <= 1.8 s,
 # cantilever_dynamic <= 0.35 s.
 # Needs FreeFem++ (skip its rows with --no-freefem) and the worm data
 # (scripts/fetch_worm_data.sh). Prints a table (markdown); writes nothing outside a temporary
@@ -77,8 +78,12 @@ echo "| same frame, Rust fixed point to 1e-9 (same method) | ${rust_fp} s (${rus
 echo "| Rust per frame in the clip (Newton warm start, tolerance 1e-9) | $(py "print('%.1f' % (1e3*$rust_frame))") ms: FreeFEM/Rust = $(py "print('%.0f' % ($ff/$rust_frame))") | >= 50 |"
 fi
 echo "| timoshenko_10pct, whole process, best of 5 | $(py "print('%.0f' % (1e3*$best))") ms | <= 30 ms |"
-echo "| cantilever_dynamic, whole process, best of 3 | ${td} s, peak RSS $((md / 1024)) MB | <= 0.35 s (issue 16) |"
-echo "| worm_roll_3d, ms per Newton iteration (whole process / iterations) | $(py "print('%.2f' % (1e3*$t3/$its_total))") ms ($(py "print('%.0f' % $its_total)") iterations) | <= 0.6 ms (issue 16) |"
-echo "| worm_omega_turn_ld1, whole process, best of 3 | ${to} s | <= 1.8 s (issue 16) |"
+echo "| cantilever_dynamic, whole process, best of 3 | ${td} s, peak RSS $((md / 1024)) MB | <= 0.35 s |"
+echo "| worm_roll_3d, ms per Newton iteration (whole process / iterations) | $(py "print('%.2f' % (1e3*$t3/$its_total))") ms ($(py "print('%.0f' % $its_total)") iterations) | <= 0.6 ms |"
+echo "| worm_omega_turn_ld1, whole process, best of 3 | ${to} s | <= 1.8 s |"
+# output size of the 3D clip: the default folder (of the runs above) against --output-format compact
+$bin run "$tmp/roll.toml" --quiet --out "$tmp/roll_compact" --output-format compact
+size_csv=$(du -sb "$tmp/roll" | cut -f1); size_compact=$(du -sb "$tmp/roll_compact" | cut -f1)
+echo "| worm_roll_3d output folder, default / --output-format compact | $(py "print('%.1f' % ($size_csv/1e6))") MB / $(py "print('%.1f' % ($size_compact/1e6))") MB: $(py "print('%.2f' % ($size_csv/$size_compact))")x | >= 4x |"
 echo
 echo "machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs)"

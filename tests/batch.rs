@@ -69,6 +69,26 @@ fn batch_runs_every_recording_fails_the_bad_one_alone_and_resumes() {
     assert_eq!(second.status.code(), Some(1));
     assert!(stdout.contains(&format!("{GOOD} already complete, skipped")), "{stdout}");
     assert_eq!(summary_without_time(&out), rows, "a resumed batch writes the same summary");
+    // The compact format is another output: the complete CSV runs are not taken for it, every
+    // recording runs again into `fields.npz`, and the summary is the same numbers.
+    let compact = cosserat()
+        .arg("batch")
+        .arg(case())
+        .arg("--recordings")
+        .arg(&recs)
+        .arg("--out")
+        .arg(&out)
+        .args(["--jobs", "2", "--quiet", "--output-format", "compact"])
+        .output()
+        .expect("batch");
+    let stdout = String::from_utf8_lossy(&compact.stdout);
+    assert_eq!(compact.status.code(), Some(1));
+    assert!(stdout.contains("(0 already complete, skipped)"), "{stdout}");
+    assert_eq!(summary_without_time(&out), rows, "the compact batch scores the same");
+    for r in &rows[2..] {
+        let folder = out.join(&r[1]);
+        assert!(folder.join("fields.npz").is_file() && !folder.join("fields.csv").exists(), "{}", folder.display());
+    }
 }
 
 #[test]

@@ -11,6 +11,7 @@ use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use cosserat::io::batch::{self, gather, list_recordings, run_batch, run_task, BatchRow, Plan, SUMMARY};
+use cosserat::io::compact::OutputFormat;
 use cosserat::io::corpus::{write_corpus, CorpusParams};
 use cosserat::io::slurm;
 
@@ -42,6 +43,9 @@ pub struct BatchArgs {
     /// Block until the job array has finished, then gather
     #[arg(long, requires = "slurm")]
     wait: bool,
+    /// How each recording's per-node fields are written (as `cosserat run --output-format`)
+    #[arg(long, value_enum, default_value_t = OutputFormat::Csv)]
+    output_format: OutputFormat,
     /// Do not show a progress bar
     #[arg(long)]
     quiet: bool,
@@ -129,7 +133,8 @@ fn report(out: &Path, rows: &[BatchRow], skipped: usize) -> ExitCode {
 pub fn cmd_batch(a: BatchArgs) -> Result<ExitCode> {
     let recordings = list_recordings(&a.recordings)?;
     let per_task = if a.slurm { a.per_task as usize } else { 1 };
-    let plan = Plan::new(&a.case, &recordings, per_task);
+    let mut plan = Plan::new(&a.case, &recordings, per_task);
+    plan.format = a.output_format;
     // the case is read (and refused if it is not a clip case) before anything is written
     let (case, _) = batch::plan_case(&plan).with_context(|| format!("batch of {}", a.case.display()))?;
     plan.begin(&a.out)?;

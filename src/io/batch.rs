@@ -95,6 +95,9 @@ pub struct Plan {
     pub recordings: Vec<PlanEntry>,
     /// recordings per Slurm array task (1 for a local batch)
     pub per_task: usize,
+    /// how each recording's per-node fields are written (`csv` if absent)
+    #[serde(default)]
+    pub format: OutputFormat,
 }
 
 /// The summary row of one recording.
@@ -215,6 +218,7 @@ impl Plan {
                 .map(|(p, folder)| PlanEntry { path: absolute(p), folder })
                 .collect(),
             per_task: per_task.max(1),
+            format: OutputFormat::Csv,
         }
     }
 
@@ -276,8 +280,18 @@ pub fn with_recording(case: &Case, recording: &Path) -> Result<Case, BatchError>
 
 /// The `run.json` of a recording's folder: the case file and its hash, the recording and its
 /// truth sidecar with theirs.
-fn recording_manifest(case: &Case, case_file: &InputFile, recording: &Path) -> Result<Manifest, FolderError> {
-    let mut m = Manifest::new("batch");
+fn recording_manifest(
+    case: &Case,
+    case_file: &InputFile,
+    recording: &Path,
+    format: OutputFormat,
+) -> Result<Manifest, FolderError> {
+    // the format is part of the command, so that a complete run in the other format is not
+    // taken for this one's
+    let mut m = Manifest::new(match format {
+        OutputFormat::Csv => "batch",
+        OutputFormat::Compact => "batch --output-format compact",
+    });
     m.case_name = Some(case.name.clone());
     m.case = Some(case_file.clone());
     m.inputs.push(input_file(recording)?);
@@ -315,7 +329,7 @@ pub struct Ran {
 /// Run `case` (its file hashed in `case_file`) on the recording of `entry` into
 /// `out/entry.folder`, or read its row back when that folder holds a complete run of the same
 /// case and recording. Never fails as a whole: a failure is the row's.
-pub fn run_recording(case: &Case, case_file: &InputFile, entry: &PlanEntry, out: &Path) -> Ran {
+pub fn run_recording(case: &Case, case_file: &InputFile, entry: &PlanEntry, out: &Path, format: OutputFormat) -> Ran {
     let start = Instant::now();
     let dir = out.join(&entry.folder);
     let failed = |reason: String| Ran {
@@ -325,7 +339,7 @@ pub fn run_recording(case: &Case, case_file: &InputFile, entry: &PlanEntry, out:
         },
         skipped: false,
     };
-    let manifest = match recording_manifest(case, case_file, &entry.path) {
+    let manifest = match recording_manifest(case, case_file, &entry.path, format) {
         Ok(m) => m,
         Err(e) => return failed(chain(&e)),
     };
@@ -344,7 +358,7 @@ pub fn run_recording(case: &Case, case_file: &InputFile, entry: &PlanEntry, out:
         Ok(f) => f,
         Err(e) => return failed(chain(&e)),
     };
-    let clip = ClipOptions { journal: true, resume: false, format: OutputFormat::Csv };
+    let clip = ClipOptions { journal: true, resume: false, format };
     let solved = solve_into(&case, Engine::Rust, folder.dir(), clip, |_| {}, |_, _| {});
     let metrics = solved.clip.as_ref().filter(|c| !c.reports.is_empty()).map(|c| clip_metrics(&case, c));
     let get = |k: &str| metrics.as_ref().and_then(|m| m.get(k)).copied();
@@ -398,7 +412,7 @@ pub fn run_batch(plan: &Plan, out: &Path, jobs: usize, tick: impl Fn() + Sync) -
         plan.recordings
             .par_iter()
             .map(|entry| {
-                let r = run_recording(&case, &case_file, entry, out);
+                let r = run_recording(&case, &case_file, entry, out, plan.format);
                 tick();
                 r
             })
@@ -414,7 +428,7 @@ pub fn run_task(out: &Path, index: usize) -> Result<Vec<Ran>, BatchError> {
     let plan = Plan::read(out)?;
     let entries = plan.task(index)?;
     let (case, case_file) = plan_case(&plan)?;
-    Ok(entries.iter().map(|e| run_recording(&case, &case_file, e, out)).collect())
+    Ok(entries.iter().map(|e| run_recording(&case, &case_file, e, out, plan.format)).collect())
 }
 
 /// The rows of the plan in `out` from its recordings' folders (`missing` where a folder holds

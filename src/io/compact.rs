@@ -29,7 +29,8 @@ pub const CURVATURE_COLUMNS: [&str; 4] = ["s_mid_m", "kappa1_per_m", "kappa2_per
 pub const COMPACT_FILE_CAP_BYTES: u64 = 1 << 32;
 
 /// How the per-node output of a clip is written.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
 pub enum OutputFormat {
     /// `fields.csv`, `curvature.csv` and ParaView `vtk/frame_NNNNN.vtp` + `clip.pvd`
     #[default]
