@@ -82,7 +82,7 @@ echo "| cantilever_dynamic, whole process, best of 3 | ${td} s, peak RSS $((md /
 echo "| worm_roll_3d, ms per Newton iteration (whole process / iterations) | $(py "print('%.2f' % (1e3*$t3/$its_total))") ms ($(py "print('%.0f' % $its_total)") iterations) | <= 0.6 ms |"
 echo "| worm_omega_turn_ld1, whole process, best of 3 | ${to} s | <= 1.8 s |"
 # output size of the 3D clip: the default folder (of the runs above) against --output-format compact
-$bin run "$tmp/roll.toml" --quiet --out "$tmp/roll_compact" --output-format compact
+$bin run "$tmp/roll.toml" --quiet --out "$tmp/roll_compact" --output-format compact >/dev/null
 size_csv=$(du -sb "$tmp/roll" | cut -f1); size_compact=$(du -sb "$tmp/roll_compact" | cut -f1)
 echo "| worm_roll_3d output folder, default / --output-format compact | $(py "print('%.1f' % ($size_csv/1e6))") MB / $(py "print('%.1f' % ($size_compact/1e6))") MB: $(py "print('%.2f' % ($size_csv/$size_compact))")x | >= 4x |"
 echo
