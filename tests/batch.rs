@@ -4,7 +4,7 @@
 mod batch_common;
 mod common;
 
-use batch_common::{case, corpus, cosserat, summary_without_time, FRAMES, GOOD};
+use batch_common::{batch_command, corpus, cosserat, summary_without_time, FRAMES, GOOD};
 
 #[test]
 fn batch_runs_every_recording_fails_the_bad_one_alone_and_resumes() {
@@ -14,18 +14,7 @@ fn batch_runs_every_recording_fails_the_bad_one_alone_and_resumes() {
     let tmp = tempfile::tempdir().expect("tempdir");
     let (recs, out) = (tmp.path().join("recordings"), tmp.path().join("out"));
     corpus(&recs);
-    let run = || {
-        cosserat()
-            .arg("batch")
-            .arg(case())
-            .arg("--recordings")
-            .arg(&recs)
-            .arg("--out")
-            .arg(&out)
-            .args(["--jobs", "2", "--quiet"])
-            .output()
-            .expect("batch")
-    };
+    let run = || batch_command(&recs, &out, &["--jobs", "2"]).output().expect("batch");
     let first = run();
     let stderr = String::from_utf8_lossy(&first.stderr);
     assert_eq!(first.status.code(), Some(1), "one bad recording: exit status 1; stderr {stderr}");
@@ -71,16 +60,7 @@ fn batch_runs_every_recording_fails_the_bad_one_alone_and_resumes() {
     assert_eq!(summary_without_time(&out), rows, "a resumed batch writes the same summary");
     // The compact format is another output: the complete CSV runs are not taken for it, every
     // recording runs again into `fields.npz`, and the summary is the same numbers.
-    let compact = cosserat()
-        .arg("batch")
-        .arg(case())
-        .arg("--recordings")
-        .arg(&recs)
-        .arg("--out")
-        .arg(&out)
-        .args(["--jobs", "2", "--quiet", "--output-format", "compact"])
-        .output()
-        .expect("batch");
+    let compact = batch_command(&recs, &out, &["--jobs", "2", "--output-format", "compact"]).output().expect("batch");
     let stdout = String::from_utf8_lossy(&compact.stdout);
     assert_eq!(compact.status.code(), Some(1));
     assert!(stdout.contains("(0 already complete, skipped)"), "{stdout}");
@@ -96,15 +76,7 @@ fn batch_refuses_a_foreign_output_folder_and_a_case_without_clip() {
     let tmp = tempfile::tempdir().expect("tempdir");
     std::fs::write(tmp.path().join("a.npy"), b"x").expect("write");
     std::fs::write(tmp.path().join("notes.txt"), b"mine").expect("write");
-    let out = cosserat()
-        .arg("batch")
-        .arg(case())
-        .arg("--recordings")
-        .arg(tmp.path())
-        .arg("--out")
-        .arg(tmp.path())
-        .output()
-        .expect("batch");
+    let out = batch_command(tmp.path(), tmp.path(), &[]).output().expect("batch");
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{stderr}");
     assert!(stderr.contains("is not the output folder of a batch"), "{stderr}");

@@ -11,7 +11,7 @@ mod common;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use batch_common::{case, corpus, cosserat, root, summary_without_time, GOOD};
+use batch_common::{batch_command, corpus, cosserat, root, summary_without_time, GOOD};
 
 /// A cluster started by the script; stopped when dropped.
 struct Cluster {
@@ -69,18 +69,7 @@ fn slurm_job_array_gathers_the_same_summary_as_the_local_batch() {
     corpus(&recs);
     let (local, slurm) = (tmp.path().join("local"), tmp.path().join("slurm"));
     let batch = |out: &Path, extra: &[&str]| {
-        cosserat()
-            .arg("batch")
-            .arg(case())
-            .arg("--recordings")
-            .arg(&recs)
-            .arg("--out")
-            .arg(out)
-            .arg("--quiet")
-            .args(extra)
-            .env("SLURM_CONF", &cluster.conf)
-            .output()
-            .expect("batch")
+        batch_command(&recs, out, extra).env("SLURM_CONF", &cluster.conf).output().expect("batch")
     };
     let l = batch(&local, &["--jobs", "2"]);
     assert_eq!(l.status.code(), Some(1), "local: {}", String::from_utf8_lossy(&l.stderr));

@@ -24,6 +24,13 @@ pub fn case() -> PathBuf {
     root().join("cases/batch/roll_recording.toml")
 }
 
+/// `cosserat batch CASE --recordings RECS --out OUT --quiet EXTRA…` of the batch case.
+pub fn batch_command(recs: &Path, out: &Path, extra: &[&str]) -> Command {
+    let mut c = cosserat();
+    c.arg("batch").arg(case()).arg("--recordings").arg(recs).arg("--out").arg(out).arg("--quiet").args(extra);
+    c
+}
+
 /// `GOOD` synthetic recordings of `FRAMES` frames (with truth sidecars) and `bad.csv`, a
 /// recording with a non-finite coordinate, in `dir`.
 pub fn corpus(dir: &Path) {
