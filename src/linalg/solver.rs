@@ -34,6 +34,9 @@ pub struct LinearSolver {
     rmax: Vec<f64>,
     cmax: Vec<f64>,
     rnext: Vec<f64>,
+    /// the factors in `lu` are those of the scaled matrix `D_r M D_c` (an equilibrated or
+    /// rescaled solve), so [`LinearSolver::solve_factored`] scales too
+    scaled: bool,
 }
 
 impl LinearSolver {
@@ -61,6 +64,7 @@ impl LinearSolver {
             rmax: vec![0.0; n],
             cmax: vec![0.0; n],
             rnext: vec![0.0; n],
+            scaled: false,
         }
     }
 
@@ -110,17 +114,23 @@ impl LinearSolver {
 
     /// Solve `M x = b` for the matrix with the pattern's structure and the given values.
     pub fn solve(&mut self, values: &[f64], b: &DVector<f64>) -> Result<DVector<f64>, LinearError> {
-        let mut x = b.clone();
         self.load(values, false);
-        self.factor_and_solve(&mut x)?;
-        Ok(x)
+        self.scaled = false;
+        self.lu.factor()?;
+        self.solve_factored(b)
     }
 
-    /// Solve `M x = b` with the factors of the last [`LinearSolver::solve`] (no copy, no
-    /// factorisation: the matrix of that solve, e.g. a chord step's frozen Jacobian).
+    /// Solve `M x = b` with the factors of the last solve (no copy, no factorisation: the
+    /// matrix of that solve, e.g. a chord step's frozen Jacobian), scaled as that solve was
+    /// (`x = D_c (D_r M D_c)⁻¹ D_r b` after an equilibrated or rescaled solve).
     pub fn solve_factored(&self, b: &DVector<f64>) -> Result<DVector<f64>, LinearError> {
-        let mut x = b.clone();
+        let mut x = if self.scaled { DVector::from_fn(b.len(), |i, _| b[i] * self.dr[i]) } else { b.clone() };
         self.lu.solve_in_place(x.as_mut_slice());
+        if self.scaled {
+            for (xi, d) in x.iter_mut().zip(&self.dc) {
+                *xi *= d;
+            }
+        }
         if let Some(index) = x.iter().position(|v| !v.is_finite()) {
             return Err(LinearError::NonFinite { index });
         }
@@ -153,22 +163,9 @@ impl LinearSolver {
 
     /// Factor the loaded (scaled) band and solve with `D_r b`, returning `D_c y`.
     fn factor_and_solve_scaled(&mut self, b: &DVector<f64>) -> Result<DVector<f64>, LinearError> {
-        let mut x = DVector::from_fn(b.len(), |i, _| b[i] * self.dr[i]);
-        self.factor_and_solve(&mut x)?;
-        for (xi, d) in x.iter_mut().zip(&self.dc) {
-            *xi *= d;
-        }
-        Ok(x)
-    }
-
-    /// Factor the loaded band and overwrite `x` (the right-hand side) by the solution.
-    fn factor_and_solve(&mut self, x: &mut DVector<f64>) -> Result<(), LinearError> {
+        self.scaled = true;
         self.lu.factor()?;
-        self.lu.solve_in_place(x.as_mut_slice());
-        if let Some(index) = x.iter().position(|v| !v.is_finite()) {
-            return Err(LinearError::NonFinite { index });
-        }
-        Ok(())
+        self.solve_factored(b)
     }
 }
 

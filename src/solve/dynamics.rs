@@ -11,15 +11,12 @@
 //! used (errata: (Δt²/2) F_n and M_{n−2}; see PAPER-NOTES and `docs/decisions.md`).
 use nalgebra::{DVector, Vector3};
 
-use super::{divergence, Problem, SolveError, Step};
+use super::{divergence, Problem, SolveError, Step, CHORD_CONTRACTION};
 use crate::assemble::Tangent;
 use crate::linalg::{LinearSolver, Pattern};
 use crate::model::loads::LoadFrame;
 use crate::model::mesh::Field;
 
-/// Largest ratio of successive increments of a time step for which a chord step (the
-/// factorisation of an earlier Jacobian) is kept; beyond it the next iteration is Newton's.
-const CHORD_CONTRACTION: f64 = 0.01;
 
 /// Time-stepping parameters.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -67,6 +67,11 @@ pub const DIVERGED_LENGTHS: f64 = 1e3;
 /// A forward iterate with an angle beyond this [rad] (≈ 160 turns) has diverged.
 pub const DIVERGED_ANGLE_RAD: f64 = 1e3;
 
+/// Chord steps (a factorised Jacobian reused for later iterations: the time stepping and the
+/// inverse Newton) are kept while each increment is at most this fraction of the one before;
+/// a weaker contraction has the iteration assemble and factor the Jacobian at its iterate.
+pub(crate) const CHORD_CONTRACTION: f64 = 0.01;
+
 /// The first sign of divergence of a forward iterate `u` after a step measured by `change`:
 /// `(quantity with its limit, value)`, or `None` when every unknown is finite and within
 /// [`DIVERGED_LENGTHS`] and [`DIVERGED_ANGLE_RAD`].

@@ -34,12 +34,17 @@ use crate::model::rotation::{
     a_matrix, a_matrix_derivatives, d3, d3_second_derivatives, rotation, rotation_derivatives, skew, PointFrame,
 };
 use crate::solve::statics::relative_change;
-use crate::solve::{Problem, SolveError, Stop};
+use crate::solve::{Problem, SolveError, Stop, CHORD_CONTRACTION};
 
 /// Smallest step fraction of the backtracking line search (2⁻¹⁰).
 const MIN_STEP: f64 = 1.0 / 1024.0;
 /// Armijo constant of the line search: accept `t` if `φ(U + t δ) ≤ (1 − c t) φ(U)`.
 const ARMIJO: f64 = 1e-4;
+/// Chord steps are taken where they converge nearly as fast as Newton's: while their
+/// contraction (the ratio of successive relative changes of `(x, α)`, D5) is at most this. A
+/// chord step from a Jacobian factorised one step ago contracts by about the square of that
+/// Newton step's contraction (the step's distance times Newton's constant `c_k / c_{k−1}²`).
+const CHORD_RATE: f64 = 1e-4;
 
 /// `∂/∂u [K_e(u) V − r_e(u)]` at `V = U_e` for one element (24 × 24, KKT numbering; only the
 /// state columns are non-zero), added into `e`: the derivative of the frozen coefficients of I4.
@@ -207,9 +212,14 @@ pub fn assemble_residual(
 
 /// Newton of one frame (I8) from the state `u0` (forward layout) with `params`; the solver's
 /// Dirichlet rows must be those of the frame. The adjoint is started consistently by one
-/// linear solve of the fixed point, `K(u0) U = r(u0)` (I4). `params.relaxation` is not used;
-/// `params.tolerance` bounds the relative change of `(x, α)` of a full Newton step (D5), and
-/// each record carries the equilibrated residual relative to its start value.
+/// linear solve of the fixed point, `K(u0) U = r(u0)` (I4), whose Ruiz factors (I6) scale
+/// every Jacobian of the frame and weigh its merit. When the predicted contraction of a chord
+/// step (the last factorised Jacobian reused) is within [`CHORD_RATE`], the next iteration is
+/// one; a chord step that contracts by more than [`CHORD_CONTRACTION`], or fails the line
+/// search's first test, is discarded and the iteration is Newton's.
+/// `params.relaxation` is not used; `params.tolerance` bounds the relative change of `(x, α)`
+/// of a full step (D5), and each record carries the equilibrated residual relative to its
+/// start value.
 pub(crate) fn solve(
     s: &mut FrameSolver,
     params: &InverseParams,
@@ -222,63 +232,92 @@ pub(crate) fn solve(
     let problem = s.problem;
     let fwd = problem.dofs();
     let FrameSolver { dofs, pattern, solver, fixed, rows, values, merit_weights, no_previous, .. } = s;
-    let previous = frame.previous.unwrap_or(no_previous.as_slice());
+    let previous_angles = frame.previous.unwrap_or(no_previous.as_slice());
+    // the Ruiz row factors of the start's matrix weigh the merit of the whole frame (I6)
+    merit_weights.clear();
+    merit_weights.extend_from_slice(solver.row_factors());
+    let merit =
+        |r: &DVector<f64>| r.iter().zip(merit_weights.iter()).map(|(a, b)| (a * b).powi(2)).sum::<f64>().sqrt();
     let mut history = Vec::new();
     let mut phi0 = f64::NAN;
     let mut adjoint = fwd.zeros();
     let mut u = dofs.kkt_state(&big);
-    // the residual at `big` when the line search already assembled it with its Jacobian
+    // the residual at `big` when the line search already assembled it (with the Jacobian,
+    // unless the next iteration is a chord step)
     let mut next: Option<DVector<f64>> = None;
-    for k in 1..=params.max_iterations {
+    // this iteration solves with the last factorisation (a chord step)
+    let mut chord = false;
+    // relative change of the last step
+    let mut previous = f64::INFINITY;
+    let mut k = 0;
+    while k < params.max_iterations {
+        k += 1;
         let r = match next.take() {
             Some(r) => r,
             None => {
-                let jacobian = Some((&*pattern, values.as_mut_slice(), rows.as_slice()));
-                assemble_residual(problem, params, frame, previous, &big, fixed, jacobian)
+                let jacobian = (!chord).then_some((&*pattern, values.as_mut_slice(), rows.as_slice()));
+                assemble_residual(problem, params, frame, previous_angles, &big, fixed, jacobian)
             }
         };
-        // Ruiz on the first Jacobian (I6); its factors scale the later ones of the frame
-        let delta =
-            if k == 1 { solver.solve_equilibrated(values, &(-&r))? } else { solver.solve_rescaled(values, &(-&r))? };
-        if k == 1 {
-            // the Ruiz row factors of the first Jacobian weigh the merit of the whole frame
-            merit_weights.clear();
-            merit_weights.extend_from_slice(solver.row_factors());
-        }
-        let merit =
-            |r: &DVector<f64>| r.iter().zip(merit_weights.iter()).map(|(a, b)| (a * b).powi(2)).sum::<f64>().sqrt();
+        let delta = if chord { solver.solve_factored(&(-&r))? } else { solver.solve_rescaled(values, &(-&r))? };
         let phi = merit(&r);
         if k == 1 {
             phi0 = phi;
         }
+        let change = relative_change(&fwd, &dofs.kkt_state(&(&big + &delta)), &dofs.kkt_state(&big));
         // A full step whose relative change is within the tolerance is taken without the
         // line search: the merit is then at its round-off floor and cannot decrease reliably.
-        let full = relative_change(&fwd, &dofs.kkt_state(&(&big + &delta)), &dofs.kkt_state(&big)) <= params.tolerance;
+        let full = change <= params.tolerance;
+        if chord && !full && change > CHORD_CONTRACTION * previous {
+            // too weak a contraction for the frozen Jacobian: this iteration is Newton's
+            (chord, k) = (false, k - 1);
+            continue;
+        }
+        // the next iteration reuses this factorisation if a chord step is predicted to
+        // contract by CHORD_RATE: the square of this Newton step's contraction, or a chord
+        // step's own
+        let rate = match (chord, k) {
+            (_, 1) => f64::INFINITY,
+            (true, _) => change / previous,
+            (false, _) => (change / previous).powi(2),
+        };
+        let chord_next = !full && rate <= CHORD_RATE;
         let mut t = 1.0;
         let (mut trial, mut phi_t);
-        loop {
+        let accepted = loop {
             trial = &big + &delta * t;
             // The full step of an iteration that is not the last is usually accepted: its
-            // residual comes with the Jacobian, which the next iteration then uses (the same
-            // element sums, so the same residual as assembling it there).
-            let with_jacobian = t == 1.0 && !full;
+            // residual comes with the Jacobian (unless a chord step follows), which the next
+            // iteration then uses (the same element sums, so the same residual as assembling
+            // it there).
+            let with_jacobian = t == 1.0 && !full && !chord_next;
             let jacobian = with_jacobian.then_some((&*pattern, values.as_mut_slice(), rows.as_slice()));
-            let r_t = assemble_residual(problem, params, frame, previous, &trial, fixed, jacobian);
+            let r_t = assemble_residual(problem, params, frame, previous_angles, &trial, fixed, jacobian);
             phi_t = merit(&r_t);
             if full || phi_t <= (1.0 - ARMIJO * t) * phi || t <= MIN_STEP {
-                if with_jacobian {
+                if t == 1.0 && !full {
                     next = Some(r_t);
                 }
-                break;
+                break true;
+            }
+            if chord {
+                break false;
             }
             t *= 0.5;
+        };
+        if !accepted {
+            // a chord step the merit rejects: this iteration is Newton's
+            (chord, k) = (false, k - 1);
+            continue;
         }
+        chord = chord_next && t == 1.0;
         let u_old = dofs.kkt_state(&big);
         u = dofs.kkt_state(&trial);
         let rel_change = relative_change(&fwd, &u, &u_old);
+        previous = rel_change;
         big = trial;
         adjoint = dofs.kkt_adjoint(&big);
-        let rec = record(problem, params, frame, previous, k, rel_change, &u, &adjoint, Some(phi_t / phi0));
+        let rec = record(problem, params, frame, previous_angles, k, rel_change, &u, &adjoint, Some(phi_t / phi0));
         rec.divergence(frame.index, &u, &adjoint)?;
         observer(&rec, &u, &adjoint);
         history.push(rec);
