@@ -39,7 +39,7 @@ pub fn assemble<const N: usize>(
     for e in 0..dofs.nodes().saturating_sub(1) {
         let r = match tangent.as_mut() {
             Some(t) => {
-                local.fill(0.0);
+                local.as_mut_slice().fill(0.0);
                 let r = kernel(e, Some(&mut local));
                 if t.scale != 1.0 {
                     local *= t.scale;

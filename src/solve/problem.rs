@@ -107,7 +107,7 @@ impl<'a> Problem<'a> {
             let (ue, ve) = (dofs.gather(u, e), dofs.gather(udot, e));
             match t {
                 Some(du) => {
-                    dv.fill(0.0);
+                    dv.as_mut_slice().fill(0.0);
                     let r = momentum(&self.props, self.scheme, h, &ue, &ve, Some(du), Some(&mut dv));
                     *du = *du * su + dv * sv;
                     r

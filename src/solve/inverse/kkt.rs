@@ -115,11 +115,17 @@ pub(crate) fn d3_jacobian(alpha: &Vector3<f64>) -> Matrix3<f64> {
 }
 
 /// Add a 3 × 3 block at `(ro, co)`.
+#[inline]
 pub(crate) fn add3(m: &mut KktMat, ro: usize, co: usize, blk: &Matrix3<f64>) {
+    let mut v = m.fixed_view_mut::<3, 3>(ro, co);
+    v += blk;
+}
+
+/// Add `s I` (3 × 3) at `(ro, co)`: the diagonal only.
+#[inline]
+fn add_diagonal3(m: &mut KktMat, ro: usize, co: usize, s: f64) {
     for i in 0..3 {
-        for j in 0..3 {
-            m[(ro + i, co + j)] += blk[(i, j)];
-        }
+        m[(ro + i, co + i)] += s;
     }
 }
 
@@ -173,9 +179,9 @@ pub(crate) fn element_system(
             }
             for c in 0..2 {
                 let nn = wh * n[a] * n[c];
-                add3(m, X[a], X[c], &(Matrix3::identity() * (w8.lambda_g * nn)));
-                add3(m, XH[a], XH[c], &(Matrix3::identity() * (-nn / w8.lambda_f)));
-                add3(m, ALH[a], ALH[c], &(Matrix3::identity() * (-nn / w8.lambda_l)));
+                add_diagonal3(m, X[a], X[c], w8.lambda_g * nn);
+                add_diagonal3(m, XH[a], XH[c], -nn / w8.lambda_f);
+                add_diagonal3(m, ALH[a], ALH[c], -nn / w8.lambda_l);
                 add3(m, AL[a], AL[c], &(W * nn));
             }
         }
@@ -186,19 +192,22 @@ pub(crate) fn element_system(
         let wh = w * h * w8.lambda_d;
         let D = d3_jacobian(&q.alpha);
         let c = d3(&q.alpha) - D * q.alpha;
+        // test operator of node a: (∂sδx, −D δα) = (dn_a I, −n_a D) applied to (δx, δα)
+        let t_alpha = [-D * q.n[0], -D * q.n[1]];
         for a in 0..2 {
-            let ta = [Matrix3::identity() * q.dn[a], -D * q.n[a]]; // test operator blocks (x, α)
+            let ta = &t_alpha[a];
+            let tac = ta.transpose() * c;
             for i in 0..3 {
-                r[X[a] + i] += wh * (ta[0].transpose() * c)[i];
-                r[AL[a] + i] += wh * (ta[1].transpose() * c)[i];
+                r[X[a] + i] += wh * (q.dn[a] * c[i]);
+                r[AL[a] + i] += wh * tac[i];
             }
             for cc in 0..2 {
-                let tc = [Matrix3::identity() * q.dn[cc], -D * q.n[cc]];
-                for (ra, ro) in [(0, X[a]), (1, AL[a])] {
-                    for (ca, co) in [(0, X[cc]), (1, AL[cc])] {
-                        add3(m, ro, co, &(ta[ra].transpose() * tc[ca] * wh));
-                    }
-                }
+                let tc = &t_alpha[cc];
+                // the blocks (x, x), (x, α), (α, x), (α, α) of ta_rᵀ tc_c
+                add_diagonal3(m, X[a], X[cc], q.dn[a] * q.dn[cc] * wh);
+                add3(m, X[a], AL[cc], &(tc * q.dn[a] * wh));
+                add3(m, AL[a], X[cc], &(ta.transpose() * q.dn[cc] * wh));
+                add3(m, AL[a], AL[cc], &(ta.transpose() * tc * wh));
             }
         }
     }

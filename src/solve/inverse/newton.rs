@@ -185,7 +185,7 @@ pub fn assemble_residual(
         let ap = [alpha_prev[e], alpha_prev[e + 1]];
         let jacobian = t.is_some();
         let m = t.unwrap_or_else(|| {
-            scratch.fill(0.0);
+            scratch.as_mut_slice().fill(0.0);
             &mut scratch
         });
         let rhs = element_system(problem, p, first, &uk, [x_g[e], x_g[e + 1]], ap, m);
