@@ -80,10 +80,17 @@ impl Pattern {
     /// Add a local `(2 block)²` matrix of element `e` into the values.
     pub fn scatter<const N: usize>(&self, values: &mut [f64], e: usize, local: &SMatrix<f64, N, N>) {
         assert_eq!(N, 2 * self.block, "local matrix size must be twice the block size");
+        // Column j of the element holds rows block·e .. block·e + N of a pattern column, whose
+        // rows are contiguous and ascending: one run of N values per column.
         let s = &self.slots[e * N * N..(e + 1) * N * N];
-        for i in 0..N {
-            for j in 0..N {
-                values[s[N * i + j]] += local[(i, j)];
+        for j in 0..N {
+            let start = s[j];
+            debug_assert!((0..N).all(|i| s[N * i + j] == start + i), "element rows must be contiguous in a column");
+            let dst: &mut [f64; N] = (&mut values[start..start + N]).try_into().expect("N rows");
+            // column-major storage: column j is the j-th run of N values
+            let src: &[f64; N] = local.as_slice()[j * N..(j + 1) * N].try_into().expect("N rows");
+            for i in 0..N {
+                dst[i] += src[i];
             }
         }
     }

@@ -59,17 +59,15 @@ pub fn interpolate(u: &LocalVec, h: f64, xi: f64) -> PointState {
     }
 }
 
+#[inline]
 fn add_vec(r: &mut LocalVec, off: usize, v: &Vector3<f64>) {
-    for i in 0..3 {
-        r[off + i] += v[i];
-    }
+    let mut rows = r.fixed_rows_mut::<3>(off);
+    rows += v;
 }
+#[inline]
 fn add_mat(t: &mut LocalMat, ro: usize, co: usize, m: &Matrix3<f64>) {
-    for i in 0..3 {
-        for j in 0..3 {
-            t[(ro + i, co + j)] += m[(i, j)];
-        }
-    }
+    let mut block = t.fixed_view_mut::<3, 3>(ro, co);
+    block += m;
 }
 fn columns(c: [Vector3<f64>; 3]) -> Matrix3<f64> {
     Matrix3::from_columns(&c)
