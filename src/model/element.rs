@@ -91,7 +91,7 @@ pub fn internal_force(
         let f = PointFrame::new(&p.alpha, with_tangent);
         let Q = f.q;
         let e = Q * p.dx - Vector3::z();
-        let n = Q.transpose() * K * e;
+        let n = Q.transpose() * (K * e);
         let c = p.dx.cross(&n);
         for a in 0..2 {
             add_vec(&mut r, X[a], &(n * (wh * p.dn[a])));
@@ -100,7 +100,8 @@ pub fn internal_force(
         if let Some(t) = tangent.as_deref_mut() {
             let dQ = f.dq;
             let dn_dx = Q.transpose() * K * Q;
-            let dn_da = columns([0, 1, 2].map(|j| dQ[j].transpose() * K * e + Q.transpose() * K * dQ[j] * p.dx));
+            let ke = K * e;
+            let dn_da = columns([0, 1, 2].map(|j| dQ[j].transpose() * ke + Q.transpose() * (K * (dQ[j] * p.dx))));
             let dc_dx = -skew(&n) + skew(&p.dx) * dn_dx;
             let dc_da = skew(&p.dx) * dn_da;
             for a in 0..2 {
@@ -116,14 +117,16 @@ pub fn internal_force(
     for_each_point(&scheme.bending(), h, u, |p, wh| {
         let f = PointFrame::new(&p.alpha, with_tangent);
         let (Q, A) = (f.q, f.a);
-        let m = Q.transpose() * J * A * p.dalpha;
+        let m = Q.transpose() * (J * (A * p.dalpha));
         for a in 0..2 {
             add_vec(&mut r, ALPHA[a], &(m * (wh * p.dn[a])));
         }
         if let Some(t) = tangent.as_deref_mut() {
             let (dQ, dA) = (f.dq, f.da);
             let dm_dda = Q.transpose() * J * A;
-            let dm_da = columns([0, 1, 2].map(|j| (dQ[j].transpose() * J * A + Q.transpose() * J * dA[j]) * p.dalpha));
+            let ja = J * (A * p.dalpha);
+            let dm_da =
+                columns([0, 1, 2].map(|j| dQ[j].transpose() * ja + Q.transpose() * (J * (dA[j] * p.dalpha))));
             for a in 0..2 {
                 for b in 0..2 {
                     let blk = dm_dda * (wh * p.dn[a] * p.dn[b]) + dm_da * (wh * p.dn[a] * p.n[b]);
@@ -212,7 +215,9 @@ pub fn momentum(
         }
         if let Some(t) = d_u.as_deref_mut() {
             let (dQ, dA) = (f.dq, f.da);
-            let dp_da = columns([0, 1, 2].map(|j| (dQ[j].transpose() * I * A + Q.transpose() * I * dA[j]) * v.alpha));
+            let ia = I * (A * v.alpha);
+            let dp_da =
+                columns([0, 1, 2].map(|j| dQ[j].transpose() * ia + Q.transpose() * (I * (dA[j] * v.alpha))));
             for a in 0..2 {
                 for b in 0..2 {
                     add_mat(t, ALPHA[a], ALPHA[b], &(dp_da * (wh * p.n[a] * p.n[b])));

@@ -6,7 +6,7 @@ use nalgebra::{DVector, Matrix3, SMatrix, SVector, Vector3};
 use super::{Frame, InverseParams};
 use crate::assemble::{assemble, Tangent};
 use crate::linalg::Pattern;
-use crate::model::element::{frozen_operator, interpolate, LocalVec};
+use crate::model::element::{frozen_operator, interpolate, LocalMat, LocalVec};
 use crate::model::mesh::{DofMap, Field, Rule, GAUSS1, GAUSS2};
 use crate::model::rotation::{a_matrix, d3, rotation_derivatives};
 use crate::solve::Problem;
@@ -59,6 +59,15 @@ const fn kkt_table(hat: bool) -> [usize; 12] {
 
 const KKT_STATE: [usize; 12] = kkt_table(false);
 const KKT_HAT: [usize; 12] = kkt_table(true);
+// `add_operator_blocks` relies on this layout: forward unknown i of node a at 12 a + i % 6,
+// its adjoint 6 further
+const _: () = {
+    let mut i = 0;
+    while i < 12 {
+        assert!(KKT_STATE[i] == 12 * (i / 6) + i % 6 && KKT_HAT[i] == KKT_STATE[i] + 6);
+        i += 1;
+    }
+};
 
 /// The state part (`hat = false`) or the adjoint part of a KKT element vector, in the forward
 /// element layout.
@@ -114,6 +123,25 @@ pub(crate) fn d3_jacobian(alpha: &Vector3<f64>) -> Matrix3<f64> {
     Matrix3::from_columns(&[dq[0].row(2).transpose(), dq[1].row(2).transpose(), dq[2].row(2).transpose()])
 }
 
+/// Add a forward-layout element matrix `l` (12 × 12) into the adjoint rows × state columns of a
+/// KKT element matrix, `m[kkt(i, true), kkt(j, false)] += l[i, j]`, and, if `transpose`, its
+/// transpose into the state rows × adjoint columns: 6 × 6 blocks per pair of nodes (a node's
+/// forward unknowns `[x, α]` are the first six of its KKT block, the adjoint's the last six).
+pub(crate) fn add_operator_blocks(m: &mut KktMat, l: &LocalMat, transpose: bool) {
+    const B: usize = 6;
+    for a in 0..2 {
+        for c in 0..2 {
+            let blk = l.fixed_view::<B, B>(B * a, B * c);
+            let mut adj_rows = m.fixed_view_mut::<B, B>(2 * B * a + B, 2 * B * c);
+            adj_rows += blk;
+            if transpose {
+                let mut state_rows = m.fixed_view_mut::<B, B>(2 * B * c, 2 * B * a + B);
+                state_rows += blk.transpose();
+            }
+        }
+    }
+}
+
 /// Add a 3 × 3 block at `(ro, co)`.
 #[inline]
 pub(crate) fn add3(m: &mut KktMat, ro: usize, co: usize, blk: &Matrix3<f64>) {
@@ -149,11 +177,8 @@ pub(crate) fn element_system(
     let (l, b) = frozen_operator(&problem.props, problem.scheme, h, uk);
     for i in 0..12 {
         r[kkt(i, true)] += b[i];
-        for j in 0..12 {
-            m[(kkt(i, true), kkt(j, false))] += l[(i, j)];
-            m[(kkt(j, false), kkt(i, true))] += l[(i, j)];
-        }
     }
+    add_operator_blocks(m, &l, true);
     let omega_on = !first_frame && w8.lambda_omega.amax() > 0.0;
     let dt = p.frame_interval_s;
     // Mass-type terms (load rule): tracking, control costs, Λω.

@@ -23,7 +23,7 @@
 //! 1. Wang et al., Comput. Mech. 71 (2023), §3–4, eqs. (52)–(61), Remark 8, Remark 10.
 use nalgebra::{DVector, Matrix3, Vector3};
 
-use super::kkt::{add3, element_part, element_system, kkt, KktMat, KktVec, PointRule, AL, KAPPA_RULE, X};
+use super::kkt::{add3, add_operator_blocks, element_part, element_system, KktMat, KktVec, PointRule, AL, KAPPA_RULE, X};
 use super::measures::record;
 use super::{Frame, FrameSolver, InverseParams, InverseRecord, InverseSolution};
 use crate::assemble::{assemble, Tangent};
@@ -74,11 +74,7 @@ fn coefficient_derivative(
     let mut t = LocalMat::zeros();
     internal_force(props, problem.scheme, h, &state, Some(&mut t));
     let (l, _) = frozen_operator(props, problem.scheme, h, &state);
-    for i in 0..12 {
-        for j in 0..12 {
-            e[(kkt(i, true), kkt(j, false))] += t[(i, j)] - l[(i, j)];
-        }
-    }
+    add_operator_blocks(e, &(t - l), false);
     let columns = |c: [Vector3<f64>; 3]| Matrix3::from_columns(&c);
     let K = Matrix3::from_diagonal(&props.shear_stretch_n);
     let Jm = Matrix3::from_diagonal(&props.bend_twist_nm2);
@@ -90,7 +86,9 @@ fn coefficient_derivative(
         let dQ = rotation_derivatives(&q.alpha);
         let S = Q.transpose() * K * Q;
         let v = qa.dx + q.dx.cross(&qa.alpha);
-        let dS_v = columns([0, 1, 2].map(|j| (dQ[j].transpose() * K * Q + Q.transpose() * K * dQ[j]) * v));
+        // ∂S/∂α_j v = dQ_jᵀ K (Q v) + Qᵀ K (dQ_j v), as matrix–vector products
+        let kqv = K * (Q * v);
+        let dS_v = columns([0, 1, 2].map(|j| dQ[j].transpose() * kqv + Q.transpose() * (K * (dQ[j] * v))));
         let dS_dx = -S * skew(&qa.alpha);
         for c in 0..2 {
             for b in 0..2 {
@@ -118,8 +116,10 @@ fn coefficient_derivative(
         let wh = w * h;
         let f = PointFrame::new(&q.alpha, true);
         let (Q, A, dQ, dA) = (f.q, f.a, f.dq, f.da);
+        // (dQ_jᵀ J A + Qᵀ J dA_j)ᵀ w = Aᵀ J (dQ_j w) + dA_jᵀ J (Q w), w = ∂s α̂
+        let jqw = Jm * (Q * qa.dalpha);
         let blk = columns(
-            [0, 1, 2].map(|j| (dQ[j].transpose() * Jm * A + Q.transpose() * Jm * dA[j]).transpose() * qa.dalpha),
+            [0, 1, 2].map(|j| A.transpose() * (Jm * (dQ[j] * qa.dalpha)) + dA[j].transpose() * jqw),
         );
         for c in 0..2 {
             for b in 0..2 {
@@ -133,7 +133,8 @@ fn coefficient_derivative(
         for (xi, w) in KAPPA_RULE.iter() {
             let q = interpolate(&state, h, xi);
             let (A, dA) = (a_matrix(&q.alpha), a_matrix_derivatives(&q.alpha));
-            let blk = columns([0, 1, 2].map(|j| (dA[j].transpose() * Lk * A + A.transpose() * Lk * dA[j]) * q.dalpha));
+            let lka = Lk * (A * q.dalpha);
+            let blk = columns([0, 1, 2].map(|j| dA[j].transpose() * lka + A.transpose() * (Lk * (dA[j] * q.dalpha))));
             for c in 0..2 {
                 for b in 0..2 {
                     add3(e, AL[c], AL[b], &(blk * (w * h * q.dn[c] * q.n[b])));
@@ -151,7 +152,8 @@ fn coefficient_derivative(
             let A = a_matrix(&q.alpha);
             let dA = a_matrix_derivatives(&q.alpha);
             let da = q.alpha - (alpha_prev[0] * q.n[0] + alpha_prev[1] * q.n[1]);
-            let blk = columns([0, 1, 2].map(|j| (dA[j].transpose() * Lw * A + A.transpose() * Lw * dA[j]) * da));
+            let lwa = Lw * (A * da);
+            let blk = columns([0, 1, 2].map(|j| dA[j].transpose() * lwa + A.transpose() * (Lw * (dA[j] * da))));
             for c in 0..2 {
                 for b in 0..2 {
                     add3(e, AL[c], AL[b], &(blk * (wh * q.n[c] * q.n[b])));
@@ -189,7 +191,7 @@ pub fn assemble_residual(
             &mut scratch
         });
         let rhs = element_system(problem, p, first, &uk, [x_g[e], x_g[e + 1]], ap, m);
-        let r = *m * ue - rhs;
+        let r = &*m * ue - rhs;
         if jacobian {
             coefficient_derivative(problem, p, first, &ue, ap, m);
         }
