@@ -155,27 +155,18 @@ impl BandLu {
                 *v /= pivot;
             }
             // rank-1 update of the columns j + 1..=ju, rows j + 1..=j + km; for the usual
-            // block sizes over all kl rows below the pivot (fixed length, unrolled): the rows
-            // past j + km hold zeros in column j (outside the band's structure, or past n) and
-            // stay zero in column c
+            // block sizes (6 and 12 unknowns per node: km from 6 to 11 and from 12 to 23) with
+            // a fixed, unrolled length
             let span = ju - j;
-            match self.kl {
-                23 => update::<23>(head, tail, col, kv, ld, span),
-                11 => update::<11>(head, tail, col, kv, ld, span),
-                _ => {
-                    let l = &head[col + 1..col + 1 + km];
-                    for c in j + 1..=ju {
-                        let base = (c - j - 1) * ld + kv + j - c;
-                        let ujc = tail[base];
-                        if ujc != 0.0 {
-                            let dst = &mut tail[base + 1..base + 1 + km];
-                            for (d, li) in dst.iter_mut().zip(l.iter()) {
-                                *d -= li * ujc;
-                            }
-                        }
+            macro_rules! fixed {
+                ($($k:literal)*) => {
+                    match km {
+                        $($k => update::<$k>(head, tail, col, kv, ld, span),)*
+                        _ => update_any(head, tail, col, kv, ld, span, km),
                     }
-                }
+                };
             }
+            fixed!(6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23);
         }
         Ok(())
     }
@@ -216,9 +207,23 @@ impl BandLu {
     }
 }
 
+/// [`update`] for any number `km` of rows below the pivot.
+fn update_any(head: &[f64], tail: &mut [f64], col: usize, kv: usize, ld: usize, span: usize, km: usize) {
+    let l = &head[col + 1..col + 1 + km];
+    for (t, column) in tail.chunks_exact_mut(ld).take(span).enumerate() {
+        let base = kv - 1 - t;
+        let ujc = column[base];
+        if ujc != 0.0 {
+            for (d, li) in column[base + 1..base + 1 + km].iter_mut().zip(l) {
+                *d -= li * ujc;
+            }
+        }
+    }
+}
+
 /// The rank-1 update of [`BandLu::factor`] over the `span` columns after the pivot column
-/// (`head` ends with it, its multipliers at `col + 1..`; `tail` holds the next columns), all `KL`
-/// rows below the pivot row.
+/// (`head` ends with it, its multipliers at `col + 1..`; `tail` holds the next columns), the `KL`
+/// rows below the pivot row that can hold non-zeros.
 #[inline]
 fn update<const KL: usize>(head: &[f64], tail: &mut [f64], col: usize, kv: usize, ld: usize, span: usize) {
     let l: &[f64; KL] = head[col + 1..col + 1 + KL].try_into().expect("KL multipliers");
