@@ -252,8 +252,7 @@ impl ClipWriter {
         ]);
         row.extend(r.chart_axis.iter());
         row.push(omega.iter().map(|w| w.norm()).fold(0.0, f64::max));
-        let line: Vec<String> = row.iter().map(|v| format!("{v:.10e}")).collect();
-        writeln!(self.frames, "{}", line.join(",")).and_then(|_| self.frames.flush()).map_err(err("frames.csv"))?;
+        writeln!(self.frames, "{}", csv_row(&row)).and_then(|_| self.frames.flush()).map_err(err("frames.csv"))?;
         let d = nodes.directors();
         let [fields, curvature] = row_files(self.format());
         for i in 0..nodes.s.len() {
@@ -270,8 +269,7 @@ impl ClipWriter {
             if self.compact.is_some() {
                 self.fields.write_all(&raw(&v)).map_err(err(fields))?;
             } else {
-                let text: Vec<String> = v.iter().map(|x| format!("{x:.10e}")).collect();
-                writeln!(self.fields, "{},{i},{}", r.frame, text.join(",")).map_err(err(fields))?;
+                writeln!(self.fields, "{},{i},{}", r.frame, csv_row(&v)).map_err(err(fields))?;
             }
         }
         self.fields.flush().map_err(err(fields))?;
@@ -279,7 +277,7 @@ impl ClipWriter {
             if self.compact.is_some() {
                 self.curvature.write_all(&raw(&[*s, k[0], k[1], k[2]])).map_err(err(curvature))?;
             } else {
-                writeln!(self.curvature, "{},{s:.10e},{:.10e},{:.10e},{:.10e}", r.frame, k[0], k[1], k[2])
+                writeln!(self.curvature, "{},{}", r.frame, csv_row(&[*s, k[0], k[1], k[2]]))
                     .map_err(err(curvature))?;
             }
         }
@@ -302,8 +300,7 @@ impl ClipWriter {
                 c.twist_rms_error_per_m,
                 c.roll_offset_rad,
             ];
-            let text: Vec<String> = v.iter().map(|x| format!("{x:.10e}")).collect();
-            writeln!(file, "{},{}", r.frame, text.join(",")).and_then(|_| file.flush()).map_err(err("truth.csv"))?;
+            writeln!(file, "{},{}", r.frame, csv_row(&v)).and_then(|_| file.flush()).map_err(err("truth.csv"))?;
         }
         if self.journal.is_some() {
             let offsets = self.offsets()?;
@@ -403,3 +400,15 @@ pub const TRUTH_COLUMNS: [&str; 10] = [
     "twist_rms_err_per_m",
     "roll_offset_rad",
 ];
+
+/// Numbers as one CSV row, `{:.10e}` each ([`super::number::push_exp`]).
+fn csv_row(values: &[f64]) -> String {
+    let mut s = String::with_capacity(18 * values.len());
+    for (k, v) in values.iter().enumerate() {
+        if k > 0 {
+            s.push(',');
+        }
+        super::number::push_exp(&mut s, *v, 10);
+    }
+    s
+}

@@ -21,7 +21,8 @@ pub struct PolylineFields<'a> {
 fn data_array(out: &mut String, name: &str, components: usize, values: impl Iterator<Item = f64>) {
     let _ = write!(out, "        <DataArray type=\"Float64\" Name=\"{name}\" NumberOfComponents=\"{components}\" format=\"ascii\">\n          ");
     for v in values {
-        let _ = write!(out, "{v:.9e} ");
+        super::number::push_exp(out, v, 9);
+        out.push(' ');
     }
     out.push_str("\n        </DataArray>\n");
 }
