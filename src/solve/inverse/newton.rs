@@ -191,6 +191,8 @@ pub fn assemble_residual(
             &mut scratch
         });
         let rhs = element_system(problem, p, first, &uk, [x_g[e], x_g[e + 1]], ap, m);
+        // by reference: `*m * ue` would copy the 24 × 24 matrix first
+        #[allow(clippy::op_ref)]
         let r = &*m * ue - rhs;
         if jacobian {
             coefficient_derivative(problem, p, first, &ue, ap, m);
