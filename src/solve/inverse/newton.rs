@@ -231,8 +231,21 @@ pub(crate) fn solve(
     u0: &DVector<f64>,
     observer: &mut impl FnMut(&InverseRecord, &DVector<f64>, &DVector<f64>),
 ) -> Result<InverseSolution, SolveError> {
+    solve_from(s, params, frame, u0, false, observer)
+}
+
+/// [`solve`]; `rescale`: the frame's Ruiz factors exist already (the warm start's fixed point
+/// computed them), so the consistent start is scaled by them instead of equilibrating again.
+fn solve_from(
+    s: &mut FrameSolver,
+    params: &InverseParams,
+    frame: &Frame,
+    u0: &DVector<f64>,
+    rescale: bool,
+    observer: &mut impl FnMut(&InverseRecord, &DVector<f64>, &DVector<f64>),
+) -> Result<InverseSolution, SolveError> {
     // Consistent start: one linear solve of the fixed point at u0.
-    let mut big = s.solve_linearised(params, frame, u0, false)?;
+    let mut big = s.solve_linearised(params, frame, u0, rescale)?;
     let problem = s.problem;
     let fwd = problem.dofs();
     let FrameSolver { dofs, pattern, solver, fixed, rows, values, merit_weights, no_previous, .. } = s;
@@ -353,7 +366,7 @@ pub(crate) fn solve_warm(
     }
     let done = start.history.len();
     let rest = InverseParams { max_iterations: p.max_iterations.saturating_sub(done).max(1), ..p };
-    let newton = solve(s, &rest, frame, &start.u, &mut |r, u, a| {
+    let newton = solve_from(s, &rest, frame, &start.u, true, &mut |r, u, a| {
         observer(&InverseRecord { iteration: r.iteration + done, ..*r }, u, a);
     })?;
     let mut history = start.history;
