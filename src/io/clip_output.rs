@@ -277,8 +277,7 @@ impl ClipWriter {
             if self.compact.is_some() {
                 self.curvature.write_all(&raw(&[*s, k[0], k[1], k[2]])).map_err(err(curvature))?;
             } else {
-                writeln!(self.curvature, "{},{}", r.frame, csv_row(&[*s, k[0], k[1], k[2]]))
-                    .map_err(err(curvature))?;
+                writeln!(self.curvature, "{},{}", r.frame, csv_row(&[*s, k[0], k[1], k[2]])).map_err(err(curvature))?;
             }
         }
         self.curvature.flush().map_err(err(curvature))?;

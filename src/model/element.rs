@@ -125,8 +125,7 @@ pub fn internal_force(
             let (dQ, dA) = (f.dq, f.da);
             let dm_dda = Q.transpose() * J * A;
             let ja = J * (A * p.dalpha);
-            let dm_da =
-                columns([0, 1, 2].map(|j| dQ[j].transpose() * ja + Q.transpose() * (J * (dA[j] * p.dalpha))));
+            let dm_da = columns([0, 1, 2].map(|j| dQ[j].transpose() * ja + Q.transpose() * (J * (dA[j] * p.dalpha))));
             for a in 0..2 {
                 for b in 0..2 {
                     let blk = dm_dda * (wh * p.dn[a] * p.dn[b]) + dm_da * (wh * p.dn[a] * p.n[b]);
@@ -216,8 +215,7 @@ pub fn momentum(
         if let Some(t) = d_u.as_deref_mut() {
             let (dQ, dA) = (f.dq, f.da);
             let ia = I * (A * v.alpha);
-            let dp_da =
-                columns([0, 1, 2].map(|j| dQ[j].transpose() * ia + Q.transpose() * (I * (dA[j] * v.alpha))));
+            let dp_da = columns([0, 1, 2].map(|j| dQ[j].transpose() * ia + Q.transpose() * (I * (dA[j] * v.alpha))));
             for a in 0..2 {
                 for b in 0..2 {
                     add_mat(t, ALPHA[a], ALPHA[b], &(dp_da * (wh * p.n[a] * p.n[b])));

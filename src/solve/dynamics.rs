@@ -17,7 +17,6 @@ use crate::linalg::{LinearSolver, Pattern};
 use crate::model::loads::LoadFrame;
 use crate::model::mesh::Field;
 
-
 /// Time-stepping parameters.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DynamicParams {

@@ -23,7 +23,9 @@
 //! 1. Wang et al., Comput. Mech. 71 (2023), §3–4, eqs. (52)–(61), Remark 8, Remark 10.
 use nalgebra::{DVector, Matrix3, Vector3};
 
-use super::kkt::{add3, add_operator_blocks, element_part, element_system, KktMat, KktVec, PointRule, AL, KAPPA_RULE, X};
+use super::kkt::{
+    add3, add_operator_blocks, element_part, element_system, KktMat, KktVec, PointRule, AL, KAPPA_RULE, X,
+};
 use super::measures::record;
 use super::{Frame, FrameSolver, InverseParams, InverseRecord, InverseSolution};
 use crate::assemble::{assemble, Tangent};
@@ -118,9 +120,7 @@ fn coefficient_derivative(
         let (Q, A, dQ, dA) = (f.q, f.a, f.dq, f.da);
         // (dQ_jᵀ J A + Qᵀ J dA_j)ᵀ w = Aᵀ J (dQ_j w) + dA_jᵀ J (Q w), w = ∂s α̂
         let jqw = Jm * (Q * qa.dalpha);
-        let blk = columns(
-            [0, 1, 2].map(|j| A.transpose() * (Jm * (dQ[j] * qa.dalpha)) + dA[j].transpose() * jqw),
-        );
+        let blk = columns([0, 1, 2].map(|j| A.transpose() * (Jm * (dQ[j] * qa.dalpha)) + dA[j].transpose() * jqw));
         for c in 0..2 {
             for b in 0..2 {
                 add3(e, AL[c], AL[b], &(blk * (wh * q.dn[c] * q.n[b])));
@@ -253,8 +253,7 @@ fn solve_from(
     // the Ruiz row factors of the start's matrix weigh the merit of the whole frame (I6)
     merit_weights.clear();
     merit_weights.extend_from_slice(solver.row_factors());
-    let merit =
-        |r: &DVector<f64>| r.iter().zip(merit_weights.iter()).map(|(a, b)| (a * b).powi(2)).sum::<f64>().sqrt();
+    let merit = |r: &DVector<f64>| r.iter().zip(merit_weights.iter()).map(|(a, b)| (a * b).powi(2)).sum::<f64>().sqrt();
     let mut history = Vec::new();
     let mut phi0 = f64::NAN;
     let mut adjoint = fwd.zeros();
