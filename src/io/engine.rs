@@ -173,9 +173,17 @@ impl<F: FnMut(&ClipFrame) + Send> FrameSink for Observed<F> {
 
 /// The summary figures of a clip run in `dir`: `plot.svg` (per frame: iterations, fit, chart,
 /// objective, roughness), `kymograph.svg` and, for synthetic clips, `truth.svg`.
+/// The two kymograph figures are drawn on a second thread while this one draws the others
+/// (about half the time of drawing them one after another).
 pub fn write_clip_figures(case: &Case, run: &ClipRun, dir: &Path) -> Result<(), OutputError> {
-    write_clip_plot(case, &run.reports, &run.roughness, &dir.join("plot.svg"))?;
-    write_clip_kymographs(case, run, &dir.join("kymograph.svg"))?;
-    write_omega_kymographs(case, run, &dir.join("omega.svg"))?;
-    write_truth_plot(case, run, &dir.join("truth.svg"))
+    std::thread::scope(|s| {
+        let kymographs = s.spawn(|| {
+            write_clip_kymographs(case, run, &dir.join("kymograph.svg"))?;
+            write_omega_kymographs(case, run, &dir.join("omega.svg"))
+        });
+        let others = write_clip_plot(case, &run.reports, &run.roughness, &dir.join("plot.svg"))
+            .and_then(|()| write_truth_plot(case, run, &dir.join("truth.svg")));
+        let kymographs = kymographs.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+        others.and(kymographs)
+    })
 }

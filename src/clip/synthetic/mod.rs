@@ -198,8 +198,9 @@ impl RollClipParams {
 }
 
 /// `κˡ` [1/m] of the module doc, step 3.
-fn local_curvature(k: f64, roll_rad: f64, twist_per_m: f64) -> Vector3<f64> {
-    let (s, c) = roll_rad.sin_cos();
+/// (`roll` = `roll_rad.sin_cos()`, computed once per frame.)
+fn local_curvature(k: f64, roll: (f64, f64), twist_per_m: f64) -> Vector3<f64> {
+    let (s, c) = roll;
     Vector3::new(-k * s, k * c, twist_per_m)
 }
 
@@ -233,7 +234,8 @@ fn integrate_frame(
     let n = params.nodes;
     let element = params.length_m / (n - 1) as f64;
     let h = element / params.substeps as f64;
-    let kappa = |s: f64| local_curvature(profile.at(s), roll_rad, params.twist_per_m);
+    let roll = roll_rad.sin_cos();
+    let kappa = |s: f64| local_curvature(profile.at(s), roll, params.twist_per_m);
     let d3 = |q: &Matrix3<f64>| -> Vector3<f64> { q.row(2).transpose() };
     let (mut x, mut q) = (Vector3::zeros(), Matrix3::identity());
     let mut xs = Vec::with_capacity(n);
