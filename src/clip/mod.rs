@@ -255,8 +255,10 @@ pub fn clip_from_angles(rows: &[Vec<f64>], params: &KymogramParams, source: Stri
             ClipPlane::Xy => Vector3::new(along, across, 0.0),
         }
     };
+    // frames are independent: resampled in parallel, collected in order
+    use rayon::prelude::*;
     let frames = joints
-        .iter()
+        .par_iter()
         .map(|frame| {
             let placed: Vec<Vector3<f64>> = frame.iter().map(place).collect();
             let (nodes, arc) = Spline::through(&placed).resample_by_arc_length(params.nodes);
