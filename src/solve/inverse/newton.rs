@@ -46,7 +46,10 @@ const ARMIJO: f64 = 1e-4;
 /// contraction (the ratio of successive relative changes of `(x, α)`, D5) is at most this. A
 /// chord step from a Jacobian factorised one step ago contracts by about the square of that
 /// Newton step's contraction (the step's distance times Newton's constant `c_k / c_{k−1}²`).
-const CHORD_RATE: f64 = 1e-4;
+/// At 3e-3 a chord step gains 2.5 decades for about a third of a Newton step's cost (no
+/// factorisation, no Jacobian; `docs/inverse.md`, I8), so from the changes where it fires
+/// (≤ 1e-4) it reaches the 1e-9 tolerances in at most one step more.
+const CHORD_RATE: f64 = 3e-3;
 
 /// `∂/∂u [K_e(u) V − r_e(u)]` at `V = U_e` for one element (24 × 24, KKT numbering; only the
 /// state columns are non-zero), added into `e`: the derivative of the frozen coefficients of I4.
