@@ -205,3 +205,25 @@ pub fn cmd_synth(a: SynthArgs) -> Result<ExitCode> {
     );
     Ok(ExitCode::SUCCESS)
 }
+
+/// glibc's malloc hands the top of its heap back to the system whenever more than 128 KB of
+/// it is free, and takes it back at the next allocation (a `brk` call, then page faults that
+/// zero the pages again). A clip frees and allocates its per-frame vectors some 500 times per
+/// thousand frames that way; keeping up to 64 MiB of freed memory (and serving blocks up to
+/// 32 MiB from the heap, not from fresh mappings) removes those system calls. Only the
+/// process's memory reuse changes, not its results.
+pub fn keep_freed_memory() {
+    #[cfg(all(target_os = "linux", target_env = "gnu"))]
+    {
+        extern "C" {
+            fn mallopt(param: std::ffi::c_int, value: std::ffi::c_int) -> std::ffi::c_int;
+        }
+        const M_TRIM_THRESHOLD: std::ffi::c_int = -1;
+        const M_MMAP_THRESHOLD: std::ffi::c_int = -3;
+        // SAFETY: mallopt only sets allocator parameters; called before any thread starts.
+        unsafe {
+            mallopt(M_TRIM_THRESHOLD, 64 << 20);
+            mallopt(M_MMAP_THRESHOLD, 32 << 20);
+        }
+    }
+}
