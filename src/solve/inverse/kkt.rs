@@ -159,7 +159,9 @@ fn add_diagonal3(m: &mut KktMat, ro: usize, co: usize, s: f64) {
 
 /// Local KKT matrix (added into `m`, which the caller zeroes) and right-hand side (returned)
 /// of one element (I4), coefficients frozen at the element's state `uk`; `xg`, `alpha_prev`:
-/// the data and the previous frame's angles at its nodes (`first_frame`: no Λω term).
+/// the data and the previous frame's angles at its nodes (`first_frame`: no Λω term). Also
+/// returns the frozen operator `L(u)` of the element (`element::frozen_operator`), which the
+/// Newton Jacobian needs again.
 #[allow(non_snake_case)] // paper symbols W, D, A, Kk
 pub(crate) fn element_system(
     problem: &Problem,
@@ -169,7 +171,7 @@ pub(crate) fn element_system(
     xg: [Vector3<f64>; 2],
     alpha_prev: [Vector3<f64>; 2],
     m: &mut KktMat,
-) -> KktVec {
+) -> (KktVec, LocalMat) {
     let h = problem.mesh.h();
     let w8 = &p.weights;
     let mut r = KktVec::zeros();
@@ -249,7 +251,7 @@ pub(crate) fn element_system(
             }
         }
     }
-    r
+    (r, l)
 }
 
 /// Dirichlet unknowns of I5 (KKT layout) with their values: `x = x_g` and `x̂ = α̂ = 0` at
@@ -300,7 +302,7 @@ pub fn assemble_system(
     assemble(&kkt_dofs, &mut rhs, Some(Tangent::new(pattern, values, 1.0)), |e, t| {
         let uk: LocalVec = fwd.gather(u, e);
         let m = t.unwrap_or(&mut scratch);
-        element_system(problem, p, first_frame, &uk, [x_g[e], x_g[e + 1]], [alpha_prev[e], alpha_prev[e + 1]], m)
+        element_system(problem, p, first_frame, &uk, [x_g[e], x_g[e + 1]], [alpha_prev[e], alpha_prev[e + 1]], m).0
     });
     rhs
 }

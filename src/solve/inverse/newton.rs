@@ -30,7 +30,7 @@ use super::measures::record;
 use super::{Frame, FrameSolver, InverseParams, InverseRecord, InverseSolution};
 use crate::assemble::{assemble, Tangent};
 use crate::linalg::Pattern;
-use crate::model::element::{frozen_operator, internal_force, interpolate, LocalMat};
+use crate::model::element::{internal_force, interpolate, LocalMat};
 use crate::model::mesh::GAUSS2;
 use crate::model::rotation::{
     a_matrix, a_matrix_derivatives, d3, d3_second_derivatives, rotation, rotation_derivatives, skew, PointFrame,
@@ -52,7 +52,9 @@ const ARMIJO: f64 = 1e-4;
 const CHORD_RATE: f64 = 3e-3;
 
 /// `∂/∂u [K_e(u) V − r_e(u)]` at `V = U_e` for one element (24 × 24, KKT numbering; only the
-/// state columns are non-zero), added into `e`: the derivative of the frozen coefficients of I4.
+/// state columns are non-zero), added into `e`: the derivative of the frozen coefficients of I4;
+/// `l`: the element's frozen operator `L(u)` (`element::frozen_operator`, as `element_system`
+/// returns it).
 ///
 /// ```text
 ///   primal rows:   ∂G/∂u − L(u)                                   (G(u) = L(u) u − b(u), D5)
@@ -68,6 +70,7 @@ fn coefficient_derivative(
     p: &InverseParams,
     first_frame: bool,
     ue: &KktVec,
+    l: &LocalMat,
     alpha_prev: [Vector3<f64>; 2],
     e: &mut KktMat,
 ) {
@@ -78,7 +81,6 @@ fn coefficient_derivative(
     // Primal rows: ∂G/∂u − L(u).
     let mut t = LocalMat::zeros();
     internal_force(props, problem.scheme, h, &state, Some(&mut t));
-    let (l, _) = frozen_operator(props, problem.scheme, h, &state);
     add_operator_blocks(e, &(t - l), false);
     let columns = |c: [Vector3<f64>; 3]| Matrix3::from_columns(&c);
     let K = Matrix3::from_diagonal(&props.shear_stretch_n);
@@ -193,12 +195,12 @@ pub fn assemble_residual(
             scratch.as_mut_slice().fill(0.0);
             &mut scratch
         });
-        let rhs = element_system(problem, p, first, &uk, [x_g[e], x_g[e + 1]], ap, m);
+        let (rhs, l) = element_system(problem, p, first, &uk, [x_g[e], x_g[e + 1]], ap, m);
         // by reference: `*m * ue` would copy the 24 × 24 matrix first
         #[allow(clippy::op_ref)]
         let r = &*m * ue - rhs;
         if jacobian {
-            coefficient_derivative(problem, p, first, &ue, ap, m);
+            coefficient_derivative(problem, p, first, &ue, &l, ap, m);
         }
         r
     };
