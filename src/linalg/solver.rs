@@ -72,7 +72,9 @@ impl LinearSolver {
     /// row/column max-norm scaling `A ← diag(1/√r) A diag(1/√c)`, then `x = D_c y`. The factors
     /// are kept for [`LinearSolver::solve_rescaled`].
     pub fn solve_equilibrated(&mut self, values: &[f64], b: &DVector<f64>) -> Result<DVector<f64>, LinearError> {
-        self.load(values, false);
+        // the copy into the band also takes Ruiz's first row and column maxima (each column
+        // while it is in cache), so `ruiz` starts with its first scaling
+        self.load_with_maxima(values);
         ruiz(
             &self.cols,
             self.lu.band_mut(),
@@ -81,6 +83,7 @@ impl LinearSolver {
             &mut self.rmax,
             &mut self.cmax,
             &mut self.rnext,
+            true,
         );
         self.factor_and_solve_scaled(b)
     }
@@ -108,7 +111,7 @@ impl LinearSolver {
         let (mut dr, mut dc) = (vec![1.0; n], vec![1.0; n]);
         let (mut r, mut c, mut r_next) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
         let csc = Columns { band: self.cols.csc.clone(), ..self.cols.clone() };
-        ruiz(&csc, &mut a, &mut dr, &mut dc, &mut r, &mut c, &mut r_next);
+        ruiz(&csc, &mut a, &mut dr, &mut dc, &mut r, &mut c, &mut r_next, false);
         (a, dr, dc)
     }
 
@@ -141,6 +144,18 @@ impl LinearSolver {
     /// rows (times `dr_i dc_j` if `scaled`) and zeros in the rest of the stored band (the
     /// factorisation's fill from the last matrix). The fill rows above are the factor's.
     fn load(&mut self, values: &[f64], scaled: bool) {
+        self.load_columns(values, scaled, false);
+    }
+
+    /// [`LinearSolver::load`] unscaled, with the row maxima `|a_ij|` into `rmax` and the column
+    /// maxima into `cmax` taken from each column just copied (the first sweep of [`ruiz`]: the
+    /// same numbers in the same order, without a second pass over the band).
+    fn load_with_maxima(&mut self, values: &[f64]) {
+        self.rmax.iter_mut().for_each(|v| *v = 0.0);
+        self.load_columns(values, false, true);
+    }
+
+    fn load_columns(&mut self, values: &[f64], scaled: bool, maxima: bool) {
         let c = &self.cols;
         let ld = self.lu.ld();
         let kl = self.lu.kl();
@@ -156,6 +171,9 @@ impl LinearSolver {
                 }
             } else {
                 dst.copy_from_slice(src);
+            }
+            if maxima {
+                self.cmax[j] = row_col_max(&mut self.rmax[c.first[j]..c.first[j] + len], dst);
             }
             col[s + len..].fill(0.0);
         }
@@ -197,6 +215,7 @@ fn row_col_max(r: &mut [f64], a: &[f64]) -> f64 {
 /// accumulated row and column factors in `dr`, `dc` (`r`, `c`, `r_next`: scratch). Each pass
 /// takes the row and column maxima of `a`, then scales `a_ij ← a_ij (1/√r_i)(1/√c_j)`; the
 /// scaling of one pass and the maxima of the next share one sweep over the values.
+#[allow(clippy::too_many_arguments)]
 fn ruiz(
     cols: &Columns,
     a: &mut [f64],
@@ -205,6 +224,7 @@ fn ruiz(
     r: &mut [f64],
     c: &mut [f64],
     r_next: &mut [f64],
+    maxima_ready: bool,
 ) {
     let n = cols.len.len();
     dr.iter_mut().for_each(|v| *v = 1.0);
@@ -212,11 +232,13 @@ fn ruiz(
     let inv_sqrt = |v: f64| if v > 0.0 { 1.0 / v.sqrt() } else { 1.0 };
     // the rows of a column are contiguous (block-tridiagonal pattern): slices, no gathers
     let column = |j: usize| (cols.band[j], cols.band[j] + cols.len[j], cols.first[j]);
-    // maxima of the unscaled values
-    r.iter_mut().for_each(|v| *v = 0.0);
-    for j in 0..n {
-        let (k0, k1, first) = column(j);
-        c[j] = row_col_max(&mut r[first..first + (k1 - k0)], &a[k0..k1]);
+    // maxima of the unscaled values (unless the caller took them already, into `r` and `c`)
+    if !maxima_ready {
+        r.iter_mut().for_each(|v| *v = 0.0);
+        for j in 0..n {
+            let (k0, k1, first) = column(j);
+            c[j] = row_col_max(&mut r[first..first + (k1 - k0)], &a[k0..k1]);
+        }
     }
     for pass in 0..RUIZ_PASSES {
         // the factors of this pass, 1/√r and 1/√c, once per row and column
@@ -286,8 +308,13 @@ mod tests {
             let mut vals2 = vals.clone();
             p.set_identity_rows(&mut vals2, &[0, 2, block + 1]);
             for v in [vals, vals2] {
-                let solver = LinearSolver::new(&p);
-                assert_eq!(solver.equilibrate(&v), ruiz_reference(&p, &v));
+                let mut solver = LinearSolver::new(&p);
+                let reference = ruiz_reference(&p, &v);
+                assert_eq!(solver.equilibrate(&v), reference);
+                // the solver's own path (first maxima taken while loading the band) as well;
+                // the factorisation itself may fail on these values, the factors exist before
+                let _ = solver.solve_equilibrated(&v, &DVector::from_element(p.ndofs(), 1.0));
+                assert_eq!((solver.row_factors(), &solver.dc[..]), (&reference.1[..], &reference.2[..]));
             }
         }
     }
