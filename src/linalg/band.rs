@@ -108,11 +108,11 @@ impl BandLu {
 
     /// Factor in place, `P A = L U`, with partial pivoting (largest magnitude in the column).
     /// On x86-64 CPUs with AVX2 the rank-1 updates run four rows per instruction (eight with
-    /// AVX-512, [`avx2::update`]): the same multiplications and subtractions, so the same factors
+    /// AVX-512, [`simd::update`]): the same multiplications and subtractions, so the same factors
     /// bit for bit.
     pub fn factor(&mut self) -> Result<(), LinearError> {
         #[cfg(target_arch = "x86_64")]
-        if avx2::available() {
+        if simd::available() {
             // SAFETY: the CPU has AVX2, checked just above.
             return unsafe { self.factor_avx2() };
         }
@@ -182,7 +182,7 @@ impl BandLu {
             macro_rules! fixed {
                 ($($k:literal)*) => {
                     match km {
-                        $($k if wide => avx2::update::<$k>(head, tail, col, kv, ld, span),)*
+                        $($k if wide => simd::update::<$k>(head, tail, col, kv, ld, span),)*
                         $($k => update::<$k>(head, tail, col, kv, ld, span),)*
                         _ => update_any(head, tail, col, kv, ld, span, km),
                     }
@@ -197,7 +197,7 @@ impl BandLu {
     /// chosen at run time; the same numbers).
     pub fn solve_in_place(&self, b: &mut [f64]) {
         #[cfg(target_arch = "x86_64")]
-        if avx2::available() {
+        if simd::available() {
             // SAFETY: the CPU has AVX2, checked just above.
             return unsafe { self.solve_avx2(b) };
         }
@@ -279,8 +279,8 @@ fn update<const KL: usize>(head: &[f64], tail: &mut [f64], col: usize, kv: usize
     }
 }
 
-/// The rank-1 update of [`BandLu::factor`] with AVX2 vectors where the CPU has them.
-mod avx2 {
+/// The rank-1 update of [`BandLu::factor`] with AVX2 (or AVX-512) vectors where the CPU has them.
+mod simd {
     /// Whether the CPU has AVX2 (detected once, then cached by the standard library).
     #[inline]
     pub fn available() -> bool {
@@ -294,11 +294,10 @@ mod avx2 {
         }
     }
 
-    /// [`super::update`] four rows at a time: the `KL` multipliers stay in registers for all
-    /// `span` columns, and each row is `d − l · u` with one rounding per operation, as there.
-    /// Only called when [`available`].
-    /// With AVX-512 (e.g. AMD Zen 4, Intel Xeon), eight rows at a time and the last `KL mod 8`
-    /// under a mask ([`kernel512`]).
+    /// [`super::update`] four rows at a time ([`kernel`]), or eight with AVX-512 (e.g. AMD Zen 4,
+    /// Intel Xeon), the last `KL mod 8` under a mask ([`kernel512`]): the `KL` multipliers stay in
+    /// registers for all `span` columns, and each row is `d − l · u` with one rounding per
+    /// operation, as there. Only called when [`available`].
     #[inline]
     pub fn update<const KL: usize>(head: &[f64], tail: &mut [f64], col: usize, kv: usize, ld: usize, span: usize) {
         #[cfg(target_arch = "x86_64")]
