@@ -255,8 +255,13 @@ impl ClipWriter {
         writeln!(self.frames, "{}", csv_row(&row)).and_then(|_| self.frames.flush()).map_err(err("frames.csv"))?;
         let d = nodes.directors();
         let [fields, curvature] = row_files(self.format());
+        // each file's rows of the frame are built in one buffer and written at once
+        let compact = self.compact.is_some();
+        let mut block = Vec::with_capacity(nodes.s.len() * 28 * 18);
+        let mut v = Vec::with_capacity(28);
         for i in 0..nodes.s.len() {
-            let mut v = vec![nodes.s[i]];
+            v.clear();
+            v.push(nodes.s[i]);
             v.extend(nodes.x[i].iter());
             v.extend(nodes.alpha[i].iter());
             for dk in &d[i] {
@@ -266,21 +271,14 @@ impl ClipWriter {
             v.extend(torque[i].iter());
             v.extend(data[i].iter());
             v.extend(omega[i].iter());
-            if self.compact.is_some() {
-                self.fields.write_all(&raw(&v)).map_err(err(fields))?;
-            } else {
-                writeln!(self.fields, "{},{i},{}", r.frame, csv_row(&v)).map_err(err(fields))?;
-            }
+            push_row(&mut block, compact, &[r.frame, i], &v);
         }
-        self.fields.flush().map_err(err(fields))?;
+        self.fields.write_all(&block).and_then(|_| self.fields.flush()).map_err(err(fields))?;
+        block.clear();
         for (s, k) in kappa {
-            if self.compact.is_some() {
-                self.curvature.write_all(&raw(&[*s, k[0], k[1], k[2]])).map_err(err(curvature))?;
-            } else {
-                writeln!(self.curvature, "{},{}", r.frame, csv_row(&[*s, k[0], k[1], k[2]])).map_err(err(curvature))?;
-            }
+            push_row(&mut block, compact, &[r.frame], &[*s, k[0], k[1], k[2]]);
         }
-        self.curvature.flush().map_err(err(curvature))?;
+        self.curvature.write_all(&block).and_then(|_| self.curvature.flush()).map_err(err(curvature))?;
         if let Some(frames) = &mut self.compact {
             frames.push(r.frame as i64);
         } else {
@@ -381,9 +379,22 @@ pub fn remove_raw(dir: &Path) -> Result<(), OutputError> {
     Ok(())
 }
 
-/// Little-endian bytes of `v`.
-fn raw(v: &[f64]) -> Vec<u8> {
-    v.iter().flat_map(|x| x.to_le_bytes()).collect()
+/// Append one row of a per-node or per-element file to `out`: raw little-endian `values` in
+/// the compact format, else the CSV line `index,…,value,…` (values `{:.10e}`,
+/// [`super::number::push_exp`]).
+fn push_row(out: &mut Vec<u8>, compact: bool, index: &[usize], values: &[f64]) {
+    if compact {
+        out.extend(values.iter().flat_map(|x| x.to_le_bytes()));
+        return;
+    }
+    let mut line = String::with_capacity(8 * index.len() + 18 * values.len());
+    for i in index {
+        line.push_str(itoa::Buffer::new().format(*i));
+        line.push(',');
+    }
+    push_csv(&mut line, values);
+    line.push('\n');
+    out.extend_from_slice(line.as_bytes());
 }
 
 /// Columns of `truth.csv` (synthetic clips, `clip::synthetic::FrameComparison`).
@@ -403,11 +414,16 @@ pub const TRUTH_COLUMNS: [&str; 10] = [
 /// Numbers as one CSV row, `{:.10e}` each ([`super::number::push_exp`]).
 fn csv_row(values: &[f64]) -> String {
     let mut s = String::with_capacity(18 * values.len());
+    push_csv(&mut s, values);
+    s
+}
+
+/// Append `values` comma-separated, `{:.10e}` each ([`super::number::push_exp`]).
+fn push_csv(s: &mut String, values: &[f64]) {
     for (k, v) in values.iter().enumerate() {
         if k > 0 {
             s.push(',');
         }
-        super::number::push_exp(&mut s, *v, 10);
+        super::number::push_exp(s, *v, 10);
     }
-    s
 }
