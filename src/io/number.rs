@@ -155,7 +155,13 @@ fn push_digits(out: &mut String, negative: bool, q: u64, p: usize, e10: i32) {
         n += 1;
     }
     let mut e = e10.unsigned_abs();
-    let width = if e >= 100 { 3 } else if e >= 10 { 2 } else { 1 };
+    let width = if e >= 100 {
+        3
+    } else if e >= 10 {
+        2
+    } else {
+        1
+    };
     for k in (0..width).rev() {
         text[n + k] = b'0' + (e % 10) as u8;
         e /= 10;
