@@ -17,11 +17,20 @@ pub struct Tangent<'a> {
     pub pattern: &'a Pattern,
     pub values: &'a mut [f64],
     pub scale: f64,
+    /// the pass writes every entry's first contribution instead of adding it
+    /// ([`Pattern::scatter_first`]): `values` needs no zeroing before it
+    pub overwrite: bool,
 }
 
 impl<'a> Tangent<'a> {
     pub fn new(pattern: &'a Pattern, values: &'a mut [f64], scale: f64) -> Self {
-        Tangent { pattern, values, scale }
+        Tangent { pattern, values, scale, overwrite: false }
+    }
+
+    /// A pass that replaces the values (the same numbers as zeroing them and adding,
+    /// [`Pattern::scatter_first`]), without a sweep that zeroes them first.
+    pub fn overwriting(pattern: &'a Pattern, values: &'a mut [f64], scale: f64) -> Self {
+        Tangent { pattern, values, scale, overwrite: true }
     }
 }
 
@@ -44,7 +53,11 @@ pub fn assemble<const N: usize>(
                 if t.scale != 1.0 {
                     local *= t.scale;
                 }
-                t.pattern.scatter(t.values, e, &local);
+                if t.overwrite {
+                    t.pattern.scatter_first(t.values, e, &local);
+                } else {
+                    t.pattern.scatter(t.values, e, &local);
+                }
                 r
             }
             None => kernel(e, None),

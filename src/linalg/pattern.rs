@@ -79,7 +79,28 @@ impl Pattern {
 
     /// Add a local `(2 block)²` matrix of element `e` into the values.
     pub fn scatter<const N: usize>(&self, values: &mut [f64], e: usize, local: &SMatrix<f64, N, N>) {
+        self.scatter_with(values, e, local, false);
+    }
+
+    /// [`Pattern::scatter`] of an assembly pass that starts from whatever `values` holds, with
+    /// the elements in order `0, 1, …`: the entries no earlier element touched are written
+    /// (`0 + a`, bit for bit what adding into zeroed values gives), the others added. Element
+    /// `e` shares only the block of node `e` (rows and columns `< block`) with element `e − 1`;
+    /// every entry of the pattern belongs to some element, so the pass leaves no old value and
+    /// the values need no zeroing before it.
+    pub fn scatter_first<const N: usize>(&self, values: &mut [f64], e: usize, local: &SMatrix<f64, N, N>) {
+        self.scatter_with(values, e, local, true);
+    }
+
+    #[inline]
+    fn scatter_with<const N: usize>(&self, values: &mut [f64], e: usize, local: &SMatrix<f64, N, N>, first: bool) {
         assert_eq!(N, 2 * self.block, "local matrix size must be twice the block size");
+        // rows [0, shared) of the columns [0, block) were touched by element e − 1 (first pass)
+        let shared = match (first, e) {
+            (false, _) => N,
+            (true, 0) => 0,
+            (true, _) => self.block,
+        };
         // Column j of the element holds rows block·e .. block·e + N of a pattern column, whose
         // rows are contiguous and ascending: one run of N values per column.
         let s = &self.slots[e * N * N..(e + 1) * N * N];
@@ -89,8 +110,14 @@ impl Pattern {
             let dst: &mut [f64; N] = (&mut values[start..start + N]).try_into().expect("N rows");
             // column-major storage: column j is the j-th run of N values
             let src: &[f64; N] = local.as_slice()[j * N..(j + 1) * N].try_into().expect("N rows");
-            for i in 0..N {
+            // rows [0, added) are added into, the others written
+            let added = if j < self.block || !first { shared } else { 0 };
+            for i in 0..added {
                 dst[i] += src[i];
+            }
+            for i in added..N {
+                // 0 + a: a, with −0 turned into +0 as the addition does
+                dst[i] = 0.0 + src[i];
             }
         }
     }
@@ -123,5 +150,70 @@ impl Pattern {
             }
         }
         m
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A pass of `scatter_first` over every element, in order, on values holding garbage gives
+    /// bit for bit what zeroing them and adding with `scatter` gives (signed zeros included).
+    #[test]
+    fn scatter_first_replaces_zeroing_bit_for_bit() {
+        for (nodes, block) in [(2, 3), (5, 6), (9, 12)] {
+            let p = Pattern::block_tridiagonal(nodes, block);
+            let mut seed = 0x2545_F491_4F6C_DD1Du64 ^ (nodes * block) as u64;
+            let mut next = || {
+                seed ^= seed << 13;
+                seed ^= seed >> 7;
+                seed ^= seed << 17;
+                seed
+            };
+            let locals: Vec<SMatrix<f64, 24, 24>> = (0..nodes - 1)
+                .map(|_| {
+                    SMatrix::from_fn(|_, _| match next() % 5 {
+                        0 => -0.0,
+                        1 => 0.0,
+                        _ => (next() >> 11) as f64 / (1u64 << 53) as f64 - 0.5,
+                    })
+                })
+                .collect();
+            let run = |first: bool| {
+                let mut values: Vec<f64> =
+                    if first { (0..p.nnz()).map(|k| 1e300 * (k as f64 + 1.0)).collect() } else { vec![0.0; p.nnz()] };
+                for (e, l) in locals.iter().enumerate() {
+                    // the top-left (2 block)² corner of the 24 × 24 sample
+                    let local =
+                        SMatrix::<f64, 24, 24>::from_fn(
+                            |i, j| {
+                                if i < 2 * block && j < 2 * block {
+                                    l[(i, j)]
+                                } else {
+                                    0.0
+                                }
+                            },
+                        );
+                    match block {
+                        12 if first => p.scatter_first(&mut values, e, &local),
+                        12 => p.scatter(&mut values, e, &local),
+                        6 => scatter_n::<12>(&p, &mut values, e, &local, first),
+                        _ => scatter_n::<6>(&p, &mut values, e, &local, first),
+                    }
+                }
+                values.iter().map(|v| v.to_bits()).collect::<Vec<_>>()
+            };
+            assert_eq!(run(true), run(false), "{nodes} nodes, block {block}");
+        }
+    }
+
+    /// The `N × N` corner of `local`, scattered by `scatter_first` or `scatter`.
+    fn scatter_n<const N: usize>(p: &Pattern, values: &mut [f64], e: usize, local: &SMatrix<f64, 24, 24>, first: bool) {
+        let m = SMatrix::<f64, N, N>::from_fn(|i, j| local[(i, j)]);
+        if first {
+            p.scatter_first(values, e, &m)
+        } else {
+            p.scatter(values, e, &m)
+        }
     }
 }

@@ -281,7 +281,7 @@ pub(crate) fn dirichlet_into(dofs: &DofMap, alpha0: f64, frame: &Frame, fixed: &
     }
 }
 
-/// Assemble the KKT matrix (into `values`, zeroed first) and right-hand side of I4 with the
+/// Assemble the KKT matrix (replacing `values`) and right-hand side of I4 with the
 /// coefficients frozen at the state `u` (forward layout); boundary conditions not applied.
 #[allow(clippy::too_many_arguments)]
 pub fn assemble_system(
@@ -296,10 +296,10 @@ pub fn assemble_system(
 ) -> DVector<f64> {
     let fwd = problem.dofs();
     let kkt_dofs = problem.mesh.kkt_dofs();
-    values.iter_mut().for_each(|v| *v = 0.0);
+
     let mut rhs = kkt_dofs.zeros();
     let mut scratch = KktMat::zeros();
-    assemble(&kkt_dofs, &mut rhs, Some(Tangent::new(pattern, values, 1.0)), |e, t| {
+    assemble(&kkt_dofs, &mut rhs, Some(Tangent::overwriting(pattern, values, 1.0)), |e, t| {
         let uk: LocalVec = fwd.gather(u, e);
         let m = t.unwrap_or(&mut scratch);
         element_system(problem, p, first_frame, &uk, [x_g[e], x_g[e + 1]], [alpha_prev[e], alpha_prev[e + 1]], m).0

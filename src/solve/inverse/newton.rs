@@ -207,8 +207,7 @@ pub fn assemble_residual(
     let mut r = dofs.zeros();
     match jacobian {
         Some((pattern, values, rows)) => {
-            values.iter_mut().for_each(|v| *v = 0.0);
-            assemble(&dofs, &mut r, Some(Tangent::new(pattern, &mut *values, 1.0)), kernel);
+            assemble(&dofs, &mut r, Some(Tangent::overwriting(pattern, &mut *values, 1.0)), kernel);
             pattern.set_identity_rows(values, rows);
         }
         None => assemble(&dofs, &mut r, None, kernel),
