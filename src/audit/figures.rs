@@ -336,15 +336,13 @@ fn kymograph(title: &str, p: &PointResult) -> Option<Svg> {
                 .filter(|v| *v > 0.0)
                 .unwrap_or(1.0);
             let t = if c == 0 { format!("{title}: kappa_1") } else { format!("kappa_{}", c + 1) };
-            Heatmap {
-                title: format!("{t} [1/m], colour ±{}", super::check::sig2(limit)),
-                x_label: "frame".into(),
-                y_label: "s [mm]".into(),
-                x: x.clone(),
-                y: y.clone(),
+            Heatmap::kymograph(
+                format!("{t} [1/m], colour ±{}", super::check::sig2(limit)),
+                x.clone(),
+                y.clone(),
                 values,
                 limit,
-            }
+            )
         })
         .collect();
     Some(render_heatmaps_svg(&maps))

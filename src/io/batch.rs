@@ -459,7 +459,7 @@ pub fn gather(out: &Path) -> Result<Vec<BatchRow>, BatchError> {
 pub fn summary_csv(rows: &[BatchRow]) -> Result<String, csv::Error> {
     let mut w = csv::Writer::from_writer(Vec::new());
     w.write_record(SUMMARY_COLUMNS)?;
-    let num = |v: Option<f64>| v.map(|v| format!("{v:.10e}")).unwrap_or_default();
+    let num = |v: Option<f64>| v.map(|v| super::number::exp(v, 10)).unwrap_or_default();
     for r in rows {
         w.write_record([
             r.recording.clone(),

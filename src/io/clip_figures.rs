@@ -85,15 +85,7 @@ pub fn write_truth_plot(case: &Case, run: &ClipRun, path: &Path) -> Result<(), O
     let mut all: Vec<f64> = t.bending_true.iter().flatten().map(|v| v.sqrt()).collect();
     all.sort_by(f64::total_cmp);
     let limit = all.get((all.len() as f64 * 0.99) as usize).copied().unwrap_or(1.0);
-    let map = |title: String, values: Vec<Vec<f64>>| Heatmap {
-        title,
-        x_label: "frame".into(),
-        y_label: "s [mm]".into(),
-        x: x.clone(),
-        y: y.clone(),
-        values,
-        limit,
-    };
+    let map = |title: String, values: Vec<Vec<f64>>| Heatmap::kymograph(title, x.clone(), y.clone(), values, limit);
     write_plot(
         path,
         render_heatmaps_svg(&[
@@ -183,15 +175,8 @@ pub fn write_clip_kymographs(case: &Case, run: &ClipRun, path: &Path) -> Result<
     let limit = abs_percentile_99(run.data_kappa.iter().flatten().copied());
     let (yd, vd) = grid(&run.data_kappa, &|j| (j + 1) as f64 * h);
     let (yr, vr) = grid(&run.kappa2, &|j| (j as f64 + 0.5) * h);
-    let map = |title: String, y: Vec<f64>, values: Vec<Vec<f64>>| Heatmap {
-        title,
-        x_label: "frame".into(),
-        y_label: "s [mm]".into(),
-        x: x.clone(),
-        y,
-        values,
-        limit,
-    };
+    let map =
+        |title: String, y: Vec<f64>, values: Vec<Vec<f64>>| Heatmap::kymograph(title, x.clone(), y, values, limit);
     write_plot(
         path,
         render_heatmaps_svg(&[
@@ -228,15 +213,13 @@ pub fn write_omega_kymographs(case: &Case, run: &ClipRun, path: &Path) -> Result
         .map(|k| {
             let limit = abs_percentile_99(run.omega[1..nf].iter().flatten().map(|w| w[k]));
             let name = if k == 0 { format!("{}: ", case.name) } else { String::new() };
-            Heatmap {
-                title: format!("{name}omega_{} [rad/s], colour ±{limit:.3e}", k + 1),
-                x_label: "frame".into(),
-                y_label: "s [mm]".into(),
-                x: x.clone(),
-                y: y.clone(),
-                values: frames.iter().map(|&i| cols.iter().map(|&j| run.omega[i][j][k]).collect()).collect(),
+            Heatmap::kymograph(
+                format!("{name}omega_{} [rad/s], colour ±{limit:.3e}", k + 1),
+                x.clone(),
+                y.clone(),
+                frames.iter().map(|&i| cols.iter().map(|&j| run.omega[i][j][k]).collect()).collect(),
                 limit,
-            }
+            )
         })
         .collect();
     write_plot(path, render_heatmaps_svg(&maps))

@@ -262,6 +262,13 @@ pub struct Heatmap {
     pub limit: f64,
 }
 
+impl Heatmap {
+    /// A kymograph: frames along x, arc length `s` [mm] along y.
+    pub fn kymograph(title: String, frames: Vec<f64>, s_mm: Vec<f64>, values: Vec<Vec<f64>>, limit: f64) -> Self {
+        Heatmap { title, x_label: "frame".into(), y_label: "s [mm]".into(), x: frames, y: s_mm, values, limit }
+    }
+}
+
 fn diverging(v: f64, limit: f64) -> RGBColor {
     let t = if limit > 0.0 && v.is_finite() { (v / limit).clamp(-1.0, 1.0) } else { 0.0 };
     let (r, g, b) = if t >= 0.0 { (1.0, 1.0 - t, 1.0 - t) } else { (1.0 + t, 1.0 + t, 1.0) };

@@ -70,11 +70,9 @@ pub fn summary_csv(keys: &[String], columns: &[&str], rows: &[SummaryRow]) -> Re
     for r in rows {
         let mut rec: Vec<String> = r.point.iter().map(|(_, v)| fmt_value(*v)).collect();
         rec.push(r.status.as_str().into());
-        rec.extend(
-            columns
-                .iter()
-                .map(|k| r.metrics.as_ref().and_then(|m| m.get(*k)).map(|v| format!("{v:.10e}")).unwrap_or_default()),
-        );
+        rec.extend(columns.iter().map(|k| {
+            r.metrics.as_ref().and_then(|m| m.get(*k)).map(|v| super::number::exp(*v, 10)).unwrap_or_default()
+        }));
         rec.push(r.error.as_deref().unwrap_or("").replace('\n', " "));
         w.write_record(&rec)?;
     }
