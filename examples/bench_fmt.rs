@@ -1,5 +1,6 @@
 //! Time per number of `io::number::push_exp` (the clip outputs' float formatting) against the
-//! `ryu` shortest representation alone, on a million values of the sizes the outputs hold.
+//! standard library's `{:.10e}` (the same bytes) and the `ryu` shortest representation alone,
+//! on a million values of the sizes the outputs hold.
 //! `cargo run --release --example bench_fmt`
 use std::time::Instant;
 
@@ -21,6 +22,13 @@ fn main() {
     let t = Instant::now();
     let n: usize = vals.iter().map(|v| ryu::Buffer::new().format_finite(*v).len()).sum();
     println!("ryu shortest alone: {:.1} ns per number ({n} bytes)", per(t));
+    let t = Instant::now();
+    let mut out = String::with_capacity(20 * vals.len());
+    for v in &vals {
+        use std::fmt::Write as _;
+        let _ = write!(out, "{v:.10e},");
+    }
+    println!("standard library format!(\"{{:.10e}}\"): {:.1} ns per number ({} bytes)", per(t), out.len());
     for decimals in [10, 9] {
         let mut best = f64::INFINITY;
         for _ in 0..5 {

@@ -1,6 +1,6 @@
 //! Numbers as text for the output tables and ParaView files: [`push_exp`] writes exactly what
-//! `format!("{v:.N$e}")` writes (the same bytes), about nine times faster than the standard
-//! library's exact-precision algorithm (33 against ~300 ns per number,
+//! `format!("{v:.N$e}")` writes (the same bytes), about three times faster than the standard
+//! library's exact-precision algorithm (33–38 against 121 ns per number on the 2-core VM,
 //! `cargo run --release --example bench_fmt`); a clip writes some ten million numbers.
 //!
 //! Two exact routes. For `|v|` between about 1e-17 and 1e10 (`v = m 2^e`): `v 10^k` with
