@@ -171,26 +171,21 @@ fn push_digits(out: &mut String, negative: bool, q: u64, p: usize, e10: i32) {
 }
 
 /// Powers of five up to 5^27 (< 2^63).
-const POW5: [u64; 28] = {
-    let mut t = [1u64; 28];
-    let mut k = 1;
-    while k < 28 {
-        t[k] = t[k - 1] * 5;
-        k += 1;
-    }
-    t
-};
+const POW5: [u64; 28] = powers(5);
 
 /// Powers of ten up to 10^17 (17 significant digits at most from the shortest representation).
-const POW10: [u64; 18] = {
-    let mut t = [1u64; 18];
+const POW10: [u64; 18] = powers(10);
+
+/// `[1, base, base², …]`, `N` of them.
+const fn powers<const N: usize>(base: u64) -> [u64; N] {
+    let mut t = [1u64; N];
     let mut k = 1;
-    while k < 18 {
-        t[k] = t[k - 1] * 10;
+    while k < N {
+        t[k] = t[k - 1] * base;
         k += 1;
     }
     t
-};
+}
 
 /// The significant digits of a shortest representation (`1.2345e-7`, `0.00123`, `123.0`; no
 /// sign) as an integer without leading or trailing zeros, their count and the power of ten of
