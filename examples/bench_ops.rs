@@ -10,7 +10,7 @@ use anyhow::{Context, Result};
 use cosserat::case::Case;
 use cosserat::io::clip_files::load_clip;
 use cosserat::linalg::LinearSolver;
-use cosserat::solve::inverse::{kkt, newton, Frame};
+use cosserat::solve::inverse::{kkt, measures, newton, Frame};
 use cosserat::solve::sequence::{solve_sequence, FrameSolution};
 use nalgebra::{DVector, Vector3};
 
@@ -82,6 +82,15 @@ fn main() -> Result<()> {
     });
     time("solve (last factorisation)", &mut || {
         std::hint::black_box(solver.solve_factored(&r).expect("solve"));
+    });
+    let fwd = problem.dofs();
+    let (us, adj) = (dofs.kkt_state(&big), dofs.kkt_adjoint(&big));
+    time("iteration record (measures)", &mut || {
+        std::hint::black_box(measures::fit_measures(&problem, &params, &us, x_g));
+        std::hint::black_box(measures::objective_terms(&problem, &params, false, &us, &adj, x_g, &prev));
+    });
+    time("relative change", &mut || {
+        std::hint::black_box(cosserat::solve::statics::relative_change(&fwd, &us, &adj));
     });
     Ok(())
 }

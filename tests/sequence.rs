@@ -4,7 +4,7 @@ mod common;
 
 use common::{case_from, case_text, edit, with_weights};
 use cosserat::model::mesh::{DofMap, Field};
-use cosserat::solve::inverse::{InverseMethod, InverseParams, Weights, DEFAULT_STABILISATION};
+use cosserat::solve::inverse::{InverseMethod, InverseParams, Records, Weights, DEFAULT_STABILISATION};
 use cosserat::solve::sequence::{solve_sequence, FrameStart, RotationTreatment, SequenceError, SequenceParams};
 use cosserat::solve::statics::{self, Method, StaticParams};
 use cosserat::solve::Problem;
@@ -59,6 +59,7 @@ fn quasi_static_clip_is_recovered_frame_by_frame() {
         start: FrameStart::PreviousFrame,
         rotation: RotationTreatment::Rebased,
         gauge: Vector3::y(),
+        records: Records::Every,
     };
     let mut streamed = 0;
     let reports = solve_sequence(
@@ -123,6 +124,7 @@ fn chart_guard_names_frame_and_node() {
         start: FrameStart::PreviousFrame,
         rotation: RotationTreatment::GlobalEuler,
         gauge: Vector3::y(),
+        records: Records::Every,
     };
     let err = solve_sequence(
         &p,
@@ -243,6 +245,7 @@ fn rebased_and_global_charts_differ_at_second_order_on_a_3d_clip() {
                 start: FrameStart::DataGuess,
                 rotation,
                 gauge: Vector3::y(),
+                records: Records::Every,
             };
             let mut out = Vec::new();
             solve_sequence(

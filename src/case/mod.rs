@@ -23,7 +23,7 @@ use crate::model::loads::Loads;
 use crate::model::material::{CrossSection, Material, RodProperties};
 use crate::model::mesh::{Mesh, QuadratureScheme};
 use crate::solve::dynamics::DynamicParams;
-use crate::solve::inverse::InverseParams;
+use crate::solve::inverse::{InverseParams, Records};
 use crate::solve::sequence::{FrameStart, RotationTreatment, SequenceParams};
 use crate::solve::statics::StaticParams;
 use crate::solve::Problem;
@@ -320,6 +320,7 @@ impl Case {
             start: clip.start,
             rotation: clip.rotation,
             gauge: clip.gauge,
+            records: Records::Every,
         })
     }
 }

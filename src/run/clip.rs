@@ -14,8 +14,10 @@ use crate::model::chart::Chart;
 use crate::model::mesh::Field;
 use crate::model::rotation::Angles;
 use crate::solve::inverse::measures::angular_velocity;
-use crate::solve::inverse::InverseSolution;
-use crate::solve::sequence::{solve_sequence_from, vector_to_space, FrameReport, FrameSolution, ResumeFrom};
+use crate::solve::inverse::{InverseSolution, Records};
+use crate::solve::sequence::{
+    solve_sequence_from, vector_to_space, FrameReport, FrameSolution, ResumeFrom, SequenceParams,
+};
 use crate::solve::Stop;
 
 /// Nodes skipped at each end when scoring curvature against a ground truth (the curvature of
@@ -188,6 +190,8 @@ pub fn run_clip<S: FrameSink>(
     mut progress: impl FnMut(usize, usize),
 ) -> Result<ClipOutcome, RunError> {
     let sp = case.sequence_params().ok_or_else(|| RunError::Kind { case: case.name.clone(), what: "a clip case" })?;
+    // a clip keeps each frame's report, not its iteration history
+    let sp = SequenceParams { records: Records::Last, ..sp };
     let problem = case.problem();
     let dofs = problem.dofs();
     let w8 = sp.inverse.weights;

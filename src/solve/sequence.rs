@@ -17,7 +17,9 @@ use crate::model::chart::{frame_axis, Chart};
 use crate::model::mesh::{DofMap, Field};
 use crate::model::rotation::{angles_from_rotation, skew, Angles};
 
-use super::inverse::{Frame, FrameSolver, InverseParams, InverseRecord, InverseSolution, ObjectiveTerms, Start};
+use super::inverse::{
+    Frame, FrameSolver, InverseParams, InverseRecord, InverseSolution, ObjectiveTerms, Records, Start,
+};
 use super::{Problem, SolveError};
 
 /// Settings of a clip solve.
@@ -36,6 +38,9 @@ pub struct SequenceParams {
     /// first frame's roll gauge (Remark 6 read in space, R7): the chart's singular axis of the
     /// first frame, so that `α(0) = α0` means `d1(0) ⟂ gauge` (for α0 = 0); e2 is the paper's
     pub gauge: Vector3<f64>,
+    /// which Newton iterations of a frame keep a record: [`Records::Last`] where only the frame
+    /// reports are kept (the iterates, and so the frames, are the same either way)
+    pub records: Records,
 }
 
 /// Angle chart of each frame (`docs/rotation.md`).
@@ -262,7 +267,7 @@ pub fn solve_sequence_from(
         None => (0, None, None),
     };
     // pattern, LU storage and scratch once per clip, reused by every frame
-    let mut solver = FrameSolver::new(problem, sp.inverse);
+    let mut solver = FrameSolver::new(problem, sp.inverse).with_records(sp.records);
     for (i, x_space) in frames.iter().enumerate().skip(first) {
         if crate::interrupt::requested() {
             return Err(SolveError::Interrupted { what: "frames", done: i, total: frames.len() }.into());
@@ -329,7 +334,7 @@ pub fn solve_sequence_from(
             .ok_or(SequenceError::Callback { frame: k, message: "no iteration ran".into() })?;
         let rep = FrameReport {
             frame: k,
-            iterations: sol.history.len(),
+            iterations: last.iteration,
             last_change: last.rel_change,
             x_err_rel: last.x_err_rel,
             tangent_misfit: last.tangent_misfit,

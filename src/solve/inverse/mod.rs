@@ -90,6 +90,20 @@ pub struct InverseParams {
     pub max_iterations: usize,
 }
 
+/// Which iterations of a Newton solve keep a record (fit measures and objective terms, each a
+/// few passes over the mesh; `docs/inverse.md`, I8).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Records {
+    /// every iteration, each with its residual: the history a single frame's run writes
+    #[default]
+    Every,
+    /// the last iteration only (its `iteration` is the count); the other iterations check
+    /// their iterate and misfit for divergence ([`early_divergence`]), and a step that stops
+    /// the solve (within the tolerance) is taken without assembling its residual, so that
+    /// record has none. What a clip keeps of a frame: its report.
+    Last,
+}
+
 /// The data of one frame.
 #[derive(Clone, Copy, Debug)]
 pub struct Frame<'a> {
@@ -154,18 +168,44 @@ impl InverseRecord {
             ("the objective term ½∫ωᵀΛωω", o.angular),
             ("the Newton residual ‖R‖/‖R₀‖", self.residual.unwrap_or(0.0)),
         ];
-        let state = [("a state unknown (x, α)", u), ("an adjoint unknown (x̂, α̂)", adjoint)];
-        let bad = state
-            .iter()
-            .find_map(|(q, v)| v.iter().find(|v| !v.is_finite()).map(|v| (*q, *v)))
-            .or_else(|| measures.iter().find(|(_, v)| !v.is_finite()).copied())
-            .or_else(|| (self.x_err_rel > DIVERGED_X_ERR).then_some(("‖x − x_g‖/‖x_g‖ (limit 10)", self.x_err_rel)));
-        match bad {
-            Some((quantity, value)) => {
-                Err(SolveError::InverseDiverged { frame, iteration: self.iteration, quantity, value })
-            }
-            None => Ok(()),
-        }
+        divergence(frame, self.iteration, &measures, self.x_err_rel, u, adjoint)
+    }
+}
+
+/// [`InverseRecord::divergence`] of an iteration that keeps no record ([`Records::Last`]):
+/// the same checks on what such an iteration has, its iterate, relative change and misfit
+/// (the other measures are finite wherever the iterate is, short of overflow).
+pub(crate) fn early_divergence(
+    frame: usize,
+    iteration: usize,
+    rel_change: f64,
+    x_err_rel: f64,
+    u: &DVector<f64>,
+    adjoint: &DVector<f64>,
+) -> Result<(), SolveError> {
+    let measures = [("the relative change of (x, α)", rel_change), ("‖x − x_g‖/‖x_g‖", x_err_rel)];
+    divergence(frame, iteration, &measures, x_err_rel, u, adjoint)
+}
+
+/// The first non-finite unknown of `u`, `adjoint`, then the first non-finite measure, then
+/// the misfit beyond [`DIVERGED_X_ERR`], as the error of iteration `iteration`.
+fn divergence(
+    frame: usize,
+    iteration: usize,
+    measures: &[(&'static str, f64)],
+    x_err_rel: f64,
+    u: &DVector<f64>,
+    adjoint: &DVector<f64>,
+) -> Result<(), SolveError> {
+    let state = [("a state unknown (x, α)", u), ("an adjoint unknown (x̂, α̂)", adjoint)];
+    let bad = state
+        .iter()
+        .find_map(|(q, v)| v.iter().find(|v| !v.is_finite()).map(|v| (*q, *v)))
+        .or_else(|| measures.iter().find(|(_, v)| !v.is_finite()).copied())
+        .or_else(|| (x_err_rel > DIVERGED_X_ERR).then_some(("‖x − x_g‖/‖x_g‖ (limit 10)", x_err_rel)));
+    match bad {
+        Some((quantity, value)) => Err(SolveError::InverseDiverged { frame, iteration, quantity, value }),
+        None => Ok(()),
     }
 }
 
@@ -218,8 +258,8 @@ impl InverseSolution {
         if self.stop == Stop::Converged {
             return Ok(self);
         }
-        let iterations = self.history.len();
         let last = self.history.last();
+        let iterations = last.map_or(0, |r| r.iteration);
         Err(match last.and_then(|r| r.residual) {
             Some(residual) => SolveError::InverseNewtonNotConverged { frame, iterations, residual },
             None => SolveError::InverseNotConverged {
@@ -259,6 +299,8 @@ pub struct FrameSolver<'p> {
     pub(crate) merit_weights: Vec<f64>,
     /// zero angles: the `α_{n−1}` of a first frame (its Λω term is off)
     pub(crate) no_previous: Vec<Angles>,
+    /// which Newton iterations keep a record
+    pub(crate) records: Records,
 }
 
 impl<'p> FrameSolver<'p> {
@@ -279,7 +321,14 @@ impl<'p> FrameSolver<'p> {
             values,
             merit_weights: Vec::new(),
             no_previous: vec![Vector3::zeros(); problem.mesh.nodes()],
+            records: Records::Every,
         }
+    }
+
+    /// The solver keeping the records `records` of its Newton iterations (the fixed point
+    /// keeps every record).
+    pub fn with_records(self, records: Records) -> Self {
+        FrameSolver { records, ..self }
     }
 
     pub fn params(&self) -> &InverseParams {

@@ -26,8 +26,8 @@ use nalgebra::{DVector, Matrix3, Vector3};
 use super::kkt::{
     add3, add_operator_blocks, element_part, element_system, KktMat, KktVec, PointRule, AL, KAPPA_RULE, X,
 };
-use super::measures::record;
-use super::{Frame, FrameSolver, InverseParams, InverseRecord, InverseSolution};
+use super::measures::{position_error, record};
+use super::{early_divergence, Frame, FrameSolver, InverseParams, InverseRecord, InverseSolution, Records};
 use crate::assemble::{assemble, Tangent};
 use crate::linalg::Pattern;
 use crate::model::element::{internal_force, interpolate, LocalMat};
@@ -227,7 +227,9 @@ pub fn assemble_residual(
 /// search's first test, is discarded and the iteration is Newton's.
 /// `params.relaxation` is not used; `params.tolerance` bounds the relative change of `(x, α)`
 /// of a full step (D5), and each record carries the equilibrated residual relative to its
-/// start value.
+/// start value. With [`Records::Last`] only the last iteration is recorded (and observed), and
+/// the step that meets the tolerance is taken without assembling its residual: the same
+/// iterates and the same last record, without that residual.
 pub(crate) fn solve(
     s: &mut FrameSolver,
     params: &InverseParams,
@@ -252,7 +254,8 @@ fn solve_from(
     let mut big = s.solve_linearised(params, frame, u0, rescale)?;
     let problem = s.problem;
     let fwd = problem.dofs();
-    let FrameSolver { dofs, pattern, solver, fixed, rows, values, merit_weights, no_previous, .. } = s;
+    let FrameSolver { dofs, pattern, solver, fixed, rows, values, merit_weights, no_previous, records, .. } = s;
+    let lean = *records == Records::Last;
     let previous_angles = frame.previous.unwrap_or(no_previous.as_slice());
     // the Ruiz row factors of the start's matrix weigh the merit of the whole frame (I6)
     merit_weights.clear();
@@ -288,6 +291,7 @@ fn solve_from(
         // A full step whose relative change is within the tolerance is taken without the
         // line search: the merit is then at its round-off floor and cannot decrease reliably.
         let full = change <= params.tolerance;
+        let skip_residual = full && lean;
         if chord && !full && change > CHORD_CONTRACTION * previous {
             // too weak a contraction for the frozen Jacobian: this iteration is Newton's
             (chord, k) = (false, k - 1);
@@ -312,6 +316,11 @@ fn solve_from(
             // it there).
             let with_jacobian = t == 1.0 && !full && !chord_next;
             let jacobian = with_jacobian.then_some((&*pattern, values.as_mut_slice(), rows.as_slice()));
+            // the last step is taken without its residual where no record needs it
+            if skip_residual {
+                phi_t = f64::NAN;
+                break true;
+            }
             let r_t = assemble_residual(problem, params, frame, previous_angles, &trial, fixed, jacobian);
             phi_t = merit(&r_t);
             if full || phi_t <= (1.0 - ARMIJO * t) * phi || t <= MIN_STEP {
@@ -337,10 +346,16 @@ fn solve_from(
         previous = rel_change;
         big = trial;
         adjoint = dofs.kkt_adjoint(&big);
-        let rec = record(problem, params, frame, previous_angles, k, rel_change, &u, &adjoint, Some(phi_t / phi0));
-        rec.divergence(frame.index, &u, &adjoint)?;
-        observer(&rec, &u, &adjoint);
-        history.push(rec);
+        if lean && !full && k < params.max_iterations {
+            let x_err = position_error(problem, &u, frame.x_g);
+            early_divergence(frame.index, k, rel_change, x_err, &u, &adjoint)?;
+        } else {
+            let residual = (!skip_residual).then_some(phi_t / phi0);
+            let rec = record(problem, params, frame, previous_angles, k, rel_change, &u, &adjoint, residual);
+            rec.divergence(frame.index, &u, &adjoint)?;
+            observer(&rec, &u, &adjoint);
+            history.push(rec);
+        }
         if full {
             return Ok(InverseSolution { u, adjoint, history, stop: Stop::Converged });
         }
