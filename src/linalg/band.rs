@@ -26,13 +26,16 @@ pub struct BandLu {
     ld: usize,
     ab: Vec<f64>,
     piv: Vec<usize>,
+    /// [`BandLu::reach`] of every row, computed once (an integer division per call otherwise)
+    reach: Vec<usize>,
 }
 
 impl BandLu {
     /// A zero `n × n` matrix with `kl` sub- and `ku` super-diagonals.
     pub fn new(n: usize, kl: usize, ku: usize) -> Self {
         let ld = 2 * kl + ku + 1;
-        BandLu { n, kl, ku, block: 0, ld, ab: vec![0.0; ld * n], piv: vec![0; n] }
+        let reach = (0..n).map(|i| (i + kl).min(n.saturating_sub(1))).collect();
+        BandLu { n, kl, ku, block: 0, ld, ab: vec![0.0; ld * n], piv: vec![0; n], reach }
     }
 
     /// A zero block-tridiagonal matrix of `nodes` × `nodes` blocks of size `block`
@@ -41,16 +44,16 @@ impl BandLu {
     pub fn block_tridiagonal(nodes: usize, block: usize) -> Self {
         assert!(block > 0, "block size must be positive");
         let band = 2 * block - 1;
-        BandLu { block, ..Self::new(nodes * block, band, band) }
+        let n = nodes * block;
+        let reach = (0..n).map(|i| ((i / block + 2) * block - 1).min(n.saturating_sub(1))).collect();
+        BandLu { block, reach, ..Self::new(n, band, band) }
     }
 
     /// Last row (or column) that row (or column) `i` can reach: `i + kl` for a general band,
     /// the end of the next node's block for a block-tridiagonal matrix.
     #[inline]
     fn reach(&self, i: usize) -> usize {
-        #[allow(clippy::manual_checked_ops)] // the division by block is guarded by block > 0
-        let r = if self.block > 0 { (i / self.block + 2) * self.block - 1 } else { i + self.kl };
-        r.min(self.n - 1)
+        self.reach[i]
     }
 
     pub fn n(&self) -> usize {
@@ -143,15 +146,7 @@ impl BandLu {
             // rows below j with (structurally) non-zero entries in column j: j + 1..=j + km
             let km = self.reach(j) - j;
             let col = j * ld + kv;
-            let mut p = 0;
-            let mut best = self.ab[col].abs();
-            for t in 1..=km {
-                let v = self.ab[col + t].abs();
-                if v > best {
-                    best = v;
-                    p = t;
-                }
-            }
+            let (p, best) = pivot(&self.ab[col..=col + km]);
             self.piv[j] = j + p;
             if best == 0.0 || !best.is_finite() {
                 return Err(LinearError::ZeroPivot { column: j, pivot: best });
@@ -244,6 +239,38 @@ impl BandLu {
             }
         }
     }
+}
+
+/// The pivot of a column `v` (the diagonal entry first, then the rows below it): the first
+/// entry of largest magnitude, and that magnitude; NaN entries are passed over, and a NaN on
+/// the diagonal is kept (the caller reports it). As the sequential scan
+/// `if |v_t| > best { best = |v_t|; p = t }` from `best = |v_0|`, in two passes: the maximum
+/// in four independent lanes (the same value: `max` is exact and, over non-NaN values,
+/// independent of order), then the first entry equal to it.
+#[inline]
+fn pivot(v: &[f64]) -> (usize, f64) {
+    let first = v[0].abs();
+    let mut acc = [first; 4];
+    let mut chunks = v[1..].chunks_exact(4);
+    for c in &mut chunks {
+        for l in 0..4 {
+            let a = c[l].abs();
+            acc[l] = if a > acc[l] { a } else { acc[l] };
+        }
+    }
+    for x in chunks.remainder() {
+        let a = x.abs();
+        acc[0] = if a > acc[0] { a } else { acc[0] };
+    }
+    let mut best = acc[0];
+    for a in &acc[1..] {
+        best = if *a > best { *a } else { best };
+    }
+    if best.is_nan() || best == first {
+        return (0, best);
+    }
+    let p = v.iter().position(|x| x.abs() == best).unwrap_or(0);
+    (p, best)
 }
 
 /// [`update`] for any number `km` of rows below the pivot.
@@ -501,6 +528,40 @@ mod tests {
                 wide.solve_in_place(&mut x);
                 portable.solve_portable(&mut y);
                 assert_eq!(x, y);
+            }
+        }
+    }
+
+    /// The two-pass pivot search against the sequential scan it replaced, on columns with
+    /// ties, zeros of both signs, infinities and NaNs anywhere.
+    #[test]
+    fn pivot_search_matches_the_sequential_scan() {
+        let scan = |v: &[f64]| {
+            let (mut p, mut best) = (0, v[0].abs());
+            for (t, x) in v.iter().enumerate().skip(1) {
+                if x.abs() > best {
+                    best = x.abs();
+                    p = t;
+                }
+            }
+            (p, best)
+        };
+        let specials = [0.0, -0.0, 1.0, -1.0, 0.5, f64::INFINITY, f64::NEG_INFINITY, f64::NAN, 1e-300];
+        let mut r = rng(41);
+        for len in 1..=24 {
+            for _ in 0..400 {
+                let v: Vec<f64> = (0..len)
+                    .map(|_| {
+                        let u = r();
+                        if u > 0.5 {
+                            specials[((u * 1e6) as usize) % specials.len()]
+                        } else {
+                            (u * 8.0).round() / 4.0
+                        }
+                    })
+                    .collect();
+                let (a, b) = (pivot(&v), scan(&v));
+                assert!(a.0 == b.0 && a.1.to_bits() == b.1.to_bits(), "{v:?}: {a:?} vs {b:?}");
             }
         }
     }
