@@ -114,6 +114,17 @@ impl BandLu {
     /// AVX-512, [`simd::update`]): the same multiplications and subtractions, so the same factors
     /// bit for bit.
     pub fn factor(&mut self) -> Result<(), LinearError> {
+        // The fill rows (above the stored upper band) start at zero.
+        let (kl, ld) = (self.kl, self.ld);
+        for column in self.ab.chunks_exact_mut(ld) {
+            column[..kl].fill(0.0);
+        }
+        self.factor_cleared()
+    }
+
+    /// [`BandLu::factor`] of a band whose fill rows (the first `kl` stored rows of every
+    /// column) are zero already, e.g. written whole by the caller column by column.
+    pub fn factor_cleared(&mut self) -> Result<(), LinearError> {
         #[cfg(target_arch = "x86_64")]
         if simd::available() {
             // SAFETY: the CPU has AVX2, checked just above.
@@ -122,24 +133,18 @@ impl BandLu {
         self.factor_with(false)
     }
 
-    /// [`BandLu::factor`] compiled for AVX2 (the divisions and interchanges too).
+    /// [`BandLu::factor_cleared`] compiled for AVX2 (the divisions and interchanges too).
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
     unsafe fn factor_avx2(&mut self) -> Result<(), LinearError> {
         self.factor_with(true)
     }
 
-    /// The body of [`BandLu::factor`]; `wide`: the CPU has AVX2.
+    /// The body of [`BandLu::factor_cleared`]; `wide`: the CPU has AVX2.
     #[inline(always)]
     fn factor_with(&mut self, wide: bool) -> Result<(), LinearError> {
         let (n, ld) = (self.n, self.ld);
         let kv = self.kl + self.ku;
-        // The fill rows (above the stored upper band) start at zero.
-        for j in 0..n {
-            for v in &mut self.ab[j * ld..j * ld + self.kl] {
-                *v = 0.0;
-            }
-        }
         // last column touched by an interchange so far (U's extent)
         let mut ju = 0usize;
         for j in 0..n {

@@ -119,7 +119,7 @@ impl LinearSolver {
     pub fn solve(&mut self, values: &[f64], b: &DVector<f64>) -> Result<DVector<f64>, LinearError> {
         self.load(values, false);
         self.scaled = false;
-        self.lu.factor()?;
+        self.lu.factor_cleared()?;
         self.solve_factored(b)
     }
 
@@ -141,8 +141,8 @@ impl LinearSolver {
     }
 
     /// Copy `values` (CSC, the pattern's order) into the band, column by column: the pattern's
-    /// rows (times `dr_i dc_j` if `scaled`) and zeros in the rest of the stored band (the
-    /// factorisation's fill from the last matrix). The fill rows above are the factor's.
+    /// rows (times `dr_i dc_j` if `scaled`) and zeros in the rest of the column, the fill rows
+    /// of the interchanges included (ready for [`BandLu::factor_cleared`]).
     fn load(&mut self, values: &[f64], scaled: bool) {
         self.load_columns(values, scaled, false);
     }
@@ -158,10 +158,9 @@ impl LinearSolver {
     fn load_columns(&mut self, values: &[f64], scaled: bool, maxima: bool) {
         let c = &self.cols;
         let ld = self.lu.ld();
-        let kl = self.lu.kl();
         for (j, col) in self.lu.band_mut().chunks_exact_mut(ld).enumerate() {
             let (s, len, k0) = (c.band[j] - j * ld, c.len[j], c.csc[j]);
-            col[kl..s].fill(0.0);
+            col[..s].fill(0.0);
             let dst = &mut col[s..s + len];
             let src = &values[k0..k0 + len];
             if scaled {
@@ -182,7 +181,7 @@ impl LinearSolver {
     /// Factor the loaded (scaled) band and solve with `D_r b`, returning `D_c y`.
     fn factor_and_solve_scaled(&mut self, b: &DVector<f64>) -> Result<DVector<f64>, LinearError> {
         self.scaled = true;
-        self.lu.factor()?;
+        self.lu.factor_cleared()?;
         self.solve_factored(b)
     }
 }
