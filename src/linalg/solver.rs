@@ -209,6 +209,46 @@ fn row_col_max(r: &mut [f64], a: &[f64]) -> f64 {
     acc[0].max(acc[1]).max(acc[2].max(acc[3]))
 }
 
+/// `v ← 1/√v` for `v > 0`, else 1 (a row or column of zeros keeps its scale), element-wise:
+/// Ruiz's factors of a pass. Compiled for AVX2 too (chosen at run time): square roots and
+/// divisions are correctly rounded in every instruction set, so the same bits, four at a time.
+fn inv_sqrt_all(v: &mut [f64]) {
+    #[inline(always)]
+    fn body(v: &mut [f64]) {
+        for x in v.iter_mut() {
+            *x = if *x > 0.0 { 1.0 / x.sqrt() } else { 1.0 };
+        }
+    }
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn wide(v: &mut [f64]) {
+        body(v)
+    }
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU has AVX2, checked just above.
+        return unsafe { wide(v) };
+    }
+    body(v)
+}
+
+/// One column of a Ruiz pass with `L` rows: `a_i ← a_i (r_i c)`, then (if `maxima`) the
+/// maxima of the scaled column into `next` (row-wise) and the returned column maximum, as
+/// [`row_col_max`] takes them.
+#[inline(always)]
+fn scale_column<const L: usize>(a: &mut [f64], r: &[f64], c: f64, next: &mut [f64], maxima: bool) -> f64 {
+    let a: &mut [f64; L] = a.try_into().expect("L rows");
+    let r: &[f64; L] = r.try_into().expect("L rows");
+    for i in 0..L {
+        a[i] *= r[i] * c;
+    }
+    if maxima {
+        row_col_max(next, a)
+    } else {
+        0.0
+    }
+}
+
 /// Five passes of Ruiz row/column max-norm scaling of the values in `a` (column `j` of the
 /// pattern at `a[cols.band[j]..][..cols.len[j]]`, rows from `cols.first[j]`), in place, with the
 /// accumulated row and column factors in `dr`, `dc` (`r`, `c`, `r_next`: scratch). Each pass
@@ -228,7 +268,6 @@ fn ruiz(
     let n = cols.len.len();
     dr.iter_mut().for_each(|v| *v = 1.0);
     dc.iter_mut().for_each(|v| *v = 1.0);
-    let inv_sqrt = |v: f64| if v > 0.0 { 1.0 / v.sqrt() } else { 1.0 };
     // the rows of a column are contiguous (block-tridiagonal pattern): slices, no gathers
     let column = |j: usize| (cols.band[j], cols.band[j] + cols.len[j], cols.first[j]);
     // maxima of the unscaled values (unless the caller took them already, into `r` and `c`)
@@ -241,20 +280,36 @@ fn ruiz(
     }
     for pass in 0..RUIZ_PASSES {
         // the factors of this pass, 1/√r and 1/√c, once per row and column
-        r.iter_mut().for_each(|v| *v = inv_sqrt(*v));
-        c.iter_mut().for_each(|v| *v = inv_sqrt(*v));
+        inv_sqrt_all(r);
+        inv_sqrt_all(c);
         let last = pass + 1 == RUIZ_PASSES;
         r_next.iter_mut().for_each(|v| *v = 0.0);
         for j in 0..n {
             let (k0, k1, first) = column(j);
             let cj = c[j];
             dc[j] *= cj;
-            for (av, rv) in a[k0..k1].iter_mut().zip(&r[first..first + (k1 - k0)]) {
-                *av *= rv * cj;
-            }
+            let (a, rows, next) = (&mut a[k0..k1], &r[first..first + (k1 - k0)], &mut r_next[first..first + (k1 - k0)]);
+            // the maxima of the next pass come from the freshly scaled column; the columns of
+            // a block-tridiagonal pattern hold 2 or 3 blocks of rows (block 6 or 12): those
+            // lengths have loops of fixed length
+            let m = match a.len() {
+                36 => scale_column::<36>(a, rows, cj, next, !last),
+                24 => scale_column::<24>(a, rows, cj, next, !last),
+                18 => scale_column::<18>(a, rows, cj, next, !last),
+                12 => scale_column::<12>(a, rows, cj, next, !last),
+                _ => {
+                    for (av, rv) in a.iter_mut().zip(rows) {
+                        *av *= rv * cj;
+                    }
+                    if last {
+                        0.0
+                    } else {
+                        row_col_max(next, a)
+                    }
+                }
+            };
             if !last {
-                // the maxima of the next pass, from the freshly scaled column
-                c[j] = row_col_max(&mut r_next[first..first + (k1 - k0)], &a[k0..k1]);
+                c[j] = m;
             }
         }
         for i in 0..n {
