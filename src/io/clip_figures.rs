@@ -82,9 +82,7 @@ pub fn write_truth_plot(case: &Case, run: &ClipRun, path: &Path) -> Result<(), O
     let grid = |field: &Vec<Vec<f64>>| -> Vec<Vec<f64>> {
         frames.iter().map(|&i| cols.iter().map(|&j| field[i][j].sqrt()).collect()).collect()
     };
-    let mut all: Vec<f64> = t.bending_true.iter().flatten().map(|v| v.sqrt()).collect();
-    all.sort_by(f64::total_cmp);
-    let limit = all.get((all.len() as f64 * 0.99) as usize).copied().unwrap_or(1.0);
+    let limit = percentile_99(t.bending_true.iter().flatten().map(|v| v.sqrt()).collect());
     let map = |title: String, values: Vec<Vec<f64>>| Heatmap::kymograph(title, x.clone(), y.clone(), values, limit);
     write_plot(
         path,
@@ -189,9 +187,17 @@ pub fn write_clip_kymographs(case: &Case, run: &ClipRun, path: &Path) -> Result<
 /// The 99th percentile of |v| over the finite values (1 if there are none): the colour limit
 /// of a kymograph.
 pub(crate) fn abs_percentile_99(values: impl Iterator<Item = f64>) -> f64 {
-    let mut all: Vec<f64> = values.map(f64::abs).filter(|v| v.is_finite()).collect();
-    all.sort_by(f64::total_cmp);
-    all.get((all.len() as f64 * 0.99) as usize).copied().unwrap_or(1.0)
+    percentile_99(values.map(f64::abs).filter(|v| v.is_finite()).collect())
+}
+
+/// The value at rank `⌊0.99 n⌋` of `all` in ascending order (`f64::total_cmp`; 1 for none), by
+/// selection rather than a full sort: the same value.
+fn percentile_99(mut all: Vec<f64>) -> f64 {
+    let k = (all.len() as f64 * 0.99) as usize;
+    if k >= all.len() {
+        return 1.0;
+    }
+    *all.select_nth_unstable_by(k, f64::total_cmp).1
 }
 
 /// Kymographs of the angular velocity (Fig. 24 style, `omega.svg`): ω1, ω2, ω3 [rad/s] in the
