@@ -160,7 +160,7 @@ impl Clip {
     /// Rotate every frame rigidly by `r` (the case's `clip.orientation`).
     pub fn rotate(&mut self, r: &Matrix3<f64>) {
         for frame in &mut self.frames {
-            frame.iter_mut().for_each(|x| *x = r * *x);
+            rotate_frame(frame, r);
         }
     }
 
@@ -172,6 +172,11 @@ impl Clip {
             .filter(|&f| self.frames[f].windows(2).any(|w| near((w[1] - w[0]).normalize())))
             .collect()
     }
+}
+
+/// Rotate the positions of one frame rigidly by `r` (as [`Clip::rotate`]).
+pub fn rotate_frame(frame: &mut [Vector3<f64>], r: &Matrix3<f64>) {
+    frame.iter_mut().for_each(|x| *x = r * *x);
 }
 
 /// Length of the polyline through `points` [m].

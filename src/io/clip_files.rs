@@ -9,9 +9,10 @@ use super::files::{csv_reader_capped, InputError};
 use super::npy::read_npy;
 use super::truth_file::{read_truth, truth_sidecar};
 use crate::case::{Case, ClipKind};
-use crate::clip::synthetic::{roll_clip, GroundTruth};
+use crate::clip::synthetic::{roll_clip, FrameTruth, GroundTruth, RollClipGenerator};
 use crate::clip::{
-    clip_from_angles, polyline_length, Clip, ClipError, KymogramParams, MAX_CLIP_POSITIONS, MAX_LENGTH_DEVIATION,
+    clip_from_angles, polyline_length, rotate_frame, Clip, ClipError, KymogramParams, MAX_CLIP_POSITIONS,
+    MAX_LENGTH_DEVIATION,
 };
 
 /// Column names of a CSV recording.
@@ -124,15 +125,7 @@ fn glitch(pts: &[Vector3<f64>]) -> String {
 /// ([`super::truth_file`]). The frame range and the orientation of the
 /// case are applied to both.
 pub fn load_clip(case: &Case) -> Result<(Clip, Option<GroundTruth>), ClipFileError> {
-    let src = case.clip().ok_or_else(|| ClipFileError::NotAClip(case.name.clone()))?;
-    if !src.file.exists() {
-        let hint = if is_fetched_data(&src.file) {
-            "; the elegansbot kymograms are fetched and checksum-verified by scripts/fetch_worm_data.sh"
-        } else {
-            ""
-        };
-        return Err(ClipFileError::Missing { path: src.file.clone(), case: case.name.clone(), hint });
-    }
+    let src = clip_source(case)?;
     let (mut clip, mut truth) = match &src.kind {
         ClipKind::Kymogram => {
             let params = case.kymogram_params().ok_or_else(|| ClipFileError::NotAClip(case.name.clone()))?;
@@ -184,6 +177,80 @@ pub fn load_clip(case: &Case) -> Result<(Clip, Option<GroundTruth>), ClipFileErr
         }
     }
     Ok((clip, truth))
+}
+
+/// The clip section of a clip case whose file exists.
+fn clip_source(case: &Case) -> Result<&crate::case::ClipSource, ClipFileError> {
+    let src = case.clip().ok_or_else(|| ClipFileError::NotAClip(case.name.clone()))?;
+    if !src.file.exists() {
+        let hint = if is_fetched_data(&src.file) {
+            "; the elegansbot kymograms are fetched and checksum-verified by scripts/fetch_worm_data.sh"
+        } else {
+            ""
+        };
+        return Err(ClipFileError::Missing { path: src.file.clone(), case: case.name.clone(), hint });
+    }
+    Ok(src)
+}
+
+/// The clip of a `roll_3d` case as a generator of its frames in order: frame for frame what
+/// [`load_clip`] builds at once (the case's frame range and orientation applied), for a run
+/// that solves the first frames while later ones are integrated.
+pub struct RollStream {
+    generator: RollClipGenerator,
+    first: usize,
+    len: usize,
+    orientation: Matrix3<f64>,
+}
+
+impl RollStream {
+    /// Frames of the clip (of its range).
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// The clip without its frames.
+    pub fn header(&self) -> Clip {
+        self.generator.header()
+    }
+
+    /// Frame `i` of the range: positions [m] and ground truth, as [`load_clip`] has them.
+    pub fn frame(&self, i: usize) -> (Vec<Vector3<f64>>, FrameTruth) {
+        let (mut x, mut truth) = self.generator.frame(self.first + i);
+        if self.orientation != Matrix3::identity() {
+            rotate_frame(&mut x, &self.orientation);
+            truth.rotate(&self.orientation);
+        }
+        (x, truth)
+    }
+}
+
+/// [`RollStream`] of a `roll_3d` case, with the checks of [`load_clip`]; `None` for the other
+/// kinds of clip.
+pub fn roll_stream(case: &Case) -> Result<Option<RollStream>, ClipFileError> {
+    let src = clip_source(case)?;
+    if !matches!(src.kind, ClipKind::Roll3d(_)) {
+        return Ok(None);
+    }
+    let params = case.roll_clip_params().ok_or_else(|| ClipFileError::NotAClip(case.name.clone()))?;
+    let rows = kymogram_rows(&src.file)?;
+    let generator = RollClipGenerator::new(&rows, None, &params)?;
+    if params.nodes != case.mesh.nodes() {
+        return Err(ClipFileError::NodeCount {
+            path: src.file.clone(),
+            nodes: params.nodes,
+            expected: case.mesh.nodes(),
+        });
+    }
+    let (first, end) = src.frames.unwrap_or((0, params.frames));
+    if first >= end || end > params.frames {
+        return Err(ClipError::FrameRange { first, end, frames: params.frames }.into());
+    }
+    Ok(Some(RollStream { generator, first, len: end - first, orientation: src.orientation }))
 }
 
 /// The rows (frames × joint angles [rad]) of a kymogram `.npy`, every angle finite.

@@ -6,7 +6,7 @@ use std::path::Path;
 
 use nalgebra::Vector3;
 
-use super::clip_files::{load_clip, ClipFileError};
+use super::clip_files::{load_clip, roll_stream, ClipFileError, RollStream};
 use super::clip_output::{
     write_clip_kymographs, write_clip_plot, write_omega_kymographs, write_truth_plot, ClipWriter,
 };
@@ -16,8 +16,10 @@ use super::files::{InputError, OutputError};
 use super::freefem::{self, FreeFemError};
 use super::journal::{read_journal, JournalError};
 use crate::case::{Case, DataSource};
+use crate::clip::synthetic::GroundTruth;
+use crate::clip::Clip;
 use crate::model::chart::Chart;
-use crate::run::clip::{run_clip, ClipFrame, ClipOutcome, ClipRun, FrameSink};
+use crate::run::clip::{run_clip, ClipFrame, ClipFrames, ClipOutcome, ClipRun, FrameSink, StreamedFrame};
 use crate::run::{self, Engine, NodalState, RunError, RunResult};
 
 /// Errors of running a case from files.
@@ -141,16 +143,53 @@ pub fn run_clip_to(
     observer: impl FnMut(&ClipFrame) + Send,
     progress: impl FnMut(usize, usize),
 ) -> Result<ClipOutcome, EngineError> {
-    let (clip, truth) = load_clip(case)?;
-    let (records, sink) = if opts.resume {
+    // A synthetic roll_3d clip is integrated on a second thread while its first frames are
+    // solved; other clips are read at once.
+    let input = match roll_stream(case)? {
+        Some(stream) => Input::Streamed(stream),
+        None => {
+            let (clip, truth) = load_clip(case)?;
+            Input::Loaded(clip, truth)
+        }
+    };
+    let has_truth = match &input {
+        Input::Streamed(_) => true,
+        Input::Loaded(_, truth) => truth.is_some(),
+    };
+    let (records, sink): (Vec<_>, _) = if opts.resume {
         let (entries, bytes) = read_journal(dir)?;
-        let sink = ClipWriter::resume(dir, truth.is_some(), &entries, bytes, opts.format)?;
+        let sink = ClipWriter::resume(dir, has_truth, &entries, bytes, opts.format)?;
         (entries.into_iter().map(|e| e.record).collect(), sink)
     } else {
-        (Vec::new(), ClipWriter::create(dir, truth.is_some(), opts.journal, opts.format)?)
+        (Vec::new(), ClipWriter::create(dir, has_truth, opts.journal, opts.format)?)
     };
     let writer = Observed { sink, observer };
-    Ok(run_clip(case, &clip, truth.as_ref(), &records, writer, progress)?)
+    match input {
+        Input::Streamed(stream) => std::thread::scope(|scope| {
+            let (tx, rx) = std::sync::mpsc::channel();
+            let (header, total) = (stream.header(), stream.len());
+            let stream = &stream;
+            // stops at the first frame the solve no longer takes (it ended early)
+            scope.spawn(move || (0..total).try_for_each(|i| tx.send(stream_frame(stream, i))));
+            let frames = ClipFrames::Streamed { header, total, truth: true, frames: rx };
+            Ok(run_clip(case, frames, &records, writer, progress)?)
+        }),
+        Input::Loaded(clip, truth) => {
+            Ok(run_clip(case, ClipFrames::Loaded { clip: &clip, truth: truth.as_ref() }, &records, writer, progress)?)
+        }
+    }
+}
+
+/// A clip's frames for [`run_clip`]: integrated while they are solved, or read at once.
+enum Input {
+    Streamed(RollStream),
+    Loaded(Clip, Option<GroundTruth>),
+}
+
+/// Frame `i` of a streamed clip with its ground truth.
+fn stream_frame(stream: &RollStream, i: usize) -> StreamedFrame {
+    let (x, truth) = stream.frame(i);
+    (x, Some(truth))
 }
 
 /// A [`FrameSink`] that writes each frame and then shows it to an observer.

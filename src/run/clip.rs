@@ -1,6 +1,7 @@
 //! A clip case frame by frame in the Rust engine (`solve::sequence`), every converged frame
 //! handed to a [`FrameSink`] (which `crate::io` implements with the streamed files) on a
 //! second thread while the next frame is solved.
+use std::sync::mpsc::Receiver;
 use std::time::Instant;
 
 use nalgebra::{DVector, Matrix3, Vector3};
@@ -8,7 +9,7 @@ use nalgebra::{DVector, Matrix3, Vector3};
 use super::metrics::INNER_SKIP_ELEMENTS;
 use super::{NodalState, RunError};
 use crate::case::Case;
-use crate::clip::synthetic::{compare_frame, FrameComparison, GroundTruth, RecoveredFrame};
+use crate::clip::synthetic::{compare_frame, FrameComparison, FrameTruth, GroundTruth, RecoveredFrame};
 use crate::clip::Clip;
 use crate::model::chart::Chart;
 use crate::model::mesh::Field;
@@ -16,9 +17,9 @@ use crate::model::rotation::Angles;
 use crate::solve::inverse::measures::angular_velocity;
 use crate::solve::inverse::{InverseSolution, Records};
 use crate::solve::sequence::{
-    solve_sequence_from, vector_to_space, FrameReport, FrameSolution, ResumeFrom, SequenceParams,
+    solve_sequence_from, vector_to_space, FrameReport, FrameSolution, ResumeFrom, SequenceError, SequenceParams,
 };
-use crate::solve::Stop;
+use crate::solve::{SolveError, Stop};
 
 /// Nodes skipped at each end when scoring curvature against a ground truth (the curvature of
 /// the inverse solution is least reliable at the free ends; as `metrics::INNER_SKIP_ELEMENTS`).
@@ -174,17 +175,76 @@ pub struct ClipOutcome {
     pub total: usize,
 }
 
-/// Solve the clip `clip` of a clip case frame by frame in the Rust engine, handing every
-/// converged frame to `sink` (on a second thread, while the next frame is solved); `truth`:
-/// the ground truth of a synthetic clip, frame for frame. `resume`: the records of the frames
-/// `0..n` of an earlier run of the same case ([`FrameRecord`]; empty: from the first frame);
-/// they are not handed to the sink again, the summary covers them. On failure or interrupt the
-/// sink has every converged frame and the outcome says why it stopped; a sink error stops the
-/// clip at the next frame and is reported in its place.
+/// One frame of a streamed clip ([`ClipFrames::Streamed`]): its node positions [m] and, for a
+/// synthetic clip, its ground truth.
+pub type StreamedFrame = (Vec<Vector3<f64>>, Option<FrameTruth>);
+
+/// The frames of a clip as [`run_clip`] takes them.
+pub enum ClipFrames<'a> {
+    /// every frame at hand: the clip and, for a synthetic clip, its ground truth frame for frame
+    Loaded { clip: &'a Clip, truth: Option<&'a GroundTruth> },
+    /// `total` frames arriving in order on `frames` (each with its ground truth where `truth`),
+    /// e.g. from a generator on another thread: the solve starts with the first frame while
+    /// later ones are made. `header`: the clip without its frames (time step, source).
+    Streamed { header: Clip, total: usize, truth: bool, frames: Receiver<StreamedFrame> },
+}
+
+/// The frames of a [`ClipFrames`] received so far.
+struct Arrivals<'a> {
+    input: ClipFrames<'a>,
+    frames: Vec<Vec<Vector3<f64>>>,
+    truth: Vec<FrameTruth>,
+}
+
+impl Arrivals<'_> {
+    /// The clip (without its frames if streamed), its frame count and whether it has a truth.
+    fn header(&self) -> (&Clip, usize, bool) {
+        match &self.input {
+            ClipFrames::Loaded { clip, truth } => (clip, clip.frame_count(), truth.is_some()),
+            ClipFrames::Streamed { header, total, truth, .. } => (header, *total, *truth),
+        }
+    }
+
+    /// Wait until at least `n` frames are at hand, take every frame that has arrived, and
+    /// return how many are at hand.
+    fn wait(&mut self, n: usize) -> Result<usize, RunError> {
+        let (rx, total) = match &self.input {
+            ClipFrames::Loaded { clip, .. } => return Ok(clip.frame_count()),
+            ClipFrames::Streamed { frames, total, .. } => (frames, *total),
+        };
+        while self.frames.len() < n.min(total) {
+            let (x, t) = rx.recv().map_err(|_| RunError::Generator { received: self.frames.len(), total })?;
+            self.frames.push(x);
+            self.truth.extend(t);
+        }
+        while let Ok((x, t)) = rx.try_recv() {
+            self.frames.push(x);
+            self.truth.extend(t);
+        }
+        Ok(self.frames.len())
+    }
+
+    /// The frames at hand and their ground truth.
+    fn frames(&self) -> (&[Vec<Vector3<f64>>], Option<&[FrameTruth]>) {
+        match &self.input {
+            ClipFrames::Loaded { clip, truth } => (&clip.frames, truth.map(|t| &t.frames[..])),
+            ClipFrames::Streamed { truth, .. } => (&self.frames, truth.then_some(&self.truth[..])),
+        }
+    }
+}
+
+/// Solve the clip of a clip case frame by frame in the Rust engine, handing every converged
+/// frame to `sink` (on a second thread, while the next frame is solved); `frames`: the clip's
+/// frames (and the ground truth of a synthetic clip), at hand or streamed. `resume`: the records
+/// of the frames `0..n` of an earlier run of the same case ([`FrameRecord`]; empty: from the
+/// first frame); they are not handed to the sink again, the summary covers them. On failure or
+/// interrupt the sink has every converged frame and the outcome says why it stopped; a sink
+/// error stops the clip at the next frame and is reported in its place. A streamed clip is
+/// solved in runs of the frames at hand, each resumed from the last two states
+/// ([`ResumeFrom`]): bit for bit the frames of one solve.
 pub fn run_clip<S: FrameSink>(
     case: &Case,
-    clip: &Clip,
-    truth: Option<&GroundTruth>,
+    frames: ClipFrames<'_>,
     resume: &[FrameRecord],
     mut sink: S,
     mut progress: impl FnMut(usize, usize),
@@ -196,13 +256,19 @@ pub fn run_clip<S: FrameSink>(
     let dofs = problem.dofs();
     let w8 = sp.inverse.weights;
     let first_frame = sp.frame_offset;
-    let total = clip.frame_count();
+    let mut arrivals = Arrivals { input: frames, frames: Vec::new(), truth: Vec::new() };
+    let (header, total, has_truth) = arrivals.header();
+    let (dt_s, source) = (header.dt_s, header.source.clone());
     let h = case.mesh.h();
     let start = Instant::now();
     let dt = sp.inverse.frame_interval_s;
-    let mut summary = Summary::new(truth.is_some());
-    // A converged frame in space coordinates with everything its consumers need.
-    let derive = |rep: &FrameReport, frame: &FrameSolution| -> Result<ClipFrame, String> {
+    let mut summary = Summary::new(has_truth);
+    // A converged frame in space coordinates with everything its consumers need, from the
+    // frames at hand.
+    let derive = |rep: &FrameReport,
+                  frame: &FrameSolution,
+                  (frames, truth): (&[Vec<Vector3<f64>>], Option<&[FrameTruth]>)|
+     -> Result<ClipFrame, String> {
         let sol = frame.solution;
         let nodes = NodalState { chart: frame.chart, ..NodalState::from_vector(&case.mesh, &sol.u) };
         let (force, torque): (Vec<_>, Vec<_>) = (0..nodes.s.len())
@@ -211,9 +277,9 @@ pub fn run_clip<S: FrameSink>(
                 (xh / w8.lambda_f, ah / w8.lambda_l)
             })
             .unzip();
-        let index = rep.frame.checked_sub(first_frame).filter(|i| *i < clip.frames.len());
+        let index = rep.frame.checked_sub(first_frame).filter(|i| *i < frames.len());
         let index = index.ok_or_else(|| format!("frame {} is outside the clip", rep.frame))?;
-        let data = &clip.frames[index];
+        let data = &frames[index];
         let kappa = nodes.element_curvature();
         let k2: Vec<f64> = kappa.iter().map(|(_, k)| k[1]).collect();
         // The data's curvature in the plane normal to the chart's axis (exactly the x–z
@@ -222,7 +288,7 @@ pub fn run_clip<S: FrameSink>(
         let kd = planar_xz_curvature(&in_chart, h);
         let mut truth_frame = None;
         if let Some(t) = truth {
-            let ft = &t.frames[index];
+            let ft = &t[index];
             let q: Vec<Matrix3<f64>> = nodes.alpha.iter().map(|a| nodes.chart.rotation(a)).collect();
             let kn = nodal_curvature(&kappa);
             let c = compare_frame(data, ft, &RecoveredFrame { x: &nodes.x, q: &q, kappa: &kn }, TRUTH_SKIP_NODES)
@@ -242,7 +308,7 @@ pub fn run_clip<S: FrameSink>(
         let roughness = (sign_alternation(&k2), sign_alternation(&kd));
         Ok(ClipFrame {
             report: *rep,
-            time_s: rep.frame as f64 * clip.dt_s,
+            time_s: rep.frame as f64 * dt_s,
             nodes,
             force,
             torque,
@@ -263,6 +329,7 @@ pub fn run_clip<S: FrameSink>(
         })
     };
     // The frames of an earlier run: their summary again, from their records.
+    arrivals.wait(resume.len())?;
     for (i, r) in resume.iter().enumerate() {
         if r.report.frame != first_frame + i || r.state.len() != dofs.len() || r.adjoint.len() != dofs.len() {
             return Err(RunError::Resume(format!(
@@ -280,9 +347,9 @@ pub fn run_clip<S: FrameSink>(
             stop: Stop::Converged,
         };
         let fs = FrameSolution { solution: &sol, chart: r.chart, previous: r.previous.as_deref(), state: &r.state };
-        summary.push(&derive(&r.report, &fs).map_err(RunError::Resume)?);
+        summary.push(&derive(&r.report, &fs, arrivals.frames()).map_err(RunError::Resume)?);
     }
-    let from = match resume {
+    let mut from = match resume {
         [] => None,
         [.., a, b] => Some(ResumeFrom {
             next: resume.len(),
@@ -299,21 +366,45 @@ pub fn run_clip<S: FrameSink>(
             }
             sink.finish()
         });
-        let result = solve_sequence_from(
-            &problem,
-            &sp,
-            &clip.frames,
-            None,
-            from,
-            |_, _| {},
-            |rep, frame| {
-                let frame = derive(rep, frame)?;
-                summary.push(&frame);
-                tx.send(frame).map_err(|_| "the output thread stopped (see the write error)".to_string())?;
-                progress(rep.frame - first_frame + 1, total);
-                Ok(())
-            },
-        );
+        let mut result = Ok(());
+        let mut solved = resume.len();
+        // the last two states solved, to resume the next run of frames from
+        let (mut last, mut last2) = match &from {
+            Some(r) => (Some(r.prev.clone()), r.prev2.clone()),
+            None => (None, None),
+        };
+        while solved < total {
+            let at_hand = match arrivals.wait(solved + 1) {
+                Ok(n) => n,
+                Err(e) => {
+                    result = Err(e);
+                    break;
+                }
+            };
+            let view = arrivals.frames();
+            let run = solve_sequence_from(
+                &problem,
+                &sp,
+                &view.0[..at_hand],
+                None,
+                from.take(),
+                |_, _| {},
+                |rep, frame| {
+                    last2 = last.replace((frame.chart, frame.state.clone()));
+                    let frame = derive(rep, frame, view)?;
+                    summary.push(&frame);
+                    tx.send(frame).map_err(|_| "the output thread stopped (see the write error)".to_string())?;
+                    progress(rep.frame - first_frame + 1, total);
+                    Ok(())
+                },
+            );
+            if let Err(e) = run {
+                result = Err(RunError::from(clip_total(e, total)));
+                break;
+            }
+            solved = at_hand;
+            from = last.clone().map(|prev| ResumeFrom { next: solved, prev, prev2: last2.clone() });
+        }
         drop(tx);
         let written = io.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic));
         (result, written)
@@ -321,10 +412,21 @@ pub fn run_clip<S: FrameSink>(
     // A write error explains a stopped clip better than the stop itself.
     let stopped = match (written, result) {
         (Err(e), _) => Some(RunError::Sink(Box::new(e))),
-        (Ok(()), Err(e)) => Some(RunError::from(e)),
-        (Ok(()), Ok(_)) => None,
+        (Ok(()), Err(e)) => Some(e),
+        (Ok(()), Ok(())) => None,
     };
-    Ok(ClipOutcome { run: summary.finish(start.elapsed().as_secs_f64(), clip.source.clone()), stopped, total })
+    Ok(ClipOutcome { run: summary.finish(start.elapsed().as_secs_f64(), source), stopped, total })
+}
+
+/// An interrupt of a run of a streamed clip's frames, counted against the whole clip's
+/// `total` frames (the run saw only the frames at hand).
+fn clip_total(e: SequenceError, total: usize) -> SequenceError {
+    match e {
+        SequenceError::Solve(SolveError::Interrupted { what, done, .. }) => {
+            SequenceError::Solve(SolveError::Interrupted { what, done, total })
+        }
+        e => e,
+    }
 }
 
 /// The per-frame summary of a clip run, frame by frame.

@@ -42,6 +42,8 @@ pub enum RunError {
     Sink(#[source] Box<dyn std::error::Error + Send + Sync>),
     #[error("resuming the clip: {0}")]
     Resume(String),
+    #[error("the clip's frame generator stopped after {received} of {total} frames")]
+    Generator { received: usize, total: usize },
     /// A forward solve diverged: the error, with the largest load of the case named (a load
     /// far beyond the rod's stiffness is the usual cause).
     #[error("rust engine: the solve could not follow the loads, the largest of which is {key} = \"{expr}\" = {value:e} (check its magnitude and units, or raise solver.continuation_steps of a static case)")]

@@ -134,6 +134,13 @@ pub struct FrameTruth {
     pub roll_rad: f64,
 }
 
+impl FrameTruth {
+    /// Rotate rigidly by `r` (as [`GroundTruth::rotate`]).
+    pub fn rotate(&mut self, r: &Matrix3<f64>) {
+        self.q.iter_mut().for_each(|q| *q *= r.transpose());
+    }
+}
+
 /// Ground truth of a whole clip.
 #[derive(Debug, Clone, PartialEq)]
 pub struct GroundTruth {
@@ -153,7 +160,7 @@ impl GroundTruth {
     /// data, `Q → Q Rᵀ` (rows are the directors).
     pub fn rotate(&mut self, r: &Matrix3<f64>) {
         for f in &mut self.frames {
-            f.q.iter_mut().for_each(|q| *q *= r.transpose());
+            f.rotate(r);
         }
     }
 
@@ -272,29 +279,66 @@ pub fn roll_clip(
     delta_rows: Option<&[Vec<f64>]>,
     params: &RollClipParams,
 ) -> Result<(Clip, GroundTruth), ClipError> {
-    let field = KymogramField::new(omega_rows, delta_rows, params)?;
+    let generator = RollClipGenerator::new(omega_rows, delta_rows, params)?;
     // Frames are independent: integrated in parallel (rayon), collected in order, so the
     // result does not depend on the thread count.
     use rayon::prelude::*;
-    let (positions, truth): (Vec<_>, Vec<_>) = (0..params.frames)
-        .into_par_iter()
-        .map(|n| integrate_frame(&field.profile(field.row_at_frame(n)), params.roll_at_frame(n), params))
-        .unzip();
-    let clip_s = (params.frames.saturating_sub(1)) as f64 * params.dt_s;
-    let kymo_s = (field.row_count() - 1) as f64 / KYMOGRAM_FPS;
-    let source = format!(
-        "synthetic worm_roll_3d: {:?}, {} kymogram rows over {clip_s} s (×{:.3} slower than {KYMOGRAM_FPS} frames/s), \
-         roll 0 → {} rad, twist {} rad/m, {} frames × {} nodes, {} substeps per element",
-        params.time_mapping,
-        field.row_count(),
-        clip_s / kymo_s,
-        params.roll_total_rad,
-        params.twist_per_m,
-        params.frames,
-        params.nodes,
-        params.substeps
-    );
-    let node_s_m = (0..params.nodes).map(|i| i as f64 * params.length_m / (params.nodes - 1) as f64).collect();
-    let clip = Clip { frames: positions, dt_s: params.dt_s, source, length_m: params.length_m };
-    Ok((clip, GroundTruth { frames: truth, node_s_m }))
+    let (positions, truth): (Vec<_>, Vec<_>) = (0..params.frames).into_par_iter().map(|n| generator.frame(n)).unzip();
+    let clip = Clip { frames: positions, ..generator.header() };
+    Ok((clip, GroundTruth { frames: truth, node_s_m: generator.node_s_m() }))
+}
+
+/// The frames of a `worm_roll_3d` clip one at a time, each exactly as [`roll_clip`] computes it:
+/// for a consumer that solves the first frames while later ones are still being integrated.
+pub struct RollClipGenerator {
+    field: KymogramField,
+    params: RollClipParams,
+}
+
+impl RollClipGenerator {
+    /// The clip's kymogram field (as [`roll_clip`] takes its rows) and parameters.
+    pub fn new(
+        omega_rows: &[Vec<f64>],
+        delta_rows: Option<&[Vec<f64>]>,
+        params: &RollClipParams,
+    ) -> Result<Self, ClipError> {
+        Ok(RollClipGenerator { field: KymogramField::new(omega_rows, delta_rows, params)?, params: params.clone() })
+    }
+
+    /// Frames of the clip.
+    pub fn frame_count(&self) -> usize {
+        self.params.frames
+    }
+
+    /// Frame `n`: node positions [m] and its ground truth.
+    pub fn frame(&self, n: usize) -> (Vec<Vector3<f64>>, FrameTruth) {
+        let p = &self.params;
+        integrate_frame(&self.field.profile(self.field.row_at_frame(n)), p.roll_at_frame(n), p)
+    }
+
+    /// The clip without its frames: time step, description and body length.
+    pub fn header(&self) -> Clip {
+        let params = &self.params;
+        let clip_s = (params.frames.saturating_sub(1)) as f64 * params.dt_s;
+        let kymo_s = (self.field.row_count() - 1) as f64 / KYMOGRAM_FPS;
+        let source = format!(
+            "synthetic worm_roll_3d: {:?}, {} kymogram rows over {clip_s} s (×{:.3} slower than {KYMOGRAM_FPS} frames/s), \
+             roll 0 → {} rad, twist {} rad/m, {} frames × {} nodes, {} substeps per element",
+            params.time_mapping,
+            self.field.row_count(),
+            clip_s / kymo_s,
+            params.roll_total_rad,
+            params.twist_per_m,
+            params.frames,
+            params.nodes,
+            params.substeps
+        );
+        Clip { frames: Vec::new(), dt_s: params.dt_s, source, length_m: params.length_m }
+    }
+
+    /// Arc length of each node `s_i` [m] (as [`GroundTruth::node_s_m`]).
+    pub fn node_s_m(&self) -> Vec<f64> {
+        let p = &self.params;
+        (0..p.nodes).map(|i| i as f64 * p.length_m / (p.nodes - 1) as f64).collect()
+    }
 }

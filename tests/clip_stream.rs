@@ -1,0 +1,140 @@
+//! A clip whose frames arrive while it is solved (`ClipFrames::Streamed`, what `cosserat run`
+//! does with a synthetic `worm_roll_3d` clip: the frames are integrated on a second thread) is
+//! solved in runs of the frames at hand, each resumed from the last two states. The frames must
+//! be bit for bit those of the clip solved in one run from all its frames, however the frames
+//! arrive; a generator that stops early stops the clip with an error naming how far it got.
+//! On a 20-frame `worm_roll_3d` with 16 nodes; needs the omega-turn kymogram.
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::sync::mpsc::{channel, Sender};
+use std::sync::{Arc, Mutex};
+use std::time::Duration;
+
+use common::{case_text, edit, worm_data_present};
+use cosserat::case::Case;
+use cosserat::io::clip_files::load_clip;
+use cosserat::run::clip::{run_clip, ClipFrame, ClipFrames, ClipOutcome, FrameSink, StreamedFrame};
+use cosserat::run::RunError;
+
+const FRAMES: usize = 20;
+const NODES: usize = 16;
+
+fn case_file(dir: &Path) -> PathBuf {
+    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/elegansbot");
+    let text =
+        edit(&case_text("worm_roll_3d"), "file = \"../data/elegansbot/", &format!("file = \"{}/", data.display()));
+    let text = edit(
+        &edit(&text, "elements = 127", &format!("elements = {}", NODES - 1)),
+        "clip_frames = 1160",
+        &format!("clip_frames = {FRAMES}"),
+    );
+    let path = dir.join("roll_stream.toml");
+    std::fs::write(&path, text).expect("case");
+    path
+}
+
+/// Keeps every frame handed to it.
+struct Collect(Arc<Mutex<Vec<ClipFrame>>>);
+
+impl FrameSink for Collect {
+    type Error = std::convert::Infallible;
+    fn frame(&mut self, frame: &ClipFrame) -> Result<(), Self::Error> {
+        self.0.lock().expect("frames").push(frame.clone());
+        Ok(())
+    }
+    fn finish(&mut self) -> Result<(), Self::Error> {
+        Ok(())
+    }
+}
+
+/// Run the clip of `case` on `frames`; the outcome and the frames the sink received.
+fn solve(case: &Case, frames: ClipFrames<'_>) -> (ClipOutcome, Vec<ClipFrame>) {
+    let got = Arc::new(Mutex::new(Vec::new()));
+    let out = run_clip(case, frames, &[], Collect(got.clone()), |_, _| {}).expect("clip runs");
+    let got = got.lock().expect("frames").clone();
+    (out, got)
+}
+
+/// Every number of a frame that derives from its solve, as bits.
+fn bits(f: &ClipFrame) -> Vec<u64> {
+    let r = &f.report;
+    let mut v: Vec<u64> = [r.last_change, r.x_err_rel, r.tangent_misfit, r.objective.tracking, r.min_cos_beta]
+        .iter()
+        .map(|x| x.to_bits())
+        .collect();
+    v.push(r.iterations as u64);
+    v.extend(f.record.state.iter().chain(f.record.adjoint.iter()).map(|x| x.to_bits()));
+    v.extend(f.kappa2.iter().map(|x| x.to_bits()));
+    v.extend(f.truth.iter().flat_map(|t| t.bending_recovered.iter().map(|x| x.to_bits())));
+    v
+}
+
+/// Send frames `0..count` of the loaded clip, waiting `pause` before each.
+fn feed(
+    tx: Sender<StreamedFrame>,
+    clip: &cosserat::clip::Clip,
+    truth: &[cosserat::clip::synthetic::FrameTruth],
+    count: usize,
+    pause: Duration,
+) {
+    for i in 0..count {
+        std::thread::sleep(pause);
+        if tx.send((clip.frames[i].clone(), Some(truth[i].clone()))).is_err() {
+            return;
+        }
+    }
+}
+
+#[test]
+fn a_streamed_clip_gives_the_frames_of_one_solve_bit_for_bit() {
+    if !worm_data_present("a_streamed_clip_gives_the_frames_of_one_solve_bit_for_bit") {
+        return;
+    }
+    let dir = tempfile::tempdir().expect("tempdir");
+    let case = Case::from_file(&case_file(dir.path())).expect("case");
+    let (clip, truth) = load_clip(&case).expect("clip");
+    let truth = truth.expect("a synthetic clip has a ground truth");
+    let (whole, reference) = solve(&case, ClipFrames::Loaded { clip: &clip, truth: Some(&truth) });
+    assert!(whole.stopped.is_none(), "{:?}", whole.stopped);
+    assert_eq!(reference.len(), FRAMES);
+    // Frames one at a time, slower than they are solved (runs of one frame: the second state
+    // to resume from comes from the run before), then all at once (one run).
+    for pause in [Duration::from_millis(30), Duration::ZERO] {
+        let (tx, rx) = channel();
+        let (out, got) = std::thread::scope(|s| {
+            s.spawn(|| feed(tx, &clip, &truth.frames, FRAMES, pause));
+            let header = cosserat::clip::Clip { frames: Vec::new(), ..clip.clone() };
+            solve(&case, ClipFrames::Streamed { header, total: FRAMES, truth: true, frames: rx })
+        });
+        assert!(out.stopped.is_none(), "pause {pause:?}: {:?}", out.stopped);
+        assert_eq!(got.len(), FRAMES);
+        for (a, b) in reference.iter().zip(&got) {
+            assert_eq!(a.report.frame, b.report.frame);
+            assert!(bits(a) == bits(b), "pause {pause:?}: frame {} differs from the one-run solve", a.report.frame);
+        }
+        assert_eq!(out.run.source, whole.run.source);
+        assert_eq!(out.total, FRAMES);
+    }
+}
+
+#[test]
+fn a_stream_that_ends_early_stops_the_clip_with_an_error() {
+    if !worm_data_present("a_stream_that_ends_early_stops_the_clip_with_an_error") {
+        return;
+    }
+    let dir = tempfile::tempdir().expect("tempdir");
+    let case = Case::from_file(&case_file(dir.path())).expect("case");
+    let (clip, truth) = load_clip(&case).expect("clip");
+    let truth = truth.expect("ground truth");
+    let (tx, rx) = channel();
+    feed(tx, &clip, &truth.frames, 5, Duration::ZERO);
+    let header = cosserat::clip::Clip { frames: Vec::new(), ..clip.clone() };
+    let (out, got) = solve(&case, ClipFrames::Streamed { header, total: FRAMES, truth: true, frames: rx });
+    assert_eq!(got.len(), 5, "the frames that arrived are solved and handed over");
+    match out.stopped {
+        Some(RunError::Generator { received: 5, total: FRAMES }) => {}
+        other => panic!("expected the generator error after 5 of {FRAMES} frames, got {other:?}"),
+    }
+    assert_eq!(out.run.reports.len(), 5);
+}
