@@ -358,7 +358,9 @@ pub fn run_clip<S: FrameSink>(
         }),
         [b] => Some(ResumeFrom { next: 1, prev: (b.chart, b.state.clone()), prev2: None }),
     };
-    let (tx, rx) = std::sync::mpsc::sync_channel::<ClipFrame>(8);
+    // room for about 0.1 s of frames: the output thread falls behind while a streamed clip's
+    // generator shares its core (the first 0.25 s of worm_roll_3d), and catches up after
+    let (tx, rx) = std::sync::mpsc::sync_channel::<ClipFrame>(64);
     let (result, written) = std::thread::scope(|scope| {
         let io = scope.spawn(move || -> Result<(), S::Error> {
             for frame in rx {
