@@ -15,11 +15,11 @@ use crate::model::chart::Chart;
 use crate::model::mesh::Field;
 use crate::model::rotation::Angles;
 use crate::solve::inverse::measures::angular_velocity;
-use crate::solve::inverse::{InverseSolution, Records};
+use crate::solve::inverse::Records;
 use crate::solve::sequence::{
-    solve_sequence_from, vector_to_space, FrameReport, FrameSolution, ResumeFrom, SequenceError, SequenceParams,
+    solve_sequence_from, vector_to_space, FrameReport, ResumeFrom, SequenceError, SequenceParams,
 };
-use crate::solve::{SolveError, Stop};
+use crate::solve::SolveError;
 
 /// Nodes skipped at each end when scoring curvature against a ground truth (the curvature of
 /// the inverse solution is least reliable at the free ends; as `metrics::INNER_SKIP_ELEMENTS`).
@@ -263,35 +263,28 @@ pub fn run_clip<S: FrameSink>(
     let start = Instant::now();
     let dt = sp.inverse.frame_interval_s;
     let mut summary = Summary::new(has_truth);
-    // A converged frame in space coordinates with everything its consumers need, from the
-    // frames at hand.
-    let derive = |rep: &FrameReport,
-                  frame: &FrameSolution,
-                  (frames, truth): (&[Vec<Vector3<f64>>], Option<&[FrameTruth]>)|
-     -> Result<ClipFrame, String> {
-        let sol = frame.solution;
-        let nodes = NodalState { chart: frame.chart, ..NodalState::from_vector(&case.mesh, &sol.u) };
+    // A converged frame in space coordinates with everything its consumers need (on the
+    // output thread).
+    let derive = |c: Converged| -> Result<ClipFrame, String> {
+        let Converged { report: rep, u, adjoint, chart, previous, state, data, truth } = c;
+        let nodes = NodalState { chart, ..NodalState::from_vector(&case.mesh, &u) };
         let (force, torque): (Vec<_>, Vec<_>) = (0..nodes.s.len())
             .map(|i| {
-                let (xh, ah) = (dofs.get(&sol.adjoint, i, Field::X), dofs.get(&sol.adjoint, i, Field::Alpha));
+                let (xh, ah) = (dofs.get(&adjoint, i, Field::X), dofs.get(&adjoint, i, Field::Alpha));
                 (xh / w8.lambda_f, ah / w8.lambda_l)
             })
             .unzip();
-        let index = rep.frame.checked_sub(first_frame).filter(|i| *i < frames.len());
-        let index = index.ok_or_else(|| format!("frame {} is outside the clip", rep.frame))?;
-        let data = &frames[index];
         let kappa = nodes.element_curvature();
         let k2: Vec<f64> = kappa.iter().map(|(_, k)| k[1]).collect();
         // The data's curvature in the plane normal to the chart's axis (exactly the x–z
         // curvature for an x–z clip; rotates with the data, R5).
-        let in_chart: Vec<Vector3<f64>> = data.iter().map(|x| frame.chart.to_chart(x)).collect();
+        let in_chart: Vec<Vector3<f64>> = data.iter().map(|x| chart.to_chart(x)).collect();
         let kd = planar_xz_curvature(&in_chart, h);
         let mut truth_frame = None;
-        if let Some(t) = truth {
-            let ft = &t[index];
+        if let Some(ft) = &truth {
             let q: Vec<Matrix3<f64>> = nodes.alpha.iter().map(|a| nodes.chart.rotation(a)).collect();
             let kn = nodal_curvature(&kappa);
-            let c = compare_frame(data, ft, &RecoveredFrame { x: &nodes.x, q: &q, kappa: &kn }, TRUTH_SKIP_NODES)
+            let c = compare_frame(&data, ft, &RecoveredFrame { x: &nodes.x, q: &q, kappa: &kn }, TRUTH_SKIP_NODES)
                 .map_err(|e| e.to_string())?;
             let twist = ft.kappa.iter().map(|k| k.z).sum::<f64>() / ft.kappa.len() as f64;
             let bend = |k: &Vector3<f64>| k.x * k.x + k.y * k.y;
@@ -303,30 +296,33 @@ pub fn run_clip<S: FrameSink>(
                 bending_recovered: kn.iter().map(bend).collect(),
             });
         }
-        let omega: Option<Vec<Vector3<f64>>> =
-            frame.previous.map(|prev| nodes.alpha.iter().zip(prev).map(|(a, p)| angular_velocity(a, p, dt)).collect());
+        let omega: Option<Vec<Vector3<f64>>> = previous
+            .as_ref()
+            .map(|prev| nodes.alpha.iter().zip(prev).map(|(a, p)| angular_velocity(a, p, dt)).collect());
         let roughness = (sign_alternation(&k2), sign_alternation(&kd));
         Ok(ClipFrame {
-            report: *rep,
+            report: rep,
             time_s: rep.frame as f64 * dt_s,
             nodes,
             force,
             torque,
-            data: data.clone(),
+            data,
             omega,
             kappa,
             kappa2: k2,
             data_kappa: kd,
             roughness,
             truth: truth_frame,
-            record: FrameRecord {
-                report: *rep,
-                chart: frame.chart,
-                state: frame.state.clone(),
-                adjoint: sol.adjoint.clone(),
-                previous: frame.previous.map(<[Angles]>::to_vec),
-            },
+            record: FrameRecord { report: rep, chart, state, adjoint, previous },
         })
+    };
+    // The data (and ground truth) of frame `rep.frame` among the frames at hand.
+    let frame_data = |rep: &FrameReport,
+                      (frames, truth): (&[Vec<Vector3<f64>>], Option<&[FrameTruth]>)|
+     -> Result<(Vec<Vector3<f64>>, Option<FrameTruth>), String> {
+        let index = rep.frame.checked_sub(first_frame).filter(|i| *i < frames.len());
+        let index = index.ok_or_else(|| format!("frame {} is outside the clip", rep.frame))?;
+        Ok((frames[index].clone(), truth.map(|t| t[index].clone())))
     };
     // The frames of an earlier run: their summary again, from their records.
     arrivals.wait(resume.len())?;
@@ -340,14 +336,18 @@ pub fn run_clip<S: FrameSink>(
                 dofs.len()
             )));
         }
-        let sol = InverseSolution {
+        let (data, truth) = frame_data(&r.report, arrivals.frames()).map_err(RunError::Resume)?;
+        let c = Converged {
+            report: r.report,
             u: vector_to_space(&dofs, &r.chart, &r.state, false),
             adjoint: r.adjoint.clone(),
-            history: Vec::new(),
-            stop: Stop::Converged,
+            chart: r.chart,
+            previous: r.previous.clone(),
+            state: r.state.clone(),
+            data,
+            truth,
         };
-        let fs = FrameSolution { solution: &sol, chart: r.chart, previous: r.previous.as_deref(), state: &r.state };
-        summary.push(&derive(&r.report, &fs, arrivals.frames()).map_err(RunError::Resume)?);
+        summary.push(&derive(c).map_err(RunError::Resume)?);
     }
     let mut from = match resume {
         [] => None,
@@ -360,13 +360,22 @@ pub fn run_clip<S: FrameSink>(
     };
     // room for about 0.1 s of frames: the output thread falls behind while a streamed clip's
     // generator shares its core (the first 0.25 s of worm_roll_3d), and catches up after
-    let (tx, rx) = std::sync::mpsc::sync_channel::<ClipFrame>(64);
-    let (result, written) = std::thread::scope(|scope| {
-        let io = scope.spawn(move || -> Result<(), S::Error> {
-            for frame in rx {
-                sink.frame(&frame)?;
-            }
-            sink.finish()
+    let (tx, rx) = std::sync::mpsc::sync_channel::<Converged>(64);
+    let (result, (summary, written)) = std::thread::scope(|scope| {
+        let derive = &derive;
+        // The output thread: each frame derived, summarised and handed to the sink.
+        let io = scope.spawn(move || {
+            let out = || -> Result<(), OutputStop<S::Error>> {
+                for c in rx {
+                    let frame = c.report.frame;
+                    let f = derive(c).map_err(|message| OutputStop::Derive { frame, message })?;
+                    summary.push(&f);
+                    sink.frame(&f).map_err(OutputStop::Sink)?;
+                }
+                sink.finish().map_err(OutputStop::Sink)
+            };
+            let written = out();
+            (summary, written)
         });
         let mut result = Ok(());
         let mut solved = resume.len();
@@ -393,9 +402,18 @@ pub fn run_clip<S: FrameSink>(
                 |_, _| {},
                 |rep, frame| {
                     last2 = last.replace((frame.chart, frame.state.clone()));
-                    let frame = derive(rep, frame, view)?;
-                    summary.push(&frame);
-                    tx.send(frame).map_err(|_| "the output thread stopped (see the write error)".to_string())?;
+                    let (data, truth) = frame_data(rep, view)?;
+                    let c = Converged {
+                        report: *rep,
+                        u: frame.solution.u.clone(),
+                        adjoint: frame.solution.adjoint.clone(),
+                        chart: frame.chart,
+                        previous: frame.previous.map(<[Angles]>::to_vec),
+                        state: frame.state.clone(),
+                        data,
+                        truth,
+                    };
+                    tx.send(c).map_err(|_| "the output thread stopped (see the write error)".to_string())?;
                     progress(rep.frame - first_frame + 1, total);
                     Ok(())
                 },
@@ -413,11 +431,37 @@ pub fn run_clip<S: FrameSink>(
     });
     // A write error explains a stopped clip better than the stop itself.
     let stopped = match (written, result) {
-        (Err(e), _) => Some(RunError::Sink(Box::new(e))),
+        (Err(OutputStop::Sink(e)), _) => Some(RunError::Sink(Box::new(e))),
+        (Err(OutputStop::Derive { frame, message }), _) => {
+            Some(RunError::Sequence(SequenceError::Callback { frame, message }))
+        }
         (Ok(()), Err(e)) => Some(e),
         (Ok(()), Ok(())) => None,
     };
     Ok(ClipOutcome { run: summary.finish(start.elapsed().as_secs_f64(), source), stopped, total })
+}
+
+/// A converged frame as the solve hands it over (owned: the output thread derives the
+/// [`ClipFrame`] from it while the next frame is solved).
+struct Converged {
+    report: FrameReport,
+    /// state and adjoint in space coordinates (forward layout; angles in the frame's chart)
+    u: DVector<f64>,
+    adjoint: DVector<f64>,
+    chart: Chart,
+    /// the previous frame's angles in this frame's chart (`None` on the first frame)
+    previous: Option<Vec<Angles>>,
+    /// the state in the frame's chart
+    state: DVector<f64>,
+    /// the frame's data positions [m] and, for a synthetic clip, its ground truth
+    data: Vec<Vector3<f64>>,
+    truth: Option<FrameTruth>,
+}
+
+/// Why the output thread stopped: the sink's error, or a frame that could not be derived.
+enum OutputStop<E> {
+    Sink(E),
+    Derive { frame: usize, message: String },
 }
 
 /// An interrupt of a run of a streamed clip's frames, counted against the whole clip's
