@@ -86,8 +86,7 @@ fn main() -> Result<()> {
     let fwd = problem.dofs();
     let (us, adj) = (dofs.kkt_state(&big), dofs.kkt_adjoint(&big));
     time("iteration record (measures)", &mut || {
-        std::hint::black_box(measures::fit_measures(&problem, &params, &us, x_g));
-        std::hint::black_box(measures::objective_terms(&problem, &params, false, &us, &adj, x_g, &prev));
+        std::hint::black_box(measures::measures(&problem, &params, false, &us, &adj, x_g, &prev));
     });
     time("relative change", &mut || {
         std::hint::black_box(cosserat::solve::statics::relative_change(&fwd, &us, &adj));

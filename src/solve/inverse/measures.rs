@@ -1,5 +1,5 @@
 //! What a frame's iterate is measured by (`docs/inverse.md`, I2): the fit to the data and the
-//! terms of the objective (41), each one pass of [`integrate`] over the mesh.
+//! terms of the objective (41), in one pass of [`integrate`] over the mesh per rule.
 use nalgebra::{DVector, Vector3};
 
 use super::kkt::{PointRule, KAPPA_RULE};
@@ -19,21 +19,68 @@ pub fn angular_velocity(alpha: &Angles, alpha_prev: &Angles, dt_s: f64) -> Vecto
     a_matrix(alpha) * (alpha - alpha_prev) / dt_s
 }
 
-/// `(‖x − x_g‖/‖x_g‖, ‖∂s x − d3‖)` with the integration rules of I2 (the misfit with the λd
-/// term's rule, I11).
-pub fn fit_measures(problem: &Problem, p: &InverseParams, u: &DVector<f64>, x_g: &[Vector3<f64>]) -> (f64, f64) {
-    let (mesh, dofs) = (&problem.mesh, problem.dofs());
-    let h = mesh.h();
-    let mut t2 = 0.0;
-    let rule = PointRule::tangent(problem, p.stabilisation);
-    integrate(mesh, rule.iter(), |e, xi, w| {
-        let q = interpolate(&dofs.gather(u, e), h, xi);
-        t2 += w * h * (q.dx - d3(&q.alpha)).norm_squared();
-    });
-    (position_error(problem, u, x_g), t2.sqrt())
+/// The fit to the data and the objective (41) at one iterate, with the rules of I2.
+#[derive(Clone, Copy, Debug)]
+pub struct Measures {
+    /// ‖x − x_g‖/‖x_g‖ (2-point Gauss)
+    pub x_err_rel: f64,
+    /// ‖∂s x − d3‖ [m^½] (the λd term's rule, I11)
+    pub tangent_misfit: f64,
+    pub objective: ObjectiveTerms,
 }
 
-/// `‖x − x_g‖/‖x_g‖` of [`fit_measures`] alone (2-point Gauss, I2): no angles, no trigonometry.
+/// [`Measures`] at the state `u` with the adjoint `adjoint` (forward layout each);
+/// `alpha_prev`: the previous frame's angles (the Λω term is off on the first frame). Three
+/// passes of [`integrate`], one per rule: the 2-point Gauss rule (fit, tracking, controls, Λω),
+/// the λd term's rule (misfit and shear term from the same `|∂s x − d3|²`) and the Λκ rule.
+pub fn measures(
+    problem: &Problem,
+    p: &InverseParams,
+    first_frame: bool,
+    u: &DVector<f64>,
+    adjoint: &DVector<f64>,
+    x_g: &[Vector3<f64>],
+    alpha_prev: &[Vector3<f64>],
+) -> Measures {
+    let (mesh, dofs) = (&problem.mesh, problem.dofs());
+    let h = mesh.h();
+    let w8 = &p.weights;
+    let mut t = ObjectiveTerms::default();
+    let (mut e2, mut g2, mut t2) = (0.0, 0.0, 0.0);
+    let state = |e: usize, xi: f64| interpolate(&dofs.gather::<12>(u, e), h, xi);
+    integrate(mesh, GAUSS2.iter(), |e, xi, w| {
+        let q = state(e, xi);
+        let ae: LocalVec = dofs.gather(adjoint, e);
+        let qa = interpolate(&ae, h, xi);
+        let xg = x_g[e] * q.n[0] + x_g[e + 1] * q.n[1];
+        let d2 = (q.x - xg).norm_squared();
+        e2 += w * h * d2;
+        g2 += w * h * xg.norm_squared();
+        let wh = 0.5 * w * h;
+        t.tracking += wh * w8.lambda_g * d2;
+        t.force += wh * qa.x.norm_squared() / w8.lambda_f;
+        t.torque += wh * qa.alpha.norm_squared() / w8.lambda_l;
+        if !first_frame {
+            let ap = alpha_prev[e] * q.n[0] + alpha_prev[e + 1] * q.n[1];
+            let om = angular_velocity(&q.alpha, &ap, p.frame_interval_s);
+            t.angular += wh * om.component_mul(&om).dot(&w8.lambda_omega);
+        }
+    });
+    integrate(mesh, PointRule::tangent(problem, p.stabilisation).iter(), |e, xi, w| {
+        let q = state(e, xi);
+        let m2 = (q.dx - d3(&q.alpha)).norm_squared();
+        t2 += w * h * m2;
+        t.shear += 0.5 * w * h * w8.lambda_d * m2;
+    });
+    integrate(mesh, KAPPA_RULE.iter(), |e, xi, w| {
+        let q = state(e, xi);
+        let k = curvature(&q.alpha, &q.dalpha);
+        t.bending += 0.5 * w * h * k.component_mul(&k).dot(&w8.lambda_kappa);
+    });
+    Measures { x_err_rel: (e2 / g2).sqrt(), tangent_misfit: t2.sqrt(), objective: t }
+}
+
+/// `‖x − x_g‖/‖x_g‖` of [`measures`] alone (the same sums): no angles, no trigonometry.
 pub fn position_error(problem: &Problem, u: &DVector<f64>, x_g: &[Vector3<f64>]) -> f64 {
     let (mesh, dofs) = (&problem.mesh, problem.dofs());
     let h = mesh.h();
@@ -45,50 +92,6 @@ pub fn position_error(problem: &Problem, u: &DVector<f64>, x_g: &[Vector3<f64>])
         g2 += w * h * xg.norm_squared();
     });
     (e2 / g2).sqrt()
-}
-
-/// The terms of the objective (41) at the state `u` with the adjoint `adjoint` (forward
-/// layout each), integrated with the rules of I2; `alpha_prev`: the previous frame's angles
-/// (the Λω term is off on the first frame).
-pub fn objective_terms(
-    problem: &Problem,
-    p: &InverseParams,
-    first_frame: bool,
-    u: &DVector<f64>,
-    adjoint: &DVector<f64>,
-    x_g: &[Vector3<f64>],
-    alpha_prev: &[Vector3<f64>],
-) -> ObjectiveTerms {
-    let (mesh, dofs) = (&problem.mesh, problem.dofs());
-    let h = mesh.h();
-    let w8 = &p.weights;
-    let mut t = ObjectiveTerms::default();
-    let state = |e: usize, xi: f64| interpolate(&dofs.gather::<12>(u, e), h, xi);
-    integrate(mesh, GAUSS2.iter(), |e, xi, w| {
-        let q = state(e, xi);
-        let ae: LocalVec = dofs.gather(adjoint, e);
-        let qa = interpolate(&ae, h, xi);
-        let wh = 0.5 * w * h;
-        let xg = x_g[e] * q.n[0] + x_g[e + 1] * q.n[1];
-        t.tracking += wh * w8.lambda_g * (q.x - xg).norm_squared();
-        t.force += wh * qa.x.norm_squared() / w8.lambda_f;
-        t.torque += wh * qa.alpha.norm_squared() / w8.lambda_l;
-        if !first_frame {
-            let ap = alpha_prev[e] * q.n[0] + alpha_prev[e + 1] * q.n[1];
-            let om = angular_velocity(&q.alpha, &ap, p.frame_interval_s);
-            t.angular += wh * om.component_mul(&om).dot(&w8.lambda_omega);
-        }
-    });
-    integrate(mesh, PointRule::tangent(problem, p.stabilisation).iter(), |e, xi, w| {
-        let q = state(e, xi);
-        t.shear += 0.5 * w * h * w8.lambda_d * (q.dx - d3(&q.alpha)).norm_squared();
-    });
-    integrate(mesh, KAPPA_RULE.iter(), |e, xi, w| {
-        let q = state(e, xi);
-        let k = curvature(&q.alpha, &q.dalpha);
-        t.bending += 0.5 * w * h * k.component_mul(&k).dot(&w8.lambda_kappa);
-    });
-    t
 }
 
 /// The per-iteration record of `frame` at the state `u` with the adjoint `adjoint` (fit
@@ -105,7 +108,7 @@ pub(crate) fn record(
     adjoint: &DVector<f64>,
     residual: Option<f64>,
 ) -> InverseRecord {
-    let (x_err_rel, tangent_misfit) = fit_measures(problem, p, u, frame.x_g);
-    let objective = objective_terms(problem, p, frame.is_first(), u, adjoint, frame.x_g, alpha_prev);
+    let m = measures(problem, p, frame.is_first(), u, adjoint, frame.x_g, alpha_prev);
+    let (x_err_rel, tangent_misfit, objective) = (m.x_err_rel, m.tangent_misfit, m.objective);
     InverseRecord { iteration, rel_change, x_err_rel, tangent_misfit, objective, residual }
 }
