@@ -85,31 +85,62 @@ impl Chart {
     /// Angles of the frame `q` (rows = directors, space coordinates) in this chart, each
     /// angle shifted by a multiple of 2π to lie nearest `near` (R6).
     pub fn angles_of(&self, q: &Matrix3<f64>, near: &Angles) -> Angles {
-        let mut a = angles_from_rotation(&(q * self.base.transpose()));
-        for k in 0..3 {
-            a[k] += 2.0 * PI * ((near[k] - a[k]) / (2.0 * PI)).round();
-        }
-        a
+        unwrap_near(angles_from_rotation(&(q * self.base.transpose())), near)
     }
 
     /// Re-express nodal angles of `from` in this chart (R6): each node's frame
     /// `Q_E(α_i) B_from` is converted, and unwrapped against `near_i` (if given) or else
     /// against the previous node. Returns the input unchanged when the bases are equal.
     pub fn reexpress(&self, from: &Chart, alpha: &[Angles], near: Option<&[Angles]>) -> Vec<Angles> {
+        self.converted(from, alpha).unwrapped(near)
+    }
+
+    /// The conversion step of [`Chart::reexpress`], before unwrapping: for angles that are
+    /// re-expressed against more than one guide, the (costly) conversion once.
+    pub fn converted(&self, from: &Chart, alpha: &[Angles]) -> Converted {
         if from.base == self.base {
-            return alpha.to_vec();
+            return Converted::Same(alpha.to_vec());
         }
-        let mut out: Vec<Angles> = Vec::with_capacity(alpha.len());
-        for (i, a) in alpha.iter().enumerate() {
+        Converted::Raw(alpha.iter().map(|a| angles_from_rotation(&(from.rotation(a) * self.base.transpose()))).collect())
+    }
+}
+
+/// Nodal angles converted to a chart by [`Chart::converted`], to be unwrapped.
+#[derive(Clone, Debug)]
+pub enum Converted {
+    /// the charts are the same: the angles as they were (not unwrapped)
+    Same(Vec<Angles>),
+    /// the angles of `angles_from_rotation` in the new chart
+    Raw(Vec<Angles>),
+}
+
+impl Converted {
+    /// The angles unwrapped as [`Chart::reexpress`] does: against `near_i` (if given) or else
+    /// against the previous node (the first node against itself).
+    pub fn unwrapped(&self, near: Option<&[Angles]>) -> Vec<Angles> {
+        let raw = match self {
+            Converted::Same(a) => return a.clone(),
+            Converted::Raw(raw) => raw,
+        };
+        let mut out: Vec<Angles> = Vec::with_capacity(raw.len());
+        for (i, a) in raw.iter().enumerate() {
             let guide = match (near, out.last()) {
                 (Some(nr), _) => nr[i],
                 (None, Some(p)) => *p,
-                (None, None) => angles_from_rotation(&(rotation(a) * from.base * self.base.transpose())),
+                (None, None) => *a,
             };
-            out.push(self.angles_of(&from.rotation(a), &guide));
+            out.push(unwrap_near(*a, &guide));
         }
         out
     }
+}
+
+/// `a` with each angle shifted by a multiple of 2π to lie nearest `near` (R6).
+fn unwrap_near(mut a: Angles, near: &Angles) -> Angles {
+    for k in 0..3 {
+        a[k] += 2.0 * PI * ((near[k] - a[k]) / (2.0 * PI)).round();
+    }
+    a
 }
 
 /// Unit tangents of the elements of a polyline (chords).

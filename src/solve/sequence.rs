@@ -13,7 +13,7 @@ use std::f64::consts::PI;
 
 use nalgebra::{DVector, Matrix3, Vector3};
 
-use crate::model::chart::{frame_axis, Chart};
+use crate::model::chart::{frame_axis, Chart, Converted};
 use crate::model::mesh::{DofMap, Field};
 use crate::model::rotation::{angles_from_rotation, skew, Angles};
 
@@ -282,8 +282,11 @@ pub fn solve_sequence_from(
         // linear predictor 2 u_{n−1} − u_{n−2} (the clip is sampled smoothly in time).
         // (Carrying the adjoint as well, instead of Newton's consistent-start solve, sent frame
         // 659 of worm_roll_3d to a wrong root: not done.)
+        // the previous frame's angles converted to this chart once, unwrapped twice (along the
+        // rod for the carried state, against the start for the Λω term)
+        let prev_angles = prev.as_ref().map(|(c, u)| chart.converted(c, &dofs.field(u, Field::Alpha)));
         let carried = prev.as_ref().map(|(c, u)| {
-            let u1 = carry_state(&dofs, &chart, c, u, None);
+            let u1 = carry_converted(&dofs, &chart, c, u, prev_angles.as_ref(), None);
             match &prev2 {
                 Some((c2, u2)) => &u1 * 2.0 - carry_state(&dofs, &chart, c2, u2, Some(&u1)),
                 None => u1,
@@ -294,9 +297,9 @@ pub fn solve_sequence_from(
             (Some(u), FrameStart::PreviousFrame, _) => u.clone(),
             _ => guess(),
         };
-        let alpha_prev: Option<Vec<Angles>> = prev.as_ref().map(|(c, u)| {
+        let alpha_prev: Option<Vec<Angles>> = prev_angles.as_ref().map(|converted| {
             let near = dofs.field(&first_start, Field::Alpha);
-            chart.reexpress(c, &dofs.field(u, Field::Alpha), Some(&near))
+            converted.unwrapped(Some(&near))
         });
         let frame = Frame { index: k, x_g: &x_g, previous: alpha_prev.as_deref() };
         // From the previous frame's solution (already close) Newton runs directly; from a guess
@@ -365,12 +368,26 @@ pub fn solve_sequence_from(
 /// angles re-expressed node by node without 2π jumps along the rod (or against `near`).
 /// `near`: a state in chart `to` whose angles the result's are unwrapped against (R6).
 fn carry_state(dofs: &DofMap, to: &Chart, from: &Chart, u: &DVector<f64>, near: Option<&DVector<f64>>) -> DVector<f64> {
+    carry_converted(dofs, to, from, u, None, near)
+}
+
+/// [`carry_state`] with `u`'s angles already converted to `to` (`Chart::converted`), if given.
+fn carry_converted(
+    dofs: &DofMap,
+    to: &Chart,
+    from: &Chart,
+    u: &DVector<f64>,
+    converted: Option<&Converted>,
+    near: Option<&DVector<f64>>,
+) -> DVector<f64> {
     if to.base == from.base {
         return u.clone();
     }
-    let alpha = dofs.field(u, Field::Alpha);
     let near: Option<Vec<Angles>> = near.map(|v| dofs.field(v, Field::Alpha));
-    let alpha = to.reexpress(from, &alpha, near.as_deref());
+    let alpha = match converted {
+        Some(c) => c.unwrapped(near.as_deref()),
+        None => to.converted(from, &dofs.field(u, Field::Alpha)).unwrapped(near.as_deref()),
+    };
     let mut out = dofs.zeros();
     for j in 0..dofs.nodes() {
         dofs.set(&mut out, j, Field::X, &to.to_chart(&from.to_space(&dofs.get(u, j, Field::X))));
