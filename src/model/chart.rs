@@ -101,7 +101,9 @@ impl Chart {
         if from.base == self.base {
             return Converted::Same(alpha.to_vec());
         }
-        Converted::Raw(alpha.iter().map(|a| angles_from_rotation(&(from.rotation(a) * self.base.transpose()))).collect())
+        Converted::Raw(
+            alpha.iter().map(|a| angles_from_rotation(&(from.rotation(a) * self.base.transpose()))).collect(),
+        )
     }
 }
 
