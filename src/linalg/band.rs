@@ -246,15 +246,30 @@ impl BandLu {
     }
 }
 
+/// Column length up to which [`pivot`] scans sequentially.
+const SHORT_COLUMN: usize = 12;
+
 /// The pivot of a column `v` (the diagonal entry first, then the rows below it): the first
 /// entry of largest magnitude, and that magnitude; NaN entries are passed over, and a NaN on
 /// the diagonal is kept (the caller reports it). As the sequential scan
 /// `if |v_t| > best { best = |v_t|; p = t }` from `best = |v_0|`, in two passes: the maximum
 /// in four independent lanes (the same value: `max` is exact and, over non-NaN values,
 /// independent of order), then the first entry equal to it.
+/// Up to [`SHORT_COLUMN`] entries (block size 6: at most 12 rows) the sequential scan itself is
+/// faster.
 #[inline]
 fn pivot(v: &[f64]) -> (usize, f64) {
     let first = v[0].abs();
+    if v.len() <= SHORT_COLUMN {
+        let (mut p, mut best) = (0, first);
+        for (t, x) in v.iter().enumerate().skip(1) {
+            if x.abs() > best {
+                best = x.abs();
+                p = t;
+            }
+        }
+        return (p, best);
+    }
     let mut acc = [first; 4];
     let mut chunks = v[1..].chunks_exact(4);
     for c in &mut chunks {

@@ -33,7 +33,9 @@ struct Trig {
 }
 
 impl Trig {
-    /// The sines and cosines of `a`, from [`TRIG_CACHE`] if they were computed lately.
+    /// The sines and cosines of `a`, from [`TRIG_CACHE`] if they were computed lately. Inlined
+    /// into every kernel (the lookup is a few comparisons; a call costs as much).
+    #[inline(always)]
     fn new(a: &Angles) -> Self {
         let key = [a[0].to_bits(), a[1].to_bits(), a[2].to_bits()];
         TRIG_CACHE.with(|c| {
@@ -49,6 +51,7 @@ impl Trig {
         })
     }
 
+    #[inline(never)]
     fn compute(a: &Angles) -> Self {
         let (sa, ca) = a[0].sin_cos();
         let (sb, cb) = a[1].sin_cos();
