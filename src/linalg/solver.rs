@@ -249,6 +249,45 @@ fn scale_column<const L: usize>(a: &mut [f64], r: &[f64], c: f64, next: &mut [f6
     }
 }
 
+/// A column of a Ruiz pass that is not the last, four rows per instruction: `a_i ← a_i (r_i c)`,
+/// `next_i ← max(next_i, |a_i|)`, and the column's maximum `|a_i|` returned, in one sweep (the
+/// scaled values are not read back). The same products, each rounded once, and the same maxima
+/// (`_mm256_max_pd(m, x)` keeps `x` where `m` is NaN, as `if m > x { m } else { x }` does).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn scale_and_measure_avx2(a: &mut [f64], r: &[f64], c: f64, next: &mut [f64]) -> f64 {
+    use std::arch::x86_64::{
+        _mm256_andnot_pd, _mm256_loadu_pd, _mm256_max_pd, _mm256_mul_pd, _mm256_set1_pd, _mm256_setzero_pd,
+        _mm256_storeu_pd,
+    };
+    let n = a.len();
+    assert!(r.len() == n && next.len() == n, "one row factor and one maximum per entry");
+    let (cv, sign) = (_mm256_set1_pd(c), _mm256_set1_pd(-0.0));
+    let mut acc = _mm256_setzero_pd();
+    let full = n / 4 * 4;
+    // SAFETY (loads and stores): lanes i..i + 4 ≤ n of the three slices of length n.
+    for i in (0..full).step_by(4) {
+        let v =
+            _mm256_mul_pd(_mm256_loadu_pd(a.as_ptr().add(i)), _mm256_mul_pd(_mm256_loadu_pd(r.as_ptr().add(i)), cv));
+        _mm256_storeu_pd(a.as_mut_ptr().add(i), v);
+        let m = _mm256_andnot_pd(sign, v);
+        let x = next.as_mut_ptr().add(i);
+        _mm256_storeu_pd(x, _mm256_max_pd(m, _mm256_loadu_pd(x)));
+        acc = _mm256_max_pd(m, acc);
+    }
+    let mut lanes = [0.0_f64; 4];
+    _mm256_storeu_pd(lanes.as_mut_ptr(), acc);
+    let mut best = lanes.iter().fold(0.0_f64, |b, &m| if m > b { m } else { b });
+    for i in full..n {
+        let v = a[i] * (r[i] * c);
+        a[i] = v;
+        let m = v.abs();
+        next[i] = if m > next[i] { m } else { next[i] };
+        best = if m > best { m } else { best };
+    }
+    best
+}
+
 /// Five passes of Ruiz row/column max-norm scaling of the values in `a` (column `j` of the
 /// pattern at `a[cols.band[j]..][..cols.len[j]]`, rows from `cols.first[j]`), in place, with the
 /// accumulated row and column factors in `dr`, `dc` (`r`, `c`, `r_next`: scratch). Each pass
@@ -266,6 +305,8 @@ fn ruiz(
     maxima_ready: bool,
 ) {
     let n = cols.len.len();
+    #[cfg(target_arch = "x86_64")]
+    let wide = std::arch::is_x86_feature_detected!("avx2");
     dr.iter_mut().for_each(|v| *v = 1.0);
     dc.iter_mut().for_each(|v| *v = 1.0);
     // the rows of a column are contiguous (block-tridiagonal pattern): slices, no gathers
@@ -292,6 +333,12 @@ fn ruiz(
             // the maxima of the next pass come from the freshly scaled column; the columns of
             // a block-tridiagonal pattern hold 2 or 3 blocks of rows (block 6 or 12): those
             // lengths have loops of fixed length
+            #[cfg(target_arch = "x86_64")]
+            if !last && wide {
+                // SAFETY: `wide` says the CPU has AVX2.
+                c[j] = unsafe { scale_and_measure_avx2(a, rows, cj, next) };
+                continue;
+            }
             let m = match a.len() {
                 36 => scale_column::<36>(a, rows, cj, next, !last),
                 24 => scale_column::<24>(a, rows, cj, next, !last),
