@@ -1,0 +1,95 @@
+//! The rank-1 update of [`super::BandLu::factor`] with AVX2 (or AVX-512) vectors where the CPU
+//! has them.
+
+/// Whether the CPU has AVX2 (detected once, then cached by the standard library).
+#[inline]
+pub fn available() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::arch::is_x86_feature_detected!("avx2")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
+/// [`super::update`] four rows at a time ([`kernel`]), or eight with AVX-512 (e.g. AMD Zen 4,
+/// Intel Xeon), the last `KL mod 8` under a mask ([`kernel512`]): the `KL` multipliers stay in
+/// registers for all `span` columns, and each row is `d − l · u` with one rounding per
+/// operation, as there. Only called when [`available`].
+#[inline]
+pub fn update<const KL: usize>(head: &[f64], tail: &mut [f64], col: usize, kv: usize, ld: usize, span: usize) {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: called only when `available()` (the CPU has AVX2), and kernel512 only when it
+    // has AVX-512F.
+    unsafe {
+        if std::arch::is_x86_feature_detected!("avx512f") {
+            kernel512::<KL>(head, tail, col, kv, ld, span)
+        } else {
+            kernel::<KL>(head, tail, col, kv, ld, span)
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    super::update::<KL>(head, tail, col, kv, ld, span)
+}
+
+/// [`kernel`] with 8-wide vectors; masked lanes are neither read nor written.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+unsafe fn kernel512<const KL: usize>(head: &[f64], tail: &mut [f64], col: usize, kv: usize, ld: usize, span: usize) {
+    use std::arch::x86_64::{
+        _mm512_loadu_pd, _mm512_mask_storeu_pd, _mm512_maskz_loadu_pd, _mm512_mul_pd, _mm512_set1_pd, _mm512_storeu_pd,
+        _mm512_sub_pd,
+    };
+    let l: &[f64; KL] = head[col + 1..col + 1 + KL].try_into().expect("KL multipliers");
+    let (full, rest) = (KL / 8, KL % 8);
+    let mask = ((1u32 << rest) - 1) as u8;
+    // SAFETY (loads and stores): full lanes 8v..8v + 8 ≤ KL, masked lanes < KL, of `l` and
+    // of the KL-long `dst`.
+    let lv = [0, 1, 2].map(|v| if v < full { _mm512_loadu_pd(l.as_ptr().add(8 * v)) } else { _mm512_set1_pd(0.0) });
+    let lr = _mm512_maskz_loadu_pd(mask, l.as_ptr().add(8 * full));
+    for (t, column) in tail.chunks_exact_mut(ld).take(span).enumerate() {
+        let base = kv - 1 - t;
+        let ujc = column[base];
+        if ujc != 0.0 {
+            let dst: &mut [f64; KL] = (&mut column[base + 1..base + 1 + KL]).try_into().expect("KL rows");
+            let u = _mm512_set1_pd(ujc);
+            for (v, lv) in lv.iter().enumerate().take(full) {
+                let p = dst.as_mut_ptr().add(8 * v);
+                _mm512_storeu_pd(p, _mm512_sub_pd(_mm512_loadu_pd(p), _mm512_mul_pd(*lv, u)));
+            }
+            if rest != 0 {
+                let p = dst.as_mut_ptr().add(8 * full);
+                let d = _mm512_maskz_loadu_pd(mask, p);
+                _mm512_mask_storeu_pd(p, mask, _mm512_sub_pd(d, _mm512_mul_pd(lr, u)));
+            }
+        }
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn kernel<const KL: usize>(head: &[f64], tail: &mut [f64], col: usize, kv: usize, ld: usize, span: usize) {
+    use std::arch::x86_64::{_mm256_loadu_pd, _mm256_mul_pd, _mm256_set1_pd, _mm256_storeu_pd, _mm256_sub_pd};
+    let l: &[f64; KL] = head[col + 1..col + 1 + KL].try_into().expect("KL multipliers");
+    let full = KL / 4;
+    // SAFETY (loads and stores): lanes 4v..4v + 4 ≤ KL of `l` and of the KL-long `dst`.
+    let lv =
+        [0, 1, 2, 3, 4, 5].map(|v| if v < full { _mm256_loadu_pd(l.as_ptr().add(4 * v)) } else { _mm256_set1_pd(0.0) });
+    for (t, column) in tail.chunks_exact_mut(ld).take(span).enumerate() {
+        let base = kv - 1 - t;
+        let ujc = column[base];
+        if ujc != 0.0 {
+            let dst: &mut [f64; KL] = (&mut column[base + 1..base + 1 + KL]).try_into().expect("KL rows");
+            let u = _mm256_set1_pd(ujc);
+            for (v, lv) in lv.iter().enumerate().take(full) {
+                let p = dst.as_mut_ptr().add(4 * v);
+                _mm256_storeu_pd(p, _mm256_sub_pd(_mm256_loadu_pd(p), _mm256_mul_pd(*lv, u)));
+            }
+            for r in 4 * full..KL {
+                dst[r] -= l[r] * ujc;
+            }
+        }
+    }
+}
