@@ -6,13 +6,14 @@
 //! On a 20-frame `worm_roll_3d` with 16 nodes; needs the omega-turn kymogram.
 mod common;
 
-use std::path::{Path, PathBuf};
 use std::sync::mpsc::{channel, Sender};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
-use common::{case_text, edit, worm_data_present};
+use common::{short_roll_case, worm_data_present};
 use cosserat::case::Case;
+use cosserat::clip::synthetic::{FrameTruth, GroundTruth};
+use cosserat::clip::Clip;
 use cosserat::io::clip_files::load_clip;
 use cosserat::run::clip::{run_clip, ClipFrame, ClipFrames, ClipOutcome, FrameSink, StreamedFrame};
 use cosserat::run::RunError;
@@ -20,18 +21,20 @@ use cosserat::run::RunError;
 const FRAMES: usize = 20;
 const NODES: usize = 16;
 
-fn case_file(dir: &Path) -> PathBuf {
-    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/elegansbot");
-    let text =
-        edit(&case_text("worm_roll_3d"), "file = \"../data/elegansbot/", &format!("file = \"{}/", data.display()));
-    let text = edit(
-        &edit(&text, "elements = 127", &format!("elements = {}", NODES - 1)),
-        "clip_frames = 1160",
-        &format!("clip_frames = {FRAMES}"),
-    );
-    let path = dir.join("roll_stream.toml");
-    std::fs::write(&path, text).expect("case");
-    path
+/// The short clip as a case, its frames and their ground truth (`None` without the worm data).
+fn short_clip(test: &str) -> Option<(tempfile::TempDir, Case, Clip, GroundTruth)> {
+    if !worm_data_present(test) {
+        return None;
+    }
+    let dir = tempfile::tempdir().expect("tempdir");
+    let case = Case::from_file(&short_roll_case(dir.path(), "roll_stream.toml", FRAMES, NODES)).expect("case");
+    let (clip, truth) = load_clip(&case).expect("clip");
+    Some((dir, case, clip, truth.expect("a synthetic clip has a ground truth")))
+}
+
+/// The clip without its frames, as a stream's header.
+fn header(clip: &Clip) -> Clip {
+    Clip { frames: Vec::new(), ..clip.clone() }
 }
 
 /// Keeps every frame handed to it.
@@ -71,13 +74,7 @@ fn bits(f: &ClipFrame) -> Vec<u64> {
 }
 
 /// Send frames `0..count` of the loaded clip, waiting `pause` before each.
-fn feed(
-    tx: Sender<StreamedFrame>,
-    clip: &cosserat::clip::Clip,
-    truth: &[cosserat::clip::synthetic::FrameTruth],
-    count: usize,
-    pause: Duration,
-) {
+fn feed(tx: Sender<StreamedFrame>, clip: &Clip, truth: &[FrameTruth], count: usize, pause: Duration) {
     for i in 0..count {
         std::thread::sleep(pause);
         if tx.send((clip.frames[i].clone(), Some(truth[i].clone()))).is_err() {
@@ -88,13 +85,10 @@ fn feed(
 
 #[test]
 fn a_streamed_clip_gives_the_frames_of_one_solve_bit_for_bit() {
-    if !worm_data_present("a_streamed_clip_gives_the_frames_of_one_solve_bit_for_bit") {
+    let Some((_dir, case, clip, truth)) = short_clip("a_streamed_clip_gives_the_frames_of_one_solve_bit_for_bit")
+    else {
         return;
-    }
-    let dir = tempfile::tempdir().expect("tempdir");
-    let case = Case::from_file(&case_file(dir.path())).expect("case");
-    let (clip, truth) = load_clip(&case).expect("clip");
-    let truth = truth.expect("a synthetic clip has a ground truth");
+    };
     let (whole, reference) = solve(&case, ClipFrames::Loaded { clip: &clip, truth: Some(&truth) });
     assert!(whole.stopped.is_none(), "{:?}", whole.stopped);
     assert_eq!(reference.len(), FRAMES);
@@ -104,8 +98,7 @@ fn a_streamed_clip_gives_the_frames_of_one_solve_bit_for_bit() {
         let (tx, rx) = channel();
         let (out, got) = std::thread::scope(|s| {
             s.spawn(|| feed(tx, &clip, &truth.frames, FRAMES, pause));
-            let header = cosserat::clip::Clip { frames: Vec::new(), ..clip.clone() };
-            solve(&case, ClipFrames::Streamed { header, total: FRAMES, truth: true, frames: rx })
+            solve(&case, ClipFrames::Streamed { header: header(&clip), total: FRAMES, truth: true, frames: rx })
         });
         assert!(out.stopped.is_none(), "pause {pause:?}: {:?}", out.stopped);
         assert_eq!(got.len(), FRAMES);
@@ -120,17 +113,13 @@ fn a_streamed_clip_gives_the_frames_of_one_solve_bit_for_bit() {
 
 #[test]
 fn a_stream_that_ends_early_stops_the_clip_with_an_error() {
-    if !worm_data_present("a_stream_that_ends_early_stops_the_clip_with_an_error") {
+    let Some((_dir, case, clip, truth)) = short_clip("a_stream_that_ends_early_stops_the_clip_with_an_error") else {
         return;
-    }
-    let dir = tempfile::tempdir().expect("tempdir");
-    let case = Case::from_file(&case_file(dir.path())).expect("case");
-    let (clip, truth) = load_clip(&case).expect("clip");
-    let truth = truth.expect("ground truth");
+    };
     let (tx, rx) = channel();
     feed(tx, &clip, &truth.frames, 5, Duration::ZERO);
-    let header = cosserat::clip::Clip { frames: Vec::new(), ..clip.clone() };
-    let (out, got) = solve(&case, ClipFrames::Streamed { header, total: FRAMES, truth: true, frames: rx });
+    let (out, got) =
+        solve(&case, ClipFrames::Streamed { header: header(&clip), total: FRAMES, truth: true, frames: rx });
     assert_eq!(got.len(), 5, "the frames that arrived are solved and handed over");
     match out.stopped {
         Some(RunError::Generator { received: 5, total: FRAMES }) => {}

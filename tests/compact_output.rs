@@ -9,7 +9,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use assert_cmd::Command;
-use common::{case_text, edit, worm_data_present};
+use common::{short_roll_case, worm_data_present};
 use cosserat::io::clip_output::CLIP_FIELD_COLUMNS;
 use cosserat::io::compact::{read_compact, CompactClip, OutputFormat, COMPACT_FILE, CURVATURE_COLUMNS, RAW_FIELDS};
 use cosserat::io::engine::{run_clip_to, ClipOptions};
@@ -22,17 +22,7 @@ const NODES: usize = 16;
 
 /// The short clip as a case file in `dir`.
 fn case_file(dir: &Path) -> PathBuf {
-    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/elegansbot");
-    let text =
-        edit(&case_text("worm_roll_3d"), "file = \"../data/elegansbot/", &format!("file = \"{}/", data.display()));
-    let text = edit(
-        &edit(&text, "elements = 127", &format!("elements = {}", NODES - 1)),
-        "clip_frames = 1160",
-        &format!("clip_frames = {FRAMES}"),
-    );
-    let path = dir.join("roll_short.toml");
-    std::fs::write(&path, text).expect("case");
-    path
+    short_roll_case(dir, "roll_short.toml", FRAMES, NODES)
 }
 
 fn run(case: &Path, out: &Path, extra: &[&str]) {

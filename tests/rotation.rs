@@ -6,7 +6,7 @@
 //! `COSSERAT_TEST_FRAMES=N` limits each run to the first N frames (for local iteration only).
 mod common;
 
-use common::{case_from, case_text, edit, worm_data_present};
+use common::{case_from, case_text_with_data, edit, worm_data_present};
 use cosserat::case::Case;
 use cosserat::io::engine::run_case;
 use cosserat::io::engine::{run_clip_case, EngineError};
@@ -32,8 +32,7 @@ fn parse(path: &Path) -> Vec<Vec<f64>> {
 
 /// The omega/delta Newton case (λd = 1) with extra `[clip]` lines.
 fn clip_case(name: &str, clip_lines: &str, frames: Option<usize>) -> Case {
-    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/elegansbot");
-    let mut text = edit(&case_text(name), "file = \"../data/elegansbot/", &format!("file = \"{}/", data.display()));
+    let mut text = case_text_with_data(name);
     text = edit(&text, "start = \"data_guess\"", &format!("start = \"data_guess\"\n{clip_lines}"));
     if let Some(n) = frames {
         text = edit(&text, "min_cos_beta = 1e-3", &format!("min_cos_beta = 1e-3\nframes = [0, {n}]"));

@@ -5,7 +5,7 @@ mod common;
 
 use std::f64::consts::PI;
 
-use common::{case_from, case_text, edit, worm_data_present};
+use common::{case_from, case_text_with_data, edit, worm_data_present};
 use cosserat::clip::synthetic::{roll_clip, RollClipParams, TimeMapping};
 use cosserat::io::clip_files::kymogram_rows;
 use cosserat::io::engine::{run_clip_case, EngineError};
@@ -17,10 +17,7 @@ use std::path::Path;
 
 /// The case with an absolute data path and extra `[clip]` lines.
 fn case(extra: &str) -> cosserat::case::Case {
-    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/elegansbot");
-    let text =
-        edit(&case_text("worm_roll_3d"), "file = \"../data/elegansbot/", &format!("file = \"{}/", data.display()));
-    case_from(&edit(&text, "rotation = \"rebased\"", extra), "worm_roll_3d")
+    case_from(&edit(&case_text_with_data("worm_roll_3d"), "rotation = \"rebased\"", extra), "worm_roll_3d")
 }
 
 fn run(extra: &str, out: &Path) -> Result<ClipRun, EngineError> {

@@ -21,6 +21,25 @@ pub fn case_text(name: &str) -> String {
     std::fs::read_to_string(cases_dir().join(format!("{name}.toml"))).expect("case file")
 }
 
+/// The text of the case `name` with its `../data/elegansbot/` path made absolute, so that the
+/// case can be written to and run from any folder.
+pub fn case_text_with_data(name: &str) -> String {
+    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/elegansbot");
+    edit(&case_text(name), "file = \"../data/elegansbot/", &format!("file = \"{}/", data.display()))
+}
+
+/// `worm_roll_3d` cut to `frames` frames of `nodes` nodes, written as `dir/file`.
+pub fn short_roll_case(dir: &Path, file: &str, frames: usize, nodes: usize) -> PathBuf {
+    let text = edit(
+        &edit(&case_text_with_data("worm_roll_3d"), "elements = 127", &format!("elements = {}", nodes - 1)),
+        "clip_frames = 1160",
+        &format!("clip_frames = {frames}"),
+    );
+    let path = dir.join(file);
+    std::fs::write(&path, text).expect("case");
+    path
+}
+
 /// Parse a case from (modified) TOML text.
 pub fn case_from(text: &str, name: &str) -> Case {
     Case::from_toml(text, name, Path::new(name)).unwrap_or_else(|e| panic!("{e}"))
