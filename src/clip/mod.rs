@@ -150,9 +150,7 @@ impl Clip {
 
     /// Keep the frames `[first, end)` (the case's `clip.frames`).
     pub fn select(&mut self, first: usize, end: usize) -> Result<(), ClipError> {
-        if first >= end || end > self.frame_count() {
-            return Err(ClipError::FrameRange { first, end, frames: self.frame_count() });
-        }
+        check_frame_range(first, end, self.frame_count())?;
         self.frames = self.frames[first..end].to_vec();
         Ok(())
     }
@@ -172,6 +170,14 @@ impl Clip {
             .filter(|&f| self.frames[f].windows(2).any(|w| near((w[1] - w[0]).normalize())))
             .collect()
     }
+}
+
+/// The frame range `[first, end)` of a clip of `frames` frames: non-empty and inside the clip.
+pub fn check_frame_range(first: usize, end: usize, frames: usize) -> Result<(), ClipError> {
+    if first >= end || end > frames {
+        return Err(ClipError::FrameRange { first, end, frames });
+    }
+    Ok(())
 }
 
 /// Rotate the positions of one frame rigidly by `r` (as [`Clip::rotate`]).

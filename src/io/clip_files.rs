@@ -11,8 +11,8 @@ use super::truth_file::{read_truth, truth_sidecar};
 use crate::case::{Case, ClipKind};
 use crate::clip::synthetic::{roll_clip, FrameTruth, GroundTruth, RollClipGenerator};
 use crate::clip::{
-    clip_from_angles, polyline_length, rotate_frame, Clip, ClipError, KymogramParams, MAX_CLIP_POSITIONS,
-    MAX_LENGTH_DEVIATION,
+    check_frame_range, clip_from_angles, polyline_length, rotate_frame, Clip, ClipError, KymogramParams,
+    MAX_CLIP_POSITIONS, MAX_LENGTH_DEVIATION,
 };
 
 /// Column names of a CSV recording.
@@ -247,9 +247,7 @@ pub fn roll_stream(case: &Case) -> Result<Option<RollStream>, ClipFileError> {
         });
     }
     let (first, end) = src.frames.unwrap_or((0, params.frames));
-    if first >= end || end > params.frames {
-        return Err(ClipError::FrameRange { first, end, frames: params.frames }.into());
-    }
+    check_frame_range(first, end, params.frames)?;
     Ok(Some(RollStream { generator, first, len: end - first, orientation: src.orientation }))
 }
 

@@ -5,7 +5,7 @@ use nalgebra::{DVector, Vector3};
 use super::kkt::{PointRule, KAPPA_RULE};
 use super::{Frame, InverseParams, InverseRecord, ObjectiveTerms};
 use crate::assemble::integrate;
-use crate::model::element::{interpolate, LocalVec};
+use crate::model::element::{interpolate, LocalVec, PointState};
 use crate::model::mesh::GAUSS2;
 use crate::model::rotation::{a_matrix, curvature, d3, Angles};
 use crate::solve::Problem;
@@ -52,10 +52,9 @@ pub fn measures(
         let q = state(e, xi);
         let ae: LocalVec = dofs.gather(adjoint, e);
         let qa = interpolate(&ae, h, xi);
-        let xg = x_g[e] * q.n[0] + x_g[e + 1] * q.n[1];
-        let d2 = (q.x - xg).norm_squared();
+        let (d2, xg2) = data_misfit(x_g, e, &q);
         e2 += w * h * d2;
-        g2 += w * h * xg.norm_squared();
+        g2 += w * h * xg2;
         let wh = 0.5 * w * h;
         t.tracking += wh * w8.lambda_g * d2;
         t.force += wh * qa.x.norm_squared() / w8.lambda_f;
@@ -86,12 +85,18 @@ pub fn position_error(problem: &Problem, u: &DVector<f64>, x_g: &[Vector3<f64>])
     let h = mesh.h();
     let (mut e2, mut g2) = (0.0, 0.0);
     integrate(mesh, GAUSS2.iter(), |e, xi, w| {
-        let q = interpolate(&dofs.gather(u, e), h, xi);
-        let xg = x_g[e] * q.n[0] + x_g[e + 1] * q.n[1];
-        e2 += w * h * (q.x - xg).norm_squared();
-        g2 += w * h * xg.norm_squared();
+        let (d2, xg2) = data_misfit(x_g, e, &interpolate(&dofs.gather(u, e), h, xi));
+        e2 += w * h * d2;
+        g2 += w * h * xg2;
     });
     (e2 / g2).sqrt()
+}
+
+/// `(|x − x_g|², |x_g|²)` at a point `q` of element `e`, `x_g` interpolated from the nodes:
+/// the summands of `‖x − x_g‖/‖x_g‖` ([`measures`], [`position_error`]).
+fn data_misfit(x_g: &[Vector3<f64>], e: usize, q: &PointState) -> (f64, f64) {
+    let xg = x_g[e] * q.n[0] + x_g[e + 1] * q.n[1];
+    ((q.x - xg).norm_squared(), xg.norm_squared())
 }
 
 /// The per-iteration record of `frame` at the state `u` with the adjoint `adjoint` (fit
