@@ -300,6 +300,11 @@ fn cmd_run(
             eprintln!("{}: interrupted; {kept}; run.json in {} says interrupted", case.name, dir.display());
             return Ok(ExitCode::from(EXIT_INTERRUPTED));
         }
+        Status::Stalled => anyhow::bail!(
+            "{}\n{} holds the last iterate, with its certificate (run.json says stalled; docs/certificate.md)",
+            end.message.unwrap_or_default(),
+            dir.display()
+        ),
         Status::Failed | Status::Running => {
             let kept = match end.frames {
                 Some((n, _)) if n > 0 => format!(

@@ -10,6 +10,7 @@ use cosserat::reference::{
     euler_bernoulli_cantilever_omegas, timoshenko_tip_deflection, tip_loaded_cantilever, undamped_forced_response,
     PlanarRod,
 };
+use cosserat::solve::certificate::DEFAULT_CERTIFICATE_TOLERANCE;
 use cosserat::solve::dynamics::{self, DynamicParams};
 use cosserat::solve::modes::modal_model;
 use cosserat::solve::statics::{self, Method, StaticParams};
@@ -19,7 +20,13 @@ fn static_tip(case: &Case, method: Method, tol: f64) -> (f64, f64, usize) {
     let p = case.problem();
     let sol = statics::solve(
         &p,
-        &StaticParams { method, tolerance: tol, max_iterations: 500, continuation_steps: 1 },
+        &StaticParams {
+            method,
+            tolerance: tol,
+            max_iterations: 500,
+            continuation_steps: 1,
+            certificate_tolerance: DEFAULT_CERTIFICATE_TOLERANCE,
+        },
         |_| {},
     )
     .and_then(|s| s.converged())
@@ -171,7 +178,13 @@ fn dynamic_cantilever_against_modal_superposition() {
     for steps in [1000, 2000, 4000] {
         let c = dynamic_case(steps);
         let p = c.problem();
-        let params = DynamicParams { end_time_s: 0.06, steps, newton_tolerance: 1e-12, newton_max_iterations: 25 };
+        let params = DynamicParams {
+            end_time_s: 0.06,
+            steps,
+            newton_tolerance: 1e-12,
+            newton_max_iterations: 25,
+            certificate_tolerance: DEFAULT_CERTIFICATE_TOLERANCE,
+        };
         let sol = dynamics::solve(&p, &params, |_, _| {}).expect("dynamic solve");
         let stride = steps / 1000;
         let mut err: f64 = 0.0;
@@ -237,6 +250,7 @@ fn follower_load_eq64_large_bend() {
             tolerance: 1e-9,
             max_iterations: 2000,
             continuation_steps: 1,
+            certificate_tolerance: DEFAULT_CERTIFICATE_TOLERANCE,
         },
         |_| {},
     )
@@ -244,7 +258,13 @@ fn follower_load_eq64_large_bend() {
     .expect("fixed point");
     let nt = statics::solve(
         &p,
-        &StaticParams { method: Method::Newton, tolerance: 1e-12, max_iterations: 30, continuation_steps: 5 },
+        &StaticParams {
+            method: Method::Newton,
+            tolerance: 1e-12,
+            max_iterations: 30,
+            continuation_steps: 5,
+            certificate_tolerance: DEFAULT_CERTIFICATE_TOLERANCE,
+        },
         |_| {},
     )
     .and_then(|s| s.converged())
@@ -272,7 +292,13 @@ fn follower_load_eq65_needs_newton() {
     let p = c.problem();
     let nt = statics::solve(
         &p,
-        &StaticParams { method: Method::Newton, tolerance: 1e-12, max_iterations: 30, continuation_steps: 10 },
+        &StaticParams {
+            method: Method::Newton,
+            tolerance: 1e-12,
+            max_iterations: 30,
+            continuation_steps: 10,
+            certificate_tolerance: DEFAULT_CERTIFICATE_TOLERANCE,
+        },
         |_| {},
     )
     .and_then(|s| s.converged())
@@ -293,6 +319,7 @@ fn follower_load_eq65_needs_newton() {
             tolerance: 1e-9,
             max_iterations: 500,
             continuation_steps: 1,
+            certificate_tolerance: DEFAULT_CERTIFICATE_TOLERANCE,
         },
         |_| {},
     )

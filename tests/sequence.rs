@@ -4,6 +4,7 @@ mod common;
 
 use common::{case_from, case_text, edit, with_weights};
 use cosserat::model::mesh::{DofMap, Field};
+use cosserat::solve::certificate::DEFAULT_CERTIFICATE_TOLERANCE;
 use cosserat::solve::inverse::{InverseMethod, InverseParams, Records, Weights, DEFAULT_STABILISATION};
 use cosserat::solve::sequence::{solve_sequence, FrameStart, RotationTreatment, SequenceError, SequenceParams};
 use cosserat::solve::statics::{self, Method, StaticParams};
@@ -27,13 +28,19 @@ fn params() -> InverseParams {
         method: InverseMethod::FixedPoint,
         tolerance: 1e-5,
         max_iterations: 400,
+        certificate_tolerance: DEFAULT_CERTIFICATE_TOLERANCE,
     }
 }
 
 /// The static solution of `p` by Newton with `steps` continuation steps.
 fn forward(p: &Problem, steps: usize) -> DVector<f64> {
-    let params =
-        StaticParams { method: Method::Newton, tolerance: 1e-13, max_iterations: 40, continuation_steps: steps };
+    let params = StaticParams {
+        method: Method::Newton,
+        tolerance: 1e-13,
+        max_iterations: 40,
+        continuation_steps: steps,
+        certificate_tolerance: DEFAULT_CERTIFICATE_TOLERANCE,
+    };
     statics::solve(p, &params, |_| {}).and_then(|s| s.converged()).expect("forward").u
 }
 

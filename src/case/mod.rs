@@ -258,6 +258,16 @@ impl Case {
         matches!(self.analysis, Analysis::Dynamic(_))
     }
 
+    /// The tolerance of the residual certificate a converged result must meet
+    /// (`solver.certificate_tolerance`, `docs/certificate.md`).
+    pub fn certificate_tolerance(&self) -> f64 {
+        match &self.analysis {
+            Analysis::Static(p) => p.certificate_tolerance,
+            Analysis::Dynamic(p) => p.certificate_tolerance,
+            Analysis::Inverse(s) => s.params.certificate_tolerance,
+        }
+    }
+
     /// The settings of an inverse case.
     pub fn inverse(&self) -> Option<&InverseSettings> {
         match &self.analysis {

@@ -112,6 +112,8 @@ pub(super) struct RawData {
     pub(super) max_iterations: usize,
     #[serde(default = "one")]
     pub(super) continuation_steps: usize,
+    /// the residual certificate a converged result must meet (docs/certificate.md)
+    pub(super) certificate_tolerance: Option<f64>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -204,6 +206,8 @@ pub(super) enum RawQuadrature {
     Selective,
     Full,
     Reduced,
+    Midpoint,
+    Gauss2,
 }
 
 #[derive(Debug, Deserialize)]
@@ -221,6 +225,8 @@ pub(super) struct RawSolver {
     pub(super) continuation_steps: usize,
     /// inverse Newton: the fixed point runs until this relative change before Newton starts
     pub(super) warm_start_tolerance: Option<f64>,
+    /// the residual certificate a converged result must meet (docs/certificate.md)
+    pub(super) certificate_tolerance: Option<f64>,
 }
 pub(super) fn one() -> usize {
     1

@@ -16,6 +16,7 @@ use super::{
 use crate::expr::{Expr, ExprError, Node};
 use crate::model::material::{CrossSection, Material, RodProperties};
 use crate::model::mesh::{Mesh, QuadratureScheme};
+use crate::solve::certificate::{CERTIFICATE_FLOOR, DEFAULT_CERTIFICATE_TOLERANCE};
 use crate::solve::dynamics::DynamicParams;
 use crate::solve::inverse::{InverseMethod, InverseParams, Weights, DEFAULT_STABILISATION};
 use crate::solve::statics::{Method, StaticParams};
@@ -85,6 +86,21 @@ impl<'a> Validator<'a> {
         Ok(v)
     }
 
+    /// `solver.certificate_tolerance` (or `data.…`): in `[CERTIFICATE_FLOOR, 1)`, default
+    /// [`DEFAULT_CERTIFICATE_TOLERANCE`] (docs/certificate.md).
+    fn certificate_tolerance(&self, key: &str, v: Option<f64>) -> Result<f64, CaseError> {
+        match v {
+            None => Ok(DEFAULT_CERTIFICATE_TOLERANCE),
+            Some(v) if (CERTIFICATE_FLOOR..1.0).contains(&v) => Ok(v),
+            Some(v) => Err(self.err(
+                key,
+                format!(
+                    "must lie in [{CERTIFICATE_FLOOR:e}, 1), got {v}: below {CERTIFICATE_FLOOR:e} the certificate is round-off (docs/certificate.md)"
+                ),
+            )),
+        }
+    }
+
     /// A count ≥ 1.
     fn count(&self, key: &str, v: usize) -> Result<usize, CaseError> {
         if v == 0 {
@@ -106,7 +122,15 @@ impl<'a> Validator<'a> {
             RawQuadrature::Selective => QuadratureScheme::Selective,
             RawQuadrature::Full => QuadratureScheme::Full,
             RawQuadrature::Reduced => QuadratureScheme::Reduced,
+            RawQuadrature::Midpoint => QuadratureScheme::Midpoint,
+            RawQuadrature::Gauss2 => QuadratureScheme::Gauss2,
         };
+        if quadrature == QuadratureScheme::Midpoint && kind == RawAnalysis::Dynamic {
+            return Err(self.err(
+                "solver.quadrature",
+                "\"midpoint\" integrates the mass matrix with one point, which is singular for P1 elements: a dynamic case needs \"selective\", \"full\", \"reduced\" or \"gauss2\"",
+            ));
+        }
         let analysis = match kind {
             RawAnalysis::Static => Analysis::Static(self.static_solve("solver", &raw.solver)?),
             RawAnalysis::Dynamic => Analysis::Dynamic(self.dynamic(&raw.solver, raw.time.as_ref())?),
@@ -289,6 +313,8 @@ impl<'a> Validator<'a> {
             tolerance: self.unit_open(&format!("{table}.tolerance"), s.tolerance)?,
             max_iterations: self.count(&format!("{table}.max_iterations"), s.max_iterations)?,
             continuation_steps: self.count(&format!("{table}.continuation_steps"), s.continuation_steps)?,
+            certificate_tolerance: self
+                .certificate_tolerance(&format!("{table}.certificate_tolerance"), s.certificate_tolerance)?,
         })
     }
 
@@ -309,6 +335,8 @@ impl<'a> Validator<'a> {
             steps: self.count("time.steps", t.steps)?,
             newton_tolerance: s.tolerance,
             newton_max_iterations: s.max_iterations,
+            certificate_tolerance: self
+                .certificate_tolerance("solver.certificate_tolerance", s.certificate_tolerance)?,
         })
     }
 
@@ -365,14 +393,22 @@ impl<'a> Validator<'a> {
         };
         let alpha0_rad =
             inv.alpha0_rad.as_ref().map(|v| self.scalar("inverse.alpha0_rad", v)).transpose()?.unwrap_or(0.0);
+        let one_rule = matches!(s.quadrature, RawQuadrature::Midpoint | RawQuadrature::Gauss2);
         let stabilisation = match &inv.stabilisation {
             Some(v) => {
                 let e = self.scalar("inverse.stabilisation", v)?;
                 if !(0.0..=1.0).contains(&e) {
                     return Err(self.err("inverse.stabilisation", format!("must lie in [0, 1], got {e}")));
                 }
+                if one_rule && e != 0.0 {
+                    return Err(self.err(
+                        "inverse.stabilisation",
+                        "blends two rules in the λd term (I11), but solver.quadrature = \"midpoint\" or \"gauss2\" applies one rule to every integral: leave it out",
+                    ));
+                }
                 e
             }
+            None if one_rule => 0.0,
             None => DEFAULT_STABILISATION,
         };
         let params = InverseParams {
@@ -384,6 +420,8 @@ impl<'a> Validator<'a> {
             method,
             tolerance: s.tolerance,
             max_iterations: s.max_iterations,
+            certificate_tolerance: self
+                .certificate_tolerance("solver.certificate_tolerance", s.certificate_tolerance)?,
         };
         Ok(InverseSettings { params, data })
     }
@@ -417,6 +455,7 @@ impl<'a> Validator<'a> {
             tolerance: self.unit_open("data.tolerance", d.tolerance)?,
             max_iterations: d.max_iterations,
             continuation_steps: d.continuation_steps,
+            certificate_tolerance: self.certificate_tolerance("data.certificate_tolerance", d.certificate_tolerance)?,
         })
     }
 

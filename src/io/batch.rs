@@ -35,12 +35,13 @@ pub const SUMMARY: &str = "summary.csv";
 /// `curvature_err_rel_max` the worst frame's relative L² error of the bending `κ1² + κ2²`
 /// against the ground truth [–] (empty without a truth sidecar). `wall_time_s` comes last: it
 /// is the only column that differs between two runs of the same batch.
-pub const SUMMARY_COLUMNS: [&str; 9] = [
+pub const SUMMARY_COLUMNS: [&str; 10] = [
     "recording",
     "folder",
     "status",
     "frames",
     "newton_iterations_per_frame",
+    "certificate_max",
     "fit_x_err_rel_max",
     "curvature_err_rel_max",
     "reason",
@@ -110,6 +111,9 @@ pub struct BatchRow {
     /// converged frames
     pub frames: Option<usize>,
     pub newton_iterations_per_frame: Option<f64>,
+    /// the largest residual certificate of the frames (`docs/certificate.md`)
+    #[serde(default)]
+    pub certificate_max: Option<f64>,
     pub fit_x_err_rel_max: Option<f64>,
     pub curvature_err_rel_max: Option<f64>,
     /// why it failed (the error and its causes)
@@ -126,6 +130,7 @@ impl BatchRow {
             status: status.into(),
             frames: None,
             newton_iterations_per_frame: None,
+            certificate_max: None,
             fit_x_err_rel_max: None,
             curvature_err_rel_max: None,
             reason: Some(reason),
@@ -368,6 +373,7 @@ pub fn run_recording(case: &Case, case_file: &InputFile, entry: &PlanEntry, out:
         status: solved.status.as_str().into(),
         frames: solved.frames.map(|f| f.0),
         newton_iterations_per_frame: get("iterations_mean"),
+        certificate_max: get("certificate"),
         fit_x_err_rel_max: get("x_err_rel_max"),
         curvature_err_rel_max: get("truth_bending_err_rel_max"),
         reason: solved.error.clone(),
@@ -375,6 +381,7 @@ pub fn run_recording(case: &Case, case_file: &InputFile, entry: &PlanEntry, out:
     };
     folder.manifest.frames_done = solved.frames.map(|f| f.0);
     folder.manifest.frames_total = solved.frames.map(|f| f.1);
+    folder.manifest.certificate = solved.certificate(&case);
     let written = serde_json::to_vec_pretty(&row)
         .map_err(|e| OutputError::Invalid { path: folder.dir().join(ROW), reason: e.to_string() })
         .and_then(|bytes| write_atomic(&folder.dir().join(ROW), &bytes));
@@ -467,6 +474,7 @@ pub fn summary_csv(rows: &[BatchRow]) -> Result<String, csv::Error> {
             r.status.clone(),
             r.frames.map(|f| f.to_string()).unwrap_or_default(),
             num(r.newton_iterations_per_frame),
+            num(r.certificate_max),
             num(r.fit_x_err_rel_max),
             num(r.curvature_err_rel_max),
             r.reason.as_deref().unwrap_or("").replace('\n', " "),

@@ -46,7 +46,7 @@ fn row_files(format: OutputFormat) -> [&'static str; 2] {
 /// `Q = Q_E(α) B`, whose singular axis `n = Bᵀ e2` is `chart_axis_*`; `docs/rotation.md`);
 /// `max_abs_omega_rad_per_s` is the largest |ωˡ| over the nodes [rad/s] (eq. 27, 0 on the
 /// first frame; `run::clip::ClipFrame::omega`).
-pub const CLIP_FRAME_COLUMNS: [&str; 23] = [
+pub const CLIP_FRAME_COLUMNS: [&str; 24] = [
     "frame",
     "time_s",
     "iterations",
@@ -70,6 +70,7 @@ pub const CLIP_FRAME_COLUMNS: [&str; 23] = [
     "chart_axis_y",
     "chart_axis_z",
     "max_abs_omega_rad_per_s",
+    "certificate",
 ];
 
 /// Columns of `fields.csv`, one row per frame and node: position [m], the angles [rad] in the
@@ -252,6 +253,7 @@ impl ClipWriter {
         ]);
         row.extend(r.chart_axis.iter());
         row.push(omega.iter().map(|w| w.norm()).fold(0.0, f64::max));
+        row.push(r.certificate);
         writeln!(self.frames, "{}", csv_row(&row)).and_then(|_| self.frames.flush()).map_err(err("frames.csv"))?;
         let d = nodes.directors();
         let [fields, curvature] = row_files(self.format());

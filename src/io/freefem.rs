@@ -290,6 +290,7 @@ pub fn run_inverse(
             },
             // −1 marks a fixed-point iteration (no Newton residual)
             residual: (r[11] >= 0.0).then_some(r[11]),
+            certificate: None,
         })
         .collect();
     let info = read_info(&workdir.join("ff_info.csv"))?;
@@ -298,6 +299,7 @@ pub fn run_inverse(
         last_change: info.get("rel_change").copied(),
         residual: None,
         max_newton_iterations: None,
+        certificate: None,
         wall_time_s: info.get("wall_time_s").copied().unwrap_or(f64::NAN),
     };
     let w = inv.params.weights;
@@ -445,6 +447,7 @@ fn read_outputs(case: &Case, dir: &Path) -> Result<RunResult, FreeFemError> {
         last_change: get("rel_change"),
         residual: get("residual"),
         max_newton_iterations: get("max_newton_iterations").map(|v| v as usize),
+        certificate: get("certificate"),
         wall_time_s: get("wall_time_s").unwrap_or(f64::NAN),
     };
     let mut history = Vec::new();
@@ -459,6 +462,7 @@ fn read_outputs(case: &Case, dir: &Path) -> Result<RunResult, FreeFemError> {
                 position_m: Vector3::new(r[1], r[2], r[3]),
                 angles_rad: Vector3::new(r[4], r[5], r[6]),
                 newton_iterations: r[7] as usize,
+                certificate: 0.0,
             });
         }
     } else {
@@ -468,7 +472,7 @@ fn read_outputs(case: &Case, dir: &Path) -> Result<RunResult, FreeFemError> {
                 .last()
                 .map(|h: &IterationRecord| if iteration <= h.iteration { h.step + 1 } else { h.step })
                 .unwrap_or(1);
-            history.push(IterationRecord { step, iteration, change: r[1] });
+            history.push(IterationRecord { step, iteration, change: r[1], certificate: f64::NAN });
         }
     }
     Ok(RunResult { engine: Engine::Freefem, nodes, history, tip, stats, inverse: None })

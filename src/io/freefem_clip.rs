@@ -157,6 +157,7 @@ fn read_frames(
             tangent_misfit: rep[4],
             objective,
             residual: None,
+            certificate: None,
         };
         let result = frame_result(
             case,

@@ -127,6 +127,7 @@ pub fn run_into(
     };
     let clip = ClipOptions { journal: true, resume: mode == Mode::Resume, format };
     let solved = solve_into(case, engine, &dir, clip, |_| {}, progress);
+    folder.manifest.certificate = solved.certificate(case);
     end.status = solved.status.folder_status();
     end.message = solved.error;
     end.single = solved.single;

@@ -41,8 +41,8 @@ pub fn write_run(case: &Case, r: &RunResult, metrics: &Metrics, dir: &Path) -> R
         put(
             "history.csv",
             csv_text(
-                &["continuation_step", "iteration", "change"],
-                r.history.iter().map(|h| vec![h.step as f64, h.iteration as f64, h.change]),
+                &["continuation_step", "iteration", "change", "certificate"],
+                r.history.iter().map(|h| vec![h.step as f64, h.iteration as f64, h.change, h.certificate]),
             )
             .into_bytes(),
         )?;
@@ -50,7 +50,7 @@ pub fn write_run(case: &Case, r: &RunResult, metrics: &Metrics, dir: &Path) -> R
     if !r.tip.is_empty() {
         let rows = r.tip.iter().map(|t| {
             let (x, a) = (t.position_m, t.angles_rad);
-            vec![t.time_s, x[0], x[1], x[2], a[0], a[1], a[2], t.newton_iterations as f64]
+            vec![t.time_s, x[0], x[1], x[2], a[0], a[1], a[2], t.newton_iterations as f64, t.certificate]
         });
         put(
             "tip_history.csv",
@@ -64,6 +64,7 @@ pub fn write_run(case: &Case, r: &RunResult, metrics: &Metrics, dir: &Path) -> R
                     "tip_beta_rad",
                     "tip_gamma_rad",
                     "newton_iterations",
+                    "certificate",
                 ],
                 rows,
             )
@@ -138,6 +139,7 @@ fn write_inverse(
     if newton {
         header.push("newton_residual_rel");
     }
+    header.push("certificate");
     header.extend(["kappa_err_rel", "kappa_err_rel_inner"]);
     let rows = inv.history.iter().enumerate().map(|(i, h)| {
         let mut row: Vec<Option<f64>> =
@@ -146,6 +148,7 @@ fn write_inverse(
         if newton {
             row.push(h.residual);
         }
+        row.push(h.certificate);
         let k = inv.kappa_err.get(i);
         row.extend([k.map(|k| k[0]), k.map(|k| k[1])]);
         row

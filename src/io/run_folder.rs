@@ -23,6 +23,9 @@ pub const MANIFEST: &str = "run.json";
 pub enum Status {
     Running,
     Complete,
+    /// the run ended with a result that is not a solution: its iteration stopped moving with a
+    /// residual certificate above the tolerance (`docs/certificate.md`)
+    Stalled,
     Failed,
     Interrupted,
 }
@@ -32,6 +35,7 @@ impl Status {
         match self {
             Status::Running => "running",
             Status::Complete => "complete",
+            Status::Stalled => "stalled",
             Status::Failed => "failed",
             Status::Interrupted => "interrupted",
         }
@@ -43,6 +47,16 @@ impl Status {
 pub struct InputFile {
     pub path: String,
     pub sha256: String,
+}
+
+/// The residual certificate of a run's result (`docs/certificate.md`) in its `run.json`.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct CertificateSummary {
+    /// the certificate of the result (a dynamic run: the largest of its steps; a clip: the
+    /// largest of its frames)
+    pub value: f64,
+    /// the tolerance a converged result meets (`solver.certificate_tolerance`)
+    pub tolerance: f64,
 }
 
 /// `run.json`.
@@ -68,6 +82,9 @@ pub struct Manifest {
     pub frames_total: Option<usize>,
     /// why the run failed or stopped
     pub message: Option<String>,
+    /// the residual certificate of the result, where the run has one
+    #[serde(default)]
+    pub certificate: Option<CertificateSummary>,
     /// the process that wrote the folder
     pub pid: u32,
     /// seconds since the Unix epoch
@@ -139,6 +156,7 @@ impl Manifest {
             frames_done: None,
             frames_total: None,
             message: None,
+            certificate: None,
             pid: std::process::id(),
             started_unix_s: now_unix_s(),
             finished_unix_s: None,

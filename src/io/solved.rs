@@ -10,12 +10,13 @@ use super::data::write_data;
 use super::engine::{load_data, run_case, run_clip_to, run_inverse_on, write_clip_figures, ClipOptions, EngineError};
 use super::journal::remove_journal;
 use super::run_files::write_run;
-use super::run_folder::Status;
+use super::run_folder::{CertificateSummary, Status};
 use crate::case::Case;
 use crate::run::clip::{ClipFrame, ClipRun};
 use crate::run::clip_metrics::clip_metrics;
 use crate::run::metrics::{all_metrics, Metrics};
 use crate::run::{Engine, RunError, RunResult};
+use crate::solve::SolveError;
 
 /// How one run ended.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -23,6 +24,9 @@ pub enum RunStatus {
     Ok,
     /// iteration limit reached; the metrics are those of the last iterate
     NotConverged,
+    /// the iteration stopped moving but its residual certificate is above the tolerance
+    /// (`solve::Stop::Stalled`); the metrics are those of the last iterate
+    Stalled,
     Failed,
     /// stopped by a signal (or not started because of one)
     Interrupted,
@@ -33,6 +37,7 @@ impl RunStatus {
         match self {
             RunStatus::Ok => "ok",
             RunStatus::NotConverged => "not_converged",
+            RunStatus::Stalled => "stalled",
             RunStatus::Failed => "failed",
             RunStatus::Interrupted => "interrupted",
         }
@@ -43,6 +48,7 @@ impl RunStatus {
         match self {
             RunStatus::Ok => Status::Complete,
             RunStatus::NotConverged | RunStatus::Failed => Status::Failed,
+            RunStatus::Stalled => Status::Stalled,
             RunStatus::Interrupted => Status::Interrupted,
         }
     }
@@ -65,6 +71,18 @@ pub struct Solved {
 }
 
 impl Solved {
+    /// The residual certificate of the result for `run.json` (`docs/certificate.md`): the
+    /// `certificate` metric (a clip's: the largest of its frames) against the case's tolerance.
+    pub fn certificate(&self, case: &Case) -> Option<CertificateSummary> {
+        let value = match (&self.metrics, &self.single, &self.clip) {
+            (Some(m), _, _) if m.contains_key("certificate") => m["certificate"],
+            (_, Some(r), _) => r.stats.certificate?,
+            (_, _, Some(c)) if !c.reports.is_empty() => c.reports.iter().map(|r| r.certificate).fold(0.0, f64::max),
+            _ => return None,
+        };
+        Some(CertificateSummary { value, tolerance: case.certificate_tolerance() })
+    }
+
     /// A run that produced nothing, with its error.
     pub fn failed(error: String) -> Self {
         Solved { status: RunStatus::Failed, error: Some(error), metrics: None, single: None, clip: None, frames: None }
@@ -111,7 +129,7 @@ fn solve_single(case: &Case, engine: Engine, dir: &Path, progress: impl FnMut(us
     let (status, r, error) = match result {
         Ok(r) => (RunStatus::Ok, r, None),
         Err(EngineError::Run(RunError::Incomplete { source, partial })) => (
-            RunStatus::NotConverged,
+            if matches!(source, SolveError::Stalled { .. }) { RunStatus::Stalled } else { RunStatus::NotConverged },
             *partial,
             Some(format!("{}: {source}; the files here hold the last iterate", case_label(case))),
         ),

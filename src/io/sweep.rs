@@ -17,8 +17,9 @@ use crate::run::metrics::Metrics;
 use crate::run::{Engine, RunResult};
 
 /// Columns of the summary table after the swept keys.
-pub const SUMMARY_METRICS: [&str; 11] = [
+pub const SUMMARY_METRICS: [&str; 12] = [
     "iterations",
+    "certificate",
     "x_err_rel",
     "kappa_err_rel",
     "kappa_err_rel_inner",
@@ -44,8 +45,9 @@ pub struct SummaryRow {
 }
 
 /// Columns of the summary table of a clip case after the swept keys (`run::clip_metrics`).
-pub const CLIP_SUMMARY_METRICS: [&str; 11] = [
+pub const CLIP_SUMMARY_METRICS: [&str; 12] = [
     "frames",
+    "certificate",
     "iterations_mean",
     "iterations_max",
     "x_err_rel_max",
@@ -86,7 +88,7 @@ pub fn summary_csv(keys: &[String], columns: &[&str], rows: &[SummaryRow]) -> Re
 /// its whole clip ([`run_clip_point`]). A point reached after a stop was requested
 /// (`crate::interrupt`) is not started and writes nothing.
 pub fn run_point(case: &Case, dir: &Path, template: &Manifest) -> SweepOutcome {
-    finish_point(dir, template, solve_into(case, Engine::Rust, dir, ClipOptions::default(), |_| {}, |_, _| {}))
+    finish_point(dir, template, case, solve_into(case, Engine::Rust, dir, ClipOptions::default(), |_| {}, |_, _| {}))
 }
 
 /// The whole clip of a clip case in the Rust engine as a point of a sweep or audit, frames
@@ -99,7 +101,7 @@ pub fn run_clip_point(
     template: &Manifest,
     observer: impl FnMut(&ClipFrame) + Send,
 ) -> SweepOutcome {
-    finish_point(dir, template, solve_into(case, Engine::Rust, dir, ClipOptions::default(), observer, |_, _| {}))
+    finish_point(dir, template, case, solve_into(case, Engine::Rust, dir, ClipOptions::default(), observer, |_, _| {}))
 }
 
 /// The `run.json` of a point of `command` (a sweep, an audit): the case and its file's hash,
@@ -115,11 +117,12 @@ pub fn point_manifest(command: &str, case: &Case, point: &Point) -> Manifest {
 }
 
 /// The point's `run.json`: `template` with the case's name, the point's status and message.
-fn finish_point(dir: &Path, template: &Manifest, outcome: Solved) -> Solved {
+fn finish_point(dir: &Path, template: &Manifest, case: &Case, outcome: Solved) -> Solved {
     if !dir.is_dir() {
         return outcome;
     }
     let mut m = template.clone();
+    m.certificate = outcome.certificate(case);
     if let Some(c) = &outcome.clip {
         m.frames_done = Some(c.reports.len());
     }

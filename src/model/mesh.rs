@@ -165,6 +165,20 @@ impl DofMap {
         }
         (nx, na)
     }
+    /// The KKT vector of a state `u` and an adjoint `adjoint` (forward layout each).
+    pub fn kkt_join(&self, u: &DVector<f64>, adjoint: &DVector<f64>) -> DVector<f64> {
+        debug_assert_eq!(self.fields, 4, "a KKT layout");
+        let fwd = DofMap::forward(self.nodes);
+        let half = 3 * Field::XHat as usize;
+        DVector::from_fn(self.len(), |i, _| {
+            let (node, c) = (i / self.block(), i % self.block());
+            if c < half {
+                u[fwd.block() * node + c]
+            } else {
+                adjoint[fwd.block() * node + c - half]
+            }
+        })
+    }
     /// The state `(x, α)` of a KKT vector, in the forward layout.
     pub fn kkt_state(&self, big: &DVector<f64>) -> DVector<f64> {
         self.kkt_part(big, 0)
@@ -180,7 +194,12 @@ impl DofMap {
     }
 }
 
-/// Which element integrals are under-integrated (D4).
+/// Which element integrals are under-integrated (D4), and the rules of the inverse problem's
+/// terms (`docs/inverse.md`, I2, I11, I12).
+///
+/// The first three are ours: they choose a rule per integrand. The last two are the paper's
+/// scheme as printed read with ONE rule for every integral of (52) and (61), the λd and Λκ terms,
+/// the control costs, the tracking term and the loads included (`docs/decisions.md`, D4).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum QuadratureScheme {
     /// Stretch–shear 1-point, bending 2-point (default, locking-free and full rank in α).
@@ -189,6 +208,28 @@ pub enum QuadratureScheme {
     Full,
     /// Stretch–shear and bending 1-point (locking-free; zero-energy α zig-zag in the inverse).
     Reduced,
+    /// The midpoint rule for every integral (static and inverse problems only: the P1 mass
+    /// matrix of the midpoint rule is singular).
+    Midpoint,
+    /// 2-point Gauss for every integral.
+    Gauss2,
+}
+
+impl QuadratureScheme {
+    /// One rule for every integral (the λd blend of I11 does not apply)?
+    pub fn is_one_rule(&self) -> bool {
+        matches!(self, QuadratureScheme::Midpoint | QuadratureScheme::Gauss2)
+    }
+    /// The name in case files (`solver.quadrature`).
+    pub fn name(&self) -> &'static str {
+        match self {
+            QuadratureScheme::Selective => "selective",
+            QuadratureScheme::Full => "full",
+            QuadratureScheme::Reduced => "reduced",
+            QuadratureScheme::Midpoint => "midpoint",
+            QuadratureScheme::Gauss2 => "gauss2",
+        }
+    }
 }
 
 /// A Gauss rule on the unit interval: points ξ ∈ (0,1) and weights summing to 1.
@@ -217,20 +258,37 @@ impl QuadratureScheme {
     /// Rule for the stretch–shear integrand `∂sδx·n − δα·(∂s x × n)`.
     pub fn stretch_shear(&self) -> Rule {
         match self {
-            QuadratureScheme::Full => GAUSS2,
-            QuadratureScheme::Selective | QuadratureScheme::Reduced => GAUSS1,
+            QuadratureScheme::Full | QuadratureScheme::Gauss2 => GAUSS2,
+            QuadratureScheme::Selective | QuadratureScheme::Reduced | QuadratureScheme::Midpoint => GAUSS1,
         }
     }
     /// Rule for the bending integrand `∂sδα·m`.
     pub fn bending(&self) -> Rule {
         match self {
-            QuadratureScheme::Reduced => GAUSS1,
-            QuadratureScheme::Selective | QuadratureScheme::Full => GAUSS2,
+            QuadratureScheme::Reduced | QuadratureScheme::Midpoint => GAUSS1,
+            QuadratureScheme::Selective | QuadratureScheme::Full | QuadratureScheme::Gauss2 => GAUSS2,
         }
     }
-    /// Rule for loads and inertia (always 2-point: a midpoint mass matrix is singular for P1).
+    /// Rule for loads and inertia: 2-point (a midpoint mass matrix is singular for P1), except
+    /// in the one-rule midpoint scheme (which refuses dynamic cases).
     pub fn loads(&self) -> Rule {
-        GAUSS2
+        match self {
+            QuadratureScheme::Midpoint => GAUSS1,
+            _ => GAUSS2,
+        }
+    }
+    /// Rule of the inverse problem's mass-type terms (I2): the tracking term λg, the control costs
+    /// λf, λl and the Λω term; the loads' rule.
+    pub fn objective(&self) -> Rule {
+        self.loads()
+    }
+    /// Rule of the Λκ term `½ ∫ κᵀ Λκ κ` (I12): the midpoint in our schemes, the one rule in the
+    /// one-rule schemes.
+    pub fn kappa(&self) -> Rule {
+        match self {
+            QuadratureScheme::Gauss2 => GAUSS2,
+            _ => GAUSS1,
+        }
     }
 }
 

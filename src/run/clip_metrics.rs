@@ -32,6 +32,7 @@ fn max(v: impl Iterator<Item = f64>) -> f64 {
 /// - `max_abs_j_minus_1`: the data's stretch `|j − 1|` (Remark 9, Remark 12), max over frames;
 /// - the objective terms of (41), median over the frames (`j_tracking_median`, …), and
 ///   `shear_share_median`: the median share of the λd term in the total (Fig. 18);
+/// - `certificate`: the largest residual certificate of the frames (`docs/certificate.md`);
 /// - `min_abs_cos_beta`: the angle chart's margin, min over frames;
 /// - `kappa_roughness_mean`, `data_kappa_roughness_mean` (sign alternation, D13);
 /// - synthetic clips, against the ground truth (max over frames): `truth_x_err_rel_max`,
@@ -52,6 +53,7 @@ pub fn clip_metrics(case: &Case, run: &ClipRun) -> Metrics {
     let d3_norm = case.mesh.length_m.sqrt();
     m.insert("tangent_misfit_rel_max".into(), max(r.iter().map(|f| f.tangent_misfit / d3_norm)));
     m.insert("max_abs_j_minus_1".into(), max(r.iter().map(|f| f.max_stretch_deviation)));
+    m.insert("certificate".into(), max(r.iter().map(|f| f.certificate)));
     m.insert("min_abs_cos_beta".into(), r.iter().map(|f| f.min_cos_beta).fold(f64::INFINITY, f64::min));
     let terms = |f: &FrameReport| {
         let o = &f.objective;

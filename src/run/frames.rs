@@ -63,6 +63,7 @@ pub fn frame_result(
             last_change: Some(last.rel_change),
             residual: None,
             max_newton_iterations: None,
+            certificate: last.certificate,
             wall_time_s,
         },
         inverse: Some(InverseOutput {

@@ -136,6 +136,9 @@ pub fn all_metrics(case: &Case, r: &RunResult) -> Result<Metrics, ReferenceError
     if let Some(v) = r.stats.max_newton_iterations {
         m.insert("max_newton_iterations".into(), v as f64);
     }
+    if let Some(v) = r.stats.certificate {
+        m.insert("certificate".into(), v);
+    }
     m.insert("wall_time_s".into(), r.stats.wall_time_s);
     Ok(m)
 }

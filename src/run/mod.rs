@@ -114,6 +114,7 @@ fn run_forward_solve(case: &Case, mut progress: impl FnMut(usize, usize)) -> Res
                     last_change: Some(sol.last_change),
                     residual: Some(sol.residual),
                     max_newton_iterations: None,
+                    certificate: Some(sol.certificate.value),
                     wall_time_s: start.elapsed().as_secs_f64(),
                 },
                 inverse: None,
@@ -135,6 +136,7 @@ fn run_forward_solve(case: &Case, mut progress: impl FnMut(usize, usize)) -> Res
                     last_change: None,
                     residual: None,
                     max_newton_iterations: Some(sol.max_newton_iterations),
+                    certificate: Some(sol.max_certificate),
                     wall_time_s: start.elapsed().as_secs_f64(),
                 },
                 inverse: None,
@@ -214,6 +216,7 @@ pub fn run_inverse(
             last_change: sol.history.last().map(|h| h.rel_change),
             residual: None,
             max_newton_iterations: None,
+            certificate: Some(sol.certificate.value),
             wall_time_s: start.elapsed().as_secs_f64(),
         },
         inverse: Some(InverseOutput {

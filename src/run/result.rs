@@ -82,6 +82,9 @@ pub struct SolverStats {
     pub residual: Option<f64>,
     /// dynamic: largest Newton iteration count of a step
     pub max_newton_iterations: Option<usize>,
+    /// the residual certificate of the result (`solve::certificate`, `docs/certificate.md`):
+    /// static and inverse at the returned state, dynamic the largest of its steps
+    pub certificate: Option<f64>,
     /// wall-clock time of the solve (engine-internal) [s]
     pub wall_time_s: f64,
 }

@@ -11,6 +11,8 @@
 //! used (errata: (Δt²/2) F_n and M_{n−2}; see PAPER-NOTES and `docs/decisions.md`).
 use nalgebra::{DVector, Vector3};
 
+use super::certificate::{system_terms, Certificate};
+use super::statics::frozen_system;
 use super::{divergence, Problem, SolveError, Step, CHORD_CONTRACTION};
 use crate::assemble::Tangent;
 use crate::linalg::{LinearSolver, Pattern};
@@ -24,6 +26,8 @@ pub struct DynamicParams {
     pub steps: usize,
     pub newton_tolerance: f64,
     pub newton_max_iterations: usize,
+    /// every step's residual certificate ([`step_certificate`]) must be at most this
+    pub certificate_tolerance: f64,
 }
 
 /// Tip state at one time level.
@@ -33,6 +37,9 @@ pub struct TipRecord {
     pub position_m: Vector3<f64>,
     pub angles_rad: Vector3<f64>,
     pub newton_iterations: usize,
+    /// the residual certificate of the step's equations (68) at the state ([`step_certificate`];
+    /// 0 at t = 0, the initial state is given)
+    pub certificate: f64,
 }
 
 /// Result of a time integration.
@@ -43,6 +50,8 @@ pub struct DynamicSolution {
     pub tip: Vec<TipRecord>,
     pub total_newton_iterations: usize,
     pub max_newton_iterations: usize,
+    /// the largest step certificate
+    pub max_certificate: f64,
 }
 
 /// Integrate from the reference configuration at rest.
@@ -63,11 +72,13 @@ pub fn solve(
     let mut p_prev = problem.momentum(&u_prev, &v_prev, None);
     let mut f_prev = problem.loads_at(&u_prev, 0.0, None);
     let mut values = vec![0.0; pattern.nnz()];
-    let record = |t: f64, u: &DVector<f64>, it: usize| {
+    let record = |t: f64, u: &DVector<f64>, it: usize, certificate: f64| {
         let (x, a) = (dofs.get(u, last, Field::X), dofs.get(u, last, Field::Alpha));
-        TipRecord { time_s: t, position_m: x, angles_rad: a, newton_iterations: it }
+        TipRecord { time_s: t, position_m: x, angles_rad: a, newton_iterations: it, certificate }
     };
-    let mut tip = vec![record(0.0, &u_prev, 0)];
+    let mut tip = vec![record(0.0, &u_prev, 0, 0.0)];
+    let mut cert_values = vec![0.0; pattern.nnz()];
+    let mut max_certificate: f64 = 0.0;
     let (mut total, mut max_it) = (0, 0);
     // Global-frame (or no distributed) loads do not depend on the state: F(t_n) once per step
     // instead of once per Newton iteration and again after it (the same numbers).
@@ -148,15 +159,85 @@ pub fn solve(
         total += it;
         max_it = max_it.max(it);
         let v = (&u - &u_prev) * (2.0 / dt) - &v_prev;
-        p_prev = problem.momentum(&u, &v, None);
-        f_prev = match f_step {
+        let p_n = problem.momentum(&u, &v, None);
+        let f_n = match f_step {
             Some(f) => f,
             None => problem.loads_at(&u, t, None),
         };
-        tip.push(record(t, &u, it));
+        let certificate = step_certificate(
+            problem,
+            StepTerms { u: &u, u_prev: &u_prev, p: &p_n, p_prev: &p_prev, f: &f_n, f_prev: &f_prev, dt },
+            &pattern,
+            &mut cert_values,
+        );
+        if !certificate.within(params.certificate_tolerance) {
+            return Err(SolveError::StepNotCertified {
+                step: n,
+                iterations: it,
+                increment,
+                certificate: certificate.value,
+                tolerance: params.certificate_tolerance,
+                block: certificate.worst_block(false),
+            });
+        }
+        max_certificate = max_certificate.max(certificate.value);
+        p_prev = p_n;
+        f_prev = f_n;
+        tip.push(record(t, &u, it, certificate.value));
         u_prev = u;
         v_prev = v;
         progress(n, params.steps);
     }
-    Ok(DynamicSolution { u: u_prev, tip, total_newton_iterations: total, max_newton_iterations: max_it })
+    Ok(DynamicSolution {
+        u: u_prev,
+        tip,
+        total_newton_iterations: total,
+        max_newton_iterations: max_it,
+        max_certificate,
+    })
+}
+
+/// What the certificate of a time step is made of: the step's state and the previous one, their
+/// momenta `P(u_n, u̇_n)`, `P(u_{n−1}, u̇_{n−1})` and loads `F(t_n)`, `F(t_{n−1})`, and Δt [s].
+pub struct StepTerms<'a> {
+    pub u: &'a DVector<f64>,
+    pub u_prev: &'a DVector<f64>,
+    pub p: &'a DVector<f64>,
+    pub p_prev: &'a DVector<f64>,
+    pub f: &'a DVector<f64>,
+    pub f_prev: &'a DVector<f64>,
+    pub dt: f64,
+}
+
+/// The residual certificate of a time step (`docs/certificate.md`): the block backward error of
+/// the step's equations (68) at its state, with the internal force in the fixed point's frozen
+/// form at the midpoint state `m = (u_n + u_{n−1})/2`,
+///
+/// ```text
+///   R = (P_n − P_{n−1})/Δt + L(m) m − b(m) − ½(F_n + F_{n−1})
+///   S = (|P_n| + |P_{n−1}|)/Δt + |L(m)| |m| + |b(m)| + ½(|F_n| + |F_{n−1}|)
+/// ```
+/// the clamp's rows as `u_d − u_ref,d` against `|u_d| + |u_ref,d|`. `values`: scratch of
+/// `pattern`'s size.
+pub fn step_certificate(problem: &Problem, s: StepTerms, pattern: &Pattern, values: &mut [f64]) -> Certificate {
+    let dofs = problem.dofs();
+    let mid = (s.u + s.u_prev) * 0.5;
+    // the frozen system at m without loads: b(m) (Dirichlet rows: the clamp's values)
+    let unloaded = Problem { load_factor: 0.0, ..*problem };
+    let b = frozen_system(&unloaded, &mid, pattern, values);
+    let (mut res, mut scale) = system_terms(pattern, values, &mid, &b);
+    let fixed = problem.clamped_dofs();
+    for i in 0..res.len() {
+        if fixed.contains(&i) {
+            continue;
+        }
+        res[i] += (s.p[i] - s.p_prev[i]) / s.dt - 0.5 * (s.f[i] + s.f_prev[i]);
+        scale[i] += (s.p[i].abs() + s.p_prev[i].abs()) / s.dt + 0.5 * (s.f[i].abs() + s.f_prev[i].abs());
+    }
+    let reference = problem.reference_state();
+    for &d in &fixed {
+        res[d] = s.u[d] - reference[d];
+        scale[d] = s.u[d].abs() + reference[d].abs();
+    }
+    Certificate::from_residual(&dofs, &res, &scale)
 }

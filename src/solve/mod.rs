@@ -4,6 +4,7 @@
 //! [`sequence`] (a clip of frames). Each solver has a params struct, returns a solution with
 //! its info (iterations, history, [`Stop`]) and fails with a [`SolveError`] that carries the
 //! numbers. All of them assemble through the one element loop of [`crate::assemble`].
+pub mod certificate;
 pub mod dynamics;
 pub mod inverse;
 pub mod modes;
@@ -19,11 +20,32 @@ use crate::model;
 /// Why an iteration stopped with a usable iterate.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Stop {
-    /// the stopping rule was met
+    /// the stopping rule was met and the residual certificate is within its tolerance
+    /// (`certificate`, `docs/certificate.md`)
     Converged,
+    /// the iteration stopped moving (a fixed point whose relative change stayed within the
+    /// tolerance for [`PLATEAU_ITERATIONS`] iterations, a Newton whose line search no longer
+    /// reduces the residual) but the certificate is above its tolerance: not a solution
+    Stalled,
     /// the iteration limit was reached first; the solution holds the last iterate
     MaxIterations,
 }
+
+impl Stop {
+    /// The status word of outputs (`converged`, `stalled`, `not_converged`).
+    pub fn status(&self) -> &'static str {
+        match self {
+            Stop::Converged => "converged",
+            Stop::Stalled => "stalled",
+            Stop::MaxIterations => "not_converged",
+        }
+    }
+}
+
+/// A fixed point stops on its relative change only when the change has stayed within the
+/// tolerance for this many consecutive iterations (one dip of a stalled iteration is not a
+/// stop); the certificate then decides between converged and stalled.
+pub const PLATEAU_ITERATIONS: usize = 5;
 
 /// Errors of the solvers; each variant carries the numbers needed to act on it.
 #[derive(Debug, thiserror::Error)]
@@ -35,6 +57,18 @@ pub enum SolveError {
     #[error("Newton did not converge after {iterations} iterations (last increment {increment:e}){}", step_text(*.step))]
     /// `step`: time step (dynamic) or continuation step (static)
     NewtonNotConverged { step: Option<Step>, iterations: usize, increment: f64 },
+    /// A time step met Newton's increment rule but its certificate is above the tolerance.
+    #[error(
+        "time step {step}: Newton's increment {increment:e} after {iterations} iterations is within its tolerance, but the residual certificate {certificate:e} is above its tolerance {tolerance:e} (worst block: {block}; docs/certificate.md)"
+    )]
+    StepNotCertified {
+        step: usize,
+        iterations: usize,
+        increment: f64,
+        certificate: f64,
+        tolerance: f64,
+        block: &'static str,
+    },
     #[error("diverged in iteration {iteration}{}: {quantity} = {value:e}", step_text(*.step))]
     /// `quantity` named with its limit (a non-finite value or one beyond [`DIVERGED_LENGTHS`],
     /// [`DIVERGED_ANGLE_RAD`]); the iterate is not returned.
@@ -47,9 +81,21 @@ pub enum SolveError {
     )]
     InverseNotConverged { frame: usize, iterations: usize, rel_change: f64 },
     #[error(
-        "inverse Newton of frame {frame} did not converge after {iterations} iterations (last residual ‖R‖/‖R₀‖ {residual:e})"
+        "inverse Newton of frame {frame} did not converge after {iterations} iterations (last residual ‖R‖/‖R₀‖ {residual:e}, certificate {certificate:e})"
     )]
-    InverseNewtonNotConverged { frame: usize, iterations: usize, residual: f64 },
+    InverseNewtonNotConverged { frame: usize, iterations: usize, residual: f64, certificate: f64 },
+    /// The iteration stopped moving but its certificate is above the tolerance (`Stop::Stalled`).
+    #[error(
+        "{solver} stalled after {iterations} iterations: the relative change of (x, α) is {rel_change:e}, but the residual certificate is {certificate:e} > its tolerance {tolerance:e} (worst block: {block}); the iterate does not solve the discrete equations (docs/certificate.md)"
+    )]
+    Stalled {
+        solver: String,
+        iterations: usize,
+        rel_change: f64,
+        certificate: f64,
+        tolerance: f64,
+        block: &'static str,
+    },
     #[error("inverse frame {frame} diverged in iteration {iteration}: {quantity} = {value:e}")]
     /// `quantity` named with its limit (a non-finite value, or the misfit beyond
     /// [`inverse::DIVERGED_X_ERR`]); the iterate is not returned.

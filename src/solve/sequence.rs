@@ -84,6 +84,8 @@ pub struct FrameReport {
     /// singular axis `n = Bᵀ e2` of the frame's chart (e2 for the global chart)
     pub chart_axis: Vector3<f64>,
     pub wall_time_s: f64,
+    /// the residual certificate of the frame's solution (`inverse::kkt::certificate`)
+    pub certificate: f64,
 }
 
 /// Errors of a clip solve: the frame's own error, or the chart guard.
@@ -316,6 +318,7 @@ pub fn solve_sequence_from(
             Err(
                 SolveError::InverseNotConverged { .. }
                 | SolveError::InverseNewtonNotConverged { .. }
+                | SolveError::Stalled { .. }
                 | SolveError::InverseDiverged { .. },
             ) if from_previous => (solve(&guess(), Start::Guess)?, true),
             Err(e) => return Err(e.into()),
@@ -348,6 +351,7 @@ pub fn solve_sequence_from(
             restarted,
             chart_axis: chart.axis(),
             wall_time_s: start.elapsed().as_secs_f64(),
+            certificate: sol.certificate.value,
         };
         let in_space = if chart.is_identity() { None } else { Some(to_space(&dofs, &chart, &sol)) };
         let solution = FrameSolution {
@@ -403,6 +407,8 @@ fn to_space(dofs: &DofMap, chart: &Chart, sol: &InverseSolution) -> InverseSolut
         adjoint: vector_to_space(dofs, chart, &sol.adjoint, true),
         history: sol.history.clone(),
         stop: sol.stop,
+        certificate: sol.certificate,
+        certificate_tolerance: sol.certificate_tolerance,
     }
 }
 

@@ -2,8 +2,13 @@
 //!
 //! * `FixedPoint` — the paper's scheme (§4, Remark 10): freeze `Q_k, A_k, B_k, q3_k` at the
 //!   iterate, solve the linear problem for `û`, relax `u_{k+1} = w û + (1 − w) u_k`, stop when
-//!   `max(‖Δx‖₂/‖x‖₂, ‖Δα‖₂/‖α‖₂) ≤ tol`. FreeFEM runs exactly this iteration.
+//!   `max(‖Δx‖₂/‖x‖₂, ‖Δα‖₂/‖α‖₂) ≤ tol` in [`PLATEAU_ITERATIONS`] consecutive iterations.
+//!   FreeFEM runs exactly this iteration.
 //! * `Newton` — exact Jacobian of the residual of D3, stop when `max(‖δx‖∞/L, ‖δα‖∞) ≤ tol`.
+//!
+//! Either way the result is `converged` only if its residual certificate (the block backward
+//! error of D3's equations at the returned state, [`certificate`], `docs/certificate.md`) is
+//! within `certificate_tolerance`; otherwise it is `stalled`.
 //!
 //! A fixed point of the first is a zero of the residual the second drives to zero, so both
 //! converge to the same discrete solution (checked in `tests/forward.rs`).
@@ -12,7 +17,8 @@
 //! 1. Wang et al., Comput. Mech. 71 (2023), §4, eqs. (52), (61), Remark 10.
 use nalgebra::DVector;
 
-use super::{divergence, Problem, SolveError, Step, Stop};
+use super::certificate::{of_system, Certificate, DEFAULT_CERTIFICATE_TOLERANCE};
+use super::{divergence, Problem, SolveError, Step, Stop, PLATEAU_ITERATIONS};
 use crate::assemble::{assemble, Tangent};
 use crate::linalg::{LinearSolver, Pattern};
 use crate::model::element::frozen_operator;
@@ -26,6 +32,21 @@ pub struct StaticParams {
     pub max_iterations: usize,
     /// loads ramped by k/steps, k = 1..=steps, each step started from the previous solution
     pub continuation_steps: usize,
+    /// the result is converged only with its certificate ([`certificate`]) at most this
+    pub certificate_tolerance: f64,
+}
+
+impl StaticParams {
+    /// Parameters with the default certificate tolerance.
+    pub fn new(method: Method, tolerance: f64, max_iterations: usize, continuation_steps: usize) -> Self {
+        StaticParams {
+            method,
+            tolerance,
+            max_iterations,
+            continuation_steps,
+            certificate_tolerance: DEFAULT_CERTIFICATE_TOLERANCE,
+        }
+    }
 }
 
 /// Nonlinear solver of a static problem (D5).
@@ -46,6 +67,8 @@ pub struct IterationRecord {
     pub iteration: usize,
     /// fixed point: relative change; Newton: increment measure
     pub change: f64,
+    /// the residual certificate of the iterate for this step's loads ([`certificate`])
+    pub certificate: f64,
 }
 
 /// Result of a static solve: the last iterate and its info.
@@ -57,9 +80,14 @@ pub struct StaticSolution {
     pub last_change: f64,
     /// `‖R(u)‖∞ / ‖F‖∞` over the free unknowns (D5)
     pub residual: f64,
+    /// the residual certificate at `u` ([`certificate`])
+    pub certificate: Certificate,
     pub history: Vec<IterationRecord>,
+    /// the tolerance the certificate was held to
+    pub certificate_tolerance: f64,
     /// [`Stop::MaxIterations`]: a continuation step reached `max_iterations` (the last record
-    /// names it); `u` is its last iterate and the later steps did not run
+    /// names it); `u` is its last iterate and the later steps did not run. [`Stop::Stalled`]:
+    /// every step met its stopping rule but the certificate is above its tolerance
     pub stop: Stop,
     pub method: Method,
 }
@@ -73,9 +101,23 @@ impl StaticSolution {
         let last = self.history.last().copied();
         let (step, iterations, change) =
             last.map(|r| (r.step, r.iteration, r.change)).unwrap_or((1, self.iterations, f64::NAN));
-        Err(match self.method {
-            Method::FixedPoint { .. } => SolveError::FixedPointNotConverged { step, iterations, rel_change: change },
-            Method::Newton => {
+        let solver = match self.method {
+            Method::FixedPoint { .. } => "static fixed point",
+            Method::Newton => "static Newton",
+        };
+        Err(match (self.stop, self.method) {
+            (Stop::Stalled, _) => SolveError::Stalled {
+                solver: solver.to_string(),
+                iterations: self.iterations,
+                rel_change: change,
+                certificate: self.certificate.value,
+                tolerance: self.certificate_tolerance,
+                block: self.certificate.worst_block(false),
+            },
+            (_, Method::FixedPoint { .. }) => {
+                SolveError::FixedPointNotConverged { step, iterations, rel_change: change }
+            }
+            (_, Method::Newton) => {
                 SolveError::NewtonNotConverged { step: Some(Step::Continuation(step)), iterations, increment: change }
             }
         })
@@ -109,7 +151,21 @@ pub fn solve(
         }
     }
     let residual = relative_residual(problem, &u);
-    Ok(StaticSolution { iterations: history.len(), u, last_change, residual, history, stop, method: params.method })
+    let certificate = certificate(problem, &u);
+    if stop == Stop::Converged && !certificate.within(params.certificate_tolerance) {
+        stop = Stop::Stalled;
+    }
+    Ok(StaticSolution {
+        iterations: history.len(),
+        u,
+        last_change,
+        residual,
+        certificate,
+        certificate_tolerance: params.certificate_tolerance,
+        history,
+        stop,
+        method: params.method,
+    })
 }
 
 /// One continuation step: iterate from `u` to the stopping rule of D5 (or the iteration
@@ -129,8 +185,14 @@ fn solve_step(
     let fixed = problem.clamped_dofs();
     let reference = problem.reference_state();
     let mut values = vec![0.0; pattern.nnz()];
-    let h = problem.mesh.h();
+    let mut cert_values = vec![0.0; pattern.nnz()];
     let mut last = f64::NAN;
+    // consecutive fixed-point changes within the tolerance (Newton stops on the first)
+    let mut within = 0;
+    let needed = match params.method {
+        Method::FixedPoint { .. } => PLATEAU_ITERATIONS,
+        Method::Newton => 1,
+    };
     for k in 1..=params.max_iterations {
         if crate::interrupt::requested() {
             return Err(SolveError::Interrupted {
@@ -139,21 +201,9 @@ fn solve_step(
                 total: params.max_iterations,
             });
         }
-        values.iter_mut().for_each(|v| *v = 0.0);
         let change = match params.method {
             Method::FixedPoint { relaxation } => {
-                let mut b = problem.loads_at(&u, 0.0, None);
-                assemble(&dofs, &mut b, Some(Tangent::new(pattern, &mut values, 1.0)), |e, t| {
-                    let (l, bl) = frozen_operator(&problem.props, problem.scheme, h, &dofs.gather(&u, e));
-                    if let Some(t) = t {
-                        *t = l;
-                    }
-                    bl
-                });
-                for &d in &fixed {
-                    b[d] = reference[d];
-                }
-                pattern.set_identity_rows(&mut values, &fixed);
+                let b = frozen_system(problem, &u, pattern, &mut values);
                 let u_hat = solver.solve(&values, &b)?;
                 let u_new = &u_hat * relaxation + &u * (1.0 - relaxation);
                 let change = relative_change(&dofs, &u_new, &u);
@@ -161,6 +211,7 @@ fn solve_step(
                 change
             }
             Method::Newton => {
+                values.iter_mut().for_each(|v| *v = 0.0);
                 let g = problem.internal_force(&u, Some(Tangent::new(pattern, &mut values, 1.0)));
                 let mut r = g - problem.loads_at(&u, 0.0, Some(Tangent::new(pattern, &mut values, -1.0)));
                 for &d in &fixed {
@@ -175,15 +226,53 @@ fn solve_step(
         if let Some((quantity, value)) = divergence(problem, &u, change) {
             return Err(SolveError::Diverged { step: Some(Step::Continuation(step)), iteration: k, quantity, value });
         }
-        let rec = IterationRecord { step, iteration: k, change };
+        let b = frozen_system(problem, &u, pattern, &mut cert_values);
+        let certificate = of_system(&dofs, pattern, &cert_values, &u, &b).value;
+        let rec = IterationRecord { step, iteration: k, change, certificate };
         progress(&rec);
         history.push(rec);
         last = change;
-        if change <= params.tolerance {
+        within = if change <= params.tolerance { within + 1 } else { 0 };
+        if within >= needed {
             return Ok((u, change, Stop::Converged));
         }
     }
     Ok((u, last, Stop::MaxIterations))
+}
+
+/// The frozen-coefficient system of the fixed point (D5) at `u` into `values` (replaced), with
+/// the clamp's identity rows: returns its right-hand side `b(u) + F(u)` (the clamp's values in
+/// the clamped rows). `L(u) u − b(u) − F(u)` is D3's residual `G(u) − F(u)`.
+pub fn frozen_system(problem: &Problem, u: &DVector<f64>, pattern: &Pattern, values: &mut [f64]) -> DVector<f64> {
+    let dofs = problem.dofs();
+    let h = problem.mesh.h();
+    let mut b = problem.loads_at(u, 0.0, None);
+    assemble(&dofs, &mut b, Some(Tangent::overwriting(pattern, values, 1.0)), |e, t| {
+        let (l, bl) = frozen_operator(&problem.props, problem.scheme, h, &dofs.gather(u, e));
+        if let Some(t) = t {
+            *t = l;
+        }
+        bl
+    });
+    let reference = problem.reference_state();
+    let fixed = problem.clamped_dofs();
+    for &d in &fixed {
+        b[d] = reference[d];
+    }
+    pattern.set_identity_rows(values, &fixed);
+    b
+}
+
+/// The residual certificate of a static state `u` (`docs/certificate.md`): the block backward
+/// error of D3's equations written as the fixed point's frozen system, `L(u) u − b(u) − F(u)`,
+/// against `|L(u)| |u| + |b(u) + F(u)|` (the clamp at the origin, so positions are measured
+/// from it), force and moment rows apart.
+pub fn certificate(problem: &Problem, u: &DVector<f64>) -> Certificate {
+    let dofs = problem.dofs();
+    let pattern = dofs.pattern();
+    let mut values = vec![0.0; pattern.nnz()];
+    let b = frozen_system(problem, u, &pattern, &mut values);
+    of_system(&dofs, &pattern, &values, u, &b)
 }
 
 /// `max(‖Δx‖₂/‖x‖₂, ‖Δα‖₂/‖α‖₂)` with 0/0 = 0 (D5), of two forward nodal vectors.

@@ -6,6 +6,7 @@ use cosserat::case::Case;
 use cosserat::io::compare::CompareReport;
 use cosserat::io::freefem::{find_executable, INSTALL_HINT};
 use cosserat::model::mesh::Field;
+use cosserat::solve::certificate::DEFAULT_CERTIFICATE_TOLERANCE;
 use cosserat::solve::inverse::{
     Frame, FrameSolver, InverseMethod, InverseParams, InverseRecord, InverseSolution, Start, Weights,
     DEFAULT_STABILISATION,
@@ -88,7 +89,13 @@ pub fn forward_data(case: &Case, steps: usize) -> (nalgebra::DVector<f64>, Vec<n
     let p = case.problem();
     let fwd = statics::solve(
         &p,
-        &StaticParams { method: Method::Newton, tolerance: 1e-13, max_iterations: 40, continuation_steps: steps },
+        &StaticParams {
+            method: Method::Newton,
+            tolerance: 1e-13,
+            max_iterations: 40,
+            continuation_steps: steps,
+            certificate_tolerance: DEFAULT_CERTIFICATE_TOLERANCE,
+        },
         |_| {},
     )
     .and_then(|s| s.converged())
@@ -117,6 +124,7 @@ pub fn paper_params_64() -> InverseParams {
         method: InverseMethod::FixedPoint,
         tolerance: 3e-6,
         max_iterations: 1000,
+        certificate_tolerance: DEFAULT_CERTIFICATE_TOLERANCE,
     }
 }
 

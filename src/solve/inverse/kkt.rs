@@ -7,8 +7,9 @@ use super::{Frame, InverseParams};
 use crate::assemble::{assemble, Tangent};
 use crate::linalg::Pattern;
 use crate::model::element::{frozen_operator, interpolate, LocalMat, LocalVec};
-use crate::model::mesh::{DofMap, Field, Rule, GAUSS1, GAUSS2};
+use crate::model::mesh::{DofMap, Field, GAUSS2};
 use crate::model::rotation::{a_matrix, d3, rotation_derivatives};
+use crate::solve::certificate::{of_system, Certificate};
 use crate::solve::Problem;
 
 /// Element matrix of the KKT system (24 × 24).
@@ -75,15 +76,10 @@ pub(crate) fn element_part(ue: &KktVec, hat: bool) -> LocalVec {
     LocalVec::from_fn(|i, _| ue[kkt(i, hat)])
 }
 
-/// Rule of the Λκ term `½ ∫ κᵀ Λκ κ` of (41) and of its linearisation (`docs/inverse.md`, I12):
-/// the midpoint, whatever the scheme. With the frozen `A_k` of the fixed point, the 2-point
-/// rule lets the Gauss-point values of `A(α_k)` (which see the nodal zig-zag of α) feed back
-/// into the next iterate; the midpoint sees only the element mean and converges for 100×
-/// larger Λκ3 on the (65) data.
-pub const KAPPA_RULE: Rule = GAUSS1;
-
 /// Points `(ξ, w)` of the λd term's rule (I11): `(1 − ε)` times the stretch–shear rule of the
-/// scheme plus `ε` times 2-point Gauss (at most 2 + 2 points, no allocation).
+/// scheme plus `ε` times 2-point Gauss (at most 2 + 2 points, no allocation). A one-rule scheme
+/// (`QuadratureScheme::is_one_rule`) has its one rule here and no blend (its ε is 0, checked
+/// when a case is read).
 #[derive(Clone, Copy, Debug)]
 pub struct PointRule {
     points: [(f64, f64); 4],
@@ -104,7 +100,7 @@ impl PointRule {
         for (x, w) in base.iter() {
             push(x, w * (1.0 - eps));
         }
-        if eps > 0.0 {
+        if eps > 0.0 && !problem.scheme.is_one_rule() {
             for (x, w) in GAUSS2.iter() {
                 push(x, w * eps);
             }
@@ -183,8 +179,8 @@ pub(crate) fn element_system(
     add_operator_blocks(m, &l, true);
     let omega_on = !first_frame && w8.lambda_omega.amax() > 0.0;
     let dt = p.frame_interval_s;
-    // Mass-type terms (load rule): tracking, control costs, Λω.
-    for (xi, w) in GAUSS2.iter() {
+    // Mass-type terms (the objective rule): tracking, control costs, Λω.
+    for (xi, w) in problem.scheme.objective().iter() {
         let q = interpolate(uk, h, xi);
         let n = q.n;
         let wh = w * h;
@@ -240,7 +236,7 @@ pub(crate) fn element_system(
     }
     // Λκ term (its rule, I12): ∫ ∂sδα · Aᵀ Λκ A ∂sα.
     if w8.lambda_kappa.amax() > 0.0 {
-        for (xi, w) in KAPPA_RULE.iter() {
+        for (xi, w) in problem.scheme.kappa().iter() {
             let q = interpolate(uk, h, xi);
             let A = a_matrix(&q.alpha);
             let Kk = A.transpose() * Matrix3::from_diagonal(&w8.lambda_kappa) * A * (w * h);
@@ -305,4 +301,39 @@ pub fn assemble_system(
         element_system(problem, p, first_frame, &uk, [x_g[e], x_g[e + 1]], [alpha_prev[e], alpha_prev[e + 1]], m).0
     });
     rhs
+}
+
+/// The residual certificate (`solve::certificate`, `docs/certificate.md`) of the KKT vector
+/// `big` for `frame`: the block backward error of `R(U) = K(u) U − r(u)` of I4/I8 with every
+/// coefficient at the state of `big` itself, against `|K(u)| |U| + |r(u)|`, positions measured
+/// from the data's first node (so that a translation of the data leaves it unchanged).
+/// `values`: scratch of `pattern`'s size.
+#[allow(clippy::too_many_arguments)]
+pub fn certificate(
+    problem: &Problem,
+    p: &InverseParams,
+    frame: &Frame,
+    alpha_prev: &[Vector3<f64>],
+    big: &DVector<f64>,
+    pattern: &Pattern,
+    values: &mut [f64],
+) -> Certificate {
+    let kd = problem.mesh.kkt_dofs();
+    let origin = frame.x_g[0];
+    let x_g: Vec<Vector3<f64>> = frame.x_g.iter().map(|x| x - origin).collect();
+    let mut big = big.clone();
+    for node in 0..kd.nodes() {
+        let x = kd.get(&big, node, Field::X) - origin;
+        kd.set(&mut big, node, Field::X, &x);
+    }
+    let shifted = Frame { x_g: &x_g, ..*frame };
+    let u = kd.kkt_state(&big);
+    let mut rhs = assemble_system(problem, p, frame.is_first(), pattern, values, &u, &x_g, alpha_prev);
+    let fixed = dirichlet(&kd, p.alpha0_rad, &shifted);
+    for &(d, v) in &fixed {
+        rhs[d] = v;
+    }
+    let rows: Vec<usize> = fixed.iter().map(|f| f.0).collect();
+    pattern.set_identity_rows(values, &rows);
+    of_system(&kd, pattern, values, &big, &rhs)
 }

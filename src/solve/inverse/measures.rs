@@ -2,11 +2,10 @@
 //! terms of the objective (41), in one pass of [`integrate`] over the mesh per rule.
 use nalgebra::{DVector, Vector3};
 
-use super::kkt::{PointRule, KAPPA_RULE};
+use super::kkt::PointRule;
 use super::{Frame, InverseParams, InverseRecord, ObjectiveTerms};
 use crate::assemble::integrate;
 use crate::model::element::{interpolate, LocalVec, PointState};
-use crate::model::mesh::GAUSS2;
 use crate::model::rotation::{a_matrix, curvature, d3, Angles};
 use crate::solve::Problem;
 
@@ -48,7 +47,7 @@ pub fn measures(
     let mut t = ObjectiveTerms::default();
     let (mut e2, mut g2, mut t2) = (0.0, 0.0, 0.0);
     let state = |e: usize, xi: f64| interpolate(&dofs.gather::<12>(u, e), h, xi);
-    integrate(mesh, GAUSS2.iter(), |e, xi, w| {
+    integrate(mesh, problem.scheme.objective().iter(), |e, xi, w| {
         let q = state(e, xi);
         let ae: LocalVec = dofs.gather(adjoint, e);
         let qa = interpolate(&ae, h, xi);
@@ -71,7 +70,7 @@ pub fn measures(
         t2 += w * h * m2;
         t.shear += 0.5 * w * h * w8.lambda_d * m2;
     });
-    integrate(mesh, KAPPA_RULE.iter(), |e, xi, w| {
+    integrate(mesh, problem.scheme.kappa().iter(), |e, xi, w| {
         let q = state(e, xi);
         let k = curvature(&q.alpha, &q.dalpha);
         t.bending += 0.5 * w * h * k.component_mul(&k).dot(&w8.lambda_kappa);
@@ -84,7 +83,7 @@ pub fn position_error(problem: &Problem, u: &DVector<f64>, x_g: &[Vector3<f64>])
     let (mesh, dofs) = (&problem.mesh, problem.dofs());
     let h = mesh.h();
     let (mut e2, mut g2) = (0.0, 0.0);
-    integrate(mesh, GAUSS2.iter(), |e, xi, w| {
+    integrate(mesh, problem.scheme.objective().iter(), |e, xi, w| {
         let (d2, xg2) = data_misfit(x_g, e, &interpolate(&dofs.gather(u, e), h, xi));
         e2 += w * h * d2;
         g2 += w * h * xg2;
@@ -115,5 +114,5 @@ pub(crate) fn record(
 ) -> InverseRecord {
     let m = measures(problem, p, frame.is_first(), u, adjoint, frame.x_g, alpha_prev);
     let (x_err_rel, tangent_misfit, objective) = (m.x_err_rel, m.tangent_misfit, m.objective);
-    InverseRecord { iteration, rel_change, x_err_rel, tangent_misfit, objective, residual }
+    InverseRecord { iteration, rel_change, x_err_rel, tangent_misfit, objective, residual, certificate: None }
 }

@@ -30,6 +30,7 @@ pub mod newton;
 
 use nalgebra::{DVector, Vector3};
 
+use super::certificate::Certificate;
 use super::{Problem, SolveError, Stop};
 use crate::linalg::{LinearSolver, Pattern};
 use crate::model::mesh::DofMap;
@@ -84,10 +85,14 @@ pub struct InverseParams {
     /// relaxation w ∈ (0, 1] of the fixed point (Remark 10); Newton's warm start uses it too
     pub relaxation: f64,
     pub method: InverseMethod,
-    /// stopping rule: relative change of (x, α) (D5) ≤ tolerance
+    /// stopping rule: relative change of (x, α) (D5) ≤ tolerance (the fixed point: in
+    /// [`crate::solve::PLATEAU_ITERATIONS`] consecutive iterations)
     pub tolerance: f64,
     /// iterations per frame (fixed point and Newton together)
     pub max_iterations: usize,
+    /// a frame is converged only with its residual certificate (`kkt::certificate`,
+    /// `docs/certificate.md`) at most this
+    pub certificate_tolerance: f64,
 }
 
 /// Which iterations of a Newton solve keep a record (fit measures and objective terms, each a
@@ -144,6 +149,9 @@ pub struct InverseRecord {
     /// Newton only (`docs/inverse.md`, I8): equilibrated KKT residual `‖D_r R(U)‖₂` after the
     /// step, relative to its value at the start of Newton; `None` for the fixed point
     pub residual: Option<f64>,
+    /// the residual certificate of the iterate (`kkt::certificate`); `None` where it was not
+    /// computed (a clip's Newton iterations before the last, [`Records::Last`])
+    pub certificate: Option<f64>,
 }
 
 /// A frame's iterate whose centreline lies farther from the data than this multiple of the
@@ -167,6 +175,7 @@ impl InverseRecord {
             ("the objective term ½∫κᵀΛκκ", o.bending),
             ("the objective term ½∫ωᵀΛωω", o.angular),
             ("the Newton residual ‖R‖/‖R₀‖", self.residual.unwrap_or(0.0)),
+            ("the residual certificate", self.certificate.unwrap_or(0.0)),
         ];
         divergence(frame, self.iteration, &measures, self.x_err_rel, u, adjoint)
     }
@@ -247,8 +256,13 @@ pub struct InverseSolution {
     /// adjoint `(x̂, α̂)` (forward layout) of the last solve
     pub adjoint: DVector<f64>,
     pub history: Vec<InverseRecord>,
-    /// [`Stop::MaxIterations`]: `u` is the last iterate (see [`InverseSolution::converged`])
+    /// [`Stop::MaxIterations`] or [`Stop::Stalled`]: `u` is the last iterate (see
+    /// [`InverseSolution::converged`])
     pub stop: Stop,
+    /// the residual certificate at `(u, adjoint)` (`kkt::certificate`)
+    pub certificate: Certificate,
+    /// the tolerance it was held to
+    pub certificate_tolerance: f64,
 }
 
 impl InverseSolution {
@@ -260,13 +274,30 @@ impl InverseSolution {
         }
         let last = self.history.last();
         let iterations = last.map_or(0, |r| r.iteration);
-        Err(match last.and_then(|r| r.residual) {
-            Some(residual) => SolveError::InverseNewtonNotConverged { frame, iterations, residual },
-            None => SolveError::InverseNotConverged {
+        let rel_change = last.map(|r| r.rel_change).unwrap_or(f64::NAN);
+        let newton = self.history.iter().any(|r| r.residual.is_some());
+        Err(match (self.stop, last.and_then(|r| r.residual)) {
+            (Stop::Stalled, _) => SolveError::Stalled {
+                solver: format!("inverse {} of frame {frame}", if newton { "Newton" } else { "fixed point" }),
+                iterations,
+                rel_change,
+                certificate: self.certificate.value,
+                tolerance: self.certificate_tolerance,
+                block: self.certificate.worst_block(true),
+            },
+            (_, Some(residual)) => SolveError::InverseNewtonNotConverged {
                 frame,
                 iterations,
-                rel_change: last.map(|r| r.rel_change).unwrap_or(f64::NAN),
+                residual,
+                certificate: self.certificate.value,
             },
+            (_, None) if newton => SolveError::InverseNewtonNotConverged {
+                frame,
+                iterations,
+                residual: f64::NAN,
+                certificate: self.certificate.value,
+            },
+            (_, None) => SolveError::InverseNotConverged { frame, iterations, rel_change },
         })
     }
 }
@@ -301,6 +332,8 @@ pub struct FrameSolver<'p> {
     pub(crate) no_previous: Vec<Angles>,
     /// which Newton iterations keep a record
     pub(crate) records: Records,
+    /// scratch matrix values of the certificate's system (`kkt::certificate`)
+    pub(crate) cert_values: Vec<f64>,
 }
 
 impl<'p> FrameSolver<'p> {
@@ -322,6 +355,7 @@ impl<'p> FrameSolver<'p> {
             merit_weights: Vec::new(),
             no_previous: vec![Vector3::zeros(); problem.mesh.nodes()],
             records: Records::Every,
+            cert_values: Vec::new(),
         }
     }
 
@@ -365,6 +399,20 @@ impl<'p> FrameSolver<'p> {
                 newton::solve_warm(self, warm_start_tolerance, frame, u0, &mut observer)
             }
         }
+    }
+
+    /// The residual certificate of the state `u` with the adjoint `adjoint` (forward layout
+    /// each) for `frame` (`kkt::certificate`).
+    pub(crate) fn certify(&mut self, frame: &Frame, u: &DVector<f64>, adjoint: &DVector<f64>) -> Certificate {
+        let big = self.dofs.kkt_join(u, adjoint);
+        self.certify_kkt(frame, &big)
+    }
+
+    /// [`FrameSolver::certify`] of a KKT vector.
+    pub(crate) fn certify_kkt(&mut self, frame: &Frame, big: &DVector<f64>) -> Certificate {
+        self.cert_values.resize(self.pattern.nnz(), 0.0);
+        let previous = frame.previous.unwrap_or(&self.no_previous);
+        kkt::certificate(self.problem, &self.params, frame, previous, big, &self.pattern, &mut self.cert_values)
     }
 
     /// Dirichlet rows and values of I5 for the frame.

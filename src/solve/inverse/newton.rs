@@ -17,21 +17,24 @@
 //!
 //! Steps are damped by backtracking on the equilibrated residual norm `‖D_r R‖₂` (D_r: Ruiz
 //! row factors of the first Jacobian, I6). Stop when the full Newton step has
-//! `relative_change(x, α) ≤ tol` (D5); that step is taken without line search.
+//! `relative_change(x, α) ≤ tol` (D5) and the residual certificate of the new iterate
+//! (`kkt::certificate`, `docs/certificate.md`) is within its tolerance; that step is taken
+//! without line search. A step within the tolerance whose iterate is not certified does not
+//! stop the iteration. Newton has stalled when the merit has fallen by less than
+//! [`STALL_DECREASE`] over [`STALL_WINDOW`] iterations: the result is then converged if its
+//! certificate is within the tolerance (the relative change is at its round-off floor) and
+//! stalled otherwise.
 //!
 //! ## References
 //! 1. Wang et al., Comput. Mech. 71 (2023), §3–4, eqs. (52)–(61), Remark 8, Remark 10.
 use nalgebra::{DVector, Matrix3, Vector3};
 
-use super::kkt::{
-    add3, add_operator_blocks, element_part, element_system, KktMat, KktVec, PointRule, AL, KAPPA_RULE, X,
-};
+use super::kkt::{add3, add_operator_blocks, element_part, element_system, KktMat, KktVec, PointRule, AL, X};
 use super::measures::{position_error, record};
 use super::{early_divergence, Frame, FrameSolver, InverseParams, InverseRecord, InverseSolution, Records};
 use crate::assemble::{assemble, Tangent};
 use crate::linalg::Pattern;
 use crate::model::element::{internal_force, interpolate, LocalMat};
-use crate::model::mesh::GAUSS2;
 use crate::model::rotation::{
     a_matrix, a_matrix_derivatives, d3, d3_second_derivatives, rotation, rotation_derivatives, skew, PointFrame,
 };
@@ -50,6 +53,11 @@ const ARMIJO: f64 = 1e-4;
 /// factorisation, no Jacobian; `docs/inverse.md`, I8), so from the changes where it fires
 /// (≤ 1e-4) it reaches the 1e-9 tolerances in at most one step more.
 const CHORD_RATE: f64 = 3e-3;
+/// Newton has stalled when the merit `φ` has fallen by less than this fraction over
+/// [`STALL_WINDOW`] iterations.
+pub const STALL_DECREASE: f64 = 0.1;
+/// Iterations over which [`STALL_DECREASE`] is measured.
+pub const STALL_WINDOW: usize = 20;
 
 /// `∂/∂u [K_e(u) V − r_e(u)]` at `V = U_e` for one element (24 × 24, KKT numbering; only the
 /// state columns are non-zero), added into `e`: the derivative of the frozen coefficients of I4;
@@ -62,7 +70,7 @@ const CHORD_RATE: f64 = 3e-3;
 ///                                   ∫ ∂sδα · (QᵀJA)ᵀ ∂s α̂                    (bending rule)
 ///                  λd:  −λd ∫ δα · [v·∂²d3/∂α_i∂α_j] δα,  v = ∂s x − d3            (stretch–shear rule)
 ///                  Λκ:  ∫ ∂sδα · ∂_α(AᵀΛκA) ∂sα                                    (Λκ rule, I12)
-///                  Λω:  ∫ δα · ∂_α(AᵀΛωA) (α − α_{n−1}) / Δt²                      (load rule)
+///                  Λω:  ∫ δα · ∂_α(AᵀΛωA) (α − α_{n−1}) / Δt²                      (objective rule)
 /// ```
 #[allow(non_snake_case)] // paper symbols K, J, Q, A, S, H2, Lk, Lw
 fn coefficient_derivative(
@@ -135,7 +143,7 @@ fn coefficient_derivative(
     // The Λκ term's rule (I12).
     if w8.lambda_kappa.amax() > 0.0 {
         let Lk = Matrix3::from_diagonal(&w8.lambda_kappa);
-        for (xi, w) in KAPPA_RULE.iter() {
+        for (xi, w) in problem.scheme.kappa().iter() {
             let q = interpolate(&state, h, xi);
             let (A, dA) = (a_matrix(&q.alpha), a_matrix_derivatives(&q.alpha));
             let lka = Lk * (A * q.dalpha);
@@ -151,7 +159,7 @@ fn coefficient_derivative(
     if !first_frame && w8.lambda_omega.amax() > 0.0 {
         let dt = p.frame_interval_s;
         let Lw = Matrix3::from_diagonal(&w8.lambda_omega) / (dt * dt);
-        for (xi, w) in GAUSS2.iter() {
+        for (xi, w) in problem.scheme.objective().iter() {
             let q = interpolate(&state, h, xi);
             let wh = w * h;
             let A = a_matrix(&q.alpha);
@@ -254,7 +262,20 @@ fn solve_from(
     let mut big = s.solve_linearised(params, frame, u0, rescale)?;
     let problem = s.problem;
     let fwd = problem.dofs();
-    let FrameSolver { dofs, pattern, solver, fixed, rows, values, merit_weights, no_previous, records, .. } = s;
+    let FrameSolver {
+        dofs,
+        pattern,
+        solver,
+        fixed,
+        rows,
+        values,
+        merit_weights,
+        no_previous,
+        records,
+        cert_values,
+        ..
+    } = s;
+    cert_values.resize(pattern.nnz(), 0.0);
     let lean = *records == Records::Last;
     let previous_angles = frame.previous.unwrap_or(no_previous.as_slice());
     // the Ruiz row factors of the start's matrix weigh the merit of the whole frame (I6)
@@ -263,6 +284,19 @@ fn solve_from(
     let merit = |r: &DVector<f64>| r.iter().zip(merit_weights.iter()).map(|(a, b)| (a * b).powi(2)).sum::<f64>().sqrt();
     let mut history = Vec::new();
     let mut phi0 = f64::NAN;
+    // the merit at the start of each iteration (stall detection)
+    let mut phis: Vec<f64> = Vec::new();
+    let mut certify = |big: &DVector<f64>| {
+        super::kkt::certificate(problem, params, frame, previous_angles, big, pattern, cert_values)
+    };
+    let done = |u, adjoint, history, stop, certificate| InverseSolution {
+        u,
+        adjoint,
+        history,
+        stop,
+        certificate,
+        certificate_tolerance: params.certificate_tolerance,
+    };
     let mut adjoint = fwd.zeros();
     let mut u = dofs.kkt_state(&big);
     // the residual at `big` when the line search already assembled it (with the Jacobian,
@@ -286,6 +320,16 @@ fn solve_from(
         let phi = merit(&r);
         if k == 1 {
             phi0 = phi;
+        }
+        if !chord {
+            phis.push(phi);
+        }
+        // stalled: the merit fell by less than STALL_DECREASE over STALL_WINDOW iterations
+        let n = phis.len();
+        if !chord && n > STALL_WINDOW && phi > (1.0 - STALL_DECREASE) * phis[n - 1 - STALL_WINDOW] {
+            let c = certify(&big);
+            let stop = if c.within(params.certificate_tolerance) { Stop::Converged } else { Stop::Stalled };
+            return Ok(done(u, adjoint, history, stop, c));
         }
         let change = relative_change(&fwd, &dofs.kkt_state(&(&big + &delta)), &dofs.kkt_state(&big));
         // A full step whose relative change is within the tolerance is taken without the
@@ -346,21 +390,33 @@ fn solve_from(
         previous = rel_change;
         big = trial;
         adjoint = dofs.kkt_adjoint(&big);
-        if lean && !full && k < params.max_iterations {
+        let last = k == params.max_iterations;
+        let cert = (!lean || full || last).then(|| certify(&big));
+        if lean && !full && !last {
             let x_err = position_error(problem, &u, frame.x_g);
             early_divergence(frame.index, k, rel_change, x_err, &u, &adjoint)?;
         } else {
             let residual = (!skip_residual).then_some(phi_t / phi0);
-            let rec = record(problem, params, frame, previous_angles, k, rel_change, &u, &adjoint, residual);
+            let rec = InverseRecord {
+                certificate: cert.map(|c| c.value),
+                ..record(problem, params, frame, previous_angles, k, rel_change, &u, &adjoint, residual)
+            };
             rec.divergence(frame.index, &u, &adjoint)?;
             observer(&rec, &u, &adjoint);
             history.push(rec);
         }
-        if full {
-            return Ok(InverseSolution { u, adjoint, history, stop: Stop::Converged });
+        match cert {
+            Some(c) if full && c.within(params.certificate_tolerance) => {
+                return Ok(done(u, adjoint, history, Stop::Converged, c));
+            }
+            Some(c) if last => return Ok(done(u, adjoint, history, Stop::MaxIterations, c)),
+            // a step within the tolerance whose iterate is not certified: go on with Newton
+            _ if full => (next, chord) = (None, false),
+            _ => {}
         }
     }
-    Ok(InverseSolution { u, adjoint, history, stop: Stop::MaxIterations })
+    let c = certify(&big);
+    Ok(done(u, adjoint, history, Stop::MaxIterations, c))
 }
 
 /// Newton started from the paper's fixed point (I8): the fixed point (relaxation
@@ -378,7 +434,7 @@ pub(crate) fn solve_warm(
 ) -> Result<InverseSolution, SolveError> {
     let p = s.params;
     let warm = InverseParams { tolerance: warm_start_tolerance.max(p.tolerance), ..p };
-    let start = super::fixed_point::solve(s, &warm, frame, u0, observer)?;
+    let start = super::fixed_point::run(s, &warm, frame, u0, super::fixed_point::StopRule::FirstDip, observer)?;
     if start.stop != Stop::Converged {
         return Ok(start);
     }
