@@ -500,7 +500,7 @@ fn cmd_audit(
     let force = force || out.join(cosserat::audit::MARKER).is_file();
     let mut manifest = Manifest::new("audit");
     manifest.inputs = files.iter().map(|f| input_file(f)).collect::<Result<_, _>>()?;
-    manifest.settings.insert("quick".into(), f64::from(u8::from(quick)));
+    manifest.settings.insert("quick".into(), f64::from(u8::from(quick)).into());
     let folder = RunFolder::begin(&out, manifest, Mode::Fresh { force })
         .with_context(|| format!("audit: output folder {}", out.display()))?;
     let pb = progress_bar(quiet, if quick { "audit (quick)" } else { "audit" });

@@ -4,7 +4,6 @@
 //! report's text changes only when a result does.
 use super::spec::{Check, Claim, Ref, Selector, Spec};
 use super::{ClaimResult, PointResult, RunResults, Verdict};
-use crate::case::sweep::fmt_value;
 use crate::io::sweep::RunStatus;
 
 /// How far a check holds.
@@ -45,13 +44,13 @@ fn point_label(p: &PointResult) -> String {
     if p.point.is_empty() {
         return "the run".into();
     }
-    p.point.iter().map(|(k, v)| format!("{k} = {}", fmt_value(*v))).collect::<Vec<_>>().join(", ")
+    p.point.iter().map(|(k, v)| format!("{k} = {v}")).collect::<Vec<_>>().join(", ")
 }
 
 /// Values of the points, `1e-20, 1e-10, 1` (single grid key) or full labels.
 fn values(points: &[&PointResult]) -> String {
     let single = points.iter().all(|p| p.point.len() == 1);
-    points.iter().map(|p| if single { fmt_value(p.point[0].1) } else { point_label(p) }).collect::<Vec<_>>().join(", ")
+    points.iter().map(|p| if single { p.point[0].1.to_string() } else { point_label(p) }).collect::<Vec<_>>().join(", ")
 }
 
 /// The grid key of a run with one key (for "λd = …" phrasing).
@@ -197,7 +196,7 @@ fn evaluate_inner(check: &Check, runs: &[RunResults]) -> Result<(Outcome, String
             let pts = select(runs, run, &empty)?;
             let mut sorted = pts.clone();
             sorted.sort_by(|a, b| {
-                let v = |p: &PointResult| p.point.first().map(|x| x.1).unwrap_or(0.0);
+                let v = |p: &PointResult| p.point.first().and_then(|x| x.1.number()).unwrap_or(0.0);
                 v(a).total_cmp(&v(b))
             });
             let vals: Vec<Option<f64>> = sorted.iter().map(|p| p.metric(metric)).collect();
@@ -297,7 +296,7 @@ fn evaluate_inner(check: &Check, runs: &[RunResults]) -> Result<(Outcome, String
                     .iter()
                     .map(|(p, s)| format!(
                         "{}: {}",
-                        p.point.first().map(|x| fmt_value(x.1)).unwrap_or_default(),
+                        p.point.first().map(|x| x.1.to_string()).unwrap_or_default(),
                         s.map(|(s, n)| format!("{} ({n} its)", sig2(s))).unwrap_or_else(|| "–".into())
                     ))
                     .collect::<Vec<_>>()

@@ -68,12 +68,7 @@ fn label(p: &PointResult) -> String {
     if p.point.is_empty() {
         return p.label.clone();
     }
-    let mut l = p
-        .point
-        .iter()
-        .map(|(k, v)| format!("{k} = {}", crate::case::sweep::fmt_value(*v)))
-        .collect::<Vec<_>>()
-        .join(", ");
+    let mut l = p.point.iter().map(|(k, v)| format!("{k} = {v}")).collect::<Vec<_>>().join(", ");
     if !p.converged() {
         l.push_str(" (not converged)");
     }

@@ -110,7 +110,9 @@ impl PointResult {
     }
     /// Does the point have these grid values?
     pub fn matches(&self, at: &spec::Selector) -> bool {
-        at.iter().all(|(k, v)| self.point.iter().any(|(pk, pv)| pk == k && (pv - v).abs() <= 1e-12 * v.abs()))
+        at.iter().all(|(k, v)| {
+            self.point.iter().any(|(pk, pv)| pk == k && pv.number().is_some_and(|pv| (pv - v).abs() <= 1e-12 * v.abs()))
+        })
     }
 }
 

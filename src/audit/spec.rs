@@ -34,7 +34,7 @@ use std::path::{Path, PathBuf};
 use serde::Deserialize;
 
 use super::Verdict;
-use crate::case::sweep::{known_keys, SweepParam};
+use crate::case::sweep::{known_keys, SweepParam, SweepValue};
 use crate::case::Case;
 use crate::io::files::{read_capped_text, InputError};
 
@@ -366,7 +366,7 @@ pub fn read_spec(path: &Path, quick: bool) -> Result<Spec, SpecError> {
             if values.is_empty() || values.iter().any(|v| !v.is_finite()) {
                 return Err(invalid(format!("run `{name}` grid `{key}`"), "needs finite values".into()));
             }
-            grid.push(SweepParam { key, values });
+            grid.push(SweepParam { key, values: values.into_iter().map(SweepValue::Number).collect() });
         }
         if !r.keep_frames.is_empty() && case.clip().is_none() {
             return Err(invalid(format!("run `{name}`"), "keep_frames needs a clip case".into()));

@@ -29,7 +29,41 @@ pub enum SweepError {
 #[derive(Clone, Debug, PartialEq)]
 pub struct SweepParam {
     pub key: String,
-    pub values: Vec<f64>,
+    pub values: Vec<SweepValue>,
+}
+
+/// A swept value: a number, or a word of a key that takes one of a few words
+/// (`quadrature = selective|full|reduced|midpoint|gauss2`).
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(untagged)]
+pub enum SweepValue {
+    Number(f64),
+    Word(String),
+}
+
+impl SweepValue {
+    /// The number, if it is one.
+    pub fn number(&self) -> Option<f64> {
+        match self {
+            SweepValue::Number(v) => Some(*v),
+            SweepValue::Word(_) => None,
+        }
+    }
+}
+
+impl std::fmt::Display for SweepValue {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            SweepValue::Number(v) => f.write_str(&fmt_value(*v)),
+            SweepValue::Word(w) => f.write_str(w),
+        }
+    }
+}
+
+impl From<f64> for SweepValue {
+    fn from(v: f64) -> Self {
+        SweepValue::Number(v)
+    }
 }
 
 /// A parameter a sweep can set: its name on the command line, its table and key in the case
@@ -40,17 +74,30 @@ struct Key {
     key: &'static str,
     index: Option<usize>,
     count: bool,
+    /// a key that takes one of these words instead of a number
+    words: Option<&'static [&'static str]>,
 }
 
 const fn key(name: &'static str, table: &'static str, key: &'static str) -> Key {
-    Key { name, table, key, index: None, count: false }
+    Key { name, table, key, index: None, count: false, words: None }
 }
 const fn count(name: &'static str, table: &'static str, key: &'static str) -> Key {
-    Key { name, table, key, index: None, count: true }
+    Key { name, table, key, index: None, count: true, words: None }
 }
 const fn entry(name: &'static str, key: &'static str, index: usize) -> Key {
-    Key { name, table: "inverse", key, index: Some(index), count: false }
+    Key { name, table: "inverse", key, index: Some(index), count: false, words: None }
 }
+/// The quadrature scheme (`solver.quadrature`, D4): ours, or the paper's scheme with one rule.
+const QUADRATURE: Key = Key {
+    name: "quadrature",
+    table: "solver",
+    key: "quadrature",
+    index: None,
+    count: false,
+    words: Some(&["selective", "full", "reduced", "midpoint", "gauss2"]),
+};
+/// `solver.certificate_tolerance` (docs/certificate.md).
+const CERTIFICATE_TOLERANCE: Key = key("certificate_tolerance", "solver", "certificate_tolerance");
 
 const INVERSE_KEYS: &[Key] = &[
     key("lambda_g", "inverse", "lambda_g"),
@@ -69,6 +116,8 @@ const INVERSE_KEYS: &[Key] = &[
     count("max_iterations", "solver", "max_iterations"),
     count("elements", "rod", "elements"),
     key("stabilisation", "inverse", "stabilisation"),
+    QUADRATURE,
+    CERTIFICATE_TOLERANCE,
 ];
 const STATIC_KEYS: &[Key] = &[
     key("relaxation", "solver", "relaxation"),
@@ -76,12 +125,16 @@ const STATIC_KEYS: &[Key] = &[
     count("max_iterations", "solver", "max_iterations"),
     count("continuation_steps", "solver", "continuation_steps"),
     count("elements", "rod", "elements"),
+    QUADRATURE,
+    CERTIFICATE_TOLERANCE,
 ];
 const DYNAMIC_KEYS: &[Key] = &[
     key("tolerance", "solver", "tolerance"),
     count("max_iterations", "solver", "max_iterations"),
     count("steps", "time", "steps"),
     count("elements", "rod", "elements"),
+    QUADRATURE,
+    CERTIFICATE_TOLERANCE,
 ];
 
 fn keys(case: &Case) -> &'static [Key] {
@@ -98,21 +151,26 @@ pub fn known_keys(case: &Case) -> Vec<&'static str> {
 }
 
 /// Parse `key=v1,v2,…`; each value once (equal numbers, e.g. `10` and `1e1`, are one value).
+/// A value that is not a number is a word (`quadrature=midpoint`), checked against the key
+/// when the grid is applied to a case.
 pub fn parse_set(spec: &str) -> Result<SweepParam, SweepError> {
     let (key, values) = spec.split_once('=').ok_or_else(|| SweepError::Syntax(spec.into()))?;
     let key = key.trim().to_string();
     if key.is_empty() || values.trim().is_empty() {
         return Err(SweepError::Syntax(spec.into()));
     }
-    let mut parsed: Vec<(f64, &str)> = Vec::new();
+    let mut parsed: Vec<(SweepValue, &str)> = Vec::new();
     for v in values.split(',').map(str::trim) {
-        let x = v
-            .parse::<f64>()
-            .ok()
-            .filter(|x| x.is_finite())
-            .ok_or_else(|| SweepError::NotANumber { key: key.clone(), value: v.into() })?;
-        if let Some(&(_, first)) = parsed.iter().find(|(y, _)| *y == x) {
-            let value = if first == v { format!("`{v}`") } else { format!("`{v}` (= `{first}`)") };
+        let x = match v.parse::<f64>() {
+            Ok(x) if x.is_finite() => SweepValue::Number(x),
+            Ok(_) => return Err(SweepError::NotANumber { key: key.clone(), value: v.into() }),
+            Err(_) if !v.is_empty() && v.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') => {
+                SweepValue::Word(v.to_string())
+            }
+            Err(_) => return Err(SweepError::NotANumber { key: key.clone(), value: v.into() }),
+        };
+        if let Some((_, first)) = parsed.iter().find(|(y, _)| *y == x) {
+            let value = if *first == v { format!("`{v}`") } else { format!("`{v}` (= `{first}`)") };
             return Err(SweepError::DuplicateValue { key, value });
         }
         parsed.push((x, v));
@@ -123,10 +181,11 @@ pub fn parse_set(spec: &str) -> Result<SweepParam, SweepError> {
 impl Case {
     /// The case with the given parameters set (command-line names, see [`known_keys`]),
     /// validated again as a whole.
-    pub fn with_values(&self, values: &[(&str, f64)]) -> Result<Case, SweepError> {
+    pub fn with_values(&self, values: &[(&str, SweepValue)]) -> Result<Case, SweepError> {
         let label = values.iter().map(|v| v.0).collect::<Vec<_>>().join(", ");
         self.revalidated(&label, |table| {
-            for &(name, v) in values {
+            for (name, v) in values {
+                let name = *name;
                 let k = keys(self).iter().find(|k| k.name == name).ok_or_else(|| SweepError::UnknownKey {
                     key: name.into(),
                     case: self.name.clone(),
@@ -192,18 +251,20 @@ impl Case {
     }
 }
 
-/// Write `v` at `k` in the case file's tables (an integer for a count).
-fn set(table: &mut toml::Table, k: &Key, v: f64) -> Result<(), SweepError> {
-    let value = if k.count {
-        if !(v >= 1.0 && v.fract() == 0.0 && v < 1e9) {
-            return Err(SweepError::Invalid {
-                key: k.name.into(),
-                reason: format!("must be a positive integer, got {v}"),
-            });
+/// Write `v` at `k` in the case file's tables (an integer for a count, a string for a word).
+fn set(table: &mut toml::Table, k: &Key, v: &SweepValue) -> Result<(), SweepError> {
+    let invalid = |reason: String| SweepError::Invalid { key: k.name.into(), reason };
+    let value = match (v, k.words) {
+        (SweepValue::Word(w), Some(words)) if words.contains(&w.as_str()) => toml::Value::String(w.clone()),
+        (_, Some(words)) => return Err(invalid(format!("must be one of {}, got {v}", words.join(", ")))),
+        (SweepValue::Word(w), None) => return Err(invalid(format!("`{w}` is not a number"))),
+        (SweepValue::Number(v), None) if k.count => {
+            if !(*v >= 1.0 && v.fract() == 0.0 && *v < 1e9) {
+                return Err(invalid(format!("must be a positive integer, got {v}")));
+            }
+            toml::Value::Integer(*v as i64)
         }
-        toml::Value::Integer(v as i64)
-    } else {
-        toml::Value::Float(v)
+        (SweepValue::Number(v), None) => toml::Value::Float(*v),
     };
     let t =
         table.entry(k.table).or_insert_with(|| toml::Value::Table(toml::Table::new())).as_table_mut().ok_or_else(
@@ -234,7 +295,7 @@ fn set(table: &mut toml::Table, k: &Key, v: f64) -> Result<(), SweepError> {
 }
 
 /// One point of the cartesian product: `(key, value)` in the order of the `--set` options.
-pub type Point = Vec<(String, f64)>;
+pub type Point = Vec<(String, SweepValue)>;
 
 /// The cartesian product of the specifications (first key varies slowest), each point
 /// applied to `case` and validated.
@@ -256,9 +317,9 @@ pub fn product(case: &Case, params: &[SweepParam]) -> Result<Vec<(Point, Case)>,
         points = points
             .into_iter()
             .flat_map(|pt| {
-                p.values.iter().map(move |&v| {
+                p.values.iter().map(move |v| {
                     let mut q = pt.clone();
-                    q.push((p.key.clone(), v));
+                    q.push((p.key.clone(), v.clone()));
                     q
                 })
             })
@@ -267,7 +328,7 @@ pub fn product(case: &Case, params: &[SweepParam]) -> Result<Vec<(Point, Case)>,
     points
         .into_iter()
         .map(|pt| {
-            let values: Vec<(&str, f64)> = pt.iter().map(|(k, v)| (k.as_str(), *v)).collect();
+            let values: Vec<(&str, SweepValue)> = pt.iter().map(|(k, v)| (k.as_str(), v.clone())).collect();
             let mut c = case.with_values(&values)?;
             c.name = run_name(case, &pt);
             Ok((pt, c))
@@ -280,7 +341,7 @@ pub fn run_name(case: &Case, point: &Point) -> String {
     if point.is_empty() {
         return case.name.clone();
     }
-    point.iter().map(|(k, v)| format!("{k}={}", fmt_value(*v))).collect::<Vec<_>>().join("_")
+    point.iter().map(|(k, v)| format!("{k}={v}")).collect::<Vec<_>>().join("_")
 }
 
 /// Shortest exact decimal of a value (`1e-20`, `0.5`, `100`).
@@ -368,6 +429,6 @@ mod tests {
             e.to_string(),
             "--set lambda_l: value `1.0e-20` (= `1e-20`) given twice: both runs would write one folder"
         );
-        assert_eq!(parse_set("elements=10,20").unwrap().values, vec![10.0, 20.0]);
+        assert_eq!(parse_set("elements=10,20").unwrap().values, vec![10.0.into(), 20.0.into()]);
     }
 }

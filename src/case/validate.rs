@@ -18,7 +18,7 @@ use crate::model::material::{CrossSection, Material, RodProperties};
 use crate::model::mesh::{Mesh, QuadratureScheme};
 use crate::solve::certificate::{CERTIFICATE_FLOOR, DEFAULT_CERTIFICATE_TOLERANCE};
 use crate::solve::dynamics::DynamicParams;
-use crate::solve::inverse::{InverseMethod, InverseParams, Weights, DEFAULT_STABILISATION};
+use crate::solve::inverse::{default_stabilisation, InverseMethod, InverseParams, Weights};
 use crate::solve::statics::{Method, StaticParams};
 
 mod clip;
@@ -134,7 +134,9 @@ impl<'a> Validator<'a> {
         let analysis = match kind {
             RawAnalysis::Static => Analysis::Static(self.static_solve("solver", &raw.solver)?),
             RawAnalysis::Dynamic => Analysis::Dynamic(self.dynamic(&raw.solver, raw.time.as_ref())?),
-            RawAnalysis::Inverse => Analysis::Inverse(self.inverse(&raw, &mesh)?),
+            RawAnalysis::Inverse => {
+                Analysis::Inverse(self.inverse(&raw, &mesh, &RodProperties::new(&material, &section))?)
+            }
         };
         self.loads_are_finite(&loads, &load_texts, &mesh, quadrature, &analysis)?;
         let compare = self.compare(&raw.compare)?;
@@ -341,7 +343,7 @@ impl<'a> Validator<'a> {
     }
 
     /// `[solver]`, `[inverse]` and `[data]` or `[clip]` of an inverse analysis.
-    fn inverse(&self, raw: &RawCase, mesh: &Mesh) -> Result<InverseSettings, CaseError> {
+    fn inverse(&self, raw: &RawCase, mesh: &Mesh, props: &RodProperties) -> Result<InverseSettings, CaseError> {
         let s = &raw.solver;
         // Both methods need the relaxation: Newton starts from the fixed point (I8).
         let relaxation = self.relaxation("solver", s.relaxation)?;
@@ -409,7 +411,7 @@ impl<'a> Validator<'a> {
                 e
             }
             None if one_rule => 0.0,
-            None => DEFAULT_STABILISATION,
+            None => default_stabilisation(&weights, &props.bend_twist_nm2, mesh.length_m),
         };
         let params = InverseParams {
             weights,

@@ -8,6 +8,8 @@
 //! outright leaves the previous folder untouched (its staging folder is removed, or resumed, by
 //! the next run). A folder holding files but no `run.json` is not replaced unless `--force`.
 use std::collections::BTreeMap;
+
+use crate::case::sweep::SweepValue;
 use std::path::{Path, PathBuf};
 
 use sha2::{Digest, Sha256};
@@ -74,7 +76,7 @@ pub struct Manifest {
     /// other inputs the results depend on (a clip's recording or kymogram)
     pub inputs: Vec<InputFile>,
     /// settings that differ from the case file (a sweep point)
-    pub settings: BTreeMap<String, f64>,
+    pub settings: BTreeMap<String, SweepValue>,
     pub engine: Option<String>,
     pub status: Status,
     /// clips: converged frames written, and frames of the clip

@@ -10,7 +10,7 @@ use super::files::OutputError;
 use super::run_folder::{input_file, Manifest};
 pub use super::solved::{case_label, chain, RunStatus, Solved as SweepOutcome};
 use super::solved::{solve_into, Solved};
-use crate::case::sweep::{fmt_value, Point};
+use crate::case::sweep::Point;
 use crate::case::Case;
 use crate::run::clip::ClipFrame;
 use crate::run::metrics::Metrics;
@@ -70,7 +70,7 @@ pub fn summary_csv(keys: &[String], columns: &[&str], rows: &[SummaryRow]) -> Re
     header.push("error".into());
     w.write_record(&header)?;
     for r in rows {
-        let mut rec: Vec<String> = r.point.iter().map(|(_, v)| fmt_value(*v)).collect();
+        let mut rec: Vec<String> = r.point.iter().map(|(_, v)| v.to_string()).collect();
         rec.push(r.status.as_str().into());
         rec.extend(columns.iter().map(|k| {
             r.metrics.as_ref().and_then(|m| m.get(*k)).map(|v| super::number::exp(*v, 10)).unwrap_or_default()
@@ -202,21 +202,21 @@ mod tests {
         let rows = vec![
             SummaryRow {
                 name: String::new(),
-                point: vec![("lambda_l".into(), 1e-20)],
+                point: vec![("lambda_l".into(), 1e-20.into())],
                 status: RunStatus::Ok,
                 metrics: Some(m.clone()),
                 error: None,
             },
             SummaryRow {
                 name: String::new(),
-                point: vec![("lambda_l".into(), 1e3)],
+                point: vec![("lambda_l".into(), 1e3.into())],
                 status: RunStatus::NotConverged,
                 metrics: Some(m),
                 error: Some("did not converge,\nat all".into()),
             },
             SummaryRow {
                 name: String::new(),
-                point: vec![("lambda_l".into(), 1.0)],
+                point: vec![("lambda_l".into(), 1.0.into())],
                 status: RunStatus::Failed,
                 metrics: None,
                 error: Some("bad".into()),

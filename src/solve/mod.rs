@@ -96,6 +96,11 @@ pub enum SolveError {
         tolerance: f64,
         block: &'static str,
     },
+    /// The KKT matrix of a frame is singular to working precision (a zero pivot of the band LU).
+    #[error(
+        "inverse frame {frame}: the KKT matrix is singular to working precision at the unknown {unknown}: {cause}"
+    )]
+    InverseSingular { frame: usize, unknown: String, cause: String },
     #[error("inverse frame {frame} diverged in iteration {iteration}: {quantity} = {value:e}")]
     /// `quantity` named with its limit (a non-finite value, or the misfit beyond
     /// [`inverse::DIVERGED_X_ERR`]); the iterate is not returned.

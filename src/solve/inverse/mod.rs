@@ -32,7 +32,7 @@ use nalgebra::{DVector, Vector3};
 
 use super::certificate::Certificate;
 use super::{Problem, SolveError, Stop};
-use crate::linalg::{LinearSolver, Pattern};
+use crate::linalg::{LinearError, LinearSolver, Pattern};
 use crate::model::mesh::DofMap;
 use crate::model::rotation::Angles;
 
@@ -65,8 +65,26 @@ pub enum InverseMethod {
 
 /// Default weight ε of the two-point rule in the λd term (I11): the smallest blend that makes the
 /// (64) data converge for λd from 1e-10 to 10 (361–375 iterations at 1e-2…10; ε = 0, the
-/// one-point rule, needs 2827 at 1e-2 and does not converge at 1 or 10).
+/// one-point rule, needs 2827 at 1e-2 and does not converge at 1 or 10). Where λd is small
+/// against the bending stiffness or the Λκ term, [`default_stabilisation`] raises it.
 pub const DEFAULT_STABILISATION: f64 = 1e-3;
+
+/// The default ε of the λd term's blend (I11, I13) for the weights `w` on a rod of length
+/// `length_m` [m] with bending and twist stiffnesses `bend_twist_nm2` [N m²]:
+/// [`DEFAULT_STABILISATION`], raised to `max(J, Λκ) / (λd L²)` (at most 1). The penalty
+/// `ε λd` on the within-element variation of `∂s x − d3` is then never weaker than the bending
+/// stiffness or the curvature weight on the rod's length scale. Weaker, the nodal zig-zag of
+/// the angles that the one-point rules cannot see is held by too little: Newton's Jacobian gets
+/// a cluster of near-zero singular values and Newton stalls (`docs/inverse.md`, I13: eq. (64)
+/// and (65) data with λd = 1e-6, where ε = 1e-3 stalls and ε ≥ 0.034 converges).
+pub fn default_stabilisation(w: &Weights, bend_twist_nm2: &Vector3<f64>, length_m: f64) -> f64 {
+    let held = bend_twist_nm2.amax().max(w.lambda_kappa.amax()) / (w.lambda_d * length_m * length_m);
+    if held.is_nan() {
+        DEFAULT_STABILISATION
+    } else {
+        held.clamp(DEFAULT_STABILISATION, 1.0)
+    }
+}
 
 /// Settings of the inverse solver, the same for every frame of a clip.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -392,13 +410,39 @@ impl<'p> FrameSolver<'p> {
         }
         self.set_dirichlet(frame);
         let params = self.params;
-        match (params.method, start) {
+        let solved = match (params.method, start) {
             (InverseMethod::FixedPoint, _) => fixed_point::solve(self, &params, frame, u0, &mut observer),
             (InverseMethod::Newton { .. }, Start::Near) => newton::solve(self, &params, frame, u0, &mut observer),
             (InverseMethod::Newton { warm_start_tolerance }, Start::Guess) => {
                 newton::solve_warm(self, warm_start_tolerance, frame, u0, &mut observer)
             }
-        }
+        };
+        solved.map_err(|e| match e {
+            SolveError::Linear(LinearError::ZeroPivot { column, .. }) => self.singular(frame.index, column),
+            e => e,
+        })
+    }
+
+    /// The error of a KKT matrix singular to working precision at unknown `column` (KKT
+    /// numbering), with the likely cause: a Λκ term that outweighs the bending stiffness by
+    /// more than the precision can hold, integrated by a one-point rule (`docs/inverse.md`, I13).
+    fn singular(&self, frame: usize, column: usize) -> SolveError {
+        const NAMES: [&str; 12] = ["x", "y", "z", "α", "β", "γ", "x̂1", "x̂2", "x̂3", "α̂1", "α̂2", "α̂3"];
+        let block = self.dofs.block();
+        let unknown = format!("{} of node {}", NAMES[column % block], column / block);
+        let stiffness = self.problem.props.bend_twist_nm2.amin();
+        let ratio = self.params.weights.lambda_kappa.amax() / stiffness;
+        let one_point = self.problem.scheme.kappa().points.len() == 1;
+        let cause = if ratio > 1e10 && one_point {
+            format!(
+                "the curvature weight max Λκ = {:e} outweighs the bending stiffness {stiffness:e} N m² by {ratio:.1e}; integrated at one point per element (solver.quadrature = \"{}\"), the Λκ term constrains one combination of the angle rates per element and leaves the other to the bending stiffness alone, below the precision of the factorisation (docs/inverse.md, I13): use solver.quadrature = \"gauss2\" or a smaller Λκ",
+                self.params.weights.lambda_kappa.amax(),
+                self.problem.scheme.name()
+            )
+        } else {
+            "the equilibrated KKT matrix has no usable pivot there (docs/inverse.md, I6)".to_string()
+        };
+        SolveError::InverseSingular { frame, unknown, cause }
     }
 
     /// The residual certificate of the state `u` with the adjoint `adjoint` (forward layout
