@@ -54,6 +54,10 @@ enum Command {
         /// Do not show a progress bar
         #[arg(long)]
         quiet: bool,
+        /// Clips: exit with status 1 when frames are over the fit-quality gate (run.json then
+        /// says complete_with_warnings either way)
+        #[arg(long)]
+        strict: bool,
     },
     /// Run both engines and compare them; exit status 1 if any row fails.
     ///
@@ -217,9 +221,9 @@ fn main() -> ExitCode {
 
 fn dispatch(cli: Cli) -> Result<ExitCode> {
     match cli.command {
-        Command::Run { case, engine, out, force, resume, output_format, limits, quiet } => {
+        Command::Run { case, engine, out, force, resume, output_format, limits, quiet, strict } => {
             let mode = if resume { Mode::Resume } else { Mode::Fresh { force } };
-            cmd_run(&case, engine, out, (mode, output_format), limits, quiet)
+            cmd_run(&case, engine, out, (mode, output_format), limits, (quiet, strict))
         }
         Command::Compare { case, out, short, frames, force, limits } => {
             cmd_compare(&case, out, short, frames, force, limits)
@@ -267,7 +271,7 @@ fn cmd_run(
     out: Option<PathBuf>,
     mode: (Mode, OutputFormat),
     limits: Limits,
-    quiet: bool,
+    (quiet, strict): (bool, bool),
 ) -> Result<ExitCode> {
     let case = load(path)?;
     check_memory(&case, Footprint::Run, limits)?;
@@ -288,6 +292,13 @@ fn cmd_run(
     }
     match end.status {
         Status::Complete => print!("{}", end.summary(&case.name, engine)),
+        Status::CompleteWithWarnings => {
+            print!("{}", end.summary(&case.name, engine));
+            eprintln!("warning: {}", end.message.unwrap_or_default());
+            if strict {
+                return Ok(ExitCode::from(1));
+            }
+        }
         Status::Interrupted => {
             let kept = match end.frames {
                 Some((n, _)) => format!(
@@ -435,7 +446,8 @@ fn cmd_sweep(
         }
     };
     let count = |s: RunStatus| rows.iter().filter(|r| r.status == s).count();
-    let (interrupted, failed) = (count(RunStatus::Interrupted), rows.len() - count(RunStatus::Ok));
+    let complete = rows.iter().filter(|r| r.status.is_complete()).count();
+    let (interrupted, failed) = (count(RunStatus::Interrupted), rows.len() - complete);
     let status = if interrupted > 0 {
         Status::Interrupted
     } else if failed > 0 {

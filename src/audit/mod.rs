@@ -16,7 +16,7 @@ use rayon::prelude::*;
 use serde::Deserialize;
 
 use crate::case::sweep::{product, Point, SweepError};
-use crate::io::sweep::{point_manifest, run_clip_point, run_point, RunStatus, SweepOutcome};
+use crate::io::sweep::{point_manifest, run_clip_point, run_point, SweepOutcome};
 use measures::{derived_metrics, ClipRecorder, ClipSeries};
 use spec::{Claim, RunSpec, Spec};
 
@@ -102,7 +102,7 @@ pub struct PointResult {
 
 impl PointResult {
     pub fn converged(&self) -> bool {
-        self.outcome.status == RunStatus::Ok
+        self.outcome.status.is_complete()
     }
     /// A metric of the point (its run's metrics with [`measures::derived_metrics`]).
     pub fn metric(&self, name: &str) -> Option<f64> {

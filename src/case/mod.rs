@@ -23,6 +23,7 @@ use crate::model::loads::Loads;
 use crate::model::material::{CrossSection, Material, RodProperties};
 use crate::model::mesh::{Mesh, QuadratureScheme};
 use crate::solve::dynamics::DynamicParams;
+use crate::solve::fit::FitGate;
 use crate::solve::inverse::{InverseParams, Records};
 use crate::solve::sequence::{FrameStart, RotationTreatment, SequenceParams};
 use crate::solve::statics::StaticParams;
@@ -128,6 +129,8 @@ pub struct ClipSource {
     /// unit gauge vector of the first frame in space coordinates (R7): `clip.gauge` rotated by
     /// `orientation`; default the placement plane's normal (e2 for x–z, e3 for x–y)
     pub gauge: Vector3<f64>,
+    /// the fit-quality gate (`clip.gate_*`, `solve::fit`)
+    pub gate: FitGate,
 }
 
 /// An inverse analysis (Problem 2, eq. 61): the solver's params and the data.
@@ -331,6 +334,7 @@ impl Case {
             rotation: clip.rotation,
             gauge: clip.gauge,
             records: Records::Every,
+            gate: clip.gate,
         })
     }
 }

@@ -76,6 +76,12 @@ pub(super) struct RawClip {
     pub(super) clip_frames: Option<usize>,
     /// roll_3d: integration steps per element
     pub(super) substeps: Option<usize>,
+    /// fit-quality gate (`solve::fit`): noise levels a misfit may reach
+    pub(super) gate_noise_multiple: Option<f64>,
+    /// fit-quality gate: position misfit [body lengths] never flagged
+    pub(super) gate_position: Option<f64>,
+    /// fit-quality gate: tangent misfit never flagged
+    pub(super) gate_tangent: Option<f64>,
 }
 
 #[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default)]

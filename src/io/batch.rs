@@ -139,7 +139,7 @@ impl BatchRow {
     }
 
     pub fn is_ok(&self) -> bool {
-        self.status == RunStatus::Ok.as_str()
+        self.status == RunStatus::Ok.as_str() || self.status == RunStatus::Warnings.as_str()
     }
 }
 
@@ -313,7 +313,7 @@ fn recording_manifest(
 fn complete_row(dir: &Path, wanted: &Manifest) -> Option<BatchRow> {
     let m = Manifest::read(dir).ok()??;
     let hashes = |m: &Manifest| m.inputs.iter().map(|f| f.sha256.clone()).collect::<Vec<_>>();
-    let same = m.status == Status::Complete
+    let same = m.status.is_complete()
         && m.command == wanted.command
         && m.version == wanted.version
         && m.case.as_ref().map(|c| &c.sha256) == wanted.case.as_ref().map(|c| &c.sha256)

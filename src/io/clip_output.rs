@@ -46,7 +46,7 @@ fn row_files(format: OutputFormat) -> [&'static str; 2] {
 /// `Q = Q_E(α) B`, whose singular axis `n = Bᵀ e2` is `chart_axis_*`; `docs/rotation.md`);
 /// `max_abs_omega_rad_per_s` is the largest |ωˡ| over the nodes [rad/s] (eq. 27, 0 on the
 /// first frame; `run::clip::ClipFrame::omega`).
-pub const CLIP_FRAME_COLUMNS: [&str; 24] = [
+pub const CLIP_FRAME_COLUMNS: [&str; 28] = [
     "frame",
     "time_s",
     "iterations",
@@ -71,6 +71,10 @@ pub const CLIP_FRAME_COLUMNS: [&str; 24] = [
     "chart_axis_z",
     "max_abs_omega_rad_per_s",
     "certificate",
+    "data_noise_m",
+    "fit_position_rel_length",
+    "fit_tangent_rms",
+    "flagged",
 ];
 
 /// Columns of `fields.csv`, one row per frame and node: position [m], the angles [rad] in the
@@ -254,6 +258,7 @@ impl ClipWriter {
         row.extend(r.chart_axis.iter());
         row.push(omega.iter().map(|w| w.norm()).fold(0.0, f64::max));
         row.push(r.certificate);
+        row.extend([r.fit.noise_m, r.fit.position, r.fit.tangent, f64::from(u8::from(r.fit.flagged))]);
         writeln!(self.frames, "{}", csv_row(&row)).and_then(|_| self.frames.flush()).map_err(err("frames.csv"))?;
         let d = nodes.directors();
         let [fields, curvature] = row_files(self.format());

@@ -25,6 +25,9 @@ pub const MANIFEST: &str = "run.json";
 pub enum Status {
     Running,
     Complete,
+    /// a clip solved whole with frames over the fit-quality gate (`solve::fit`): every frame is
+    /// certified, but some do not follow their data
+    CompleteWithWarnings,
     /// the run ended with a result that is not a solution: its iteration stopped moving with a
     /// residual certificate above the tolerance (`docs/certificate.md`)
     Stalled,
@@ -33,10 +36,16 @@ pub enum Status {
 }
 
 impl Status {
+    /// A whole result: complete, with or without warnings.
+    pub fn is_complete(self) -> bool {
+        matches!(self, Status::Complete | Status::CompleteWithWarnings)
+    }
+
     pub fn as_str(self) -> &'static str {
         match self {
             Status::Running => "running",
             Status::Complete => "complete",
+            Status::CompleteWithWarnings => "complete_with_warnings",
             Status::Stalled => "stalled",
             Status::Failed => "failed",
             Status::Interrupted => "interrupted",
@@ -401,7 +410,7 @@ fn check_resumable(previous: &Manifest, new: &Manifest) -> Result<(), String> {
     if previous.command != "run" || previous.frames_done.is_none() {
         return Err(format!("it holds a `{}` run, not a clip run (only clips resume)", previous.command));
     }
-    if previous.status == Status::Complete {
+    if previous.status.is_complete() {
         return Err("its run is complete; nothing to resume".into());
     }
     if previous.version != new.version {

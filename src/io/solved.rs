@@ -16,6 +16,7 @@ use crate::run::clip::{ClipFrame, ClipRun};
 use crate::run::clip_metrics::clip_metrics;
 use crate::run::metrics::{all_metrics, Metrics};
 use crate::run::{Engine, RunError, RunResult};
+use crate::solve::sequence::FrameReport;
 use crate::solve::SolveError;
 
 /// How one run ended.
@@ -27,17 +28,26 @@ pub enum RunStatus {
     /// the iteration stopped moving but its residual certificate is above the tolerance
     /// (`solve::Stop::Stalled`); the metrics are those of the last iterate
     Stalled,
+    /// a clip solved whole, with frames over the fit-quality gate (`solve::fit`): every frame
+    /// is certified, but some do not follow their data
+    Warnings,
     Failed,
     /// stopped by a signal (or not started because of one)
     Interrupted,
 }
 
 impl RunStatus {
+    /// A result whole: `ok`, or a clip complete with warnings.
+    pub fn is_complete(&self) -> bool {
+        matches!(self, RunStatus::Ok | RunStatus::Warnings)
+    }
+
     pub fn as_str(&self) -> &'static str {
         match self {
             RunStatus::Ok => "ok",
             RunStatus::NotConverged => "not_converged",
             RunStatus::Stalled => "stalled",
+            RunStatus::Warnings => "complete_with_warnings",
             RunStatus::Failed => "failed",
             RunStatus::Interrupted => "interrupted",
         }
@@ -49,6 +59,7 @@ impl RunStatus {
             RunStatus::Ok => Status::Complete,
             RunStatus::NotConverged | RunStatus::Failed => Status::Failed,
             RunStatus::Stalled => Status::Stalled,
+            RunStatus::Warnings => Status::CompleteWithWarnings,
             RunStatus::Interrupted => Status::Interrupted,
         }
     }
@@ -173,7 +184,9 @@ fn solve_clip(
         Err(e) => return fail(&e),
     };
     let (done, total) = (out.run.reports.len(), out.total);
+    let flagged: Vec<&FrameReport> = out.run.reports.iter().filter(|r| r.fit.flagged).collect();
     let (status, error) = match &out.stopped {
+        None if !flagged.is_empty() => (RunStatus::Warnings, Some(flag_message(case, &flagged, done))),
         None => (RunStatus::Ok, None),
         Some(e) if e.is_interrupted() => (RunStatus::Interrupted, Some(format!("{}: {}", case_label(case), chain(e)))),
         Some(e) => (
@@ -186,13 +199,27 @@ fn solve_clip(
             return fail(&e);
         }
     }
-    if status == RunStatus::Ok && opts.journal {
+    if status.is_complete() && opts.journal {
         if let Err(e) = remove_journal(dir).and_then(|_| remove_raw(dir)) {
             return Solved::failed(chain(&e));
         }
     }
-    let metrics = (status == RunStatus::Ok).then(|| clip_metrics(case, &out.run));
+    let metrics = status.is_complete().then(|| clip_metrics(case, &out.run));
     Solved { status, error, metrics, single: None, clip: Some(out.run), frames: Some((done, total)) }
+}
+
+/// The message of a clip whose frames `flagged` (of `done`) are over the fit-quality gate.
+fn flag_message(case: &Case, flagged: &[&FrameReport], done: usize) -> String {
+    let first = flagged[0];
+    let (h, length) = (case.mesh.h(), case.mesh.length_m);
+    let gate = case.clip().map(|c| c.gate).unwrap_or_default();
+    format!(
+        "{}: {} of {done} frames are over the fit-quality gate (`flagged` in frames.csv; docs/certificate.md C5): each is certified, but does not follow its data. The first is frame {}: {}",
+        case_label(case),
+        flagged.len(),
+        first.frame,
+        first.fit.reason(&gate, length, h)
+    )
 }
 
 /// The case's name and file, for messages.

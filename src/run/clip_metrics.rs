@@ -33,6 +33,8 @@ fn max(v: impl Iterator<Item = f64>) -> f64 {
 /// - the objective terms of (41), median over the frames (`j_tracking_median`, …), and
 ///   `shear_share_median`: the median share of the λd term in the total (Fig. 18);
 /// - `certificate`: the largest residual certificate of the frames (`docs/certificate.md`);
+/// - the fit-quality gate (`solve::fit`): `flagged_frames`, `fit_position_rel_length_max`,
+///   `fit_tangent_rms_max` and `data_noise_m_median` (the data's noise level [m]);
 /// - `min_abs_cos_beta`: the angle chart's margin, min over frames;
 /// - `kappa_roughness_mean`, `data_kappa_roughness_mean` (sign alternation, D13);
 /// - synthetic clips, against the ground truth (max over frames): `truth_x_err_rel_max`,
@@ -54,6 +56,10 @@ pub fn clip_metrics(case: &Case, run: &ClipRun) -> Metrics {
     m.insert("tangent_misfit_rel_max".into(), max(r.iter().map(|f| f.tangent_misfit / d3_norm)));
     m.insert("max_abs_j_minus_1".into(), max(r.iter().map(|f| f.max_stretch_deviation)));
     m.insert("certificate".into(), max(r.iter().map(|f| f.certificate)));
+    m.insert("flagged_frames".into(), r.iter().filter(|f| f.fit.flagged).count() as f64);
+    m.insert("fit_position_rel_length_max".into(), max(r.iter().map(|f| f.fit.position)));
+    m.insert("fit_tangent_rms_max".into(), max(r.iter().map(|f| f.fit.tangent)));
+    m.insert("data_noise_m_median".into(), median(r.iter().map(|f| f.fit.noise_m).collect()));
     m.insert("min_abs_cos_beta".into(), r.iter().map(|f| f.min_cos_beta).fold(f64::INFINITY, f64::min));
     let terms = |f: &FrameReport| {
         let o = &f.objective;

@@ -6,6 +6,7 @@
 //! numbers. All of them assemble through the one element loop of [`crate::assemble`].
 pub mod certificate;
 pub mod dynamics;
+pub mod fit;
 pub mod inverse;
 pub mod modes;
 pub mod problem;

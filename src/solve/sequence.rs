@@ -17,6 +17,7 @@ use crate::model::chart::{frame_axis, Chart, Converted};
 use crate::model::mesh::{DofMap, Field};
 use crate::model::rotation::{angles_from_rotation, skew, Angles};
 
+use super::fit::{noise_level, position_misfit, FitGate, FrameFit};
 use super::inverse::{
     Frame, FrameSolver, InverseParams, InverseRecord, InverseSolution, ObjectiveTerms, Records, Start,
 };
@@ -41,6 +42,8 @@ pub struct SequenceParams {
     /// which Newton iterations of a frame keep a record: [`Records::Last`] where only the frame
     /// reports are kept (the iterates, and so the frames, are the same either way)
     pub records: Records,
+    /// the fit-quality gate that flags frames (`solve::fit`)
+    pub gate: FitGate,
 }
 
 /// Angle chart of each frame (`docs/rotation.md`).
@@ -86,13 +89,24 @@ pub struct FrameReport {
     pub wall_time_s: f64,
     /// the residual certificate of the frame's solution (`inverse::kkt::certificate`)
     pub certificate: f64,
+    /// how well the frame follows its data, and whether it is over the gate (`solve::fit`)
+    pub fit: FrameFit,
 }
 
 /// Errors of a clip solve: the frame's own error, or the chart guard.
 #[derive(Debug, thiserror::Error)]
 pub enum SequenceError {
-    #[error("frame {frame}: |cos β| = {cos_beta:.3e} at node {node} (below the guard {guard:e}): the frame's tangent there is along the angle chart's singular axis ({:.3}, {:.3}, {:.3}) (eq. 1, det A = −cos β). With clip.rotation = \"rebased\" only the first frame's axis is fixed, by clip.gauge: choose a gauge vector away from the first frame's tangents (e.g. the normal of its plane)", axis[0], axis[1], axis[2])]
-    SingularChart { frame: usize, node: usize, cos_beta: f64, guard: f64, axis: [f64; 3] },
+    #[error("frame {frame}: |cos β| = {cos_beta:.3e} at node {node} (below the guard {guard:e}): the frame's tangent there is along the angle chart's singular axis ({:.3}, {:.3}, {:.3}) (eq. 1, det A = −cos β). {}", axis[0], axis[1], axis[2], chart_hint(*.frame, .degraded))]
+    SingularChart {
+        frame: usize,
+        node: usize,
+        cos_beta: f64,
+        guard: f64,
+        axis: [f64; 3],
+        /// frames over the fit-quality gate among those this solve ran before it:
+        /// `(count, first flagged, first frame of the solve)`
+        degraded: Option<(usize, usize, usize)>,
+    },
     #[error(transparent)]
     Solve(#[from] SolveError),
     #[error("frame {frame}: {message}")]
@@ -144,6 +158,39 @@ pub fn min_cos_beta(dofs: &DofMap, u: &DVector<f64>) -> (f64, usize) {
 /// max_e |j_e − 1|, j_e = |x_{e+1} − x_e| / h (Remark 9).
 pub fn max_stretch_deviation(x_g: &[Vector3<f64>], h: f64) -> f64 {
     x_g.windows(2).map(|w| ((w[1] - w[0]).norm() / h - 1.0).abs()).fold(0.0, f64::max)
+}
+
+/// The fit measures of a frame's solution `sol` on its data `x_g` (chart coordinates both) and
+/// the gate's verdict (`solve::fit`); `tangent_misfit`: `‖∂s x − d3‖` [m^½] of its last record.
+fn frame_fit(
+    gate: &FitGate,
+    problem: &Problem,
+    dofs: &DofMap,
+    sol: &InverseSolution,
+    x_g: &[Vector3<f64>],
+    tangent_misfit: f64,
+) -> FrameFit {
+    let length = problem.mesh.length_m;
+    let mut fit = FrameFit {
+        noise_m: noise_level(x_g),
+        position: position_misfit(&dofs.field(&sol.u, Field::X), x_g, length),
+        tangent: tangent_misfit / length.sqrt(),
+        flagged: false,
+    };
+    fit.flagged = gate.check(&fit, length, problem.mesh.h());
+    fit
+}
+
+/// The advice of a chart-guard stop: where the fit had degraded before it, the degradation;
+/// otherwise the gauge.
+fn chart_hint(frame: usize, degraded: &Option<(usize, usize, usize)>) -> String {
+    match degraded {
+        Some((count, first, from)) => format!(
+            "The fit had degraded before this frame: {count} of the frames {from}–{} are over the fit-quality gate (the first is frame {first}; `flagged` in frames.csv): the reconstruction had left its data, so the chart is not the cause. A large Λω makes the frames lag behind the data and d3 leave the tangent; lower inverse.lambda_omega (or raise inverse.lambda_d) rather than changing clip.gauge",
+            frame - 1
+        ),
+        None => "With clip.rotation = \"rebased\" only the first frame's axis is fixed, by clip.gauge: choose a gauge vector away from the first frame's tangents (e.g. the normal of its plane)".to_string(),
+    }
 }
 
 /// An initial iterate read off the data (D13): x = x_g, and at each node the frame whose d3
@@ -261,7 +308,7 @@ pub fn solve_sequence_from(
 ) -> Result<Vec<FrameReport>, SequenceError> {
     let dofs = problem.dofs();
     let h = problem.mesh.h();
-    let mut reports = Vec::with_capacity(frames.len());
+    let mut reports: Vec<FrameReport> = Vec::with_capacity(frames.len());
     // the previous frame: its chart and its state in that chart; the frame before that, for
     // the linear predictor of a warm start
     let (first, mut prev, mut prev2) = match resume {
@@ -325,12 +372,14 @@ pub fn solve_sequence_from(
         };
         let (cos_beta, node) = min_cos_beta(&dofs, &sol.u);
         if cos_beta < sp.min_cos_beta {
+            let flagged: Vec<usize> = reports.iter().filter(|r| r.fit.flagged).map(|r| r.frame).collect();
             return Err(SequenceError::SingularChart {
                 frame: k,
                 node,
                 cos_beta,
                 guard: sp.min_cos_beta,
                 axis: chart.axis().into(),
+                degraded: flagged.first().map(|&first| (flagged.len(), first, reports[0].frame)),
             });
         }
         let last = sol
@@ -352,6 +401,7 @@ pub fn solve_sequence_from(
             chart_axis: chart.axis(),
             wall_time_s: start.elapsed().as_secs_f64(),
             certificate: sol.certificate.value,
+            fit: frame_fit(&sp.gate, problem, &dofs, &sol, &x_g, last.tangent_misfit),
         };
         let in_space = if chart.is_identity() { None } else { Some(to_space(&dofs, &chart, &sol)) };
         let solution = FrameSolution {

@@ -10,6 +10,7 @@ use super::Validator;
 use crate::clip::synthetic::RollClipParams;
 use crate::clip::{ClipPlane, CLIP_SKIP_ELEMENTS, MAX_CLIP_POSITIONS, MIN_CLIP_ELEMENTS};
 use crate::model::mesh::Mesh;
+use crate::solve::fit::FitGate;
 use crate::solve::sequence::{FrameStart, RotationTreatment};
 
 impl Validator<'_> {
@@ -84,9 +85,21 @@ impl Validator<'_> {
                 "roll_total_rad, twist_per_m, clip_frames and substeps apply to kind = \"roll_3d\" only",
             ));
         }
+        let d = FitGate::default();
+        let gate_key = |key: &str, v: Option<f64>, default: f64| match v {
+            None => Ok(default),
+            Some(v) if v > 0.0 && v.is_finite() => Ok(v),
+            Some(v) => Err(self.err(key, format!("must be a positive number, got {v}"))),
+        };
+        let gate = FitGate {
+            noise_multiple: gate_key("clip.gate_noise_multiple", cl.gate_noise_multiple, d.noise_multiple)?,
+            position_min: gate_key("clip.gate_position", cl.gate_position, d.position_min)?,
+            tangent_min: gate_key("clip.gate_tangent", cl.gate_tangent, d.tangent_min)?,
+        };
         Ok(ClipSource {
             kind,
             file: base.join(&cl.file),
+            gate,
             frames,
             min_cos_beta: cl.min_cos_beta,
             start: match cl.start {
