@@ -62,10 +62,12 @@ fn key_of(points: &[&PointResult]) -> String {
 fn failure(p: &PointResult) -> String {
     let e = p.outcome.error.as_deref().unwrap_or("no result");
     match p.outcome.status {
-        RunStatus::NotConverged => {
+        RunStatus::NotConverged | RunStatus::Stalled => {
             let its = p.metric("iterations").map(|i| format!(" after {}", sig2(i))).unwrap_or_default();
             let x = p.metric("x_err_rel").map(|x| format!(", x error {}", sig2(x))).unwrap_or_default();
-            format!("not converged{its} iterations{x}")
+            let c = p.metric("certificate").map(|c| format!(", certificate {}", sig2(c))).unwrap_or_default();
+            let word = if p.outcome.status == RunStatus::Stalled { "stalled" } else { "not converged" };
+            format!("{word}{its} iterations{x}{c}")
         }
         _ => {
             // the innermost cause: after the last ": " of the error chain
