@@ -99,7 +99,23 @@ fn compare_runs_both_engines() {
 #[test]
 fn inverse_run_writes_frame_controls_history_and_plot() {
     let dir = tempfile::tempdir().expect("tempdir");
-    cosserat().args(["run", "cases/inverse_bend_twist.toml", "--quiet", "--out"]).arg(dir.path()).assert().success();
+    // the paper's fixed point at its stopping rule is stalled (docs/certificate.md C4): exit 1,
+    // the last iterate kept, run.json saying stalled with the certificate
+    let stalled = dir.path().join("stalled");
+    cosserat()
+        .args(["run", "cases/inverse_bend_twist.toml", "--quiet", "--out"])
+        .arg(&stalled)
+        .assert()
+        .code(1)
+        .stderr(predicate::str::contains("stalled after").and(predicate::str::contains("certificate")));
+    let manifest = std::fs::read_to_string(stalled.join("run.json")).expect("run.json");
+    assert!(manifest.contains("\"status\": \"stalled\"") && manifest.contains("\"tolerance\": 1e-10"), "{manifest}");
+    assert!(stalled.join("inverse_nodes.csv").is_file());
+    cosserat()
+        .args(["run", "cases/inverse_bend_twist_newton.toml", "--quiet", "--out"])
+        .arg(dir.path())
+        .assert()
+        .success();
     let nodes = std::fs::read_to_string(dir.path().join("inverse_nodes.csv")).expect("inverse_nodes.csv");
     let header = nodes.lines().next().expect("header");
     for col in ["alpha_rad", "d1_x", "d3_z", "f_x_n_per_m", "l_z_nm_per_m", "data_x_m"] {
@@ -118,12 +134,13 @@ fn inverse_run_writes_frame_controls_history_and_plot() {
         assert!(dot13.abs() < 1e-14 && (n2 - 1.0).abs() < 1e-14);
     }
     let hist = std::fs::read_to_string(dir.path().join("inverse_history.csv")).expect("history");
-    assert!(hist.starts_with("iteration,rel_change,x_err_rel,tangent_misfit_m05,j_tracking,j_force,j_torque,j_shear,j_bending,j_angular,j_total,kappa_err_rel,kappa_err_rel_inner\n"));
+    assert!(hist.starts_with("iteration,rel_change,x_err_rel,tangent_misfit_m05,j_tracking,j_force,j_torque,j_shear,j_bending,j_angular,j_total,newton_residual_rel,certificate,kappa_err_rel,kappa_err_rel_inner\n"));
     assert!(dir.path().join("data.csv").is_file() && dir.path().join("inverse_curvature.csv").is_file());
     let m: std::collections::BTreeMap<String, f64> =
         serde_json::from_str(&std::fs::read_to_string(dir.path().join("metrics.json")).expect("metrics"))
             .expect("json");
     assert!(m["x_err_rel"] < 2e-5 && m["kappa_err_rel_inner"] < 1e-2, "{m:?}");
+    assert!(m["certificate"] <= 1e-14, "{m:?}");
     assert_eq!(m["iterations"] as usize + 1, hist.lines().count());
     assert!(std::fs::read_to_string(dir.path().join("plot.svg")).expect("svg").contains("recovered torque"));
 }
@@ -140,6 +157,9 @@ fn sweep_writes_one_folder_per_run_a_summary_and_a_convergence_plot() {
             "lambda_l=1e-6,1",
             "--set",
             "tolerance=1e-3",
+            "--set",
+            // a fixed point stopped at a change of 1e-3 leaves a certificate ~1e-5: held to that
+            "certificate_tolerance=1e-4",
             "--out",
         ])
         .arg(dir.path())
@@ -148,10 +168,14 @@ fn sweep_writes_one_folder_per_run_a_summary_and_a_convergence_plot() {
         .stdout(predicate::str::contains("2 runs, 0 failed or not converged"));
     let summary = std::fs::read_to_string(dir.path().join("summary.csv")).expect("summary");
     let lines: Vec<&str> = summary.lines().collect();
-    assert!(lines[0].starts_with("lambda_l,tolerance,status,iterations,x_err_rel"), "{}", lines[0]);
+    assert!(
+        lines[0].starts_with("lambda_l,tolerance,certificate_tolerance,status,iterations,certificate,x_err_rel"),
+        "{}",
+        lines[0]
+    );
     assert_eq!(lines.len(), 3);
-    assert!(lines[1].starts_with("1e-6,1e-3,ok,") && lines[2].starts_with("1,1e-3,ok,"), "{summary}");
-    assert!(dir.path().join("lambda_l=1e-6_tolerance=1e-3/inverse_history.csv").is_file());
+    assert!(lines[1].starts_with("1e-6,1e-3,1e-4,ok,") && lines[2].starts_with("1,1e-3,1e-4,ok,"), "{summary}");
+    assert!(dir.path().join("lambda_l=1e-6_tolerance=1e-3_certificate_tolerance=1e-4/inverse_history.csv").is_file());
     assert!(std::fs::read_to_string(dir.path().join("convergence.svg")).expect("svg").contains("<svg"));
     // A run that hits its iteration limit is a failed row naming frame, iteration and change.
     cosserat()

@@ -10,7 +10,7 @@ mod common;
 
 use std::sync::OnceLock;
 
-use common::{case_from, case_text, edit, solve_frame, with_weights};
+use common::{case_from, case_text, edit, with_weights};
 use cosserat::case::Case;
 use cosserat::model::mesh::{DofMap, Field};
 use cosserat::model::rotation::{angles_from_rotation, rotation};
@@ -81,7 +81,7 @@ fn run(d: &Data, params: &InverseParams, xg: &[Vector3<f64>], u0: &DVector<f64>,
     let mut u = u0.clone();
     let (mut history, mut kappa, mut converged) = (Vec::new(), Vec::new(), false);
     for k in 1..=params.max_iterations {
-        let Ok(sol) = solve_frame(&p, &one, xg, None, &u, Start::Guess, |_| {}) else { break };
+        let Ok(sol) = common::solve_frame_any(&p, &one, xg, None, &u, Start::Guess, |_| {}) else { break };
         u = sol.u;
         let rec = InverseRecord { iteration: k, ..sol.history[0] };
         history.push(rec);

@@ -1,7 +1,7 @@
 //! Newton mode of the inverse problem (`docs/inverse.md`, I8) on forward data of eqs. (64), (65).
 mod common;
 
-use common::{case_from, case_text, solve_frame, solve_newton, with_weights};
+use common::{case_from, case_text, solve_frame_any, solve_newton, with_weights};
 use cosserat::linalg::{LinearSolver, Pattern};
 use cosserat::model::mesh::{DofMap, Field, Mesh};
 use cosserat::run::metrics::curvature_error;
@@ -168,7 +168,8 @@ fn newton_vs_fixed_point(
     tight: f64,
 ) -> (Vec<InverseRecord>, f64, [f64; 3], DVector<f64>) {
     let fp_params = |tolerance| InverseParams { tolerance, max_iterations: 3000, ..*params };
-    let start = solve_frame(p, &fp_params(fp_tol), xg, None, &p.reference_state(), Start::Guess, |_| {})
+    // the fixed point's iterates are starts and references here, stalled or not (C4)
+    let start = solve_frame_any(p, &fp_params(fp_tol), xg, None, &p.reference_state(), Start::Guess, |_| {})
         .expect("fixed point (start)");
     let t0 = std::time::Instant::now();
     let mut hist = Vec::new();
@@ -183,7 +184,7 @@ fn newton_vs_fixed_point(
             r.x_err_rel
         );
     }
-    let fp = solve_frame(p, &fp_params(tight), xg, None, &p.reference_state(), Start::Guess, |_| {})
+    let fp = solve_frame_any(p, &fp_params(tight), xg, None, &p.reference_state(), Start::Guess, |_| {})
         .expect("fixed point (tight)");
     let (dx, da) = p.dofs().split_norms_inf(&(&fp.u - &sol.u));
     let (kn, kf) = (element_curvatures(&p.mesh, &sol.u), element_curvatures(&p.mesh, &fp.u));
@@ -197,7 +198,7 @@ fn newton_vs_fixed_point(
     );
     // The fixed point started at Newton's solution stays there (it is a fixed point of I4).
     let again_params = InverseParams { tolerance: 1e-10, max_iterations: 5, ..*params };
-    let again = solve_frame(p, &again_params, xg, None, &sol.u, Start::Guess, |_| {})
+    let again = solve_frame_any(p, &again_params, xg, None, &sol.u, Start::Guess, |_| {})
         .expect("fixed point from Newton's solution");
     let (dx2, da2) = p.dofs().split_norms_inf(&(&again.u - &sol.u));
     let dk2 = element_curvatures(&p.mesh, &again.u).iter().zip(&kn).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
@@ -269,7 +270,7 @@ fn newton_on_eq64_paper_parameters_fails_with_a_clear_error() {
     let (_, xg) = common::forward_data(&case, 5);
     let params = paper_params_64();
     let fp = InverseParams { tolerance: 3e-6, max_iterations: 1000, ..params };
-    let start = solve_frame(&p, &fp, &xg, None, &p.reference_state(), Start::Guess, |_| {}).expect("fixed point");
+    let start = solve_frame_any(&p, &fp, &xg, None, &p.reference_state(), Start::Guess, |_| {}).expect("fixed point");
     let mut hist = Vec::new();
     let newton = InverseParams {
         method: cosserat::solve::inverse::InverseMethod::Newton { warm_start_tolerance: 1e-3 },
@@ -299,7 +300,7 @@ fn jacobian_spectrum_eq64() {
     let params = paper_params_64();
     let tol_fp: f64 = std::env::var("FPTOL").map(|s| s.parse().unwrap()).unwrap_or(3e-6);
     let fp_params = InverseParams { tolerance: tol_fp, max_iterations: 20000, ..params };
-    let fp = solve_frame(&p, &fp_params, &xg, None, &p.reference_state(), Start::Guess, |_| {}).expect("fp");
+    let fp = solve_frame_any(&p, &fp_params, &xg, None, &p.reference_state(), Start::Guess, |_| {}).expect("fp");
     eprintln!("fp iterations {}", fp.history.len());
     let kd = case.mesh.kkt_dofs();
     const BLOCK: usize = 12;

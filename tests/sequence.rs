@@ -5,6 +5,7 @@ mod common;
 use common::{case_from, case_text, edit, with_weights};
 use cosserat::model::mesh::{DofMap, Field};
 use cosserat::solve::certificate::DEFAULT_CERTIFICATE_TOLERANCE;
+use cosserat::solve::fit::FitGate;
 use cosserat::solve::inverse::{InverseMethod, InverseParams, Records, Weights, DEFAULT_STABILISATION};
 use cosserat::solve::sequence::{solve_sequence, FrameStart, RotationTreatment, SequenceError, SequenceParams};
 use cosserat::solve::statics::{self, Method, StaticParams};
@@ -28,7 +29,11 @@ fn params() -> InverseParams {
         method: InverseMethod::FixedPoint,
         tolerance: 1e-5,
         max_iterations: 400,
-        certificate_tolerance: DEFAULT_CERTIFICATE_TOLERANCE,
+        // These tests are about the clip's mechanics (charts, carried states, the guard) with
+        // the fixed point stopped early; a fixed point at a relative change of 1e-5 leaves a
+        // certificate of ~4e-7 (docs/certificate.md C4), so the tolerance is set to what such
+        // a stop gives, not to the default that means "solved".
+        certificate_tolerance: 1e-5,
     }
 }
 
@@ -67,6 +72,7 @@ fn quasi_static_clip_is_recovered_frame_by_frame() {
         rotation: RotationTreatment::Rebased,
         gauge: Vector3::y(),
         records: Records::Every,
+        gate: FitGate::default(),
     };
     let mut streamed = 0;
     let reports = solve_sequence(
@@ -132,6 +138,7 @@ fn chart_guard_names_frame_and_node() {
         rotation: RotationTreatment::GlobalEuler,
         gauge: Vector3::y(),
         records: Records::Every,
+        gate: FitGate::default(),
     };
     let err = solve_sequence(
         &p,
@@ -253,6 +260,7 @@ fn rebased_and_global_charts_differ_at_second_order_on_a_3d_clip() {
                 rotation,
                 gauge: Vector3::y(),
                 records: Records::Every,
+                gate: FitGate::default(),
             };
             let mut out = Vec::new();
             solve_sequence(

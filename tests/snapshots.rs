@@ -7,9 +7,10 @@ use std::collections::BTreeMap;
 
 use common::sig;
 use cosserat::case::{case_files, Case};
-use cosserat::io::engine::run_case;
+use cosserat::io::engine::{run_case, EngineError};
 use cosserat::run::metrics::all_metrics;
-use cosserat::run::Engine;
+use cosserat::run::{Engine, RunError};
+use cosserat::solve::SolveError;
 
 /// Significant digits kept for physical metrics of static cases (deterministic to ~1e-10).
 const DIGITS: i32 = 7;
@@ -29,7 +30,13 @@ fn case_metrics_snapshots() {
             continue;
         }
         let dir = tempfile::tempdir().expect("tempdir");
-        let r = run_case(&case, Engine::Rust, dir.path(), |_, _| {}).unwrap_or_else(|e| panic!("{}: {e}", case.name));
+        // the paper's fixed point ends stalled (docs/certificate.md C4): its last iterate is what
+        // the snapshot guards
+        let r = match run_case(&case, Engine::Rust, dir.path(), |_, _| {}) {
+            Ok(r) => r,
+            Err(EngineError::Run(RunError::Incomplete { source: SolveError::Stalled { .. }, partial })) => *partial,
+            Err(e) => panic!("{}: {e}", case.name),
+        };
         let inverse = case.inverse().is_some();
         let digits = if case.is_dynamic() {
             DYNAMIC_DIGITS
@@ -41,7 +48,8 @@ fn case_metrics_snapshots() {
         let m: BTreeMap<String, f64> = all_metrics(&case, &r)
             .expect("reference metrics")
             .into_iter()
-            .filter(|(k, _)| !matches!(k.as_str(), "wall_time_s" | "last_change" | "relative_residual"))
+            // the certificate is round-off near a root (asserted in tests/certificate.rs)
+            .filter(|(k, _)| !matches!(k.as_str(), "wall_time_s" | "last_change" | "relative_residual" | "certificate"))
             // Total Newton count of a dynamic run depends on increments near the threshold.
             .filter(|(k, _)| !((case.is_dynamic() || inverse) && k == "iterations"))
             .map(|(k, v)| {

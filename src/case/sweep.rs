@@ -404,7 +404,15 @@ mod tests {
     #[test]
     fn bad_specifications_are_errors() {
         assert!(matches!(parse_set("lambda_l"), Err(SweepError::Syntax(_))));
-        assert!(matches!(parse_set("lambda_l=1,x"), Err(SweepError::NotANumber { .. })));
+        assert!(matches!(parse_set("lambda_l=1,x-y"), Err(SweepError::NotANumber { .. })));
+        // a word is taken by a key of words only
+        let e = product(&case("inverse_bend"), &[parse_set("lambda_l=1,x").unwrap()]).unwrap_err();
+        assert!(e.to_string().contains("`x` is not a number"), "{e}");
+        let e = product(&case("inverse_bend"), &[parse_set("quadrature=gauss3").unwrap()]).unwrap_err();
+        assert!(e.to_string().contains("must be one of selective, full, reduced, midpoint, gauss2"), "{e}");
+        let q = product(&case("inverse_bend"), &[parse_set("quadrature=gauss2").unwrap()]).unwrap();
+        assert_eq!(q[0].1.quadrature, crate::model::mesh::QuadratureScheme::Gauss2);
+        assert_eq!(q[0].1.inverse().unwrap().params.stabilisation, 0.0);
         assert!(matches!(parse_set("lambda_l=nan"), Err(SweepError::NotANumber { .. })));
         let c = case("inverse_bend");
         assert!(matches!(product(&c, &[parse_set("lambda_q=1").unwrap()]), Err(SweepError::UnknownKey { .. })));

@@ -30,6 +30,7 @@ use super::files::{write_atomic, OutputError};
 use super::freefem::{self, RunOptions};
 use super::freefem_clip::run_clip;
 use super::run_files::write_run;
+use crate::solve::certificate::CERTIFICATE_FLOOR;
 use crate::case::{Analysis, Case, CompareOverrides};
 use crate::run::frames::{solve_frames, SolvedFrame};
 use crate::run::metrics::{all_metrics, differences, ComparisonRow, Difference, Group};
@@ -203,6 +204,7 @@ fn tolerance(d: &Difference, sens: &[Difference], tau: f64, case: &Case) -> (f64
         Group::Angles => o.angles_rel,
         Group::Adjoint => o.adjoint_rel,
         Group::Iterations => o.iterations_abs,
+        Group::Certificate => None,
         Group::Metric => match (o.metric_rel, o.metric_abs) {
             (None, None) => None,
             (r, a) => Some(r.unwrap_or(0.0) * value + a.unwrap_or(0.0)),
@@ -225,6 +227,9 @@ fn tolerance(d: &Difference, sens: &[Difference], tau: f64, case: &Case) -> (f64
     };
     let t = match d.group {
         Group::Iterations => 1.0 + SAFETY * sigma,
+        // a certificate is a ratio of round-off-sized residuals near a root: below ten times the
+        // floor both engines have solved the same equations, whatever the digits
+        Group::Certificate => SAFETY * (sigma + tau * value) + FLOOR_REL * value + 10.0 * CERTIFICATE_FLOOR,
         Group::Metric => {
             let abs = if d.name.ends_with("_m") {
                 FLOOR_REL * case.mesh.length_m

@@ -224,7 +224,7 @@ mod tests {
         ];
         let text = summary_csv(&["lambda_l".into()], &SUMMARY_METRICS, &rows).unwrap();
         let lines: Vec<&str> = text.lines().collect();
-        assert!(lines[0].starts_with("lambda_l,status,iterations,x_err_rel"));
+        assert!(lines[0].starts_with("lambda_l,status,iterations,certificate,x_err_rel"));
         assert!(lines[1].starts_with("1e-20,ok,1.2000000000e1"));
         assert!(
             lines[2].starts_with("1e3,not_converged,1.2000000000e1")

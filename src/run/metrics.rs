@@ -157,6 +157,9 @@ pub enum Group {
     Metric,
     /// iteration counts (`iterations_abs`)
     Iterations,
+    /// the residual certificates of the two results (`docs/certificate.md`): equal to their
+    /// sensitivity, or both at the round-off floor
+    Certificate,
 }
 
 /// One compared quantity of two runs: a field difference (relative, D8), a scalar metric of
@@ -255,6 +258,9 @@ pub fn differences(a: &RunResult, b: &RunResult, iterations: bool) -> Vec<Differ
             };
             rows.push(scalar(name, Group::Metric, ma.get(name).copied(), mb.get(name).copied(), Some(bound)));
         }
+    }
+    if a.stats.certificate.is_some() || b.stats.certificate.is_some() {
+        rows.push(scalar("certificate", Group::Certificate, a.stats.certificate, b.stats.certificate, None));
     }
     if iterations {
         let (x, y) = (a.stats.iterations as f64, b.stats.iterations as f64);

@@ -172,6 +172,31 @@ pub fn solve_frame(
     FrameSolver::new(p, *params).solve(&frame, u0, start, |r, _, _| on(r))?.converged(0)
 }
 
+/// [`solve_frame`] without the convergence check: the solution whatever its stop (converged,
+/// stalled or at the iteration limit), for tests of what an iteration does.
+pub fn solve_frame_any(
+    p: &Problem,
+    params: &InverseParams,
+    x_g: &[Vector3<f64>],
+    previous: Option<&[Vector3<f64>]>,
+    u0: &DVector<f64>,
+    start: Start,
+    mut on: impl FnMut(&InverseRecord),
+) -> Result<InverseSolution, SolveError> {
+    let frame = Frame { index: 0, x_g, previous };
+    FrameSolver::new(p, *params).solve(&frame, u0, start, |r, _, _| on(r))
+}
+
+/// A run of a case in the Rust engine that may end stalled or at its iteration limit: the
+/// result (the last iterate) and, for such an end, the solver's error.
+pub fn run_any(case: &Case) -> (cosserat::run::RunResult, Option<SolveError>) {
+    match cosserat::run::run_rust(case, |_, _| {}) {
+        Ok(r) => (r, None),
+        Err(cosserat::run::RunError::Incomplete { source, partial }) => (*partial, Some(source)),
+        Err(e) => panic!("{}: {}", case.name, error_chain(&e)),
+    }
+}
+
 /// [`solve_frame`] by Newton directly from `u0` (no warm start), with `params`' stopping rule.
 pub fn solve_newton(
     p: &Problem,
