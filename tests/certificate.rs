@@ -13,7 +13,12 @@ use cosserat::solve::{statics, SolveError, Stop, PLATEAU_ITERATIONS};
 use nalgebra::{DVector, Vector3};
 
 /// The KKT certificate of a state and adjoint (forward layout each) for the data `x_g`.
-fn kkt_certificate(case: &cosserat::case::Case, x_g: &[Vector3<f64>], u: &DVector<f64>, a: &DVector<f64>) -> Certificate {
+fn kkt_certificate(
+    case: &cosserat::case::Case,
+    x_g: &[Vector3<f64>],
+    u: &DVector<f64>,
+    a: &DVector<f64>,
+) -> Certificate {
     let p = case.problem();
     let kd = case.mesh.kkt_dofs();
     let pattern = kd.pattern();
@@ -70,18 +75,26 @@ fn certificate_detects_a_perturbation_and_ignores_a_translation() {
         dofs.set(&mut u_t, n, Field::X, &x);
     }
     let moved = kkt_certificate(&case, &xg_t, &u_t, &sol.adjoint);
-    let moved_off = kkt_certificate(&case, &xg_t, &{
-        let mut b = bumped.clone();
-        for n in 0..case.mesh.nodes() {
-            let x = dofs.get(&b, n, Field::X) + shift;
-            dofs.set(&mut b, n, Field::X, &x);
-        }
-        b
-    }, &sol.adjoint);
+    let moved_off = kkt_certificate(
+        &case,
+        &xg_t,
+        &{
+            let mut b = bumped.clone();
+            for n in 0..case.mesh.nodes() {
+                let x = dofs.get(&b, n, Field::X) + shift;
+                dofs.set(&mut b, n, Field::X, &x);
+            }
+            b
+        },
+        &sol.adjoint,
+    );
     eprintln!("translated: root {:e}, perturbed {:e}", moved.value, moved_off.value);
-    // the root stays at the floor (positions are measured from x_g(0)); the perturbed state's
-    // certificate is the same to the round-off of the shift (1 m against 1 mm: 1e-13 relative)
-    assert!(moved.value <= CERTIFICATE_FLOOR, "{:e}", moved.value);
+    // the root stays at the floor of what a translation by 2 m can keep of a 1 mm rod: the
+    // positions themselves carry eps·|shift| = 4.4e-16 m of round-off, 4.4e-13 of the rod's
+    // size (positions are measured from x_g(0), so the terms do not grow with the shift); the
+    // perturbed state's certificate is the same to that round-off
+    let shift_floor = 10.0 * f64::EPSILON * shift.norm() / case.mesh.length_m;
+    assert!(moved.value <= shift_floor, "{:e} > {shift_floor:e}", moved.value);
     assert!((moved_off.value / off - 1.0).abs() < 1e-6, "{off:e} vs {:e}", moved_off.value);
 }
 
@@ -123,11 +136,15 @@ fn dynamic_steps_are_certified() {
 
 /// I13: on eq. (65) with Λκ = (0, 0, 1e-10) Newton stalls when the λd blend is the old
 /// default ε = 1e-3 and converges to the floor with the default that scales with the weights
-/// (`default_stabilisation`: 0.034 here).
+/// (`default_stabilisation`: Λκ3/(λd L²) = 100, so ε = 1 here).
 #[test]
 fn newton_lambda_kappa_stall_and_its_fix() {
     let base = edit(
-        &edit(&case_text("inverse_bend_twist_newton"), "lambda_kappa = [1e-20, 1e-20, 1e-20]", "lambda_kappa = [0, 0, 1e-10]"),
+        &edit(
+            &case_text("inverse_bend_twist_newton"),
+            "lambda_kappa = [1e-20, 1e-20, 1e-20]",
+            "lambda_kappa = [0, 0, 1e-10]",
+        ),
         "max_iterations = 200",
         "max_iterations = 300",
     );
@@ -136,7 +153,7 @@ fn newton_lambda_kappa_stall_and_its_fix() {
     let r = run_rust(&fixed, |_, _| {}).expect("Newton with the default ε");
     let c = r.stats.certificate.unwrap();
     eprintln!("default ε = {eps:.3}: {} iterations, certificate {c:e}", r.stats.iterations);
-    assert!((eps - 0.0326).abs() < 1e-3, "{eps}");
+    assert_eq!(eps, 1.0);
     assert!(c <= CERTIFICATE_FLOOR);
     let old = case_from(&edit(&base, "lambda_d = 1e-6", "lambda_d = 1e-6\nstabilisation = 1e-3"), "old");
     match run_rust(&old, |_, _| {}) {
@@ -165,15 +182,17 @@ fn lambda_kappa_one_is_explained_or_solved() {
     assert!(r.stats.certificate.unwrap() <= CERTIFICATE_FLOOR);
 }
 
-/// The fit-quality gate (C5): a short worm_roll_3d (60 frames, 33 nodes) is clean with the
-/// case's weights, and flags its frames with Λω = 0.5·I (certified, but lagging its data).
+/// The fit-quality gate (C5): worm_roll_3d at 33 nodes (all 1160 frames: cut to a few dozen
+/// frames the roll per frame is so fast that frames go to wrong branches, which the gate flags
+/// too) is clean with the case's weights, and flags its frames with Λω = 0.5·I (certified, but
+/// lagging its data).
 #[test]
 fn fit_gate_flags_a_lagging_clip() {
     if !worm_data_present("fit_gate_flags_a_lagging_clip") {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
-    let clean = short_roll_case(dir.path(), "clean.toml", 60, 33);
+    let clean = short_roll_case(dir.path(), "clean.toml", 1160, 33);
     let text = std::fs::read_to_string(&clean).unwrap();
     let lag = dir.path().join("lag.toml");
     std::fs::write(&lag, edit(&text, "lambda_omega = [0, 0, 1e-20]", "lambda_omega = [0.5, 0.5, 0.5]")).unwrap();
@@ -199,10 +218,10 @@ fn fit_gate_flags_a_lagging_clip() {
     assert!(manifest.contains("\"status\": \"complete\""), "{manifest}");
     assert_eq!(flagged, 0);
     let (code, manifest, flagged, stderr) = run(&lag, "lag", false);
-    eprintln!("Λω = 0.5·I: {flagged} of 60 frames flagged; {stderr}");
+    eprintln!("Λω = 0.5·I: {flagged} of 1160 frames flagged; {stderr}");
     assert_eq!(code, Some(0));
     assert!(manifest.contains("\"status\": \"complete_with_warnings\""), "{manifest}");
-    assert!(flagged >= 50, "{flagged}");
+    assert!(flagged >= 1000, "{flagged}");
     assert!(stderr.contains("over the fit-quality gate"), "{stderr}");
     let (code, ..) = run(&lag, "lag_strict", true);
     assert_eq!(code, Some(1));

@@ -101,7 +101,8 @@ fn inverse_run_writes_frame_controls_history_and_plot() {
     let dir = tempfile::tempdir().expect("tempdir");
     // the paper's fixed point at its stopping rule is stalled (docs/certificate.md C4): exit 1,
     // the last iterate kept, run.json saying stalled with the certificate
-    let stalled = dir.path().join("stalled");
+    let stalled_dir = tempfile::tempdir().expect("tempdir");
+    let stalled = stalled_dir.path().join("stalled");
     cosserat()
         .args(["run", "cases/inverse_bend_twist.toml", "--quiet", "--out"])
         .arg(&stalled)

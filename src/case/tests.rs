@@ -49,8 +49,7 @@ fn good_case_parses() {
 fn compare_overrides_need_a_reason() {
     let text = GOOD.replace("frames = 4", "frames = 4\nangles_rel = 1e-6");
     expect_key(&text, "compare.angles_rel");
-    let ok =
-        parse(&text.replace("frames = 4", "frames = 4\nreason = \"measured: the twist is held by 1e-10 only\""));
+    let ok = parse(&text.replace("frames = 4", "frames = 4\nreason = \"measured: the twist is held by 1e-10 only\""));
     assert_eq!(ok.unwrap().compare.overrides.angles_rel, Some(1e-6));
     expect_key(&GOOD.replace("frames = 4", "frames = 0"), "compare.frames");
     expect_key(&GOOD.replace("frames = 4", "metric_abs = -1\nreason = \"x\""), "compare.metric_abs");
@@ -98,9 +97,7 @@ fn case_files_are_read_within_the_cap() {
         let e = Case::from_file(Path::new("/dev/zero")).unwrap_err().to_string();
         assert_eq!(
             e,
-            format!(
-                "/dev/zero: case file is not a regular file and did not end within {cap}: reading stopped there"
-            )
+            format!("/dev/zero: case file is not a regular file and did not end within {cap}: reading stopped there")
         );
     }
 }
@@ -117,7 +114,9 @@ fn non_finite_loads_are_refused_at_load() {
     );
     assert_eq!(
         reason(&with_force("1/(s - L0)")),
-        format!("t.toml: key `loads.force_n_per_m[1]`: `1/(s - L0)` is not finite (inf) at s = 0.001 m, t = 0 s: {tail}")
+        format!(
+            "t.toml: key `loads.force_n_per_m[1]`: `1/(s - L0)` is not finite (inf) at s = 0.001 m, t = 0 s: {tail}"
+        )
     );
     // A load quadrature point, not a node: the first Gauss point of element 3.
     let mesh = Mesh::new(1e-3, 10);
@@ -138,10 +137,7 @@ fn non_finite_loads_are_refused_at_load() {
         )
     );
     let e = reason(&dynamic.replace("[loads]", "[loads]\ntorque_nm_per_m = [\"s/(t - 0.5)\", 0, 0]"));
-    assert!(
-        e.contains("`loads.torque_nm_per_m[0]`: `s/(t - 0.5)` is not finite (NaN) at s = 0 m, t = 0.5 s"),
-        "{e}"
-    );
+    assert!(e.contains("`loads.torque_nm_per_m[0]`: `s/(t - 0.5)` is not finite (NaN) at s = 0 m, t = 0.5 s"), "{e}");
 }
 
 /// NaN and infinity, as TOML numbers or as names, and names a key does not have.
@@ -212,8 +208,7 @@ fn meshes_clip_meshes_and_clip_vectors_are_bounded() {
     assert!(parse(&worm.replace("elements = 127", "elements = 11")).is_ok());
     let e = reason(&worm.replace("start = \"data_guess\"", "start = \"data_guess\"\ngauge = [1e308, 1e308, 0]"));
     assert!(e.contains("key `clip.gauge`: must be a finite non-zero vector"), "{e}");
-    let e = reason(
-        &worm.replace("start = \"data_guess\"", "start = \"data_guess\"\norientation = [1e308, 1e308, 1e308]"),
-    );
+    let e =
+        reason(&worm.replace("start = \"data_guess\"", "start = \"data_guess\"\norientation = [1e308, 1e308, 1e308]"));
     assert!(e.contains("key `clip.orientation`: rotation vector"), "{e}");
 }

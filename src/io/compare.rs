@@ -30,11 +30,11 @@ use super::files::{write_atomic, OutputError};
 use super::freefem::{self, RunOptions};
 use super::freefem_clip::run_clip;
 use super::run_files::write_run;
-use crate::solve::certificate::CERTIFICATE_FLOOR;
 use crate::case::{Analysis, Case, CompareOverrides};
 use crate::run::frames::{solve_frames, SolvedFrame};
 use crate::run::metrics::{all_metrics, differences, ComparisonRow, Difference, Group};
 use crate::run::{run_forward, run_inverse, NodalState, RunError, RunResult};
+use crate::solve::certificate::CERTIFICATE_FLOOR;
 use crate::solve::inverse::InverseMethod;
 use crate::solve::statics::Method;
 
