@@ -136,10 +136,20 @@ pub fn include_file(case: &Case, opts: &RunOptions) -> String {
     for (k, v) in &case.constants {
         let _ = writeln!(o, "real {} = {}; // constant `{k}`", names[k], num(*v));
     }
+    // One rule macro per integral (D4; docs/inverse.md I2, I11, I12), from the scheme's own rules.
     let scheme = case.quadrature;
-    let _ = writeln!(o, "macro QFS {} //", rule_name(&scheme.stretch_shear()));
-    let _ = writeln!(o, "macro QFB {} //", rule_name(&scheme.bending()));
-    let _ = writeln!(o, "macro QFL {} //", rule_name(&scheme.loads()));
+    let _ = writeln!(o, "// quadrature scheme `{}`", scheme.name());
+    let rules = [
+        ("QFS", scheme.stretch_shear(), "stretch-shear integrand"),
+        ("QFB", scheme.bending(), "bending integrand"),
+        ("QFL", scheme.loads(), "loads and inertia"),
+        ("QFO", scheme.objective(), "inverse: tracking, control costs, Lambda_omega"),
+        ("QFK", scheme.kappa(), "inverse: Lambda_kappa term"),
+        ("QFD", scheme.stretch_shear(), "inverse: lambda_d term's base rule, blended with stab * qf2pE"),
+    ];
+    for (name, rule, what) in rules {
+        let _ = writeln!(o, "macro {name} {} // {what}", rule_name(&rule));
+    }
     let groups = [("F", "(S,T)"), ("L", "(S,T)"), ("FE", "(T)"), ("LE", "(T)")];
     for (g, (prefix, args)) in groups.iter().enumerate() {
         for k in 0..3 {
@@ -200,12 +210,14 @@ pub fn include_file(case: &Case, opts: &RunOptions) -> String {
             num(w.lambda_omega[1]),
             num(w.lambda_omega[2])
         );
+        // the λd blend of I11 (`kkt::PointRule::tangent`): none in a one-rule scheme
+        let stab = if case.quadrature.is_one_rule() { 0.0 } else { p.stabilisation };
         let _ = writeln!(
             o,
             "real dt = {};\nint firstFrame = 1;\nreal alpha0 = {};\nreal stab = {};",
             num(p.frame_interval_s),
             num(p.alpha0_rad),
-            num(p.stabilisation)
+            num(stab)
         );
         let (method, warm) = match p.method {
             InverseMethod::FixedPoint => (0, 0.0),
