@@ -1,6 +1,12 @@
 //! FreeFEM runner: writes the case as a FreeFEM include file (`case.idp`), runs
 //! `freefem/forward.edp` headless in a work directory and reads its CSV output back into a
 //! [`RunResult`]. The scripts hold no physical constant: everything comes from `case.idp`.
+//!
+//! The scripts compute the residual certificate of `docs/certificate.md` as the Rust engine does
+//! (`freefem/certificate.idp`) and end a run whose stopping rule was met but whose certificate is
+//! above `solver.certificate_tolerance` with exit status 3 and `STALLED: …`; that run is read
+//! back as [`FreeFemError::Incomplete`] with [`SolveError::Stalled`] and the last iterate, the
+//! error the Rust engine gives (`crate::io::engine` turns it into `RunError::Incomplete`).
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -14,9 +20,11 @@ use crate::model::chart::Chart;
 use crate::model::loads::LoadFrame;
 use crate::model::mesh::Rule;
 use crate::run::{angles_known, Engine, InverseOutput, NodalState, RunResult, SolverStats};
+use crate::solve::certificate::Certificate;
 use crate::solve::dynamics::TipRecord;
 use crate::solve::inverse::{InverseMethod, InverseRecord, ObjectiveTerms};
 use crate::solve::statics::{IterationRecord, Method};
+use crate::solve::SolveError;
 
 /// Environment variable pointing at the `freefem/` script directory (default: the crate's).
 pub const SCRIPT_DIR_ENV: &str = "COSSERAT_FREEFEM_DIR";
@@ -51,6 +59,47 @@ pub enum FreeFemError {
     BadOutput { path: PathBuf, reason: String },
     #[error("cannot read FreeFEM output")]
     Read(#[from] InputError),
+    /// FreeFEM met its stopping rule, but the certificate of its result is above the tolerance
+    /// (exit status [`STALLED_STATUS`]): `source` is the error the Rust engine gives for it,
+    /// `partial` the last iterate and its history.
+    #[error("freefem engine stopped without a certified result")]
+    Incomplete { source: SolveError, partial: Box<RunResult> },
+}
+
+/// Exit status of a FreeFEM script whose result is stalled (`STALLED: …`, docs/certificate.md C4).
+pub const STALLED_STATUS: i32 = 3;
+
+/// The keys of `ff_info.csv` holding the certificate's blocks, in the order of
+/// [`Certificate::blocks`] (the forward scripts write the first two).
+const CERTIFICATE_BLOCK_KEYS: [&str; 4] =
+    ["certificate_x_rows", "certificate_alpha_rows", "certificate_xhat_rows", "certificate_ahat_rows"];
+
+/// The certificate of the result in `ff_info.csv`, with its blocks.
+pub(super) fn info_certificate(info: &BTreeMap<String, f64>) -> Option<Certificate> {
+    let value = *info.get("certificate")?;
+    let blocks = CERTIFICATE_BLOCK_KEYS.map(|k| info.get(k).copied().unwrap_or(0.0));
+    Some(Certificate { value, blocks })
+}
+
+/// A certificate column of FreeFEM's inverse histories: −1 marks a record without one.
+fn optional_certificate(v: f64) -> Option<f64> {
+    (v >= 0.0).then_some(v)
+}
+
+/// Run `script`; `Ok(true)` if it ended stalled (exit status [`STALLED_STATUS`]: its outputs
+/// hold the last iterate), `Ok(false)` if it succeeded.
+fn execute_allowing_stall(
+    case: &Case,
+    workdir: &Path,
+    script: &str,
+    outputs: &[&str],
+    opts: &RunOptions,
+) -> Result<bool, FreeFemError> {
+    match execute(case, workdir, script, outputs, opts) {
+        Ok(()) => Ok(false),
+        Err(FreeFemError::Failed { status: STALLED_STATUS, .. }) => Ok(true),
+        Err(e) => Err(e),
+    }
 }
 
 /// The I/O error on `path`, for `map_err`.
@@ -150,6 +199,11 @@ pub fn include_file(case: &Case, opts: &RunOptions) -> String {
     for (name, rule, what) in rules {
         let _ = writeln!(o, "macro {name} {} // {what}", rule_name(&rule));
     }
+    let _ = writeln!(
+        o,
+        "real certTol = {}; // tolerance of the residual certificate (docs/certificate.md)",
+        num(case.certificate_tolerance())
+    );
     let groups = [("F", "(S,T)"), ("L", "(S,T)"), ("FE", "(T)"), ("LE", "(T)")];
     for (g, (prefix, args)) in groups.iter().enumerate() {
         for k in 0..3 {
@@ -264,7 +318,13 @@ pub fn run_inverse(
     if !same {
         std::fs::copy(data_path, &target).map_err(io(&target))?;
     }
-    execute(case, workdir, "inverse.edp", &["ff_inverse_nodes.csv", "ff_inverse_history.csv", "ff_info.csv"], opts)?;
+    let stalled = execute_allowing_stall(
+        case,
+        workdir,
+        "inverse.edp",
+        &["ff_inverse_nodes.csv", "ff_inverse_history.csv", "ff_info.csv"],
+        opts,
+    )?;
     let nodes_path = workdir.join("ff_inverse_nodes.csv");
     let mut header = vec!["s_m", "x_m", "y_m", "z_m", "alpha_rad", "beta_rad", "gamma_rad"];
     header.extend(["xhat_1", "xhat_2", "xhat_3", "ahat_1", "ahat_2", "ahat_3"]);
@@ -284,8 +344,8 @@ pub fn run_inverse(
     };
     let mut hist_header = vec!["iteration", "rel_change", "x_err_rel", "tangent_misfit"];
     hist_header.extend(ObjectiveTerms::NAMES);
-    hist_header.push("newton_residual");
-    let history = read_table(&workdir.join("ff_inverse_history.csv"), &hist_header)?
+    hist_header.extend(["newton_residual", "certificate"]);
+    let history: Vec<InverseRecord> = read_table(&workdir.join("ff_inverse_history.csv"), &hist_header)?
         .into_iter()
         .map(|r| InverseRecord {
             iteration: r[0] as usize,
@@ -302,20 +362,35 @@ pub fn run_inverse(
             },
             // −1 marks a fixed-point iteration (no Newton residual)
             residual: (r[11] >= 0.0).then_some(r[11]),
-            certificate: None,
+            certificate: optional_certificate(r[12]),
         })
         .collect();
     let info = read_info(&workdir.join("ff_info.csv"))?;
+    let certificate = info_certificate(&info);
     let stats = SolverStats {
         iterations: info.get("iterations").copied().unwrap_or(0.0) as usize,
         last_change: info.get("rel_change").copied(),
         residual: None,
         max_newton_iterations: None,
-        certificate: None,
+        certificate: certificate.map(|c| c.value),
         wall_time_s: info.get("wall_time_s").copied().unwrap_or(f64::NAN),
     };
     let w = inv.params.weights;
-    Ok(RunResult {
+    // the error the Rust engine gives for a stalled frame (`InverseSolution::converged`)
+    let stall = stalled.then(|| {
+        let last = history.last();
+        let newton = history.iter().any(|r| r.residual.is_some());
+        let c = certificate.unwrap_or(Certificate { value: f64::NAN, blocks: [f64::NAN; 4] });
+        SolveError::Stalled {
+            solver: format!("inverse {} of frame 0", if newton { "Newton" } else { "fixed point" }),
+            iterations: last.map_or(0, |r| r.iteration),
+            rel_change: last.map_or(f64::NAN, |r| r.rel_change),
+            certificate: c.value,
+            tolerance: inv.params.certificate_tolerance,
+            block: c.worst_block(true),
+        }
+    });
+    let result = RunResult {
         engine: Engine::Freefem,
         nodes,
         history: Vec::new(),
@@ -331,19 +406,42 @@ pub fn run_inverse(
             lambda_f: w.lambda_f,
             lambda_l: w.lambda_l,
         }),
-    })
+    };
+    match stall {
+        Some(source) => Err(FreeFemError::Incomplete { source, partial: Box::new(result) }),
+        None => Ok(result),
+    }
 }
 
 /// Run the FreeFEM engine on `case` inside `workdir` (created if needed).
+/// A static run that ends stalled is [`FreeFemError::Incomplete`] with the Rust engine's error
+/// (`StaticSolution::converged`) and the last iterate.
 pub fn run(case: &Case, workdir: &Path) -> Result<RunResult, FreeFemError> {
-    execute(
+    let stalled = execute_allowing_stall(
         case,
         workdir,
         "forward.edp",
         &["ff_nodes.csv", "ff_info.csv", "ff_history.csv", "ff_tip.csv"],
         &RunOptions::default(),
     )?;
-    read_outputs(case, workdir)
+    let (result, certificate) = read_outputs(case, workdir)?;
+    if !stalled {
+        return Ok(result);
+    }
+    let solver = match &case.analysis {
+        Analysis::Static(p) if p.method == Method::Newton => "static Newton",
+        _ => "static fixed point",
+    };
+    let c = certificate.unwrap_or(Certificate { value: f64::NAN, blocks: [f64::NAN; 4] });
+    let source = SolveError::Stalled {
+        solver: solver.to_string(),
+        iterations: result.stats.iterations,
+        rel_change: result.stats.last_change.unwrap_or(f64::NAN),
+        certificate: c.value,
+        tolerance: case.certificate_tolerance(),
+        block: c.worst_block(false),
+    };
+    Err(FreeFemError::Incomplete { source, partial: Box::new(result) })
 }
 
 /// Write `case.idp` into `workdir`, remove stale `outputs`, run `script` headless there.
@@ -437,7 +535,8 @@ pub(super) fn read_table(path: &Path, expected: &[&str]) -> Result<Vec<Vec<f64>>
     Ok(rows)
 }
 
-fn read_outputs(case: &Case, dir: &Path) -> Result<RunResult, FreeFemError> {
+/// The result of `forward.edp` in `dir`, and its certificate with the blocks.
+fn read_outputs(case: &Case, dir: &Path) -> Result<(RunResult, Option<Certificate>), FreeFemError> {
     let nodes_path = dir.join("ff_nodes.csv");
     let rows = read_table(&nodes_path, &["s_m", "x_m", "y_m", "z_m", "alpha_rad", "beta_rad", "gamma_rad"])?;
     if rows.len() != case.mesh.nodes() {
@@ -454,12 +553,13 @@ fn read_outputs(case: &Case, dir: &Path) -> Result<RunResult, FreeFemError> {
     };
     let info = read_info(&dir.join("ff_info.csv"))?;
     let get = |k: &str| info.get(k).copied();
+    let certificate = info_certificate(&info);
     let stats = SolverStats {
         iterations: get("iterations").unwrap_or(0.0) as usize,
         last_change: get("rel_change"),
         residual: get("residual"),
         max_newton_iterations: get("max_newton_iterations").map(|v| v as usize),
-        certificate: get("certificate"),
+        certificate: certificate.map(|c| c.value),
         wall_time_s: get("wall_time_s").unwrap_or(f64::NAN),
     };
     let mut history = Vec::new();
@@ -467,25 +567,25 @@ fn read_outputs(case: &Case, dir: &Path) -> Result<RunResult, FreeFemError> {
     if case.is_dynamic() {
         for r in read_table(
             &dir.join("ff_tip.csv"),
-            &["time_s", "x_m", "y_m", "z_m", "alpha_rad", "beta_rad", "gamma_rad", "newton_iterations"],
+            &["time_s", "x_m", "y_m", "z_m", "alpha_rad", "beta_rad", "gamma_rad", "newton_iterations", "certificate"],
         )? {
             tip.push(TipRecord {
                 time_s: r[0],
                 position_m: Vector3::new(r[1], r[2], r[3]),
                 angles_rad: Vector3::new(r[4], r[5], r[6]),
                 newton_iterations: r[7] as usize,
-                certificate: 0.0,
+                certificate: r[8],
             });
         }
     } else {
-        for r in read_table(&dir.join("ff_history.csv"), &["iteration", "rel_change"])? {
+        for r in read_table(&dir.join("ff_history.csv"), &["iteration", "rel_change", "certificate"])? {
             let iteration = r[0] as usize;
             let step = history
                 .last()
                 .map(|h: &IterationRecord| if iteration <= h.iteration { h.step + 1 } else { h.step })
                 .unwrap_or(1);
-            history.push(IterationRecord { step, iteration, change: r[1], certificate: f64::NAN });
+            history.push(IterationRecord { step, iteration, change: r[1], certificate: r[2] });
         }
     }
-    Ok(RunResult { engine: Engine::Freefem, nodes, history, tip, stats, inverse: None })
+    Ok((RunResult { engine: Engine::Freefem, nodes, history, tip, stats, inverse: None }, certificate))
 }
