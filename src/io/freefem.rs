@@ -4,9 +4,10 @@
 //!
 //! The scripts compute the residual certificate of `docs/certificate.md` as the Rust engine does
 //! (`freefem/certificate.idp`) and end a run whose stopping rule was met but whose certificate is
-//! above `solver.certificate_tolerance` with exit status 3 and `STALLED: …`; that run is read
-//! back as [`FreeFemError::Incomplete`] with [`SolveError::Stalled`] and the last iterate, the
-//! error the Rust engine gives (`crate::io::engine` turns it into `RunError::Incomplete`).
+//! above `solver.certificate_tolerance` with exit status 3 and `STALLED: …`, a static or inverse
+//! run at its iteration limit with 4; both are read back as [`FreeFemError::Incomplete`] with the
+//! error the Rust engine gives ([`SolveError::Stalled`], `…NotConverged`) and the last iterate
+//! (`crate::io::engine` turns it into `RunError::Incomplete`).
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -24,7 +25,7 @@ use crate::solve::certificate::Certificate;
 use crate::solve::dynamics::TipRecord;
 use crate::solve::inverse::{InverseMethod, InverseRecord, ObjectiveTerms};
 use crate::solve::statics::{IterationRecord, Method};
-use crate::solve::SolveError;
+use crate::solve::{SolveError, Step};
 
 /// Environment variable pointing at the `freefem/` script directory (default: the crate's).
 pub const SCRIPT_DIR_ENV: &str = "COSSERAT_FREEFEM_DIR";
@@ -59,8 +60,9 @@ pub enum FreeFemError {
     BadOutput { path: PathBuf, reason: String },
     #[error("cannot read FreeFEM output")]
     Read(#[from] InputError),
-    /// FreeFEM met its stopping rule, but the certificate of its result is above the tolerance
-    /// (exit status [`STALLED_STATUS`]): `source` is the error the Rust engine gives for it,
+    /// FreeFEM met its stopping rule but the certificate of its result is above the tolerance
+    /// (exit status [`STALLED_STATUS`]), or it reached its iteration limit
+    /// ([`ITERATION_LIMIT_STATUS`]): `source` is the error the Rust engine gives for it,
     /// `partial` the last iterate and its history.
     #[error("freefem engine stopped without a certified result")]
     Incomplete { source: SolveError, partial: Box<RunResult> },
@@ -68,6 +70,9 @@ pub enum FreeFemError {
 
 /// Exit status of a FreeFEM script whose result is stalled (`STALLED: …`, docs/certificate.md C4).
 pub const STALLED_STATUS: i32 = 3;
+/// Exit status of a static or single-frame inverse FreeFEM run that reached its iteration limit
+/// (`FAILED: …`); its outputs hold the last iterate.
+pub const ITERATION_LIMIT_STATUS: i32 = 4;
 
 /// The keys of `ff_info.csv` holding the certificate's blocks, in the order of
 /// [`Certificate::blocks`] (the forward scripts write the first two).
@@ -86,18 +91,30 @@ fn optional_certificate(v: f64) -> Option<f64> {
     (v >= 0.0).then_some(v)
 }
 
-/// Run `script`; `Ok(true)` if it ended stalled (exit status [`STALLED_STATUS`]: its outputs
-/// hold the last iterate), `Ok(false)` if it succeeded.
-fn execute_allowing_stall(
+/// How a FreeFEM run with a result ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum End {
+    /// its stopping rule met and its result certified
+    Converged,
+    /// exit status [`STALLED_STATUS`]
+    Stalled,
+    /// exit status [`ITERATION_LIMIT_STATUS`]
+    IterationLimit,
+}
+
+/// Run `script`: how it ended when its outputs hold a result (the last iterate when not
+/// converged), else the error.
+fn execute_to_end(
     case: &Case,
     workdir: &Path,
     script: &str,
     outputs: &[&str],
     opts: &RunOptions,
-) -> Result<bool, FreeFemError> {
+) -> Result<End, FreeFemError> {
     match execute(case, workdir, script, outputs, opts) {
-        Ok(()) => Ok(false),
-        Err(FreeFemError::Failed { status: STALLED_STATUS, .. }) => Ok(true),
+        Ok(()) => Ok(End::Converged),
+        Err(FreeFemError::Failed { status: STALLED_STATUS, .. }) => Ok(End::Stalled),
+        Err(FreeFemError::Failed { status: ITERATION_LIMIT_STATUS, .. }) => Ok(End::IterationLimit),
         Err(e) => Err(e),
     }
 }
@@ -318,7 +335,7 @@ pub fn run_inverse(
     if !same {
         std::fs::copy(data_path, &target).map_err(io(&target))?;
     }
-    let stalled = execute_allowing_stall(
+    let end = execute_to_end(
         case,
         workdir,
         "inverse.edp",
@@ -376,20 +393,33 @@ pub fn run_inverse(
         wall_time_s: info.get("wall_time_s").copied().unwrap_or(f64::NAN),
     };
     let w = inv.params.weights;
-    // the error the Rust engine gives for a stalled frame (`InverseSolution::converged`)
-    let stall = stalled.then(|| {
-        let last = history.last();
-        let newton = history.iter().any(|r| r.residual.is_some());
-        let c = certificate.unwrap_or(Certificate { value: f64::NAN, blocks: [f64::NAN; 4] });
-        SolveError::Stalled {
+    // the error the Rust engine gives for a frame that did not converge (`InverseSolution::converged`)
+    let last = history.last();
+    let iterations = last.map_or(0, |r| r.iteration);
+    let rel_change = last.map_or(f64::NAN, |r| r.rel_change);
+    let newton = history.iter().any(|r| r.residual.is_some());
+    let c = certificate.unwrap_or(Certificate { value: f64::NAN, blocks: [f64::NAN; 4] });
+    let stop = match (end, last.and_then(|r| r.residual)) {
+        (End::Converged, _) => None,
+        (End::Stalled, _) => Some(SolveError::Stalled {
             solver: format!("inverse {} of frame 0", if newton { "Newton" } else { "fixed point" }),
-            iterations: last.map_or(0, |r| r.iteration),
-            rel_change: last.map_or(f64::NAN, |r| r.rel_change),
+            iterations,
+            rel_change,
             certificate: c.value,
             tolerance: inv.params.certificate_tolerance,
             block: c.worst_block(true),
+        }),
+        (End::IterationLimit, Some(residual)) => {
+            Some(SolveError::InverseNewtonNotConverged { frame: 0, iterations, residual, certificate: c.value })
         }
-    });
+        (End::IterationLimit, None) if newton => Some(SolveError::InverseNewtonNotConverged {
+            frame: 0,
+            iterations,
+            residual: f64::NAN,
+            certificate: c.value,
+        }),
+        (End::IterationLimit, None) => Some(SolveError::InverseNotConverged { frame: 0, iterations, rel_change }),
+    };
     let result = RunResult {
         engine: Engine::Freefem,
         nodes,
@@ -407,17 +437,17 @@ pub fn run_inverse(
             lambda_l: w.lambda_l,
         }),
     };
-    match stall {
+    match stop {
         Some(source) => Err(FreeFemError::Incomplete { source, partial: Box::new(result) }),
         None => Ok(result),
     }
 }
 
 /// Run the FreeFEM engine on `case` inside `workdir` (created if needed).
-/// A static run that ends stalled is [`FreeFemError::Incomplete`] with the Rust engine's error
-/// (`StaticSolution::converged`) and the last iterate.
+/// A static run that ends stalled or at its iteration limit is [`FreeFemError::Incomplete`] with
+/// the Rust engine's error (`StaticSolution::converged`) and the last iterate.
 pub fn run(case: &Case, workdir: &Path) -> Result<RunResult, FreeFemError> {
-    let stalled = execute_allowing_stall(
+    let end = execute_to_end(
         case,
         workdir,
         "forward.edp",
@@ -425,21 +455,25 @@ pub fn run(case: &Case, workdir: &Path) -> Result<RunResult, FreeFemError> {
         &RunOptions::default(),
     )?;
     let (result, certificate) = read_outputs(case, workdir)?;
-    if !stalled {
-        return Ok(result);
-    }
-    let solver = match &case.analysis {
-        Analysis::Static(p) if p.method == Method::Newton => "static Newton",
-        _ => "static fixed point",
-    };
+    let newton = matches!(&case.analysis, Analysis::Static(p) if p.method == Method::Newton);
+    let last = result.history.last();
+    let (step, iterations, change) =
+        last.map(|r| (r.step, r.iteration, r.change)).unwrap_or((1, result.stats.iterations, f64::NAN));
     let c = certificate.unwrap_or(Certificate { value: f64::NAN, blocks: [f64::NAN; 4] });
-    let source = SolveError::Stalled {
-        solver: solver.to_string(),
-        iterations: result.stats.iterations,
-        rel_change: result.stats.last_change.unwrap_or(f64::NAN),
-        certificate: c.value,
-        tolerance: case.certificate_tolerance(),
-        block: c.worst_block(false),
+    let source = match (end, newton) {
+        (End::Converged, _) => return Ok(result),
+        (End::Stalled, _) => SolveError::Stalled {
+            solver: if newton { "static Newton" } else { "static fixed point" }.to_string(),
+            iterations: result.stats.iterations,
+            rel_change: change,
+            certificate: c.value,
+            tolerance: case.certificate_tolerance(),
+            block: c.worst_block(false),
+        },
+        (End::IterationLimit, false) => SolveError::FixedPointNotConverged { step, iterations, rel_change: change },
+        (End::IterationLimit, true) => {
+            SolveError::NewtonNotConverged { step: Some(Step::Continuation(step)), iterations, increment: change }
+        }
     };
     Err(FreeFemError::Incomplete { source, partial: Box::new(result) })
 }
