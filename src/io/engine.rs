@@ -27,8 +27,9 @@ use crate::run::{self, Engine, NodalState, RunError, RunResult};
 pub enum EngineError {
     #[error(transparent)]
     Run(#[from] RunError),
+    /// (a stalled FreeFEM run is [`EngineError::Run`], see the `From` impl)
     #[error("freefem engine")]
-    FreeFem(#[from] FreeFemError),
+    FreeFem(#[source] FreeFemError),
     #[error("inverse data")]
     Input(#[from] InputError),
     #[error("inverse data")]
@@ -39,6 +40,18 @@ pub enum EngineError {
     NotInverse(String),
     #[error(transparent)]
     Journal(#[from] JournalError),
+}
+
+/// A FreeFEM error; a FreeFEM result that is not certified ([`FreeFemError::Incomplete`]) is the
+/// Rust engine's [`RunError::Incomplete`], with the same solver error and the last iterate, so
+/// that `run`, sweeps and batches treat both engines' stalled runs alike.
+impl From<FreeFemError> for EngineError {
+    fn from(e: FreeFemError) -> Self {
+        match e {
+            FreeFemError::Incomplete { source, partial } => EngineError::Run(RunError::Incomplete { source, partial }),
+            e => EngineError::FreeFem(e),
+        }
+    }
 }
 
 /// The data of an inverse case: the Rust forward engine on its `[data]` solve (I7), or the

@@ -1,6 +1,13 @@
 //! FreeFEM runner: writes the case as a FreeFEM include file (`case.idp`), runs
 //! `freefem/forward.edp` headless in a work directory and reads its CSV output back into a
 //! [`RunResult`]. The scripts hold no physical constant: everything comes from `case.idp`.
+//!
+//! The scripts compute the residual certificate of `docs/certificate.md` as the Rust engine does
+//! (`freefem/certificate.idp`) and end a run whose stopping rule was met but whose certificate is
+//! above `solver.certificate_tolerance` with exit status 3 and `STALLED: …`, a static or inverse
+//! run at its iteration limit with 4; both are read back as [`FreeFemError::Incomplete`] with the
+//! error the Rust engine gives ([`SolveError::Stalled`], `…NotConverged`) and the last iterate
+//! (`crate::io::engine` turns it into `RunError::Incomplete`).
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -14,9 +21,11 @@ use crate::model::chart::Chart;
 use crate::model::loads::LoadFrame;
 use crate::model::mesh::Rule;
 use crate::run::{angles_known, Engine, InverseOutput, NodalState, RunResult, SolverStats};
+use crate::solve::certificate::Certificate;
 use crate::solve::dynamics::TipRecord;
 use crate::solve::inverse::{InverseMethod, InverseRecord, ObjectiveTerms};
 use crate::solve::statics::{IterationRecord, Method};
+use crate::solve::{SolveError, Step};
 
 /// Environment variable pointing at the `freefem/` script directory (default: the crate's).
 pub const SCRIPT_DIR_ENV: &str = "COSSERAT_FREEFEM_DIR";
@@ -51,6 +60,63 @@ pub enum FreeFemError {
     BadOutput { path: PathBuf, reason: String },
     #[error("cannot read FreeFEM output")]
     Read(#[from] InputError),
+    /// FreeFEM met its stopping rule but the certificate of its result is above the tolerance
+    /// (exit status [`STALLED_STATUS`]), or it reached its iteration limit
+    /// ([`ITERATION_LIMIT_STATUS`]): `source` is the error the Rust engine gives for it,
+    /// `partial` the last iterate and its history.
+    #[error("freefem engine stopped without a certified result")]
+    Incomplete { source: SolveError, partial: Box<RunResult> },
+}
+
+/// Exit status of a FreeFEM script whose result is stalled (`STALLED: …`, docs/certificate.md C4).
+pub const STALLED_STATUS: i32 = 3;
+/// Exit status of a static or single-frame inverse FreeFEM run that reached its iteration limit
+/// (`FAILED: …`); its outputs hold the last iterate.
+pub const ITERATION_LIMIT_STATUS: i32 = 4;
+
+/// The keys of `ff_info.csv` holding the certificate's blocks, in the order of
+/// [`Certificate::blocks`] (the forward scripts write the first two).
+const CERTIFICATE_BLOCK_KEYS: [&str; 4] =
+    ["certificate_x_rows", "certificate_alpha_rows", "certificate_xhat_rows", "certificate_ahat_rows"];
+
+/// The certificate of the result in `ff_info.csv`, with its blocks.
+pub(super) fn info_certificate(info: &BTreeMap<String, f64>) -> Option<Certificate> {
+    let value = *info.get("certificate")?;
+    let blocks = CERTIFICATE_BLOCK_KEYS.map(|k| info.get(k).copied().unwrap_or(0.0));
+    Some(Certificate { value, blocks })
+}
+
+/// A certificate column of FreeFEM's inverse histories: −1 marks a record without one.
+fn optional_certificate(v: f64) -> Option<f64> {
+    (v >= 0.0).then_some(v)
+}
+
+/// How a FreeFEM run with a result ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum End {
+    /// its stopping rule met and its result certified
+    Converged,
+    /// exit status [`STALLED_STATUS`]
+    Stalled,
+    /// exit status [`ITERATION_LIMIT_STATUS`]
+    IterationLimit,
+}
+
+/// Run `script`: how it ended when its outputs hold a result (the last iterate when not
+/// converged), else the error.
+fn execute_to_end(
+    case: &Case,
+    workdir: &Path,
+    script: &str,
+    outputs: &[&str],
+    opts: &RunOptions,
+) -> Result<End, FreeFemError> {
+    match execute(case, workdir, script, outputs, opts) {
+        Ok(()) => Ok(End::Converged),
+        Err(FreeFemError::Failed { status: STALLED_STATUS, .. }) => Ok(End::Stalled),
+        Err(FreeFemError::Failed { status: ITERATION_LIMIT_STATUS, .. }) => Ok(End::IterationLimit),
+        Err(e) => Err(e),
+    }
 }
 
 /// The I/O error on `path`, for `map_err`.
@@ -136,10 +202,25 @@ pub fn include_file(case: &Case, opts: &RunOptions) -> String {
     for (k, v) in &case.constants {
         let _ = writeln!(o, "real {} = {}; // constant `{k}`", names[k], num(*v));
     }
+    // One rule macro per integral (D4; docs/inverse.md I2, I11, I12), from the scheme's own rules.
     let scheme = case.quadrature;
-    let _ = writeln!(o, "macro QFS {} //", rule_name(&scheme.stretch_shear()));
-    let _ = writeln!(o, "macro QFB {} //", rule_name(&scheme.bending()));
-    let _ = writeln!(o, "macro QFL {} //", rule_name(&scheme.loads()));
+    let _ = writeln!(o, "// quadrature scheme `{}`", scheme.name());
+    let rules = [
+        ("QFS", scheme.stretch_shear(), "stretch-shear integrand"),
+        ("QFB", scheme.bending(), "bending integrand"),
+        ("QFL", scheme.loads(), "loads and inertia"),
+        ("QFO", scheme.objective(), "inverse: tracking, control costs, Lambda_omega"),
+        ("QFK", scheme.kappa(), "inverse: Lambda_kappa term"),
+        ("QFD", scheme.stretch_shear(), "inverse: lambda_d term's base rule, blended with stab * qf2pE"),
+    ];
+    for (name, rule, what) in rules {
+        let _ = writeln!(o, "macro {name} {} // {what}", rule_name(&rule));
+    }
+    let _ = writeln!(
+        o,
+        "real certTol = {}; // tolerance of the residual certificate (docs/certificate.md)",
+        num(case.certificate_tolerance())
+    );
     let groups = [("F", "(S,T)"), ("L", "(S,T)"), ("FE", "(T)"), ("LE", "(T)")];
     for (g, (prefix, args)) in groups.iter().enumerate() {
         for k in 0..3 {
@@ -200,12 +281,14 @@ pub fn include_file(case: &Case, opts: &RunOptions) -> String {
             num(w.lambda_omega[1]),
             num(w.lambda_omega[2])
         );
+        // the λd blend of I11 (`kkt::PointRule::tangent`): none in a one-rule scheme
+        let stab = if case.quadrature.is_one_rule() { 0.0 } else { p.stabilisation };
         let _ = writeln!(
             o,
             "real dt = {};\nint firstFrame = 1;\nreal alpha0 = {};\nreal stab = {};",
             num(p.frame_interval_s),
             num(p.alpha0_rad),
-            num(p.stabilisation)
+            num(stab)
         );
         let (method, warm) = match p.method {
             InverseMethod::FixedPoint => (0, 0.0),
@@ -252,7 +335,13 @@ pub fn run_inverse(
     if !same {
         std::fs::copy(data_path, &target).map_err(io(&target))?;
     }
-    execute(case, workdir, "inverse.edp", &["ff_inverse_nodes.csv", "ff_inverse_history.csv", "ff_info.csv"], opts)?;
+    let end = execute_to_end(
+        case,
+        workdir,
+        "inverse.edp",
+        &["ff_inverse_nodes.csv", "ff_inverse_history.csv", "ff_info.csv"],
+        opts,
+    )?;
     let nodes_path = workdir.join("ff_inverse_nodes.csv");
     let mut header = vec!["s_m", "x_m", "y_m", "z_m", "alpha_rad", "beta_rad", "gamma_rad"];
     header.extend(["xhat_1", "xhat_2", "xhat_3", "ahat_1", "ahat_2", "ahat_3"]);
@@ -272,8 +361,8 @@ pub fn run_inverse(
     };
     let mut hist_header = vec!["iteration", "rel_change", "x_err_rel", "tangent_misfit"];
     hist_header.extend(ObjectiveTerms::NAMES);
-    hist_header.push("newton_residual");
-    let history = read_table(&workdir.join("ff_inverse_history.csv"), &hist_header)?
+    hist_header.extend(["newton_residual", "certificate"]);
+    let history: Vec<InverseRecord> = read_table(&workdir.join("ff_inverse_history.csv"), &hist_header)?
         .into_iter()
         .map(|r| InverseRecord {
             iteration: r[0] as usize,
@@ -290,20 +379,48 @@ pub fn run_inverse(
             },
             // −1 marks a fixed-point iteration (no Newton residual)
             residual: (r[11] >= 0.0).then_some(r[11]),
-            certificate: None,
+            certificate: optional_certificate(r[12]),
         })
         .collect();
     let info = read_info(&workdir.join("ff_info.csv"))?;
+    let certificate = info_certificate(&info);
     let stats = SolverStats {
         iterations: info.get("iterations").copied().unwrap_or(0.0) as usize,
         last_change: info.get("rel_change").copied(),
         residual: None,
         max_newton_iterations: None,
-        certificate: None,
+        certificate: certificate.map(|c| c.value),
         wall_time_s: info.get("wall_time_s").copied().unwrap_or(f64::NAN),
     };
     let w = inv.params.weights;
-    Ok(RunResult {
+    // the error the Rust engine gives for a frame that did not converge (`InverseSolution::converged`)
+    let last = history.last();
+    let iterations = last.map_or(0, |r| r.iteration);
+    let rel_change = last.map_or(f64::NAN, |r| r.rel_change);
+    let newton = history.iter().any(|r| r.residual.is_some());
+    let c = certificate.unwrap_or(Certificate { value: f64::NAN, blocks: [f64::NAN; 4] });
+    let stop = match (end, last.and_then(|r| r.residual)) {
+        (End::Converged, _) => None,
+        (End::Stalled, _) => Some(SolveError::Stalled {
+            solver: format!("inverse {} of frame 0", if newton { "Newton" } else { "fixed point" }),
+            iterations,
+            rel_change,
+            certificate: c.value,
+            tolerance: inv.params.certificate_tolerance,
+            block: c.worst_block(true),
+        }),
+        (End::IterationLimit, Some(residual)) => {
+            Some(SolveError::InverseNewtonNotConverged { frame: 0, iterations, residual, certificate: c.value })
+        }
+        (End::IterationLimit, None) if newton => Some(SolveError::InverseNewtonNotConverged {
+            frame: 0,
+            iterations,
+            residual: f64::NAN,
+            certificate: c.value,
+        }),
+        (End::IterationLimit, None) => Some(SolveError::InverseNotConverged { frame: 0, iterations, rel_change }),
+    };
+    let result = RunResult {
         engine: Engine::Freefem,
         nodes,
         history: Vec::new(),
@@ -319,19 +436,46 @@ pub fn run_inverse(
             lambda_f: w.lambda_f,
             lambda_l: w.lambda_l,
         }),
-    })
+    };
+    match stop {
+        Some(source) => Err(FreeFemError::Incomplete { source, partial: Box::new(result) }),
+        None => Ok(result),
+    }
 }
 
 /// Run the FreeFEM engine on `case` inside `workdir` (created if needed).
+/// A static run that ends stalled or at its iteration limit is [`FreeFemError::Incomplete`] with
+/// the Rust engine's error (`StaticSolution::converged`) and the last iterate.
 pub fn run(case: &Case, workdir: &Path) -> Result<RunResult, FreeFemError> {
-    execute(
+    let end = execute_to_end(
         case,
         workdir,
         "forward.edp",
         &["ff_nodes.csv", "ff_info.csv", "ff_history.csv", "ff_tip.csv"],
         &RunOptions::default(),
     )?;
-    read_outputs(case, workdir)
+    let (result, certificate) = read_outputs(case, workdir)?;
+    let newton = matches!(&case.analysis, Analysis::Static(p) if p.method == Method::Newton);
+    let last = result.history.last();
+    let (step, iterations, change) =
+        last.map(|r| (r.step, r.iteration, r.change)).unwrap_or((1, result.stats.iterations, f64::NAN));
+    let c = certificate.unwrap_or(Certificate { value: f64::NAN, blocks: [f64::NAN; 4] });
+    let source = match (end, newton) {
+        (End::Converged, _) => return Ok(result),
+        (End::Stalled, _) => SolveError::Stalled {
+            solver: if newton { "static Newton" } else { "static fixed point" }.to_string(),
+            iterations: result.stats.iterations,
+            rel_change: change,
+            certificate: c.value,
+            tolerance: case.certificate_tolerance(),
+            block: c.worst_block(false),
+        },
+        (End::IterationLimit, false) => SolveError::FixedPointNotConverged { step, iterations, rel_change: change },
+        (End::IterationLimit, true) => {
+            SolveError::NewtonNotConverged { step: Some(Step::Continuation(step)), iterations, increment: change }
+        }
+    };
+    Err(FreeFemError::Incomplete { source, partial: Box::new(result) })
 }
 
 /// Write `case.idp` into `workdir`, remove stale `outputs`, run `script` headless there.
@@ -425,7 +569,8 @@ pub(super) fn read_table(path: &Path, expected: &[&str]) -> Result<Vec<Vec<f64>>
     Ok(rows)
 }
 
-fn read_outputs(case: &Case, dir: &Path) -> Result<RunResult, FreeFemError> {
+/// The result of `forward.edp` in `dir`, and its certificate with the blocks.
+fn read_outputs(case: &Case, dir: &Path) -> Result<(RunResult, Option<Certificate>), FreeFemError> {
     let nodes_path = dir.join("ff_nodes.csv");
     let rows = read_table(&nodes_path, &["s_m", "x_m", "y_m", "z_m", "alpha_rad", "beta_rad", "gamma_rad"])?;
     if rows.len() != case.mesh.nodes() {
@@ -442,12 +587,13 @@ fn read_outputs(case: &Case, dir: &Path) -> Result<RunResult, FreeFemError> {
     };
     let info = read_info(&dir.join("ff_info.csv"))?;
     let get = |k: &str| info.get(k).copied();
+    let certificate = info_certificate(&info);
     let stats = SolverStats {
         iterations: get("iterations").unwrap_or(0.0) as usize,
         last_change: get("rel_change"),
         residual: get("residual"),
         max_newton_iterations: get("max_newton_iterations").map(|v| v as usize),
-        certificate: get("certificate"),
+        certificate: certificate.map(|c| c.value),
         wall_time_s: get("wall_time_s").unwrap_or(f64::NAN),
     };
     let mut history = Vec::new();
@@ -455,25 +601,25 @@ fn read_outputs(case: &Case, dir: &Path) -> Result<RunResult, FreeFemError> {
     if case.is_dynamic() {
         for r in read_table(
             &dir.join("ff_tip.csv"),
-            &["time_s", "x_m", "y_m", "z_m", "alpha_rad", "beta_rad", "gamma_rad", "newton_iterations"],
+            &["time_s", "x_m", "y_m", "z_m", "alpha_rad", "beta_rad", "gamma_rad", "newton_iterations", "certificate"],
         )? {
             tip.push(TipRecord {
                 time_s: r[0],
                 position_m: Vector3::new(r[1], r[2], r[3]),
                 angles_rad: Vector3::new(r[4], r[5], r[6]),
                 newton_iterations: r[7] as usize,
-                certificate: 0.0,
+                certificate: r[8],
             });
         }
     } else {
-        for r in read_table(&dir.join("ff_history.csv"), &["iteration", "rel_change"])? {
+        for r in read_table(&dir.join("ff_history.csv"), &["iteration", "rel_change", "certificate"])? {
             let iteration = r[0] as usize;
             let step = history
                 .last()
                 .map(|h: &IterationRecord| if iteration <= h.iteration { h.step + 1 } else { h.step })
                 .unwrap_or(1);
-            history.push(IterationRecord { step, iteration, change: r[1], certificate: f64::NAN });
+            history.push(IterationRecord { step, iteration, change: r[1], certificate: r[2] });
         }
     }
-    Ok(RunResult { engine: Engine::Freefem, nodes, history, tip, stats, inverse: None })
+    Ok((RunResult { engine: Engine::Freefem, nodes, history, tip, stats, inverse: None }, certificate))
 }

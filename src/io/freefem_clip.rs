@@ -9,13 +9,15 @@ use std::path::Path;
 
 use nalgebra::Vector3;
 
-use super::freefem::{execute, io, read_info, read_table, ClipInclude, FreeFemError, RunOptions};
+use super::freefem::{execute, info_certificate, io, read_info, read_table, ClipInclude, FreeFemError, RunOptions};
 use crate::case::Case;
 use crate::model::chart::Chart;
 use crate::run::frames::{frame_result, SolvedFrame};
 use crate::run::{Engine, NodalState};
+use crate::solve::certificate::Certificate;
 use crate::solve::inverse::{InverseRecord, ObjectiveTerms};
 use crate::solve::sequence::{clip_charts, FrameStart};
+use crate::solve::SolveError;
 
 /// Frames solved by FreeFEM, and its failure message if it stopped early.
 #[derive(Debug)]
@@ -23,6 +25,9 @@ pub struct FreeFemFrames {
     pub frames: Vec<SolvedFrame>,
     /// the driver's `FAILED: frame K: …` message when it stopped before the last frame
     pub error: Option<String>,
+    /// when it stopped because a frame stalled (its stopping rule met, its certificate above the
+    /// tolerance, `docs/certificate.md`): the error the Rust engine gives for that frame
+    pub stalled: Option<SolveError>,
     /// FreeFEM's own clock for the whole clip [s]
     pub wall_time_s: f64,
 }
@@ -76,26 +81,51 @@ pub fn run_clip(
         }),
     };
     let outputs = ["ff_clip_nodes.csv", "ff_clip_frames.csv", "ff_info.csv"];
-    let failure = match execute(case, workdir, "clip.edp", &outputs, &opts) {
-        Ok(()) => None,
-        Err(FreeFemError::Failed { status: 2, output, .. }) => Some(
-            output.lines().find(|l| l.starts_with("FAILED")).map(str::to_string).unwrap_or(output.trim().to_string()),
-        ),
-        Err(e) => return Err(e),
-    };
+    match execute(case, workdir, "clip.edp", &outputs, &opts) {
+        Ok(()) | Err(FreeFemError::Failed { status: 2, .. }) => read_clip_run(case, frames, workdir),
+        Err(e) => Err(e),
+    }
+}
+
+/// What `freefem/clip.edp` left in `workdir` after a run on `frames` (as [`run_clip`] returns it):
+/// the frames it solved, its failure message and, for a stalled frame, the Rust engine's error.
+pub fn read_clip_run(case: &Case, frames: &[Vec<Vector3<f64>>], workdir: &Path) -> Result<FreeFemFrames, FreeFemError> {
+    let sp = case.sequence_params().ok_or_else(|| FreeFemError::NotInverse(case.name.clone()))?;
+    let charts = clip_charts(&sp, frames);
     let frames_out = read_frames(case, sp.frame_offset, frames, &charts, workdir)?;
-    let wall_time_s = read_info(&workdir.join("ff_info.csv"))
-        .ok()
-        .and_then(|i| i.get("wall_time_s").copied())
-        .unwrap_or_else(|| frames_out.iter().map(|f| f.result.stats.wall_time_s).sum());
-    Ok(FreeFemFrames { frames: frames_out, error: failure, wall_time_s })
+    let info = read_info(&workdir.join("ff_info.csv")).ok();
+    let get = |k: &str| info.as_ref().and_then(|i| i.get(k).copied());
+    // the driver's `FAILED: frame K: …` line (its output, `execute`'s log)
+    let output = std::fs::read_to_string(workdir.join("freefem_output.txt")).unwrap_or_default();
+    let error = output.lines().find(|l| l.starts_with("FAILED")).map(str::to_string);
+    // solveFrame's code 4: the frame stalled (freefem/inverse_core.idp)
+    let stalled = match get("failed_frame") {
+        Some(frame) if get("failed_status") == Some(4.0) => {
+            let c = info
+                .as_ref()
+                .and_then(info_certificate)
+                .unwrap_or(Certificate { value: f64::NAN, blocks: [f64::NAN; 4] });
+            let solver = if get("failed_newton") == Some(1.0) { "Newton" } else { "fixed point" };
+            Some(SolveError::Stalled {
+                solver: format!("inverse {solver} of frame {}", frame as usize),
+                iterations: get("failed_iterations").unwrap_or(0.0) as usize,
+                rel_change: get("failed_rel_change").unwrap_or(f64::NAN),
+                certificate: c.value,
+                tolerance: case.certificate_tolerance(),
+                block: c.worst_block(true),
+            })
+        }
+        _ => None,
+    };
+    let wall_time_s = get("wall_time_s").unwrap_or_else(|| frames_out.iter().map(|f| f.result.stats.wall_time_s).sum());
+    Ok(FreeFemFrames { frames: frames_out, error, stalled, wall_time_s })
 }
 
 /// Columns of `ff_clip_frames.csv` (the contract of `freefem/clip.edp`).
 fn frame_header() -> Vec<&'static str> {
     let mut h = vec!["frame", "iterations", "rel_change", "x_err_rel", "tangent_misfit"];
     h.extend(ObjectiveTerms::NAMES);
-    h.extend(["min_cos_beta", "min_cos_beta_node", "restarted", "wall_time_s"]);
+    h.extend(["min_cos_beta", "min_cos_beta_node", "restarted", "wall_time_s", "certificate"]);
     h
 }
 
@@ -157,7 +187,8 @@ fn read_frames(
             tangent_misfit: rep[4],
             objective,
             residual: None,
-            certificate: None,
+            // the certificate of the frame's solution (`FrameReport::certificate`)
+            certificate: Some(rep[16]),
         };
         let result = frame_result(
             case,
