@@ -181,9 +181,7 @@ fn clip_certificates(case: &Case, dir: &Path, failures: &mut Vec<String>) -> Agr
         }
     }
     let stall = |e: Option<&SolveError>| match e {
-        Some(SolveError::Stalled { solver, iterations, certificate, .. }) => {
-            Some((solver.clone(), *iterations, *certificate))
-        }
+        Some(SolveError::Stalled(s)) => Some((s.solver.clone(), s.iterations, s.certificate)),
         _ => None,
     };
     let rust_stall = stall(match &rust.error {

@@ -216,7 +216,7 @@ fn newton_vs_fixed_point(
 fn assert_fast(hist: &[InverseRecord], max_its: usize, floor: f64) {
     assert!(hist.len() <= max_its, "{} iterations", hist.len());
     let cert: Vec<f64> = hist.iter().map(|r| r.certificate.expect("certificate of every record")).collect();
-    eprintln!("  certificates {cert:.2e?}");
+    eprintln!("  certificates {:?}", cert.iter().map(|c| format!("{c:.2e}")).collect::<Vec<_>>());
     for w in cert.windows(2) {
         assert!(w[1] <= floor.max(0.1 * w[0]), "{cert:?}");
     }

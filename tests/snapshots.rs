@@ -34,7 +34,7 @@ fn case_metrics_snapshots() {
         // the snapshot guards
         let r = match run_case(&case, Engine::Rust, dir.path(), |_, _| {}) {
             Ok(r) => r,
-            Err(EngineError::Run(RunError::Incomplete { source: SolveError::Stalled { .. }, partial })) => *partial,
+            Err(EngineError::Run(RunError::Incomplete { source: SolveError::Stalled(_), partial })) => *partial,
             Err(e) => panic!("{}: {e}", case.name),
         };
         let inverse = case.inverse().is_some();

@@ -401,14 +401,14 @@ pub fn run_inverse(
     let c = certificate.unwrap_or(Certificate { value: f64::NAN, blocks: [f64::NAN; 4] });
     let stop = match (end, last.and_then(|r| r.residual)) {
         (End::Converged, _) => None,
-        (End::Stalled, _) => Some(SolveError::Stalled {
+        (End::Stalled, _) => Some(SolveError::Stalled(Box::new(crate::solve::Stall {
             solver: format!("inverse {} of frame 0", if newton { "Newton" } else { "fixed point" }),
             iterations,
             rel_change,
             certificate: c.value,
             tolerance: inv.params.certificate_tolerance,
             block: c.worst_block(true),
-        }),
+        }))),
         (End::IterationLimit, Some(residual)) => {
             Some(SolveError::InverseNewtonNotConverged { frame: 0, iterations, residual, certificate: c.value })
         }
@@ -462,14 +462,14 @@ pub fn run(case: &Case, workdir: &Path) -> Result<RunResult, FreeFemError> {
     let c = certificate.unwrap_or(Certificate { value: f64::NAN, blocks: [f64::NAN; 4] });
     let source = match (end, newton) {
         (End::Converged, _) => return Ok(result),
-        (End::Stalled, _) => SolveError::Stalled {
+        (End::Stalled, _) => SolveError::Stalled(Box::new(crate::solve::Stall {
             solver: if newton { "static Newton" } else { "static fixed point" }.to_string(),
             iterations: result.stats.iterations,
             rel_change: change,
             certificate: c.value,
             tolerance: case.certificate_tolerance(),
             block: c.worst_block(false),
-        },
+        })),
         (End::IterationLimit, false) => SolveError::FixedPointNotConverged { step, iterations, rel_change: change },
         (End::IterationLimit, true) => {
             SolveError::NewtonNotConverged { step: Some(Step::Continuation(step)), iterations, increment: change }

@@ -106,14 +106,14 @@ pub fn read_clip_run(case: &Case, frames: &[Vec<Vector3<f64>>], workdir: &Path) 
                 .and_then(info_certificate)
                 .unwrap_or(Certificate { value: f64::NAN, blocks: [f64::NAN; 4] });
             let solver = if get("failed_newton") == Some(1.0) { "Newton" } else { "fixed point" };
-            Some(SolveError::Stalled {
+            Some(SolveError::Stalled(Box::new(crate::solve::Stall {
                 solver: format!("inverse {solver} of frame {}", frame as usize),
                 iterations: get("failed_iterations").unwrap_or(0.0) as usize,
                 rel_change: get("failed_rel_change").unwrap_or(f64::NAN),
                 certificate: c.value,
                 tolerance: case.certificate_tolerance(),
                 block: c.worst_block(true),
-            })
+            })))
         }
         _ => None,
     };

@@ -140,7 +140,7 @@ fn solve_single(case: &Case, engine: Engine, dir: &Path, progress: impl FnMut(us
     let (status, r, error) = match result {
         Ok(r) => (RunStatus::Ok, r, None),
         Err(EngineError::Run(RunError::Incomplete { source, partial })) => (
-            if matches!(source, SolveError::Stalled { .. }) { RunStatus::Stalled } else { RunStatus::NotConverged },
+            if matches!(source, SolveError::Stalled(_)) { RunStatus::Stalled } else { RunStatus::NotConverged },
             *partial,
             Some(format!("{}: {source}; the files here hold the last iterate", case_label(case))),
         ),

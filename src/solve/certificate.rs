@@ -54,7 +54,7 @@ impl Certificate {
         let blocks = top.map(|(res, size)| match (res, size) {
             (res, _) if res.is_nan() => f64::NAN,
             (res, size) if size > 0.0 => res / size,
-            (res, _) if res == 0.0 => 0.0,
+            (0.0, _) => 0.0,
             _ => f64::INFINITY,
         });
         let value = blocks.iter().fold(0.0_f64, |m, &b| if b.is_nan() || m.is_nan() { f64::NAN } else { m.max(b) });

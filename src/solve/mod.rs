@@ -86,17 +86,8 @@ pub enum SolveError {
     )]
     InverseNewtonNotConverged { frame: usize, iterations: usize, residual: f64, certificate: f64 },
     /// The iteration stopped moving but its certificate is above the tolerance (`Stop::Stalled`).
-    #[error(
-        "{solver} stalled after {iterations} iterations: the relative change of (x, α) is {rel_change:e}, but the residual certificate is {certificate:e} > its tolerance {tolerance:e} (worst block: {block}); the iterate does not solve the discrete equations (docs/certificate.md)"
-    )]
-    Stalled {
-        solver: String,
-        iterations: usize,
-        rel_change: f64,
-        certificate: f64,
-        tolerance: f64,
-        block: &'static str,
-    },
+    #[error(transparent)]
+    Stalled(Box<Stall>),
     /// The KKT matrix of a frame is singular to working precision (a zero pivot of the band LU).
     #[error(
         "inverse frame {frame}: the KKT matrix is singular to working precision at the unknown {unknown}: {cause}"
@@ -151,6 +142,24 @@ pub(crate) fn divergence(problem: &Problem, u: &nalgebra::DVector<f64>, change: 
         return Some(("max |α| [rad] (limit 1e3)", angle));
     }
     None
+}
+
+/// A solve that stopped moving with its certificate above the tolerance (`Stop::Stalled`,
+/// `docs/certificate.md`): which solver, after how many iterations, and the numbers.
+#[derive(Debug, thiserror::Error)]
+#[error(
+    "{solver} stalled after {iterations} iterations: the relative change of (x, α) is {rel_change:e}, but the residual certificate is {certificate:e} > its tolerance {tolerance:e} (worst block: {block}); the iterate does not solve the discrete equations (docs/certificate.md)"
+)]
+pub struct Stall {
+    /// the solver and, for an inverse frame, its frame
+    pub solver: String,
+    pub iterations: usize,
+    /// the last relative change of (x, α) (D5)
+    pub rel_change: f64,
+    pub certificate: f64,
+    pub tolerance: f64,
+    /// the block of equations with the largest backward error
+    pub block: &'static str,
 }
 
 /// Where a forward solve was when it stopped: a time step (dynamic) or a load-continuation

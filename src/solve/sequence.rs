@@ -365,7 +365,7 @@ pub fn solve_sequence_from(
             Err(
                 SolveError::InverseNotConverged { .. }
                 | SolveError::InverseNewtonNotConverged { .. }
-                | SolveError::Stalled { .. }
+                | SolveError::Stalled(_)
                 | SolveError::InverseDiverged { .. },
             ) if from_previous => (solve(&guess(), Start::Guess)?, true),
             Err(e) => return Err(e.into()),

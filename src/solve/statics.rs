@@ -18,7 +18,7 @@
 use nalgebra::DVector;
 
 use super::certificate::{of_system, Certificate, DEFAULT_CERTIFICATE_TOLERANCE};
-use super::{divergence, Problem, SolveError, Step, Stop, PLATEAU_ITERATIONS};
+use super::{divergence, Problem, SolveError, Stall, Step, Stop, PLATEAU_ITERATIONS};
 use crate::assemble::{assemble, Tangent};
 use crate::linalg::{LinearSolver, Pattern};
 use crate::model::element::frozen_operator;
@@ -106,14 +106,14 @@ impl StaticSolution {
             Method::Newton => "static Newton",
         };
         Err(match (self.stop, self.method) {
-            (Stop::Stalled, _) => SolveError::Stalled {
+            (Stop::Stalled, _) => SolveError::Stalled(Box::new(Stall {
                 solver: solver.to_string(),
                 iterations: self.iterations,
                 rel_change: change,
                 certificate: self.certificate.value,
                 tolerance: self.certificate_tolerance,
                 block: self.certificate.worst_block(false),
-            },
+            })),
             (_, Method::FixedPoint { .. }) => {
                 SolveError::FixedPointNotConverged { step, iterations, rel_change: change }
             }

@@ -31,7 +31,7 @@ pub mod newton;
 use nalgebra::{DVector, Vector3};
 
 use super::certificate::Certificate;
-use super::{Problem, SolveError, Stop};
+use super::{Problem, SolveError, Stall, Stop};
 use crate::linalg::{LinearError, LinearSolver, Pattern};
 use crate::model::mesh::DofMap;
 use crate::model::rotation::Angles;
@@ -295,14 +295,14 @@ impl InverseSolution {
         let rel_change = last.map(|r| r.rel_change).unwrap_or(f64::NAN);
         let newton = self.history.iter().any(|r| r.residual.is_some());
         Err(match (self.stop, last.and_then(|r| r.residual)) {
-            (Stop::Stalled, _) => SolveError::Stalled {
+            (Stop::Stalled, _) => SolveError::Stalled(Box::new(Stall {
                 solver: format!("inverse {} of frame {frame}", if newton { "Newton" } else { "fixed point" }),
                 iterations,
                 rel_change,
                 certificate: self.certificate.value,
                 tolerance: self.certificate_tolerance,
                 block: self.certificate.worst_block(true),
-            },
+            })),
             (_, Some(residual)) => SolveError::InverseNewtonNotConverged {
                 frame,
                 iterations,

@@ -1,4 +1,15 @@
-//! Diagnostic (not committed): certificate of the FP and of Newton. usage: diag_newton CASE LK3 FPTOL NEWTON_ITS
+//! The evidence of `docs/inverse.md` I13 (Newton's Λκ stall): the fixed point of an inverse case
+//! from the straight state to a relative change `FPTOL`, the certificate along the way, Newton
+//! from there for `NEWTON_ITS` iterations with the certificate of every iterate, and with
+//! `SVD=1` the smallest singular values of the equilibrated Jacobian at the fixed point's
+//! iterate with the singular components that make up the Newton step (`SHAPE=1`: their angle
+//! shapes).
+//!
+//! ```sh
+//! cargo run --release --example newton_stall -- cases/inverse_bend_twist_newton.toml 1e-10 1e-6 60
+//! SVD=1 cargo run --release --example newton_stall -- cases/inverse_bend_twist_newton.toml 1e-10 1e-6 1
+//! ```
+//! `LK3`: Λκ3 to set (negative: the case's), `FPTOL`: the fixed point's tolerance.
 use cosserat::case::Case;
 use cosserat::model::mesh::Field;
 use cosserat::solve::inverse::kkt::dirichlet;
@@ -120,12 +131,10 @@ fn main() {
         let tot: f64 = contrib.iter().map(|c| c.2 * c.2).sum::<f64>().sqrt();
         eprintln!("scaled step norm {tot:.3e}");
         let mut acc = 0.0;
-        let mut printed = 0;
         for (i, c) in contrib.iter().enumerate() {
             acc += c.2 * c.2;
             if i < 40 && (c.2.abs() > 0.05 * tot || i < 12) {
                 eprintln!("  #{i} sigma {:.2e} proj {:.2e} step {:.2e} cum {:.3}", c.0, c.1, c.2, (acc).sqrt() / tot);
-                printed += 1;
             }
         }
         let mut order: Vec<usize> = (0..contrib.len()).collect();
