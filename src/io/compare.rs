@@ -34,6 +34,7 @@ use crate::case::{Analysis, Case, CompareOverrides};
 use crate::run::frames::{solve_frames, SolvedFrame};
 use crate::run::metrics::{all_metrics, differences, ComparisonRow, Difference, Group};
 use crate::run::{run_forward, run_inverse, NodalState, RunError, RunResult};
+use crate::solve::{SolveError, PLATEAU_ITERATIONS};
 use crate::solve::certificate::CERTIFICATE_FLOOR;
 use crate::solve::inverse::InverseMethod;
 use crate::solve::statics::Method;
@@ -263,9 +264,11 @@ fn rows(case: &Case, tau: f64, diffs: &[Difference], sens: &[Difference]) -> Vec
         .collect()
 }
 
-/// The first iteration whose relative change met `tol` (the natural stop), if any.
+/// The first iteration at which the relative change had met `tol` in
+/// [`PLATEAU_ITERATIONS`] consecutive iterations (the fixed point's natural stop, C4), if any.
 fn natural_stop(r: &RunResult, tol: f64) -> Option<usize> {
-    r.inverse.as_ref()?.history.iter().find(|h| h.rel_change <= tol).map(|h| h.iteration)
+    let h = &r.inverse.as_ref()?.history;
+    h.windows(PLATEAU_ITERATIONS).find(|w| w.iter().all(|r| r.rel_change <= tol)).map(|w| w[w.len() - 1].iteration)
 }
 
 /// Rust inverse run for exactly `n` fixed-point iterations (the tolerance ignored).
@@ -282,6 +285,16 @@ fn rust_exact(case: &Case, data: &NodalState, n: usize) -> Result<RunResult, Run
     }
 }
 
+/// A Rust inverse run whose end is a result to compare: converged, or stalled (the paper's
+/// fixed point at its stopping rule; its last iterate, which FreeFEM reaches too, with its
+/// certificate, docs/certificate.md C4).
+fn comparable(run: Result<RunResult, RunError>) -> Result<RunResult, RunError> {
+    match run {
+        Err(RunError::Incomplete { source: SolveError::Stalled(_), partial }) => Ok(*partial),
+        other => other,
+    }
+}
+
 fn compare_single(case: &Case, dir: &Path, opts: &CompareOptions) -> Result<CompareReport, CompareError> {
     let short = opts.horizon == Horizon::Short;
     let case = if short { case.time_prefix(SHORT_STEPS) } else { case.clone() };
@@ -294,14 +307,17 @@ fn compare_single(case: &Case, dir: &Path, opts: &CompareOptions) -> Result<Comp
         let pert = NodalState { x: perturb_positions(&data.x, 11), ..data.clone() };
         let fixed_point = is_fixed_point_inverse(&case);
         let (rust, perturbed, exact) = if fixed_point {
-            let rust =
-                if short { rust_exact(&case, &data, SHORT_ITERATIONS)? } else { run_inverse(&case, &data, |_, _| {})? };
+            let rust = if short {
+                rust_exact(&case, &data, SHORT_ITERATIONS)?
+            } else {
+                comparable(run_inverse(&case, &data, |_, _| {}))?
+            };
             let n = rust.stats.iterations;
             let p = rust_exact(&case, &pert, n).map_err(|e| CompareError::Perturbed(e.into()))?;
             (rust, p, Some(n))
         } else {
-            let rust = run_inverse(&case, &data, |_, _| {})?;
-            let p = run_inverse(&case, &pert, |_, _| {}).map_err(|e| CompareError::Perturbed(e.into()))?;
+            let rust = comparable(run_inverse(&case, &data, |_, _| {}))?;
+            let p = comparable(run_inverse(&case, &pert, |_, _| {})).map_err(|e| CompareError::Perturbed(e.into()))?;
             (rust, p, None)
         };
         let ro = RunOptions { exact_iterations: exact, clip: None };
