@@ -167,21 +167,36 @@ fn newton_lambda_kappa_stall_and_its_fix() {
     }
 }
 
-/// λκ3 = 1 on eq. (64): with a one-point Λκ term the KKT matrix is singular to working
-/// precision, and the error names the cause; the one-rule gauss2 reading converges.
+/// λκ3 = 1 on eq. (64): the Λκ3 term outweighs the bending stiffness by 3.3e13; the band LU
+/// of the equilibrated Jacobian meets an exactly zero pivot there and falls back to the plain
+/// factorisation (I13). Newton then solves it to the floor in our scheme, with the κ error of
+/// λκ3 = 1e-10 (eq. 64 is planar: κ3 ≡ 0, so λκ3 changes nothing but the conditioning), as
+/// FreeFEM's UMFPACK does (35 iterations, certificate 2.1e-16), and in the gauss2 reading.
 #[test]
-fn lambda_kappa_one_is_explained_or_solved() {
+fn lambda_kappa_one_is_solved() {
     let text = edit(&case_text("inverse_bend"), "lambda_kappa = [0, 0, 1e-10]", "lambda_kappa = [0, 0, 1]");
     let text = edit(&text, "method = \"fixed_point\"", "method = \"newton\"\nwarm_start_tolerance = 1e-4");
     let text = edit(&text, "tolerance = 3e-6", "tolerance = 1e-10");
-    let err = run_rust(&case_from(&text, "lk1"), |_, _| {}).expect_err("singular");
-    let msg = common::error_chain(&err);
-    eprintln!("{msg}");
-    assert!(msg.contains("singular to working precision") && msg.contains("gauss2"), "{msg}");
-    let g2 = edit(&text, "analysis = \"inverse\"", "analysis = \"inverse\"\nquadrature = \"gauss2\"");
-    let r = run_rust(&case_from(&g2, "lk1g2"), |_, _| {}).expect("gauss2 converges");
-    eprintln!("gauss2: {} iterations, certificate {:e}", r.stats.iterations, r.stats.certificate.unwrap());
-    assert!(r.stats.certificate.unwrap() <= CERTIFICATE_FLOOR);
+    let small = edit(&text, "lambda_kappa = [0, 0, 1]", "lambda_kappa = [0, 0, 1e-10]");
+    let reference = run_rust(&case_from(&small, "lk10"), |_, _| {}).expect("λκ3 = 1e-10");
+    let k_ref = cosserat::run::metrics::inverse_metrics(&reference)["kappa_err_rel_inner"];
+    for (label, t) in [
+        ("selective", text.clone()),
+        ("gauss2", edit(&text, "analysis = \"inverse\"", "analysis = \"inverse\"\nquadrature = \"gauss2\"")),
+    ] {
+        let r = run_rust(&case_from(&t, label), |_, _| {})
+            .unwrap_or_else(|e| panic!("{label}: {}", common::error_chain(&e)));
+        let c = r.stats.certificate.unwrap();
+        let k = cosserat::run::metrics::inverse_metrics(&r)["kappa_err_rel_inner"];
+        eprintln!(
+            "λκ3 = 1, {label}: {} iterations, certificate {c:e}, κ error inner {k:.4} (λκ3 = 1e-10: {k_ref:.4})",
+            r.stats.iterations
+        );
+        assert!(c <= CERTIFICATE_FLOOR, "{label}: {c:e}");
+        if label == "selective" {
+            assert!((k / k_ref - 1.0).abs() < 1e-6, "{k} vs {k_ref}");
+        }
+    }
 }
 
 /// The fit-quality gate (C5): worm_roll_3d at 33 nodes (all 1160 frames: cut to a few dozen

@@ -34,10 +34,10 @@ use crate::case::{Analysis, Case, CompareOverrides};
 use crate::run::frames::{solve_frames, SolvedFrame};
 use crate::run::metrics::{all_metrics, differences, ComparisonRow, Difference, Group};
 use crate::run::{run_forward, run_inverse, NodalState, RunError, RunResult};
-use crate::solve::{SolveError, PLATEAU_ITERATIONS};
 use crate::solve::certificate::CERTIFICATE_FLOOR;
 use crate::solve::inverse::InverseMethod;
 use crate::solve::statics::Method;
+use crate::solve::{SolveError, PLATEAU_ITERATIONS};
 
 /// Relative size of the input perturbation that measures a case's conditioning: 450 ulps, far
 /// above the engines' own round-off and far below any physical change.
@@ -228,9 +228,11 @@ fn tolerance(d: &Difference, sens: &[Difference], tau: f64, case: &Case) -> (f64
     };
     let t = match d.group {
         Group::Iterations => 1.0 + SAFETY * sigma,
-        // a certificate is a ratio of round-off-sized residuals near a root: below ten times the
-        // floor both engines have solved the same equations, whatever the digits
-        Group::Certificate => SAFETY * (sigma + tau * value) + FLOOR_REL * value + 10.0 * CERTIFICATE_FLOOR,
+        // A certificate is relative, like a relative change: two engines stopped by a change
+        // within τ can differ by about τ in it (the residual of an iterate a change τ from the
+        // root); below ten times the floor both have solved the same equations, whatever the
+        // digits (docs/certificate.md)
+        Group::Certificate => SAFETY * (sigma + tau) + 10.0 * CERTIFICATE_FLOOR,
         Group::Metric => {
             let abs = if d.name.ends_with("_m") {
                 FLOOR_REL * case.mesh.length_m

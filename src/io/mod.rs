@@ -16,6 +16,7 @@ pub mod engine;
 pub mod files;
 pub mod freefem;
 pub mod freefem_clip;
+pub mod freefem_include;
 pub mod job;
 pub mod journal;
 pub mod npy;

@@ -85,7 +85,25 @@ impl LinearSolver {
             &mut self.rnext,
             true,
         );
-        self.factor_and_solve_scaled(b)
+        let solved = self.factor_and_solve_scaled(b);
+        self.unscaled_if_zero_pivot(solved, values, b)
+    }
+
+    /// A scaled factorisation that met an exactly zero pivot is tried once more on the matrix
+    /// as given. Scaling rows and columns by powers that differ by 1e13 can turn the small
+    /// remainder of an elimination into an exact zero that the unscaled elimination keeps
+    /// (`docs/inverse.md`, I13: eq. (64) with Λκ3 = 1, which FreeFEM's UMFPACK solves too). A
+    /// factorisation that succeeds is never redone, so results elsewhere are unchanged.
+    fn unscaled_if_zero_pivot(
+        &mut self,
+        solved: Result<DVector<f64>, LinearError>,
+        values: &[f64],
+        b: &DVector<f64>,
+    ) -> Result<DVector<f64>, LinearError> {
+        match solved {
+            Err(LinearError::ZeroPivot { .. }) => self.solve(values, b),
+            other => other,
+        }
     }
 
     /// Solve `M x = b` scaled by the row and column factors of the last
@@ -95,7 +113,8 @@ impl LinearSolver {
     /// unchanged up to round-off; these keep the pivots as well-scaled as the equilibrated ones.
     pub fn solve_rescaled(&mut self, values: &[f64], b: &DVector<f64>) -> Result<DVector<f64>, LinearError> {
         self.load(values, true);
-        self.factor_and_solve_scaled(b)
+        let solved = self.factor_and_solve_scaled(b);
+        self.unscaled_if_zero_pivot(solved, values, b)
     }
 
     /// Row factors `D_r` of the last [`LinearSolver::solve_equilibrated`].

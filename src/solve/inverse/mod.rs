@@ -435,7 +435,7 @@ impl<'p> FrameSolver<'p> {
         let one_point = self.problem.scheme.kappa().points.len() == 1;
         let cause = if ratio > 1e10 && one_point {
             format!(
-                "the curvature weight max Λκ = {:e} outweighs the bending stiffness {stiffness:e} N m² by {ratio:.1e}; integrated at one point per element (solver.quadrature = \"{}\"), the Λκ term constrains one combination of the angle rates per element and leaves the other to the bending stiffness alone, below the precision of the factorisation (docs/inverse.md, I13): use solver.quadrature = \"gauss2\" or a smaller Λκ",
+                "the curvature weight max Λκ = {:e} outweighs the bending stiffness {stiffness:e} N m² by {ratio:.1e}; integrated at one point per element (solver.quadrature = \"{}\"), the Λκ term constrains one combination of the angle rates per element and leaves the other to the bending stiffness alone, and both the equilibrated and the plain band LU lose it (docs/inverse.md, I13): use solver.quadrature = \"gauss2\" or a smaller Λκ",
                 self.params.weights.lambda_kappa.amax(),
                 self.problem.scheme.name()
             )
