@@ -239,6 +239,9 @@ fn fit_gate_flags_a_lagging_clip() {
     assert_eq!(code, Some(0));
     assert!(manifest.contains("\"status\": \"complete_with_warnings\""), "{manifest}");
     assert!(flagged >= 1000, "{flagged}");
+    // run.json counts them
+    let json: serde_json::Value = serde_json::from_str(&manifest).unwrap();
+    assert_eq!(json["certificate"]["flagged_frames"].as_u64(), Some(flagged as u64), "{manifest}");
     assert!(stderr.contains("over the fit-quality gate"), "{stderr}");
     let (code, ..) = run(&lag, "lag_strict", true);
     assert_eq!(code, Some(1));

@@ -68,6 +68,9 @@ pub struct CertificateSummary {
     pub value: f64,
     /// the tolerance a converged result meets (`solver.certificate_tolerance`)
     pub tolerance: f64,
+    /// clips: the frames over the fit-quality gate (`solve::fit`, docs/certificate.md C5)
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub flagged_frames: Option<usize>,
 }
 
 /// `run.json`.

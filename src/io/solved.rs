@@ -91,7 +91,8 @@ impl Solved {
             (_, _, Some(c)) if !c.reports.is_empty() => c.reports.iter().map(|r| r.certificate).fold(0.0, f64::max),
             _ => return None,
         };
-        Some(CertificateSummary { value, tolerance: case.certificate_tolerance() })
+        let flagged_frames = self.clip.as_ref().map(|c| c.reports.iter().filter(|r| r.fit.flagged).count());
+        Some(CertificateSummary { value, tolerance: case.certificate_tolerance(), flagged_frames })
     }
 
     /// A run that produced nothing, with its error.
