@@ -89,7 +89,7 @@ enum Command {
     /// values, status, iterations, recovery errors, objective, wall time, error message) and
     /// `convergence.svg` (log-log histories, one curve per run; Figs. 9-11 of the paper). A run
     /// that reaches its iteration limit is `not_converged`: its folder holds the last iterate
-    /// and FAILED.txt, and its curve is plotted. A clip case solves its whole clip for every
+    /// with a run.json saying failed, and its curve is plotted. A clip case solves its whole clip for every
     /// point (the folder holds the files of `run` on the clip; the summary has one row per
     /// point: frames, iterations, worst fit, tangent misfit, |j - 1|, objective). Exit status 1
     /// if any run failed or did not converge (after writing everything).
@@ -153,7 +153,11 @@ enum Command {
     #[command(hide = true)]
     BatchTask(cli::TaskArgs),
     /// Write OUT/summary.csv from the recordings' folders of a batch (after a Slurm job array).
-    Gather { out: PathBuf },
+    Gather {
+        /// Output folder of the batch (`--out` of `cosserat batch`: holds batch.json and one
+        /// folder per recording); summary.csv is written there
+        out: PathBuf,
+    },
     /// Write a corpus of synthetic 3D recordings with their ground truth.
     Synth(cli::SynthArgs),
     /// List the cases of a directory with their descriptions.

@@ -176,11 +176,26 @@ pub fn csv_text(header: &[&str], rows: impl Iterator<Item = Vec<f64>>) -> String
 
 /// CSV with empty fields where a value does not apply.
 pub fn csv_text_opt(header: &[&str], rows: impl Iterator<Item = Vec<Option<f64>>>) -> String {
+    csv_text_int(header, &[], rows)
+}
+
+/// [`csv_text_opt`] with the columns named in `integers` (iteration counts, indices, flags)
+/// written as integers (`12`, not `1.20000000000000000e1`).
+pub fn csv_text_int(header: &[&str], integers: &[&str], rows: impl Iterator<Item = Vec<Option<f64>>>) -> String {
+    let integer: Vec<bool> = header.iter().map(|h| integers.contains(h)).collect();
     let mut s = header.join(",");
     s.push('\n');
     for r in rows {
-        let line: Vec<String> = r.iter().map(|v| v.map(|v| format!("{v:.17e}")).unwrap_or_default()).collect();
-        s.push_str(&line.join(","));
+        for (k, v) in r.iter().enumerate() {
+            if k > 0 {
+                s.push(',');
+            }
+            match v {
+                Some(v) if integer.get(k).copied().unwrap_or(false) => super::number::push_integer(&mut s, *v, 17),
+                Some(v) => s.push_str(&format!("{v:.17e}")),
+                None => {}
+            }
+        }
         s.push('\n');
     }
     s

@@ -30,7 +30,7 @@ pub struct JobEnd {
     pub clip: Option<ClipRun>,
     /// clips: frames written and frames of the clip
     pub frames: Option<(usize, usize)>,
-    /// files in the folder (`run.json` excepted)
+    /// files in the folder, `run.json` included
     pub files: usize,
     /// what was done around the folder (stale staging folders), for the user
     pub notes: Vec<String>,
@@ -136,6 +136,7 @@ pub fn run_into(
     folder.manifest.frames_done = end.frames.map(|f| f.0);
     folder.manifest.frames_total = end.frames.map(|f| f.1);
     let target = folder.finish(end.status, end.message.clone())?;
-    end.files = Manifest::read(&target)?.map(|m| m.files.len()).unwrap_or(0);
+    // the manifest lists every file but itself
+    end.files = Manifest::read(&target)?.map(|m| m.files.len() + 1).unwrap_or(0);
     Ok(end)
 }

@@ -72,14 +72,31 @@ pub fn summary_csv(keys: &[String], columns: &[&str], rows: &[SummaryRow]) -> Re
     for r in rows {
         let mut rec: Vec<String> = r.point.iter().map(|(_, v)| fmt_value(*v)).collect();
         rec.push(r.status.as_str().into());
-        rec.extend(columns.iter().map(|k| {
-            r.metrics.as_ref().and_then(|m| m.get(*k)).map(|v| super::number::exp(*v, 10)).unwrap_or_default()
-        }));
+        rec.extend(
+            columns
+                .iter()
+                .map(|k| r.metrics.as_ref().and_then(|m| m.get(*k)).map(|v| summary_number(k, *v)).unwrap_or_default()),
+        );
         rec.push(r.error.as_deref().unwrap_or("").replace('\n', " "));
         w.write_record(&rec)?;
     }
     let bytes = w.into_inner().map_err(|e| csv::Error::from(e.into_error()))?;
     Ok(String::from_utf8_lossy(&bytes).into_owned())
+}
+
+/// The columns of the summary that count (iterations, frames): written as integers.
+pub const SUMMARY_INTEGER_METRICS: [&str; 3] = ["iterations", "frames", "iterations_max"];
+
+/// A value of the summary: a count of [`SUMMARY_INTEGER_METRICS`] as an integer, any other
+/// number with 10 significant digits.
+fn summary_number(column: &str, v: f64) -> String {
+    let mut s = String::new();
+    if SUMMARY_INTEGER_METRICS.contains(&column) {
+        super::number::push_integer(&mut s, v, 10);
+    } else {
+        super::number::push_exp(&mut s, v, 10);
+    }
+    s
 }
 
 /// One point of a sweep in the Rust engine, writing its folder `dir` and its `run.json`
@@ -224,11 +241,10 @@ mod tests {
         ];
         let text = summary_csv(&["lambda_l".into()], &SUMMARY_METRICS, &rows).unwrap();
         let lines: Vec<&str> = text.lines().collect();
-        assert!(lines[0].starts_with("lambda_l,status,iterations,x_err_rel"));
-        assert!(lines[1].starts_with("1e-20,ok,1.2000000000e1"));
+        assert!(lines[0].starts_with("lambda_l,status,iterations,certificate,x_err_rel"), "{}", lines[0]);
+        assert!(lines[1].starts_with("1e-20,ok,12,"), "{}", lines[1]);
         assert!(
-            lines[2].starts_with("1e3,not_converged,1.2000000000e1")
-                && lines[2].ends_with("\"did not converge, at all\""),
+            lines[2].starts_with("1e3,not_converged,12,") && lines[2].ends_with("\"did not converge, at all\""),
             "{}",
             lines[2]
         );
