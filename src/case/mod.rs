@@ -43,6 +43,8 @@ pub enum CaseError {
     Syntax { path: PathBuf, message: String },
     #[error("{path}: key `{key}`: {reason}")]
     Invalid { path: PathBuf, key: String, reason: String },
+    #[error("{}", crate::file_kind::not_regular_text(path, "case file", *kind))]
+    NotRegular { path: PathBuf, kind: crate::file_kind::FileKind },
     #[error("{path}: case file {}", too_large_text(*.size))]
     TooLarge {
         path: PathBuf,
@@ -344,15 +346,26 @@ fn too_large_text(size: Option<u64>) -> String {
     }
 }
 
-/// The text of a case file, refused above [`CASE_FILE_CAP_BYTES`]: a regular file by its size,
-/// anything else (a device, a pipe) after reading one byte more than the cap. The same rule as
-/// `crate::io::files::read_capped`, which this layer cannot import (`tests/architecture.rs`).
+/// The text of a case file, refused above [`CASE_FILE_CAP_BYTES`] by its size, and refused
+/// before it is opened unless it is a regular file (a pipe would block the open, a device
+/// never end: `crate::file_kind`). The same rule as `crate::io::files::read_capped`, which
+/// this layer cannot import (`tests/architecture.rs`).
 fn read_case_file(path: &Path) -> Result<String, CaseError> {
+    use crate::file_kind::{kind, FileKind};
     use std::io::Read;
     let io = |source| CaseError::Io { path: path.to_path_buf(), source };
     let too_large = |size| CaseError::TooLarge { path: path.to_path_buf(), size };
+    let not_regular = |kind| CaseError::NotRegular { path: path.to_path_buf(), kind };
+    match kind(path).map_err(io)? {
+        FileKind::Regular => {}
+        other => return Err(not_regular(other)),
+    }
     let file = std::fs::File::open(path).map_err(io)?;
     let meta = file.metadata().map_err(io)?;
+    if !meta.is_file() {
+        // replaced between the check and the open
+        return Err(not_regular(FileKind::of(&meta)));
+    }
     if meta.is_file() && meta.len() > CASE_FILE_CAP_BYTES {
         return Err(too_large(Some(meta.len())));
     }
@@ -476,12 +489,15 @@ frames = 4
         assert_eq!(e, format!("{}: case file of 1048577 bytes is larger than {cap}", p.display()));
         if cfg!(unix) {
             let e = Case::from_file(Path::new("/dev/zero")).unwrap_err().to_string();
-            assert_eq!(
-                e,
-                format!(
-                    "/dev/zero: case file is not a regular file and did not end within {cap}: reading stopped there"
-                )
-            );
+            assert!(e.starts_with("/dev/zero: the case file is a character device, not a regular file"), "{e}");
+            // a named pipe with no writer: refused at once, never opened (the open would block)
+            let fifo = dir.path().join("pipe.toml");
+            if std::process::Command::new("mkfifo").arg(&fifo).status().is_ok_and(|s| s.success()) {
+                let e = Case::from_file(&fifo).unwrap_err().to_string();
+                assert!(e.contains("is a named pipe (FIFO), not a regular file"), "{e}");
+            }
+            let e = Case::from_file(dir.path()).unwrap_err().to_string();
+            assert!(e.contains("the case file is a folder"), "{e}");
         }
     }
 

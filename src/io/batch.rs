@@ -17,7 +17,7 @@ use std::time::Instant;
 use super::compact::OutputFormat;
 use super::engine::ClipOptions;
 use super::files::{write_atomic, OutputError};
-use super::run_folder::{input_file, sha256_file, FolderError, InputFile, Manifest, Mode, RunFolder, Status};
+use super::run_folder::{input_file_as, sha256_file, FolderError, InputFile, Manifest, Mode, RunFolder, Status};
 use super::solved::{chain, solve_into, RunStatus};
 use super::truth_file::{is_truth_sidecar, truth_sidecar};
 use crate::case::{Analysis, Case, CaseError, DataSource};
@@ -65,6 +65,8 @@ pub enum BatchError {
     NotAClip(String),
     #[error(transparent)]
     Folder(#[from] FolderError),
+    #[error(transparent)]
+    Input(#[from] super::files::InputError),
     #[error(transparent)]
     Output(#[from] OutputError),
     #[error("{path}: {reason}")]
@@ -147,11 +149,15 @@ fn read_err(path: &Path) -> impl Fn(std::io::Error) -> BatchError + '_ {
     move |source| BatchError::Read { path: path.to_path_buf(), source }
 }
 
-/// Is `path` a recording by its name (`.csv` or `.npy`, not a truth sidecar)?
+/// Is `path` a recording by its name (`.csv` or `.npy`, not a truth sidecar, not a folder)?
+/// A pipe or device of that name is one: its row fails, saying what it is.
 fn is_recording(path: &Path) -> bool {
     let ext = path.extension().and_then(|e| e.to_str());
-    matches!(ext, Some("csv") | Some("npy")) && !is_truth_sidecar(path) && path.is_file()
+    matches!(ext, Some("csv") | Some("npy")) && !is_truth_sidecar(path) && !path.is_dir()
 }
+
+/// Largest list of recordings read [bytes]: 16 MiB, some 100 000 paths.
+const LIST_FILE_CAP_BYTES: u64 = 16 << 20;
 
 /// The recordings of `input`: the `.csv` and `.npy` files of a folder (sorted by name; truth
 /// sidecars excepted), or the lines of a list file (paths relative to the list's folder;
@@ -167,7 +173,7 @@ pub fn list_recordings(input: &Path) -> Result<Vec<PathBuf>, BatchError> {
         }
         out.sort();
     } else {
-        let text = std::fs::read_to_string(input).map_err(read_err(input))?;
+        let text = super::files::read_capped_text(input, LIST_FILE_CAP_BYTES, "list of recordings")?;
         let base = input.parent().unwrap_or(Path::new(""));
         out = text
             .lines()
@@ -299,10 +305,10 @@ fn recording_manifest(
     });
     m.case_name = Some(case.name.clone());
     m.case = Some(case_file.clone());
-    m.inputs.push(input_file(recording)?);
+    m.inputs.push(input_file_as(recording, "recording")?);
     let sidecar = truth_sidecar(recording);
     if sidecar.is_file() {
-        m.inputs.push(input_file(&sidecar)?);
+        m.inputs.push(input_file_as(&sidecar, "ground-truth sidecar")?);
     }
     m.engine = Some(Engine::Rust.to_string());
     m.frames_done = Some(0);

@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 
 use super::compact::OutputFormat;
 use super::engine::ClipOptions;
-use super::run_folder::{input_file, FolderError, Manifest, Mode, RunFolder, Status};
+use super::run_folder::{input_file_as, FolderError, InputFile, Manifest, Mode, RunFolder, Status};
 pub use super::solved::case_label;
 use super::solved::solve_into;
 use crate::case::Case;
@@ -91,16 +91,32 @@ impl JobEnd {
 pub fn run_manifest(case: &Case, engine: Engine) -> Result<Manifest, FolderError> {
     let mut m = Manifest::new("run");
     m.case_name = Some(case.name.clone());
-    m.case = case.source.as_deref().map(input_file).transpose()?;
-    if let Some(c) = case.clip() {
+    m.case = case.source.as_deref().map(|p| input_file_as(p, "case file")).transpose()?;
+    m.inputs = case_inputs(case)?;
+    if case.clip().is_some() {
         // a clip's folder counts frames from the start (what makes it resumable)
         m.frames_done = Some(0);
-        if c.file.is_file() {
-            m.inputs.push(input_file(&c.file)?);
-        }
     }
     m.engine = Some(engine.to_string());
     Ok(m)
+}
+
+/// The files a case reads besides its case file, with their SHA-256: a clip's file (the
+/// recording, or the kymogram of a kymogram or `roll_3d` clip) and a recording's ground-truth
+/// sidecar. A file that is there but is not a regular file (a pipe, a device, a folder) is
+/// refused here, before any folder is claimed; a missing one is left to the run, whose error
+/// names it.
+pub fn case_inputs(case: &Case) -> Result<Vec<InputFile>, FolderError> {
+    let mut inputs = Vec::new();
+    let Some(c) = case.clip() else { return Ok(inputs) };
+    if std::fs::metadata(&c.file).is_ok() {
+        inputs.push(input_file_as(&c.file, "clip file")?);
+        let sidecar = super::truth_file::truth_sidecar(&c.file);
+        if c.kind == crate::case::ClipKind::Recording && sidecar.is_file() {
+            inputs.push(input_file_as(&sidecar, "ground-truth sidecar")?);
+        }
+    }
+    Ok(inputs)
 }
 
 /// Run `case` in `engine` into the folder `out` ([`Mode`]: fresh, or resuming a clip; a clip's

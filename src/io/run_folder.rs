@@ -117,6 +117,8 @@ pub enum FolderError {
     },
     #[error("{path}: {reason}")]
     Manifest { path: PathBuf, reason: String },
+    #[error(transparent)]
+    Input(#[from] super::files::InputError),
 }
 
 fn io_err(path: &Path) -> impl Fn(std::io::Error) -> FolderError + '_ {
@@ -133,6 +135,14 @@ pub fn sha256_file(path: &Path) -> std::io::Result<String> {
 
 /// An input file with its hash.
 pub fn input_file(path: &Path) -> Result<InputFile, FolderError> {
+    input_file_as(path, "input file")
+}
+
+/// The input file `path` (`what` names it in messages: "clip file", "recording") with its
+/// hash; anything but a regular file is refused before it is opened (a pipe's open would
+/// block: `super::files::check_regular`).
+pub fn input_file_as(path: &Path, what: &'static str) -> Result<InputFile, FolderError> {
+    super::files::check_regular(path, what)?;
     Ok(InputFile { path: path.display().to_string(), sha256: sha256_file(path).map_err(io_err(path))? })
 }
 

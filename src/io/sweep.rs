@@ -127,7 +127,7 @@ pub fn point_manifest(command: &str, case: &Case, point: &Point) -> Manifest {
     let mut m = Manifest::new(command);
     m.case_name = Some(case.name.clone());
     m.case = case.source.as_deref().and_then(|p| input_file(p).ok());
-    m.inputs = case.clip().and_then(|c| input_file(&c.file).ok()).into_iter().collect();
+    m.inputs = super::job::case_inputs(case).unwrap_or_default();
     m.settings = point.iter().cloned().collect();
     m.engine = Some("rust".into());
     m
