@@ -28,6 +28,7 @@ fn batch_runs_every_recording_fails_the_bad_one_alone_and_resumes() {
             "status",
             "frames",
             "newton_iterations_per_frame",
+            "certificate_max",
             "fit_x_err_rel_max",
             "curvature_err_rel_max",
             "reason"
@@ -36,17 +37,17 @@ fn batch_runs_every_recording_fails_the_bad_one_alone_and_resumes() {
     assert_eq!(rows.len(), GOOD + 2, "{rows:?}");
     let bad = &rows[1];
     assert_eq!((bad[1].as_str(), bad[2].as_str()), ("bad", "failed"), "{bad:?}");
-    assert!(bad[7].contains("bad.csv") && bad[7].contains("not finite"), "reason: {}", bad[7]);
+    assert!(bad[8].contains("bad.csv") && bad[8].contains("not finite"), "reason: {}", bad[8]);
     for r in &rows[2..] {
         assert_eq!(r[2], "ok", "{r:?}");
         assert_eq!(r[3], FRAMES.to_string(), "{r:?}");
         let num = |k: usize| r[k].parse::<f64>().unwrap_or_else(|_| panic!("column {k} of {r:?}"));
         assert!(num(4) >= 1.0 && num(4) < 20.0, "Newton iterations per frame: {r:?}");
-        assert!(num(5) < 1e-2, "fit: {r:?}");
+        assert!(num(6) < 1e-2, "fit: {r:?}");
         // the truth sidecar is read: the recovered bending of the noisy recording (noise 1e-7 m,
         // 0.3 % of an element) within 30 % of the truth's in the worst frame
-        assert!(num(6) > 0.0 && num(6) < 0.3, "curvature error against the truth: {r:?}");
-        assert!(r[7].is_empty(), "{r:?}");
+        assert!(num(7) > 0.0 && num(7) < 0.3, "curvature error against the truth: {r:?}");
+        assert!(r[8].is_empty(), "{r:?}");
         let folder = out.join(&r[1]);
         let manifest = std::fs::read_to_string(folder.join("run.json")).expect("run.json");
         assert!(manifest.contains("\"status\": \"complete\"") && manifest.contains("\"command\": \"batch\""));

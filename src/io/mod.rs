@@ -14,6 +14,7 @@ pub mod corpus;
 pub mod data;
 pub mod engine;
 pub mod files;
+pub mod folder_lock;
 pub mod freefem;
 pub mod freefem_clip;
 pub mod job;

@@ -1,18 +1,23 @@
 //! The output-folder contract. Every command that writes results (`run`, `sweep`, `compare`,
-//! `audit`) writes them into a staging folder beside its output folder, `.NAME.staging-PID`,
-//! and `run.json` there says what the folder is: the command, the case and the SHA-256 of its
-//! file and inputs, the engine, the program version, the status (`running`, `complete`,
-//! `failed`, `interrupted`), the frames done and the files written. When the run ends — complete,
-//! failed or interrupted — the staging folder replaces the output folder whole (two renames in
-//! one parent), so a folder never mixes two runs and never holds stale files, and a run killed
-//! outright leaves the previous folder untouched (its staging folder is removed, or resumed, by
-//! the next run). A folder holding files but no `run.json` is not replaced unless `--force`.
+//! `audit`, each recording of `batch`) writes them into a staging folder beside its output
+//! folder, `.NAME.staging-PID`, and `run.json` there says what the folder is: the command, the
+//! case and the SHA-256 of its file and inputs, the engine, the program version, the status
+//! (`running`, `complete`, `failed`, `interrupted`), the frames done and the files written.
+//! When the run ends — complete, failed or interrupted — the staging folder takes the output
+//! folder's place in one exchange of names, so a folder never mixes two runs, never holds stale
+//! files, and a run killed at any moment leaves the output folder either as it was or whole and
+//! new. One run writes a folder at a time ([`super::folder_lock`]); what a killed run left is
+//! removed, or resumed, by the next run. `--resume` continues in a staging folder of its own (a
+//! copy of the output folder, or the staging folder of a killed run), so the previous folder
+//! stays in place until the resumed run ends. A folder holding files but no `run.json` is not
+//! replaced unless `--force`.
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use sha2::{Digest, Sha256};
 
 use super::files::write_atomic;
+use super::folder_lock::{FolderLock, LockError};
 
 /// File name of the manifest in an output folder.
 pub const MANIFEST: &str = "run.json";
@@ -105,8 +110,11 @@ pub enum FolderError {
     Foreign { path: PathBuf, examples: String },
     #[error("{path}: refusing to replace the working folder, one of its parents or the root; choose a folder for the results")]
     Dangerous { path: PathBuf },
-    #[error("{path} is being written by another cosserat process (pid {pid}, run.json status running)")]
-    Busy { path: PathBuf, pid: u32 },
+    #[error(
+        "{path} is being written by another cosserat process ({}): one run writes a folder at a time; wait for it to end, or choose another --out",
+        pid.map_or("its pid not yet known".to_string(), |p| format!("pid {p}"))
+    )]
+    Busy { path: PathBuf, pid: Option<u32> },
     #[error("{path}: cannot resume: {reason}")]
     CannotResume { path: PathBuf, reason: String },
     #[error("{path}")]
@@ -244,7 +252,8 @@ pub enum Mode {
 }
 
 /// An output folder being written: the run writes into [`RunFolder::dir`] (the staging folder)
-/// and [`RunFolder::finish`] puts it in place.
+/// and [`RunFolder::finish`] puts it in place. The folder's lock ([`super::folder_lock`]) is
+/// held from [`RunFolder::begin`] until the `RunFolder` is dropped.
 #[derive(Debug)]
 pub struct RunFolder {
     target: PathBuf,
@@ -254,10 +263,8 @@ pub struct RunFolder {
     pub resumed: Option<Manifest>,
     /// what was done to the folder's surroundings (stale staging folders removed), for the user
     pub notes: Vec<String>,
-}
-
-fn pid_alive(pid: u32) -> bool {
-    pid == std::process::id() || Path::new(&format!("/proc/{pid}")).exists()
+    /// one writer per folder
+    _lock: FolderLock,
 }
 
 /// Is `path` the working folder, one of its parents, or the root?
@@ -267,8 +274,124 @@ fn dangerous(path: &Path) -> bool {
     abs.parent().is_none() || cwd.is_some_and(|c| c.starts_with(&abs))
 }
 
+/// A staging folder `.NAME.staging-PID` left beside an output folder by a run that ended
+/// before it put it in place (killed, or stopped by a full disk).
+#[derive(Debug)]
+struct Leftover {
+    dir: PathBuf,
+    pid: u32,
+    manifest: Option<Manifest>,
+}
+
+impl Leftover {
+    /// Does it hold the work of a run that did not end normally? Its `run.json` says running
+    /// (killed while it ran), or was written by the process of its name (ended by a full disk:
+    /// kept to be resumed). A folder that replaced the output folder in the swap at the end of
+    /// a run holds the previous output folder (finished, written by another process) for an
+    /// instant, and is no run's work.
+    fn in_progress(&self) -> bool {
+        self.manifest.as_ref().is_some_and(|m| m.status == Status::Running || m.pid == self.pid)
+    }
+}
+
+/// What runs that ended before putting `NAME` in place left in `parent`: their staging folders,
+/// and the folders of an interrupted swap (`.NAME.swap-PID`, `.NAME.old-PID`), which hold
+/// nothing to keep.
+fn leftovers(parent: &Path, name: &str) -> Result<(Vec<Leftover>, Vec<PathBuf>), FolderError> {
+    let (staging, others) = (format!(".{name}.staging-"), [format!(".{name}.swap-"), format!(".{name}.old-")]);
+    let pid_after = |n: &str, prefix: &str| n.strip_prefix(prefix).and_then(|p| p.parse::<u32>().ok());
+    let (mut stagings, mut rest) = (Vec::new(), Vec::new());
+    for entry in std::fs::read_dir(parent).map_err(io_err(parent))? {
+        let entry = entry.map_err(io_err(parent))?;
+        let n = entry.file_name().to_string_lossy().into_owned();
+        if let Some(pid) = pid_after(&n, &staging) {
+            // an unreadable run.json is no run's work
+            let manifest = Manifest::read(&entry.path()).ok().flatten();
+            stagings.push(Leftover { dir: entry.path(), pid, manifest });
+        } else if others.iter().any(|p| pid_after(&n, p).is_some()) {
+            rest.push(entry.path());
+        }
+    }
+    stagings.sort_by(|a, b| a.dir.cmp(&b.dir));
+    Ok((stagings, rest))
+}
+
+/// Converged frames in the resume journal of `dir` (0 without one).
+fn journal_frames(dir: &Path) -> usize {
+    super::journal::read_journal(dir).map(|(entries, _)| entries.len()).unwrap_or(0)
+}
+
+/// Where a resumed run continues from.
+enum ResumeSource {
+    /// a staging folder left by a run that was killed (or stopped by a full disk): adopted
+    Leftover(usize),
+    /// the output folder itself: copied, so that it stays in place until the resumed run ends
+    Target,
+}
+
+/// The run that `--resume` continues: among the left staging folders in progress and the
+/// output folder, those that `new` may continue ([`check_resumable`]), the one with the most
+/// converged frames (a left folder on a tie: it is taken over, not copied).
+fn resume_source(
+    target: &Path,
+    old: Option<&Manifest>,
+    left: &[Leftover],
+    new: &Manifest,
+) -> Result<(ResumeSource, Manifest), FolderError> {
+    let cannot = |reason: String| FolderError::CannotResume { path: target.to_path_buf(), reason };
+    let mut best: Option<(usize, ResumeSource, Manifest)> = None;
+    for (i, l) in left.iter().enumerate().filter(|(_, l)| l.in_progress()) {
+        let m = l.manifest.clone().unwrap_or_else(|| new.clone());
+        if check_resumable(&m, new).is_ok() {
+            let frames = journal_frames(&l.dir);
+            if best.as_ref().is_none_or(|b| frames > b.0) {
+                best = Some((frames, ResumeSource::Leftover(i), m));
+            }
+        }
+    }
+    let target_reason = match old {
+        None => "it holds no run.json (no run to resume)".to_string(),
+        Some(m) => match check_resumable(m, new) {
+            Ok(()) => {
+                let frames = journal_frames(target);
+                if best.as_ref().is_none_or(|b| frames > b.0) {
+                    best = Some((frames, ResumeSource::Target, m.clone()));
+                }
+                String::new()
+            }
+            Err(reason) => reason,
+        },
+    };
+    best.map(|(_, source, m)| (source, m)).ok_or_else(|| cannot(target_reason))
+}
+
+/// Copy the folder `from` into the new folder `to` (files and subfolders; `run.json` at the
+/// top excepted: the run writes its own).
+fn copy_run(from: &Path, to: &Path) -> Result<(), FolderError> {
+    fn copy(from: &Path, to: &Path, top: bool) -> Result<(), FolderError> {
+        std::fs::create_dir(to).map_err(io_err(to))?;
+        for entry in std::fs::read_dir(from).map_err(io_err(from))? {
+            let entry = entry.map_err(io_err(from))?;
+            let (src, dst) = (entry.path(), to.join(entry.file_name()));
+            if entry.file_type().map_err(io_err(&src))?.is_dir() {
+                copy(&src, &dst, false)?;
+            } else if !(top && entry.file_name() == MANIFEST) {
+                std::fs::copy(&src, &dst).map_err(io_err(&dst))?;
+            }
+        }
+        Ok(())
+    }
+    copy(from, to, true).inspect_err(|_| {
+        let _ = std::fs::remove_dir_all(to);
+    })
+}
+
 impl RunFolder {
-    /// Start a run whose results go to `target`, described by `manifest` (status running).
+    /// Start a run whose results go to `target`, described by `manifest` (status running):
+    /// take the folder's lock (refused at once if another run holds it), clear what runs that
+    /// ended early left beside it, and make the staging folder: empty, or for `--resume` the
+    /// run being continued (a killed run's staging folder taken over, or a copy of the output
+    /// folder, which stays in place until this run ends).
     pub fn begin(target: &Path, mut manifest: Manifest, mode: Mode) -> Result<RunFolder, FolderError> {
         let name = target
             .file_name()
@@ -287,28 +410,15 @@ impl RunFolder {
             }
         }
         std::fs::create_dir_all(&parent).map_err(io_err(&parent))?;
+        let lock = FolderLock::acquire(&parent, &name).map_err(|e| match e {
+            LockError::Held { pid } => FolderError::Busy { path: target.to_path_buf(), pid },
+            LockError::Io { path, source } => FolderError::Io { path, source },
+        })?;
         let staging = parent.join(format!(".{name}.staging-{}", std::process::id()));
         let mut notes = Vec::new();
-        // Staging folders of runs that were killed: the newest may be resumed, the rest go.
-        let prefix = format!(".{name}.staging-");
-        let mut stale: Vec<(std::time::SystemTime, PathBuf)> = Vec::new();
-        for entry in std::fs::read_dir(&parent).map_err(io_err(&parent))? {
-            let entry = entry.map_err(io_err(&parent))?;
-            let n = entry.file_name().to_string_lossy().into_owned();
-            if let Some(pid) = n.strip_prefix(&prefix).and_then(|p| p.parse::<u32>().ok()) {
-                if !pid_alive(pid) {
-                    let t = entry.metadata().and_then(|m| m.modified()).unwrap_or(std::time::UNIX_EPOCH);
-                    stale.push((t, entry.path()));
-                }
-            }
-        }
-        stale.sort();
+        // holding the lock, every staging folder of NAME is a run's that has ended
+        let (mut left, others) = leftovers(&parent, &name)?;
         let old = Manifest::read(target)?;
-        if let Some(m) = &old {
-            if m.status == Status::Running && pid_alive(m.pid) {
-                return Err(FolderError::Busy { path: target.to_path_buf(), pid: m.pid });
-            }
-        }
         let resumed = match mode {
             Mode::Fresh { force } => {
                 let files = if target.is_dir() { list_entries(target)? } else { Vec::new() };
@@ -324,36 +434,37 @@ impl RunFolder {
                 None
             }
             Mode::Resume => {
-                // the run to continue: a killed run's staging folder, else the folder itself
-                let (source, previous) = match stale.pop() {
-                    Some((_, dir)) => {
-                        let m = Manifest::read(&dir)?;
+                let (source, previous) = resume_source(target, old.as_ref(), &left, &manifest)?;
+                match source {
+                    ResumeSource::Leftover(i) => {
+                        let dir = left.remove(i).dir;
+                        if dir != staging {
+                            std::fs::rename(&dir, &staging).map_err(io_err(&dir))?;
+                        }
                         notes.push(format!("resuming the run that was stopped while writing {}", dir.display()));
-                        (dir, m)
                     }
-                    None => (target.to_path_buf(), old.clone()),
-                };
-                let cannot = |reason: String| FolderError::CannotResume { path: target.to_path_buf(), reason };
-                let previous = previous.ok_or_else(|| cannot("it holds no run.json (no run to resume)".into()))?;
-                check_resumable(&previous, &manifest).map_err(cannot)?;
-                std::fs::rename(&source, &staging).map_err(io_err(&source))?;
+                    ResumeSource::Target => {
+                        if let Some(i) = left.iter().position(|l| l.dir == staging) {
+                            let dir = left.remove(i).dir;
+                            std::fs::remove_dir_all(&dir).map_err(io_err(&dir))?;
+                        }
+                        copy_run(target, &staging)?;
+                    }
+                }
                 manifest.started_unix_s = previous.started_unix_s;
                 Some(previous)
             }
         };
-        for (_, dir) in stale {
+        for dir in left.into_iter().map(|l| l.dir).chain(others) {
             std::fs::remove_dir_all(&dir).map_err(io_err(&dir))?;
-            notes.push(format!("removed {}, left by a run that was killed", dir.display()));
+            notes.push(format!("removed {}, left by a run that ended before its folder was in place", dir.display()));
         }
         if resumed.is_none() {
-            if staging.exists() {
-                std::fs::remove_dir_all(&staging).map_err(io_err(&staging))?;
-            }
             std::fs::create_dir_all(&staging).map_err(io_err(&staging))?;
         }
         manifest.status = Status::Running;
         manifest.write(&staging)?;
-        Ok(RunFolder { target: target.to_path_buf(), staging, manifest, resumed, notes })
+        Ok(RunFolder { target: target.to_path_buf(), staging, manifest, resumed, notes, _lock: lock })
     }
 
     /// Where the run writes (the staging folder).
@@ -367,30 +478,60 @@ impl RunFolder {
     }
 
     /// End the run as `status`: `run.json` written with the files, then the staging folder put
-    /// in place of the output folder (the previous one removed). Returns the output folder.
+    /// in place of the output folder in one step ([`put_in_place`]), the previous one removed
+    /// after. Returns the output folder.
     pub fn finish(mut self, status: Status, message: Option<String>) -> Result<PathBuf, FolderError> {
         self.manifest.finish(&self.staging, status, message)?;
-        let parent = self.staging.parent().unwrap_or(Path::new(".")).to_path_buf();
-        let old = parent.join(format!(
-            ".{}.old-{}",
-            self.target.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default(),
-            std::process::id()
-        ));
-        let had_old = self.target.exists();
-        if had_old {
-            std::fs::rename(&self.target, &old).map_err(io_err(&self.target))?;
-        }
-        if let Err(source) = std::fs::rename(&self.staging, &self.target) {
-            if had_old {
-                let _ = std::fs::rename(&old, &self.target);
-            }
-            return Err(FolderError::Io { path: self.staging.clone(), source });
-        }
-        if had_old {
-            std::fs::remove_dir_all(&old).map_err(io_err(&old))?;
-        }
+        put_in_place(&self.staging, &self.target)?;
         Ok(self.target.clone())
     }
+}
+
+/// Put the folder `staging` in place of `target`. Where `target` exists, the two are exchanged
+/// in one system call (`renameat2(RENAME_EXCHANGE)`, Linux 3.15; so a kill at any moment leaves
+/// `target` either the previous folder or the new one) and the previous folder, now at
+/// `staging`, is removed. Where the file system cannot exchange (NFS), it takes two renames,
+/// between which `target` is briefly absent.
+fn put_in_place(staging: &Path, target: &Path) -> Result<(), FolderError> {
+    if std::fs::symlink_metadata(target).is_err() {
+        return std::fs::rename(staging, target).map_err(io_err(staging));
+    }
+    match exchange(staging, target) {
+        Ok(()) => {
+            // the previous folder; a failure here leaves it to the next run (a leftover)
+            let _ = std::fs::remove_dir_all(staging);
+            Ok(())
+        }
+        Err(e) if matches!(e.raw_os_error(), Some(code) if EXCHANGE_UNSUPPORTED.contains(&code)) => {
+            let name = target.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+            let parent = staging.parent().unwrap_or(Path::new("."));
+            let old = parent.join(format!(".{name}.swap-{}", std::process::id()));
+            std::fs::rename(target, &old).map_err(io_err(target))?;
+            if let Err(source) = std::fs::rename(staging, target) {
+                let _ = std::fs::rename(&old, target);
+                return Err(FolderError::Io { path: staging.to_path_buf(), source });
+            }
+            let _ = std::fs::remove_dir_all(&old);
+            Ok(())
+        }
+        Err(source) => Err(FolderError::Io { path: target.to_path_buf(), source }),
+    }
+}
+
+/// `errno` of a file system or kernel that cannot exchange two names: EINVAL, ENOSYS,
+/// EOPNOTSUPP.
+const EXCHANGE_UNSUPPORTED: [i32; 3] = [22, 38, 95];
+
+/// Exchange the names `a` and `b` atomically.
+#[cfg(target_os = "linux")]
+fn exchange(a: &Path, b: &Path) -> std::io::Result<()> {
+    use rustix::fs::{renameat_with, RenameFlags, CWD};
+    renameat_with(CWD, a, CWD, b, RenameFlags::EXCHANGE).map_err(std::io::Error::from)
+}
+
+#[cfg(not(target_os = "linux"))]
+fn exchange(_: &Path, _: &Path) -> std::io::Result<()> {
+    Err(std::io::Error::from_raw_os_error(EXCHANGE_UNSUPPORTED[1]))
 }
 
 /// The names in a folder.
