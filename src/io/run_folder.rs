@@ -340,7 +340,7 @@ fn resume_source(
 ) -> Result<(ResumeSource, Manifest), FolderError> {
     let cannot = |reason: String| FolderError::CannotResume { path: target.to_path_buf(), reason };
     let mut best: Option<(usize, ResumeSource, Manifest)> = None;
-    for (i, l) in left.iter().enumerate().filter(|(_, l)| l.in_progress()) {
+    for (i, l) in left.iter().enumerate() {
         let m = l.manifest.clone().unwrap_or_else(|| new.clone());
         if check_resumable(&m, new).is_ok() {
             let frames = journal_frames(&l.dir);
@@ -416,8 +416,13 @@ impl RunFolder {
         })?;
         let staging = parent.join(format!(".{name}.staging-{}", std::process::id()));
         let mut notes = Vec::new();
-        // holding the lock, every staging folder of NAME is a run's that has ended
-        let (mut left, others) = leftovers(&parent, &name)?;
+        // Holding the lock, every staging folder of NAME is a run's that has ended. What holds
+        // no run's work goes at once; a killed run's work stays until it is resumed or replaced.
+        let (left, others) = leftovers(&parent, &name)?;
+        let (mut left, garbage): (Vec<_>, Vec<_>) = left.into_iter().partition(Leftover::in_progress);
+        for dir in garbage.into_iter().map(|l| l.dir).chain(others) {
+            std::fs::remove_dir_all(&dir).map_err(io_err(&dir))?;
+        }
         let old = Manifest::read(target)?;
         let resumed = match mode {
             Mode::Fresh { force } => {
@@ -455,7 +460,7 @@ impl RunFolder {
                 Some(previous)
             }
         };
-        for dir in left.into_iter().map(|l| l.dir).chain(others) {
+        for dir in left.into_iter().map(|l| l.dir) {
             std::fs::remove_dir_all(&dir).map_err(io_err(&dir))?;
             notes.push(format!("removed {}, left by a run that ended before its folder was in place", dir.display()));
         }
