@@ -309,6 +309,9 @@ fn cmd_run(
             end.message.unwrap_or_default(),
             dir.display()
         ),
+        Status::Failed | Status::Running if end.disk_full.is_some() => {
+            anyhow::bail!("{}{}", end.message.clone().unwrap_or_default(), full_disk_note(&end, path, &dir))
+        }
         Status::Failed | Status::Running => {
             let kept = match end.frames {
                 Some((n, _)) if n > 0 => format!(
@@ -321,6 +324,20 @@ fn cmd_run(
         }
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// What a run stopped by a full disk left, and how to go on.
+fn full_disk_note(end: &cosserat::io::job::JobEnd, case: &Path, dir: &Path) -> String {
+    let previous = format!("\n{} is left as it was", dir.display());
+    match (&end.disk_full, end.frames) {
+        (Some(Some(staging)), Some((n, _))) => format!(
+            "{previous}. The {n} converged frames are kept in {}: free some space, then `cosserat run {} --out {} --resume` continues from them (or remove that folder to free its space)",
+            staging.display(),
+            case.display(),
+            dir.display()
+        ),
+        _ => format!("{previous}; nothing of this run was kept (its staging folder is removed)"),
+    }
 }
 
 /// `--count`: a positive number.
@@ -432,6 +449,16 @@ fn cmd_sweep(
     pb.finish_and_clear();
     let rows = match result {
         Ok(rows) => rows,
+        Err(e) if cosserat::io::disk::is_full(&e) => {
+            folder.abandon();
+            anyhow::bail!(
+                "{}: sweep: {}: {}\n{} is left as it was; nothing of this sweep was kept (its staging folder is removed)",
+                case_label(&case),
+                cosserat::io::disk::full_text(&target),
+                cosserat::io::sweep::chain(&e),
+                target.display()
+            );
+        }
         Err(e) => {
             let message = cosserat::io::sweep::chain(&e);
             folder.finish(Status::Failed, Some(message.clone()))?;

@@ -371,6 +371,11 @@ pub fn run_recording(case: &Case, case_file: &InputFile, entry: &PlanEntry, out:
     };
     let clip = ClipOptions { journal: true, resume: false, format };
     let solved = solve_into(&case, Engine::Rust, folder.dir(), clip, |_| {}, |_, _| {});
+    if solved.disk_full {
+        // the recording's previous folder stays; its staging folder goes, freeing its space
+        folder.abandon();
+        return failed(format!("{}: {}", super::disk::full_text(&dir), solved.error.unwrap_or_default()));
+    }
     let metrics = solved.clip.as_ref().filter(|c| !c.reports.is_empty()).map(|c| clip_metrics(&case, c));
     let get = |k: &str| metrics.as_ref().and_then(|m| m.get(k)).copied();
     let row = BatchRow {

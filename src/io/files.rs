@@ -28,6 +28,9 @@ pub enum OutputError {
     },
     #[error("cannot write {path}: {reason}")]
     Invalid { path: PathBuf, reason: String },
+    /// a part of the output (a sweep's point) could not be written for want of space
+    #[error("{path}: {message}")]
+    DiskFull { path: PathBuf, message: String },
 }
 
 /// Errors reading an input file; each names the file and, where it applies, the row, frame,

@@ -58,7 +58,8 @@ impl FolderLock {
             if !still_at(&file, &path) {
                 continue; // removed by the run that held it before us: lock the new file
             }
-            file.set_len(0).and_then(|_| file.write_all(std::process::id().to_string().as_bytes())).map_err(io)?;
+            // the pid is for the message of a refused run; a full disk may refuse it: no matter
+            let _ = file.set_len(0).and_then(|_| file.write_all(std::process::id().to_string().as_bytes()));
             return Ok(FolderLock { path, file });
         }
     }

@@ -34,6 +34,9 @@ pub struct JobEnd {
     pub files: usize,
     /// what was done around the folder (stale staging folders), for the user
     pub notes: Vec<String>,
+    /// a run stopped by a full disk: the output folder is the previous one, and this staging
+    /// folder keeps the converged frames of a clip for `--resume` (`None`: nothing was kept)
+    pub disk_full: Option<Option<PathBuf>>,
 }
 
 impl JobEnd {
@@ -85,6 +88,22 @@ impl JobEnd {
         );
         out
     }
+}
+
+/// A run stopped by a full disk leaves the output folder `out` as it was: the converged frames
+/// of a clip stay in its staging folder, which `--resume` continues once there is space; a
+/// run with nothing to keep removes it (and so frees its space).
+fn stopped_by_full_disk(folder: RunFolder, mut end: JobEnd, out: &Path) -> JobEnd {
+    end.status = Status::Failed;
+    end.message = Some(format!("{}: {}", super::disk::full_text(out), end.message.unwrap_or_default()));
+    end.disk_full = Some(match end.frames {
+        Some((n, _)) if n > 0 => Some(folder.keep_staging(Status::Failed, end.message.clone())),
+        _ => {
+            folder.abandon();
+            None
+        }
+    });
+    end
 }
 
 /// The `run.json` of `cosserat run` on `case` in `engine`.
@@ -140,6 +159,7 @@ pub fn run_into(
         frames: None,
         files: 0,
         notes: std::mem::take(&mut folder.notes),
+        disk_full: None,
     };
     let clip = ClipOptions { journal: true, resume: mode == Mode::Resume, format };
     let solved = solve_into(case, engine, &dir, clip, |_| {}, progress);
@@ -151,6 +171,9 @@ pub fn run_into(
     end.frames = solved.frames;
     folder.manifest.frames_done = end.frames.map(|f| f.0);
     folder.manifest.frames_total = end.frames.map(|f| f.1);
+    if solved.disk_full {
+        return Ok(stopped_by_full_disk(folder, end, out));
+    }
     let target = folder.finish(end.status, end.message.clone())?;
     // the manifest lists every file but itself
     end.files = Manifest::read(&target)?.map(|m| m.files.len() + 1).unwrap_or(0);

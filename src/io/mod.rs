@@ -12,6 +12,7 @@ pub mod compact;
 pub mod compare;
 pub mod corpus;
 pub mod data;
+pub mod disk;
 pub mod engine;
 pub mod files;
 pub mod folder_lock;

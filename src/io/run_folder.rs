@@ -482,6 +482,21 @@ impl RunFolder {
         &self.target
     }
 
+    /// End a run that the disk could not hold without touching the output folder: the staging
+    /// folder stays where it is, to be resumed (its `run.json` says `status` with `message` and
+    /// the frames done where there is room to write it; otherwise it still says running, which
+    /// `--resume` takes the same way). Returns the staging folder.
+    pub fn keep_staging(mut self, status: Status, message: Option<String>) -> PathBuf {
+        let _ = self.manifest.finish(&self.staging, status, message);
+        self.staging.clone()
+    }
+
+    /// End a run whose staging folder holds nothing worth keeping (a full disk before any
+    /// result): it is removed, and the output folder is left as it was.
+    pub fn abandon(self) {
+        let _ = std::fs::remove_dir_all(&self.staging);
+    }
+
     /// End the run as `status`: `run.json` written with the files, then the staging folder put
     /// in place of the output folder in one step ([`put_in_place`]), the previous one removed
     /// after. Returns the output folder.

@@ -186,6 +186,7 @@ pub fn sweep_into(
             })
             .collect()
     });
+    stop_if_disk_full(dir, &results)?;
     let rows: Vec<SummaryRow> = results
         .iter()
         .map(|(name, point, o)| SummaryRow {
@@ -206,6 +207,17 @@ pub fn sweep_into(
         super::run_files::write_convergence_plot(&curves, &dir.join("convergence.svg"))?;
     }
     Ok(rows)
+}
+
+/// A point stopped by a full disk stops the sweep: its folder is not a result to put in place.
+fn stop_if_disk_full(dir: &Path, results: &[(String, Point, SweepOutcome)]) -> Result<(), OutputError> {
+    match results.iter().find(|(_, _, o)| o.disk_full) {
+        Some((name, _, o)) => Err(OutputError::DiskFull {
+            path: dir.join(name),
+            message: o.error.clone().unwrap_or_else(|| "no space left on device".into()),
+        }),
+        None => Ok(()),
+    }
 }
 
 #[cfg(test)]
