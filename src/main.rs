@@ -486,10 +486,13 @@ fn cmd_sweep(
         target.join("summary.csv").display(),
         target.display()
     );
-    for r in &rows {
+    for r in rows.iter().filter(|r| r.error.as_deref() != Some(cosserat::io::sweep::NOT_STARTED)) {
         if let Some(e) = &r.error {
             eprintln!("  {}: {}: {e}", r.name, r.status.as_str());
         }
+    }
+    if interrupted > 0 {
+        eprintln!("{}", sweep_interrupted_summary(&rows, &target));
     }
     Ok(if interrupted > 0 {
         ExitCode::from(EXIT_INTERRUPTED)
@@ -498,6 +501,28 @@ fn cmd_sweep(
     } else {
         ExitCode::from(1)
     })
+}
+
+/// What an interrupted sweep kept: points complete, stopped (their folders, a clip's converged
+/// frames) and not started.
+fn sweep_interrupted_summary(rows: &[cosserat::io::sweep::SummaryRow], target: &Path) -> String {
+    use cosserat::io::sweep::NOT_STARTED;
+    let not_started = rows.iter().filter(|r| r.error.as_deref() == Some(NOT_STARTED)).count();
+    let stopped: Vec<_> =
+        rows.iter().filter(|r| r.status == RunStatus::Interrupted && r.error.as_deref() != Some(NOT_STARTED)).collect();
+    let frames: Vec<String> = stopped
+        .iter()
+        .filter_map(|r| r.metrics.as_ref().and_then(|m| m.get("frames")).map(|f| format!("{} {f} frames", r.name)))
+        .collect();
+    let ok = rows.iter().filter(|r| r.status == RunStatus::Ok).count();
+    format!(
+        "interrupted: {ok} of {} points complete, {} stopped at their next iteration or frame{}, {not_started} not started; {} marks each (status interrupted), and {} holds run.json saying interrupted",
+        rows.len(),
+        stopped.len(),
+        if frames.is_empty() { String::new() } else { format!(" (kept: {})", frames.join(", ")) },
+        target.join("summary.csv").display(),
+        target.display()
+    )
 }
 
 fn cmd_audit(
@@ -536,7 +561,9 @@ fn cmd_audit(
         .with_context(|| format!("audit: output folder {}", out.display()))?;
     let pb = progress_bar(quiet, if quick { "audit (quick)" } else { "audit" });
     let opts = AuditOptions { out: folder.dir().to_path_buf(), jobs: jobs.unwrap_or(0) };
+    let points = std::sync::atomic::AtomicUsize::new(0);
     let report = run_audit(&specs, quick, &opts, |done, total| {
+        points.store(total, std::sync::atomic::Ordering::SeqCst);
         pb.set_length(total as u64);
         pb.set_position(done as u64);
     });
@@ -547,8 +574,12 @@ fn cmd_audit(
             r
         }
         Ok(_) => {
-            folder.finish(Status::Interrupted, Some("interrupted by a signal: points not run".into()))?;
-            eprintln!("audit interrupted; {} holds run.json saying interrupted", out.display());
+            let kept = audit_points_kept(folder.dir(), points.load(std::sync::atomic::Ordering::SeqCst));
+            folder.finish(Status::Interrupted, Some(format!("interrupted by a signal: {kept}")))?;
+            eprintln!(
+                "audit interrupted: {kept}; REPORT.md judges the claims on what ran; {} holds run.json saying interrupted",
+                out.display()
+            );
             return Ok(ExitCode::from(EXIT_INTERRUPTED));
         }
         Err(e) => {
@@ -580,6 +611,36 @@ fn cmd_audit(
         );
     }
     Ok(if unexpected.is_empty() { ExitCode::SUCCESS } else { ExitCode::from(1) })
+}
+
+/// What the points of an interrupted audit in `dir` kept, from their `run.json`: complete,
+/// stopped at their next iteration or frame, failed, and (of `total`) not started.
+fn audit_points_kept(dir: &Path, total: usize) -> String {
+    fn walk(dir: &Path, depth: usize, out: &mut Vec<Status>) {
+        if let Ok(Some(m)) = Manifest::read(dir) {
+            if m.command == "audit point" {
+                out.push(m.status);
+                return;
+            }
+        }
+        if depth == 0 {
+            return;
+        }
+        for e in std::fs::read_dir(dir).into_iter().flatten().flatten() {
+            if e.path().is_dir() {
+                walk(&e.path(), depth - 1, out);
+            }
+        }
+    }
+    let mut statuses = Vec::new();
+    walk(dir, 3, &mut statuses);
+    let count = |s: Status| statuses.iter().filter(|x| **x == s).count();
+    let (complete, stopped) = (count(Status::Complete), count(Status::Interrupted));
+    format!(
+        "of {total} points {complete} complete, {stopped} stopped at their next iteration or frame, {} failed or stalled, {} not started",
+        statuses.len() - complete - stopped,
+        total.saturating_sub(statuses.len())
+    )
 }
 
 fn cmd_modes(path: &Path, count: usize, limits: Limits) -> Result<ExitCode> {

@@ -314,3 +314,59 @@ fn runs_beyond_the_memory_limit_are_refused_before_allocating() {
         .code(1)
         .stderr(predicate::str::contains("GiB"));
 }
+
+/// Wait until a file under the staging folder of `target` (written by `child`) has `lines`
+/// lines: `rel` is its path under the staging folder.
+fn wait_for_lines(child: &mut Child, target: &Path, rel: &str, lines: usize) {
+    let stage = staging(target, child.id());
+    let start = Instant::now();
+    while std::fs::read_to_string(stage.join(rel)).map(|t| t.lines().count()).unwrap_or(0) < lines {
+        assert!(child.try_wait().expect("try_wait").is_none(), "ended before it was interrupted");
+        assert!(start.elapsed() < Duration::from_secs(120), "no progress in {}", stage.join(rel).display());
+        std::thread::sleep(Duration::from_millis(5));
+    }
+}
+
+/// SIGINT stops every running point of a sweep at its next frame (a clip) or iteration (an
+/// inverse solve), the points not started are not run, and the summary marks each: status
+/// interrupted, the frames a clip point kept, "not started"; exit status 130.
+#[test]
+fn an_interrupted_sweep_stops_every_point_and_says_what_it_kept() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = dir.path().join("clips");
+    let mut child = spawn(&["sweep", CLIP, "--quiet", "--jobs", "2", "--set", "lambda_d=1,2,3"], &out);
+    wait_for_lines(&mut child, &out, "lambda_d=1/frames.csv", 20);
+    signal(&child, "-INT");
+    let o = child.wait_with_output().expect("wait");
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(130), "{stderr}");
+    assert!(
+        stderr.contains("interrupted: 0 of 3 points complete, 2 stopped at their next iteration or frame"),
+        "{stderr}"
+    );
+    assert!(stderr.contains("1 not started"), "{stderr}");
+    let summary = std::fs::read_to_string(out.join("summary.csv")).expect("summary");
+    let rows: Vec<Vec<&str>> = summary.lines().skip(1).map(|l| l.split(',').collect()).collect();
+    for row in &rows[..2] {
+        assert_eq!(row[1], "interrupted", "{summary}");
+        let frames: usize = row[2].parse().unwrap_or_else(|_| panic!("frames of {row:?}"));
+        assert!(frames >= 20 && frames < 300, "{row:?}");
+    }
+    assert!(
+        rows[2][1] == "interrupted"
+            && summary.lines().last().unwrap_or("").ends_with("not started: a stop was requested before its turn"),
+        "{summary}"
+    );
+    assert_eq!(status(&out), "interrupted");
+    // An inverse point stops at its next iteration, not at the end of its solve.
+    let out = dir.path().join("inverse");
+    let mut child =
+        spawn(&["sweep", "cases/inverse_bend_twist.toml", "--quiet", "--jobs", "1", "--set", "elements=1600"], &out);
+    wait_for_lines(&mut child, &out, "elements=1600/data.csv", 2);
+    std::thread::sleep(Duration::from_millis(300));
+    signal(&child, "-INT");
+    let o = child.wait_with_output().expect("wait");
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(130), "{stderr}");
+    assert!(stderr.contains("interrupted by a signal after") && stderr.contains("of 1000 iterations"), "{stderr}");
+}

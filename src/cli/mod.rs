@@ -122,12 +122,33 @@ fn report(out: &Path, rows: &[BatchRow], skipped: usize) -> ExitCode {
     if failed.is_empty() {
         return ExitCode::SUCCESS;
     }
-    let names: Vec<&str> = failed.iter().map(|r| r.folder.as_str()).collect();
-    eprintln!("error: {} of {} recordings failed: {} (see {})", failed.len(), rows.len(), names.join(", "), SUMMARY);
     if rows.iter().any(|r| r.status == "interrupted") {
+        eprintln!("{}", interrupted_summary(out, rows));
         return ExitCode::from(crate::EXIT_INTERRUPTED);
     }
+    let names: Vec<&str> = failed.iter().map(|r| r.folder.as_str()).collect();
+    eprintln!("error: {} of {} recordings failed: {} (see {})", failed.len(), rows.len(), names.join(", "), SUMMARY);
     ExitCode::from(1)
+}
+
+/// What an interrupted batch kept: recordings complete, stopped at their next frame (with the
+/// frames their folders keep), not started, failed.
+fn interrupted_summary(out: &Path, rows: &[BatchRow]) -> String {
+    let not_started = rows.iter().filter(|r| r.reason.as_deref() == Some(batch::NOT_STARTED)).count();
+    let stopped: Vec<String> = rows
+        .iter()
+        .filter(|r| r.status == "interrupted" && r.reason.as_deref() != Some(batch::NOT_STARTED))
+        .map(|r| format!("{} ({} frames)", r.folder, r.frames.unwrap_or(0)))
+        .collect();
+    let ok = rows.iter().filter(|r| r.is_ok()).count();
+    let failed = rows.iter().filter(|r| !r.is_ok() && r.status != "interrupted").count();
+    format!(
+        "interrupted: {ok} of {} recordings complete, {} stopped at their next frame{}, {not_started} not started, {failed} failed; {} marks each. Run the same command again to run the others (complete recordings are skipped)",
+        rows.len(),
+        stopped.len(),
+        if stopped.is_empty() { String::new() } else { format!(": {}", stopped.join(", ")) },
+        out.join(SUMMARY).display()
+    )
 }
 
 pub fn cmd_batch(a: BatchArgs) -> Result<ExitCode> {

@@ -330,6 +330,9 @@ fn complete_row(dir: &Path, wanted: &Manifest) -> Option<BatchRow> {
     serde_json::from_slice(&std::fs::read(dir.join(ROW)).ok()?).ok()
 }
 
+/// The reason of a recording not started because a stop was requested.
+pub const NOT_STARTED: &str = "not started: a stop was requested before its turn";
+
 /// How [`run_recording`] ended.
 pub struct Ran {
     pub row: BatchRow,
@@ -358,7 +361,7 @@ pub fn run_recording(case: &Case, case_file: &InputFile, entry: &PlanEntry, out:
         return Ran { row, skipped: true };
     }
     if crate::interrupt::requested() {
-        let row = BatchRow::without_result(entry, RunStatus::Interrupted.as_str(), "not started: interrupted".into());
+        let row = BatchRow::without_result(entry, RunStatus::Interrupted.as_str(), NOT_STARTED.into());
         return Ran { row, skipped: false };
     }
     let case = match with_recording(case, &entry.path) {

@@ -136,7 +136,11 @@ fn solve_single(case: &Case, engine: Engine, dir: &Path, progress: impl FnMut(us
         let path = dir.join("data.csv");
         match load_data(case).and_then(|d| Ok(write_data(&path, &d)?)) {
             Ok(()) => run_inverse_on(case, engine, &path, &work, progress),
-            Err(e) => return Solved::failed(format!("{}: generating the data: {}", case_label(case), chain(&e))),
+            Err(e) => {
+                let status = if interrupted(&e) { RunStatus::Interrupted } else { RunStatus::Failed };
+                let error = format!("{}: generating the data: {}", case_label(case), chain(&e));
+                return Solved { status, ..Solved::failed_by(error, &e) };
+            }
         }
     } else {
         run_case(case, engine, &work, progress)
@@ -149,12 +153,7 @@ fn solve_single(case: &Case, engine: Engine, dir: &Path, progress: impl FnMut(us
             Some(format!("{}: {source}; the files here hold the last iterate", case_label(case))),
         ),
         Err(e) => {
-            let interrupted = match &e {
-                EngineError::Run(r) => r.is_interrupted(),
-                EngineError::FreeFem(f) => f.is_interrupted(),
-                _ => false,
-            };
-            let status = if interrupted { RunStatus::Interrupted } else { RunStatus::Failed };
+            let status = if interrupted(&e) { RunStatus::Interrupted } else { RunStatus::Failed };
             return Solved { status, ..Solved::failed_by(format!("{}: {}", case_label(case), chain(&e)), &e) };
         }
     };
@@ -167,6 +166,15 @@ fn solve_single(case: &Case, engine: Engine, dir: &Path, progress: impl FnMut(us
             Solved { status, error, metrics: Some(m), single: Some(r), clip: None, frames: None, disk_full: false }
         }
         Err(e) => Solved::failed_by(format!("{}: {}", case_label(case), chain(&e)), &e),
+    }
+}
+
+/// Did the engine stop because a stop was requested (`crate::interrupt`)?
+fn interrupted(e: &EngineError) -> bool {
+    match e {
+        EngineError::Run(r) => r.is_interrupted(),
+        EngineError::FreeFem(f) => f.is_interrupted(),
+        _ => false,
     }
 }
 

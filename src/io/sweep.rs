@@ -136,7 +136,7 @@ pub fn point_manifest(command: &str, case: &Case, point: &Point) -> Manifest {
 /// The point's `run.json`: `template` with the case's name, the point's status and message.
 fn finish_point(dir: &Path, template: &Manifest, case: &Case, outcome: Solved) -> Solved {
     if !dir.is_dir() {
-        return outcome;
+        return not_started(outcome);
     }
     let mut m = template.clone();
     m.certificate = outcome.certificate(case);
@@ -180,7 +180,7 @@ pub fn sweep_into(
             .par_iter()
             .map(|(point, c)| {
                 let template = point_manifest("sweep point", c, point);
-                let r = run_point(c, &dir.join(&c.name), &template);
+                let r = with_kept_frames(c, run_point(c, &dir.join(&c.name), &template));
                 tick();
                 (c.name.clone(), point.clone(), r)
             })
@@ -207,6 +207,28 @@ pub fn sweep_into(
         super::run_files::write_convergence_plot(&curves, &dir.join("convergence.svg"))?;
     }
     Ok(rows)
+}
+
+/// A point that a stop request kept from starting says so (its row, no folder).
+fn not_started(outcome: Solved) -> Solved {
+    match outcome.status {
+        RunStatus::Interrupted => Solved { error: Some(NOT_STARTED.into()), ..outcome },
+        _ => outcome,
+    }
+}
+
+/// The message of a point not started because a stop was requested.
+pub const NOT_STARTED: &str = "not started: a stop was requested before its turn";
+
+/// A clip point of a sweep that stopped early (interrupted, failed) reports the metrics of the
+/// frames it kept, so that its row says how many (`frames`) and how they went.
+fn with_kept_frames(case: &Case, outcome: Solved) -> Solved {
+    match (&outcome.metrics, &outcome.clip) {
+        (None, Some(c)) if !c.reports.is_empty() => {
+            Solved { metrics: Some(crate::run::clip_metrics::clip_metrics(case, c)), ..outcome }
+        }
+        _ => outcome,
+    }
 }
 
 /// A point stopped by a full disk stops the sweep: its folder is not a result to put in place.
