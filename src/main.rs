@@ -4,7 +4,6 @@ use std::process::ExitCode;
 
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
-use indicatif::{ProgressBar, ProgressStyle};
 
 use cosserat::case::Case;
 use cosserat::io::compact::OutputFormat;
@@ -16,6 +15,8 @@ use cosserat::run::Engine;
 use cosserat::solve::modes::modal_model;
 
 mod cli;
+
+use cli::progress::Progress;
 
 /// Forward Cosserat rods after Wang et al. (Comput. Mech. 71, 2023), in Rust and FreeFEM.
 #[derive(Parser, Debug)]
@@ -245,18 +246,16 @@ fn load(path: &Path) -> Result<Case> {
     Ok(Case::from_file(path)?)
 }
 
-fn progress_bar(quiet: bool, label: &str) -> ProgressBar {
-    if quiet {
-        return ProgressBar::hidden();
+/// What the progress of a run of `case` in `engine` counts: clip frames, time steps or
+/// iterations ("" for FreeFEM, which reports no progress: the time elapsed is shown).
+fn progress_unit(case: &Case, engine: Engine) -> &'static str {
+    use cosserat::case::Analysis;
+    match (&case.analysis, engine) {
+        (_, Engine::Freefem) => "",
+        _ if case.clip().is_some() => "frames",
+        (Analysis::Dynamic(_), _) => "time steps",
+        _ => "iterations",
     }
-    let pb = ProgressBar::new(0);
-    pb.set_style(
-        ProgressStyle::with_template("{prefix} [{bar:40}] {pos}/{len} {per_sec} eta {eta}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar())
-            .progress_chars("=> "),
-    );
-    pb.set_prefix(label.to_string());
-    pb
 }
 
 /// Refuse a run whose estimated memory exceeds the limit (`--max-memory-gib`).
@@ -276,17 +275,13 @@ fn cmd_run(
     let case = load(path)?;
     check_memory(&case, Footprint::Run, limits)?;
     let dir = out.unwrap_or_else(|| PathBuf::from("out").join(&case.name).join(engine.to_string()));
-    let label = if case.clip().is_some() { "frames" } else { "" };
-    let pb = progress_bar(quiet || engine == Engine::Freefem, &format!("{} [{engine}] {label}", case.name));
+    let pb = Progress::new(&format!("{} [{engine}]", case.name), progress_unit(&case, engine), 0, quiet);
     if engine == Engine::Freefem && !quiet {
         eprintln!("{} [freefem]: running FreeFEM in a staging folder beside {}", case.name, dir.display());
     }
-    let end = run_into(&case, engine, &dir, mode, |done, total| {
-        pb.set_length(total as u64);
-        pb.set_position(done as u64);
-    })
-    .with_context(|| format!("{}: output folder {}", case_label(&case), dir.display()))?;
-    pb.finish_and_clear();
+    let end = run_into(&case, engine, &dir, mode, |done, total| pb.set(done, total))
+        .with_context(|| format!("{}: output folder {}", case_label(&case), dir.display()))?;
+    pb.finish();
     for n in &end.notes {
         eprintln!("note: {n}");
     }
@@ -379,7 +374,12 @@ fn cmd_compare(
     for n in &folder.notes {
         eprintln!("note: {n}");
     }
+    // Without a terminal, a line every 10 s says the comparison is still running; on a
+    // terminal the engines' own output is left alone.
+    let on_terminal = std::io::IsTerminal::is_terminal(&std::io::stderr());
+    let pb = Progress::new(&format!("{} compare", case.name), "", 0, on_terminal);
     let result = compare_into(&case, folder.dir(), &target, short, frames);
+    pb.finish();
     let (status, message) = match &result {
         Ok(_) => (Status::Complete, None),
         Err(_) if cosserat::interrupt::requested() => (Status::Interrupted, Some("interrupted by a signal".into())),
@@ -442,11 +442,10 @@ fn cmd_sweep(
     for n in &folder.notes {
         eprintln!("note: {n}");
     }
-    let pb = progress_bar(quiet, &format!("{} sweep", case.name));
-    pb.set_length(points.len() as u64);
+    let pb = Progress::new(&format!("{} sweep", case.name), "points", points.len(), quiet);
     let keys: Vec<String> = params.iter().map(|p| p.key.clone()).collect();
-    let result = sweep_into(&case, &keys, &points, folder.dir(), jobs.unwrap_or(0), || pb.inc(1));
-    pb.finish_and_clear();
+    let result = sweep_into(&case, &keys, &points, folder.dir(), jobs.unwrap_or(0), || pb.inc());
+    pb.finish();
     let rows = match result {
         Ok(rows) => rows,
         Err(e) if cosserat::io::disk::is_full(&e) => {
@@ -559,15 +558,14 @@ fn cmd_audit(
     manifest.settings.insert("quick".into(), f64::from(u8::from(quick)));
     let folder = RunFolder::begin(&out, manifest, Mode::Fresh { force })
         .with_context(|| format!("audit: output folder {}", out.display()))?;
-    let pb = progress_bar(quiet, if quick { "audit (quick)" } else { "audit" });
+    let pb = Progress::new(if quick { "audit (quick)" } else { "audit" }, "points", 0, quiet);
     let opts = AuditOptions { out: folder.dir().to_path_buf(), jobs: jobs.unwrap_or(0) };
     let points = std::sync::atomic::AtomicUsize::new(0);
     let report = run_audit(&specs, quick, &opts, |done, total| {
         points.store(total, std::sync::atomic::Ordering::SeqCst);
-        pb.set_length(total as u64);
-        pb.set_position(done as u64);
+        pb.set(done, total);
     });
-    pb.finish_and_clear();
+    pb.finish();
     let report = match report {
         Ok(r) if !cosserat::interrupt::requested() => {
             folder.finish(Status::Complete, None)?;

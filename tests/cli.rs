@@ -220,3 +220,33 @@ fn compare_refuses_frames_on_a_case_without_a_clip() {
         .failure()
         .stderr(predicate::str::contains("`--frames` applies to clips only"));
 }
+
+/// Without a terminal (stderr to a pipe: a log file, nohup, a Slurm task) a long command prints
+/// a progress line every interval (10 s; 0.1 s here) with done/total, rate and time left, and a
+/// final line; `--quiet` prints none.
+#[test]
+fn progress_without_a_terminal_is_a_line_every_interval_and_a_final_line() {
+    if !std::path::Path::new("data/elegansbot/kymogram_delta-turn.npy").is_file() {
+        return;
+    }
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = cosserat()
+        .env("COSSERAT_PROGRESS_INTERVAL_S", "0.1")
+        .args(["run", "cases/worm_delta_turn_ld1.toml", "--out"])
+        .arg(dir.path().join("clip"))
+        .output()
+        .expect("run");
+    assert!(out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    let lines: Vec<&str> = stderr.lines().filter(|l| l.starts_with("worm_delta_turn_ld1 [rust]: ")).collect();
+    assert!(lines.len() >= 3, "{stderr}");
+    assert!(lines[0].contains("/300 frames (") && lines[0].contains(" frames/s, ETA "), "{stderr}");
+    assert!(lines.last().is_some_and(|l| l.contains("300/300 frames in ")), "{stderr}");
+    let quiet = cosserat()
+        .env("COSSERAT_PROGRESS_INTERVAL_S", "0.1")
+        .args(["run", "cases/worm_delta_turn_ld1.toml", "--quiet", "--out"])
+        .arg(dir.path().join("quiet"))
+        .output()
+        .expect("run");
+    assert!(quiet.status.success() && quiet.stderr.is_empty(), "{}", String::from_utf8_lossy(&quiet.stderr));
+}

@@ -2,18 +2,20 @@
 //! (locally or as a Slurm job array), the hidden
 //! `batch-task` of an array task, `gather` and `synth`.
 pub mod list;
+pub mod progress;
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Duration;
 
 use anyhow::{Context, Result};
-use indicatif::{ProgressBar, ProgressStyle};
 
 use cosserat::io::batch::{self, gather, list_recordings, run_batch, run_task, BatchRow, Plan, SUMMARY};
 use cosserat::io::compact::OutputFormat;
 use cosserat::io::corpus::{write_corpus, CorpusParams};
 use cosserat::io::slurm;
+
+use progress::Progress;
 
 /// `cosserat batch`.
 #[derive(clap::Args, Debug)]
@@ -90,20 +92,6 @@ pub struct SynthArgs {
     kymogram: PathBuf,
 }
 
-fn bar(quiet: bool, len: usize, label: &str) -> ProgressBar {
-    if quiet {
-        return ProgressBar::hidden();
-    }
-    let pb = ProgressBar::new(len as u64);
-    pb.set_style(
-        ProgressStyle::with_template("{prefix} [{bar:40}] {pos}/{len} recordings, eta {eta}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar())
-            .progress_chars("=> "),
-    );
-    pb.set_prefix(label.to_string());
-    pb
-}
-
 /// Print the outcome of `rows` (written to `out/summary.csv`): one line on stdout, one line per
 /// failure and a one-line summary on stderr; exit status 1 if any recording did not succeed.
 fn report(out: &Path, rows: &[BatchRow], skipped: usize) -> ExitCode {
@@ -175,17 +163,15 @@ pub fn cmd_batch(a: BatchArgs) -> Result<ExitCode> {
             eprintln!("when it has finished: cosserat gather {}", out.display());
             return Ok(ExitCode::SUCCESS);
         }
-        let pb = bar(a.quiet, plan.tasks(), &format!("{} job {id}", case.name));
-        slurm::wait(&id, Duration::from_millis(500), |queued| {
-            pb.set_position((plan.tasks() - queued.min(plan.tasks())) as u64)
-        })?;
-        pb.finish_and_clear();
+        let pb = Progress::new(&format!("{} job {id}", case.name), "array tasks", plan.tasks(), a.quiet);
+        slurm::wait(&id, Duration::from_millis(500), |queued| pb.set(plan.tasks() - queued.min(plan.tasks()), 0))?;
+        pb.finish();
         let rows = gather(&out)?;
         return Ok(report(&out, &rows, 0));
     }
-    let pb = bar(a.quiet, plan.recordings.len(), &case.name);
-    let ran = run_batch(&plan, &out, a.jobs.unwrap_or(0), || pb.inc(1))?;
-    pb.finish_and_clear();
+    let pb = Progress::new(&format!("{} batch", case.name), "recordings", plan.recordings.len(), a.quiet);
+    let ran = run_batch(&plan, &out, a.jobs.unwrap_or(0), || pb.inc())?;
+    pb.finish();
     let skipped = ran.iter().filter(|r| r.skipped).count();
     let rows: Vec<BatchRow> = ran.into_iter().map(|r| r.row).collect();
     Ok(report(&out, &rows, skipped))
