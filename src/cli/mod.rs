@@ -45,6 +45,28 @@ pub struct BatchArgs {
     /// Block until the job array has finished, then gather
     #[arg(long, requires = "slurm")]
     wait: bool,
+    /// Time limit of each array task (sbatch --time: `MM`, `HH:MM:SS`, `D-HH:MM`) [default:
+    /// the partition's]
+    #[arg(long, value_name = "TIME", requires = "slurm")]
+    time: Option<String>,
+    /// Memory of each array task (sbatch --mem: `500M`, `2G`) [default: the partition's]
+    #[arg(long, value_name = "MEM", requires = "slurm")]
+    mem: Option<String>,
+    /// Account charged for the array (sbatch --account)
+    #[arg(long, value_name = "ACCOUNT", requires = "slurm")]
+    account: Option<String>,
+    /// Any other sbatch option, written as an `#SBATCH` line of the job script; repeat for
+    /// more, e.g. `--sbatch-arg=--qos=long --sbatch-arg=--constraint=avx2`
+    #[arg(long = "sbatch-arg", value_name = "ARG", allow_hyphen_values = true, requires = "slurm")]
+    sbatch_arg: Vec<String>,
+    /// A file of shell lines that each array task runs before cosserat (`module load …`,
+    /// `export …`), copied into the job script
+    #[arg(long, value_name = "FILE", requires = "slurm")]
+    setup: Option<PathBuf>,
+    /// Write the plan (batch.json) and the job script (batch.sbatch) into OUT without
+    /// submitting it; `sbatch OUT/batch.sbatch` submits it
+    #[arg(long, requires = "slurm", conflicts_with = "wait")]
+    dry_run: bool,
     /// How each recording's per-node fields are written (as `cosserat run --output-format`)
     #[arg(long, value_enum, default_value_t = OutputFormat::Csv)]
     output_format: OutputFormat,
@@ -146,28 +168,11 @@ pub fn cmd_batch(a: BatchArgs) -> Result<ExitCode> {
     plan.format = a.output_format;
     // the case is read (and refused if it is not a clip case) before anything is written
     let (case, _) = batch::plan_case(&plan).with_context(|| format!("batch of {}", a.case.display()))?;
+    let _lock = lock_batch(&a.out)?;
     plan.begin(&a.out)?;
     let out = std::fs::canonicalize(&a.out).with_context(|| format!("output folder {}", a.out.display()))?;
     if a.slurm {
-        let exe = std::env::current_exe().context("cannot find the cosserat executable for the job script")?;
-        let id = slurm::submit(&plan, &out, &exe, a.partition.as_deref())?;
-        eprintln!(
-            "{}: submitted Slurm job {id}: {} recordings in {} array tasks; job script {}",
-            case.name,
-            plan.recordings.len(),
-            plan.tasks(),
-            out.join(slurm::SCRIPT).display()
-        );
-        if !a.wait {
-            println!("{id}");
-            eprintln!("when it has finished: cosserat gather {}", out.display());
-            return Ok(ExitCode::SUCCESS);
-        }
-        let pb = Progress::new(&format!("{} job {id}", case.name), "array tasks", plan.tasks(), a.quiet);
-        slurm::wait(&id, Duration::from_millis(500), |queued| pb.set(plan.tasks() - queued.min(plan.tasks()), 0))?;
-        pb.finish();
-        let rows = gather(&out)?;
-        return Ok(report(&out, &rows, 0));
+        return submit_batch(&a, &plan, &out, &case.name);
     }
     let pb = Progress::new(&format!("{} batch", case.name), "recordings", plan.recordings.len(), a.quiet);
     let ran = run_batch(&plan, &out, a.jobs.unwrap_or(0), || pb.inc())?;
@@ -177,8 +182,86 @@ pub fn cmd_batch(a: BatchArgs) -> Result<ExitCode> {
     Ok(report(&out, &rows, skipped))
 }
 
+/// The lock of a batch's output folder while this process writes its plan and runs or submits
+/// it: a second `cosserat batch` into the same folder is refused at once.
+fn lock_batch(out: &Path) -> Result<cosserat::io::folder_lock::FolderLock> {
+    use cosserat::io::folder_lock::{FolderLock, LockError};
+    let name = out.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "batch".into());
+    let parent = out.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    std::fs::create_dir_all(parent).with_context(|| format!("cannot create {}", parent.display()))?;
+    FolderLock::acquire(parent, &name).map_err(|e| match e {
+        LockError::Held { pid } => anyhow::anyhow!(
+            "{} is being written by another cosserat batch ({}): wait for it to end, or choose another --out",
+            out.display(),
+            pid.map_or("its pid not yet known".to_string(), |p| format!("pid {p}"))
+        ),
+        LockError::Io { path, source } => anyhow::Error::new(source).context(format!("cannot lock {}", path.display())),
+    })
+}
+
+/// `batch --slurm`: the job script of the array tasks that have a recording to run (a
+/// resubmission runs only the unfinished recordings), submitted unless `--dry-run`; with
+/// `--wait`, waited for and gathered.
+fn submit_batch(a: &BatchArgs, plan: &Plan, out: &Path, name: &str) -> Result<ExitCode> {
+    let exe = std::env::current_exe().context("cannot find the cosserat executable for the job script")?;
+    let complete = batch::complete_recordings(plan, out)?;
+    let skipped = complete.iter().filter(|c| **c).count();
+    let tasks = batch::unfinished_tasks(plan, &complete);
+    let total = plan.recordings.len();
+    if tasks.is_empty() {
+        eprintln!("{name}: all {total} recordings hold a complete run: nothing to submit");
+        let rows = gather(out)?;
+        return Ok(report(out, &rows, skipped));
+    }
+    let setup = match &a.setup {
+        Some(p) => Some(cosserat::io::files::read_capped_text(p, SETUP_FILE_CAP_BYTES, "set-up file")?),
+        None => None,
+    };
+    let opts = slurm::JobOptions {
+        partition: a.partition.clone(),
+        time: a.time.clone(),
+        mem: a.mem.clone(),
+        account: a.account.clone(),
+        sbatch_args: a.sbatch_arg.clone(),
+        setup,
+    };
+    let script = slurm::write_script(plan, &tasks, out, &exe, &opts)?;
+    let counts = format!(
+        "{} of {total} recordings to run ({skipped} already complete, skipped) in {} of {} array tasks",
+        total - skipped,
+        tasks.len(),
+        plan.tasks()
+    );
+    if a.dry_run {
+        eprintln!(
+            "{name}: wrote {} ({counts}); not submitted: `sbatch {}` submits it",
+            script.display(),
+            script.display()
+        );
+        println!("{}", script.display());
+        return Ok(ExitCode::SUCCESS);
+    }
+    let id = slurm::submit(&script)?;
+    eprintln!("{name}: submitted Slurm job {id}: {counts}; job script {}", script.display());
+    if !a.wait {
+        println!("{id}");
+        eprintln!("when it has finished: cosserat gather {}", out.display());
+        return Ok(ExitCode::SUCCESS);
+    }
+    let pb = Progress::new(&format!("{name} job {id}"), "array tasks", tasks.len(), a.quiet);
+    slurm::wait(&id, Duration::from_millis(500), |queued| pb.set(tasks.len() - queued.min(tasks.len()), 0))?;
+    pb.finish();
+    let rows = gather(out)?;
+    Ok(report(out, &rows, skipped))
+}
+
+/// Largest `--setup` file read [bytes]: 64 KiB of shell lines.
+const SETUP_FILE_CAP_BYTES: u64 = 64 << 10;
+
 pub fn cmd_batch_task(a: TaskArgs) -> Result<ExitCode> {
-    let ran = run_task(&a.out, a.index)?;
+    let pb = Progress::new(&format!("batch task {}", a.index), "recordings", 0, false);
+    let ran = run_task(&a.out, a.index, |done, total| pb.set(done, total))?;
+    pb.finish();
     for r in &ran {
         let what = if r.skipped { "already complete".into() } else { r.row.status.clone() };
         eprintln!("{}: {what}{}", r.row.folder, r.row.reason.as_deref().map(|m| format!(": {m}")).unwrap_or_default());

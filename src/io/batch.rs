@@ -422,6 +422,26 @@ pub fn plan_case(plan: &Plan) -> Result<(Case, InputFile), BatchError> {
     Ok((case, InputFile { path: plan.case.display().to_string(), sha256 }))
 }
 
+/// Which recordings of the plan in `out` hold a complete run of the same case and recording
+/// (and are skipped when run again), in the plan's order.
+pub fn complete_recordings(plan: &Plan, out: &Path) -> Result<Vec<bool>, BatchError> {
+    let (case, case_file) = plan_case(plan)?;
+    Ok(plan
+        .recordings
+        .iter()
+        .map(|e| {
+            recording_manifest(&case, &case_file, &e.path, plan.format)
+                .is_ok_and(|m| complete_row(&out.join(&e.folder), &m).is_some())
+        })
+        .collect())
+}
+
+/// The Slurm array tasks of the plan that have a recording to run (`complete`: as
+/// [`complete_recordings`] says).
+pub fn unfinished_tasks(plan: &Plan, complete: &[bool]) -> Vec<usize> {
+    (0..plan.tasks()).filter(|&t| complete.chunks(plan.per_task).nth(t).is_some_and(|c| c.iter().any(|d| !d))).collect()
+}
+
 /// Run every recording of the plan in `out` on `jobs` threads (0: one per core), then write
 /// `summary.csv`; `tick` after each recording. Rows in the plan's order.
 pub fn run_batch(plan: &Plan, out: &Path, jobs: usize, tick: impl Fn() + Sync) -> Result<Vec<Ran>, BatchError> {
@@ -444,12 +464,18 @@ pub fn run_batch(plan: &Plan, out: &Path, jobs: usize, tick: impl Fn() + Sync) -
     Ok(ran)
 }
 
-/// Run the recordings of Slurm array task `index` of the plan in `out`, one after the other.
-pub fn run_task(out: &Path, index: usize) -> Result<Vec<Ran>, BatchError> {
+/// Run the recordings of Slurm array task `index` of the plan in `out`, one after the other;
+/// `progress(done, total)` after each.
+pub fn run_task(out: &Path, index: usize, mut progress: impl FnMut(usize, usize)) -> Result<Vec<Ran>, BatchError> {
     let plan = Plan::read(out)?;
     let entries = plan.task(index)?;
     let (case, case_file) = plan_case(&plan)?;
-    Ok(entries.iter().map(|e| run_recording(&case, &case_file, e, out, plan.format)).collect())
+    let mut ran = Vec::with_capacity(entries.len());
+    for e in entries {
+        ran.push(run_recording(&case, &case_file, e, out, plan.format));
+        progress(ran.len(), entries.len());
+    }
+    Ok(ran)
 }
 
 /// The rows of the plan in `out` from its recordings' folders (`missing` where a folder holds
