@@ -160,7 +160,7 @@ enum Command {
         out: PathBuf,
     },
     /// Write a corpus of synthetic 3D recordings with their ground truth.
-    Synth(cli::SynthArgs),
+    Synth(cli::synth::SynthArgs),
     /// List the cases of a directory with their descriptions.
     List {
         /// Directory holding *.toml case files
@@ -236,7 +236,7 @@ fn dispatch(cli: Cli) -> Result<ExitCode> {
         Command::Batch(a) => cli::cmd_batch(a),
         Command::BatchTask(a) => cli::cmd_batch_task(a),
         Command::Gather { out } => cli::cmd_gather(&out),
-        Command::Synth(a) => cli::cmd_synth(a),
+        Command::Synth(a) => cli::synth::cmd_synth(a),
         Command::List { dir } => cli::list::cmd_list(&dir),
         Command::Modes { case, count, limits } => cmd_modes(&case, count, limits),
     }
@@ -244,18 +244,6 @@ fn dispatch(cli: Cli) -> Result<ExitCode> {
 
 fn load(path: &Path) -> Result<Case> {
     Ok(Case::from_file(path)?)
-}
-
-/// What the progress of a run of `case` in `engine` counts: clip frames, time steps or
-/// iterations ("" for FreeFEM, which reports no progress: the time elapsed is shown).
-fn progress_unit(case: &Case, engine: Engine) -> &'static str {
-    use cosserat::case::Analysis;
-    match (&case.analysis, engine) {
-        (_, Engine::Freefem) => "",
-        _ if case.clip().is_some() => "frames",
-        (Analysis::Dynamic(_), _) => "time steps",
-        _ => "iterations",
-    }
 }
 
 /// Refuse a run whose estimated memory exceeds the limit (`--max-memory-gib`).
@@ -275,7 +263,7 @@ fn cmd_run(
     let case = load(path)?;
     check_memory(&case, Footprint::Run, limits)?;
     let dir = out.unwrap_or_else(|| PathBuf::from("out").join(&case.name).join(engine.to_string()));
-    let pb = Progress::new(&format!("{} [{engine}]", case.name), progress_unit(&case, engine), 0, quiet);
+    let pb = Progress::new(&format!("{} [{engine}]", case.name), cli::outcome::progress_unit(&case, engine), 0, quiet);
     if engine == Engine::Freefem && !quiet {
         eprintln!("{} [freefem]: running FreeFEM in a staging folder beside {}", case.name, dir.display());
     }
@@ -305,7 +293,11 @@ fn cmd_run(
             dir.display()
         ),
         Status::Failed | Status::Running if end.disk_full.is_some() => {
-            anyhow::bail!("{}{}", end.message.clone().unwrap_or_default(), full_disk_note(&end, path, &dir))
+            anyhow::bail!(
+                "{}{}",
+                end.message.clone().unwrap_or_default(),
+                cli::outcome::full_disk_note(&end, path, &dir)
+            )
         }
         Status::Failed | Status::Running => {
             let kept = match end.frames {
@@ -319,20 +311,6 @@ fn cmd_run(
         }
     }
     Ok(ExitCode::SUCCESS)
-}
-
-/// What a run stopped by a full disk left, and how to go on.
-fn full_disk_note(end: &cosserat::io::job::JobEnd, case: &Path, dir: &Path) -> String {
-    let previous = format!("\n{} is left as it was", dir.display());
-    match (&end.disk_full, end.frames) {
-        (Some(Some(staging)), Some((n, _))) => format!(
-            "{previous}. The {n} converged frames are kept in {}: free some space, then `cosserat run {} --out {} --resume` continues from them (or remove that folder to free its space)",
-            staging.display(),
-            case.display(),
-            dir.display()
-        ),
-        _ => format!("{previous}; nothing of this run was kept (its staging folder is removed)"),
-    }
 }
 
 /// `--count`: a positive number.
@@ -450,13 +428,7 @@ fn cmd_sweep(
         Ok(rows) => rows,
         Err(e) if cosserat::io::disk::is_full(&e) => {
             folder.abandon();
-            anyhow::bail!(
-                "{}: sweep: {}: {}\n{} is left as it was; nothing of this sweep was kept (its staging folder is removed)",
-                case_label(&case),
-                cosserat::io::disk::full_text(&target),
-                cosserat::io::sweep::chain(&e),
-                target.display()
-            );
+            anyhow::bail!("{}: sweep: {}", case_label(&case), cli::outcome::disk_full_text(&e, &target, "sweep"));
         }
         Err(e) => {
             let message = cosserat::io::sweep::chain(&e);
@@ -491,7 +463,7 @@ fn cmd_sweep(
         }
     }
     if interrupted > 0 {
-        eprintln!("{}", sweep_interrupted_summary(&rows, &target));
+        eprintln!("{}", cli::outcome::sweep_interrupted_summary(&rows, &target));
     }
     Ok(if interrupted > 0 {
         ExitCode::from(EXIT_INTERRUPTED)
@@ -500,28 +472,6 @@ fn cmd_sweep(
     } else {
         ExitCode::from(1)
     })
-}
-
-/// What an interrupted sweep kept: points complete, stopped (their folders, a clip's converged
-/// frames) and not started.
-fn sweep_interrupted_summary(rows: &[cosserat::io::sweep::SummaryRow], target: &Path) -> String {
-    use cosserat::io::sweep::NOT_STARTED;
-    let not_started = rows.iter().filter(|r| r.error.as_deref() == Some(NOT_STARTED)).count();
-    let stopped: Vec<_> =
-        rows.iter().filter(|r| r.status == RunStatus::Interrupted && r.error.as_deref() != Some(NOT_STARTED)).collect();
-    let frames: Vec<String> = stopped
-        .iter()
-        .filter_map(|r| r.metrics.as_ref().and_then(|m| m.get("frames")).map(|f| format!("{} {f} frames", r.name)))
-        .collect();
-    let ok = rows.iter().filter(|r| r.status == RunStatus::Ok).count();
-    format!(
-        "interrupted: {ok} of {} points complete, {} stopped at their next iteration or frame{}, {not_started} not started; {} marks each (status interrupted), and {} holds run.json saying interrupted",
-        rows.len(),
-        stopped.len(),
-        if frames.is_empty() { String::new() } else { format!(" (kept: {})", frames.join(", ")) },
-        target.join("summary.csv").display(),
-        target.display()
-    )
 }
 
 fn cmd_audit(
@@ -572,7 +522,7 @@ fn cmd_audit(
             r
         }
         Ok(_) => {
-            let kept = audit_points_kept(folder.dir(), points.load(std::sync::atomic::Ordering::SeqCst));
+            let kept = cli::outcome::audit_points_kept(folder.dir(), points.load(std::sync::atomic::Ordering::SeqCst));
             folder.finish(Status::Interrupted, Some(format!("interrupted by a signal: {kept}")))?;
             eprintln!(
                 "audit interrupted: {kept}; REPORT.md judges the claims on what ran; {} holds run.json saying interrupted",
@@ -609,36 +559,6 @@ fn cmd_audit(
         );
     }
     Ok(if unexpected.is_empty() { ExitCode::SUCCESS } else { ExitCode::from(1) })
-}
-
-/// What the points of an interrupted audit in `dir` kept, from their `run.json`: complete,
-/// stopped at their next iteration or frame, failed, and (of `total`) not started.
-fn audit_points_kept(dir: &Path, total: usize) -> String {
-    fn walk(dir: &Path, depth: usize, out: &mut Vec<Status>) {
-        if let Ok(Some(m)) = Manifest::read(dir) {
-            if m.command == "audit point" {
-                out.push(m.status);
-                return;
-            }
-        }
-        if depth == 0 {
-            return;
-        }
-        for e in std::fs::read_dir(dir).into_iter().flatten().flatten() {
-            if e.path().is_dir() {
-                walk(&e.path(), depth - 1, out);
-            }
-        }
-    }
-    let mut statuses = Vec::new();
-    walk(dir, 3, &mut statuses);
-    let count = |s: Status| statuses.iter().filter(|x| **x == s).count();
-    let (complete, stopped) = (count(Status::Complete), count(Status::Interrupted));
-    format!(
-        "of {total} points {complete} complete, {stopped} stopped at their next iteration or frame, {} failed or stalled, {} not started",
-        statuses.len() - complete - stopped,
-        total.saturating_sub(statuses.len())
-    )
 }
 
 fn cmd_modes(path: &Path, count: usize, limits: Limits) -> Result<ExitCode> {

@@ -149,3 +149,42 @@ fn an_interrupted_batch_stops_at_the_next_frame_and_says_what_it_kept() {
         assert!(!out.join(&r[1]).exists(), "no folder for a recording not started");
     }
 }
+
+/// `synth` writes a corpus into a folder of its own: a folder that is not empty (an earlier
+/// corpus) is refused unless --force, which replaces it whole; its default kymogram is found
+/// from any working folder.
+#[test]
+fn synth_refuses_a_folder_that_is_not_empty_and_finds_its_kymogram_anywhere() {
+    if !common::worm_data_present("synth") {
+        return;
+    }
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let synth = |count: &str, extra: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_cosserat"))
+            .current_dir(tmp.path()) // not the source tree: the default kymogram is found anyway
+            .args(["synth", "--out", "corpus", "--frames", "4", "--count", count])
+            .args(extra)
+            .output()
+            .expect("synth")
+    };
+    let first = synth("3", &[]);
+    assert!(first.status.success(), "{}", String::from_utf8_lossy(&first.stderr));
+    let second = synth("2", &[]);
+    let stderr = String::from_utf8_lossy(&second.stderr);
+    assert_eq!(second.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("is not empty") && stderr.contains("--force"), "{stderr}");
+    let forced = synth("2", &["--force"]);
+    assert!(forced.status.success(), "{}", String::from_utf8_lossy(&forced.stderr));
+    let mut names: Vec<String> = std::fs::read_dir(tmp.path().join("corpus"))
+        .expect("corpus")
+        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    assert_eq!(
+        names,
+        ["corpus.json", "roll_000.npy", "roll_000.truth.npy", "roll_001.npy", "roll_001.truth.npy", "run.json"],
+        "the earlier corpus is gone whole"
+    );
+    let m = std::fs::read_to_string(tmp.path().join("corpus/run.json")).expect("run.json");
+    assert!(m.contains("\"command\": \"synth\"") && m.contains("kymogram_omega-turn.npy"), "{m}");
+}

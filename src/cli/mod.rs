@@ -2,7 +2,9 @@
 //! (locally or as a Slurm job array), the hidden
 //! `batch-task` of an array task, `gather` and `synth`.
 pub mod list;
+pub mod outcome;
 pub mod progress;
+pub mod synth;
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -12,7 +14,6 @@ use anyhow::{Context, Result};
 
 use cosserat::io::batch::{self, gather, list_recordings, run_batch, run_task, BatchRow, Plan, SUMMARY};
 use cosserat::io::compact::OutputFormat;
-use cosserat::io::corpus::{write_corpus, CorpusParams};
 use cosserat::io::slurm;
 
 use progress::Progress;
@@ -83,35 +84,6 @@ pub struct TaskArgs {
     /// Array task index ($SLURM_ARRAY_TASK_ID)
     #[arg(long)]
     index: usize,
-}
-
-/// `cosserat synth`.
-#[derive(clap::Args, Debug)]
-pub struct SynthArgs {
-    /// Output folder for the recordings (roll_KKK.npy), their truth sidecars and corpus.json
-    #[arg(long)]
-    out: PathBuf,
-    /// Number of recordings
-    #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
-    count: u64,
-    /// Frames per recording (>= 2)
-    #[arg(long, value_parser = clap::value_parser!(u64).range(2..))]
-    frames: u64,
-    /// Seed of the rolls, twists, kymogram excerpts and noise
-    #[arg(long, default_value_t = 0)]
-    seed: u64,
-    /// Nodes per frame: the batch case's rod.elements + 1
-    #[arg(long, default_value_t = 33, value_parser = clap::value_parser!(u64).range(3..))]
-    nodes: u64,
-    /// Standard deviation of the noise added to every coordinate [m]
-    #[arg(long, default_value_t = 1e-7)]
-    noise_m: f64,
-    /// Time between frames [s]
-    #[arg(long, default_value_t = 0.04)]
-    frame_interval_s: f64,
-    /// The kymogram whose curvature the recordings play (scripts/fetch_worm_data.sh)
-    #[arg(long, default_value = "data/elegansbot/kymogram_omega-turn.npy")]
-    kymogram: PathBuf,
 }
 
 /// Print the outcome of `rows` (written to `out/summary.csv`): one line on stdout, one line per
@@ -272,28 +244,6 @@ pub fn cmd_batch_task(a: TaskArgs) -> Result<ExitCode> {
 pub fn cmd_gather(out: &Path) -> Result<ExitCode> {
     let rows = gather(out).with_context(|| format!("gather {}", out.display()))?;
     Ok(report(out, &rows, 0))
-}
-
-pub fn cmd_synth(a: SynthArgs) -> Result<ExitCode> {
-    let params = CorpusParams {
-        count: a.count as usize,
-        frames: a.frames as usize,
-        nodes: a.nodes as usize,
-        dt_s: a.frame_interval_s,
-        noise_m: a.noise_m,
-        seed: a.seed,
-        ..CorpusParams::default()
-    };
-    let entries =
-        write_corpus(&a.out, &a.kymogram, &params).with_context(|| format!("synth into {}", a.out.display()))?;
-    println!(
-        "wrote {} recordings ({} frames x {} nodes, with truth sidecars) and corpus.json to {}",
-        entries.len(),
-        params.frames,
-        params.nodes,
-        a.out.display()
-    );
-    Ok(ExitCode::SUCCESS)
 }
 
 /// glibc's malloc hands the top of its heap back to the system whenever more than 128 KB of
