@@ -65,6 +65,14 @@ fn bad_case_is_a_clear_error_not_a_panic() {
             .and(predicate::str::contains("must be > 0"))
             .and(predicate::str::contains("panicked").not()),
     );
+    // A length no double-precision rod can have is blamed, not the loads that then fail.
+    std::fs::write(&bad, common::edit(&common::case_text("timoshenko_5pct"), "length_m = \"L0\"", "length_m = 1e200"))
+        .expect("write");
+    cosserat().arg("run").arg(&bad).assert().code(1).stderr(
+        predicate::str::contains("rod.length_m")
+            .and(predicate::str::contains("radius of gyration"))
+            .and(predicate::str::contains("loads").not()),
+    );
     cosserat()
         .args(["run", "cases/does_not_exist.toml"])
         .assert()
