@@ -207,7 +207,12 @@ fn install_signal_handler() {
     }
 }
 
+/// A failed allocation ends the process with a message and status 1, not an abort.
+#[global_allocator]
+static ALLOCATOR: cli::alloc::Guarded = cli::alloc::Guarded;
+
 fn main() -> ExitCode {
+    cli::alloc::at_start();
     cli::keep_freed_memory();
     let cli = Cli::parse();
     install_signal_handler();

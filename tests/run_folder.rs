@@ -370,3 +370,28 @@ fn an_interrupted_sweep_stops_every_point_and_says_what_it_kept() {
     assert_eq!(o.status.code(), Some(130), "{stderr}");
     assert!(stderr.contains("interrupted by a signal after") && stderr.contains("of 1000 iterations"), "{stderr}");
 }
+
+/// Under an address-space limit (`ulimit -v`) a run is refused by its estimate against that
+/// limit, or, where the estimate passes and an allocation fails later, ends with an error and
+/// status 1: never an abort (status 134).
+#[test]
+fn an_address_space_limit_gives_an_error_not_an_abort() {
+    if !Path::new(env!("CARGO_MANIFEST_DIR")).join("data/elegansbot/kymogram_omega-turn.npy").is_file() {
+        return;
+    }
+    let dir = tempfile::tempdir().expect("tempdir");
+    // 50 000 KiB is below the estimate (49.4 MiB); at 52 000 the estimate passes and the run
+    // needs more than the limit (about 55 MB) on this machine's allocator
+    for (kib, words) in [(50_000, "the run would need about"), (52_000, "out of memory: an allocation of")] {
+        let script = format!(
+            "ulimit -v {kib} && exec '{}' run cases/worm_roll_3d.toml --quiet --out '{}'",
+            env!("CARGO_BIN_EXE_cosserat"),
+            dir.path().join(format!("o{kib}")).display()
+        );
+        let o =
+            StdCommand::new("sh").args(["-c", &script]).current_dir(env!("CARGO_MANIFEST_DIR")).output().expect("sh");
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "ulimit -v {kib}: {stderr}");
+        assert!(stderr.contains(words) && stderr.contains("ulimit -v"), "ulimit -v {kib}: {stderr}");
+    }
+}

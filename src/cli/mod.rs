@@ -1,6 +1,7 @@
 //! Commands beyond a single case: `list` ([`list`]), and those of many recordings: `batch`
 //! (locally or as a Slurm job array), the hidden
 //! `batch-task` of an array task, `gather` and `synth`.
+pub mod alloc;
 pub mod list;
 pub mod outcome;
 pub mod progress;
