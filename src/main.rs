@@ -42,9 +42,9 @@ enum Command {
         /// Replace the output directory even if it holds files but no run.json
         #[arg(long)]
         force: bool,
-        /// Continue the interrupted or failed clip in the output directory from its last
-        /// converged frame (same case file and clip file); the CSVs are then byte for byte those
-        /// of an uninterrupted run
+        /// Continue the interrupted, failed or killed clip of the output directory from its
+        /// last converged frame (same case file and clip file), in a staging folder of its own;
+        /// the CSVs are then byte for byte those of an uninterrupted run
         #[arg(long, conflicts_with = "force")]
         resume: bool,
         /// Clips: per-node fields as CSV + ParaView VTK, or all in one fields.npz (docs/output.md)
@@ -52,7 +52,7 @@ enum Command {
         output_format: OutputFormat,
         #[command(flatten)]
         limits: Limits,
-        /// Do not show a progress bar
+        /// Do not show progress (a bar on a terminal, else a line every 10 s)
         #[arg(long)]
         quiet: bool,
     },
@@ -116,7 +116,7 @@ enum Command {
         /// Parallel runs [default: number of cores]
         #[arg(long)]
         jobs: Option<usize>,
-        /// Do not show a progress bar
+        /// Do not show progress (a bar on a terminal, else a line every 10 s)
         #[arg(long)]
         quiet: bool,
     },
@@ -144,7 +144,7 @@ enum Command {
         /// Parallel runs [default: number of cores]
         #[arg(long)]
         jobs: Option<usize>,
-        /// Do not show a progress bar
+        /// Do not show progress (a bar on a terminal, else a line every 10 s)
         #[arg(long)]
         quiet: bool,
     },

@@ -258,3 +258,74 @@ fn progress_without_a_terminal_is_a_line_every_interval_and_a_final_line() {
         .expect("run");
     assert!(quiet.status.success() && quiet.stderr.is_empty(), "{}", String::from_utf8_lossy(&quiet.stderr));
 }
+
+/// The flags of a piece of README text: `--name` at the start of a word (after `[` or `(`),
+/// up to `=` or the first character that cannot be in a flag's name.
+fn flags_in(text: &str) -> Vec<String> {
+    text.split_whitespace()
+        .filter_map(|w| {
+            let w = w.trim_start_matches(['[', '(']);
+            let name: String =
+                w.strip_prefix("--")?.chars().take_while(|c| c.is_ascii_alphanumeric() || *c == '-').collect();
+            (!name.is_empty()).then(|| format!("--{name}"))
+        })
+        .collect()
+}
+
+/// Does the help text `text` name the flag `flag` as a whole word (`--out`, not the start of
+/// `--output-format`)?
+fn has_flag(text: &str, flag: &str) -> bool {
+    text.match_indices(flag)
+        .any(|(i, _)| !text[i + flag.len()..].starts_with(|c: char| c.is_ascii_alphanumeric() || c == '-'))
+}
+
+/// The README and the `--help` texts agree: every flag on a code line or in a code span that
+/// runs `cosserat SUB` is in `cosserat SUB --help`, and every other flag the README names (in
+/// prose) is in the help of some command.
+#[test]
+fn every_flag_the_readme_names_is_in_the_help() {
+    let readme =
+        std::fs::read_to_string(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("README.md")).expect("README");
+    let subs = ["run", "compare", "sweep", "audit", "batch", "batch-task", "gather", "synth", "list", "modes"];
+    let help: std::collections::BTreeMap<&str, String> = subs
+        .iter()
+        .map(|s| {
+            (*s, String::from_utf8_lossy(&cosserat().args([s, "--help"]).output().expect("help").stdout).into_owned())
+        })
+        .collect();
+    // the lines of fenced code blocks, and the inline code spans of the prose (which may wrap)
+    let (mut pieces, mut prose, mut block) = (Vec::new(), String::new(), false);
+    for line in readme.lines() {
+        if line.trim_start().starts_with("```") {
+            block = !block;
+        } else if block {
+            pieces.push(line.to_string());
+        } else {
+            prose += line;
+            prose.push('\n');
+        }
+    }
+    pieces.extend(prose.split('`').skip(1).step_by(2).map(|s| s.replace('\n', " ")));
+    let external =
+        ["cargo", "bash", "sbatch", "squeue", "scripts/", "python", "pip", "ulimit", "target/release/cosserat gather"];
+    let mut checked = 0;
+    for piece in &pieces {
+        let code = piece.split('#').next().unwrap_or("").trim(); // a shell comment is prose
+        if let Some(at) = code.find("cosserat ").or_else(|| code.find("target/release/cosserat ")) {
+            let rest = &code[at..];
+            let rest = rest.split_once("cosserat ").map(|(_, r)| r).unwrap_or("");
+            let sub = rest.split_whitespace().next().unwrap_or("");
+            let Some(text) = help.get(sub) else { continue };
+            for flag in flags_in(rest) {
+                assert!(has_flag(text, &flag), "README: `{piece}`: `cosserat {sub} --help` has no {flag}");
+                checked += 1;
+            }
+        } else if !external.iter().any(|e| code.starts_with(e)) {
+            for flag in flags_in(code).into_iter().filter(|f| f != "--help") {
+                assert!(help.values().any(|t| has_flag(t, &flag)), "README: `{piece}`: no command has {flag}");
+                checked += 1;
+            }
+        }
+    }
+    assert!(checked > 30, "only {checked} flags found in the README");
+}

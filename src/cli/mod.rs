@@ -72,7 +72,7 @@ pub struct BatchArgs {
     /// How each recording's per-node fields are written (as `cosserat run --output-format`)
     #[arg(long, value_enum, default_value_t = OutputFormat::Csv)]
     output_format: OutputFormat,
-    /// Do not show a progress bar
+    /// Do not show progress (a bar on a terminal, else a line every 10 s)
     #[arg(long)]
     quiet: bool,
 }
