@@ -16,18 +16,17 @@ use cosserat::io::run_folder::sha256_file;
 
 /// Kills per campaign.
 const KILLS: usize = 20;
-/// The moments are drawn in [0, SPAN × the run's median duration]: some fall after its end.
-const SPAN: f64 = 1.25;
+/// The moments are drawn in [0, SPAN × the longest of three runs]: some fall after its end,
+/// also when the machine is busier during the campaign than while it was timed.
+const SPAN: f64 = 1.3;
 
 /// The tests of this file run one at a time (the campaign's moments are scaled by measured
 /// durations, which a second test on the same cores would stretch).
 static SERIAL: std::sync::Mutex<()> = std::sync::Mutex::new(());
 
-/// The median wall time of three runs of `make` (which prepares and runs one).
-fn median_duration(mut make: impl FnMut(usize) -> Duration) -> Duration {
-    let mut t: Vec<Duration> = (0..3).map(&mut make).collect();
-    t.sort();
-    t[1]
+/// The longest wall time of three runs of `make` (which prepares and runs one).
+fn longest_duration(mut make: impl FnMut(usize) -> Duration) -> Duration {
+    (0..3).map(&mut make).max().unwrap_or_default()
 }
 /// Frames of the clip: the delta turn cut to its first 150 (a run takes about half a second).
 const FRAMES: usize = 150;
@@ -171,7 +170,7 @@ fn sigkill_at_twenty_random_moments_of_a_run_and_of_a_resume() {
     std::fs::write(&case, text).expect("case");
     // The uninterrupted run, and its duration.
     let whole_dir = tmp.path().join("whole");
-    let t_run = median_duration(|k| {
+    let t_run = longest_duration(|k| {
         let dir = tmp.path().join(format!("whole{k}"));
         let start = Instant::now();
         let (code, err) = run(&[], &case, &dir);
@@ -198,7 +197,7 @@ fn sigkill_at_twenty_random_moments_of_a_run_and_of_a_resume() {
     let (code, err) = run(&[], &common::cases_dir().join("timoshenko_5pct.toml"), &other);
     assert_eq!(code, Some(0), "{err}");
     // How long a resume of the interrupted run takes.
-    let t_resume = median_duration(|k| {
+    let t_resume = longest_duration(|k| {
         let probe = tmp.path().join(format!("probe{k}"));
         copy_dir(&base, &probe);
         let start = Instant::now();
@@ -246,7 +245,7 @@ fn sigkill_at_twenty_random_moments_of_a_run_and_of_a_resume() {
         }
         assert_eq!(counts.previous + counts.new, KILLS, "{what}: {counts:?}");
         report.push(format!(
-            "{what} ({:.2} s uninterrupted, median of 3): {KILLS} SIGKILLs: the previous folder left {}, the new one {} ({} had ended before the kill); --resume then byte-identical {}, nothing to resume {}",
+            "{what} ({:.2} s uninterrupted, longest of 3): {KILLS} SIGKILLs: the previous folder left {}, the new one {} ({} had ended before the kill); --resume then byte-identical {}, nothing to resume {}",
             t.as_secs_f64(),
             counts.previous,
             counts.new,
