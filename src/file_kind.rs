@@ -65,6 +65,27 @@ pub fn kind(path: &Path) -> std::io::Result<FileKind> {
     std::fs::metadata(path).map(|m| FileKind::of(&m))
 }
 
+/// Is `path` this process's standard input (the file of descriptor 0: `/dev/stdin`, or the
+/// pipe a case is piped through)? A pipe read there blocks only on what the user piped in.
+pub fn is_standard_input(path: &Path) -> bool {
+    #[cfg(unix)]
+    {
+        use std::os::fd::AsFd;
+        use std::os::unix::fs::MetadataExt;
+        let stdin = std::io::stdin();
+        let Ok(fd) = stdin.as_fd().try_clone_to_owned() else { return false };
+        match (std::fs::File::from(fd).metadata(), std::fs::metadata(path)) {
+            (Ok(a), Ok(b)) => a.dev() == b.dev() && a.ino() == b.ino(),
+            _ => false,
+        }
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = path;
+        false
+    }
+}
+
 /// The sentence of an error refusing `path` of kind `kind` as `what` (an input file).
 pub fn not_regular_text(path: &Path, what: &str, kind: FileKind) -> String {
     format!(

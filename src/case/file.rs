@@ -1,5 +1,6 @@
-//! Reading a case file: refused unless it is a regular file (a pipe would block its open, a
-//! device never end), and above [`CASE_FILE_CAP_BYTES`] by its size.
+//! Reading a case file: refused unless it is a regular file (a named pipe would block its
+//! open, a device never end) or the standard input a case is piped into, and above
+//! [`CASE_FILE_CAP_BYTES`].
 use std::path::Path;
 
 use super::{CaseError, CASE_FILE_CAP_BYTES};
@@ -13,23 +14,26 @@ pub(super) fn too_large_text(size: Option<u64>) -> String {
     }
 }
 
-/// The text of a case file, refused above [`CASE_FILE_CAP_BYTES`] by its size, and refused
-/// before it is opened unless it is a regular file (a pipe would block the open, a device
-/// never end: `crate::file_kind`). The same rule as `crate::io::files::read_capped`, which
-/// this layer cannot import (`tests/architecture.rs`).
+/// The text of a case file, refused above [`CASE_FILE_CAP_BYTES`] (a regular file by its size,
+/// a pipe after one byte more), and refused before it is opened unless it is a regular file or
+/// the pipe of this process's standard input (`cosserat run /dev/stdin < case.toml`, read to its
+/// end as piped): a named pipe would block the open, a device never end (`crate::file_kind`).
+/// The same rule as `crate::io::files::read_capped`, which this layer cannot import
+/// (`tests/architecture.rs`).
 pub(super) fn read_case_file(path: &Path) -> Result<String, CaseError> {
-    use crate::file_kind::{kind, FileKind};
+    use crate::file_kind::{is_standard_input, kind, FileKind};
     use std::io::Read;
     let io = |source| CaseError::Io { path: path.to_path_buf(), source };
     let too_large = |size| CaseError::TooLarge { path: path.to_path_buf(), size };
     let not_regular = |kind| CaseError::NotRegular { path: path.to_path_buf(), kind };
-    match kind(path).map_err(io)? {
-        FileKind::Regular => {}
+    let piped = match kind(path).map_err(io)? {
+        FileKind::Regular => false,
+        FileKind::Fifo if is_standard_input(path) => true,
         other => return Err(not_regular(other)),
-    }
+    };
     let file = std::fs::File::open(path).map_err(io)?;
     let meta = file.metadata().map_err(io)?;
-    if !meta.is_file() {
+    if !meta.is_file() && !piped {
         // replaced between the check and the open
         return Err(not_regular(FileKind::of(&meta)));
     }
@@ -45,4 +49,10 @@ pub(super) fn read_case_file(path: &Path) -> Result<String, CaseError> {
         path: path.to_path_buf(),
         message: format!("not UTF-8 text (invalid byte at offset {})", e.utf8_error().valid_up_to()),
     })
+}
+
+/// SHA-256 of `bytes` (hex).
+pub(super) fn sha256_hex(bytes: &[u8]) -> String {
+    use sha2::{Digest, Sha256};
+    Sha256::digest(bytes).iter().map(|b| format!("{b:02x}")).collect()
 }

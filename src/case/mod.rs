@@ -198,6 +198,8 @@ pub struct Case {
     pub name: String,
     pub description: String,
     pub source: Option<PathBuf>,
+    /// the SHA-256 (hex) of the case file's bytes as they were read (also of a case piped in)
+    pub source_sha256: Option<String>,
     pub constants: BTreeMap<String, f64>,
     pub mesh: Mesh,
     pub material: Material,
@@ -222,6 +224,7 @@ impl Case {
         let name = path.file_stem().and_then(|s| s.to_str()).unwrap_or("case").to_string();
         let mut case = Case::from_toml(&text, &name, path)?;
         case.source = Some(path.to_path_buf());
+        case.source_sha256 = Some(file::sha256_hex(text.as_bytes()));
         Ok(case)
     }
 

@@ -145,6 +145,7 @@ impl<'a> Validator<'a> {
             name: name.to_string(),
             description: raw.description,
             source: None,
+            source_sha256: None,
             constants: self.constants,
             mesh,
             material,

@@ -110,7 +110,7 @@ fn stopped_by_full_disk(folder: RunFolder, mut end: JobEnd, out: &Path) -> JobEn
 pub fn run_manifest(case: &Case, engine: Engine) -> Result<Manifest, FolderError> {
     let mut m = Manifest::new("run");
     m.case_name = Some(case.name.clone());
-    m.case = case.source.as_deref().map(|p| input_file_as(p, "case file")).transpose()?;
+    m.case = case_file(case)?;
     m.inputs = case_inputs(case)?;
     if case.clip().is_some() {
         // a clip's folder counts frames from the start (what makes it resumable)
@@ -118,6 +118,16 @@ pub fn run_manifest(case: &Case, engine: Engine) -> Result<Manifest, FolderError
     }
     m.engine = Some(engine.to_string());
     Ok(m)
+}
+
+/// The case file with the SHA-256 of the bytes that were read (also of a case piped in through
+/// standard input), or hashed now for a case that was not read from a file by `Case::from_file`.
+pub fn case_file(case: &Case) -> Result<Option<InputFile>, FolderError> {
+    let Some(path) = &case.source else { return Ok(None) };
+    Ok(Some(match &case.source_sha256 {
+        Some(sha256) => InputFile { path: path.display().to_string(), sha256: sha256.clone() },
+        None => input_file_as(path, "case file")?,
+    }))
 }
 
 /// The files a case reads besides its case file, with their SHA-256: a clip's file (the

@@ -7,7 +7,7 @@ use std::path::Path;
 
 use super::engine::ClipOptions;
 use super::files::OutputError;
-use super::run_folder::{input_file, Manifest};
+use super::run_folder::Manifest;
 pub use super::solved::{case_label, chain, RunStatus, Solved as SweepOutcome};
 use super::solved::{solve_into, Solved};
 use crate::case::sweep::{fmt_value, Point};
@@ -126,7 +126,7 @@ pub fn run_clip_point(
 pub fn point_manifest(command: &str, case: &Case, point: &Point) -> Manifest {
     let mut m = Manifest::new(command);
     m.case_name = Some(case.name.clone());
-    m.case = case.source.as_deref().and_then(|p| input_file(p).ok());
+    m.case = super::job::case_file(case).ok().flatten();
     m.inputs = super::job::case_inputs(case).unwrap_or_default();
     m.settings = point.iter().cloned().collect();
     m.engine = Some("rust".into());
