@@ -140,7 +140,7 @@ fn an_interrupted_batch_stops_at_the_next_frame_and_says_what_it_kept() {
     for r in stopped {
         assert_eq!(r[2], "interrupted", "{r:?}");
         let n: usize = r[3].parse().expect("frames");
-        assert!(n >= 20 && n < 400, "{r:?}");
+        assert!((20..400).contains(&n), "{r:?}");
         let m = std::fs::read_to_string(out.join(&r[1]).join("run.json")).expect("run.json");
         assert!(m.contains("\"status\": \"interrupted\"") && m.contains(&format!("\"frames_done\": {n}")), "{m}");
     }

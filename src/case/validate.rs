@@ -284,7 +284,7 @@ impl<'a> Validator<'a> {
         }
         let r_g = (m[0].min(m[1]) / area).sqrt();
         let (slenderness, max) = (mesh.length_m / r_g, f64::EPSILON.sqrt().recip());
-        if !(slenderness <= max) {
+        if slenderness.is_nan() || slenderness > max {
             return Err(self.err(
                 "rod.length_m",
                 format!(

@@ -4,8 +4,6 @@
 use std::error::Error;
 use std::path::Path;
 
-use super::files::human_bytes;
-
 /// `errno` values of a full disk: ENOSPC (no space left on device), EDQUOT (disk quota
 /// exceeded).
 const FULL: [i32; 2] = [28, 122];
@@ -52,18 +50,13 @@ pub fn full_text(folder: &Path) -> String {
     format!("the disk holding {} is full ({space})", folder.display())
 }
 
-/// A size for people: `1.5 MiB`, `2 MiB`, `734 bytes`.
+/// A size for people: `2 MiB`, `1.5 MiB`, `48 KiB`, `700 bytes`.
 fn bytes_text(n: u64) -> String {
-    let exact = human_bytes(n);
-    if !exact.ends_with("bytes") || n < 1024 {
-        return exact;
+    match [(30, "GiB"), (20, "MiB"), (10, "KiB")].into_iter().find(|(shift, _)| n >= 1 << shift) {
+        Some((shift, unit)) if n.is_multiple_of(1 << shift) => format!("{} {unit}", n >> shift),
+        Some((shift, unit)) => format!("{:.1} {unit}", n as f64 / (1u64 << shift) as f64),
+        None => format!("{n} bytes"),
     }
-    let (v, unit) = [(1u64 << 30, "GiB"), (1 << 20, "MiB"), (1 << 10, "KiB")]
-        .into_iter()
-        .find(|(u, _)| n >= *u)
-        .map(|(u, name)| (n as f64 / u as f64, name))
-        .unwrap_or((n as f64, "bytes"));
-    format!("{v:.1} {unit}")
 }
 
 #[cfg(test)]
