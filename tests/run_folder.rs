@@ -340,23 +340,21 @@ fn an_interrupted_sweep_stops_every_point_and_says_what_it_kept() {
     let o = child.wait_with_output().expect("wait");
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(130), "{stderr}");
-    assert!(
-        stderr.contains("interrupted: 0 of 3 points complete, 2 stopped at their next iteration or frame"),
-        "{stderr}"
-    );
-    assert!(stderr.contains("1 not started"), "{stderr}");
+    assert!(stderr.contains("interrupted: 0 of 3 points complete, "), "{stderr}");
     let summary = std::fs::read_to_string(out.join("summary.csv")).expect("summary");
     let rows: Vec<Vec<&str>> = summary.lines().skip(1).map(|l| l.split(',').collect()).collect();
-    for row in &rows[..2] {
+    let not_started = "not started: a stop was requested before its turn";
+    for (k, row) in rows.iter().enumerate() {
         assert_eq!(row[1], "interrupted", "{summary}");
-        let frames: usize = row[2].parse().unwrap_or_else(|_| panic!("frames of {row:?}"));
-        assert!((20..300).contains(&frames), "{row:?}");
+        if row.last() == Some(&not_started) {
+            assert!(k > 0, "the point waited for was running: {summary}");
+            continue;
+        }
+        // the point waited for kept at least 20 frames; the other one may have fewer, or none
+        let frames: usize = row[2].parse().unwrap_or(0);
+        assert!(frames < 300 && (k > 0 || frames >= 20), "{row:?}");
     }
-    assert!(
-        rows[2][1] == "interrupted"
-            && summary.lines().last().unwrap_or("").ends_with("not started: a stop was requested before its turn"),
-        "{summary}"
-    );
+    assert!(rows[2].last() == Some(&not_started) && stderr.contains("1 not started"), "{summary}\n{stderr}");
     assert_eq!(status(&out), "interrupted");
     // An inverse point stops at its next iteration, not at the end of its solve.
     let out = dir.path().join("inverse");
