@@ -205,7 +205,9 @@ fn sigkill_at_twenty_random_moments_of_a_run_and_of_a_resume() {
         start.elapsed()
     });
 
-    let mut moments = Moments(31);
+    // another seed for a longer search: COSSERAT_KILL_SEED=7 cargo test --release --test kill_campaign
+    let seed = std::env::var("COSSERAT_KILL_SEED").ok().and_then(|s| s.parse().ok()).unwrap_or(31);
+    let mut moments = Moments(seed);
     let mut report = Vec::new();
     for (what, previous_dir, args, t) in
         [("run", &other, &[][..], t_run), ("resume", &base, &["--resume"][..], t_resume)]
@@ -254,7 +256,7 @@ fn sigkill_at_twenty_random_moments_of_a_run_and_of_a_resume() {
             counts.nothing_to_resume
         ));
     }
-    eprintln!("SIGKILL campaign, clip of {FRAMES} frames:\n  {}", report.join("\n  "));
+    eprintln!("SIGKILL campaign, clip of {FRAMES} frames, seed {seed}:\n  {}", report.join("\n  "));
 }
 
 /// A second run into a folder being written is refused at once, naming the process; a run
