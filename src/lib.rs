@@ -17,7 +17,8 @@
 //! Each layer imports only the layers above it in this list (checked by
 //! `tests/architecture.rs`):
 //! 1. foundation: [`expr`] (load expressions), [`linalg`] (block-tridiagonal systems),
-//!    [`reference`] (analytic solutions), [`interrupt`] (the stop requested by a signal);
+//!    [`reference`] (analytic solutions), [`interrupt`] (the stop requested by a signal),
+//!    [`file_kind`] (regular file, pipe, device: an input's kind, found without opening it);
 //! 2. [`model`]: material, rotation kinematics and charts, mesh and the layout of the unknowns
 //!    ([`model::mesh::DofMap`]), loads, the element kernels;
 //! 3. [`assemble`]: the one element loop and the integration of functionals;
@@ -58,6 +59,7 @@ pub mod audit;
 pub mod case;
 pub mod clip;
 pub mod expr;
+pub mod file_kind;
 pub mod interrupt;
 pub mod io;
 pub mod linalg;

@@ -4,7 +4,6 @@ use std::process::ExitCode;
 
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
-use indicatif::{ProgressBar, ProgressStyle};
 
 use cosserat::case::Case;
 use cosserat::io::compact::OutputFormat;
@@ -16,6 +15,8 @@ use cosserat::run::Engine;
 use cosserat::solve::modes::modal_model;
 
 mod cli;
+
+use cli::progress::Progress;
 
 /// Forward Cosserat rods after Wang et al. (Comput. Mech. 71, 2023), in Rust and FreeFEM.
 #[derive(Parser, Debug)]
@@ -41,9 +42,9 @@ enum Command {
         /// Replace the output directory even if it holds files but no run.json
         #[arg(long)]
         force: bool,
-        /// Continue the interrupted or failed clip in the output directory from its last
-        /// converged frame (same case file and clip file); the CSVs are then byte for byte those
-        /// of an uninterrupted run
+        /// Continue the interrupted, failed or killed clip of the output directory from its
+        /// last converged frame (same case file and clip file), in a staging folder of its own;
+        /// the CSVs are then byte for byte those of an uninterrupted run
         #[arg(long, conflicts_with = "force")]
         resume: bool,
         /// Clips: per-node fields as CSV + ParaView VTK, or all in one fields.npz (docs/output.md)
@@ -51,7 +52,7 @@ enum Command {
         output_format: OutputFormat,
         #[command(flatten)]
         limits: Limits,
-        /// Do not show a progress bar
+        /// Do not show progress (a bar on a terminal, else a line every 10 s)
         #[arg(long)]
         quiet: bool,
         /// Clips: exit with status 1 when frames are over the fit-quality gate (run.json then
@@ -93,7 +94,7 @@ enum Command {
     /// values, status, iterations, recovery errors, objective, wall time, error message) and
     /// `convergence.svg` (log-log histories, one curve per run; Figs. 9-11 of the paper). A run
     /// that reaches its iteration limit is `not_converged`: its folder holds the last iterate
-    /// and FAILED.txt, and its curve is plotted. A clip case solves its whole clip for every
+    /// with a run.json saying failed, and its curve is plotted. A clip case solves its whole clip for every
     /// point (the folder holds the files of `run` on the clip; the summary has one row per
     /// point: frames, iterations, worst fit, tangent misfit, |j - 1|, objective). Exit status 1
     /// if any run failed or did not converge (after writing everything).
@@ -119,7 +120,7 @@ enum Command {
         /// Parallel runs [default: number of cores]
         #[arg(long)]
         jobs: Option<usize>,
-        /// Do not show a progress bar
+        /// Do not show progress (a bar on a terminal, else a line every 10 s)
         #[arg(long)]
         quiet: bool,
     },
@@ -147,7 +148,7 @@ enum Command {
         /// Parallel runs [default: number of cores]
         #[arg(long)]
         jobs: Option<usize>,
-        /// Do not show a progress bar
+        /// Do not show progress (a bar on a terminal, else a line every 10 s)
         #[arg(long)]
         quiet: bool,
     },
@@ -157,9 +158,13 @@ enum Command {
     #[command(hide = true)]
     BatchTask(cli::TaskArgs),
     /// Write OUT/summary.csv from the recordings' folders of a batch (after a Slurm job array).
-    Gather { out: PathBuf },
+    Gather {
+        /// Output folder of the batch (`--out` of `cosserat batch`: holds batch.json and one
+        /// folder per recording); summary.csv is written there
+        out: PathBuf,
+    },
     /// Write a corpus of synthetic 3D recordings with their ground truth.
-    Synth(cli::SynthArgs),
+    Synth(cli::synth::SynthArgs),
     /// List the cases of a directory with their descriptions.
     List {
         /// Directory holding *.toml case files
@@ -206,7 +211,12 @@ fn install_signal_handler() {
     }
 }
 
+/// A failed allocation ends the process with a message and status 1, not an abort.
+#[global_allocator]
+static ALLOCATOR: cli::alloc::Guarded = cli::alloc::Guarded;
+
 fn main() -> ExitCode {
+    cli::alloc::at_start();
     cli::keep_freed_memory();
     let cli = Cli::parse();
     install_signal_handler();
@@ -235,7 +245,7 @@ fn dispatch(cli: Cli) -> Result<ExitCode> {
         Command::Batch(a) => cli::cmd_batch(a),
         Command::BatchTask(a) => cli::cmd_batch_task(a),
         Command::Gather { out } => cli::cmd_gather(&out),
-        Command::Synth(a) => cli::cmd_synth(a),
+        Command::Synth(a) => cli::synth::cmd_synth(a),
         Command::List { dir } => cli::list::cmd_list(&dir),
         Command::Modes { case, count, limits } => cmd_modes(&case, count, limits),
     }
@@ -243,20 +253,6 @@ fn dispatch(cli: Cli) -> Result<ExitCode> {
 
 fn load(path: &Path) -> Result<Case> {
     Ok(Case::from_file(path)?)
-}
-
-fn progress_bar(quiet: bool, label: &str) -> ProgressBar {
-    if quiet {
-        return ProgressBar::hidden();
-    }
-    let pb = ProgressBar::new(0);
-    pb.set_style(
-        ProgressStyle::with_template("{prefix} [{bar:40}] {pos}/{len} {per_sec} eta {eta}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar())
-            .progress_chars("=> "),
-    );
-    pb.set_prefix(label.to_string());
-    pb
 }
 
 /// Refuse a run whose estimated memory exceeds the limit (`--max-memory-gib`).
@@ -276,17 +272,13 @@ fn cmd_run(
     let case = load(path)?;
     check_memory(&case, Footprint::Run, limits)?;
     let dir = out.unwrap_or_else(|| PathBuf::from("out").join(&case.name).join(engine.to_string()));
-    let label = if case.clip().is_some() { "frames" } else { "" };
-    let pb = progress_bar(quiet || engine == Engine::Freefem, &format!("{} [{engine}] {label}", case.name));
+    let pb = Progress::new(&format!("{} [{engine}]", case.name), cli::outcome::progress_unit(&case, engine), 0, quiet);
     if engine == Engine::Freefem && !quiet {
         eprintln!("{} [freefem]: running FreeFEM in a staging folder beside {}", case.name, dir.display());
     }
-    let end = run_into(&case, engine, &dir, mode, |done, total| {
-        pb.set_length(total as u64);
-        pb.set_position(done as u64);
-    })
-    .with_context(|| format!("{}: output folder {}", case_label(&case), dir.display()))?;
-    pb.finish_and_clear();
+    let end = run_into(&case, engine, &dir, mode, |done, total| pb.set(done, total))
+        .with_context(|| format!("{}: output folder {}", case_label(&case), dir.display()))?;
+    pb.finish();
     for n in &end.notes {
         eprintln!("note: {n}");
     }
@@ -316,6 +308,13 @@ fn cmd_run(
             end.message.unwrap_or_default(),
             dir.display()
         ),
+        Status::Failed | Status::Running if end.disk_full.is_some() => {
+            anyhow::bail!(
+                "{}{}",
+                end.message.clone().unwrap_or_default(),
+                cli::outcome::full_disk_note(&end, path, &dir)
+            )
+        }
         Status::Failed | Status::Running => {
             let kept = match end.frames {
                 Some((n, _)) if n > 0 => format!(
@@ -369,7 +368,12 @@ fn cmd_compare(
     for n in &folder.notes {
         eprintln!("note: {n}");
     }
+    // Without a terminal, a line every 10 s says the comparison is still running; on a
+    // terminal the engines' own output is left alone.
+    let on_terminal = std::io::IsTerminal::is_terminal(&std::io::stderr());
+    let pb = Progress::new(&format!("{} compare", case.name), "", 0, on_terminal);
     let result = compare_into(&case, folder.dir(), &target, short, frames);
+    pb.finish();
     let (status, message) = match &result {
         Ok(_) => (Status::Complete, None),
         Err(_) if cosserat::interrupt::requested() => (Status::Interrupted, Some("interrupted by a signal".into())),
@@ -432,13 +436,16 @@ fn cmd_sweep(
     for n in &folder.notes {
         eprintln!("note: {n}");
     }
-    let pb = progress_bar(quiet, &format!("{} sweep", case.name));
-    pb.set_length(points.len() as u64);
+    let pb = Progress::new(&format!("{} sweep", case.name), "points", points.len(), quiet);
     let keys: Vec<String> = params.iter().map(|p| p.key.clone()).collect();
-    let result = sweep_into(&case, &keys, &points, folder.dir(), jobs.unwrap_or(0), || pb.inc(1));
-    pb.finish_and_clear();
+    let result = sweep_into(&case, &keys, &points, folder.dir(), jobs.unwrap_or(0), || pb.inc());
+    pb.finish();
     let rows = match result {
         Ok(rows) => rows,
+        Err(e) if cosserat::io::disk::is_full(&e) => {
+            folder.abandon();
+            anyhow::bail!("{}: sweep: {}", case_label(&case), cli::outcome::disk_full_text(&e, &target, "sweep"));
+        }
         Err(e) => {
             let message = cosserat::io::sweep::chain(&e);
             folder.finish(Status::Failed, Some(message.clone()))?;
@@ -467,10 +474,13 @@ fn cmd_sweep(
         target.join("summary.csv").display(),
         target.display()
     );
-    for r in &rows {
+    for r in rows.iter().filter(|r| r.error.as_deref() != Some(cosserat::io::sweep::NOT_STARTED)) {
         if let Some(e) = &r.error {
             eprintln!("  {}: {}: {e}", r.name, r.status.as_str());
         }
+    }
+    if interrupted > 0 {
+        eprintln!("{}", cli::outcome::sweep_interrupted_summary(&rows, &target));
     }
     Ok(if interrupted > 0 {
         ExitCode::from(EXIT_INTERRUPTED)
@@ -515,21 +525,26 @@ fn cmd_audit(
     manifest.settings.insert("quick".into(), f64::from(u8::from(quick)).into());
     let folder = RunFolder::begin(&out, manifest, Mode::Fresh { force })
         .with_context(|| format!("audit: output folder {}", out.display()))?;
-    let pb = progress_bar(quiet, if quick { "audit (quick)" } else { "audit" });
+    let pb = Progress::new(if quick { "audit (quick)" } else { "audit" }, "points", 0, quiet);
     let opts = AuditOptions { out: folder.dir().to_path_buf(), jobs: jobs.unwrap_or(0) };
+    let points = std::sync::atomic::AtomicUsize::new(0);
     let report = run_audit(&specs, quick, &opts, |done, total| {
-        pb.set_length(total as u64);
-        pb.set_position(done as u64);
+        points.store(total, std::sync::atomic::Ordering::SeqCst);
+        pb.set(done, total);
     });
-    pb.finish_and_clear();
+    pb.finish();
     let report = match report {
         Ok(r) if !cosserat::interrupt::requested() => {
             folder.finish(Status::Complete, None)?;
             r
         }
         Ok(_) => {
-            folder.finish(Status::Interrupted, Some("interrupted by a signal: points not run".into()))?;
-            eprintln!("audit interrupted; {} holds run.json saying interrupted", out.display());
+            let kept = cli::outcome::audit_points_kept(folder.dir(), points.load(std::sync::atomic::Ordering::SeqCst));
+            folder.finish(Status::Interrupted, Some(format!("interrupted by a signal: {kept}")))?;
+            eprintln!(
+                "audit interrupted: {kept}; REPORT.md judges the claims on what ran; {} holds run.json saying interrupted",
+                out.display()
+            );
             return Ok(ExitCode::from(EXIT_INTERRUPTED));
         }
         Err(e) => {

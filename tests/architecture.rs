@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 /// Layers, lowest first; a module may use its own top-level module and those of lower layers.
 const LAYERS: &[&[&str]] = &[
-    &["expr", "linalg", "reference", "interrupt"],
+    &["expr", "linalg", "reference", "interrupt", "file_kind"],
     &["model"],
     &["assemble"],
     &["solve"],

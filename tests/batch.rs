@@ -95,3 +95,98 @@ fn batch_refuses_a_foreign_output_folder_and_a_case_without_clip() {
     assert!(stderr.contains("has no [clip]"), "{stderr}");
     assert!(!tmp.path().join("o").exists(), "nothing written for a refused case");
 }
+
+/// SIGINT stops the running recordings at their next frame and starts no other; the summary
+/// marks each, and stderr says what was kept (exit status 130).
+#[test]
+fn an_interrupted_batch_stops_at_the_next_frame_and_says_what_it_kept() {
+    if !common::worm_data_present("batch") {
+        return;
+    }
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let (recs, out) = (tmp.path().join("recordings"), tmp.path().join("out"));
+    let synth = cosserat()
+        .args(["synth", "--count", "4", "--frames", "400", "--seed", "5", "--out"])
+        .arg(&recs)
+        .output()
+        .expect("synth");
+    assert!(synth.status.success());
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_cosserat"))
+        .arg("batch")
+        .arg(batch_common::case())
+        .arg("--recordings")
+        .arg(&recs)
+        .arg("--out")
+        .arg(&out)
+        .args(["--quiet", "--jobs", "2"])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("batch");
+    let frames = out.join(format!(".roll_000.staging-{}", child.id())).join("frames.csv");
+    let start = std::time::Instant::now();
+    while std::fs::read_to_string(&frames).map(|t| t.lines().count()).unwrap_or(0) < 20 {
+        assert!(start.elapsed().as_secs() < 60 && child.try_wait().expect("try_wait").is_none(), "no progress");
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    let _ = std::process::Command::new("kill").args(["-INT", &child.id().to_string()]).status();
+    let o = child.wait_with_output().expect("wait");
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(130), "{stderr}");
+    assert!(stderr.contains("interrupted: 0 of 4 recordings complete, 2 stopped at their next frame"), "{stderr}");
+    assert!(stderr.contains("2 not started"), "{stderr}");
+    let rows = summary_without_time(&out);
+    let not_started = "not started: a stop was requested before its turn";
+    let (waiting, stopped): (Vec<_>, Vec<_>) = rows[1..].iter().partition(|r| r[8] == not_started);
+    assert_eq!((stopped.len(), waiting.len()), (2, 2), "{rows:?}");
+    for r in stopped {
+        assert_eq!(r[2], "interrupted", "{r:?}");
+        let n: usize = r[3].parse().expect("frames");
+        assert!((20..400).contains(&n), "{r:?}");
+        let m = std::fs::read_to_string(out.join(&r[1]).join("run.json")).expect("run.json");
+        assert!(m.contains("\"status\": \"interrupted\"") && m.contains(&format!("\"frames_done\": {n}")), "{m}");
+    }
+    for r in waiting {
+        assert_eq!(r[2], "interrupted", "{r:?}");
+        assert!(!out.join(&r[1]).exists(), "no folder for a recording not started");
+    }
+}
+
+/// `synth` writes a corpus into a folder of its own: a folder that is not empty (an earlier
+/// corpus) is refused unless --force, which replaces it whole; its default kymogram is found
+/// from any working folder.
+#[test]
+fn synth_refuses_a_folder_that_is_not_empty_and_finds_its_kymogram_anywhere() {
+    if !common::worm_data_present("synth") {
+        return;
+    }
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let synth = |count: &str, extra: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_cosserat"))
+            .current_dir(tmp.path()) // not the source tree: the default kymogram is found anyway
+            .args(["synth", "--out", "corpus", "--frames", "4", "--count", count])
+            .args(extra)
+            .output()
+            .expect("synth")
+    };
+    let first = synth("3", &[]);
+    assert!(first.status.success(), "{}", String::from_utf8_lossy(&first.stderr));
+    let second = synth("2", &[]);
+    let stderr = String::from_utf8_lossy(&second.stderr);
+    assert_eq!(second.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("is not empty") && stderr.contains("--force"), "{stderr}");
+    let forced = synth("2", &["--force"]);
+    assert!(forced.status.success(), "{}", String::from_utf8_lossy(&forced.stderr));
+    let mut names: Vec<String> = std::fs::read_dir(tmp.path().join("corpus"))
+        .expect("corpus")
+        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    assert_eq!(
+        names,
+        ["corpus.json", "roll_000.npy", "roll_000.truth.npy", "roll_001.npy", "roll_001.truth.npy", "run.json"],
+        "the earlier corpus is gone whole"
+    );
+    let m = std::fs::read_to_string(tmp.path().join("corpus/run.json")).expect("run.json");
+    assert!(m.contains("\"command\": \"synth\"") && m.contains("kymogram_omega-turn.npy"), "{m}");
+}

@@ -65,6 +65,14 @@ fn bad_case_is_a_clear_error_not_a_panic() {
             .and(predicate::str::contains("must be > 0"))
             .and(predicate::str::contains("panicked").not()),
     );
+    // A length no double-precision rod can have is blamed, not the loads that then fail.
+    std::fs::write(&bad, common::edit(&common::case_text("timoshenko_5pct"), "length_m = \"L0\"", "length_m = 1e200"))
+        .expect("write");
+    cosserat().arg("run").arg(&bad).assert().code(1).stderr(
+        predicate::str::contains("rod.length_m")
+            .and(predicate::str::contains("radius of gyration"))
+            .and(predicate::str::contains("loads").not()),
+    );
     cosserat()
         .args(["run", "cases/does_not_exist.toml"])
         .assert()
@@ -186,7 +194,7 @@ fn sweep_writes_one_folder_per_run_a_summary_and_a_convergence_plot() {
         .code(1)
         .stderr(predicate::str::contains("frame 0 did not converge after 3 iterations"));
     let summary = std::fs::read_to_string(dir.path().join("fail/summary.csv")).expect("summary");
-    assert!(summary.lines().nth(1).expect("row").starts_with("3,not_converged,3.0000000000e0,"), "{summary}");
+    assert!(summary.lines().nth(1).expect("row").starts_with("3,not_converged,3,"), "{summary}");
     // The last iterate is kept, labelled, and its history plotted.
     let manifest = std::fs::read_to_string(dir.path().join("fail/max_iterations=3/run.json")).expect("run.json");
     assert!(manifest.contains("\"status\": \"failed\"") && manifest.contains("did not converge"), "{manifest}");
@@ -244,4 +252,105 @@ fn compare_refuses_frames_on_a_case_without_a_clip() {
         .assert()
         .failure()
         .stderr(predicate::str::contains("`--frames` applies to clips only"));
+}
+
+/// Without a terminal (stderr to a pipe: a log file, nohup, a Slurm task) a long command prints
+/// a progress line every interval (10 s; 0.1 s here) with done/total, rate and time left, and a
+/// final line; `--quiet` prints none.
+#[test]
+fn progress_without_a_terminal_is_a_line_every_interval_and_a_final_line() {
+    if !std::path::Path::new("data/elegansbot/kymogram_delta-turn.npy").is_file() {
+        return;
+    }
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = cosserat()
+        .env("COSSERAT_PROGRESS_INTERVAL_S", "0.1")
+        .args(["run", "cases/worm_delta_turn_ld1.toml", "--out"])
+        .arg(dir.path().join("clip"))
+        .output()
+        .expect("run");
+    assert!(out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    let lines: Vec<&str> = stderr.lines().filter(|l| l.starts_with("worm_delta_turn_ld1 [rust]: ")).collect();
+    assert!(lines.len() >= 3, "{stderr}");
+    assert!(lines[0].contains("/300 frames (") && lines[0].contains(" frames/s, ETA "), "{stderr}");
+    assert!(lines.last().is_some_and(|l| l.contains("300/300 frames in ")), "{stderr}");
+    let quiet = cosserat()
+        .env("COSSERAT_PROGRESS_INTERVAL_S", "0.1")
+        .args(["run", "cases/worm_delta_turn_ld1.toml", "--quiet", "--out"])
+        .arg(dir.path().join("quiet"))
+        .output()
+        .expect("run");
+    assert!(quiet.status.success() && quiet.stderr.is_empty(), "{}", String::from_utf8_lossy(&quiet.stderr));
+}
+
+/// The flags of a piece of README text: `--name` at the start of a word (after `[` or `(`),
+/// up to `=` or the first character that cannot be in a flag's name.
+fn flags_in(text: &str) -> Vec<String> {
+    text.split_whitespace()
+        .filter_map(|w| {
+            let w = w.trim_start_matches(['[', '(']);
+            let name: String =
+                w.strip_prefix("--")?.chars().take_while(|c| c.is_ascii_alphanumeric() || *c == '-').collect();
+            (!name.is_empty()).then(|| format!("--{name}"))
+        })
+        .collect()
+}
+
+/// Does the help text `text` name the flag `flag` as a whole word (`--out`, not the start of
+/// `--output-format`)?
+fn has_flag(text: &str, flag: &str) -> bool {
+    text.match_indices(flag)
+        .any(|(i, _)| !text[i + flag.len()..].starts_with(|c: char| c.is_ascii_alphanumeric() || c == '-'))
+}
+
+/// The README and the `--help` texts agree: every flag on a code line or in a code span that
+/// runs `cosserat SUB` is in `cosserat SUB --help`, and every other flag the README names (in
+/// prose) is in the help of some command.
+#[test]
+fn every_flag_the_readme_names_is_in_the_help() {
+    let readme =
+        std::fs::read_to_string(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("README.md")).expect("README");
+    let subs = ["run", "compare", "sweep", "audit", "batch", "batch-task", "gather", "synth", "list", "modes"];
+    let help: std::collections::BTreeMap<&str, String> = subs
+        .iter()
+        .map(|s| {
+            (*s, String::from_utf8_lossy(&cosserat().args([s, "--help"]).output().expect("help").stdout).into_owned())
+        })
+        .collect();
+    // the lines of fenced code blocks, and the inline code spans of the prose (which may wrap)
+    let (mut pieces, mut prose, mut block) = (Vec::new(), String::new(), false);
+    for line in readme.lines() {
+        if line.trim_start().starts_with("```") {
+            block = !block;
+        } else if block {
+            pieces.push(line.to_string());
+        } else {
+            prose += line;
+            prose.push('\n');
+        }
+    }
+    pieces.extend(prose.split('`').skip(1).step_by(2).map(|s| s.replace('\n', " ")));
+    let external =
+        ["cargo", "bash", "sbatch", "squeue", "scripts/", "python", "pip", "ulimit", "target/release/cosserat gather"];
+    let mut checked = 0;
+    for piece in &pieces {
+        let code = piece.split('#').next().unwrap_or("").trim(); // a shell comment is prose
+        if let Some(at) = code.find("cosserat ").or_else(|| code.find("target/release/cosserat ")) {
+            let rest = &code[at..];
+            let rest = rest.split_once("cosserat ").map(|(_, r)| r).unwrap_or("");
+            let sub = rest.split_whitespace().next().unwrap_or("");
+            let Some(text) = help.get(sub) else { continue };
+            for flag in flags_in(rest) {
+                assert!(has_flag(text, &flag), "README: `{piece}`: `cosserat {sub} --help` has no {flag}");
+                checked += 1;
+            }
+        } else if !external.iter().any(|e| code.starts_with(e)) {
+            for flag in flags_in(code).into_iter().filter(|f| f != "--help") {
+                assert!(help.values().any(|t| has_flag(t, &flag)), "README: `{piece}`: no command has {flag}");
+                checked += 1;
+            }
+        }
+    }
+    assert!(checked > 30, "only {checked} flags found in the README");
 }

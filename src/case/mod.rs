@@ -12,6 +12,7 @@ use std::path::{Path, PathBuf};
 
 use nalgebra::{Matrix3, Vector3};
 
+mod file;
 mod raw;
 pub mod sweep;
 mod toml_error;
@@ -44,7 +45,9 @@ pub enum CaseError {
     Syntax { path: PathBuf, message: String },
     #[error("{path}: key `{key}`: {reason}")]
     Invalid { path: PathBuf, key: String, reason: String },
-    #[error("{path}: case file {}", too_large_text(*.size))]
+    #[error("{}", crate::file_kind::not_regular_text(path, "case file", *kind))]
+    NotRegular { path: PathBuf, kind: crate::file_kind::FileKind },
+    #[error("{path}: case file {}", file::too_large_text(*.size))]
     TooLarge {
         path: PathBuf,
         /// the size of a regular file; `None`: more than the cap was read from a stream
@@ -198,6 +201,8 @@ pub struct Case {
     pub name: String,
     pub description: String,
     pub source: Option<PathBuf>,
+    /// the SHA-256 (hex) of the case file's bytes as they were read (also of a case piped in)
+    pub source_sha256: Option<String>,
     pub constants: BTreeMap<String, f64>,
     pub mesh: Mesh,
     pub material: Material,
@@ -218,10 +223,11 @@ pub struct Case {
 impl Case {
     /// Read and validate a case file (at most [`CASE_FILE_CAP_BYTES`]).
     pub fn from_file(path: &Path) -> Result<Case, CaseError> {
-        let text = read_case_file(path)?;
+        let text = file::read_case_file(path)?;
         let name = path.file_stem().and_then(|s| s.to_str()).unwrap_or("case").to_string();
         let mut case = Case::from_toml(&text, &name, path)?;
         case.source = Some(path.to_path_buf());
+        case.source_sha256 = Some(file::sha256_hex(text.as_bytes()));
         Ok(case)
     }
 
@@ -337,38 +343,6 @@ impl Case {
             gate: clip.gate,
         })
     }
-}
-
-/// The message of `CaseError::TooLarge` (worded as `crate::io::InputError::TooLarge`).
-fn too_large_text(size: Option<u64>) -> String {
-    let cap = format!("{CASE_FILE_CAP_BYTES} bytes (1 MiB), the cap for case files");
-    match size {
-        Some(n) => format!("of {n} bytes is larger than {cap}"),
-        None => format!("is not a regular file and did not end within {cap}: reading stopped there"),
-    }
-}
-
-/// The text of a case file, refused above [`CASE_FILE_CAP_BYTES`]: a regular file by its size,
-/// anything else (a device, a pipe) after reading one byte more than the cap. The same rule as
-/// `crate::io::files::read_capped`, which this layer cannot import (`tests/architecture.rs`).
-fn read_case_file(path: &Path) -> Result<String, CaseError> {
-    use std::io::Read;
-    let io = |source| CaseError::Io { path: path.to_path_buf(), source };
-    let too_large = |size| CaseError::TooLarge { path: path.to_path_buf(), size };
-    let file = std::fs::File::open(path).map_err(io)?;
-    let meta = file.metadata().map_err(io)?;
-    if meta.is_file() && meta.len() > CASE_FILE_CAP_BYTES {
-        return Err(too_large(Some(meta.len())));
-    }
-    let mut bytes = Vec::new();
-    file.take(CASE_FILE_CAP_BYTES + 1).read_to_end(&mut bytes).map_err(io)?;
-    if bytes.len() as u64 > CASE_FILE_CAP_BYTES {
-        return Err(too_large(meta.is_file().then_some(bytes.len() as u64)));
-    }
-    String::from_utf8(bytes).map_err(|e| CaseError::Syntax {
-        path: path.to_path_buf(),
-        message: format!("not UTF-8 text (invalid byte at offset {})", e.utf8_error().valid_up_to()),
-    })
 }
 
 /// All `*.toml` files of a directory, sorted by name.

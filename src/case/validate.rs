@@ -116,6 +116,7 @@ impl<'a> Validator<'a> {
         let kind = raw.solver.analysis;
         let material = self.material(&raw.material, kind)?;
         let section = self.section(&raw.cross_section)?;
+        self.slenderness(&mesh, &section)?;
         let (loads, load_texts) = self.loads(&raw.loads, kind)?;
         self.tables_of_other_analyses(&raw, kind)?;
         let quadrature = match raw.solver.quadrature {
@@ -146,6 +147,7 @@ impl<'a> Validator<'a> {
             name: name.to_string(),
             description: raw.description,
             source: None,
+            source_sha256: None,
             constants: self.constants,
             mesh,
             material,
@@ -260,6 +262,40 @@ impl<'a> Validator<'a> {
                 height_m: self.positive("cross_section.height_m", height_m)?,
             },
         })
+    }
+
+    /// The rod's geometry within what double precision solves: the cross section's area and
+    /// second moments finite and > 0, and the slenderness `L / r_g` (`r_g = √(min(I1, I2)/A)`,
+    /// the radius of gyration) at most `1/√ε` ≈ 6.7e7. The stretching stiffness `EA` exceeds
+    /// the bending stiffness `EI/L²` by `(L/r_g)²`; beyond `1/ε` one matrix cannot hold both, and
+    /// the tangent is singular in double precision (a length in the wrong unit, `1e200`, …).
+    fn slenderness(&self, mesh: &Mesh, section: &CrossSection) -> Result<(), CaseError> {
+        let (area, m) = (section.area_m2(), section.second_moments_m4());
+        let key = match section {
+            CrossSection::Circle { .. } => "cross_section.radius_m",
+            CrossSection::Rectangle { .. } => "cross_section.width_m",
+        };
+        if !(area.is_finite() && area > 0.0 && m.iter().all(|v| v.is_finite() && *v > 0.0)) {
+            return Err(self.err(
+                key,
+                format!(
+                    "the cross section's area {area:e} m² and second moments {:e}, {:e} m⁴ must be finite and > 0 in double precision",
+                    m[0], m[1]
+                ),
+            ));
+        }
+        let r_g = (m[0].min(m[1]) / area).sqrt();
+        let (slenderness, max) = (mesh.length_m / r_g, f64::EPSILON.sqrt().recip());
+        if slenderness.is_nan() || slenderness > max {
+            return Err(self.err(
+                "rod.length_m",
+                format!(
+                    "{:e} m is {slenderness:.2e} times the cross section's radius of gyration ({r_g:e} m); above {max:.1e} (1/√ε) the stretching stiffness EA exceeds the bending stiffness EI/L² by more than 1/ε, and the discrete equations cannot be solved in double precision: check the units of the length and of the cross section",
+                    mesh.length_m
+                ),
+            ));
+        }
+        Ok(())
     }
 
     /// Tables and `[solver]` keys that belong to another analysis are refused.

@@ -1,19 +1,23 @@
 //! Commands beyond a single case: `list` ([`list`]), and those of many recordings: `batch`
 //! (locally or as a Slurm job array), the hidden
 //! `batch-task` of an array task, `gather` and `synth`.
+pub mod alloc;
 pub mod list;
+pub mod outcome;
+pub mod progress;
+pub mod synth;
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Duration;
 
 use anyhow::{Context, Result};
-use indicatif::{ProgressBar, ProgressStyle};
 
 use cosserat::io::batch::{self, gather, list_recordings, run_batch, run_task, BatchRow, Plan, SUMMARY};
 use cosserat::io::compact::OutputFormat;
-use cosserat::io::corpus::{write_corpus, CorpusParams};
 use cosserat::io::slurm;
+
+use progress::Progress;
 
 /// `cosserat batch`.
 #[derive(clap::Args, Debug)]
@@ -43,10 +47,32 @@ pub struct BatchArgs {
     /// Block until the job array has finished, then gather
     #[arg(long, requires = "slurm")]
     wait: bool,
+    /// Time limit of each array task (sbatch --time: `MM`, `HH:MM:SS`, `D-HH:MM`) [default:
+    /// the partition's]
+    #[arg(long, value_name = "TIME", requires = "slurm")]
+    time: Option<String>,
+    /// Memory of each array task (sbatch --mem: `500M`, `2G`) [default: the partition's]
+    #[arg(long, value_name = "MEM", requires = "slurm")]
+    mem: Option<String>,
+    /// Account charged for the array (sbatch --account)
+    #[arg(long, value_name = "ACCOUNT", requires = "slurm")]
+    account: Option<String>,
+    /// Any other sbatch option, written as an `#SBATCH` line of the job script; repeat for
+    /// more, e.g. `--sbatch-arg=--qos=long --sbatch-arg=--constraint=avx2`
+    #[arg(long = "sbatch-arg", value_name = "ARG", allow_hyphen_values = true, requires = "slurm")]
+    sbatch_arg: Vec<String>,
+    /// A file of shell lines that each array task runs before cosserat (`module load …`,
+    /// `export …`), copied into the job script
+    #[arg(long, value_name = "FILE", requires = "slurm")]
+    setup: Option<PathBuf>,
+    /// Write the plan (batch.json) and the job script (batch.sbatch) into OUT without
+    /// submitting it; `sbatch OUT/batch.sbatch` submits it
+    #[arg(long, requires = "slurm", conflicts_with = "wait")]
+    dry_run: bool,
     /// How each recording's per-node fields are written (as `cosserat run --output-format`)
     #[arg(long, value_enum, default_value_t = OutputFormat::Csv)]
     output_format: OutputFormat,
-    /// Do not show a progress bar
+    /// Do not show progress (a bar on a terminal, else a line every 10 s)
     #[arg(long)]
     quiet: bool,
 }
@@ -59,49 +85,6 @@ pub struct TaskArgs {
     /// Array task index ($SLURM_ARRAY_TASK_ID)
     #[arg(long)]
     index: usize,
-}
-
-/// `cosserat synth`.
-#[derive(clap::Args, Debug)]
-pub struct SynthArgs {
-    /// Output folder for the recordings (roll_KKK.npy), their truth sidecars and corpus.json
-    #[arg(long)]
-    out: PathBuf,
-    /// Number of recordings
-    #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
-    count: u64,
-    /// Frames per recording (>= 2)
-    #[arg(long, value_parser = clap::value_parser!(u64).range(2..))]
-    frames: u64,
-    /// Seed of the rolls, twists, kymogram excerpts and noise
-    #[arg(long, default_value_t = 0)]
-    seed: u64,
-    /// Nodes per frame: the batch case's rod.elements + 1
-    #[arg(long, default_value_t = 33, value_parser = clap::value_parser!(u64).range(3..))]
-    nodes: u64,
-    /// Standard deviation of the noise added to every coordinate [m]
-    #[arg(long, default_value_t = 1e-7)]
-    noise_m: f64,
-    /// Time between frames [s]
-    #[arg(long, default_value_t = 0.04)]
-    frame_interval_s: f64,
-    /// The kymogram whose curvature the recordings play (scripts/fetch_worm_data.sh)
-    #[arg(long, default_value = "data/elegansbot/kymogram_omega-turn.npy")]
-    kymogram: PathBuf,
-}
-
-fn bar(quiet: bool, len: usize, label: &str) -> ProgressBar {
-    if quiet {
-        return ProgressBar::hidden();
-    }
-    let pb = ProgressBar::new(len as u64);
-    pb.set_style(
-        ProgressStyle::with_template("{prefix} [{bar:40}] {pos}/{len} recordings, eta {eta}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar())
-            .progress_chars("=> "),
-    );
-    pb.set_prefix(label.to_string());
-    pb
 }
 
 /// Print the outcome of `rows` (written to `out/summary.csv`): one line on stdout, one line per
@@ -122,12 +105,33 @@ fn report(out: &Path, rows: &[BatchRow], skipped: usize) -> ExitCode {
     if failed.is_empty() {
         return ExitCode::SUCCESS;
     }
-    let names: Vec<&str> = failed.iter().map(|r| r.folder.as_str()).collect();
-    eprintln!("error: {} of {} recordings failed: {} (see {})", failed.len(), rows.len(), names.join(", "), SUMMARY);
     if rows.iter().any(|r| r.status == "interrupted") {
+        eprintln!("{}", interrupted_summary(out, rows));
         return ExitCode::from(crate::EXIT_INTERRUPTED);
     }
+    let names: Vec<&str> = failed.iter().map(|r| r.folder.as_str()).collect();
+    eprintln!("error: {} of {} recordings failed: {} (see {})", failed.len(), rows.len(), names.join(", "), SUMMARY);
     ExitCode::from(1)
+}
+
+/// What an interrupted batch kept: recordings complete, stopped at their next frame (with the
+/// frames their folders keep), not started, failed.
+fn interrupted_summary(out: &Path, rows: &[BatchRow]) -> String {
+    let not_started = rows.iter().filter(|r| r.reason.as_deref() == Some(batch::NOT_STARTED)).count();
+    let stopped: Vec<String> = rows
+        .iter()
+        .filter(|r| r.status == "interrupted" && r.reason.as_deref() != Some(batch::NOT_STARTED))
+        .map(|r| format!("{} ({} frames)", r.folder, r.frames.unwrap_or(0)))
+        .collect();
+    let ok = rows.iter().filter(|r| r.is_ok()).count();
+    let failed = rows.iter().filter(|r| !r.is_ok() && r.status != "interrupted").count();
+    format!(
+        "interrupted: {ok} of {} recordings complete, {} stopped at their next frame{}, {not_started} not started, {failed} failed; {} marks each. Run the same command again to run the others (complete recordings are skipped)",
+        rows.len(),
+        stopped.len(),
+        if stopped.is_empty() { String::new() } else { format!(": {}", stopped.join(", ")) },
+        out.join(SUMMARY).display()
+    )
 }
 
 pub fn cmd_batch(a: BatchArgs) -> Result<ExitCode> {
@@ -137,41 +141,100 @@ pub fn cmd_batch(a: BatchArgs) -> Result<ExitCode> {
     plan.format = a.output_format;
     // the case is read (and refused if it is not a clip case) before anything is written
     let (case, _) = batch::plan_case(&plan).with_context(|| format!("batch of {}", a.case.display()))?;
+    let _lock = lock_batch(&a.out)?;
     plan.begin(&a.out)?;
     let out = std::fs::canonicalize(&a.out).with_context(|| format!("output folder {}", a.out.display()))?;
     if a.slurm {
-        let exe = std::env::current_exe().context("cannot find the cosserat executable for the job script")?;
-        let id = slurm::submit(&plan, &out, &exe, a.partition.as_deref())?;
-        eprintln!(
-            "{}: submitted Slurm job {id}: {} recordings in {} array tasks; job script {}",
-            case.name,
-            plan.recordings.len(),
-            plan.tasks(),
-            out.join(slurm::SCRIPT).display()
-        );
-        if !a.wait {
-            println!("{id}");
-            eprintln!("when it has finished: cosserat gather {}", out.display());
-            return Ok(ExitCode::SUCCESS);
-        }
-        let pb = bar(a.quiet, plan.tasks(), &format!("{} job {id}", case.name));
-        slurm::wait(&id, Duration::from_millis(500), |queued| {
-            pb.set_position((plan.tasks() - queued.min(plan.tasks())) as u64)
-        })?;
-        pb.finish_and_clear();
-        let rows = gather(&out)?;
-        return Ok(report(&out, &rows, 0));
+        return submit_batch(&a, &plan, &out, &case.name);
     }
-    let pb = bar(a.quiet, plan.recordings.len(), &case.name);
-    let ran = run_batch(&plan, &out, a.jobs.unwrap_or(0), || pb.inc(1))?;
-    pb.finish_and_clear();
+    let pb = Progress::new(&format!("{} batch", case.name), "recordings", plan.recordings.len(), a.quiet);
+    let ran = run_batch(&plan, &out, a.jobs.unwrap_or(0), || pb.inc())?;
+    pb.finish();
     let skipped = ran.iter().filter(|r| r.skipped).count();
     let rows: Vec<BatchRow> = ran.into_iter().map(|r| r.row).collect();
     Ok(report(&out, &rows, skipped))
 }
 
+/// The lock of a batch's output folder while this process writes its plan and runs or submits
+/// it: a second `cosserat batch` into the same folder is refused at once.
+fn lock_batch(out: &Path) -> Result<cosserat::io::folder_lock::FolderLock> {
+    use cosserat::io::folder_lock::{FolderLock, LockError};
+    let name = out.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "batch".into());
+    let parent = out.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    std::fs::create_dir_all(parent).with_context(|| format!("cannot create {}", parent.display()))?;
+    FolderLock::acquire(parent, &name).map_err(|e| match e {
+        LockError::Held { pid } => anyhow::anyhow!(
+            "{} is being written by another cosserat batch ({}): wait for it to end, or choose another --out",
+            out.display(),
+            pid.map_or("its pid not yet known".to_string(), |p| format!("pid {p}"))
+        ),
+        LockError::Io { path, source } => anyhow::Error::new(source).context(format!("cannot lock {}", path.display())),
+    })
+}
+
+/// `batch --slurm`: the job script of the array tasks that have a recording to run (a
+/// resubmission runs only the unfinished recordings), submitted unless `--dry-run`; with
+/// `--wait`, waited for and gathered.
+fn submit_batch(a: &BatchArgs, plan: &Plan, out: &Path, name: &str) -> Result<ExitCode> {
+    let exe = std::env::current_exe().context("cannot find the cosserat executable for the job script")?;
+    let complete = batch::complete_recordings(plan, out)?;
+    let skipped = complete.iter().filter(|c| **c).count();
+    let tasks = batch::unfinished_tasks(plan, &complete);
+    let total = plan.recordings.len();
+    if tasks.is_empty() {
+        eprintln!("{name}: all {total} recordings hold a complete run: nothing to submit");
+        let rows = gather(out)?;
+        return Ok(report(out, &rows, skipped));
+    }
+    let setup = match &a.setup {
+        Some(p) => Some(cosserat::io::files::read_capped_text(p, SETUP_FILE_CAP_BYTES, "set-up file")?),
+        None => None,
+    };
+    let opts = slurm::JobOptions {
+        partition: a.partition.clone(),
+        time: a.time.clone(),
+        mem: a.mem.clone(),
+        account: a.account.clone(),
+        sbatch_args: a.sbatch_arg.clone(),
+        setup,
+    };
+    let script = slurm::write_script(plan, &tasks, out, &exe, &opts)?;
+    let counts = format!(
+        "{} of {total} recordings to run ({skipped} already complete, skipped) in {} of {} array tasks",
+        total - skipped,
+        tasks.len(),
+        plan.tasks()
+    );
+    if a.dry_run {
+        eprintln!(
+            "{name}: wrote {} ({counts}); not submitted: `sbatch {}` submits it",
+            script.display(),
+            script.display()
+        );
+        println!("{}", script.display());
+        return Ok(ExitCode::SUCCESS);
+    }
+    let id = slurm::submit(&script)?;
+    eprintln!("{name}: submitted Slurm job {id}: {counts}; job script {}", script.display());
+    if !a.wait {
+        println!("{id}");
+        eprintln!("when it has finished: cosserat gather {}", out.display());
+        return Ok(ExitCode::SUCCESS);
+    }
+    let pb = Progress::new(&format!("{name} job {id}"), "array tasks", tasks.len(), a.quiet);
+    slurm::wait(&id, Duration::from_millis(500), |queued| pb.set(tasks.len() - queued.min(tasks.len()), 0))?;
+    pb.finish();
+    let rows = gather(out)?;
+    Ok(report(out, &rows, skipped))
+}
+
+/// Largest `--setup` file read [bytes]: 64 KiB of shell lines.
+const SETUP_FILE_CAP_BYTES: u64 = 64 << 10;
+
 pub fn cmd_batch_task(a: TaskArgs) -> Result<ExitCode> {
-    let ran = run_task(&a.out, a.index)?;
+    let pb = Progress::new(&format!("batch task {}", a.index), "recordings", 0, false);
+    let ran = run_task(&a.out, a.index, |done, total| pb.set(done, total))?;
+    pb.finish();
     for r in &ran {
         let what = if r.skipped { "already complete".into() } else { r.row.status.clone() };
         eprintln!("{}: {what}{}", r.row.folder, r.row.reason.as_deref().map(|m| format!(": {m}")).unwrap_or_default());
@@ -182,28 +245,6 @@ pub fn cmd_batch_task(a: TaskArgs) -> Result<ExitCode> {
 pub fn cmd_gather(out: &Path) -> Result<ExitCode> {
     let rows = gather(out).with_context(|| format!("gather {}", out.display()))?;
     Ok(report(out, &rows, 0))
-}
-
-pub fn cmd_synth(a: SynthArgs) -> Result<ExitCode> {
-    let params = CorpusParams {
-        count: a.count as usize,
-        frames: a.frames as usize,
-        nodes: a.nodes as usize,
-        dt_s: a.frame_interval_s,
-        noise_m: a.noise_m,
-        seed: a.seed,
-        ..CorpusParams::default()
-    };
-    let entries =
-        write_corpus(&a.out, &a.kymogram, &params).with_context(|| format!("synth into {}", a.out.display()))?;
-    println!(
-        "wrote {} recordings ({} frames x {} nodes, with truth sidecars) and corpus.json to {}",
-        entries.len(),
-        params.frames,
-        params.nodes,
-        a.out.display()
-    );
-    Ok(ExitCode::SUCCESS)
 }
 
 /// glibc's malloc hands the top of its heap back to the system whenever more than 128 KB of

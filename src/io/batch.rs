@@ -17,7 +17,7 @@ use std::time::Instant;
 use super::compact::OutputFormat;
 use super::engine::ClipOptions;
 use super::files::{write_atomic, OutputError};
-use super::run_folder::{input_file, sha256_file, FolderError, InputFile, Manifest, Mode, RunFolder, Status};
+use super::run_folder::{input_file_as, sha256_file, FolderError, InputFile, Manifest, Mode, RunFolder, Status};
 use super::solved::{chain, solve_into, RunStatus};
 use super::truth_file::{is_truth_sidecar, truth_sidecar};
 use crate::case::{Analysis, Case, CaseError, DataSource};
@@ -65,6 +65,8 @@ pub enum BatchError {
     NotAClip(String),
     #[error(transparent)]
     Folder(#[from] FolderError),
+    #[error(transparent)]
+    Input(#[from] super::files::InputError),
     #[error(transparent)]
     Output(#[from] OutputError),
     #[error("{path}: {reason}")]
@@ -147,11 +149,15 @@ fn read_err(path: &Path) -> impl Fn(std::io::Error) -> BatchError + '_ {
     move |source| BatchError::Read { path: path.to_path_buf(), source }
 }
 
-/// Is `path` a recording by its name (`.csv` or `.npy`, not a truth sidecar)?
+/// Is `path` a recording by its name (`.csv` or `.npy`, not a truth sidecar, not a folder)?
+/// A pipe or device of that name is one: its row fails, saying what it is.
 fn is_recording(path: &Path) -> bool {
     let ext = path.extension().and_then(|e| e.to_str());
-    matches!(ext, Some("csv") | Some("npy")) && !is_truth_sidecar(path) && path.is_file()
+    matches!(ext, Some("csv") | Some("npy")) && !is_truth_sidecar(path) && !path.is_dir()
 }
+
+/// Largest list of recordings read [bytes]: 16 MiB, some 100 000 paths.
+const LIST_FILE_CAP_BYTES: u64 = 16 << 20;
 
 /// The recordings of `input`: the `.csv` and `.npy` files of a folder (sorted by name; truth
 /// sidecars excepted), or the lines of a list file (paths relative to the list's folder;
@@ -167,7 +173,7 @@ pub fn list_recordings(input: &Path) -> Result<Vec<PathBuf>, BatchError> {
         }
         out.sort();
     } else {
-        let text = std::fs::read_to_string(input).map_err(read_err(input))?;
+        let text = super::files::read_capped_text(input, LIST_FILE_CAP_BYTES, "list of recordings")?;
         let base = input.parent().unwrap_or(Path::new(""));
         out = text
             .lines()
@@ -299,10 +305,10 @@ fn recording_manifest(
     });
     m.case_name = Some(case.name.clone());
     m.case = Some(case_file.clone());
-    m.inputs.push(input_file(recording)?);
+    m.inputs.push(input_file_as(recording, "recording")?);
     let sidecar = truth_sidecar(recording);
     if sidecar.is_file() {
-        m.inputs.push(input_file(&sidecar)?);
+        m.inputs.push(input_file_as(&sidecar, "ground-truth sidecar")?);
     }
     m.engine = Some(Engine::Rust.to_string());
     m.frames_done = Some(0);
@@ -323,6 +329,9 @@ fn complete_row(dir: &Path, wanted: &Manifest) -> Option<BatchRow> {
     }
     serde_json::from_slice(&std::fs::read(dir.join(ROW)).ok()?).ok()
 }
+
+/// The reason of a recording not started because a stop was requested.
+pub const NOT_STARTED: &str = "not started: a stop was requested before its turn";
 
 /// How [`run_recording`] ended.
 pub struct Ran {
@@ -352,7 +361,7 @@ pub fn run_recording(case: &Case, case_file: &InputFile, entry: &PlanEntry, out:
         return Ran { row, skipped: true };
     }
     if crate::interrupt::requested() {
-        let row = BatchRow::without_result(entry, RunStatus::Interrupted.as_str(), "not started: interrupted".into());
+        let row = BatchRow::without_result(entry, RunStatus::Interrupted.as_str(), NOT_STARTED.into());
         return Ran { row, skipped: false };
     }
     let case = match with_recording(case, &entry.path) {
@@ -365,6 +374,11 @@ pub fn run_recording(case: &Case, case_file: &InputFile, entry: &PlanEntry, out:
     };
     let clip = ClipOptions { journal: true, resume: false, format };
     let solved = solve_into(&case, Engine::Rust, folder.dir(), clip, |_| {}, |_, _| {});
+    if solved.disk_full {
+        // the recording's previous folder stays; its staging folder goes, freeing its space
+        folder.abandon();
+        return failed(format!("{}: {}", super::disk::full_text(&dir), solved.error.unwrap_or_default()));
+    }
     let metrics = solved.clip.as_ref().filter(|c| !c.reports.is_empty()).map(|c| clip_metrics(&case, c));
     let get = |k: &str| metrics.as_ref().and_then(|m| m.get(k)).copied();
     let row = BatchRow {
@@ -408,6 +422,26 @@ pub fn plan_case(plan: &Plan) -> Result<(Case, InputFile), BatchError> {
     Ok((case, InputFile { path: plan.case.display().to_string(), sha256 }))
 }
 
+/// Which recordings of the plan in `out` hold a complete run of the same case and recording
+/// (and are skipped when run again), in the plan's order.
+pub fn complete_recordings(plan: &Plan, out: &Path) -> Result<Vec<bool>, BatchError> {
+    let (case, case_file) = plan_case(plan)?;
+    Ok(plan
+        .recordings
+        .iter()
+        .map(|e| {
+            recording_manifest(&case, &case_file, &e.path, plan.format)
+                .is_ok_and(|m| complete_row(&out.join(&e.folder), &m).is_some())
+        })
+        .collect())
+}
+
+/// The Slurm array tasks of the plan that have a recording to run (`complete`: as
+/// [`complete_recordings`] says).
+pub fn unfinished_tasks(plan: &Plan, complete: &[bool]) -> Vec<usize> {
+    (0..plan.tasks()).filter(|&t| complete.chunks(plan.per_task).nth(t).is_some_and(|c| c.iter().any(|d| !d))).collect()
+}
+
 /// Run every recording of the plan in `out` on `jobs` threads (0: one per core), then write
 /// `summary.csv`; `tick` after each recording. Rows in the plan's order.
 pub fn run_batch(plan: &Plan, out: &Path, jobs: usize, tick: impl Fn() + Sync) -> Result<Vec<Ran>, BatchError> {
@@ -430,12 +464,18 @@ pub fn run_batch(plan: &Plan, out: &Path, jobs: usize, tick: impl Fn() + Sync) -
     Ok(ran)
 }
 
-/// Run the recordings of Slurm array task `index` of the plan in `out`, one after the other.
-pub fn run_task(out: &Path, index: usize) -> Result<Vec<Ran>, BatchError> {
+/// Run the recordings of Slurm array task `index` of the plan in `out`, one after the other;
+/// `progress(done, total)` after each.
+pub fn run_task(out: &Path, index: usize, mut progress: impl FnMut(usize, usize)) -> Result<Vec<Ran>, BatchError> {
     let plan = Plan::read(out)?;
     let entries = plan.task(index)?;
     let (case, case_file) = plan_case(&plan)?;
-    Ok(entries.iter().map(|e| run_recording(&case, &case_file, e, out, plan.format)).collect())
+    let mut ran = Vec::with_capacity(entries.len());
+    for e in entries {
+        ran.push(run_recording(&case, &case_file, e, out, plan.format));
+        progress(ran.len(), entries.len());
+    }
+    Ok(ran)
 }
 
 /// The rows of the plan in `out` from its recordings' folders (`missing` where a folder holds

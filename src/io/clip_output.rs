@@ -259,7 +259,7 @@ impl ClipWriter {
         row.push(omega.iter().map(|w| w.norm()).fold(0.0, f64::max));
         row.push(r.certificate);
         row.extend([r.fit.noise_m, r.fit.position, r.fit.tangent, f64::from(u8::from(r.fit.flagged))]);
-        writeln!(self.frames, "{}", csv_row(&row)).and_then(|_| self.frames.flush()).map_err(err("frames.csv"))?;
+        writeln!(self.frames, "{}", frames_row(&row)).and_then(|_| self.frames.flush()).map_err(err("frames.csv"))?;
         let d = nodes.directors();
         let [fields, curvature] = row_files(self.format());
         // each file's rows of the frame are built in one buffer and written at once
@@ -417,6 +417,27 @@ pub const TRUTH_COLUMNS: [&str; 10] = [
     "twist_rms_err_per_m",
     "roll_offset_rad",
 ];
+
+/// The integer columns of `frames.csv` (the frame, its iterations, a node index, a flag).
+pub const CLIP_FRAME_INTEGER_COLUMNS: [&str; 5] =
+    ["frame", "iterations", "min_abs_cos_beta_node", "restarted", "flagged"];
+
+/// One row of `frames.csv` ([`CLIP_FRAME_COLUMNS`]): the [`CLIP_FRAME_INTEGER_COLUMNS`] as
+/// integers, the others `{:.10e}`.
+fn frames_row(values: &[f64]) -> String {
+    let mut s = String::with_capacity(18 * values.len());
+    for (k, v) in values.iter().enumerate() {
+        if k > 0 {
+            s.push(',');
+        }
+        if CLIP_FRAME_COLUMNS.get(k).is_some_and(|c| CLIP_FRAME_INTEGER_COLUMNS.contains(c)) {
+            super::number::push_integer(&mut s, *v, 10);
+        } else {
+            super::number::push_exp(&mut s, *v, 10);
+        }
+    }
+    s
+}
 
 /// Numbers as one CSV row, `{:.10e}` each ([`super::number::push_exp`]).
 fn csv_row(values: &[f64]) -> String {

@@ -170,7 +170,11 @@ pub fn run_clip_to(
         Input::Loaded(_, truth) => truth.is_some(),
     };
     let (records, sink): (Vec<_>, _) = if opts.resume {
-        let (entries, bytes) = read_journal(dir)?;
+        // a run killed before its first frame has no journal yet: it resumes from the start
+        let (entries, bytes) = match read_journal(dir) {
+            Err(JournalError::Missing { .. }) => (Vec::new(), 0),
+            read => read?,
+        };
         let sink = ClipWriter::resume(dir, has_truth, &entries, bytes, opts.format)?;
         (entries.into_iter().map(|e| e.record).collect(), sink)
     } else {

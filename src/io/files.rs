@@ -28,6 +28,9 @@ pub enum OutputError {
     },
     #[error("cannot write {path}: {reason}")]
     Invalid { path: PathBuf, reason: String },
+    /// a part of the output (a sweep's point) could not be written for want of space
+    #[error("{path}: {message}")]
+    DiskFull { path: PathBuf, message: String },
 }
 
 /// Errors reading an input file; each names the file and, where it applies, the row, frame,
@@ -77,6 +80,8 @@ pub enum InputError {
         size: Option<u64>,
         cap: u64,
     },
+    #[error("{}", crate::file_kind::not_regular_text(path, what, *kind))]
+    NotRegular { path: PathBuf, what: &'static str, kind: crate::file_kind::FileKind },
     #[error("{path}: {what} is not UTF-8 text (invalid byte at offset {offset})")]
     NotText { path: PathBuf, what: &'static str, offset: usize },
 }
@@ -105,15 +110,22 @@ pub fn human_bytes(n: u64) -> String {
 }
 
 /// The whole content of the input file `path` (`what` names its kind in messages: "recording",
-/// "kymogram", …), refused if it holds more than `cap` bytes. A regular file is refused by its
-/// size before it is read; anything else (a device, a pipe) is read through
-/// `Read::take(cap + 1)`, so `/dev/zero` is refused after `cap + 1` bytes instead of being
-/// read forever. The caps are chosen per reader, far above any real input of its kind.
+/// "kymogram", …), refused if it holds more than `cap` bytes. Anything but a regular file (a
+/// pipe, whose open blocks until a writer comes; a device such as `/dev/zero`, which never
+/// ends; a folder) is refused before it is opened ([`check_regular`]); a regular file is
+/// refused by its size before it is read, and read through `Read::take(cap + 1)` in case it
+/// grows meanwhile. The caps are chosen per reader, far above any real input of its kind.
 pub fn read_capped(path: &Path, cap: u64, what: &'static str) -> Result<Vec<u8>, InputError> {
     let open = |source| InputError::Open { path: path.to_path_buf(), source };
     let too_large = |size| InputError::TooLarge { path: path.to_path_buf(), what, size, cap };
+    check_regular(path, what)?;
     let file = std::fs::File::open(path).map_err(open)?;
     let meta = file.metadata().map_err(open)?;
+    if !meta.is_file() {
+        // replaced between the check and the open
+        let kind = crate::file_kind::FileKind::of(&meta);
+        return Err(InputError::NotRegular { path: path.to_path_buf(), what, kind });
+    }
     if meta.is_file() && meta.len() > cap {
         return Err(too_large(Some(meta.len())));
     }
@@ -125,6 +137,17 @@ pub fn read_capped(path: &Path, cap: u64, what: &'static str) -> Result<Vec<u8>,
         return Err(too_large(meta.is_file().then_some(bytes.len() as u64)));
     }
     Ok(bytes)
+}
+
+/// `Ok` if `path` is a regular file (symbolic links followed), found without opening it
+/// (`crate::file_kind`); the error names the input (`what`) and what the path is instead.
+pub fn check_regular(path: &Path, what: &'static str) -> Result<(), InputError> {
+    use crate::file_kind::{kind, FileKind};
+    match kind(path) {
+        Ok(FileKind::Regular) => Ok(()),
+        Ok(kind) => Err(InputError::NotRegular { path: path.to_path_buf(), what, kind }),
+        Err(source) => Err(InputError::Open { path: path.to_path_buf(), source }),
+    }
 }
 
 /// [`read_capped`] for a text file: its content must be UTF-8.
@@ -176,11 +199,26 @@ pub fn csv_text(header: &[&str], rows: impl Iterator<Item = Vec<f64>>) -> String
 
 /// CSV with empty fields where a value does not apply.
 pub fn csv_text_opt(header: &[&str], rows: impl Iterator<Item = Vec<Option<f64>>>) -> String {
+    csv_text_int(header, &[], rows)
+}
+
+/// [`csv_text_opt`] with the columns named in `integers` (iteration counts, indices, flags)
+/// written as integers (`12`, not `1.20000000000000000e1`).
+pub fn csv_text_int(header: &[&str], integers: &[&str], rows: impl Iterator<Item = Vec<Option<f64>>>) -> String {
+    let integer: Vec<bool> = header.iter().map(|h| integers.contains(h)).collect();
     let mut s = header.join(",");
     s.push('\n');
     for r in rows {
-        let line: Vec<String> = r.iter().map(|v| v.map(|v| format!("{v:.17e}")).unwrap_or_default()).collect();
-        s.push_str(&line.join(","));
+        for (k, v) in r.iter().enumerate() {
+            if k > 0 {
+                s.push(',');
+            }
+            match v {
+                Some(v) if integer.get(k).copied().unwrap_or(false) => super::number::push_integer(&mut s, *v, 17),
+                Some(v) => s.push_str(&format!("{v:.17e}")),
+                None => {}
+            }
+        }
         s.push('\n');
     }
     s
@@ -267,15 +305,23 @@ mod tests {
         );
     }
 
+    /// Devices, pipes and folders are refused before they are opened: `/dev/zero` would never
+    /// end, and the open of a pipe without a writer would never return.
     #[cfg(unix)]
     #[test]
-    fn dev_zero_is_refused_at_the_cap() {
-        let e = read_capped(Path::new("/dev/zero"), 1 << 20, "case file").unwrap_err().to_string();
-        assert_eq!(
-            e,
-            "/dev/zero: case file is not a regular file and did not end within 1048576 bytes (1 MiB), the cap for \
-             case files: reading stopped there"
-        );
+    fn devices_pipes_and_folders_are_refused_unopened() {
+        let e = read_capped(Path::new("/dev/zero"), 1 << 20, "recording").unwrap_err().to_string();
+        assert!(e.starts_with("/dev/zero: the recording is a character device, not a regular file"), "{e}");
+        let dir = tempfile::tempdir().unwrap();
+        let e = read_capped(dir.path(), 1 << 20, "kymogram").unwrap_err().to_string();
+        assert!(e.contains("the kymogram is a folder, not a regular file"), "{e}");
+        let fifo = dir.path().join("p.npy");
+        if std::process::Command::new("mkfifo").arg(&fifo).status().is_ok_and(|s| s.success()) {
+            let start = std::time::Instant::now();
+            let e = read_capped(&fifo, 1 << 20, "recording").unwrap_err().to_string();
+            assert!(e.contains("is a named pipe (FIFO), not a regular file"), "{e}");
+            assert!(start.elapsed().as_secs() < 5);
+        }
     }
 
     #[cfg(unix)]

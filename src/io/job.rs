@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 
 use super::compact::OutputFormat;
 use super::engine::ClipOptions;
-use super::run_folder::{input_file, FolderError, Manifest, Mode, RunFolder, Status};
+use super::run_folder::{input_file_as, FolderError, InputFile, Manifest, Mode, RunFolder, Status};
 pub use super::solved::case_label;
 use super::solved::solve_into;
 use crate::case::Case;
@@ -30,10 +30,13 @@ pub struct JobEnd {
     pub clip: Option<ClipRun>,
     /// clips: frames written and frames of the clip
     pub frames: Option<(usize, usize)>,
-    /// files in the folder (`run.json` excepted)
+    /// files in the folder, `run.json` included
     pub files: usize,
     /// what was done around the folder (stale staging folders), for the user
     pub notes: Vec<String>,
+    /// a run stopped by a full disk: the output folder is the previous one, and this staging
+    /// folder keeps the converged frames of a clip for `--resume` (`None`: nothing was kept)
+    pub disk_full: Option<Option<PathBuf>>,
 }
 
 impl JobEnd {
@@ -87,20 +90,62 @@ impl JobEnd {
     }
 }
 
+/// A run stopped by a full disk leaves the output folder `out` as it was: the converged frames
+/// of a clip stay in its staging folder, which `--resume` continues once there is space; a
+/// run with nothing to keep removes it (and so frees its space).
+fn stopped_by_full_disk(folder: RunFolder, mut end: JobEnd, out: &Path) -> JobEnd {
+    end.status = Status::Failed;
+    end.message = Some(format!("{}: {}", super::disk::full_text(out), end.message.unwrap_or_default()));
+    end.disk_full = Some(match end.frames {
+        Some((n, _)) if n > 0 => Some(folder.keep_staging(Status::Failed, end.message.clone())),
+        _ => {
+            folder.abandon();
+            None
+        }
+    });
+    end
+}
+
 /// The `run.json` of `cosserat run` on `case` in `engine`.
 pub fn run_manifest(case: &Case, engine: Engine) -> Result<Manifest, FolderError> {
     let mut m = Manifest::new("run");
     m.case_name = Some(case.name.clone());
-    m.case = case.source.as_deref().map(input_file).transpose()?;
-    if let Some(c) = case.clip() {
+    m.case = case_file(case)?;
+    m.inputs = case_inputs(case)?;
+    if case.clip().is_some() {
         // a clip's folder counts frames from the start (what makes it resumable)
         m.frames_done = Some(0);
-        if c.file.is_file() {
-            m.inputs.push(input_file(&c.file)?);
-        }
     }
     m.engine = Some(engine.to_string());
     Ok(m)
+}
+
+/// The case file with the SHA-256 of the bytes that were read (also of a case piped in through
+/// standard input), or hashed now for a case that was not read from a file by `Case::from_file`.
+pub fn case_file(case: &Case) -> Result<Option<InputFile>, FolderError> {
+    let Some(path) = &case.source else { return Ok(None) };
+    Ok(Some(match &case.source_sha256 {
+        Some(sha256) => InputFile { path: path.display().to_string(), sha256: sha256.clone() },
+        None => input_file_as(path, "case file")?,
+    }))
+}
+
+/// The files a case reads besides its case file, with their SHA-256: a clip's file (the
+/// recording, or the kymogram of a kymogram or `roll_3d` clip) and a recording's ground-truth
+/// sidecar. A file that is there but is not a regular file (a pipe, a device, a folder) is
+/// refused here, before any folder is claimed; a missing one is left to the run, whose error
+/// names it.
+pub fn case_inputs(case: &Case) -> Result<Vec<InputFile>, FolderError> {
+    let mut inputs = Vec::new();
+    let Some(c) = case.clip() else { return Ok(inputs) };
+    if std::fs::metadata(&c.file).is_ok() {
+        inputs.push(input_file_as(&c.file, "clip file")?);
+        let sidecar = super::truth_file::truth_sidecar(&c.file);
+        if c.kind == crate::case::ClipKind::Recording && sidecar.is_file() {
+            inputs.push(input_file_as(&sidecar, "ground-truth sidecar")?);
+        }
+    }
+    Ok(inputs)
 }
 
 /// Run `case` in `engine` into the folder `out` ([`Mode`]: fresh, or resuming a clip; a clip's
@@ -124,6 +169,7 @@ pub fn run_into(
         frames: None,
         files: 0,
         notes: std::mem::take(&mut folder.notes),
+        disk_full: None,
     };
     let clip = ClipOptions { journal: true, resume: mode == Mode::Resume, format };
     let solved = solve_into(case, engine, &dir, clip, |_| {}, progress);
@@ -135,7 +181,11 @@ pub fn run_into(
     end.frames = solved.frames;
     folder.manifest.frames_done = end.frames.map(|f| f.0);
     folder.manifest.frames_total = end.frames.map(|f| f.1);
+    if solved.disk_full {
+        return Ok(stopped_by_full_disk(folder, end, out));
+    }
     let target = folder.finish(end.status, end.message.clone())?;
-    end.files = Manifest::read(&target)?.map(|m| m.files.len()).unwrap_or(0);
+    // the manifest lists every file but itself
+    end.files = Manifest::read(&target)?.map(|m| m.files.len() + 1).unwrap_or(0);
     Ok(end)
 }

@@ -3,7 +3,8 @@
 //! a run ([`run_files`]) and of a clip ([`clip_output`], [`clip_figures`], [`vtk`], [`compact`], the resume [`journal`]),
 //! SVG figures ([`plot`]), numbers as text ([`number`]), the FreeFEM engine ([`freefem`]), a case in either engine from its files ([`engine`]) and the
 //! files of a sweep ([`sweep`]), a batch of recordings ([`batch`], on Slurm: [`slurm`]) and a
-//! corpus of synthetic recordings ([`corpus`]).
+//! corpus of synthetic recordings ([`corpus`]); the output-folder contract ([`run_folder`]: its
+//! lock [`folder_lock`], what runs leave beside a folder `staging`, a full disk [`disk`]).
 pub mod batch;
 pub mod clip_figures;
 pub mod clip_files;
@@ -12,8 +13,10 @@ pub mod compact;
 pub mod compare;
 pub mod corpus;
 pub mod data;
+pub mod disk;
 pub mod engine;
 pub mod files;
+pub mod folder_lock;
 pub mod freefem;
 pub mod freefem_clip;
 pub mod freefem_include;
@@ -27,6 +30,7 @@ pub mod run_files;
 pub mod run_folder;
 pub mod slurm;
 pub mod solved;
+mod staging;
 pub mod sweep;
 pub mod truth_file;
 pub mod vtk;

@@ -242,9 +242,34 @@ pub fn exp(v: f64, decimals: usize) -> String {
     s
 }
 
+/// Append the count, index or flag `v` (a whole number held as `f64`: iteration counts, frame
+/// and node indices, 0/1 flags) as an integer, `12` rather than `1.2000000000e1`; a value that
+/// is not a whole number (never written by the callers) keeps the `{v:.decimals$e}` form.
+pub fn push_integer(out: &mut String, v: f64, decimals: usize) {
+    /// 2^53: every whole `f64` below it is an exact integer
+    const EXACT: f64 = 9_007_199_254_740_992.0;
+    if v.fract() == 0.0 && v.abs() < EXACT {
+        out.push_str(itoa::Buffer::new().format(v as i64));
+    } else {
+        push_exp(out, v, decimals);
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn integers_are_written_as_integers() {
+        let text = |v: f64| {
+            let mut s = String::new();
+            push_integer(&mut s, v, 10);
+            s
+        };
+        assert_eq!([text(0.0), text(12.0), text(-3.0), text(1.0)], ["0", "12", "-3", "1"]);
+        assert_eq!(text(0.5), "5.0000000000e-1");
+        assert_eq!(text(f64::NAN), "NaN");
+    }
 
     fn check(v: f64) {
         for d in [0, 1, 3, 9, 10, 14, 15, 16] {

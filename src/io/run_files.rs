@@ -2,7 +2,7 @@
 //! and an SVG plot of the headline result, each written atomically (`io::files`).
 use std::path::{Path, PathBuf};
 
-use super::files::{csv_text, csv_text_opt, write_atomic, write_plot, OutputError};
+use super::files::{csv_text, csv_text_int, write_atomic, write_plot, OutputError};
 use super::plot::{render_panels_svg, LinePlot, Series};
 use crate::case::Case;
 use crate::run::metrics::Metrics;
@@ -40,9 +40,12 @@ pub fn write_run(case: &Case, r: &RunResult, metrics: &Metrics, dir: &Path) -> R
     if !r.history.is_empty() {
         put(
             "history.csv",
-            csv_text(
+            csv_text_int(
                 &["continuation_step", "iteration", "change", "certificate"],
-                r.history.iter().map(|h| vec![h.step as f64, h.iteration as f64, h.change, h.certificate]),
+                &["continuation_step", "iteration"],
+                r.history
+                    .iter()
+                    .map(|h| vec![Some(h.step as f64), Some(h.iteration as f64), Some(h.change), Some(h.certificate)]),
             )
             .into_bytes(),
         )?;
@@ -50,11 +53,14 @@ pub fn write_run(case: &Case, r: &RunResult, metrics: &Metrics, dir: &Path) -> R
     if !r.tip.is_empty() {
         let rows = r.tip.iter().map(|t| {
             let (x, a) = (t.position_m, t.angles_rad);
-            vec![t.time_s, x[0], x[1], x[2], a[0], a[1], a[2], t.newton_iterations as f64, t.certificate]
+            [t.time_s, x[0], x[1], x[2], a[0], a[1], a[2], t.newton_iterations as f64, t.certificate]
+                .into_iter()
+                .map(Some)
+                .collect()
         });
         put(
             "tip_history.csv",
-            csv_text(
+            csv_text_int(
                 &[
                     "time_s",
                     "tip_x_m",
@@ -66,6 +72,7 @@ pub fn write_run(case: &Case, r: &RunResult, metrics: &Metrics, dir: &Path) -> R
                     "newton_iterations",
                     "certificate",
                 ],
+                &["newton_iterations"],
                 rows,
             )
             .into_bytes(),
@@ -153,7 +160,7 @@ fn write_inverse(
         row.extend([k.map(|k| k[0]), k.map(|k| k[1])]);
         row
     });
-    put("inverse_history.csv", csv_text_opt(&header, rows).into_bytes())?;
+    put("inverse_history.csv", csv_text_int(&header, &["iteration"], rows).into_bytes())?;
     Ok(())
 }
 

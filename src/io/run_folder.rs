@@ -1,12 +1,16 @@
 //! The output-folder contract. Every command that writes results (`run`, `sweep`, `compare`,
-//! `audit`) writes them into a staging folder beside its output folder, `.NAME.staging-PID`,
-//! and `run.json` there says what the folder is: the command, the case and the SHA-256 of its
-//! file and inputs, the engine, the program version, the status (`running`, `complete`,
-//! `failed`, `interrupted`), the frames done and the files written. When the run ends — complete,
-//! failed or interrupted — the staging folder replaces the output folder whole (two renames in
-//! one parent), so a folder never mixes two runs and never holds stale files, and a run killed
-//! outright leaves the previous folder untouched (its staging folder is removed, or resumed, by
-//! the next run). A folder holding files but no `run.json` is not replaced unless `--force`.
+//! `audit`, each recording of `batch`) writes them into a staging folder beside its output
+//! folder, `.NAME.staging-PID`, and `run.json` there says what the folder is: the command, the
+//! case and the SHA-256 of its file and inputs, the engine, the program version, the status
+//! (`running`, `complete`, `failed`, `interrupted`), the frames done and the files written.
+//! When the run ends — complete, failed or interrupted — the staging folder takes the output
+//! folder's place in one exchange of names, so a folder never mixes two runs, never holds stale
+//! files, and a run killed at any moment leaves the output folder either as it was or whole and
+//! new. One run writes a folder at a time ([`super::folder_lock`]); what a killed run left is
+//! removed, or resumed, by the next run. `--resume` continues in a staging folder of its own (a
+//! copy of the output folder, or the staging folder of a killed run), so the previous folder
+//! stays in place until the resumed run ends. A folder holding files but no `run.json` is not
+//! replaced unless `--force`.
 use std::collections::BTreeMap;
 
 use crate::case::sweep::SweepValue;
@@ -15,6 +19,10 @@ use std::path::{Path, PathBuf};
 use sha2::{Digest, Sha256};
 
 use super::files::write_atomic;
+use super::folder_lock::{FolderLock, LockError};
+use super::staging::{
+    copy_run, is_temporary, leftovers, put_in_place, remove_temporaries, resume_source, Leftover, ResumeSource,
+};
 
 /// File name of the manifest in an output folder.
 pub const MANIFEST: &str = "run.json";
@@ -119,8 +127,11 @@ pub enum FolderError {
     Foreign { path: PathBuf, examples: String },
     #[error("{path}: refusing to replace the working folder, one of its parents or the root; choose a folder for the results")]
     Dangerous { path: PathBuf },
-    #[error("{path} is being written by another cosserat process (pid {pid}, run.json status running)")]
-    Busy { path: PathBuf, pid: u32 },
+    #[error(
+        "{path} is being written by another cosserat process ({}): one run writes a folder at a time; wait for it to end, or choose another --out",
+        pid.map_or("its pid not yet known".to_string(), |p| format!("pid {p}"))
+    )]
+    Busy { path: PathBuf, pid: Option<u32> },
     #[error("{path}: cannot resume: {reason}")]
     CannotResume { path: PathBuf, reason: String },
     #[error("{path}")]
@@ -131,9 +142,11 @@ pub enum FolderError {
     },
     #[error("{path}: {reason}")]
     Manifest { path: PathBuf, reason: String },
+    #[error(transparent)]
+    Input(#[from] super::files::InputError),
 }
 
-fn io_err(path: &Path) -> impl Fn(std::io::Error) -> FolderError + '_ {
+pub(super) fn io_err(path: &Path) -> impl Fn(std::io::Error) -> FolderError + '_ {
     move |source| FolderError::Io { path: path.to_path_buf(), source }
 }
 
@@ -147,6 +160,14 @@ pub fn sha256_file(path: &Path) -> std::io::Result<String> {
 
 /// An input file with its hash.
 pub fn input_file(path: &Path) -> Result<InputFile, FolderError> {
+    input_file_as(path, "input file")
+}
+
+/// The input file `path` (`what` names it in messages: "clip file", "recording") with its
+/// hash; anything but a regular file is refused before it is opened (a pipe's open would
+/// block: `super::files::check_regular`).
+pub fn input_file_as(path: &Path, what: &'static str) -> Result<InputFile, FolderError> {
+    super::files::check_regular(path, what)?;
     Ok(InputFile { path: path.display().to_string(), sha256: sha256_file(path).map_err(io_err(path))? })
 }
 
@@ -222,7 +243,7 @@ pub fn list_files(dir: &Path) -> Result<Vec<String>, FolderError> {
             if entry.file_type().map_err(io_err(&p))?.is_dir() {
                 walk(root, &p, out)?;
             } else {
-                let skip = (dir == root && name == MANIFEST) || (name.starts_with('.') && name.ends_with(".tmp"));
+                let skip = (dir == root && name == MANIFEST) || is_temporary(&name);
                 if skip {
                     continue;
                 }
@@ -248,7 +269,8 @@ pub enum Mode {
 }
 
 /// An output folder being written: the run writes into [`RunFolder::dir`] (the staging folder)
-/// and [`RunFolder::finish`] puts it in place.
+/// and [`RunFolder::finish`] puts it in place. The folder's lock ([`super::folder_lock`]) is
+/// held from [`RunFolder::begin`] until the `RunFolder` is dropped.
 #[derive(Debug)]
 pub struct RunFolder {
     target: PathBuf,
@@ -258,10 +280,8 @@ pub struct RunFolder {
     pub resumed: Option<Manifest>,
     /// what was done to the folder's surroundings (stale staging folders removed), for the user
     pub notes: Vec<String>,
-}
-
-fn pid_alive(pid: u32) -> bool {
-    pid == std::process::id() || Path::new(&format!("/proc/{pid}")).exists()
+    /// one writer per folder
+    _lock: FolderLock,
 }
 
 /// Is `path` the working folder, one of its parents, or the root?
@@ -272,7 +292,11 @@ fn dangerous(path: &Path) -> bool {
 }
 
 impl RunFolder {
-    /// Start a run whose results go to `target`, described by `manifest` (status running).
+    /// Start a run whose results go to `target`, described by `manifest` (status running):
+    /// take the folder's lock (refused at once if another run holds it), clear what runs that
+    /// ended early left beside it, and make the staging folder: empty, or for `--resume` the
+    /// run being continued (a killed run's staging folder taken over, or a copy of the output
+    /// folder, which stays in place until this run ends).
     pub fn begin(target: &Path, mut manifest: Manifest, mode: Mode) -> Result<RunFolder, FolderError> {
         let name = target
             .file_name()
@@ -291,28 +315,20 @@ impl RunFolder {
             }
         }
         std::fs::create_dir_all(&parent).map_err(io_err(&parent))?;
+        let lock = FolderLock::acquire(&parent, &name).map_err(|e| match e {
+            LockError::Held { pid } => FolderError::Busy { path: target.to_path_buf(), pid },
+            LockError::Io { path, source } => FolderError::Io { path, source },
+        })?;
         let staging = parent.join(format!(".{name}.staging-{}", std::process::id()));
         let mut notes = Vec::new();
-        // Staging folders of runs that were killed: the newest may be resumed, the rest go.
-        let prefix = format!(".{name}.staging-");
-        let mut stale: Vec<(std::time::SystemTime, PathBuf)> = Vec::new();
-        for entry in std::fs::read_dir(&parent).map_err(io_err(&parent))? {
-            let entry = entry.map_err(io_err(&parent))?;
-            let n = entry.file_name().to_string_lossy().into_owned();
-            if let Some(pid) = n.strip_prefix(&prefix).and_then(|p| p.parse::<u32>().ok()) {
-                if !pid_alive(pid) {
-                    let t = entry.metadata().and_then(|m| m.modified()).unwrap_or(std::time::UNIX_EPOCH);
-                    stale.push((t, entry.path()));
-                }
-            }
+        // Holding the lock, every staging folder of NAME is a run's that has ended. What holds
+        // no run's work goes at once; a killed run's work stays until it is resumed or replaced.
+        let (left, others) = leftovers(&parent, &name)?;
+        let (mut left, garbage): (Vec<_>, Vec<_>) = left.into_iter().partition(Leftover::in_progress);
+        for dir in garbage.into_iter().map(|l| l.dir).chain(others) {
+            std::fs::remove_dir_all(&dir).map_err(io_err(&dir))?;
         }
-        stale.sort();
         let old = Manifest::read(target)?;
-        if let Some(m) = &old {
-            if m.status == Status::Running && pid_alive(m.pid) {
-                return Err(FolderError::Busy { path: target.to_path_buf(), pid: m.pid });
-            }
-        }
         let resumed = match mode {
             Mode::Fresh { force } => {
                 let files = if target.is_dir() { list_entries(target)? } else { Vec::new() };
@@ -328,36 +344,38 @@ impl RunFolder {
                 None
             }
             Mode::Resume => {
-                // the run to continue: a killed run's staging folder, else the folder itself
-                let (source, previous) = match stale.pop() {
-                    Some((_, dir)) => {
-                        let m = Manifest::read(&dir)?;
+                let (source, previous) = resume_source(target, old.as_ref(), &left, &manifest)?;
+                match source {
+                    ResumeSource::Leftover(i) => {
+                        let dir = left.remove(i).dir;
+                        if dir != staging {
+                            std::fs::rename(&dir, &staging).map_err(io_err(&dir))?;
+                        }
                         notes.push(format!("resuming the run that was stopped while writing {}", dir.display()));
-                        (dir, m)
                     }
-                    None => (target.to_path_buf(), old.clone()),
-                };
-                let cannot = |reason: String| FolderError::CannotResume { path: target.to_path_buf(), reason };
-                let previous = previous.ok_or_else(|| cannot("it holds no run.json (no run to resume)".into()))?;
-                check_resumable(&previous, &manifest).map_err(cannot)?;
-                std::fs::rename(&source, &staging).map_err(io_err(&source))?;
+                    ResumeSource::Target => {
+                        if let Some(i) = left.iter().position(|l| l.dir == staging) {
+                            let dir = left.remove(i).dir;
+                            std::fs::remove_dir_all(&dir).map_err(io_err(&dir))?;
+                        }
+                        copy_run(target, &staging)?;
+                    }
+                }
+                remove_temporaries(&staging)?;
                 manifest.started_unix_s = previous.started_unix_s;
                 Some(previous)
             }
         };
-        for (_, dir) in stale {
+        for dir in left.into_iter().map(|l| l.dir) {
             std::fs::remove_dir_all(&dir).map_err(io_err(&dir))?;
-            notes.push(format!("removed {}, left by a run that was killed", dir.display()));
+            notes.push(format!("removed {}, left by a run that ended before its folder was in place", dir.display()));
         }
         if resumed.is_none() {
-            if staging.exists() {
-                std::fs::remove_dir_all(&staging).map_err(io_err(&staging))?;
-            }
             std::fs::create_dir_all(&staging).map_err(io_err(&staging))?;
         }
         manifest.status = Status::Running;
         manifest.write(&staging)?;
-        Ok(RunFolder { target: target.to_path_buf(), staging, manifest, resumed, notes })
+        Ok(RunFolder { target: target.to_path_buf(), staging, manifest, resumed, notes, _lock: lock })
     }
 
     /// Where the run writes (the staging folder).
@@ -370,29 +388,27 @@ impl RunFolder {
         &self.target
     }
 
+    /// End a run that the disk could not hold without touching the output folder: the staging
+    /// folder stays where it is, to be resumed (its `run.json` says `status` with `message` and
+    /// the frames done where there is room to write it; otherwise it still says running, which
+    /// `--resume` takes the same way). Returns the staging folder.
+    pub fn keep_staging(mut self, status: Status, message: Option<String>) -> PathBuf {
+        let _ = self.manifest.finish(&self.staging, status, message);
+        self.staging.clone()
+    }
+
+    /// End a run whose staging folder holds nothing worth keeping (a full disk before any
+    /// result): it is removed, and the output folder is left as it was.
+    pub fn abandon(self) {
+        let _ = std::fs::remove_dir_all(&self.staging);
+    }
+
     /// End the run as `status`: `run.json` written with the files, then the staging folder put
-    /// in place of the output folder (the previous one removed). Returns the output folder.
+    /// in place of the output folder in one step ([`put_in_place`]), the previous one removed
+    /// after. Returns the output folder.
     pub fn finish(mut self, status: Status, message: Option<String>) -> Result<PathBuf, FolderError> {
         self.manifest.finish(&self.staging, status, message)?;
-        let parent = self.staging.parent().unwrap_or(Path::new(".")).to_path_buf();
-        let old = parent.join(format!(
-            ".{}.old-{}",
-            self.target.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default(),
-            std::process::id()
-        ));
-        let had_old = self.target.exists();
-        if had_old {
-            std::fs::rename(&self.target, &old).map_err(io_err(&self.target))?;
-        }
-        if let Err(source) = std::fs::rename(&self.staging, &self.target) {
-            if had_old {
-                let _ = std::fs::rename(&old, &self.target);
-            }
-            return Err(FolderError::Io { path: self.staging.clone(), source });
-        }
-        if had_old {
-            std::fs::remove_dir_all(&old).map_err(io_err(&old))?;
-        }
+        put_in_place(&self.staging, &self.target)?;
         Ok(self.target.clone())
     }
 }
@@ -409,7 +425,7 @@ fn list_entries(dir: &Path) -> Result<Vec<String>, FolderError> {
 
 /// Can the run of `previous` be continued by the run described by `new`? The same command
 /// (`run`) on the same case file and inputs, a clip, not complete.
-fn check_resumable(previous: &Manifest, new: &Manifest) -> Result<(), String> {
+pub(super) fn check_resumable(previous: &Manifest, new: &Manifest) -> Result<(), String> {
     if previous.command != "run" || previous.frames_done.is_none() {
         return Err(format!("it holds a `{}` run, not a clip run (only clips resume)", previous.command));
     }

@@ -79,6 +79,8 @@ pub struct Solved {
     pub clip: Option<ClipRun>,
     /// clips: frames in the folder and frames of the clip
     pub frames: Option<(usize, usize)>,
+    /// it stopped because the disk (or quota) was full (`super::disk`)
+    pub disk_full: bool,
 }
 
 impl Solved {
@@ -97,7 +99,20 @@ impl Solved {
 
     /// A run that produced nothing, with its error.
     pub fn failed(error: String) -> Self {
-        Solved { status: RunStatus::Failed, error: Some(error), metrics: None, single: None, clip: None, frames: None }
+        Solved {
+            status: RunStatus::Failed,
+            error: Some(error),
+            metrics: None,
+            single: None,
+            clip: None,
+            frames: None,
+            disk_full: false,
+        }
+    }
+
+    /// A run that produced nothing, with its error `e` described as `error`.
+    fn failed_by(error: String, e: &(dyn std::error::Error + 'static)) -> Self {
+        Solved { disk_full: super::disk::is_full(e), ..Solved::failed(error) }
     }
 
     /// A run stopped (or not started) by a signal.
@@ -133,7 +148,11 @@ fn solve_single(case: &Case, engine: Engine, dir: &Path, progress: impl FnMut(us
         let path = dir.join("data.csv");
         match load_data(case).and_then(|d| Ok(write_data(&path, &d)?)) {
             Ok(()) => run_inverse_on(case, engine, &path, &work, progress),
-            Err(e) => return Solved::failed(format!("{}: generating the data: {}", case_label(case), chain(&e))),
+            Err(e) => {
+                let status = if interrupted(&e) { RunStatus::Interrupted } else { RunStatus::Failed };
+                let error = format!("{}: generating the data: {}", case_label(case), chain(&e));
+                return Solved { status, ..Solved::failed_by(error, &e) };
+            }
         }
     } else {
         run_case(case, engine, &work, progress)
@@ -146,22 +165,28 @@ fn solve_single(case: &Case, engine: Engine, dir: &Path, progress: impl FnMut(us
             Some(format!("{}: {source}; the files here hold the last iterate", case_label(case))),
         ),
         Err(e) => {
-            let interrupted = match &e {
-                EngineError::Run(r) => r.is_interrupted(),
-                EngineError::FreeFem(f) => f.is_interrupted(),
-                _ => false,
-            };
-            let status = if interrupted { RunStatus::Interrupted } else { RunStatus::Failed };
-            return Solved { status, ..Solved::failed(format!("{}: {}", case_label(case), chain(&e))) };
+            let status = if interrupted(&e) { RunStatus::Interrupted } else { RunStatus::Failed };
+            return Solved { status, ..Solved::failed_by(format!("{}: {}", case_label(case), chain(&e)), &e) };
         }
     };
-    let written = all_metrics(case, &r).map_err(|e| chain(&e)).and_then(|m| {
-        write_run(case, &r, &m, dir).map_err(|e| chain(&e))?;
-        Ok(m)
-    });
-    match written {
-        Ok(m) => Solved { status, error, metrics: Some(m), single: Some(r), clip: None, frames: None },
-        Err(e) => Solved::failed(format!("{}: {e}", case_label(case))),
+    let m = match all_metrics(case, &r) {
+        Ok(m) => m,
+        Err(e) => return Solved::failed(format!("{}: {}", case_label(case), chain(&e))),
+    };
+    match write_run(case, &r, &m, dir) {
+        Ok(_) => {
+            Solved { status, error, metrics: Some(m), single: Some(r), clip: None, frames: None, disk_full: false }
+        }
+        Err(e) => Solved::failed_by(format!("{}: {}", case_label(case), chain(&e)), &e),
+    }
+}
+
+/// Did the engine stop because a stop was requested (`crate::interrupt`)?
+fn interrupted(e: &EngineError) -> bool {
+    match e {
+        EngineError::Run(r) => r.is_interrupted(),
+        EngineError::FreeFem(f) => f.is_interrupted(),
+        _ => false,
     }
 }
 
@@ -173,7 +198,8 @@ fn solve_clip(
     observer: impl FnMut(&ClipFrame) + Send,
     progress: impl FnMut(usize, usize),
 ) -> Solved {
-    let fail = |e: &dyn std::error::Error| Solved::failed(format!("{}: {}", case_label(case), chain(e)));
+    let fail =
+        |e: &(dyn std::error::Error + 'static)| Solved::failed_by(format!("{}: {}", case_label(case), chain(e)), e);
     if engine != Engine::Rust {
         return Solved::failed(format!(
             "{}: `run` solves clips in the Rust engine (`--engine rust`); to run a clip in FreeFEM against it, use `cosserat compare CASE --frames N` (or `--frames all`)",
@@ -186,7 +212,8 @@ fn solve_clip(
     };
     let (done, total) = (out.run.reports.len(), out.total);
     let flagged: Vec<&FrameReport> = out.run.reports.iter().filter(|r| r.fit.flagged).collect();
-    let (status, error) = match &out.stopped {
+    let mut disk_full = out.stopped.as_ref().is_some_and(|e| super::disk::is_full(e));
+    let (mut status, mut error) = match &out.stopped {
         None if !flagged.is_empty() => (RunStatus::Warnings, Some(flag_message(case, &flagged, done))),
         None => (RunStatus::Ok, None),
         Some(e) if e.is_interrupted() => (RunStatus::Interrupted, Some(format!("{}: {}", case_label(case), chain(e)))),
@@ -195,18 +222,23 @@ fn solve_clip(
             Some(format!("{}: {}; the converged frames before it are in this folder", case_label(case), chain(e))),
         ),
     };
-    if done > 0 {
-        if let Err(e) = write_clip_figures(case, &out.run, dir) {
-            return fail(&e);
-        }
+    // A clip whose figures cannot be written keeps its frames (and says so).
+    let figures = if done > 0 { write_clip_figures(case, &out.run, dir) } else { Ok(()) };
+    if let Err(e) = figures {
+        disk_full |= super::disk::is_full(&e);
+        error = Some(match error {
+            Some(m) => format!("{m}; then {}", chain(&e)),
+            None => format!("{}: {}", case_label(case), chain(&e)),
+        });
+        status = RunStatus::Failed;
     }
     if status.is_complete() && opts.journal {
         if let Err(e) = remove_journal(dir).and_then(|_| remove_raw(dir)) {
-            return Solved::failed(chain(&e));
+            return Solved::failed_by(chain(&e), &e);
         }
     }
     let metrics = status.is_complete().then(|| clip_metrics(case, &out.run));
-    Solved { status, error, metrics, single: None, clip: Some(out.run), frames: Some((done, total)) }
+    Solved { status, error, metrics, single: None, clip: Some(out.run), frames: Some((done, total)), disk_full }
 }
 
 /// The message of a clip whose frames `flagged` (of `done`) are over the fit-quality gate.

@@ -7,7 +7,7 @@ use std::path::Path;
 
 use super::engine::ClipOptions;
 use super::files::OutputError;
-use super::run_folder::{input_file, Manifest};
+use super::run_folder::Manifest;
 pub use super::solved::{case_label, chain, RunStatus, Solved as SweepOutcome};
 use super::solved::{solve_into, Solved};
 use crate::case::sweep::Point;
@@ -72,14 +72,31 @@ pub fn summary_csv(keys: &[String], columns: &[&str], rows: &[SummaryRow]) -> Re
     for r in rows {
         let mut rec: Vec<String> = r.point.iter().map(|(_, v)| v.to_string()).collect();
         rec.push(r.status.as_str().into());
-        rec.extend(columns.iter().map(|k| {
-            r.metrics.as_ref().and_then(|m| m.get(*k)).map(|v| super::number::exp(*v, 10)).unwrap_or_default()
-        }));
+        rec.extend(
+            columns
+                .iter()
+                .map(|k| r.metrics.as_ref().and_then(|m| m.get(*k)).map(|v| summary_number(k, *v)).unwrap_or_default()),
+        );
         rec.push(r.error.as_deref().unwrap_or("").replace('\n', " "));
         w.write_record(&rec)?;
     }
     let bytes = w.into_inner().map_err(|e| csv::Error::from(e.into_error()))?;
     Ok(String::from_utf8_lossy(&bytes).into_owned())
+}
+
+/// The columns of the summary that count (iterations, frames): written as integers.
+pub const SUMMARY_INTEGER_METRICS: [&str; 3] = ["iterations", "frames", "iterations_max"];
+
+/// A value of the summary: a count of [`SUMMARY_INTEGER_METRICS`] as an integer, any other
+/// number with 10 significant digits.
+fn summary_number(column: &str, v: f64) -> String {
+    let mut s = String::new();
+    if SUMMARY_INTEGER_METRICS.contains(&column) {
+        super::number::push_integer(&mut s, v, 10);
+    } else {
+        super::number::push_exp(&mut s, v, 10);
+    }
+    s
 }
 
 /// One point of a sweep in the Rust engine, writing its folder `dir` and its `run.json`
@@ -109,8 +126,8 @@ pub fn run_clip_point(
 pub fn point_manifest(command: &str, case: &Case, point: &Point) -> Manifest {
     let mut m = Manifest::new(command);
     m.case_name = Some(case.name.clone());
-    m.case = case.source.as_deref().and_then(|p| input_file(p).ok());
-    m.inputs = case.clip().and_then(|c| input_file(&c.file).ok()).into_iter().collect();
+    m.case = super::job::case_file(case).ok().flatten();
+    m.inputs = super::job::case_inputs(case).unwrap_or_default();
     m.settings = point.iter().cloned().collect();
     m.engine = Some("rust".into());
     m
@@ -119,7 +136,7 @@ pub fn point_manifest(command: &str, case: &Case, point: &Point) -> Manifest {
 /// The point's `run.json`: `template` with the case's name, the point's status and message.
 fn finish_point(dir: &Path, template: &Manifest, case: &Case, outcome: Solved) -> Solved {
     if !dir.is_dir() {
-        return outcome;
+        return not_started(outcome);
     }
     let mut m = template.clone();
     m.certificate = outcome.certificate(case);
@@ -163,12 +180,13 @@ pub fn sweep_into(
             .par_iter()
             .map(|(point, c)| {
                 let template = point_manifest("sweep point", c, point);
-                let r = run_point(c, &dir.join(&c.name), &template);
+                let r = with_kept_frames(c, run_point(c, &dir.join(&c.name), &template));
                 tick();
                 (c.name.clone(), point.clone(), r)
             })
             .collect()
     });
+    stop_if_disk_full(dir, &results)?;
     let rows: Vec<SummaryRow> = results
         .iter()
         .map(|(name, point, o)| SummaryRow {
@@ -189,6 +207,39 @@ pub fn sweep_into(
         super::run_files::write_convergence_plot(&curves, &dir.join("convergence.svg"))?;
     }
     Ok(rows)
+}
+
+/// A point that a stop request kept from starting says so (its row, no folder).
+fn not_started(outcome: Solved) -> Solved {
+    match outcome.status {
+        RunStatus::Interrupted => Solved { error: Some(NOT_STARTED.into()), ..outcome },
+        _ => outcome,
+    }
+}
+
+/// The message of a point not started because a stop was requested.
+pub const NOT_STARTED: &str = "not started: a stop was requested before its turn";
+
+/// A clip point of a sweep that stopped early (interrupted, failed) reports the metrics of the
+/// frames it kept, so that its row says how many (`frames`) and how they went.
+fn with_kept_frames(case: &Case, outcome: Solved) -> Solved {
+    match (&outcome.metrics, &outcome.clip) {
+        (None, Some(c)) if !c.reports.is_empty() => {
+            Solved { metrics: Some(crate::run::clip_metrics::clip_metrics(case, c)), ..outcome }
+        }
+        _ => outcome,
+    }
+}
+
+/// A point stopped by a full disk stops the sweep: its folder is not a result to put in place.
+fn stop_if_disk_full(dir: &Path, results: &[(String, Point, SweepOutcome)]) -> Result<(), OutputError> {
+    match results.iter().find(|(_, _, o)| o.disk_full) {
+        Some((name, _, o)) => Err(OutputError::DiskFull {
+            path: dir.join(name),
+            message: o.error.clone().unwrap_or_else(|| "no space left on device".into()),
+        }),
+        None => Ok(()),
+    }
 }
 
 #[cfg(test)]
@@ -224,11 +275,10 @@ mod tests {
         ];
         let text = summary_csv(&["lambda_l".into()], &SUMMARY_METRICS, &rows).unwrap();
         let lines: Vec<&str> = text.lines().collect();
-        assert!(lines[0].starts_with("lambda_l,status,iterations,certificate,x_err_rel"));
-        assert!(lines[1].starts_with("1e-20,ok,1.2000000000e1"));
+        assert!(lines[0].starts_with("lambda_l,status,iterations,certificate,x_err_rel"), "{}", lines[0]);
+        assert!(lines[1].starts_with("1e-20,ok,12,"), "{}", lines[1]);
         assert!(
-            lines[2].starts_with("1e3,not_converged,1.2000000000e1")
-                && lines[2].ends_with("\"did not converge, at all\""),
+            lines[2].starts_with("1e3,not_converged,12,") && lines[2].ends_with("\"did not converge, at all\""),
             "{}",
             lines[2]
         );

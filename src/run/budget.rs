@@ -23,9 +23,9 @@ pub enum Footprint {
 /// A run refused before it started.
 #[derive(Debug, thiserror::Error)]
 #[error(
-    "{case}: {what} would need about {:.3e} GiB of memory (estimated from {basis}), above the limit of {:.1} GiB; reduce {key} or raise the limit with --max-memory-gib",
+    "{case}: {what} would need about {:.3e} GiB of memory (estimated from {basis}), above {}",
     .bytes / GIB,
-    .limit / GIB
+    limit_text(*.limit, *.address_space, key)
 )]
 pub struct BudgetError {
     /// the case file (or the case's name)
@@ -35,6 +35,28 @@ pub struct BudgetError {
     pub limit: f64,
     pub basis: String,
     pub key: &'static str,
+    /// the limit is the process's address-space limit (`ulimit -v`), below the one asked for
+    pub address_space: bool,
+}
+
+/// The limit of a [`BudgetError`] and how to raise it.
+fn limit_text(limit: f64, address_space: bool, key: &str) -> String {
+    if address_space {
+        format!(
+            "the process's address-space limit of {:.1} MiB (ulimit -v); reduce {key} or raise that limit",
+            limit / (1024.0 * 1024.0)
+        )
+    } else {
+        format!("the limit of {:.1} GiB; reduce {key} or raise the limit with --max-memory-gib", limit / GIB)
+    }
+}
+
+/// The soft limit of the process's address space (`ulimit -v`, `RLIMIT_AS`) [bytes], if it has
+/// one (from `/proc/self/limits`).
+pub fn address_space_limit() -> Option<f64> {
+    let text = std::fs::read_to_string("/proc/self/limits").ok()?;
+    let line = text.lines().find(|l| l.starts_with("Max address space"))?;
+    line.trim_start_matches("Max address space").split_whitespace().next()?.parse::<f64>().ok()
 }
 
 /// Fixed cost of a process [bytes] (binary, allocator, thread stacks).
@@ -117,16 +139,21 @@ pub fn estimate(case: &Case, what: Footprint) -> (f64, String, &'static str) {
     }
 }
 
-/// Refuse `what` on `case` if its estimate exceeds `limit_bytes`.
+/// Refuse `what` on `case` if its estimate exceeds `limit_bytes`, or the process's
+/// address-space limit where that is lower (an allocation beyond it would fail mid-run).
 pub fn check(case: &Case, what: Footprint, limit_bytes: f64) -> Result<(), BudgetError> {
     let (bytes, basis, key) = estimate(case, what);
+    let (limit_bytes, address_space) = match address_space_limit() {
+        Some(a) if a < limit_bytes => (a, true),
+        _ => (limit_bytes, false),
+    };
     if bytes > limit_bytes {
         let what = match what {
             Footprint::Run => "the run",
             Footprint::Modes => "the modal model",
         };
         let case = case.source.as_ref().map(|p| p.display().to_string()).unwrap_or_else(|| case.name.clone());
-        return Err(BudgetError { case, what, bytes, limit: limit_bytes, basis, key });
+        return Err(BudgetError { case, what, bytes, limit: limit_bytes, basis, key, address_space });
     }
     Ok(())
 }

@@ -371,8 +371,9 @@ pub fn run_clip<S: FrameSink>(
                 for c in rx {
                     let frame = c.report.frame;
                     let f = derive(c).map_err(|message| OutputStop::Derive { frame, message })?;
-                    summary.push(&f);
+                    // counted once written whole: the frames of the summary are the folder's
                     sink.frame(&f).map_err(OutputStop::Sink)?;
+                    summary.push(&f);
                 }
                 sink.finish().map_err(OutputStop::Sink)
             };

@@ -1,0 +1,98 @@
+//! What a command that ended early kept, in words for stderr: a run stopped by a full disk,
+//! an interrupted sweep or audit (the batch's is `super::interrupted_summary`); and what the
+//! progress of a run counts.
+use std::path::Path;
+
+use cosserat::case::Case;
+use cosserat::io::run_folder::{Manifest, Status};
+use cosserat::io::sweep::RunStatus;
+use cosserat::run::Engine;
+
+/// What a run stopped by a full disk left, and how to go on.
+pub fn full_disk_note(end: &cosserat::io::job::JobEnd, case: &Path, dir: &Path) -> String {
+    let previous = format!("\n{} is left as it was", dir.display());
+    match (&end.disk_full, end.frames) {
+        (Some(Some(staging)), Some((n, _))) => format!(
+            "{previous}. The {n} converged frames are kept in {}: free some space, then `cosserat run {} --out {} --resume` continues from them (or remove that folder to free its space)",
+            staging.display(),
+            case.display(),
+            dir.display()
+        ),
+        _ => format!("{previous}; nothing of this run was kept (its staging folder is removed)"),
+    }
+}
+
+/// What an interrupted sweep kept: points complete, stopped (their folders, a clip's converged
+/// frames) and not started.
+pub fn sweep_interrupted_summary(rows: &[cosserat::io::sweep::SummaryRow], target: &Path) -> String {
+    use cosserat::io::sweep::NOT_STARTED;
+    let not_started = rows.iter().filter(|r| r.error.as_deref() == Some(NOT_STARTED)).count();
+    let stopped: Vec<_> =
+        rows.iter().filter(|r| r.status == RunStatus::Interrupted && r.error.as_deref() != Some(NOT_STARTED)).collect();
+    let frames: Vec<String> = stopped
+        .iter()
+        .filter_map(|r| r.metrics.as_ref().and_then(|m| m.get("frames")).map(|f| format!("{} {f} frames", r.name)))
+        .collect();
+    let ok = rows.iter().filter(|r| r.status == RunStatus::Ok).count();
+    format!(
+        "interrupted: {ok} of {} points complete, {} stopped at their next iteration or frame{}, {not_started} not started; {} marks each (status interrupted), and {} holds run.json saying interrupted",
+        rows.len(),
+        stopped.len(),
+        if frames.is_empty() { String::new() } else { format!(" (kept: {})", frames.join(", ")) },
+        target.join("summary.csv").display(),
+        target.display()
+    )
+}
+
+/// What the points of an interrupted audit in `dir` kept, from their `run.json`: complete,
+/// stopped at their next iteration or frame, failed, and (of `total`) not started.
+pub fn audit_points_kept(dir: &Path, total: usize) -> String {
+    fn walk(dir: &Path, depth: usize, out: &mut Vec<Status>) {
+        if let Ok(Some(m)) = Manifest::read(dir) {
+            if m.command == "audit point" {
+                out.push(m.status);
+                return;
+            }
+        }
+        if depth == 0 {
+            return;
+        }
+        for e in std::fs::read_dir(dir).into_iter().flatten().flatten() {
+            if e.path().is_dir() {
+                walk(&e.path(), depth - 1, out);
+            }
+        }
+    }
+    let mut statuses = Vec::new();
+    walk(dir, 3, &mut statuses);
+    let count = |s: Status| statuses.iter().filter(|x| **x == s).count();
+    let (complete, stopped) = (count(Status::Complete), count(Status::Interrupted));
+    format!(
+        "of {total} points {complete} complete, {stopped} stopped at their next iteration or frame, {} failed or stalled, {} not started",
+        statuses.len() - complete - stopped,
+        total.saturating_sub(statuses.len())
+    )
+}
+
+/// What the progress of a run of `case` in `engine` counts: clip frames, time steps or
+/// iterations ("" for FreeFEM, which reports no progress: the time elapsed is shown).
+pub fn progress_unit(case: &Case, engine: Engine) -> &'static str {
+    use cosserat::case::Analysis;
+    match (&case.analysis, engine) {
+        (_, Engine::Freefem) => "",
+        _ if case.clip().is_some() => "frames",
+        (Analysis::Dynamic(_), _) => "time steps",
+        _ => "iterations",
+    }
+}
+
+/// The error of a command (`what`: "sweep") stopped by a full disk, which keeps nothing and
+/// leaves its output folder `target` as it was.
+pub fn disk_full_text(e: &(dyn std::error::Error + 'static), target: &Path, what: &str) -> String {
+    format!(
+        "{}: {}\n{} is left as it was; nothing of this {what} was kept (its staging folder is removed)",
+        cosserat::io::disk::full_text(target),
+        cosserat::io::sweep::chain(e),
+        target.display()
+    )
+}
