@@ -282,51 +282,7 @@ fn cmd_run(
     for n in &end.notes {
         eprintln!("note: {n}");
     }
-    match end.status {
-        Status::Complete => print!("{}", end.summary(&case.name, engine)),
-        Status::CompleteWithWarnings => {
-            print!("{}", end.summary(&case.name, engine));
-            eprintln!("warning: {}", end.message.unwrap_or_default());
-            if strict {
-                return Ok(ExitCode::from(1));
-            }
-        }
-        Status::Interrupted => {
-            let kept = match end.frames {
-                Some((n, _)) => format!(
-                    "kept {n} converged frames (the folder's files and figures cover exactly them); continue with `cosserat run {} --out {} --resume`",
-                    path.display(),
-                    dir.display()
-                ),
-                None => "a single run keeps no partial result".into(),
-            };
-            eprintln!("{}: interrupted; {kept}; run.json in {} says interrupted", case.name, dir.display());
-            return Ok(ExitCode::from(EXIT_INTERRUPTED));
-        }
-        Status::Stalled => anyhow::bail!(
-            "{}\n{} holds the last iterate, with its certificate (run.json says stalled; docs/certificate.md)",
-            end.message.unwrap_or_default(),
-            dir.display()
-        ),
-        Status::Failed | Status::Running if end.disk_full.is_some() => {
-            anyhow::bail!(
-                "{}{}",
-                end.message.clone().unwrap_or_default(),
-                cli::outcome::full_disk_note(&end, path, &dir)
-            )
-        }
-        Status::Failed | Status::Running => {
-            let kept = match end.frames {
-                Some((n, _)) if n > 0 => format!(
-                    "\nThe {n} converged frames before it are in {} (run.json says failed); after a fix that does not change the case, `--resume` continues from them",
-                    dir.display()
-                ),
-                _ => format!("\n{} holds run.json saying failed", dir.display()),
-            };
-            anyhow::bail!("{}{kept}", end.message.unwrap_or_default());
-        }
-    }
-    Ok(ExitCode::SUCCESS)
+    cli::outcome::run_end(end, (&case, engine), path, &dir, strict)
 }
 
 /// `--count`: a positive number.

@@ -161,6 +161,12 @@ pub fn read_capped_text(path: &Path, cap: u64, what: &'static str) -> Result<Str
 
 static TMP_COUNTER: AtomicU64 = AtomicU64::new(0);
 
+/// Is `name` the temporary file of an atomic write ([`write_atomic`])? A run killed while it
+/// wrote one leaves it behind.
+pub fn is_temporary(name: &str) -> bool {
+    name.starts_with('.') && name.ends_with(".tmp")
+}
+
 /// Write `bytes` to `path` atomically: a temporary file next to it (created with the umask's
 /// permissions), then a rename; the temporary file is removed on failure. Creates the
 /// directory if needed.

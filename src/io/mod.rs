@@ -22,6 +22,7 @@ pub mod freefem_clip;
 pub mod freefem_include;
 pub mod job;
 pub mod journal;
+pub mod manifest;
 pub mod npy;
 pub mod number;
 pub mod plot;

@@ -4,7 +4,8 @@
 //! in place.
 use std::path::{Path, PathBuf};
 
-use super::run_folder::{check_resumable, io_err, FolderError, Manifest, Status, MANIFEST};
+use super::files::is_temporary;
+use super::manifest::{check_resumable, io_err, FolderError, Manifest, Status, MANIFEST};
 
 /// A staging folder `.NAME.staging-PID` left beside an output folder by a run that ended
 /// before it put it in place (killed, or stopped by a full disk).
@@ -95,11 +96,6 @@ pub(super) fn resume_source(
         },
     };
     best.map(|(_, source, m)| (source, m)).ok_or_else(|| cannot(target_reason))
-}
-
-/// Is `name` the temporary file of an atomic write (`super::files::write_atomic`)?
-pub(super) fn is_temporary(name: &str) -> bool {
-    name.starts_with('.') && name.ends_with(".tmp")
 }
 
 /// Remove the temporary files of atomic writes under `dir`: a run killed while it wrote one

@@ -441,7 +441,24 @@ pub fn run_clip<S: FrameSink>(
         (Ok(()), Err(e)) => Some(e),
         (Ok(()), Ok(())) => None,
     };
-    Ok(ClipOutcome { run: summary.finish(start.elapsed().as_secs_f64(), source), stopped, total })
+    let run = summary.finish(start.elapsed().as_secs_f64(), source);
+    let stopped = stopped.map(|e| with_degradation(e, &run.reports));
+    Ok(ClipOutcome { run, stopped, total })
+}
+
+/// A chart-guard stop with the frames before it that were over the fit-quality gate, counted
+/// over every frame of the clip (a streamed clip is solved in runs, each of which sees only its
+/// own frames): `(count, first flagged, first frame)`.
+fn with_degradation(e: RunError, reports: &[FrameReport]) -> RunError {
+    match e {
+        RunError::Sequence(SequenceError::SingularChart { frame, node, cos_beta, guard, axis, .. }) => {
+            let flagged: Vec<usize> = reports.iter().filter(|r| r.fit.flagged).map(|r| r.frame).collect();
+            let first = reports.first().map_or(frame, |r| r.frame);
+            let degraded = flagged.first().map(|&f| (flagged.len(), f, first));
+            RunError::Sequence(SequenceError::SingularChart { frame, node, cos_beta, guard, axis, degraded })
+        }
+        e => e,
+    }
 }
 
 /// A converged frame as the solve hands it over (owned: the output thread derives the
