@@ -11,23 +11,13 @@
 //! ```
 //! `LK3`: Λκ3 to set (negative: the case's), `FPTOL`: the fixed point's tolerance.
 use cosserat::case::Case;
-use cosserat::model::mesh::Field;
 use cosserat::solve::inverse::kkt::dirichlet;
 
 use cosserat::solve::inverse::{Frame, FrameSolver, InverseMethod, Start};
 use nalgebra::{DVector, Vector3};
 
 fn big_of(case: &Case, u: &DVector<f64>, a: &DVector<f64>) -> DVector<f64> {
-    let kd = case.mesh.kkt_dofs();
-    let fwd = case.mesh.dofs();
-    let mut big = kd.zeros();
-    for n in 0..kd.nodes() {
-        for (field, hat) in [(Field::X, Field::XHat), (Field::Alpha, Field::AlphaHat)] {
-            kd.set(&mut big, n, field, &fwd.get(u, n, field));
-            kd.set(&mut big, n, hat, &fwd.get(a, n, field));
-        }
-    }
-    big
+    case.mesh.kkt_dofs().kkt_join(u, a)
 }
 
 fn main() {

@@ -114,18 +114,6 @@ fn certificates_agree(what: &str, rust: f64, freefem: f64, perturbed: f64, tau: 
     }
 }
 
-/// The solver's stopping tolerance τ where the engines are compared (as `compare` derives it).
-fn stop_tolerance(case: &Case) -> f64 {
-    match &case.analysis {
-        Analysis::Static(p) => p.tolerance,
-        Analysis::Dynamic(p) => p.newton_tolerance,
-        Analysis::Inverse(inv) => match inv.params.method {
-            InverseMethod::FixedPoint => 0.0,
-            InverseMethod::Newton { .. } => inv.params.tolerance,
-        },
-    }
-}
-
 /// Rust's result of `case` on its input perturbed as `compare`'s conditioning run does it, at
 /// the point compared: an inverse fixed point at exactly `iterations` iterations.
 fn perturbed_rust(case: &Case, iterations: usize) -> RunResult {
@@ -152,9 +140,13 @@ fn single_certificates(case: &Case, report: &CompareReport, failures: &mut Vec<S
     let perturbed = perturbed_rust(case, rust.stats.iterations);
     let certificate = |r: &RunResult| r.stats.certificate.unwrap_or(f64::NAN);
     let what = format!("{} result", case.name);
-    if let Err(e) =
-        certificates_agree(&what, certificate(rust), certificate(ff), certificate(&perturbed), stop_tolerance(case))
-    {
+    if let Err(e) = certificates_agree(
+        &what,
+        certificate(rust),
+        certificate(ff),
+        certificate(&perturbed),
+        cosserat::io::compare::stop_tolerance(case),
+    ) {
         failures.push(e);
     }
 }
@@ -171,7 +163,7 @@ fn clip_certificates(case: &Case, dir: &Path, failures: &mut Vec<String>) -> Agr
     let rust = solve_frames(case, frames).expect("rust frames");
     let perturbed = solve_frames(case, &pert).expect("perturbed frames");
     let ff = read_clip_run(case, frames, &dir.join("freefem_work")).expect("freefem frames");
-    let tau = stop_tolerance(case);
+    let tau = cosserat::io::compare::stop_tolerance(case);
     let mut out = Agreement::Compared;
     for ((r, f), p) in rust.frames.iter().zip(&ff.frames).zip(&perturbed.frames) {
         let c = |x: &RunResult| x.stats.certificate.unwrap_or(f64::NAN);

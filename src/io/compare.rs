@@ -170,7 +170,7 @@ pub fn perturb_material(case: &Case) -> Case {
 
 /// The solver's stopping tolerance τ of a run compared at its converged point (relative
 /// change of the unknowns, D5/I8); 0 for the inverse fixed point compared at an equal count.
-fn stop_tolerance(case: &Case) -> f64 {
+pub fn stop_tolerance(case: &Case) -> f64 {
     match &case.analysis {
         Analysis::Static(p) => p.tolerance,
         Analysis::Dynamic(p) => p.newton_tolerance,

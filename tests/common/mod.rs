@@ -166,10 +166,9 @@ pub fn solve_frame(
     previous: Option<&[Vector3<f64>]>,
     u0: &DVector<f64>,
     start: Start,
-    mut on: impl FnMut(&InverseRecord),
+    on: impl FnMut(&InverseRecord),
 ) -> Result<InverseSolution, SolveError> {
-    let frame = Frame { index: 0, x_g, previous };
-    FrameSolver::new(p, *params).solve(&frame, u0, start, |r, _, _| on(r))?.converged(0)
+    solve_frame_any(p, params, x_g, previous, u0, start, on)?.converged(0)
 }
 
 /// [`solve_frame`] without the convergence check: the solution whatever its stop (converged,
