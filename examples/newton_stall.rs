@@ -22,6 +22,10 @@ fn big_of(case: &Case, u: &DVector<f64>, a: &DVector<f64>) -> DVector<f64> {
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
+    if args.len() != 5 {
+        eprintln!("usage: newton_stall CASE.toml LK3 FPTOL NEWTON_ITS (see the top of examples/newton_stall.rs)");
+        std::process::exit(2);
+    }
     let case = Case::from_file(std::path::Path::new(&args[1])).expect("case");
     let lk3: f64 = args[2].parse().unwrap();
     let fptol: f64 = args[3].parse().unwrap();
@@ -39,24 +43,18 @@ fn main() {
     let kd = case.mesh.kkt_dofs();
     let fixed = dirichlet(&kd, 0.0, &frame);
     let prev = vec![Vector3::zeros(); kd.nodes()];
+    // the KKT certificate (C1) of a primal state and its adjoint
+    let cert = |u: &DVector<f64>, a: &DVector<f64>| {
+        let pt = kd.pattern();
+        let mut v = vec![0.0; pt.nnz()];
+        cosserat::solve::inverse::kkt::certificate(&p, &params, &frame, &prev, &big_of(&case, u, a), &pt, &mut v)
+    };
     let mut k = 0;
     let fp = FrameSolver::new(&p, params)
         .solve(&frame, &p.reference_state(), Start::Guess, |r, u, a| {
             k += 1;
             if k % 100 == 0 || k < 2 {
-                let c = {
-                    let pt = kd.pattern();
-                    let mut v = vec![0.0; pt.nnz()];
-                    cosserat::solve::inverse::kkt::certificate(
-                        &p,
-                        &params,
-                        &frame,
-                        &prev,
-                        &big_of(&case, u, a),
-                        &pt,
-                        &mut v,
-                    )
-                };
+                let c = cert(u, a);
                 eprintln!(
                     "fp {k}: change {:.3e} cert {:.3e} blocks {:?}",
                     r.rel_change,
@@ -66,19 +64,7 @@ fn main() {
             }
         })
         .unwrap();
-    let c = {
-        let pt = kd.pattern();
-        let mut v = vec![0.0; pt.nnz()];
-        cosserat::solve::inverse::kkt::certificate(
-            &p,
-            &params,
-            &frame,
-            &prev,
-            &big_of(&case, &fp.u, &fp.adjoint),
-            &pt,
-            &mut v,
-        )
-    };
+    let c = cert(&fp.u, &fp.adjoint);
     eprintln!(
         "fp end {} its stop {:?} change {:.3e} cert {:.3e} blocks {:?}",
         fp.history.len(),
@@ -136,18 +122,19 @@ fn main() {
         // unscaled step from the top singular component
         let k = idx[order[0]];
         let v = vt.row(k).transpose();
-        let sh: Vec<String> = (0..kd.nodes())
-            .step_by(4)
-            .map(|nd| {
-                format!(
-                    "[{:.1e} {:.1e} {:.1e}]",
-                    v[12 * nd + 3] * dc[12 * nd + 3],
-                    v[12 * nd + 4] * dc[12 * nd + 4],
-                    v[12 * nd + 5] * dc[12 * nd + 5]
-                )
-            })
-            .collect();
-        eprintln!("  top alpha shape (unscaled): {}", sh.join(" "));
+        // the angle part of a singular vector, unscaled, at every 4th node
+        let alpha_shape = |v: &DVector<f64>, digits: usize| -> String {
+            let sh: Vec<String> = (0..kd.nodes())
+                .step_by(4)
+                .map(|nd| {
+                    let c: Vec<String> =
+                        (3..6).map(|c| format!("{:.*e}", digits, v[12 * nd + c] * dc[12 * nd + c])).collect();
+                    format!("[{}]", c.join(" "))
+                })
+                .collect();
+            sh.join(" ")
+        };
+        eprintln!("  top alpha shape (unscaled): {}", alpha_shape(&v, 1));
         let sh: Vec<String> = (0..kd.nodes()).step_by(4).map(|nd| format!("{:.1e}", dc[12 * nd + 3])).collect();
         eprintln!("  dc alpha: {}", sh.join(" "));
         contrib.clear();
@@ -158,18 +145,7 @@ fn main() {
                 .collect();
             eprintln!("sigma {:.3e}: u·D_rR {:.3e} weights {:?}", svd.singular_values[k], uu.column(k).dot(&rs), w);
             if std::env::var("SHAPE").is_ok() {
-                let sh: Vec<String> = (0..kd.nodes())
-                    .step_by(4)
-                    .map(|nd| {
-                        format!(
-                            "[{:.2} {:.2} {:.2}]",
-                            v[12 * nd + 3] * dc[12 * nd + 3],
-                            v[12 * nd + 4] * dc[12 * nd + 4],
-                            v[12 * nd + 5] * dc[12 * nd + 5]
-                        )
-                    })
-                    .collect();
-                eprintln!("  alpha shape (unscaled): {}", sh.join(" "));
+                eprintln!("  alpha shape (unscaled): {}", alpha_shape(&v, 2));
             }
         }
     }
