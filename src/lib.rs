@@ -67,3 +67,4 @@ pub mod model;
 pub mod reference;
 pub mod run;
 pub mod solve;
+pub mod study;

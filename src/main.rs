@@ -165,6 +165,8 @@ enum Command {
     },
     /// Write a corpus of synthetic 3D recordings with their ground truth.
     Synth(cli::synth::SynthArgs),
+    /// Reconstruct synthetic recordings at several noise levels beside a smoothing spline.
+    NoiseStudy(cli::noise_study::NoiseStudyArgs),
     /// List the cases of a directory with their descriptions.
     List {
         /// Directory holding *.toml case files
@@ -246,6 +248,7 @@ fn dispatch(cli: Cli) -> Result<ExitCode> {
         Command::BatchTask(a) => cli::cmd_batch_task(a),
         Command::Gather { out } => cli::cmd_gather(&out),
         Command::Synth(a) => cli::synth::cmd_synth(a),
+        Command::NoiseStudy(a) => cli::noise_study::cmd_noise_study(a),
         Command::List { dir } => cli::list::cmd_list(&dir),
         Command::Modes { case, count, limits } => cmd_modes(&case, count, limits),
     }

@@ -15,7 +15,7 @@ const LAYERS: &[&[&str]] = &[
     &["case"],
     &["run"],
     &["io"],
-    &["audit"],
+    &["audit", "study"],
     &["main", "cli"],
 ];
 

@@ -141,6 +141,21 @@ pub struct ClipSource {
 pub struct InverseSettings {
     pub params: InverseParams,
     pub data: DataSource,
+    /// how the tracking weight λg of `params` is chosen
+    pub weights_rule: WeightsRule,
+}
+
+/// `[inverse] weights`: how the tracking weight λg is chosen (`docs/noise.md`, N2).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum WeightsRule {
+    /// `lambda_g` as the case gives it (the paper's Table 1: 1e9)
+    #[default]
+    Fixed,
+    /// per recording, by the discrepancy principle: the fit's RMS distance to the data per
+    /// coordinate equals the noise level estimated from the recording; `lambda_g` is the
+    /// largest value allowed (clip cases only)
+    Auto,
 }
 
 /// What is solved.
@@ -221,6 +236,12 @@ pub struct Case {
 }
 
 impl Case {
+    /// The case file's tables as validated (with any overrides applied), if it was read from
+    /// TOML.
+    pub fn toml_table(&self) -> Option<&toml::Table> {
+        self.raw.as_ref().map(|(t, _)| t)
+    }
+
     /// Read and validate a case file (at most [`CASE_FILE_CAP_BYTES`]).
     pub fn from_file(path: &Path) -> Result<Case, CaseError> {
         let text = file::read_case_file(path)?;

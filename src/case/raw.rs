@@ -137,6 +137,9 @@ pub(super) struct RawInverse {
     pub(super) alpha0_rad: Option<Scalar>,
     #[serde(default)]
     pub(super) stabilisation: Option<Scalar>,
+    /// how λg is chosen: as given, or from the recording's noise (`docs/noise.md`)
+    #[serde(default)]
+    pub(super) weights: super::WeightsRule,
 }
 
 #[derive(Debug, Deserialize)]

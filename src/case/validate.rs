@@ -10,7 +10,7 @@ use nalgebra::Vector3;
 
 use super::raw::*;
 use super::{
-    Analysis, Case, CaseError, CompareOverrides, CompareSpec, DataSource, InverseSettings, Reference,
+    Analysis, Case, CaseError, CompareOverrides, CompareSpec, DataSource, InverseSettings, Reference, WeightsRule,
     DEFAULT_COMPARE_FRAMES,
 };
 use crate::expr::{Expr, ExprError, Node};
@@ -461,7 +461,13 @@ impl<'a> Validator<'a> {
             certificate_tolerance: self
                 .certificate_tolerance("solver.certificate_tolerance", s.certificate_tolerance)?,
         };
-        Ok(InverseSettings { params, data })
+        if inv.weights == WeightsRule::Auto && !matches!(data, DataSource::Clip(_)) {
+            return Err(self.err(
+                "inverse.weights",
+                "\"auto\" chooses λg from a recording's noise: only a clip case has one (use the default, \"fixed\")",
+            ));
+        }
+        Ok(InverseSettings { params, data, weights_rule: inv.weights })
     }
 
     /// `[inverse]`: the weights of eq. (41).

@@ -3,6 +3,7 @@
 //! `batch-task` of an array task, `gather` and `synth`.
 pub mod alloc;
 pub mod list;
+pub mod noise_study;
 pub mod outcome;
 pub mod progress;
 pub mod synth;

@@ -40,6 +40,7 @@
 //! [`Clip::stretch`] is the polyline length of the nodes divided by [`Clip::length_m`].
 use nalgebra::{Matrix3, Vector2, Vector3};
 
+pub mod smoothing;
 mod spline;
 pub mod synthetic;
 

@@ -33,9 +33,11 @@ pub const SUMMARY: &str = "summary.csv";
 
 /// Columns of `summary.csv`. `fit_x_err_rel_max` is the worst frame's `‖x − x_g‖/‖x_g‖` [–],
 /// `curvature_err_rel_max` the worst frame's relative L² error of the bending `κ1² + κ2²`
-/// against the ground truth [–] (empty without a truth sidecar). `wall_time_s` comes last: it
+/// against the ground truth [–] (empty without a truth sidecar). `noise_m` [m] and `lambda_g`
+/// are the noise level and tracking weight `[inverse] weights = "auto"` chose (empty with fixed
+/// weights; `docs/noise.md`). `wall_time_s` comes last: it
 /// is the only column that differs between two runs of the same batch.
-pub const SUMMARY_COLUMNS: [&str; 10] = [
+pub const SUMMARY_COLUMNS: [&str; 12] = [
     "recording",
     "folder",
     "status",
@@ -44,6 +46,8 @@ pub const SUMMARY_COLUMNS: [&str; 10] = [
     "certificate_max",
     "fit_x_err_rel_max",
     "curvature_err_rel_max",
+    "noise_m",
+    "lambda_g",
     "reason",
     "wall_time_s",
 ];
@@ -118,6 +122,11 @@ pub struct BatchRow {
     pub certificate_max: Option<f64>,
     pub fit_x_err_rel_max: Option<f64>,
     pub curvature_err_rel_max: Option<f64>,
+    /// `weights = "auto"`: the recording's noise level per coordinate [m] and the λg chosen
+    #[serde(default)]
+    pub noise_m: Option<f64>,
+    #[serde(default)]
+    pub lambda_g: Option<f64>,
     /// why it failed (the error and its causes)
     pub reason: Option<String>,
     /// this recording's wall time [s]
@@ -135,6 +144,8 @@ impl BatchRow {
             certificate_max: None,
             fit_x_err_rel_max: None,
             curvature_err_rel_max: None,
+            noise_m: None,
+            lambda_g: None,
             reason: Some(reason),
             wall_time_s: 0.0,
         }
@@ -381,6 +392,8 @@ pub fn run_recording(case: &Case, case_file: &InputFile, entry: &PlanEntry, out:
     }
     let metrics = solved.clip.as_ref().filter(|c| !c.reports.is_empty()).map(|c| clip_metrics(&case, c));
     let get = |k: &str| metrics.as_ref().and_then(|m| m.get(k)).copied();
+    let weights = solved.clip.as_ref().and_then(|c| c.weights);
+    folder.manifest.weights = weights;
     let row = BatchRow {
         recording: entry.path.display().to_string(),
         folder: entry.folder.clone(),
@@ -390,6 +403,8 @@ pub fn run_recording(case: &Case, case_file: &InputFile, entry: &PlanEntry, out:
         certificate_max: get("certificate"),
         fit_x_err_rel_max: get("x_err_rel_max"),
         curvature_err_rel_max: get("truth_bending_err_rel_max"),
+        noise_m: weights.map(|w| w.noise_m),
+        lambda_g: weights.map(|w| w.lambda_g),
         reason: solved.error.clone(),
         wall_time_s: start.elapsed().as_secs_f64(),
     };
@@ -517,6 +532,8 @@ pub fn summary_csv(rows: &[BatchRow]) -> Result<String, csv::Error> {
             num(r.certificate_max),
             num(r.fit_x_err_rel_max),
             num(r.curvature_err_rel_max),
+            num(r.noise_m),
+            num(r.lambda_g),
             r.reason.as_deref().unwrap_or("").replace('\n', " "),
             format!("{:.3}", r.wall_time_s),
         ])?;

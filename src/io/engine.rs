@@ -15,11 +15,12 @@ use super::data::{read_data, write_data};
 use super::files::{InputError, OutputError};
 use super::freefem::{self, FreeFemError};
 use super::journal::{read_journal, JournalError};
-use crate::case::{Case, DataSource};
+use crate::case::{Case, DataSource, WeightsRule};
 use crate::clip::synthetic::GroundTruth;
 use crate::clip::Clip;
 use crate::model::chart::Chart;
 use crate::run::clip::{run_clip, ClipFrame, ClipFrames, ClipOutcome, ClipRun, FrameSink, StreamedFrame};
+use crate::run::weights::choose_weights;
 use crate::run::{self, Engine, NodalState, RunError, RunResult};
 
 /// Errors of running a case from files.
@@ -158,13 +159,21 @@ pub fn run_clip_to(
 ) -> Result<ClipOutcome, EngineError> {
     // A synthetic roll_3d clip is integrated on a second thread while its first frames are
     // solved; other clips are read at once.
-    let input = match roll_stream(case)? {
+    // weights = "auto" needs every frame before the first solve (the noise level, N2)
+    let auto = case.inverse().is_some_and(|s| s.weights_rule == WeightsRule::Auto);
+    let input = match roll_stream(case)?.filter(|_| !auto) {
         Some(stream) => Input::Streamed(stream),
         None => {
             let (clip, truth) = load_clip(case)?;
             Input::Loaded(clip, truth)
         }
     };
+    let chosen = match &input {
+        Input::Loaded(clip, _) => choose_weights(case, &clip.frames),
+        Input::Streamed(_) => None,
+    };
+    let case = chosen.as_ref().map_or(case, |(c, _)| c);
+    let weights = chosen.as_ref().map(|(_, w)| *w);
     let has_truth = match &input {
         Input::Streamed(_) => true,
         Input::Loaded(_, truth) => truth.is_some(),
@@ -192,7 +201,10 @@ pub fn run_clip_to(
             Ok(run_clip(case, frames, &records, writer, progress)?)
         }),
         Input::Loaded(clip, truth) => {
-            Ok(run_clip(case, ClipFrames::Loaded { clip: &clip, truth: truth.as_ref() }, &records, writer, progress)?)
+            let mut out =
+                run_clip(case, ClipFrames::Loaded { clip: &clip, truth: truth.as_ref() }, &records, writer, progress)?;
+            out.run.weights = weights;
+            Ok(out)
         }
     }
 }

@@ -178,6 +178,7 @@ pub fn run_into(
     end.message = solved.error;
     end.single = solved.single;
     end.clip = solved.clip;
+    folder.manifest.weights = end.clip.as_ref().and_then(|c| c.weights);
     end.frames = solved.frames;
     folder.manifest.frames_done = end.frames.map(|f| f.0);
     folder.manifest.frames_total = end.frames.map(|f| f.1);

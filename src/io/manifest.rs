@@ -92,6 +92,9 @@ pub struct Manifest {
     /// the residual certificate of the result, where the run has one
     #[serde(default)]
     pub certificate: Option<CertificateSummary>,
+    /// clips with `[inverse] weights = "auto"`: the noise level and the weights chosen
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub weights: Option<crate::run::weights::ChosenWeights>,
     /// the process that wrote the folder
     pub pid: u32,
     /// seconds since the Unix epoch
@@ -177,6 +180,7 @@ impl Manifest {
             frames_total: None,
             message: None,
             certificate: None,
+            weights: None,
             pid: std::process::id(),
             started_unix_s: now_unix_s(),
             finished_unix_s: None,

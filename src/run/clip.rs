@@ -102,6 +102,8 @@ pub struct ClipRun {
     pub truth: Option<TruthRun>,
     pub wall_time_s: f64,
     pub source: String,
+    /// the weights `[inverse] weights = "auto"` chose (`super::weights`)
+    pub weights: Option<super::weights::ChosenWeights>,
 }
 
 /// Ground-truth scores of a synthetic clip run.
@@ -512,6 +514,7 @@ impl Summary {
                 truth: truth.then(TruthRun::default),
                 wall_time_s: 0.0,
                 source: String::new(),
+                weights: None,
             },
         }
     }

@@ -8,6 +8,7 @@ pub mod clip_metrics;
 pub mod frames;
 pub mod metrics;
 pub mod result;
+pub mod weights;
 
 use std::time::Instant;
 

@@ -1,0 +1,158 @@
+//! `cosserat noise-study SPEC --out DIR`: the noise study of `cosserat::study` — synthetic
+//! recordings at several noise levels reconstructed beside a smoothing spline — with its table
+//! (`noise_study.csv`) and figure (`noise_study.svg`).
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use anyhow::{Context, Result};
+
+use cosserat::io::plot::{render_panels_svg, LinePlot, Series};
+use cosserat::io::write_atomic;
+use cosserat::study::{run_study, StudyRow, StudySpec, SPLINE};
+
+use super::progress::Progress;
+
+/// `cosserat noise-study`.
+#[derive(clap::Args, Debug)]
+pub struct NoiseStudyArgs {
+    /// The study spec (TOML), e.g. cases/bench/noise_study.toml
+    spec: PathBuf,
+    /// Output folder: corpora/, cases/, runs/ (one batch per mesh, noise level and variant),
+    /// noise_study.csv (one row per mesh, noise level, method and recording) and noise_study.svg;
+    /// it must be new or empty unless --force
+    #[arg(long)]
+    out: PathBuf,
+    /// The spec's [quick] plan: fewer noise levels, recordings and frames
+    #[arg(long)]
+    quick: bool,
+    /// Replace a folder that is not empty
+    #[arg(long)]
+    force: bool,
+    /// Do not show progress
+    #[arg(long)]
+    quiet: bool,
+}
+
+pub fn cmd_noise_study(a: NoiseStudyArgs) -> Result<ExitCode> {
+    let spec = StudySpec::read(&a.spec)?;
+    if a.out.exists() && std::fs::read_dir(&a.out).map(|mut d| d.next().is_some()).unwrap_or(true) {
+        anyhow::ensure!(a.force, "noise-study: {} is not empty; choose a new --out or pass --force", a.out.display());
+        std::fs::remove_dir_all(&a.out).with_context(|| format!("cannot remove {}", a.out.display()))?;
+    }
+    std::fs::create_dir_all(&a.out).with_context(|| format!("cannot create {}", a.out.display()))?;
+    let plan = spec.plan(a.quick);
+    let total = spec.meshes.len() * plan.noise_m.len() * spec.variants.len();
+    let pb = Progress::new(&spec.title, "batches", total, a.quiet);
+    let rows = run_study(&spec, &a.out, a.quick, |_| pb.inc()).with_context(|| format!("noise study {}", a.spec.display()))?;
+    pb.finish();
+    let svg = figure(&spec, &rows)?;
+    write_atomic(&a.out.join("noise_study.svg"), svg.as_bytes())?;
+    print!("{}", table(&spec, &rows));
+    eprintln!("wrote {}/noise_study.csv and noise_study.svg", a.out.display());
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Per mesh, σ and method: the range over the recordings of the median and the worst frame,
+/// and the reconstructed fraction.
+struct Cell {
+    median: (f64, f64),
+    worst: (f64, f64),
+    reconstructed: usize,
+    frames: usize,
+    noise_estimate: Option<(f64, f64)>,
+    lambda_g: Option<(f64, f64)>,
+}
+
+fn range(v: impl Iterator<Item = f64>) -> (f64, f64) {
+    v.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| if x.is_finite() { (a.min(x), b.max(x)) } else { (a, b) })
+}
+
+fn cells(rows: &[StudyRow]) -> BTreeMap<(usize, String, u64), Cell> {
+    let mut groups: BTreeMap<(usize, String, u64), Vec<&StudyRow>> = BTreeMap::new();
+    for r in rows {
+        groups.entry((r.nodes, r.method.clone(), r.noise_m.to_bits())).or_default().push(r);
+    }
+    let opt = |r: (f64, f64)| if r.0.is_finite() { Some(r) } else { None };
+    groups
+        .into_iter()
+        .map(|(k, g)| {
+            let cell = Cell {
+                median: range(g.iter().map(|r| r.bending_err_median)),
+                worst: range(g.iter().map(|r| r.bending_err_worst)),
+                reconstructed: g.iter().map(|r| r.frames_reconstructed).sum(),
+                frames: g.iter().map(|r| r.frames).sum(),
+                noise_estimate: opt(range(g.iter().filter_map(|r| r.noise_estimate_m))),
+                lambda_g: opt(range(g.iter().filter_map(|r| r.lambda_g))),
+            };
+            (k, cell)
+        })
+        .collect()
+}
+
+fn methods(spec: &StudySpec) -> Vec<(String, String)> {
+    let mut m: Vec<(String, String)> = spec.variants.iter().map(|v| (v.name.clone(), v.label.clone())).collect();
+    m.push((SPLINE.into(), "smoothing spline (GCV)".into()));
+    m
+}
+
+/// The markdown table of the study (docs/results.md).
+fn table(spec: &StudySpec, rows: &[StudyRow]) -> String {
+    let cells = cells(rows);
+    let span = |(a, b): (f64, f64)| if a.is_finite() { format!("{a:.3}–{b:.3}") } else { "–".into() };
+    let span_e = |r: Option<(f64, f64)>| r.map_or("".into(), |(a, b)| format!("{a:.2e}–{b:.2e}"));
+    let mut s = String::from("| nodes | σ [µm] | method | frames reconstructed | bending error, median | worst frame | σ estimated [µm] | λg chosen |\n|---|---|---|---|---|---|---|---|\n");
+    for ((nodes, method, bits), c) in &cells {
+        let label = methods(spec).into_iter().find(|m| &m.0 == method).map_or(method.clone(), |m| m.1);
+        let est = c.noise_estimate.map(|(a, b)| (a * 1e6, b * 1e6));
+        s += &format!(
+            "| {nodes} | {} | {label} | {} / {} | {} | {} | {} | {} |\n",
+            f64::from_bits(*bits) * 1e6,
+            c.reconstructed,
+            c.frames,
+            span(c.median),
+            span(c.worst),
+            est.map_or("".into(), |(a, b)| format!("{a:.3}–{b:.3}")),
+            span_e(c.lambda_g)
+        );
+    }
+    s
+}
+
+/// Per mesh: bending error (median: solid; worst frame: dashed, the worst recording of each)
+/// and the reconstructed fraction against σ.
+fn figure(spec: &StudySpec, rows: &[StudyRow]) -> Result<String> {
+    let cells = cells(rows);
+    let mut panels = Vec::new();
+    for mesh in &spec.meshes {
+        let mut err = LinePlot {
+            title: format!("{} nodes: bending error vs noise (worst recording)", mesh.nodes),
+            x_label: "noise σ [µm] (σ = 0 not drawn: see the table)".into(),
+            y_label: "relative L² error of |κ| [–]".into(),
+            log_x: true,
+            log_y: true,
+            ..LinePlot::default()
+        };
+        let mut frac = LinePlot {
+            title: format!("{} nodes: frames reconstructed", mesh.nodes),
+            x_label: "noise σ [µm]".into(),
+            y_label: "fraction of frames [–]".into(),
+            log_x: true,
+            ..LinePlot::default()
+        };
+        for (name, label) in methods(spec) {
+            let pts: Vec<(f64, &Cell)> = cells
+                .iter()
+                .filter(|((n, m, _), _)| *n == mesh.nodes && *m == name)
+                .map(|((_, _, b), c)| (f64::from_bits(*b) * 1e6, c))
+                .collect();
+            let x: Vec<f64> = pts.iter().map(|p| p.0).collect();
+            err.series.push(Series { label: format!("{label}: median"), x: x.clone(), y: pts.iter().map(|p| p.1.median.1).collect() });
+            err.series.push(Series { label: format!("{label}: worst frame"), x: x.clone(), y: pts.iter().map(|p| p.1.worst.1).collect() });
+            frac.series.push(Series { label, x, y: pts.iter().map(|p| p.1.reconstructed as f64 / p.1.frames.max(1) as f64).collect() });
+        }
+        panels.push(err);
+        panels.push(frac);
+    }
+    Ok(render_panels_svg(&panels, 2)?)
+}

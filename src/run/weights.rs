@@ -1,0 +1,184 @@
+//! `[inverse] weights = "auto"`: the tracking weight λg of eq. (41) chosen from the recording
+//! (`docs/noise.md`, N2).
+//!
+//! The recording's noise level is `σ̂ = median over frames of fit::noise_level(frame)` (per
+//! coordinate [m]). λg is then set by Morozov's discrepancy principle: the fit's RMS distance
+//! to the data per coordinate on the clip's first [`CALIBRATION_FRAMES`] frames,
+//!
+//! ```text
+//!   r(λg) = ( (1/3K) Σ_frames (1/L) ∫ |x − x_g|² )^½ ,
+//! ```
+//!
+//! equals `σ̂`. `r` falls as λg grows (the other weights fixed); λg is searched in `ln λg` by
+//! the Illinois variant of regula falsi on `ln r − ln σ̂`, from the case's `lambda_g` (the
+//! largest allowed) down, until `r` is within [`MATCH`] of `σ̂`. Where `r(λg_max) ≥ σ̂` (the
+//! model cannot follow the data more closely than the noise even at the cap, e.g. clean data)
+//! λg is the cap. Each calibration solve starts frame 0 from the previous solve's frame 0
+//! (continuation in λg). A calibration solve that fails counts as a fit that follows the
+//! noise (`r < σ̂`): only a too-large λg fails that way on noisy data.
+use nalgebra::{DVector, Vector3};
+
+use crate::case::{Analysis, Case, WeightsRule};
+use crate::solve::fit::noise_level;
+use crate::solve::sequence::{solve_sequence, SequenceParams};
+
+/// Frames of the clip's start on which `r(λg)` is measured.
+pub const CALIBRATION_FRAMES: usize = 3;
+/// `r` within this factor of `σ̂` ends the search.
+pub const MATCH: f64 = 1.1;
+/// Largest number of calibration solves.
+pub const MAX_SOLVES: usize = 12;
+/// The search's floor: `λg_max · MIN_RATIO`.
+pub const MIN_RATIO: f64 = 1e-12;
+
+/// The weights `"auto"` chose, for run.json and the batch summary.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct ChosenWeights {
+    /// the recording's noise level σ̂ per coordinate [m]
+    pub noise_m: f64,
+    /// the chosen tracking weight λg
+    pub lambda_g: f64,
+    /// the case's `lambda_g`: the largest allowed
+    pub lambda_g_max: f64,
+    /// the fit's RMS distance to the data per coordinate at the chosen λg, `r` [m]
+    pub fit_residual_m: f64,
+    /// frames of the clip's start the choice was calibrated on
+    pub calibration_frames: usize,
+    /// calibration solves
+    pub solves: usize,
+}
+
+/// The noise level σ̂ of a recording [m]: the median of the frames' [`noise_level`].
+pub fn recording_noise(frames: &[Vec<Vector3<f64>>]) -> f64 {
+    let mut v: Vec<f64> = frames.iter().map(|f| noise_level(f)).filter(|v| v.is_finite()).collect();
+    if v.is_empty() {
+        return 0.0;
+    }
+    let mid = v.len() / 2;
+    let (_, m, _) = v.select_nth_unstable_by(mid, f64::total_cmp);
+    *m
+}
+
+/// The case with λg chosen for `frames` when its weights are `"auto"` (and the choice), else
+/// `None`.
+pub fn choose_weights(case: &Case, frames: &[Vec<Vector3<f64>>]) -> Option<(Case, ChosenWeights)> {
+    let rule = case.inverse().map(|s| s.weights_rule)?;
+    let sp = case.sequence_params()?;
+    if rule != WeightsRule::Auto || frames.is_empty() {
+        return None;
+    }
+    let sigma = recording_noise(frames);
+    let cap = sp.inverse.weights.lambda_g;
+    let calib = &frames[..CALIBRATION_FRAMES.min(frames.len())];
+    let mut search = Search { case, sp, calib, u0: None, solves: 0 };
+    let (lambda_g, r) = search.run(sigma, cap);
+    let chosen = ChosenWeights {
+        noise_m: sigma,
+        lambda_g,
+        lambda_g_max: cap,
+        fit_residual_m: r,
+        calibration_frames: calib.len(),
+        solves: search.solves,
+    };
+    let mut out = case.clone();
+    if let Analysis::Inverse(s) = &mut out.analysis {
+        s.params.weights.lambda_g = lambda_g;
+    }
+    Some((out, chosen))
+}
+
+/// The state of the λg search.
+struct Search<'a> {
+    case: &'a Case,
+    sp: SequenceParams,
+    calib: &'a [Vec<Vector3<f64>>],
+    /// frame 0's state of the last successful solve (continuation)
+    u0: Option<DVector<f64>>,
+    solves: usize,
+}
+
+impl Search<'_> {
+    /// `r(λg)` [m], 0 when the solve fails.
+    fn residual(&mut self, lambda_g: f64) -> f64 {
+        self.solves += 1;
+        let mut sp = self.sp;
+        sp.inverse.weights.lambda_g = lambda_g;
+        let problem = self.case.problem();
+        let length = self.case.mesh.length_m;
+        let mut first: Option<DVector<f64>> = None;
+        let solved = solve_sequence(&problem, &sp, self.calib, self.u0.as_ref(), |_, _| {}, |rep, sol| {
+            if rep.frame == sp.frame_offset {
+                first = Some(sol.state.clone());
+            }
+            Ok(())
+        });
+        match solved {
+            Ok(reports) if !reports.is_empty() => {
+                self.u0 = first;
+                let mean_p2 = reports.iter().map(|r| r.fit.position.powi(2)).sum::<f64>() / reports.len() as f64;
+                mean_p2.sqrt() * length / 3f64.sqrt()
+            }
+            _ => 0.0,
+        }
+    }
+
+    /// `(λg, r(λg))` by the module doc's rule.
+    fn run(&mut self, sigma: f64, cap: f64) -> (f64, f64) {
+        let f = |r: f64| if r > 0.0 { (r / sigma).ln() } else { f64::NEG_INFINITY };
+        let (mut hi, mut r_hi) = (cap, self.residual(cap));
+        if !(sigma > 0.0) || f(r_hi) >= 0.0 {
+            return (hi, r_hi);
+        }
+        // bracket: r(lo) ≥ σ̂ > r(hi), stepping down by 100 at a time
+        let (mut lo, mut r_lo) = (hi, r_hi);
+        while f(r_lo) < 0.0 {
+            if lo <= cap * MIN_RATIO || self.solves >= MAX_SOLVES {
+                return (lo, r_lo);
+            }
+            (hi, r_hi) = (lo, r_lo);
+            lo = (lo * 1e-2).max(cap * MIN_RATIO);
+            r_lo = self.residual(lo);
+        }
+        if f(r_lo) < MATCH.ln() {
+            return (lo, r_lo);
+        }
+        // Illinois regula falsi in ln λg on ln r − ln σ̂ (decreasing)
+        let (mut a, mut fa, mut b, mut fb) = (lo.ln(), f(r_lo), hi.ln(), f(r_hi));
+        let mut best = (lo, r_lo);
+        let mut side = 0;
+        while self.solves < MAX_SOLVES {
+            let c = if fb.is_finite() { b - fb * (b - a) / (fb - fa) } else { 0.5 * (a + b) };
+            let r = self.residual(c.exp());
+            let fc = f(r);
+            if fc.abs() < best_gap(best.1, sigma) {
+                best = (c.exp(), r);
+            }
+            if fc.abs() < MATCH.ln() {
+                return (c.exp(), r);
+            }
+            if fc > 0.0 {
+                (a, fa) = (c, fc);
+                if side == 1 {
+                    fb *= 0.5;
+                }
+                side = 1;
+            } else {
+                (b, fb) = (c, fc);
+                if side == -1 {
+                    fa *= 0.5;
+                }
+                side = -1;
+            }
+        }
+        best
+    }
+}
+
+/// `|ln(r/σ̂)|`, infinite for a failed solve.
+fn best_gap(r: f64, sigma: f64) -> f64 {
+    if r > 0.0 {
+        (r / sigma).ln().abs()
+    } else {
+        f64::INFINITY
+    }
+}

@@ -1,0 +1,187 @@
+//! The noise study (`cosserat noise-study cases/bench/noise_study.toml`, `docs/noise.md`):
+//! synthetic recordings with their truth at several noise levels and meshes, reconstructed by
+//! the batch case under several weight settings, and scored beside a generic smoothing spline
+//! of the same noisy frames, in one run.
+//!
+//! For each mesh (node count) and noise level σ a corpus is written (`io::corpus`, the same
+//! seed for every σ, so the recordings differ only by their noise), each variant of the case
+//! (its `set` keys applied to the mesh's case) runs as a batch over it (`io::batch`), and every
+//! frame is scored ([`score`]). `noise_study.csv` has one row per mesh, σ, method and
+//! recording; `noise_study.svg` draws the bending error (median and worst frame, the worst
+//! recording) and the reconstructed fraction against σ.
+pub mod score;
+mod spec;
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+pub use spec::{Mesh, StudySpec, Variant};
+
+use crate::io::batch::{run_batch, Plan};
+use crate::io::clip_files::read_recording;
+use crate::io::corpus::{recording_path, write_corpus, CorpusParams};
+use crate::io::truth_file::{read_truth, truth_sidecar};
+use crate::io::{write_atomic, InputError, OutputError};
+use score::{bending_error, median_and_worst, read_curvature, spline_bending, truth_bending, ScoreError};
+
+/// Errors of the study.
+#[derive(Debug, thiserror::Error)]
+pub enum StudyError {
+    #[error(transparent)]
+    Spec(#[from] spec::SpecError),
+    #[error(transparent)]
+    Input(#[from] InputError),
+    #[error(transparent)]
+    Output(#[from] OutputError),
+    #[error(transparent)]
+    Score(#[from] ScoreError),
+    #[error("corpus: {0}")]
+    Corpus(#[from] crate::io::corpus::CorpusError),
+    #[error("batch: {0}")]
+    Batch(#[from] crate::io::batch::BatchError),
+    #[error("plot: {0}")]
+    Plot(#[from] crate::io::plot::PlotError),
+    #[error("csv: {0}")]
+    Csv(#[from] csv::Error),
+}
+
+/// The name of the baseline in the table.
+pub const SPLINE: &str = "spline";
+
+/// One row of `noise_study.csv`: one recording reconstructed by one method.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct StudyRow {
+    pub nodes: usize,
+    /// the standard deviation of the added noise [m]
+    pub noise_m: f64,
+    /// a variant's name, or `spline`
+    pub method: String,
+    pub recording: String,
+    pub frames: usize,
+    /// frames with a reconstruction (a converged frame, or a fitted spline)
+    pub frames_reconstructed: usize,
+    /// median over the frames of the bending error [–]
+    pub bending_err_median: f64,
+    /// the largest bending error of a frame [–]
+    pub bending_err_worst: f64,
+    /// the noise level the run estimated from the recording, if it did [m]
+    pub noise_estimate_m: Option<f64>,
+    /// the tracking weight λg the run used [1/m³… as in the case]
+    pub lambda_g: Option<f64>,
+    /// reconstructed frames per second of wall time (this method's share of the run)
+    pub frames_per_s: f64,
+}
+
+/// Run the study of `spec` (read from `spec_path`) into `out`, calling `tick` after each batch.
+pub fn run_study(spec: &StudySpec, out: &Path, quick: bool, tick: impl Fn(&str)) -> Result<Vec<StudyRow>, StudyError> {
+    let plan = spec.plan(quick);
+    let mut rows = Vec::new();
+    for mesh in &spec.meshes {
+        for &noise_m in &plan.noise_m {
+            let tag = format!("n{}_s{}", mesh.nodes, crate::case::sweep::fmt_value(noise_m));
+            let corpus = out.join("corpora").join(&tag);
+            let params = CorpusParams {
+                count: plan.recordings,
+                frames: plan.frames,
+                nodes: mesh.nodes,
+                noise_m,
+                seed: spec.seed,
+                ..CorpusParams::default()
+            };
+            let entries = write_corpus(&corpus, &spec.kymogram, &params)?;
+            let recordings: Vec<PathBuf> = entries.iter().map(|e| recording_path(&corpus, &e.name)).collect();
+            let started = Instant::now();
+            rows.extend(spline_rows(mesh.nodes, noise_m, &recordings, spec.skip_elements)?);
+            let spline_s = started.elapsed().as_secs_f64();
+            rows.iter_mut().rev().take(recordings.len()).for_each(|r| r.frames_per_s = r.frames as f64 / (spline_s / recordings.len() as f64));
+            for variant in &spec.variants {
+                let case = spec.variant_case(mesh, variant, &out.join("cases"))?;
+                let runs = out.join("runs").join(&tag).join(&variant.name);
+                let plan = Plan::new(&case, &recordings, 1);
+                plan.begin(&runs)?;
+                let ran = run_batch(&plan, &runs, 0, || {})?;
+                for (r, recording) in ran.iter().zip(&recordings) {
+                    let mut row = score_run(mesh.nodes, noise_m, &variant.name, recording, &runs.join(&r.row.folder), spec.skip_elements)?;
+                    row.frames_per_s = row.frames_reconstructed as f64 / r.row.wall_time_s.max(1e-9);
+                    rows.push(row);
+                }
+                tick(&format!("{tag} {}", variant.name));
+            }
+        }
+    }
+    write_table(out, &rows)?;
+    Ok(rows)
+}
+
+/// The truth of a recording and its noisy frames.
+fn recording_and_truth(
+    recording: &Path,
+) -> Result<(Vec<Vec<nalgebra::Vector3<f64>>>, crate::clip::synthetic::GroundTruth), StudyError> {
+    let clip = read_recording(recording, 1.0)?;
+    let n = clip.node_count();
+    let s: Vec<f64> = (0..n).map(|i| i as f64 / (n - 1) as f64).collect();
+    let truth = read_truth(&truth_sidecar(recording), clip.frames.len(), &s)?;
+    Ok((clip.frames, truth))
+}
+
+fn spline_rows(nodes: usize, noise_m: f64, recordings: &[PathBuf], skip: usize) -> Result<Vec<StudyRow>, StudyError> {
+    let mut rows = Vec::new();
+    for recording in recordings {
+        let (frames, truth) = recording_and_truth(recording)?;
+        let errors: Vec<f64> = frames
+            .iter()
+            .zip(&truth.frames)
+            .map(|(f, t)| bending_error(&spline_bending(f), &truth_bending(t), skip))
+            .collect();
+        rows.push(row(nodes, noise_m, SPLINE, recording, &errors));
+    }
+    Ok(rows)
+}
+
+fn row(nodes: usize, noise_m: f64, method: &str, recording: &Path, errors: &[f64]) -> StudyRow {
+    let (median, worst) = median_and_worst(errors);
+    StudyRow {
+        nodes,
+        noise_m,
+        method: method.into(),
+        recording: recording.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default(),
+        frames: errors.len(),
+        frames_reconstructed: errors.iter().filter(|e| e.is_finite()).count(),
+        bending_err_median: median,
+        bending_err_worst: worst,
+        noise_estimate_m: None,
+        lambda_g: None,
+        frames_per_s: f64::NAN,
+    }
+}
+
+/// Score one recording's run folder (its `curvature.csv`; the weights from `run.json`).
+fn score_run(nodes: usize, noise_m: f64, method: &str, recording: &Path, dir: &Path, skip: usize) -> Result<StudyRow, StudyError> {
+    let (frames, truth) = recording_and_truth(recording)?;
+    let curvature = dir.join("curvature.csv");
+    let recovered = if curvature.is_file() { read_curvature(&curvature)? } else { Vec::new() };
+    let errors: Vec<f64> = (0..frames.len())
+        .map(|k| match recovered.get(k) {
+            Some(b) if !b.is_empty() => bending_error(b, &truth_bending(&truth.frames[k]), skip),
+            _ => f64::NAN,
+        })
+        .collect();
+    let mut r = row(nodes, noise_m, method, recording, &errors);
+    if let Ok(Some(m)) = crate::io::manifest::Manifest::read(dir) {
+        if let Some(w) = m.weights {
+            r.noise_estimate_m = Some(w.noise_m);
+            r.lambda_g = Some(w.lambda_g);
+        }
+    }
+    Ok(r)
+}
+
+fn write_table(out: &Path, rows: &[StudyRow]) -> Result<(), StudyError> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    for r in rows {
+        w.serialize(r)?;
+    }
+    let bytes = w.into_inner().map_err(|e| csv::Error::from(e.into_error()))?;
+    write_atomic(&out.join("noise_study.csv"), &bytes)?;
+    Ok(())
+}

@@ -1,0 +1,115 @@
+//! Scoring a reconstruction of a synthetic recording against its truth: the bending-curvature
+//! error per frame (`docs/noise.md`, N5).
+//!
+//! Per frame, with `b_e = √(κ1² + κ2²)` on element `e` (the roll-invariant bending curvature;
+//! the recovered `κ` is element-wise, the truth's nodal `κ1, κ2` are averaged to the element
+//! midpoints), over the elements without `skip` at each end:
+//!
+//! ```text
+//!   error = ( Σ_e (b_e − b_e^true)² / Σ_e (b_e^true)² )^½
+//! ```
+use std::path::Path;
+
+use nalgebra::Vector3;
+
+use crate::clip::smoothing::SmoothingSpline;
+use crate::clip::synthetic::FrameTruth;
+use crate::io::{InputError, OutputError};
+
+/// Errors of scoring a run.
+#[derive(Debug, thiserror::Error)]
+pub enum ScoreError {
+    #[error(transparent)]
+    Input(#[from] InputError),
+    #[error(transparent)]
+    Output(#[from] OutputError),
+    #[error("{path}: {reason}")]
+    Curvature { path: String, reason: String },
+}
+
+/// The truth's bending curvature on each element [1/m] (nodal `κ1, κ2` averaged to the
+/// element's midpoint).
+pub fn truth_bending(truth: &FrameTruth) -> Vec<f64> {
+    truth.kappa.windows(2).map(|w| (0.5 * (w[0].x + w[1].x)).hypot(0.5 * (w[0].y + w[1].y))).collect()
+}
+
+/// The relative L² error of `b` against `truth` over the elements without `skip` at each end
+/// (the module doc); NaN when `b` is missing or the truth is zero there.
+pub fn bending_error(b: &[f64], truth: &[f64], skip: usize) -> f64 {
+    if b.len() != truth.len() || 2 * skip >= truth.len() {
+        return f64::NAN;
+    }
+    let kept = skip..truth.len() - skip;
+    let num: f64 = kept.clone().map(|e| (b[e] - truth[e]).powi(2)).sum();
+    let den: f64 = kept.map(|e| truth[e].powi(2)).sum();
+    if den > 0.0 {
+        (num / den).sqrt()
+    } else {
+        f64::NAN
+    }
+}
+
+/// The smoothing-spline baseline's bending curvature per element of a noisy frame, NaN where no
+/// spline can be fitted.
+pub fn spline_bending(frame: &[Vector3<f64>]) -> Vec<f64> {
+    let elements = frame.len().saturating_sub(1);
+    SmoothingSpline::fit(frame).map_or_else(|| vec![f64::NAN; elements], |s| s.element_curvatures(elements))
+}
+
+/// The recovered bending curvature per frame and element from a run's `curvature.csv`
+/// (columns `frame, s_mid_m, kappa1_per_m, kappa2_per_m, kappa3_per_m`); frames that were not
+/// written (the run stopped) are absent.
+pub fn read_curvature(path: &Path) -> Result<Vec<Vec<f64>>, ScoreError> {
+    let bad = |reason: String| ScoreError::Curvature { path: path.display().to_string(), reason };
+    let mut reader = csv::Reader::from_path(path).map_err(|e| bad(e.to_string()))?;
+    let mut frames: Vec<Vec<f64>> = Vec::new();
+    for record in reader.records() {
+        let r = record.map_err(|e| bad(e.to_string()))?;
+        let num = |i: usize| -> Result<f64, ScoreError> {
+            r.get(i).and_then(|v| v.parse::<f64>().ok()).ok_or_else(|| bad(format!("column {i} of {r:?}")))
+        };
+        let frame = num(0)? as usize;
+        while frames.len() <= frame {
+            frames.push(Vec::new());
+        }
+        frames[frame].push(num(2)?.hypot(num(3)?));
+    }
+    Ok(frames)
+}
+
+/// Median and largest of a set of per-frame errors (NaN entries are frames not reconstructed
+/// and are left out); `(NaN, NaN)` when none is finite.
+pub fn median_and_worst(errors: &[f64]) -> (f64, f64) {
+    let mut v: Vec<f64> = errors.iter().copied().filter(|e| e.is_finite()).collect();
+    if v.is_empty() {
+        return (f64::NAN, f64::NAN);
+    }
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    let median = if n % 2 == 1 { v[n / 2] } else { 0.5 * (v[n / 2 - 1] + v[n / 2]) };
+    (median, v[n - 1])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bending_error_is_relative_and_skips_the_ends() {
+        let truth = vec![100.0, 1.0, 2.0, 2.0, 1.0, 100.0];
+        let mut b = truth.clone();
+        b[0] = 0.0;
+        b[5] = 0.0;
+        assert_eq!(bending_error(&b, &truth, 1), 0.0);
+        b[2] = 3.0; // error 1 against a norm of √10
+        assert!((bending_error(&b, &truth, 1) - (0.1f64).sqrt()).abs() < 1e-15);
+        assert!(bending_error(&b, &truth, 3).is_nan());
+    }
+
+    #[test]
+    fn median_and_worst_leave_out_missing_frames() {
+        assert_eq!(median_and_worst(&[3.0, f64::NAN, 1.0, 2.0]), (2.0, 3.0));
+        assert_eq!(median_and_worst(&[4.0, 1.0]), (2.5, 4.0));
+        assert!(median_and_worst(&[f64::NAN]).0.is_nan());
+    }
+}
