@@ -89,7 +89,7 @@ fn a_streamed_clip_gives_the_frames_of_one_solve_bit_for_bit() {
     else {
         return;
     };
-    let (whole, reference) = solve(&case, ClipFrames::Loaded { clip: &clip, truth: Some(&truth) });
+    let (whole, reference) = solve(&case, ClipFrames::Loaded { clip: &clip, truth: Some(&truth), start: None });
     assert!(whole.stopped.is_none(), "{:?}", whole.stopped);
     assert_eq!(reference.len(), FRAMES);
     // Frames one at a time, slower than they are solved (runs of one frame: the second state

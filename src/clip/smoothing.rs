@@ -1,5 +1,6 @@
 //! The generic baseline a reconstruction of noisy data must beat: a cubic smoothing spline of
-//! each coordinate against the chord-length parameter of the noisy points, its smoothing chosen
+//! each coordinate against arc length (the nodes' equal spacing, [`SmoothingSpline::fit_uniform`],
+//! or the chord length of the noisy points, [`SmoothingSpline::fit`]), its smoothing chosen
 //! by generalised cross-validation (GCV), no physics, no time coupling (`docs/noise.md`, N4).
 //!
 //! For knots `t_0 < … < t_{n−1}` (the cumulative chord lengths of the points) and values `y_i`
@@ -131,21 +132,31 @@ impl Smoother {
 }
 
 impl SmoothingSpline {
-    /// The GCV smoothing spline of `points` (at least 4, consecutive points distinct and
-    /// finite), parametrised by their cumulative chord length. `None` when the points do not
+    /// The GCV smoothing spline of `points` (at least 4, finite) parametrised by their
+    /// cumulative chord length (consecutive points distinct). `None` when the points do not
     /// allow one.
     pub fn fit(points: &[Vector3<f64>]) -> Option<Self> {
-        let n = points.len();
-        if n < 4 || points.iter().any(|p| !p.iter().all(|v| v.is_finite())) {
-            return None;
+        let mut t = vec![0.0; points.len()];
+        for i in 1..points.len() {
+            t[i] = t[i - 1] + (points[i] - points[i - 1]).norm();
         }
-        let mut t = vec![0.0; n];
-        for i in 1..n {
-            let h = (points[i] - points[i - 1]).norm();
-            if h <= 0.0 {
-                return None;
-            }
-            t[i] = t[i - 1] + h;
+        Self::fit_at(points, t)
+    }
+
+    /// The GCV smoothing spline of `points` at nodes equally spaced in arc length over a body
+    /// of length `length_m` [m] (a tracker's output: knots `t_i = i L/(n − 1)`). Noise of the
+    /// order of the node spacing makes the chord-length parameter of [`Self::fit`] a poor arc
+    /// length (σ = 3 µm on 128 nodes of a 1 mm body: curvature errors of 20–30 against 0.3
+    /// with these knots).
+    pub fn fit_uniform(points: &[Vector3<f64>], length_m: f64) -> Option<Self> {
+        let n = points.len().max(2);
+        Self::fit_at(points, (0..points.len()).map(|i| length_m * i as f64 / (n - 1) as f64).collect())
+    }
+
+    fn fit_at(points: &[Vector3<f64>], t: Vec<f64>) -> Option<Self> {
+        let n = points.len();
+        if n < 4 || points.iter().any(|p| !p.iter().all(|v| v.is_finite())) || t.windows(2).any(|w| !(w[1] > w[0])) {
+            return None;
         }
         let s = Smoother::new(&t);
         let mut g = vec![Vector3::zeros(); n];

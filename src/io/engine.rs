@@ -172,8 +172,9 @@ pub fn run_clip_to(
         Input::Loaded(clip, _) => choose_weights(case, &clip.frames),
         Input::Streamed(_) => None,
     };
-    let case = chosen.as_ref().map_or(case, |(c, _)| c);
-    let weights = chosen.as_ref().map(|(_, w)| *w);
+    let case = chosen.as_ref().map_or(case, |a| &a.case);
+    let weights = chosen.as_ref().map(|a| a.chosen);
+    let start = chosen.as_ref().and_then(|a| a.start.as_ref());
     let has_truth = match &input {
         Input::Streamed(_) => true,
         Input::Loaded(_, truth) => truth.is_some(),
@@ -202,7 +203,7 @@ pub fn run_clip_to(
         }),
         Input::Loaded(clip, truth) => {
             let mut out =
-                run_clip(case, ClipFrames::Loaded { clip: &clip, truth: truth.as_ref() }, &records, writer, progress)?;
+                run_clip(case, ClipFrames::Loaded { clip: &clip, truth: truth.as_ref(), start }, &records, writer, progress)?;
             out.run.weights = weights;
             Ok(out)
         }

@@ -186,7 +186,8 @@ pub type StreamedFrame = (Vec<Vector3<f64>>, Option<FrameTruth>);
 /// The frames of a clip as [`run_clip`] takes them.
 pub enum ClipFrames<'a> {
     /// every frame at hand: the clip and, for a synthetic clip, its ground truth frame for frame
-    Loaded { clip: &'a Clip, truth: Option<&'a GroundTruth> },
+    /// `start`: frame 0's initial iterate in its chart (`None`: the data guess)
+    Loaded { clip: &'a Clip, truth: Option<&'a GroundTruth>, start: Option<&'a DVector<f64>> },
     /// `total` frames arriving in order on `frames` (each with its ground truth where `truth`),
     /// e.g. from a generator on another thread: the solve starts with the first frame while
     /// later ones are made. `header`: the clip without its frames (time step, source).
@@ -204,7 +205,7 @@ impl Arrivals<'_> {
     /// The clip (without its frames if streamed), its frame count and whether it has a truth.
     fn header(&self) -> (&Clip, usize, bool) {
         match &self.input {
-            ClipFrames::Loaded { clip, truth } => (clip, clip.frame_count(), truth.is_some()),
+            ClipFrames::Loaded { clip, truth, .. } => (clip, clip.frame_count(), truth.is_some()),
             ClipFrames::Streamed { header, total, truth, .. } => (header, *total, *truth),
         }
     }
@@ -231,7 +232,7 @@ impl Arrivals<'_> {
     /// The frames at hand and their ground truth.
     fn frames(&self) -> (&[Vec<Vector3<f64>>], Option<&[FrameTruth]>) {
         match &self.input {
-            ClipFrames::Loaded { clip, truth } => (&clip.frames, truth.map(|t| &t.frames[..])),
+            ClipFrames::Loaded { clip, truth, .. } => (&clip.frames, truth.map(|t| &t.frames[..])),
             ClipFrames::Streamed { truth, .. } => (&self.frames, truth.then_some(&self.truth[..])),
         }
     }
@@ -260,6 +261,11 @@ pub fn run_clip<S: FrameSink>(
     let dofs = problem.dofs();
     let w8 = sp.inverse.weights;
     let first_frame = sp.frame_offset;
+    // frame 0's initial iterate, for the first run of frames only
+    let mut frame0_start = match &frames {
+        ClipFrames::Loaded { start, .. } => start.cloned(),
+        ClipFrames::Streamed { .. } => None,
+    };
     let mut arrivals = Arrivals { input: frames, frames: Vec::new(), truth: Vec::new() };
     let (header, total, has_truth) = arrivals.header();
     let (dt_s, source) = (header.dt_s, header.source.clone());
@@ -402,7 +408,7 @@ pub fn run_clip<S: FrameSink>(
                 &problem,
                 &sp,
                 &view.0[..at_hand],
-                None,
+                frame0_start.take().as_ref(),
                 from.take(),
                 |_, _| {},
                 |rep, frame| {

@@ -30,6 +30,10 @@ pub const MATCH: f64 = 1.1;
 pub const MAX_SOLVES: usize = 12;
 /// The search's floor: `λg_max · MIN_RATIO`.
 pub const MIN_RATIO: f64 = 1e-12;
+/// The search's first λg: `λg_max · START_RATIO` (1e3 for the paper's 1e9), a fit far
+/// smoother than the noise of any recording we measured, which every frame 0 solves from the
+/// data guess.
+pub const START_RATIO: f64 = 1e-6;
 
 /// The weights `"auto"` chose, for run.json and the batch summary.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -59,9 +63,9 @@ pub fn recording_noise(frames: &[Vec<Vector3<f64>>]) -> f64 {
     *m
 }
 
-/// The case with λg chosen for `frames` when its weights are `"auto"` (and the choice), else
-/// `None`.
-pub fn choose_weights(case: &Case, frames: &[Vec<Vector3<f64>>]) -> Option<(Case, ChosenWeights)> {
+/// The case with λg chosen for `frames` when its weights are `"auto"`, the choice, and frame 0's
+/// solution at that λg in its chart (the clip's frame 0 starts there), else `None`.
+pub fn choose_weights(case: &Case, frames: &[Vec<Vector3<f64>>]) -> Option<Auto> {
     let rule = case.inverse().map(|s| s.weights_rule)?;
     let sp = case.sequence_params()?;
     if rule != WeightsRule::Auto || frames.is_empty() {
@@ -70,7 +74,7 @@ pub fn choose_weights(case: &Case, frames: &[Vec<Vector3<f64>>]) -> Option<(Case
     let sigma = recording_noise(frames);
     let cap = sp.inverse.weights.lambda_g;
     let calib = &frames[..CALIBRATION_FRAMES.min(frames.len())];
-    let mut search = Search { case, sp, calib, u0: None, solves: 0 };
+    let mut search = Search { case, sp, calib, u0: None, states: Vec::new(), solves: 0 };
     let (lambda_g, r) = search.run(sigma, cap);
     let chosen = ChosenWeights {
         noise_m: sigma,
@@ -84,7 +88,17 @@ pub fn choose_weights(case: &Case, frames: &[Vec<Vector3<f64>>]) -> Option<(Case
     if let Analysis::Inverse(s) = &mut out.analysis {
         s.params.weights.lambda_g = lambda_g;
     }
-    Some((out, chosen))
+    let start = search.states.into_iter().find(|(g, _)| *g == lambda_g).map(|(_, u)| u);
+    Some(Auto { case: out, chosen, start })
+}
+
+/// What [`choose_weights`] gives.
+pub struct Auto {
+    /// the case with the chosen λg
+    pub case: Case,
+    pub chosen: ChosenWeights,
+    /// frame 0's solution at the chosen λg, in frame 0's chart
+    pub start: Option<DVector<f64>>,
 }
 
 /// The state of the λg search.
@@ -94,6 +108,8 @@ struct Search<'a> {
     calib: &'a [Vec<Vector3<f64>>],
     /// frame 0's state of the last successful solve (continuation)
     u0: Option<DVector<f64>>,
+    /// every successful solve's λg and frame 0's state
+    states: Vec<(f64, DVector<f64>)>,
     solves: usize,
 }
 
@@ -114,6 +130,9 @@ impl Search<'_> {
         });
         match solved {
             Ok(reports) if !reports.is_empty() => {
+                if let Some(u) = &first {
+                    self.states.push((lambda_g, u.clone()));
+                }
                 self.u0 = first;
                 let mean_p2 = reports.iter().map(|r| r.fit.position.powi(2)).sum::<f64>() / reports.len() as f64;
                 mean_p2.sqrt() * length / 3f64.sqrt()
@@ -125,19 +144,29 @@ impl Search<'_> {
     /// `(λg, r(λg))` by the module doc's rule.
     fn run(&mut self, sigma: f64, cap: f64) -> (f64, f64) {
         let f = |r: f64| if r > 0.0 { (r / sigma).ln() } else { f64::NEG_INFINITY };
-        let (mut hi, mut r_hi) = (cap, self.residual(cap));
-        if !(sigma > 0.0) || f(r_hi) >= 0.0 {
-            return (hi, r_hi);
+        let floor = cap * MIN_RATIO;
+        if !(sigma > 0.0) {
+            return (cap, self.residual(cap));
         }
-        // bracket: r(lo) ≥ σ̂ > r(hi), stepping down by 100 at a time
-        let (mut lo, mut r_lo) = (hi, r_hi);
-        while f(r_lo) < 0.0 {
-            if lo <= cap * MIN_RATIO || self.solves >= MAX_SOLVES {
-                return (lo, r_lo);
-            }
-            (hi, r_hi) = (lo, r_lo);
-            lo = (lo * 1e-2).max(cap * MIN_RATIO);
+        // bracket r(lo) ≥ σ̂ > r(hi): up by 100 at a time from the smooth (easy) end, each solve
+        // continuing from the last
+        let mut lo = cap * START_RATIO;
+        let mut r_lo = self.residual(lo);
+        while f(r_lo) < 0.0 && lo > floor && self.solves < MAX_SOLVES {
+            lo = (lo * 1e-2).max(floor);
             r_lo = self.residual(lo);
+        }
+        if f(r_lo) < 0.0 {
+            return (lo, r_lo);
+        }
+        let (mut hi, mut r_hi) = (lo, r_lo);
+        while f(r_hi) >= 0.0 {
+            if hi >= cap || self.solves >= MAX_SOLVES {
+                return (hi, r_hi);
+            }
+            (lo, r_lo) = (hi, r_hi);
+            hi = (hi * 1e2).min(cap);
+            r_hi = self.residual(hi);
         }
         if f(r_lo) < MATCH.ln() {
             return (lo, r_lo);

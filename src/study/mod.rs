@@ -91,7 +91,7 @@ pub fn run_study(spec: &StudySpec, out: &Path, quick: bool, tick: impl Fn(&str))
             let entries = write_corpus(&corpus, &spec.kymogram, &params)?;
             let recordings: Vec<PathBuf> = entries.iter().map(|e| recording_path(&corpus, &e.name)).collect();
             let started = Instant::now();
-            rows.extend(spline_rows(mesh.nodes, noise_m, &recordings, spec.skip_elements)?);
+            rows.extend(spline_rows(mesh.nodes, noise_m, params.length_m, &recordings, spec.skip_elements)?);
             let spline_s = started.elapsed().as_secs_f64();
             rows.iter_mut().rev().take(recordings.len()).for_each(|r| r.frames_per_s = r.frames as f64 / (spline_s / recordings.len() as f64));
             for variant in &spec.variants {
@@ -124,14 +124,14 @@ fn recording_and_truth(
     Ok((clip.frames, truth))
 }
 
-fn spline_rows(nodes: usize, noise_m: f64, recordings: &[PathBuf], skip: usize) -> Result<Vec<StudyRow>, StudyError> {
+fn spline_rows(nodes: usize, noise_m: f64, length_m: f64, recordings: &[PathBuf], skip: usize) -> Result<Vec<StudyRow>, StudyError> {
     let mut rows = Vec::new();
     for recording in recordings {
         let (frames, truth) = recording_and_truth(recording)?;
         let errors: Vec<f64> = frames
             .iter()
             .zip(&truth.frames)
-            .map(|(f, t)| bending_error(&spline_bending(f), &truth_bending(t), skip))
+            .map(|(f, t)| bending_error(&spline_bending(f, length_m), &truth_bending(t), skip))
             .collect();
         rows.push(row(nodes, noise_m, SPLINE, recording, &errors));
     }

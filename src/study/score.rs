@@ -49,11 +49,13 @@ pub fn bending_error(b: &[f64], truth: &[f64], skip: usize) -> f64 {
     }
 }
 
-/// The smoothing-spline baseline's bending curvature per element of a noisy frame, NaN where no
-/// spline can be fitted.
-pub fn spline_bending(frame: &[Vector3<f64>]) -> Vec<f64> {
+/// The smoothing-spline baseline's bending curvature per element of a noisy frame of a body of
+/// length `length_m` [m] (nodes equally spaced in arc length), NaN where no spline can be
+/// fitted.
+pub fn spline_bending(frame: &[Vector3<f64>], length_m: f64) -> Vec<f64> {
     let elements = frame.len().saturating_sub(1);
-    SmoothingSpline::fit(frame).map_or_else(|| vec![f64::NAN; elements], |s| s.element_curvatures(elements))
+    SmoothingSpline::fit_uniform(frame, length_m)
+        .map_or_else(|| vec![f64::NAN; elements], |s| s.element_curvatures(elements))
 }
 
 /// The recovered bending curvature per frame and element from a run's `curvature.csv`
