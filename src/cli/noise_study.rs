@@ -9,7 +9,7 @@ use anyhow::{Context, Result};
 
 use cosserat::io::plot::{render_panels_svg, LinePlot, Series};
 use cosserat::io::write_atomic;
-use cosserat::study::{run_study, StudyRow, StudySpec, SPLINE};
+use cosserat::study::{recovered_name, run_study, StudyRow, StudySpec, SPLINE};
 
 use super::progress::Progress;
 
@@ -91,7 +91,13 @@ fn cells(rows: &[StudyRow]) -> BTreeMap<(usize, String, u64), Cell> {
 }
 
 fn methods(spec: &StudySpec) -> Vec<(String, String)> {
-    let mut m: Vec<(String, String)> = spec.variants.iter().map(|v| (v.name.clone(), v.label.clone())).collect();
+    let mut m: Vec<(String, String)> = Vec::new();
+    for v in &spec.variants {
+        m.push((v.name.clone(), v.label.clone()));
+        if v.recovered {
+            m.push((recovered_name(&v.name), format!("{}, nodal recovery", v.label)));
+        }
+    }
     m.push((SPLINE.into(), "smoothing spline (GCV)".into()));
     m
 }

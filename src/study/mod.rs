@@ -22,7 +22,10 @@ use crate::io::clip_files::read_recording;
 use crate::io::corpus::{recording_path, write_corpus, CorpusParams};
 use crate::io::truth_file::{read_truth, truth_sidecar};
 use crate::io::{write_atomic, InputError, OutputError};
-use score::{bending_error, median_and_worst, read_curvature, spline_bending, truth_bending, ScoreError};
+use score::{
+    bending_error, median_and_worst, read_curvature, recovered_nodal, spline_bending, truth_bending, truth_bending_nodal,
+    ScoreError,
+};
 
 /// Errors of the study.
 #[derive(Debug, thiserror::Error)]
@@ -101,9 +104,12 @@ pub fn run_study(spec: &StudySpec, out: &Path, quick: bool, tick: impl Fn(&str))
                 plan.begin(&runs)?;
                 let ran = run_batch(&plan, &runs, 0, || {})?;
                 for (r, recording) in ran.iter().zip(&recordings) {
-                    let mut row = score_run(mesh.nodes, noise_m, &variant.name, recording, &runs.join(&r.row.folder), spec.skip_elements)?;
-                    row.frames_per_s = row.frames_reconstructed as f64 / r.row.wall_time_s.max(1e-9);
-                    rows.push(row);
+                    let dir = runs.join(&r.row.folder);
+                    let scored = score_run(mesh.nodes, noise_m, variant, recording, &dir, spec.skip_elements)?;
+                    for mut row in scored {
+                        row.frames_per_s = row.frames_reconstructed as f64 / r.row.wall_time_s.max(1e-9);
+                        rows.push(row);
+                    }
                 }
                 tick(&format!("{tag} {}", variant.name));
             }
@@ -155,25 +161,45 @@ fn row(nodes: usize, noise_m: f64, method: &str, recording: &Path, errors: &[f64
     }
 }
 
-/// Score one recording's run folder (its `curvature.csv`; the weights from `run.json`).
-fn score_run(nodes: usize, noise_m: f64, method: &str, recording: &Path, dir: &Path, skip: usize) -> Result<StudyRow, StudyError> {
+/// The name of a variant's row scored with the nodal recovery ([`score::recovered_nodal`]).
+pub fn recovered_name(variant: &str) -> String {
+    format!("{variant}+nodal")
+}
+
+/// Score one recording's run folder (its `curvature.csv`; the weights from `run.json`): the
+/// variant's row, and with `recovered` its nodal recovery's.
+fn score_run(
+    nodes: usize,
+    noise_m: f64,
+    variant: &Variant,
+    recording: &Path,
+    dir: &Path,
+    skip: usize,
+) -> Result<Vec<StudyRow>, StudyError> {
     let (frames, truth) = recording_and_truth(recording)?;
     let curvature = dir.join("curvature.csv");
     let recovered = if curvature.is_file() { read_curvature(&curvature)? } else { Vec::new() };
-    let errors: Vec<f64> = (0..frames.len())
-        .map(|k| match recovered.get(k) {
-            Some(b) if !b.is_empty() => bending_error(b, &truth_bending(&truth.frames[k]), skip),
-            _ => f64::NAN,
-        })
-        .collect();
-    let mut r = row(nodes, noise_m, method, recording, &errors);
-    if let Ok(Some(m)) = crate::io::manifest::Manifest::read(dir) {
-        if let Some(w) = m.weights {
-            r.noise_estimate_m = Some(w.noise_m);
-            r.lambda_g = Some(w.lambda_g);
-        }
+    let score = |nodal: bool| -> Vec<f64> {
+        (0..frames.len())
+            .map(|k| match recovered.get(k) {
+                Some(b) if !b.is_empty() && nodal => {
+                    bending_error(&recovered_nodal(b), &truth_bending_nodal(&truth.frames[k]), skip)
+                }
+                Some(b) if !b.is_empty() => bending_error(b, &truth_bending(&truth.frames[k]), skip),
+                _ => f64::NAN,
+            })
+            .collect()
+    };
+    let weights = crate::io::manifest::Manifest::read(dir).ok().flatten().and_then(|m| m.weights);
+    let mut rows = vec![row(nodes, noise_m, &variant.name, recording, &score(false))];
+    if variant.recovered {
+        rows.push(row(nodes, noise_m, &recovered_name(&variant.name), recording, &score(true)));
     }
-    Ok(r)
+    for r in &mut rows {
+        r.noise_estimate_m = weights.map(|w| w.noise_m);
+        r.lambda_g = weights.map(|w| w.lambda_g);
+    }
+    Ok(rows)
 }
 
 fn write_table(out: &Path, rows: &[StudyRow]) -> Result<(), StudyError> {

@@ -79,6 +79,26 @@ pub fn read_curvature(path: &Path) -> Result<Vec<Vec<f64>>, ScoreError> {
     Ok(frames)
 }
 
+/// The nodal bending curvature recovered from element values `b` (a patch recovery): each
+/// interior node takes the mean of its two elements, an end node its element's. For a smooth
+/// curvature sampled at element midpoints this is second order at the interior nodes
+/// (`b(s_i) + h² b''/8`), and it averages the noise of two elements.
+pub fn recovered_nodal(b: &[f64]) -> Vec<f64> {
+    let n = b.len();
+    (0..=n)
+        .map(|i| match i {
+            0 => b[0],
+            i if i == n => b[n - 1],
+            i => 0.5 * (b[i - 1] + b[i]),
+        })
+        .collect()
+}
+
+/// The truth's bending curvature at the nodes [1/m].
+pub fn truth_bending_nodal(truth: &FrameTruth) -> Vec<f64> {
+    truth.kappa.iter().map(|k| k.x.hypot(k.y)).collect()
+}
+
 /// Median and largest of a set of per-frame errors (NaN entries are frames not reconstructed
 /// and are left out); `(NaN, NaN)` when none is finite.
 pub fn median_and_worst(errors: &[f64]) -> (f64, f64) {
@@ -106,6 +126,18 @@ mod tests {
         b[2] = 3.0; // error 1 against a norm of √10
         assert!((bending_error(&b, &truth, 1) - (0.1f64).sqrt()).abs() < 1e-15);
         assert!(bending_error(&b, &truth, 3).is_nan());
+    }
+
+    /// Linear curvature sampled as element means is recovered exactly at the interior nodes.
+    #[test]
+    fn nodal_recovery_is_exact_for_linear_curvature() {
+        let h = 0.1;
+        let means: Vec<f64> = (0..8).map(|e| 2.0 + 3.0 * (e as f64 + 0.5) * h).collect();
+        let r = recovered_nodal(&means);
+        assert_eq!(r.len(), 9);
+        for (i, v) in r.iter().enumerate().take(8).skip(1) {
+            assert!((v - (2.0 + 3.0 * i as f64 * h)).abs() < 1e-14, "node {i}: {v}");
+        }
     }
 
     #[test]

@@ -35,6 +35,10 @@ pub struct Variant {
     pub label: String,
     #[serde(default)]
     pub set: toml::Table,
+    /// also score the curvature recovered at the nodes (`score::recovered_nodal`), as the
+    /// method `NAME+nodal`
+    #[serde(default)]
+    pub recovered: bool,
 }
 
 /// The smaller plan of `--quick`.

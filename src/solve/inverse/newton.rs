@@ -336,6 +336,15 @@ fn solve_from(
         if !chord && n > STALL_WINDOW && phi > (1.0 - STALL_DECREASE) * phis[n - 1 - STALL_WINDOW] {
             let c = certify(&big);
             let stop = if c.within(params.certificate_tolerance) { Stop::Converged } else { Stop::Stalled };
+            if lean {
+                // a lean solve kept no record of the iterate it returns: its report is this one
+                let rec = InverseRecord {
+                    certificate: Some(c.value),
+                    ..record(problem, params, frame, previous_angles, k - 1, previous, &u, &adjoint, Some(phi / phi0))
+                };
+                observer(&rec, &u, &adjoint);
+                history.push(rec);
+            }
             return Ok(done(u, adjoint, history, stop, c));
         }
         let change = relative_change(&fwd, &dofs.kkt_state(&(&big + &delta)), &dofs.kkt_state(&big));
