@@ -40,6 +40,7 @@
 //! [`Clip::stretch`] is the polyline length of the nodes divided by [`Clip::length_m`].
 use nalgebra::{Matrix3, Vector2, Vector3};
 
+pub mod length;
 pub mod smoothing;
 mod spline;
 pub mod synthetic;
@@ -67,10 +68,14 @@ pub const MIN_CLIP_ELEMENTS: usize = 2 * CLIP_SKIP_ELEMENTS + 1;
 /// is 1.4·10⁷. A kymogram's frames and a synthetic clip's `clip_frames` are multiplied by the
 /// mesh's node count before anything is allocated.
 pub const MAX_CLIP_POSITIONS: usize = 1 << 25;
-/// Largest deviation of a recorded frame's polyline length from the rod length,
-/// `|L_frame / rod.length_m − 1|`, accepted when a recording is loaded (kymograms are scaled to
-/// the rod length by design and not checked). Measured, max over all frames of every clip case
-/// of `cases/` on its own mesh (`io::clip_files` test `length_ratios_of_the_clip_cases`):
+/// Largest deviation of a recorded frame's length from the rod length, `|L_frame / rod.length_m
+/// − 1|`, accepted when a recording is loaded (kymograms are scaled to the rod length by design
+/// and not checked). `L_frame` is the frame's length corrected for its own noise
+/// ([`length::FrameLength`], docs/decisions.md D18): noise of σ per coordinate lengthens a
+/// polyline of node spacing h by about 2σ²/h², 20 % for 10 µm at 33 nodes on 1 mm.
+///
+/// Measured, max over all frames of every clip case of `cases/` on its own mesh (`io::clip_files`
+/// test `length_ratios_of_the_clip_cases`, polyline lengths: these clips have no noise):
 ///
 /// | clip | frames | max deviation | without `scale_to_length` |
 /// |---|---|---|---|
@@ -78,11 +83,23 @@ pub const MAX_CLIP_POSITIONS: usize = 1 << 25;
 /// | worm_delta_turn(_ld1) | 300 | 3.6e-4 | 8.8e-3 |
 /// | worm_roll_3d (synthetic, j = 1) | 1160 | 3.1e-4 | – |
 ///
-/// The band is 10 %: 11× the largest deviation measured (0.88 %, the unscaled spline), far
-/// below the errors it is there to name (a recording in mm read as m is 1000×, a wrong
-/// `rod.length_m` 0.5× or 1.2×). It is not a convergence bound: frames 100–103 of the omega
-/// turn scaled by k about the head converge for k = 1 … 1.2 with λd = 1 and Newton
-/// (`worm_omega_turn_ld1`), but not for k = 0.95 or 1.05 with Table 1's λd = 1e2.
+/// and over the 400 frames of `cosserat synth --count 4 --frames 100 --seed 11` (1 mm body),
+/// polyline → corrected:
+///
+/// | σ [µm] | 33 nodes | 128 nodes |
+/// |---|---|---|
+/// | 0 | 3.2e-3 → 5.7e-5 | 2.0e-4 → 1.7e-7 |
+/// | 0.3 | 3.4e-3 → 1.8e-3 | 4.6e-3 → 2.1e-3 |
+/// | 1 | 6.5e-3 → 6.8e-3 | 4.8e-2 → 1.5e-2 |
+/// | 3 | 3.9e-2 → 2.1e-2 | 3.9e-1 → 2.0e-2 |
+/// | 10 | 3.5e-1 → 4.9e-2 | 2.4 → 3.2e-2 |
+///
+/// The band is 10 %: 2× the largest corrected deviation measured (4.9 %, 10 µm of noise on 33
+/// nodes, where one frame's length has a spread of 1.6 %: `clip::length` tests), far below the
+/// errors it is there to name (a recording in mm read as m is 1000×, a wrong `rod.length_m`
+/// 0.5× or 1.2×). It is not a convergence bound: frames 100–103 of the omega turn scaled by k
+/// about the head converge for k = 1 … 1.2 with λd = 1 and Newton (`worm_omega_turn_ld1`), but
+/// not for k = 0.95 or 1.05 with Table 1's λd = 1e2.
 pub const MAX_LENGTH_DEVIATION: f64 = 0.10;
 
 /// Errors of building, cutting and scoring clips (reading their files is `crate::io`'s).

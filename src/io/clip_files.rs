@@ -9,6 +9,7 @@ use super::files::{csv_reader_capped, InputError};
 use super::npy::read_npy;
 use super::truth_file::{read_truth, truth_sidecar};
 use crate::case::{Case, ClipKind};
+use crate::clip::length::FrameLength;
 use crate::clip::synthetic::{roll_clip, FrameTruth, GroundTruth, RollClipGenerator};
 use crate::clip::{
     check_frame_range, clip_from_angles, polyline_length, rotate_frame, Clip, ClipError, KymogramParams,
@@ -40,12 +41,26 @@ pub enum ClipFileError {
     #[error("{path}: {nodes} nodes per frame, but the case's mesh has {expected} (rod.elements + 1)")]
     NodeCount { path: PathBuf, nodes: usize, expected: usize },
     #[error(
-        "{path}, frame {frame}: the centreline is {length_m:e} m long, {ratio:.3}× the rod length rod.length_m = \
-         {rod_m:e} m (allowed: within ±{:.0} %){glitch}; scale the recording to metres of this rod, or set \
-         rod.length_m to the length of the recorded body",
+        "{path}, frame {frame}: the centreline is {corrected_m:.4e} m long after the noise correction (measured: \
+         {polyline_m:.4e} m as the polyline of its nodes, noise level {noise_m:.2e} m per coordinate, chords of \
+         {chord_nodes} node spacing(s); docs/decisions.md D18), {ratio:.3}× the rod length rod.length_m = {rod_m:e} m \
+         (allowed: {:.3}× to {:.3}×, ±{:.0} %){glitch}; scale the recording to metres of this rod, or set \
+         rod.length_m to the length of the recorded body (\"from_data\" estimates it)",
+        1.0 - MAX_LENGTH_DEVIATION,
+        1.0 + MAX_LENGTH_DEVIATION,
         100.0 * MAX_LENGTH_DEVIATION
     )]
-    Length { path: PathBuf, frame: usize, length_m: f64, rod_m: f64, ratio: f64, glitch: String },
+    Length {
+        path: PathBuf,
+        frame: usize,
+        polyline_m: f64,
+        noise_m: f64,
+        chord_nodes: usize,
+        corrected_m: f64,
+        rod_m: f64,
+        ratio: f64,
+        glitch: String,
+    },
     #[error(
         "{path}: {frames} frames × {nodes} nodes are {positions} positions, more than the {MAX_CLIP_POSITIONS} a clip \
          may hold; use a shorter clip"
@@ -68,21 +83,24 @@ fn check_positions(path: &Path, frames: usize, nodes: usize) -> Result<(), ClipF
     Ok(())
 }
 
-/// Refuse a recording frame (`first` is the file's index of `frames[0]`) whose polyline length
-/// deviates from the rod length by more than [`MAX_LENGTH_DEVIATION`].
+/// Refuse a recording frame (`first` is the file's index of `frames[0]`) whose length,
+/// corrected for the frame's noise ([`FrameLength`], docs/decisions.md D18), deviates from the
+/// rod length by more than [`MAX_LENGTH_DEVIATION`].
 fn check_lengths(path: &Path, frames: &[Vec<Vector3<f64>>], first: usize, rod_m: f64) -> Result<(), ClipFileError> {
     for (k, f) in frames.iter().enumerate() {
-        let length_m = polyline_length(f);
-        let ratio = length_m / rod_m;
+        let l = FrameLength::of(f);
+        let ratio = l.corrected_m / rod_m;
         if ratio.is_nan() || (ratio - 1.0).abs() > MAX_LENGTH_DEVIATION {
-            let glitch = glitch(f);
             return Err(ClipFileError::Length {
                 path: path.to_path_buf(),
                 frame: first + k,
-                length_m,
+                polyline_m: l.polyline_m,
+                noise_m: l.noise_m,
+                chord_nodes: l.chord_nodes,
+                corrected_m: l.corrected_m,
                 rod_m,
                 ratio,
-                glitch,
+                glitch: glitch(f),
             });
         }
     }
@@ -120,7 +138,7 @@ fn glitch(pts: &[Vector3<f64>]) -> String {
 
 /// The clip of a clip case: kymograms become spline centrelines with the mesh's node count
 /// and the rod's length in the case's plane; recordings must have that node count, and every
-/// frame solved the rod's length within [`MAX_LENGTH_DEVIATION`]; a synthetic clip
+/// frame solved the rod's length within [`MAX_LENGTH_DEVIATION`] once corrected for its noise; a synthetic clip
 /// (`kind = "roll_3d"`) comes with its ground truth, and so does a recording with a truth sidecar
 /// ([`super::truth_file`]). The frame range and the orientation of the
 /// case are applied to both.
