@@ -41,7 +41,7 @@
 use nalgebra::{Matrix3, Vector2, Vector3};
 
 pub mod length;
-pub mod smoothing;
+pub use crate::solve::smoothing;
 mod spline;
 pub mod synthetic;
 

@@ -11,6 +11,7 @@ pub mod inverse;
 pub mod modes;
 pub mod problem;
 pub mod sequence;
+pub mod smoothing;
 pub mod statics;
 
 pub use problem::Problem;

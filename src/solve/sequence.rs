@@ -263,6 +263,43 @@ pub struct FrameSolution<'a> {
     pub state: &'a DVector<f64>,
 }
 
+/// Decades of λg below the case's at which [`continued`] starts.
+pub const CONTINUATION_DECADES: i32 = 3;
+
+/// Errors of a frame's solve that another start may avoid.
+fn recoverable(e: &SolveError) -> bool {
+    matches!(
+        e,
+        SolveError::InverseNotConverged { .. }
+            | SolveError::InverseNewtonNotConverged { .. }
+            | SolveError::Stalled(_)
+            | SolveError::InverseDiverged { .. }
+    )
+}
+
+/// The data guess ([`data_frame_guess`]) of the frame's data smoothed by a GCV smoothing spline
+/// (`solve::smoothing`, nodes equally spaced over `length_m`): on noisy data the plain guess's
+/// tangents carry the noise. `None` where no spline can be fitted.
+pub fn smoothed_guess(x_g: &[Vector3<f64>], length_m: f64) -> Option<DVector<f64>> {
+    let s = super::smoothing::SmoothingSpline::fit_uniform(x_g, length_m)?;
+    Some(data_frame_guess(s.knot_values()))
+}
+
+/// Continuation in λg of a frame that failed from its starts (`docs/noise.md`, N7): solved from
+/// `guess` at `λg·10^−CONTINUATION_DECADES`, where the tracking term is weak and the frame is
+/// smooth, then at ten times that from the last solution, up to `lambda_g`.
+fn continued(
+    solve: &mut impl FnMut(&DVector<f64>, Start, f64) -> Result<InverseSolution, SolveError>,
+    guess: &DVector<f64>,
+    lambda_g: f64,
+) -> Result<InverseSolution, SolveError> {
+    let mut sol = solve(guess, Start::Guess, lambda_g * 10f64.powi(-CONTINUATION_DECADES))?;
+    for d in (0..CONTINUATION_DECADES).rev() {
+        sol = solve(&sol.u, Start::Near, lambda_g * 10f64.powi(-d))?;
+    }
+    Ok(sol)
+}
+
 /// Solve every frame of `frames` (positions per node, the mesh's nodes) in order. `u0` is the
 /// initial iterate of the first frame in the chart of the first frame (e.g. [`data_frame_guess`]
 /// of the data in that chart; `None`: that guess). Later frames start from the previous frame's
@@ -353,21 +390,29 @@ pub fn solve_sequence_from(
         let frame = Frame { index: k, x_g: &x_g, previous: alpha_prev.as_deref() };
         // From the previous frame's solution (already close) Newton runs directly; from a guess
         // it needs the fixed point's warm start (I8).
-        let mut solve = |u0: &DVector<f64>, start: Start| -> Result<InverseSolution, SolveError> {
+        let lambda_g = sp.inverse.weights.lambda_g;
+        let mut solve = |u0: &DVector<f64>, start: Start, lambda: f64| -> Result<InverseSolution, SolveError> {
+            solver.params.weights.lambda_g = lambda;
             solver.solve(&frame, u0, start, |r, _, _| on_iteration(k, r))?.converged(k)
         };
         // A frame that does not converge from the previous frame's solution is solved again
-        // from the data guess (D13), and the restart is reported.
+        // from the data guess (D13), and the restart is reported; one that does not converge
+        // from there either is continued in λg from the smoothed data ([`continued`]).
         let from_previous = i > 0 && sp.start == FrameStart::PreviousFrame;
         let first_kind = if from_previous { Start::Near } else { Start::Guess };
-        let (sol, restarted) = match solve(&first_start, first_kind) {
+        let (sol, restarted) = match solve(&first_start, first_kind, lambda_g) {
             Ok(sol) => (sol, false),
-            Err(
-                SolveError::InverseNotConverged { .. }
-                | SolveError::InverseNewtonNotConverged { .. }
-                | SolveError::Stalled(_)
-                | SolveError::InverseDiverged { .. },
-            ) if from_previous => (solve(&guess(), Start::Guess)?, true),
+            Err(e) if recoverable(&e) => {
+                let again = if from_previous { solve(&guess(), Start::Guess, lambda_g) } else { Err(e) };
+                match again {
+                    Ok(sol) => (sol, true),
+                    Err(e) if recoverable(&e) => {
+                        let smooth = smoothed_guess(&x_g, problem.mesh.length_m).unwrap_or_else(guess);
+                        (continued(&mut solve, &smooth, lambda_g).map_err(|_| e)?, true)
+                    }
+                    Err(e) => return Err(e.into()),
+                }
+            }
             Err(e) => return Err(e.into()),
         };
         let (cos_beta, node) = min_cos_beta(&dofs, &sol.u);

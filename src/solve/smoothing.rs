@@ -175,6 +175,11 @@ impl SmoothingSpline {
         Some(SmoothingSpline { t, g, gamma, p })
     }
 
+    /// The smoothed points (the spline at its knots) [m].
+    pub fn knot_values(&self) -> &[Vector3<f64>] {
+        &self.g
+    }
+
     /// Parameter range `[0, t_end]` (the chord length of the noisy points) [m].
     pub fn t_end(&self) -> f64 {
         *self.t.last().unwrap_or(&0.0)
