@@ -7,7 +7,7 @@ use std::process::ExitCode;
 
 use anyhow::{Context, Result};
 
-use cosserat::io::plot::{render_panels_svg, LinePlot, Series};
+use cosserat::io::plot::{render_panels_svg, Legend, LinePlot, Series};
 use cosserat::io::write_atomic;
 use cosserat::study::{recovered_name, run_study, StudyRow, StudySpec, SPLINE};
 
@@ -125,40 +125,42 @@ fn table(spec: &StudySpec, rows: &[StudyRow]) -> String {
     s
 }
 
-/// Per mesh: bending error (median: solid; worst frame: dashed, the worst recording of each)
-/// and the reconstructed fraction against σ.
+/// Per mesh: the bending error's median and worst frame (each the worst recording's) and the
+/// reconstructed fraction against σ, for the variants marked `plot` and the spline.
 fn figure(spec: &StudySpec, rows: &[StudyRow]) -> Result<String> {
     let cells = cells(rows);
+    let shown: Vec<(String, String)> = methods(spec)
+        .into_iter()
+        .filter(|(name, _)| name == SPLINE || spec.variants.iter().any(|v| &v.name == name && v.plot))
+        .collect();
     let mut panels = Vec::new();
     for mesh in &spec.meshes {
-        let mut err = LinePlot {
-            title: format!("{} nodes: bending error vs noise (worst recording)", mesh.nodes),
-            x_label: "noise σ [µm] (σ = 0 not drawn: see the table)".into(),
-            y_label: "relative L² error of |κ| [–]".into(),
+        let panel = |what: &str, y_label: &str, log_y: bool, legend: Legend| LinePlot {
+            title: format!("{} nodes: {what}", mesh.nodes),
+            x_label: "noise σ per coordinate [µm] (σ = 0: see the table)".into(),
+            y_label: y_label.into(),
             log_x: true,
-            log_y: true,
+            log_y,
+            legend,
             ..LinePlot::default()
         };
-        let mut frac = LinePlot {
-            title: format!("{} nodes: frames reconstructed", mesh.nodes),
-            x_label: "noise σ [µm]".into(),
-            y_label: "fraction of frames [–]".into(),
-            log_x: true,
-            ..LinePlot::default()
-        };
-        for (name, label) in methods(spec) {
+        let mut median = panel("bending error, median frame", "relative L² error of |κ| [–]", true, Legend::UpperLeft);
+        let mut worst = panel("bending error, worst frame", "relative L² error of |κ| [–]", true, Legend::UpperLeft);
+        let mut frac = panel("frames reconstructed", "fraction of frames [–]", false, Legend::LowerLeft);
+        for (name, label) in &shown {
             let pts: Vec<(f64, &Cell)> = cells
                 .iter()
-                .filter(|((n, m, _), _)| *n == mesh.nodes && *m == name)
+                .filter(|((n, m, _), _)| *n == mesh.nodes && m == name)
                 .map(|((_, _, b), c)| (f64::from_bits(*b) * 1e6, c))
+                .filter(|(s, _)| *s > 0.0)
                 .collect();
             let x: Vec<f64> = pts.iter().map(|p| p.0).collect();
-            err.series.push(Series { label: format!("{label}: median"), x: x.clone(), y: pts.iter().map(|p| p.1.median.1).collect() });
-            err.series.push(Series { label: format!("{label}: worst frame"), x: x.clone(), y: pts.iter().map(|p| p.1.worst.1).collect() });
-            frac.series.push(Series { label, x, y: pts.iter().map(|p| p.1.reconstructed as f64 / p.1.frames.max(1) as f64).collect() });
+            let series = |y: Vec<f64>| Series { label: label.clone(), x: x.clone(), y };
+            median.series.push(series(pts.iter().map(|p| p.1.median.1).collect()));
+            worst.series.push(series(pts.iter().map(|p| p.1.worst.1).collect()));
+            frac.series.push(series(pts.iter().map(|p| p.1.reconstructed as f64 / p.1.frames.max(1) as f64).collect()));
         }
-        panels.push(err);
-        panels.push(frac);
+        panels.extend([median, worst, frac]);
     }
-    Ok(render_panels_svg(&panels, 2)?)
+    Ok(render_panels_svg(&panels, 3)?)
 }

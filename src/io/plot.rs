@@ -39,6 +39,17 @@ pub struct LinePlot {
     pub log_x: bool,
     /// Logarithmic y axis.
     pub log_y: bool,
+    /// Where the legend goes (the corner the curves leave free).
+    pub legend: Legend,
+}
+
+/// A corner of the plot for the legend.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Legend {
+    #[default]
+    UpperRight,
+    UpperLeft,
+    LowerLeft,
 }
 
 /// Errors from the plotting helpers.
@@ -168,6 +179,11 @@ where
     }
     chart
         .configure_series_labels()
+        .position(match plot.legend {
+            Legend::UpperRight => SeriesLabelPosition::UpperRight,
+            Legend::UpperLeft => SeriesLabelPosition::UpperLeft,
+            Legend::LowerLeft => SeriesLabelPosition::LowerLeft,
+        })
         .background_style(WHITE.mix(0.85))
         .border_style(BLACK)
         .draw()

@@ -175,6 +175,7 @@ pub fn headline_panels(case: &Case, r: &RunResult) -> Vec<LinePlot> {
         series: s,
         log_x: false,
         log_y: false,
+        legend: Default::default(),
     };
     if let Some(inv) = &r.inverse {
         return inverse_panels(case, r, inv);
@@ -240,6 +241,7 @@ fn inverse_panels(case: &Case, r: &RunResult, inv: &InverseOutput) -> Vec<LinePl
         series: s,
         log_x: log,
         log_y: log,
+        legend: Default::default(),
     };
     let s = r.nodes.s.clone();
     let comp = ["x", "y", "z"];
@@ -291,6 +293,7 @@ pub fn write_convergence_plot(runs: &[(&String, &RunResult)], path: &Path) -> Re
         series,
         log_x: true,
         log_y: true,
+        legend: Default::default(),
     };
     let mut xerr = Vec::new();
     let mut kerr = Vec::new();

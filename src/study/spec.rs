@@ -39,6 +39,13 @@ pub struct Variant {
     /// method `NAME+nodal`
     #[serde(default)]
     pub recovered: bool,
+    /// drawn in noise_study.svg (every variant is in the table)
+    #[serde(default = "yes")]
+    pub plot: bool,
+}
+
+fn yes() -> bool {
+    true
 }
 
 /// The smaller plan of `--quick`.
