@@ -8,6 +8,7 @@ use sha2::{Digest, Sha256};
 
 use super::files::{is_temporary, write_atomic};
 use crate::case::sweep::SweepValue;
+use crate::clip::length::BodyLength;
 
 /// File name of the manifest in an output folder.
 pub const MANIFEST: &str = "run.json";
@@ -92,6 +93,10 @@ pub struct Manifest {
     /// the residual certificate of the result, where the run has one
     #[serde(default)]
     pub certificate: Option<CertificateSummary>,
+    /// `rod.length_m = "from_data"`: the body length estimated from the recording, with the
+    /// spread and range of its frames (`clip::length`)
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub body_length: Option<BodyLength>,
     /// the process that wrote the folder
     pub pid: u32,
     /// seconds since the Unix epoch
@@ -177,6 +182,7 @@ impl Manifest {
             frames_total: None,
             message: None,
             certificate: None,
+            body_length: None,
             pid: std::process::id(),
             started_unix_s: now_unix_s(),
             finished_unix_s: None,
