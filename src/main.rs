@@ -254,8 +254,9 @@ fn dispatch(cli: Cli) -> Result<ExitCode> {
     }
 }
 
+/// The case of `path`, its `rod.length_m = "from_data"` resolved from its recording.
 fn load(path: &Path) -> Result<Case> {
-    Ok(Case::from_file(path)?)
+    Ok(cosserat::io::clip_files::resolve_length(&Case::from_file(path)?)?)
 }
 
 /// Refuse a run whose estimated memory exceeds the limit (`--max-memory-gib`).

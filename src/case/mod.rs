@@ -18,6 +18,7 @@ pub mod sweep;
 mod toml_error;
 mod validate;
 
+use crate::clip::length::BodyLength;
 use crate::clip::synthetic::{RollClipParams, TimeMapping};
 use crate::clip::{ClipPlane, KymogramParams};
 use crate::model::loads::Loads;
@@ -59,6 +60,24 @@ pub enum CaseError {
 /// (the largest, `cases/paper/sec6_worm.toml`, 11 037 bytes), so the cap is ~100× above any
 /// real case and stops `cosserat run /dev/zero` at once instead of reading forever.
 pub const CASE_FILE_CAP_BYTES: u64 = 1 << 20;
+
+/// The word of `rod.length_m` that asks for the body length of the recording.
+pub const FROM_DATA: &str = "from_data";
+
+/// The mesh length of a case whose `rod.length_m = "from_data"` is not resolved yet [m]: a
+/// placeholder that nothing solves with (`io::clip_files::load_clip` refuses such a case).
+pub const FROM_DATA_PLACEHOLDER_M: f64 = 1.0;
+
+/// Where the rod length `mesh.length_m` comes from (`rod.length_m`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum RodLength {
+    /// a number or an expression of the case file
+    Given,
+    /// `"from_data"`: the body length of the recording, estimated when it is read
+    /// (`io::clip_files::resolve_length`, `clip::length`); `None` until then, when the mesh's
+    /// length is [`FROM_DATA_PLACEHOLDER_M`]
+    FromData(Option<BodyLength>),
+}
 
 /// Where the centreline data of an inverse case come from.
 #[derive(Clone, Debug, PartialEq)]
@@ -220,6 +239,8 @@ pub struct Case {
     pub source_sha256: Option<String>,
     pub constants: BTreeMap<String, f64>,
     pub mesh: Mesh,
+    /// where `mesh.length_m` comes from
+    pub rod_length: RodLength,
     pub material: Material,
     pub section: CrossSection,
     pub props: RodProperties,
@@ -303,6 +324,14 @@ impl Case {
         match &self.analysis {
             Analysis::Inverse(s) => Some(s),
             _ => None,
+        }
+    }
+
+    /// The body length estimated from the recording (`rod.length_m = "from_data"`, resolved).
+    pub fn body_length(&self) -> Option<BodyLength> {
+        match self.rod_length {
+            RodLength::FromData(b) => b,
+            RodLength::Given => None,
         }
     }
 

@@ -5,7 +5,7 @@
 //! exactly the path, of a value written in the file.
 use super::raw::RawCase;
 use super::validate::Validator;
-use super::{Analysis, Case, CaseError};
+use super::{Analysis, Case, CaseError, RodLength};
 
 /// Errors of sweep specifications.
 #[derive(Debug, thiserror::Error)]
@@ -247,6 +247,13 @@ impl Case {
         })?;
         case.source = self.source.clone();
         case.raw = Some((table, path));
+        // a body length estimated from the recording stays with the case while its length does
+        // (`rod.length_m = "from_data"` resolved: the tables hold the estimate as a number)
+        if case.rod_length == RodLength::Given && case.mesh.length_m == self.mesh.length_m {
+            if let RodLength::FromData(Some(b)) = self.rod_length {
+                case.rod_length = RodLength::FromData(Some(b));
+            }
+        }
         Ok(case)
     }
 }

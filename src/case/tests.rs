@@ -217,3 +217,27 @@ fn meshes_clip_meshes_and_clip_vectors_are_bounded() {
         reason(&worm.replace("start = \"data_guess\"", "start = \"data_guess\"\norientation = [1e308, 1e308, 1e308]"));
     assert!(e.contains("key `clip.orientation`: rotation vector"), "{e}");
 }
+
+/// `rod.length_m = "from_data"` is a typed variant of a recorded clip case, with the mesh's
+/// placeholder length until the recording is read; any other case refuses it, naming what it is.
+#[test]
+fn length_from_data_is_for_recordings_only() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let batch = std::fs::read_to_string(root.join("cases/batch/roll_recording.toml")).unwrap();
+    let c = parse(&batch.replace("length_m = \"L\"", "length_m = \"from_data\"")).unwrap();
+    assert_eq!(
+        (c.rod_length, c.mesh.length_m, c.body_length()),
+        (RodLength::FromData(None), FROM_DATA_PLACEHOLDER_M, None)
+    );
+    assert_eq!(parse(&batch).unwrap().rod_length, RodLength::Given);
+    let tail = "\"from_data\" estimates the body length from a recording: only for an inverse case with [clip] kind = \
+                \"recording\", but this is";
+    let e = reason(&GOOD.replace("length_m = \"L0\"", "length_m = \"from_data\""));
+    assert_eq!(e, format!("t.toml: key `rod.length_m`: {tail} a static case; give the length in metres"));
+    let worm = std::fs::read_to_string(root.join("cases/worm_omega_turn.toml")).unwrap();
+    let e = reason(&worm.replace("length_m = \"L\"", "length_m = \"from_data\""));
+    assert!(e.contains(&format!("{tail} a kymogram clip")), "{e}");
+    // a misspelt word is an expression with an unknown name
+    let e = reason(&batch.replace("length_m = \"L\"", "length_m = \"from-data\""));
+    assert!(e.contains("key `rod.length_m`"), "{e}");
+}

@@ -10,7 +10,7 @@ use nalgebra::Vector3;
 
 use super::raw::*;
 use super::{
-    Analysis, Case, CaseError, CompareOverrides, CompareSpec, DataSource, InverseSettings, Reference, WeightsRule,
+    Analysis, Case, CaseError, CompareOverrides, CompareSpec, DataSource, InverseSettings, Reference, WeightsRule, RodLength,
     DEFAULT_COMPARE_FRAMES,
 };
 use crate::expr::{Expr, ExprError, Node};
@@ -23,6 +23,7 @@ use crate::solve::statics::{Method, StaticParams};
 
 mod clip;
 mod loads;
+mod rod;
 
 /// Most elements of a mesh: 10⁶. The cases use 10–400 (the Timoshenko convergence study of
 /// `cases/paper/fig07_timoshenko.toml` goes to 400); a mesh beyond this would not fit the
@@ -112,11 +113,14 @@ impl<'a> Validator<'a> {
     /// The whole case.
     pub(super) fn case(mut self, mut raw: RawCase, name: &str) -> Result<Case, CaseError> {
         self.constants(std::mem::take(&mut raw.constants))?;
-        let mesh = self.mesh(&raw.rod)?;
+        let (mesh, rod_length) = self.mesh(&raw.rod)?;
         let kind = raw.solver.analysis;
         let material = self.material(&raw.material, kind)?;
         let section = self.section(&raw.cross_section)?;
-        self.slenderness(&mesh, &section)?;
+        if rod_length == RodLength::Given {
+            // a length from the data is checked when it is known (the case is validated again)
+            self.slenderness(&mesh, &section)?;
+        }
         let (loads, load_texts) = self.loads(&raw.loads, kind)?;
         self.tables_of_other_analyses(&raw, kind)?;
         let quadrature = match raw.solver.quadrature {
@@ -140,6 +144,7 @@ impl<'a> Validator<'a> {
             }
         };
         self.loads_are_finite(&loads, &load_texts, &mesh, quadrature, &analysis)?;
+        self.length_from_data(rod_length, &analysis)?;
         let compare = self.compare(&raw.compare)?;
         let reference = self.reference(raw.reference.as_ref(), kind, &loads)?;
         Ok(Case {
@@ -150,6 +155,7 @@ impl<'a> Validator<'a> {
             source_sha256: None,
             constants: self.constants,
             mesh,
+            rod_length,
             material,
             section,
             props: RodProperties::new(&material, &section),
@@ -222,18 +228,6 @@ impl<'a> Validator<'a> {
         Ok(())
     }
 
-    /// `[rod]`.
-    fn mesh(&self, rod: &RawRod) -> Result<Mesh, CaseError> {
-        let length = self.positive("rod.length_m", &rod.length_m)?;
-        if rod.elements < 2 {
-            return Err(self.err("rod.elements", format!("need at least 2 elements, got {}", rod.elements)));
-        }
-        if rod.elements > MAX_ELEMENTS {
-            return Err(self.err("rod.elements", format!("at most {MAX_ELEMENTS} elements, got {}", rod.elements)));
-        }
-        Ok(Mesh::new(length, rod.elements))
-    }
-
     /// `[material]`; the density is required by a dynamic analysis only.
     fn material(&self, m: &RawMaterial, kind: RawAnalysis) -> Result<Material, CaseError> {
         let density = match (&m.density_kg_m3, kind) {
@@ -262,40 +256,6 @@ impl<'a> Validator<'a> {
                 height_m: self.positive("cross_section.height_m", height_m)?,
             },
         })
-    }
-
-    /// The rod's geometry within what double precision solves: the cross section's area and
-    /// second moments finite and > 0, and the slenderness `L / r_g` (`r_g = √(min(I1, I2)/A)`,
-    /// the radius of gyration) at most `1/√ε` ≈ 6.7e7. The stretching stiffness `EA` exceeds
-    /// the bending stiffness `EI/L²` by `(L/r_g)²`; beyond `1/ε` one matrix cannot hold both, and
-    /// the tangent is singular in double precision (a length in the wrong unit, `1e200`, …).
-    fn slenderness(&self, mesh: &Mesh, section: &CrossSection) -> Result<(), CaseError> {
-        let (area, m) = (section.area_m2(), section.second_moments_m4());
-        let key = match section {
-            CrossSection::Circle { .. } => "cross_section.radius_m",
-            CrossSection::Rectangle { .. } => "cross_section.width_m",
-        };
-        if !(area.is_finite() && area > 0.0 && m.iter().all(|v| v.is_finite() && *v > 0.0)) {
-            return Err(self.err(
-                key,
-                format!(
-                    "the cross section's area {area:e} m² and second moments {:e}, {:e} m⁴ must be finite and > 0 in double precision",
-                    m[0], m[1]
-                ),
-            ));
-        }
-        let r_g = (m[0].min(m[1]) / area).sqrt();
-        let (slenderness, max) = (mesh.length_m / r_g, f64::EPSILON.sqrt().recip());
-        if slenderness.is_nan() || slenderness > max {
-            return Err(self.err(
-                "rod.length_m",
-                format!(
-                    "{:e} m is {slenderness:.2e} times the cross section's radius of gyration ({r_g:e} m); above {max:.1e} (1/√ε) the stretching stiffness EA exceeds the bending stiffness EI/L² by more than 1/ε, and the discrete equations cannot be solved in double precision: check the units of the length and of the cross section",
-                    mesh.length_m
-                ),
-            ));
-        }
-        Ok(())
     }
 
     /// Tables and `[solver]` keys that belong to another analysis are refused.

@@ -28,6 +28,10 @@ pub struct SynthArgs {
     /// Nodes per frame: the batch case's rod.elements + 1
     #[arg(long, default_value_t = 33, value_parser = clap::value_parser!(u64).range(3..))]
     nodes: u64,
+    /// Body length of the recorded worm [m] (a batch case with rod.length_m = "from_data"
+    /// measures it from each recording)
+    #[arg(long, default_value_t = cosserat::clip::WORM_LENGTH_M)]
+    length_m: f64,
     /// Standard deviation of the noise added to every coordinate [m]
     #[arg(long, default_value_t = 1e-7)]
     noise_m: f64,
@@ -77,6 +81,7 @@ pub fn cmd_synth(a: SynthArgs) -> Result<ExitCode> {
         count: a.count as usize,
         frames: a.frames as usize,
         nodes: a.nodes as usize,
+        length_m: a.length_m,
         dt_s: a.frame_interval_s,
         noise_m: a.noise_m,
         seed: a.seed,
@@ -98,6 +103,7 @@ pub fn cmd_synth(a: SynthArgs) -> Result<ExitCode> {
         ("count", params.count as f64),
         ("frames", params.frames as f64),
         ("nodes", params.nodes as f64),
+        ("length_m", params.length_m),
         ("seed", params.seed as f64),
         ("noise_m", params.noise_m),
         ("frame_interval_s", params.dt_s),

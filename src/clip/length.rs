@@ -1,12 +1,16 @@
 //! The length of a recorded centreline, corrected for the position noise of the recording, and
-//! the body length estimated from a whole recording (`rod.length_m = "from_data"`).
+//! the body length estimated from a whole recording (`rod.length_m = "from_data"`). The data
+//! give the body's current arc length (Remark 9 of [R1], the stretch `j`); a recording whose
+//! frames are far from the rod length is in the wrong unit or of another body
+//! (`crate::clip::MAX_LENGTH_DEVIATION`). Decisions: `docs/decisions.md` D18.
 //!
 //! ## Why a noisy polyline is too long
 //! A recorded node is `y_i = x_i + e_i`, with independent Gaussian noise of standard deviation
 //! `σ` on each coordinate. A chord `c_i = y_{i+1} − y_i = d_i + (e_{i+1} − e_i)` is its true
-//! chord `d_i` plus a Gaussian vector of `s² = 2σ²` per coordinate, so `|c_i|` has the mean of a
-//! non-central χ distribution with 3 degrees of freedom (Johnson, Kotz & Balakrishnan,
-//! *Continuous Univariate Distributions* 2, 2nd ed., eq. 29.17, with ν = 3):
+//! chord `d_i` plus a Gaussian vector of `s² = 2σ²` per coordinate, so `|c_i|/s` is a
+//! non-central χ variable with 3 degrees of freedom and non-centrality `λ = |d_i|/s`, whose mean
+//! is, in closed form for 3 degrees of freedom (integrate `r` over the Gaussian shell about `d`;
+//! checked against a Monte Carlo mean in the tests):
 //!
 //! ```text
 //!   E|c_i| = s m(|d_i|/s),   m(λ) = √(2/π) e^{−λ²/2} + (λ + 1/λ) erf(λ/√2)        (1)
@@ -24,10 +28,12 @@
 //! 1. **Chords long against the noise.** At `σ/h` near or above 1 (10 µm of noise at 128 nodes
 //!    on 1 mm) a chord holds more noise than length, and its fluctuation, not its mean, decides:
 //!    the relative spread of a sum of `n` chords is about `1/(λ² √n)`, `λ = h/s`. So the frame
-//!    is measured with chords of `k` node spacings, `k` the smallest with `k ℓ₁ ≥ Λ s`
-//!    ([`MIN_CHORD_OVER_NOISE`] `Λ = 5`), `ℓ₁` the mean chord of the nodes corrected by (2)
-//!    below; the `m = ⌊(N − 1)/k⌋` chords join the nodes `i_j = round(j (N − 1)/m)`. Without
-//!    noise `k = 1`: every node.
+//!    is measured with chords of `k` node spacings, `k` the smallest whose mean chord
+//!    `|x_{i+k} − x_i|` over every start node `i` is at least `Λ s` ([`MIN_CHORD_OVER_NOISE`],
+//!    `Λ = 7`). Each offset `o < k` gives the polyline through the nodes `o, o + k, …`, whose
+//!    corrected length (steps 2, 3) is scaled by `(N − 1)/(k m_o)` to the whole rod (`m_o` its
+//!    chords; the nodes are equally spaced in arc length, as the rod's mesh is), and the `k`
+//!    offsets, which share no node, are averaged. Without noise `k = 1`: every node.
 //! 2. **Noise.** Each chord `c_j` joins two nodes of independent noise, so (1) holds for it
 //!    with `s`, and its length is corrected by inverting (1),
 //!
@@ -38,7 +44,7 @@
 //!    (bisection: `m` increases and `m(λ) ≥ λ`; `ℓ_j = 0` where `|c_j| ≤ s m(0)`, no longer
 //!    than noise alone makes it). For `λ ≥ Λ` the inverse is nearly linear,
 //!    `m⁻¹(q) ≈ q − 1/q`, and inverting a noisy `|c_j|` chord by chord is biased by about
-//!    `1/λ⁴` (1.6e-3 at `Λ`).
+//!    `1/λ⁴` (4e-4 at `Λ`).
 //! 3. **Curvature.** A chord is shorter than the arc it spans: for an arc of curvature `κ`,
 //!    `arc/chord = (θ/2)/sin(θ/2) ≈ 1 + θ²/24`, `θ = κ ℓ` the turning angle. The turning angle
 //!    `θ_j` between chords `j − 1` and `j` is measured and its noise removed:
@@ -48,10 +54,10 @@
 //!    ```
 //!
 //!    (the two components of the nodes' noise across the chords, each of variance σ̂², move the
-//!    chords' directions by `e⊥/ℓ`). Chord `j` then counts `ℓ_j (1 + θ̄_j²/24)`, `θ̄_j²` the mean
-//!    of `θ̃²` at its ends (its one end for the first and last chord).
+//!    chords' directions by `e⊥/ℓ`). Chord `j` then counts `ℓ_j (θ̄_j/2)/sin(θ̄_j/2)`, `θ̄_j²`
+//!    the mean of `θ̃²` at its ends (its one end for the first and last chord of the polyline).
 //!
-//! The corrected length is `Σ_j ℓ_j (1 + θ̄_j²/24)`. With `k = 1` and no noise it is the
+//! The corrected length is `Σ_j ℓ_j (θ̄_j/2)/sin(θ̄_j/2)`. With `k = 1` and no noise it is the
 //! polyline length with the chord-to-arc excess of a bent centreline added back (3.2e-3 of the
 //! body on the 33-node synthetic recordings, 2e-4 on 128 nodes).
 //!
@@ -234,7 +240,7 @@ fn chord_step(x: &[Vector3<f64>], s: f64) -> usize {
 }
 
 /// Steps 2 and 3 of the module doc on the chords of `nodes` (the nodes kept) with noise
-/// `noise_m` [m] per coordinate: `Σ_j ℓ_j (1 + θ̄_j²/24)` [m].
+/// `noise_m` [m] per coordinate: `Σ_j ℓ_j (θ̄_j/2)/sin(θ̄_j/2)` [m].
 fn curvature_corrected(nodes: &[Vector3<f64>], noise_m: f64) -> f64 {
     let s = std::f64::consts::SQRT_2 * noise_m;
     let chords: Vec<Vector3<f64>> = nodes.windows(2).map(|w| w[1] - w[0]).collect();

@@ -31,23 +31,30 @@ pub const ROW: &str = "batch_row.json";
 /// The summary table in the output folder.
 pub const SUMMARY: &str = "summary.csv";
 
-/// Columns of `summary.csv`. `fit_x_err_rel_max` is the worst frame's `‖x − x_g‖/‖x_g‖` [–],
-/// `curvature_err_rel_max` the worst frame's relative L² error of the bending `κ1² + κ2²`
-/// against the ground truth [–] (empty without a truth sidecar). `noise_m` [m] and `lambda_g`
-/// are the noise level and tracking weight `[inverse] weights = "auto"` chose (empty with fixed
-/// weights; `docs/noise.md`). `wall_time_s` comes last: it
-/// is the only column that differs between two runs of the same batch.
-pub const SUMMARY_COLUMNS: [&str; 12] = [
+/// Columns of `summary.csv`. `fit_position_rel_length_max` is the worst frame's position
+/// misfit in body lengths, `((1/L) ∫ |x − x_g|²)^½ / L` (`solve::fit`): unlike `‖x − x_g‖/‖x_g‖`
+/// it does not depend on where the recording sits in space. `curvature_err_rel_max` is the
+/// worst frame's relative L² error of the bending `κ1² + κ2²` against the ground truth [–]
+/// (empty without a truth sidecar). `length_m` is the rod length the recording was solved with
+/// [m], and `length_spread_rel` the spread of its frames' corrected lengths about it (`1.4826`
+/// median absolute deviation over the median, `clip::length`), where `rod.length_m =
+/// "from_data"` estimated it (empty otherwise). `wall_time_s` comes last: it is the only column
+/// that differs between two runs of the same batch. `noise_m` [m] and `lambda_g` are the noise
+/// level and tracking weight `[inverse] weights = "auto"` chose (empty with fixed weights;
+/// `docs/noise.md`).
+pub const SUMMARY_COLUMNS: [&str; 14] = [
     "recording",
     "folder",
     "status",
     "frames",
     "newton_iterations_per_frame",
     "certificate_max",
-    "fit_x_err_rel_max",
+    "fit_position_rel_length_max",
     "curvature_err_rel_max",
     "noise_m",
     "lambda_g",
+    "length_m",
+    "length_spread_rel",
     "reason",
     "wall_time_s",
 ];
@@ -120,13 +127,21 @@ pub struct BatchRow {
     /// the largest residual certificate of the frames (`docs/certificate.md`)
     #[serde(default)]
     pub certificate_max: Option<f64>,
-    pub fit_x_err_rel_max: Option<f64>,
+    /// the worst frame's position misfit in body lengths (`solve::fit`)
+    #[serde(default)]
+    pub fit_position_rel_length_max: Option<f64>,
     pub curvature_err_rel_max: Option<f64>,
     /// `weights = "auto"`: the recording's noise level per coordinate [m] and the λg chosen
     #[serde(default)]
     pub noise_m: Option<f64>,
     #[serde(default)]
     pub lambda_g: Option<f64>,
+    /// the rod length solved with [m]
+    #[serde(default)]
+    pub length_m: Option<f64>,
+    /// `rod.length_m = "from_data"`: the spread of the frames' lengths (`clip::length`)
+    #[serde(default)]
+    pub length_spread_rel: Option<f64>,
     /// why it failed (the error and its causes)
     pub reason: Option<String>,
     /// this recording's wall time [s]
@@ -142,10 +157,12 @@ impl BatchRow {
             frames: None,
             newton_iterations_per_frame: None,
             certificate_max: None,
-            fit_x_err_rel_max: None,
+            fit_position_rel_length_max: None,
             curvature_err_rel_max: None,
             noise_m: None,
             lambda_g: None,
+            length_m: None,
+            length_spread_rel: None,
             reason: Some(reason),
             wall_time_s: 0.0,
         }
@@ -379,6 +396,12 @@ pub fn run_recording(case: &Case, case_file: &InputFile, entry: &PlanEntry, out:
         Ok(c) => c,
         Err(e) => return failed(chain(&e)),
     };
+    // rod.length_m = "from_data": this recording's body length
+    let case = match super::clip_files::resolve_length(&case) {
+        Ok(c) => c,
+        Err(e) => return failed(chain(&e)),
+    };
+    let manifest = Manifest { body_length: case.body_length(), ..manifest };
     let mut folder = match RunFolder::begin(&dir, manifest, Mode::Fresh { force: false }) {
         Ok(f) => f,
         Err(e) => return failed(chain(&e)),
@@ -401,10 +424,12 @@ pub fn run_recording(case: &Case, case_file: &InputFile, entry: &PlanEntry, out:
         frames: solved.frames.map(|f| f.0),
         newton_iterations_per_frame: get("iterations_mean"),
         certificate_max: get("certificate"),
-        fit_x_err_rel_max: get("x_err_rel_max"),
+        fit_position_rel_length_max: get("fit_position_rel_length_max"),
         curvature_err_rel_max: get("truth_bending_err_rel_max"),
         noise_m: weights.map(|w| w.noise_m),
         lambda_g: weights.map(|w| w.lambda_g),
+        length_m: Some(case.mesh.length_m),
+        length_spread_rel: case.body_length().map(|b| b.spread_rel),
         reason: solved.error.clone(),
         wall_time_s: start.elapsed().as_secs_f64(),
     };
@@ -530,10 +555,12 @@ pub fn summary_csv(rows: &[BatchRow]) -> Result<String, csv::Error> {
             r.frames.map(|f| f.to_string()).unwrap_or_default(),
             num(r.newton_iterations_per_frame),
             num(r.certificate_max),
-            num(r.fit_x_err_rel_max),
+            num(r.fit_position_rel_length_max),
             num(r.curvature_err_rel_max),
             num(r.noise_m),
             num(r.lambda_g),
+            num(r.length_m),
+            num(r.length_spread_rel),
             r.reason.as_deref().unwrap_or("").replace('\n', " "),
             format!("{:.3}", r.wall_time_s),
         ])?;

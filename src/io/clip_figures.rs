@@ -116,7 +116,7 @@ pub fn write_clip_plot(
             "fit per frame".into(),
             "value",
             vec![
-                s("|x - x_g|/|x_g|", reports.iter().map(|r| r.x_err_rel).collect()),
+                s("position misfit [body lengths]", reports.iter().map(|r| r.fit.position).collect()),
                 s("|x' - d3| [m^1/2]", reports.iter().map(|r| r.tangent_misfit).collect()),
                 s("last relative change", reports.iter().map(|r| r.last_change).collect()),
             ],

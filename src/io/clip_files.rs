@@ -8,8 +8,9 @@ use nalgebra::{Matrix3, Vector3};
 use super::files::{csv_reader_capped, InputError};
 use super::npy::read_npy;
 use super::truth_file::{read_truth, truth_sidecar};
-use crate::case::{Case, ClipKind};
-use crate::clip::length::FrameLength;
+use crate::case::sweep::SweepError;
+use crate::case::{Case, ClipKind, RodLength, FROM_DATA};
+use crate::clip::length::{BodyLength, FrameLength};
 use crate::clip::synthetic::{roll_clip, FrameTruth, GroundTruth, RollClipGenerator};
 use crate::clip::{
     check_frame_range, clip_from_angles, polyline_length, rotate_frame, Clip, ClipError, KymogramParams,
@@ -60,6 +61,23 @@ pub enum ClipFileError {
         rod_m: f64,
         ratio: f64,
         glitch: String,
+    },
+    #[error(
+        "case `{case}`: rod.length_m = \"{FROM_DATA}\" is the body length of the recording, estimated when it is \
+         read (io::clip_files::resolve_length), and this case's was not"
+    )]
+    LengthNotResolved { case: String },
+    #[error(
+        "{path}: no frame has a positive finite length to estimate the body length from (rod.length_m = \
+         \"{FROM_DATA}\")"
+    )]
+    NoBodyLength { path: PathBuf },
+    #[error("{path}: the body length {length_m:e} m estimated from the recording (rod.length_m = \"{FROM_DATA}\")")]
+    FromData {
+        path: PathBuf,
+        length_m: f64,
+        #[source]
+        source: SweepError,
     },
     #[error(
         "{path}: {frames} frames × {nodes} nodes are {positions} positions, more than the {MAX_CLIP_POSITIONS} a clip \
@@ -143,6 +161,9 @@ fn glitch(pts: &[Vector3<f64>]) -> String {
 /// ([`super::truth_file`]). The frame range and the orientation of the
 /// case are applied to both.
 pub fn load_clip(case: &Case) -> Result<(Clip, Option<GroundTruth>), ClipFileError> {
+    if case.rod_length == RodLength::FromData(None) {
+        return Err(ClipFileError::LengthNotResolved { case: case.name.clone() });
+    }
     let src = clip_source(case)?;
     let (mut clip, mut truth) = match &src.kind {
         ClipKind::Kymogram => {
@@ -195,6 +216,38 @@ pub fn load_clip(case: &Case) -> Result<(Clip, Option<GroundTruth>), ClipFileErr
         }
     }
     Ok((clip, truth))
+}
+
+/// The case with `rod.length_m = "from_data"` resolved: the body length of its recording (the
+/// frames of its range), [`BodyLength::estimate`], is written into the case file's tables and
+/// the case validated again, so that everything derived from the length (the slenderness check,
+/// the default stabilisation) follows it; the estimate is kept in [`Case::rod_length`]. The
+/// clip file is written as an absolute path (a batch's recording replaces the file's). Any other
+/// case is returned as it is.
+pub fn resolve_length(case: &Case) -> Result<Case, ClipFileError> {
+    if case.rod_length != RodLength::FromData(None) {
+        return Ok(case.clone());
+    }
+    let src = clip_source(case)?;
+    let mut clip = read_recording(&src.file, f64::NAN)?;
+    if let Some((a, b)) = src.frames {
+        clip.select(a, b)?;
+    }
+    let body =
+        BodyLength::estimate(&clip.frames).ok_or_else(|| ClipFileError::NoBodyLength { path: src.file.clone() })?;
+    let file = std::path::absolute(&src.file).unwrap_or_else(|_| src.file.clone());
+    let overrides = [
+        ("rod.length_m".to_string(), toml::Value::Float(body.length_m)),
+        ("clip.file".to_string(), toml::Value::String(file.display().to_string())),
+    ];
+    let mut resolved = case.with_overrides(&overrides).map_err(|source| ClipFileError::FromData {
+        path: src.file.clone(),
+        length_m: body.length_m,
+        source,
+    })?;
+    resolved.rod_length = RodLength::FromData(Some(body));
+    resolved.source_sha256.clone_from(&case.source_sha256);
+    Ok(resolved)
 }
 
 /// The clip section of a clip case whose file exists.

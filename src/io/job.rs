@@ -74,10 +74,11 @@ impl JobEnd {
         }
         let n = run.reports.len();
         let its: Vec<usize> = run.reports.iter().map(|r| r.iterations).collect();
-        let worst = run.reports.iter().map(|r| r.x_err_rel).fold(0.0, f64::max);
+        // in body lengths (solve::fit): ‖x − x_g‖/‖x_g‖ would depend on where the clip sits
+        let worst = run.reports.iter().map(|r| r.fit.position).fold(0.0, f64::max);
         let jmax = run.reports.iter().map(|r| r.max_stretch_deviation).fold(0.0, f64::max);
         out += &format!(
-            "{name} [rust]: {n} frames in {:.2} s ({:.1} frames/s; solving {:.2} s); iterations per frame min {} / mean {:.1} / max {}; max |x - x_g|/|x_g| {worst:.3e}; max |j - 1| {jmax:.3e}; wrote {}\n",
+            "{name} [rust]: {n} frames in {:.2} s ({:.1} frames/s; solving {:.2} s); iterations per frame min {} / mean {:.1} / max {}; max position misfit {worst:.3e} body lengths; max |j - 1| {jmax:.3e}; wrote {}\n",
             run.wall_time_s,
             n as f64 / run.wall_time_s,
             run.reports.iter().map(|r| r.wall_time_s).sum::<f64>(),
@@ -117,6 +118,7 @@ pub fn run_manifest(case: &Case, engine: Engine) -> Result<Manifest, FolderError
         m.frames_done = Some(0);
     }
     m.engine = Some(engine.to_string());
+    m.body_length = case.body_length();
     Ok(m)
 }
 

@@ -8,6 +8,7 @@ use sha2::{Digest, Sha256};
 
 use super::files::{is_temporary, write_atomic};
 use crate::case::sweep::SweepValue;
+use crate::clip::length::BodyLength;
 
 /// File name of the manifest in an output folder.
 pub const MANIFEST: &str = "run.json";
@@ -95,6 +96,10 @@ pub struct Manifest {
     /// clips with `[inverse] weights = "auto"`: the noise level and the weights chosen
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub weights: Option<crate::run::weights::ChosenWeights>,
+    /// `rod.length_m = "from_data"`: the body length estimated from the recording, with the
+    /// spread and range of its frames (`clip::length`)
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub body_length: Option<BodyLength>,
     /// the process that wrote the folder
     pub pid: u32,
     /// seconds since the Unix epoch
@@ -181,6 +186,7 @@ impl Manifest {
             message: None,
             certificate: None,
             weights: None,
+            body_length: None,
             pid: std::process::id(),
             started_unix_s: now_unix_s(),
             finished_unix_s: None,

@@ -130,6 +130,7 @@ pub fn point_manifest(command: &str, case: &Case, point: &Point) -> Manifest {
     m.inputs = super::job::case_inputs(case).unwrap_or_default();
     m.settings = point.iter().cloned().collect();
     m.engine = Some("rust".into());
+    m.body_length = case.body_length();
     m
 }
 

@@ -299,6 +299,35 @@ fn recordings_must_have_the_rod_length() {
     assert!(e.contains("rec.csv, frame 2: the centreline is 1.3000e-3 m long") && e.contains("1.300×"), "{e}");
 }
 
+/// `rod.length_m = "from_data"`: the case cannot be loaded before its length is resolved; the
+/// resolved case has the median corrected length of the frames in its range, their spread
+/// (1.4826 × the median absolute deviation 5e-5 m over 1.2e-3 m) and range, and loads.
+#[test]
+fn from_data_is_resolved_from_the_frames_of_the_recording() {
+    let dir = tempfile::tempdir().unwrap();
+    let frames = straight_frames(&[2e-3, 1.25e-3, 1.15e-3, 1.2e-3], 12);
+    std::fs::write(dir.path().join("rec.csv"), csv_text(&frames)).unwrap();
+    let from_data = [("rod.length_m".to_string(), toml::Value::String("from_data".into()))];
+    let case = recording_case(dir.path(), "rec.csv", 11, Some([1, 4])).with_overrides(&from_data).unwrap();
+    let e = load_clip(&case).unwrap_err().to_string();
+    assert!(e.starts_with("case `rec`: rod.length_m = \"from_data\" is the body length of the recording"), "{e}");
+    let resolved = resolve_length(&case).unwrap();
+    let b = resolved.body_length().unwrap();
+    assert!((resolved.mesh.length_m / 1.2e-3 - 1.0).abs() < 1e-14, "{b:?}");
+    assert_eq!((b.length_m, b.frames), (resolved.mesh.length_m, 3));
+    assert!((b.spread_rel / (1.482_602_218_505_602 * 5e-5 / 1.2e-3) - 1.0).abs() < 1e-9, "{b:?}");
+    assert!((b.min_m / 1.15e-3 - 1.0).abs() < 1e-14 && (b.max_m / 1.25e-3 - 1.0).abs() < 1e-14, "{b:?}");
+    assert_eq!(load_clip(&resolved).map(|(c, _)| c.frame_count()).map_err(|e| e.to_string()), Ok(3));
+    // resolved once: returned as it is; a sweep point of it keeps the estimate
+    assert_eq!(resolve_length(&resolved).unwrap().rod_length, resolved.rod_length);
+    let point = resolved.with_values(&[("lambda_d", 2.0.into())]).unwrap();
+    assert_eq!(point.body_length(), Some(b));
+    // the whole file: frame 0 is 2e-3 m, 1.67× the median of the four (1.225e-3 m)
+    let whole = recording_case(dir.path(), "rec.csv", 11, None).with_overrides(&from_data).unwrap();
+    let e = load_clip(&resolve_length(&whole).unwrap()).unwrap_err().to_string();
+    assert!(e.contains("frame 0: the centreline is 2.0000e-3 m long") && e.contains("1.633×"), "{e}");
+}
+
 /// The ratio `R` of a length error's "R× the rod length".
 fn ratio_in(e: &str) -> f64 {
     let head = &e[..e.find("× the rod length").expect("a length error")];
