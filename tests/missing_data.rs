@@ -34,7 +34,7 @@ use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 
 use assert_cmd::Command;
-use common::worm_data_present;
+use common::{freefem_required, worm_data_present};
 use cosserat::case::Case;
 use cosserat::io::clip_files::load_clip;
 use cosserat::io::npy::{read_npy, write_npy};
@@ -318,6 +318,34 @@ fn recordings_with_missing_nodes_and_frames_reconstruct() {
     for which in ['a', 'b', 'c'] {
         check(which, &scenario(dir.path(), &recording, &base, which));
     }
+}
+
+/// The FreeFEM engine carries the same weight (a P1 field in the tracking term): `cosserat
+/// compare` passes every row, with its derived tolerances, on frames 28–37 of the recording with
+/// 10 % of the nodes missing and frames 30–34 missing entirely.
+#[test]
+fn freefem_agrees_on_a_recording_with_missing_data() {
+    if !freefem_required() || !worm_data_present("freefem_agrees_on_a_recording_with_missing_data") {
+        return;
+    }
+    let dir = tempfile::tempdir().expect("tempdir");
+    let recording = synth(dir.path());
+    let mut t = tracked('a');
+    t[30..35].iter_mut().for_each(|f| f.fill(false));
+    let masked = dir.path().join("missing_ac.npy");
+    write_masked(&recording, &masked, &t);
+    let case = case_file(dir.path(), &masked, true);
+    let text = std::fs::read_to_string(&case)
+        .expect("case")
+        .replace("missing = \"nan\"", "missing = \"nan\"\nframes = [28, 38]");
+    std::fs::write(&case, text).expect("case");
+    let out = dir.path().join("compare");
+    let run =
+        cosserat().arg("compare").arg(&case).args(["--frames", "10", "--out"]).arg(&out).output().expect("compare");
+    let report = std::fs::read_to_string(out.join("compare.csv")).unwrap_or_default();
+    assert!(run.status.success(), "{}\n{report}", String::from_utf8_lossy(&run.stderr));
+    let rows: Vec<&str> = report.lines().skip(1).collect();
+    assert!(rows.len() > 10 && rows.iter().all(|r| r.contains(",pass,")), "{report}");
 }
 
 /// Without `clip.missing`, a NaN in a recording is an error naming its frame and node (and the
