@@ -223,10 +223,11 @@ fn fit_gate_flags_a_lagging_clip() {
         let o = cmd.output().unwrap();
         let manifest = std::fs::read_to_string(dir.path().join(out).join("run.json")).unwrap();
         let frames = std::fs::read_to_string(dir.path().join(out).join("frames.csv")).unwrap();
+        let column = frames.lines().next().and_then(|h| h.split(',').position(|c| c == "flagged")).expect("flagged");
         let flagged = frames
             .lines()
             .skip(1)
-            .filter(|l| l.rsplit(',').next().and_then(|v| v.trim().parse::<f64>().ok()).is_some_and(|v| v > 0.5))
+            .filter(|l| l.split(',').nth(column).and_then(|v| v.trim().parse::<f64>().ok()).is_some_and(|v| v > 0.5))
             .count();
         (o.status.code(), manifest, flagged, String::from_utf8_lossy(&o.stderr).into_owned())
     };

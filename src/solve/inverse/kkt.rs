@@ -3,6 +3,7 @@
 //! `[x, α, x̂, α̂]` per node (24 unknowns).
 use nalgebra::{DVector, Matrix3, SMatrix, SVector, Vector3};
 
+use super::tracking::weight_at;
 use super::{Frame, InverseParams, Tracking};
 use crate::assemble::{assemble, Tangent};
 use crate::linalg::Pattern;
@@ -187,7 +188,7 @@ pub(crate) fn element_system(
         let wh = w * h;
         let xg_q = xg[0] * n[0] + xg[1] * n[1];
         // λg w at the point: the one place the tracking weight enters (I14)
-        let lg = w8.lambda_g * (wg[0] * n[0] + wg[1] * n[1]);
+        let lg = w8.lambda_g * weight_at(wg, n);
         let ap_q = alpha_prev[0] * n[0] + alpha_prev[1] * n[1];
         let W = if omega_on {
             let A = a_matrix(&q.alpha);

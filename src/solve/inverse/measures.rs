@@ -3,6 +3,7 @@
 use nalgebra::{DVector, Vector3};
 
 use super::kkt::PointRule;
+use super::tracking::weight_at;
 use super::{Frame, InverseParams, InverseRecord, ObjectiveTerms, Tracking};
 use crate::assemble::integrate;
 use crate::model::element::{interpolate, LocalVec, PointState};
@@ -100,7 +101,7 @@ pub fn position_error<'a>(problem: &Problem, u: &DVector<f64>, data: impl Into<T
 fn data_misfit(data: &Tracking, e: usize, q: &PointState) -> (f64, f64, f64) {
     let ([a, b], [wa, wb]) = data.element(e);
     let xg = a * q.n[0] + b * q.n[1];
-    ((q.x - xg).norm_squared(), xg.norm_squared(), wa * q.n[0] + wb * q.n[1])
+    ((q.x - xg).norm_squared(), xg.norm_squared(), weight_at([wa, wb], q.n))
 }
 
 /// The per-iteration record of `frame` at the state `u` with the adjoint `adjoint` (fit

@@ -36,6 +36,17 @@ impl Tracking<'_> {
     }
 }
 
+/// The weight at the point with shape function values `n` of an element with nodal weights
+/// `w`: exactly 1 where both are 1 (`(1 − ξ) + ξ` need not round to 1), so that a clip without
+/// missing data gives the same bits as the unweighted term.
+pub fn weight_at(w: [f64; 2], n: [f64; 2]) -> f64 {
+    if w == [1.0, 1.0] {
+        1.0
+    } else {
+        w[0] * n[0] + w[1] * n[1]
+    }
+}
+
 impl<'a> From<&'a [Vector3<f64>]> for Tracking<'a> {
     fn from(x_g: &'a [Vector3<f64>]) -> Self {
         Tracking { x_g, weight: None }
