@@ -153,6 +153,8 @@ pub struct ClipSource {
     pub gauge: Vector3<f64>,
     /// the fit-quality gate (`clip.gate_*`, `solve::fit`)
     pub gate: FitGate,
+    /// what marks an untracked node of a recording (`clip.missing`, `clip::missing`)
+    pub missing: crate::clip::missing::MissingData,
 }
 
 /// An inverse analysis (Problem 2, eq. 61): the solver's params and the data.

@@ -82,6 +82,15 @@ pub(super) struct RawClip {
     pub(super) gate_position: Option<f64>,
     /// fit-quality gate: tangent misfit never flagged
     pub(super) gate_tangent: Option<f64>,
+    /// what marks a node that was not tracked in a recording (`clip::missing`); absent: a NaN
+    /// is an error
+    pub(super) missing: Option<RawMissing>,
+}
+
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub(super) enum RawMissing {
+    Nan,
 }
 
 #[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default)]

@@ -241,3 +241,20 @@ fn length_from_data_is_for_recordings_only() {
     let e = reason(&batch.replace("length_m = \"L\"", "length_m = \"from-data\""));
     assert!(e.contains("key `rod.length_m`"), "{e}");
 }
+
+/// `clip.missing` is a typed key: "nan" on a recording, refused on a kymogram, any other value
+/// unknown; without it a recording's NaN is an error (`MissingData::Error`).
+#[test]
+fn clip_missing_is_validated_once() {
+    use crate::clip::missing::MissingData;
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let batch = std::fs::read_to_string(root.join("cases/batch/roll_recording.toml")).unwrap();
+    let with = |v: &str| batch.replace("rotation = \"rebased\"", &format!("rotation = \"rebased\"\nmissing = {v}"));
+    assert_eq!(parse(&batch).unwrap().clip().unwrap().missing, MissingData::Error);
+    assert_eq!(parse(&with("\"nan\"")).unwrap().clip().unwrap().missing, MissingData::Nan);
+    let e = parse(&with("\"zero\"")).unwrap_err().to_string();
+    assert!(e.contains("unknown variant `zero`") && e.contains("nan"), "{e}");
+    let worm = std::fs::read_to_string(root.join("cases/worm_omega_turn.toml")).unwrap();
+    let e = reason(&worm.replace("start = \"data_guess\"", "start = \"data_guess\"\nmissing = \"nan\""));
+    assert!(e.contains("key `clip.missing`: applies to kind = \"recording\" only"), "{e}");
+}

@@ -42,6 +42,7 @@ use nalgebra::{Matrix3, Vector2, Vector3};
 
 pub mod length;
 pub use crate::solve::smoothing;
+pub mod missing;
 mod spline;
 pub mod synthetic;
 
@@ -119,6 +120,11 @@ pub enum ClipError {
     SyntheticParameter { name: &'static str, value: f64, requirement: &'static str },
     #[error("synthetic clip: time mapping OmegaThenDelta needs the delta-turn kymogram")]
     SyntheticMissingDelta,
+    #[error(
+        "clip.missing = \"nan\": none of the frames {first}–{} has {minimum} tracked nodes (a node is untracked where a coordinate is NaN); there is nothing to reconstruct",
+        first + frames - 1
+    )]
+    NothingTracked { first: usize, frames: usize, minimum: usize },
     #[error("frame comparison: {what} has {len} nodes, truth has {expected}")]
     ComparisonSize { what: &'static str, len: usize, expected: usize },
     #[error("frame comparison: skipping {skip} nodes at each end of {nodes} leaves none")]
@@ -137,6 +143,10 @@ pub struct Clip {
     /// Reference body length L used for the stretch j [m]: the kymogram's body length, or the
     /// polyline length of frame 0 for a recording.
     pub length_m: f64,
+    /// which nodes were tracked, frames × nodes (`clip.missing = "nan"`, [`missing`]); `None`:
+    /// every node of every frame. The untracked positions in `frames` are filled
+    /// ([`missing::fill_missing`]).
+    pub tracked: Option<Vec<Vec<bool>>>,
 }
 
 impl Clip {
@@ -148,6 +158,17 @@ impl Clip {
     /// Number of frames.
     pub fn frame_count(&self) -> usize {
         self.frames.len()
+    }
+
+    /// The tracking weights `w_i` of frame `frame` ([`missing::tracking_weights`]); `None`
+    /// where every node was tracked (w ≡ 1).
+    pub fn tracking_weights(&self, frame: usize) -> Option<Vec<f64>> {
+        self.tracked.as_ref().map(|t| missing::tracking_weights(&t[frame]))
+    }
+
+    /// Tracked nodes of frame `frame`.
+    pub fn nodes_tracked(&self, frame: usize) -> usize {
+        self.tracked.as_ref().map_or(self.node_count(), |t| t[frame].iter().filter(|x| **x).count())
     }
 
     /// Stretch `j` of a frame: polyline length of its nodes / `length_m` (Remark 9 of [R1]).
@@ -170,6 +191,9 @@ impl Clip {
     pub fn select(&mut self, first: usize, end: usize) -> Result<(), ClipError> {
         check_frame_range(first, end, self.frame_count())?;
         self.frames = self.frames[first..end].to_vec();
+        if let Some(t) = &mut self.tracked {
+            *t = t[first..end].to_vec();
+        }
         Ok(())
     }
 
@@ -271,7 +295,7 @@ pub fn clip_from_angles(rows: &[Vec<f64>], params: &KymogramParams, source: Stri
     assert!(params.nodes >= 2, "at least two nodes");
     let joints: Vec<Vec<Vector2<f64>>> = rows.iter().map(|a| kymogram_joints(a, params.length_m)).collect();
     let Some(first) = joints.first() else {
-        return Clip { frames: Vec::new(), dt_s: params.dt_s, source, length_m: params.length_m };
+        return Clip { frames: Vec::new(), dt_s: params.dt_s, source, length_m: params.length_m, tracked: None };
     };
     let (head, chord) = (first[0], first[first.len() - 1] - first[0]);
     let (c, s) = (chord.x / chord.norm(), chord.y / chord.norm());
@@ -299,7 +323,7 @@ pub fn clip_from_angles(rows: &[Vec<f64>], params: &KymogramParams, source: Stri
             }
         })
         .collect();
-    Clip { frames, dt_s: params.dt_s, source, length_m: params.length_m }
+    Clip { frames, dt_s: params.dt_s, source, length_m: params.length_m, tracked: None }
 }
 
 #[cfg(test)]
@@ -440,7 +464,8 @@ pub(crate) mod tests {
     fn stretch_and_tangent_diagnostics() {
         let straight: Vec<Vector3<f64>> = (0..5).map(|i| Vector3::new(0.0, 0.0, i as f64 * 0.25e-3)).collect();
         let bent: Vec<Vector3<f64>> = (0..5).map(|i| Vector3::new(0.0, i as f64 * 0.26e-3, 0.0)).collect();
-        let clip = Clip { frames: vec![straight, bent], dt_s: 0.1, source: "test".into(), length_m: 1e-3 };
+        let clip =
+            Clip { frames: vec![straight, bent], dt_s: 0.1, source: "test".into(), length_m: 1e-3, tracked: None };
         assert!((clip.stretch(0) - 1.0).abs() < 1e-15);
         let (frame, dev) = clip.max_stretch_deviation();
         assert_eq!(frame, 1);

@@ -11,6 +11,7 @@ use super::truth_file::{read_truth, truth_sidecar};
 use crate::case::sweep::SweepError;
 use crate::case::{Case, ClipKind, RodLength, FROM_DATA};
 use crate::clip::length::{BodyLength, FrameLength};
+use crate::clip::missing::{fill_missing, MissingData, MIN_TRACKED};
 use crate::clip::synthetic::{roll_clip, FrameTruth, GroundTruth, RollClipGenerator};
 use crate::clip::{
     check_frame_range, clip_from_angles, polyline_length, rotate_frame, Clip, ClipError, KymogramParams,
@@ -103,9 +104,13 @@ fn check_positions(path: &Path, frames: usize, nodes: usize) -> Result<(), ClipF
 
 /// Refuse a recording frame (`first` is the file's index of `frames[0]`) whose length,
 /// corrected for the frame's noise ([`FrameLength`], docs/decisions.md D18), deviates from the
-/// rod length by more than [`MAX_LENGTH_DEVIATION`].
-fn check_lengths(path: &Path, frames: &[Vec<Vector3<f64>>], first: usize, rod_m: f64) -> Result<(), ClipFileError> {
-    for (k, f) in frames.iter().enumerate() {
+/// rod length by more than [`MAX_LENGTH_DEVIATION`]; frames with too few tracked nodes are
+/// bridged from checked ones and not checked.
+fn check_lengths(path: &Path, clip: &Clip, first: usize, rod_m: f64) -> Result<(), ClipFileError> {
+    for (k, f) in clip.frames.iter().enumerate() {
+        if clip.nodes_tracked(k) < MIN_TRACKED {
+            continue;
+        }
         let l = FrameLength::of(f);
         let ratio = l.corrected_m / rod_m;
         if ratio.is_nan() || (ratio - 1.0).abs() > MAX_LENGTH_DEVIATION {
@@ -174,7 +179,7 @@ pub fn load_clip(case: &Case) -> Result<(Clip, Option<GroundTruth>), ClipFileErr
         }
         ClipKind::Recording => {
             let dt = case.inverse().map(|i| i.params.frame_interval_s).unwrap_or(f64::NAN);
-            let clip = read_recording(&src.file, dt)?;
+            let clip = read_recording_with(&src.file, dt, src.missing)?;
             // a synthetic recording's ground truth, when its sidecar lies next to it
             let sidecar = truth_sidecar(&src.file);
             let truth = if sidecar.is_file() {
@@ -207,7 +212,8 @@ pub fn load_clip(case: &Case) -> Result<(Clip, Option<GroundTruth>), ClipFileErr
     }
     if src.kind == ClipKind::Recording {
         // Kymograms are scaled to the rod length by design; a recording's length is the user's.
-        check_lengths(&src.file, &clip.frames, src.frames.map_or(0, |f| f.0), case.mesh.length_m)?;
+        // (a bridged frame, too few tracked nodes, is an interpolation of checked ones)
+        check_lengths(&src.file, &clip, src.frames.map_or(0, |f| f.0), case.mesh.length_m)?;
     }
     if src.orientation != Matrix3::identity() {
         clip.rotate(&src.orientation);
@@ -377,6 +383,26 @@ fn kymogram_clip(path: &Path, rows: &[Vec<f64>], params: &KymogramParams) -> Cli
 /// Read a user recording: `.csv` (header `frame,node,x_m,y_m,z_m`) or `.npy` (frames × nodes × 3,
 /// float64) [m]; `dt_s` is the time between frames [s].
 pub fn read_recording(path: &Path, dt_s: f64) -> Result<Clip, InputError> {
+    read_recording_marked(path, dt_s, MissingData::Error)
+}
+
+/// [`read_recording`] with untracked nodes marked as `missing` says: with
+/// [`MissingData::Nan`], NaN coordinates are untracked nodes, filled and recorded in
+/// [`Clip::tracked`] ([`fill_missing`]).
+pub fn read_recording_with(path: &Path, dt_s: f64, missing: MissingData) -> Result<Clip, ClipFileError> {
+    let mut clip = read_recording_marked(path, dt_s, missing)?;
+    if missing == MissingData::Nan {
+        let tracked = fill_missing(&mut clip.frames, 0)?;
+        clip.length_m = polyline_length(&clip.frames[0]);
+        if tracked.iter().any(|f| f.iter().any(|t| !t)) {
+            clip.tracked = Some(tracked);
+        }
+    }
+    Ok(clip)
+}
+
+/// [`read_recording`], NaN coordinates accepted where `missing` says so (not filled).
+fn read_recording_marked(path: &Path, dt_s: f64, missing: MissingData) -> Result<Clip, InputError> {
     if path.is_dir() {
         return Err(InputError::Shape {
             path: path.to_path_buf(),
@@ -384,8 +410,8 @@ pub fn read_recording(path: &Path, dt_s: f64) -> Result<Clip, InputError> {
         });
     }
     let frames = match path.extension().and_then(|e| e.to_str()) {
-        Some("npy") => recording_npy(path)?,
-        Some("csv") => recording_csv(path)?,
+        Some("npy") => recording_npy(path, missing)?,
+        Some("csv") => recording_csv(path, missing)?,
         _ => {
             return Err(InputError::Shape {
                 path: path.to_path_buf(),
@@ -394,15 +420,24 @@ pub fn read_recording(path: &Path, dt_s: f64) -> Result<Clip, InputError> {
         }
     };
     let length_m = polyline_length(&frames[0]);
-    if length_m <= 0.0 {
+    if length_m <= 0.0 && missing == MissingData::Error {
         return Err(InputError::Shape { path: path.to_path_buf(), reason: "frame 0 has zero length".into() });
     }
     let source = format!("{} ({} frames × {} nodes)", path.display(), frames.len(), frames[0].len());
-    Ok(Clip { frames, dt_s, source, length_m })
+    Ok(Clip { frames, dt_s, source, length_m, tracked: None })
 }
 
-fn check_position(path: &Path, frame: usize, node: usize, p: &Vector3<f64>) -> Result<(), InputError> {
-    match (0..3).find(|&k| !p[k].is_finite()) {
+/// A position's coordinates must be finite; with [`MissingData::Nan`] a NaN marks an untracked
+/// node (an infinity stays an error).
+fn check_position(
+    path: &Path,
+    frame: usize,
+    node: usize,
+    p: &Vector3<f64>,
+    missing: MissingData,
+) -> Result<(), InputError> {
+    let marked = |v: f64| missing == MissingData::Nan && v.is_nan();
+    match (0..3).find(|&k| !p[k].is_finite() && !marked(p[k])) {
         Some(k) => Err(InputError::NonFinitePosition {
             path: path.to_path_buf(),
             frame,
@@ -414,7 +449,7 @@ fn check_position(path: &Path, frame: usize, node: usize, p: &Vector3<f64>) -> R
     }
 }
 
-fn recording_npy(path: &Path) -> Result<Vec<Vec<Vector3<f64>>>, InputError> {
+fn recording_npy(path: &Path, missing: MissingData) -> Result<Vec<Vec<Vector3<f64>>>, InputError> {
     let a = read_npy(path)?;
     let shape = |reason: String| InputError::Shape { path: path.to_path_buf(), reason };
     let &[frames, nodes, 3] = a.shape.as_slice() else {
@@ -435,7 +470,7 @@ fn recording_npy(path: &Path) -> Result<Vec<Vec<Vector3<f64>>>, InputError> {
     for (f, frame) in a.data.chunks_exact(3 * nodes).enumerate() {
         let pts: Vec<Vector3<f64>> = frame.chunks_exact(3).map(|c| Vector3::new(c[0], c[1], c[2])).collect();
         for (i, p) in pts.iter().enumerate() {
-            check_position(path, f, i, p)?;
+            check_position(path, f, i, p, missing)?;
         }
         out.push(pts);
     }
@@ -453,7 +488,7 @@ struct RecordingRow {
 /// The frames of a CSV recording. Every index read from the file is only compared and sorted,
 /// never used to size or index an allocation: the rows are sorted by (frame, node) and must run
 /// 0, 1, … in both, so the frames built hold exactly the rows the file has.
-fn recording_csv(path: &Path) -> Result<Vec<Vec<Vector3<f64>>>, InputError> {
+fn recording_csv(path: &Path, missing: MissingData) -> Result<Vec<Vec<Vector3<f64>>>, InputError> {
     let mut rdr = csv_reader_capped(path, CSV_RECORDING_CAP_BYTES, "recording", &RECORDING_HEADER)?;
     let mut rows: Vec<RecordingRow> = Vec::new();
     for (i, rec) in rdr.records().enumerate() {
@@ -475,7 +510,7 @@ fn recording_csv(path: &Path) -> Result<Vec<Vec<Vector3<f64>>>, InputError> {
         let coord =
             |k: usize| rec[k].parse::<f64>().map_err(|e| bad(format!("{} `{}`: {e}", RECORDING_HEADER[k], &rec[k])));
         let position = Vector3::new(coord(2)?, coord(3)?, coord(4)?);
-        check_position(path, frame, node, &position)?;
+        check_position(path, frame, node, &position, missing)?;
         rows.push(RecordingRow { frame, node, row, position });
     }
     if rows.is_empty() {

@@ -45,8 +45,10 @@ fn row_files(format: OutputFormat) -> [&'static str; 2] {
 /// `min_abs_cos_beta` is the chart's (the angles of `fields.csv` are in the frame's chart
 /// `Q = Q_E(α) B`, whose singular axis `n = Bᵀ e2` is `chart_axis_*`; `docs/rotation.md`);
 /// `max_abs_omega_rad_per_s` is the largest |ωˡ| over the nodes [rad/s] (eq. 27, 0 on the
-/// first frame; `run::clip::ClipFrame::omega`).
-pub const CLIP_FRAME_COLUMNS: [&str; 28] = [
+/// first frame; `run::clip::ClipFrame::omega`). `nodes_tracked`: the nodes of the frame that were
+/// tracked (`clip.missing`; all of them without missing data); `x_err_rel` and the `fit_*`
+/// columns measure the fit over those nodes.
+pub const CLIP_FRAME_COLUMNS: [&str; 29] = [
     "frame",
     "time_s",
     "iterations",
@@ -75,6 +77,7 @@ pub const CLIP_FRAME_COLUMNS: [&str; 28] = [
     "fit_position_rel_length",
     "fit_tangent_rms",
     "flagged",
+    "nodes_tracked",
 ];
 
 /// Columns of `fields.csv`, one row per frame and node: position [m], the angles [rad] in the
@@ -259,6 +262,7 @@ impl ClipWriter {
         row.push(omega.iter().map(|w| w.norm()).fold(0.0, f64::max));
         row.push(r.certificate);
         row.extend([r.fit.noise_m, r.fit.position, r.fit.tangent, f64::from(u8::from(r.fit.flagged))]);
+        row.push(r.nodes_tracked as f64);
         writeln!(self.frames, "{}", frames_row(&row)).and_then(|_| self.frames.flush()).map_err(err("frames.csv"))?;
         let d = nodes.directors();
         let [fields, curvature] = row_files(self.format());
@@ -419,8 +423,8 @@ pub const TRUTH_COLUMNS: [&str; 10] = [
 ];
 
 /// The integer columns of `frames.csv` (the frame, its iterations, a node index, a flag).
-pub const CLIP_FRAME_INTEGER_COLUMNS: [&str; 5] =
-    ["frame", "iterations", "min_abs_cos_beta_node", "restarted", "flagged"];
+pub const CLIP_FRAME_INTEGER_COLUMNS: [&str; 6] =
+    ["frame", "iterations", "min_abs_cos_beta_node", "restarted", "flagged", "nodes_tracked"];
 
 /// One row of `frames.csv` ([`CLIP_FRAME_COLUMNS`]): the [`CLIP_FRAME_INTEGER_COLUMNS`] as
 /// integers, the others `{:.10e}`.

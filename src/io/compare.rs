@@ -36,6 +36,7 @@ use crate::run::metrics::{all_metrics, differences, ComparisonRow, Difference, G
 use crate::run::{run_forward, run_inverse, NodalState, RunError, RunResult};
 use crate::solve::certificate::CERTIFICATE_FLOOR;
 use crate::solve::inverse::InverseMethod;
+use crate::solve::sequence::ClipData;
 use crate::solve::statics::Method;
 use crate::solve::{SolveError, PLATEAU_ITERATIONS};
 
@@ -377,16 +378,19 @@ fn compare_clip(case: &Case, dir: &Path, opts: &CompareOptions) -> Result<Compar
     };
     let n = opts.frames.unwrap_or(default).min(clip.frames.len()).max(1);
     let frames = &clip.frames[..n];
+    let tracked = clip.tracked.as_deref().map(|t| &t[..n]);
     let tau = stop_tolerance(case);
     let fixed_point = is_fixed_point_inverse(case);
-    let rust = solve_frames(case, frames)?;
+    let rust = solve_frames(case, ClipData { positions: frames, tracked })?;
     let pert: Vec<Vec<Vector3<f64>>> =
         frames.iter().enumerate().map(|(f, x)| perturb_positions(x, 1000 + f as u64)).collect();
-    let perturbed = solve_frames(case, &pert).map_err(|e| CompareError::Perturbed(e.into()))?;
+    let perturbed =
+        solve_frames(case, ClipData { positions: &pert, tracked }).map_err(|e| CompareError::Perturbed(e.into()))?;
     let exact: Option<Vec<(usize, bool)>> =
         fixed_point.then(|| rust.frames.iter().map(|f| (f.result.stats.iterations, f.restarted)).collect());
     let work = dir.join("freefem_work");
-    let ff = run_clip(case, frames, exact.as_deref(), &work).map_err(EngineError::from)?;
+    let ff =
+        run_clip(case, ClipData { positions: frames, tracked }, exact.as_deref(), &work).map_err(EngineError::from)?;
     let mut out = Vec::new();
     // per quantity: the row of the frame with the largest difference/tolerance ratio
     let mut worst: Vec<(ComparisonRow, usize, f64)> = Vec::new();

@@ -59,7 +59,10 @@ pub enum InputError {
     Shape { path: PathBuf, reason: String },
     #[error("{path}, frame {frame}, joint {joint}: angle {value} is not finite")]
     NonFiniteAngle { path: PathBuf, frame: usize, joint: usize, value: f64 },
-    #[error("{path}, frame {frame}, node {node}: {axis} = {value} is not finite")]
+    #[error(
+        "{path}, frame {frame}, node {node}: {axis} = {value} is not finite{}",
+        if value.is_nan() { " (if the tracker marks untracked nodes with NaN, set clip.missing = \"nan\" in the case)" } else { "" }
+    )]
     NonFinitePosition { path: PathBuf, frame: usize, node: usize, axis: char, value: f64 },
     #[error("{path}, frame {frame}: {nodes} nodes, but frame 0 has {expected}")]
     NodeCount { path: PathBuf, frame: usize, nodes: usize, expected: usize },

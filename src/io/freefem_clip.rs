@@ -16,7 +16,7 @@ use crate::run::frames::{frame_result, SolvedFrame};
 use crate::run::{Engine, NodalState};
 use crate::solve::certificate::Certificate;
 use crate::solve::inverse::{InverseRecord, ObjectiveTerms};
-use crate::solve::sequence::{clip_charts, FrameStart};
+use crate::solve::sequence::{clip_charts, ClipData, FrameStart};
 use crate::solve::SolveError;
 
 /// Frames solved by FreeFEM, and its failure message if it stopped early.
@@ -41,18 +41,21 @@ pub struct FreeFemFrames {
 /// the message.
 pub fn run_clip(
     case: &Case,
-    frames: &[Vec<Vector3<f64>>],
+    clip: ClipData<'_>,
     follow: Option<&[(usize, bool)]>,
     workdir: &Path,
 ) -> Result<FreeFemFrames, FreeFemError> {
     let sp = case.sequence_params().ok_or_else(|| FreeFemError::NotInverse(case.name.clone()))?;
     std::fs::create_dir_all(workdir).map_err(io(workdir))?;
+    let frames = clip.positions;
     let charts = clip_charts(&sp, frames);
-    let mut data = String::from("frame,s_m,x_m,y_m,z_m\n");
+    let mut data = String::from("frame,s_m,x_m,y_m,z_m,w\n");
     for (f, x) in frames.iter().enumerate() {
+        let w = clip.weights(f);
         for (i, p) in x.iter().enumerate() {
-            let _ =
-                writeln!(data, "{},{:e},{:e},{:e},{:e}", f + sp.frame_offset, case.mesh.node_s(i), p[0], p[1], p[2]);
+            let (k, s) = (f + sp.frame_offset, case.mesh.node_s(i));
+            let wi = w.as_ref().map_or(1.0, |w| w[i]);
+            let _ = writeln!(data, "{k},{s:e},{:e},{:e},{:e},{wi:e}", p[0], p[1], p[2]);
         }
     }
     let mut bases = String::from("frame,b11,b12,b13,b21,b22,b23,b31,b32,b33,exact_iterations,restarted\n");

@@ -19,7 +19,7 @@ use crate::model::rotation::Angles;
 use crate::solve::inverse::measures::angular_velocity;
 use crate::solve::inverse::Records;
 use crate::solve::sequence::{
-    solve_sequence_from, vector_to_space, FrameReport, ResumeFrom, SequenceError, SequenceParams,
+    solve_sequence_from, vector_to_space, ClipData, FrameReport, ResumeFrom, SequenceError, SequenceParams,
 };
 use crate::solve::SolveError;
 
@@ -229,6 +229,14 @@ impl Arrivals<'_> {
         Ok(self.frames.len())
     }
 
+    /// Which nodes of each frame were tracked (`clip::missing`; `None`: all of them).
+    fn tracked(&self) -> Option<&[Vec<bool>]> {
+        match &self.input {
+            ClipFrames::Loaded { clip, .. } => clip.tracked.as_deref(),
+            ClipFrames::Streamed { .. } => None,
+        }
+    }
+
     /// The frames at hand and their ground truth.
     fn frames(&self) -> (&[Vec<Vector3<f64>>], Option<&[FrameTruth]>) {
         match &self.input {
@@ -404,10 +412,11 @@ pub fn run_clip<S: FrameSink>(
                 }
             };
             let view = arrivals.frames();
+            let data = ClipData { positions: &view.0[..at_hand], tracked: arrivals.tracked().map(|t| &t[..at_hand]) };
             let run = solve_sequence_from(
                 &problem,
                 &sp,
-                &view.0[..at_hand],
+                data,
                 frame0_start.take().as_ref(),
                 from.take(),
                 |_, _| {},

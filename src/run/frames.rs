@@ -10,7 +10,7 @@ use super::{Engine, InverseOutput, NodalState, RunError, RunResult, SolverStats}
 use crate::case::Case;
 use crate::model::mesh::Field;
 use crate::solve::inverse::InverseRecord;
-use crate::solve::sequence::{solve_sequence, SequenceError};
+use crate::solve::sequence::{solve_sequence, ClipData, SequenceError};
 
 /// One solved frame of a clip.
 #[derive(Clone, Debug)]
@@ -79,10 +79,12 @@ pub fn frame_result(
     }
 }
 
-/// Solve `frames` (space coordinates, the clip's frames from its first) of the clip case
+/// Solve `data` (space coordinates, the clip's frames from its first) of the clip case
 /// `case` in order, exactly as `cosserat run` does ([`solve_sequence`]), keeping every frame.
 /// A failing frame ends the list and is returned as the error.
-pub fn solve_frames(case: &Case, frames: &[Vec<Vector3<f64>>]) -> Result<SolvedFrames, RunError> {
+pub fn solve_frames<'a>(case: &Case, data: impl Into<ClipData<'a>>) -> Result<SolvedFrames, RunError> {
+    let data = data.into();
+    let frames = data.positions;
     let sp = case.sequence_params().ok_or_else(|| RunError::kind(case, "a clip case"))?;
     let problem = case.problem();
     let dofs = problem.dofs();
@@ -91,7 +93,7 @@ pub fn solve_frames(case: &Case, frames: &[Vec<Vector3<f64>>]) -> Result<SolvedF
     let result = solve_sequence(
         &problem,
         &sp,
-        frames,
+        data,
         None,
         |_, _| {},
         |rep, f| {

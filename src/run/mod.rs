@@ -207,7 +207,7 @@ pub fn run_inverse(
         }
         progress(r.iteration, params.max_iterations)
     };
-    let frame = Frame { index: 0, x_g: &data.x, previous: None };
+    let frame = Frame { index: 0, x_g: &data.x, previous: None, weight: None };
     let solve = || FrameSolver::new(&problem, params).solve(&frame, &problem.reference_state(), Start::Guess, observer);
     let sol = match std::panic::catch_unwind(std::panic::AssertUnwindSafe(solve)) {
         Ok(solved) => solved?,

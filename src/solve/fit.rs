@@ -60,13 +60,19 @@ pub fn noise_level(x: &[Vector3<f64>]) -> f64 {
 /// The position misfit `p` of the module doc: `((1/L) ∫ |x − x_g|²)^½ / L` for P1 fields on a
 /// uniform mesh of `x.len() − 1` elements of a rod of length `length_m` [m], integrated
 /// exactly (`∫ |a(1 − ξ) + b ξ|² = h (|a|² + a·b + |b|²)/3` per element, `a, b` the nodal
-/// differences).
-pub fn position_misfit(x: &[Vector3<f64>], x_g: &[Vector3<f64>], length_m: f64) -> f64 {
+/// differences). With `tracked` (`clip::missing`) the integral and the `1/L` run over the
+/// elements whose two nodes were tracked; a frame without such an element is measured whole.
+pub fn position_misfit(x: &[Vector3<f64>], x_g: &[Vector3<f64>], tracked: Option<&[bool]>, length_m: f64) -> f64 {
     let d: Vec<Vector3<f64>> = x.iter().zip(x_g).map(|(a, b)| a - b).collect();
     let h = length_m / (d.len().max(2) - 1) as f64;
+    let both = |e: usize| tracked.is_none_or(|t| t[e] && t[e + 1]);
+    let elements: Vec<usize> = (0..d.len().saturating_sub(1)).filter(|&e| both(e)).collect();
+    // no element with two tracked nodes (a bridged frame): against the whole filled frame
+    let elements = if elements.is_empty() { (0..d.len().saturating_sub(1)).collect() } else { elements };
     let integral: f64 =
-        d.windows(2).map(|w| h * (w[0].norm_squared() + w[0].dot(&w[1]) + w[1].norm_squared()) / 3.0).sum();
-    (integral / length_m).sqrt() / length_m
+        elements.iter().map(|&e| h * (d[e].norm_squared() + d[e].dot(&d[e + 1]) + d[e + 1].norm_squared()) / 3.0).sum();
+    let measured = if elements.len() + 1 == d.len() { length_m } else { h * elements.len() as f64 };
+    (integral / measured).sqrt() / length_m
 }
 
 /// The fit measures of one frame (module doc).

@@ -18,6 +18,7 @@ use crate::model::mesh::{DofMap, Field};
 use crate::model::rotation::{angles_from_rotation, skew, Angles};
 
 use super::fit::{noise_level, position_misfit, FitGate, FrameFit};
+use super::inverse::tracking::{tracking_weights, MIN_TRACKED};
 use super::inverse::{
     Frame, FrameSolver, InverseParams, InverseRecord, InverseSolution, ObjectiveTerms, Records, Start,
 };
@@ -44,6 +45,38 @@ pub struct SequenceParams {
     pub records: Records,
     /// the fit-quality gate that flags frames (`solve::fit`)
     pub gate: FitGate,
+}
+
+/// The frames of a clip as the solve takes them: positions per node (untracked ones filled,
+/// `clip::missing`) and which nodes were tracked (`None`: all of them).
+#[derive(Clone, Copy, Debug)]
+pub struct ClipData<'a> {
+    pub positions: &'a [Vec<Vector3<f64>>],
+    pub tracked: Option<&'a [Vec<bool>]>,
+}
+
+impl ClipData<'_> {
+    /// The tracking weights of frame `i` ([`tracking_weights`]); `None`: w ≡ 1.
+    pub fn weights(&self, i: usize) -> Option<Vec<f64>> {
+        self.tracked.map(|t| tracking_weights(&t[i]))
+    }
+
+    /// The tracked nodes of frame `i`.
+    pub fn tracked(&self, i: usize) -> Option<&[bool]> {
+        self.tracked.map(|t| &t[i][..])
+    }
+}
+
+impl<'a> From<&'a [Vec<Vector3<f64>>]> for ClipData<'a> {
+    fn from(positions: &'a [Vec<Vector3<f64>>]) -> Self {
+        ClipData { positions, tracked: None }
+    }
+}
+
+impl<'a> From<&'a Vec<Vec<Vector3<f64>>>> for ClipData<'a> {
+    fn from(positions: &'a Vec<Vec<Vector3<f64>>>) -> Self {
+        ClipData { positions, tracked: None }
+    }
 }
 
 /// Angle chart of each frame (`docs/rotation.md`).
@@ -91,6 +124,9 @@ pub struct FrameReport {
     pub certificate: f64,
     /// how well the frame follows its data, and whether it is over the gate (`solve::fit`)
     pub fit: FrameFit,
+    /// nodes of the frame that were tracked (`clip::missing`; all of them without missing data)
+    #[serde(default)]
+    pub nodes_tracked: usize,
 }
 
 /// Errors of a clip solve: the frame's own error, or the chart guard.
@@ -155,29 +191,43 @@ pub fn min_cos_beta(dofs: &DofMap, u: &DVector<f64>) -> (f64, usize) {
     })
 }
 
-/// max_e |j_e − 1|, j_e = |x_{e+1} − x_e| / h (Remark 9).
-pub fn max_stretch_deviation(x_g: &[Vector3<f64>], h: f64) -> f64 {
-    x_g.windows(2).map(|w| ((w[1] - w[0]).norm() / h - 1.0).abs()).fold(0.0, f64::max)
+/// max_e |j_e − 1|, j_e = |x_{e+1} − x_e| / h (Remark 9), over the elements whose two nodes
+/// were tracked (`tracked`; `None`: all).
+pub fn max_stretch_deviation(x_g: &[Vector3<f64>], h: f64, tracked: Option<&[bool]>) -> f64 {
+    let both = |e: usize| tracked.is_none_or(|t| t[e] && t[e + 1]);
+    (0..x_g.len().saturating_sub(1))
+        .filter(|&e| both(e))
+        .map(|e| ((x_g[e + 1] - x_g[e]).norm() / h - 1.0).abs())
+        .fold(0.0, f64::max)
 }
 
-/// The fit measures of a frame's solution `sol` on its data `x_g` (chart coordinates both) and
-/// the gate's verdict (`solve::fit`); `tangent_misfit`: `‖∂s x − d3‖` [m^½] of its last record.
+/// The fit measures of a frame's solution `sol` on its data `x_g` (chart coordinates both) over
+/// its `tracked` nodes (`None`: all) and the gate's verdict (`solve::fit`); `tangent_misfit`:
+/// `‖∂s x − d3‖` [m^½] of its last record.
 fn frame_fit(
     gate: &FitGate,
     problem: &Problem,
     dofs: &DofMap,
     sol: &InverseSolution,
     x_g: &[Vector3<f64>],
+    tracked: Option<&[bool]>,
     tangent_misfit: f64,
 ) -> FrameFit {
     let length = problem.mesh.length_m;
+    // the noise of the tracked positions only (the filled ones are smooth by construction)
+    let recorded: Vec<Vector3<f64>> = match tracked {
+        Some(t) => x_g.iter().zip(t).map(|(x, &t)| if t { *x } else { Vector3::repeat(f64::NAN) }).collect(),
+        None => Vec::new(),
+    };
     let mut fit = FrameFit {
-        noise_m: noise_level(x_g),
-        position: position_misfit(&dofs.field(&sol.u, Field::X), x_g, length),
+        noise_m: noise_level(if tracked.is_some() { &recorded } else { x_g }),
+        position: position_misfit(&dofs.field(&sol.u, Field::X), x_g, tracked, length),
         tangent: tangent_misfit / length.sqrt(),
         flagged: false,
     };
-    fit.flagged = gate.check(&fit, length, problem.mesh.h());
+    // a bridged frame (too few tracked nodes, `clip::missing`) has no data to fall short of
+    let bridged = tracked.is_some_and(|t| t.iter().filter(|t| **t).count() < MIN_TRACKED);
+    fit.flagged = !bridged && gate.check(&fit, length, problem.mesh.h());
     fit
 }
 
@@ -307,10 +357,10 @@ fn continued(
 /// from the data guess, as `sp.start` says. `on_frame` receives each converged frame (e.g. to
 /// stream it to disk) and may stop the clip by returning an error message; `on_iteration` sees
 /// every iteration's record.
-pub fn solve_sequence(
+pub fn solve_sequence<'a>(
     problem: &Problem,
     sp: &SequenceParams,
-    frames: &[Vec<Vector3<f64>>],
+    frames: impl Into<ClipData<'a>>,
     u0: Option<&DVector<f64>>,
     on_iteration: impl FnMut(usize, &InverseRecord),
     on_frame: impl FnMut(&FrameReport, &FrameSolution) -> Result<(), String>,
@@ -334,15 +384,17 @@ pub struct ResumeFrom {
 /// are those of the frames solved here. Before each frame it checks for a requested stop
 /// (`crate::interrupt`): the clip then ends with [`SolveError::Interrupted`], every frame before
 /// it handed to `on_frame`.
-pub fn solve_sequence_from(
+pub fn solve_sequence_from<'a>(
     problem: &Problem,
     sp: &SequenceParams,
-    frames: &[Vec<Vector3<f64>>],
+    data: impl Into<ClipData<'a>>,
     u0: Option<&DVector<f64>>,
     resume: Option<ResumeFrom>,
     mut on_iteration: impl FnMut(usize, &InverseRecord),
     mut on_frame: impl FnMut(&FrameReport, &FrameSolution) -> Result<(), String>,
 ) -> Result<Vec<FrameReport>, SequenceError> {
+    let data = data.into();
+    let frames = data.positions;
     let dofs = problem.dofs();
     let h = problem.mesh.h();
     let mut reports: Vec<FrameReport> = Vec::with_capacity(frames.len());
@@ -387,7 +439,8 @@ pub fn solve_sequence_from(
             let near = dofs.field(&first_start, Field::Alpha);
             converted.unwrapped(Some(&near))
         });
-        let frame = Frame { index: k, x_g: &x_g, previous: alpha_prev.as_deref() };
+        let (weight, tracked) = (data.weights(i), data.tracked(i));
+        let frame = Frame { index: k, x_g: &x_g, previous: alpha_prev.as_deref(), weight: weight.as_deref() };
         // From the previous frame's solution (already close) Newton runs directly; from a guess
         // it needs the fixed point's warm start (I8).
         let lambda_g = sp.inverse.weights.lambda_g;
@@ -441,12 +494,13 @@ pub fn solve_sequence_from(
             objective: last.objective,
             min_cos_beta: cos_beta,
             min_cos_beta_node: node,
-            max_stretch_deviation: max_stretch_deviation(x_space, h),
+            max_stretch_deviation: max_stretch_deviation(x_space, h, tracked),
             restarted,
             chart_axis: chart.axis(),
             wall_time_s: start.elapsed().as_secs_f64(),
             certificate: sol.certificate.value,
-            fit: frame_fit(&sp.gate, problem, &dofs, &sol, &x_g, last.tangent_misfit),
+            fit: frame_fit(&sp.gate, problem, &dofs, &sol, &x_g, tracked, last.tangent_misfit),
+            nodes_tracked: tracked.map_or(x_g.len(), |t| t.iter().filter(|t| **t).count()),
         };
         let in_space = if chart.is_identity() { None } else { Some(to_space(&dofs, &chart, &sol)) };
         let solution = FrameSolution {

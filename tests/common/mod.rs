@@ -182,7 +182,7 @@ pub fn solve_frame_any(
     start: Start,
     mut on: impl FnMut(&InverseRecord),
 ) -> Result<InverseSolution, SolveError> {
-    let frame = Frame { index: 0, x_g, previous };
+    let frame = Frame { index: 0, x_g, previous, weight: None };
     FrameSolver::new(p, *params).solve(&frame, u0, start, |r, _, _| on(r))
 }
 

@@ -4,9 +4,10 @@ use std::path::Path;
 
 use nalgebra::{Rotation3, Vector3};
 
-use super::super::raw::{RawClip, RawClipKind, RawPlane, RawRotation, RawStart};
+use super::super::raw::{RawClip, RawClipKind, RawMissing, RawPlane, RawRotation, RawStart};
 use super::super::{CaseError, ClipKind, ClipSource, SyntheticClip};
 use super::Validator;
+use crate::clip::missing::MissingData;
 use crate::clip::synthetic::RollClipParams;
 use crate::clip::{ClipPlane, CLIP_SKIP_ELEMENTS, MAX_CLIP_POSITIONS, MIN_CLIP_ELEMENTS};
 use crate::model::mesh::Mesh;
@@ -85,6 +86,16 @@ impl Validator<'_> {
                 "roll_total_rad, twist_per_m, clip_frames and substeps apply to kind = \"roll_3d\" only",
             ));
         }
+        let missing = match (cl.missing, &kind) {
+            (None, _) => MissingData::Error,
+            (Some(RawMissing::Nan), ClipKind::Recording) => MissingData::Nan,
+            (Some(_), _) => {
+                return Err(self.err(
+                    "clip.missing",
+                    "applies to kind = \"recording\" only (kymograms and synthetic clips have no untracked nodes)",
+                ))
+            }
+        };
         let d = FitGate::default();
         let gate_key = |key: &str, v: Option<f64>, default: f64| match v {
             None => Ok(default),
@@ -100,6 +111,7 @@ impl Validator<'_> {
             kind,
             file: base.join(&cl.file),
             gate,
+            missing,
             frames,
             min_cos_beta: cl.min_cos_beta,
             start: match cl.start {

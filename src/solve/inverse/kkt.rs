@@ -3,7 +3,8 @@
 //! `[x, α, x̂, α̂]` per node (24 unknowns).
 use nalgebra::{DVector, Matrix3, SMatrix, SVector, Vector3};
 
-use super::{Frame, InverseParams};
+use super::tracking::weight_at;
+use super::{Frame, InverseParams, Tracking};
 use crate::assemble::{assemble, Tangent};
 use crate::linalg::Pattern;
 use crate::model::element::{frozen_operator, interpolate, LocalMat, LocalVec};
@@ -155,7 +156,8 @@ fn add_diagonal3(m: &mut KktMat, ro: usize, co: usize, s: f64) {
 
 /// Local KKT matrix (added into `m`, which the caller zeroes) and right-hand side (returned)
 /// of one element (I4), coefficients frozen at the element's state `uk`; `xg`, `alpha_prev`:
-/// the data and the previous frame's angles at its nodes (`first_frame`: no Λω term). Also
+/// the data and the previous frame's angles at its nodes (`first_frame`: no Λω term), `wg`
+/// the nodal weights of the tracking term (I14: `λg ∫ w δx·(x − x_g)`, w P1). Also
 /// returns the frozen operator `L(u)` of the element (`element::frozen_operator`), which the
 /// Newton Jacobian needs again.
 #[allow(non_snake_case)] // paper symbols W, D, A, Kk
@@ -164,7 +166,7 @@ pub(crate) fn element_system(
     p: &InverseParams,
     first_frame: bool,
     uk: &LocalVec,
-    xg: [Vector3<f64>; 2],
+    (xg, wg): ([Vector3<f64>; 2], [f64; 2]),
     alpha_prev: [Vector3<f64>; 2],
     m: &mut KktMat,
 ) -> (KktVec, LocalMat) {
@@ -185,6 +187,8 @@ pub(crate) fn element_system(
         let n = q.n;
         let wh = w * h;
         let xg_q = xg[0] * n[0] + xg[1] * n[1];
+        // λg w at the point: the one place the tracking weight enters (I14)
+        let lg = w8.lambda_g * weight_at(wg, n);
         let ap_q = alpha_prev[0] * n[0] + alpha_prev[1] * n[1];
         let W = if omega_on {
             let A = a_matrix(&q.alpha);
@@ -194,7 +198,7 @@ pub(crate) fn element_system(
         };
         for a in 0..2 {
             for i in 0..3 {
-                r[X[a] + i] += wh * n[a] * w8.lambda_g * xg_q[i];
+                r[X[a] + i] += wh * n[a] * lg * xg_q[i];
             }
             let wa = W * ap_q * (wh * n[a]);
             for i in 0..3 {
@@ -202,7 +206,7 @@ pub(crate) fn element_system(
             }
             for c in 0..2 {
                 let nn = wh * n[a] * n[c];
-                add_diagonal3(m, X[a], X[c], w8.lambda_g * nn);
+                add_diagonal3(m, X[a], X[c], lg * nn);
                 add_diagonal3(m, XH[a], XH[c], -nn / w8.lambda_f);
                 add_diagonal3(m, ALH[a], ALH[c], -nn / w8.lambda_l);
                 add3(m, AL[a], AL[c], &(W * nn));
@@ -280,16 +284,17 @@ pub(crate) fn dirichlet_into(dofs: &DofMap, alpha0: f64, frame: &Frame, fixed: &
 /// Assemble the KKT matrix (replacing `values`) and right-hand side of I4 with the
 /// coefficients frozen at the state `u` (forward layout); boundary conditions not applied.
 #[allow(clippy::too_many_arguments)]
-pub fn assemble_system(
+pub fn assemble_system<'a>(
     problem: &Problem,
     p: &InverseParams,
     first_frame: bool,
     pattern: &Pattern,
     values: &mut [f64],
     u: &DVector<f64>,
-    x_g: &[Vector3<f64>],
+    data: impl Into<Tracking<'a>>,
     alpha_prev: &[Vector3<f64>],
 ) -> DVector<f64> {
+    let data = data.into();
     let fwd = problem.dofs();
     let kkt_dofs = problem.mesh.kkt_dofs();
 
@@ -298,7 +303,7 @@ pub fn assemble_system(
     assemble(&kkt_dofs, &mut rhs, Some(Tangent::overwriting(pattern, values, 1.0)), |e, t| {
         let uk: LocalVec = fwd.gather(u, e);
         let m = t.unwrap_or(&mut scratch);
-        element_system(problem, p, first_frame, &uk, [x_g[e], x_g[e + 1]], [alpha_prev[e], alpha_prev[e + 1]], m).0
+        element_system(problem, p, first_frame, &uk, data.element(e), [alpha_prev[e], alpha_prev[e + 1]], m).0
     });
     rhs
 }
@@ -328,7 +333,7 @@ pub fn certificate(
     }
     let shifted = Frame { x_g: &x_g, ..*frame };
     let u = kd.kkt_state(&big);
-    let mut rhs = assemble_system(problem, p, frame.is_first(), pattern, values, &u, &x_g, alpha_prev);
+    let mut rhs = assemble_system(problem, p, frame.is_first(), pattern, values, &u, shifted.tracking(), alpha_prev);
     let fixed = dirichlet(&kd, p.alpha0_rad, &shifted);
     for &(d, v) in &fixed {
         rhs[d] = v;

@@ -3,7 +3,8 @@
 use nalgebra::{DVector, Vector3};
 
 use super::kkt::PointRule;
-use super::{Frame, InverseParams, InverseRecord, ObjectiveTerms};
+use super::tracking::weight_at;
+use super::{Frame, InverseParams, InverseRecord, ObjectiveTerms, Tracking};
 use crate::assemble::integrate;
 use crate::model::element::{interpolate, LocalVec, PointState};
 use crate::model::rotation::{a_matrix, curvature, d3, Angles};
@@ -18,10 +19,11 @@ pub fn angular_velocity(alpha: &Angles, alpha_prev: &Angles, dt_s: f64) -> Vecto
     a_matrix(alpha) * (alpha - alpha_prev) / dt_s
 }
 
-/// The fit to the data and the objective (41) at one iterate, with the rules of I2.
+/// The fit to the data and the objective (41) at one iterate, with the rules of I2. The fit
+/// and the tracking term are weighted by the tracking weight `w` (I14): over the tracked nodes.
 #[derive(Clone, Copy, Debug)]
 pub struct Measures {
-    /// ‖x − x_g‖/‖x_g‖ (2-point Gauss)
+    /// ‖x − x_g‖/‖x_g‖ (2-point Gauss), both norms weighted by `w` (I14)
     pub x_err_rel: f64,
     /// ‖∂s x − d3‖ [m^½] (the λd term's rule, I11)
     pub tangent_misfit: f64,
@@ -32,15 +34,16 @@ pub struct Measures {
 /// `alpha_prev`: the previous frame's angles (the Λω term is off on the first frame). Three
 /// passes of [`integrate`], one per rule: the 2-point Gauss rule (fit, tracking, controls, Λω),
 /// the λd term's rule (misfit and shear term from the same `|∂s x − d3|²`) and the Λκ rule.
-pub fn measures(
+pub fn measures<'a>(
     problem: &Problem,
     p: &InverseParams,
     first_frame: bool,
     u: &DVector<f64>,
     adjoint: &DVector<f64>,
-    x_g: &[Vector3<f64>],
+    data: impl Into<Tracking<'a>>,
     alpha_prev: &[Vector3<f64>],
 ) -> Measures {
+    let data = data.into();
     let (mesh, dofs) = (&problem.mesh, problem.dofs());
     let h = mesh.h();
     let w8 = &p.weights;
@@ -51,11 +54,11 @@ pub fn measures(
         let q = state(e, xi);
         let ae: LocalVec = dofs.gather(adjoint, e);
         let qa = interpolate(&ae, h, xi);
-        let (d2, xg2) = data_misfit(x_g, e, &q);
-        e2 += w * h * d2;
-        g2 += w * h * xg2;
+        let (d2, xg2, wq) = data_misfit(&data, e, &q);
+        e2 += w * h * wq * d2;
+        g2 += w * h * wq * xg2;
         let wh = 0.5 * w * h;
-        t.tracking += wh * w8.lambda_g * d2;
+        t.tracking += wh * w8.lambda_g * wq * d2;
         t.force += wh * qa.x.norm_squared() / w8.lambda_f;
         t.torque += wh * qa.alpha.norm_squared() / w8.lambda_l;
         if !first_frame {
@@ -79,23 +82,26 @@ pub fn measures(
 }
 
 /// `‖x − x_g‖/‖x_g‖` of [`measures`] alone (the same sums): no angles, no trigonometry.
-pub fn position_error(problem: &Problem, u: &DVector<f64>, x_g: &[Vector3<f64>]) -> f64 {
+pub fn position_error<'a>(problem: &Problem, u: &DVector<f64>, data: impl Into<Tracking<'a>>) -> f64 {
+    let data = data.into();
     let (mesh, dofs) = (&problem.mesh, problem.dofs());
     let h = mesh.h();
     let (mut e2, mut g2) = (0.0, 0.0);
     integrate(mesh, problem.scheme.objective().iter(), |e, xi, w| {
-        let (d2, xg2) = data_misfit(x_g, e, &interpolate(&dofs.gather(u, e), h, xi));
-        e2 += w * h * d2;
-        g2 += w * h * xg2;
+        let (d2, xg2, wq) = data_misfit(&data, e, &interpolate(&dofs.gather(u, e), h, xi));
+        e2 += w * h * wq * d2;
+        g2 += w * h * wq * xg2;
     });
     (e2 / g2).sqrt()
 }
 
-/// `(|x − x_g|², |x_g|²)` at a point `q` of element `e`, `x_g` interpolated from the nodes:
-/// the summands of `‖x − x_g‖/‖x_g‖` ([`measures`], [`position_error`]).
-fn data_misfit(x_g: &[Vector3<f64>], e: usize, q: &PointState) -> (f64, f64) {
-    let xg = x_g[e] * q.n[0] + x_g[e + 1] * q.n[1];
-    ((q.x - xg).norm_squared(), xg.norm_squared())
+/// `(|x − x_g|², |x_g|², w)` at a point `q` of element `e`, `x_g` and the tracking weight `w`
+/// interpolated from the nodes: the summands of `‖x − x_g‖/‖x_g‖` ([`measures`],
+/// [`position_error`]) and their weight.
+fn data_misfit(data: &Tracking, e: usize, q: &PointState) -> (f64, f64, f64) {
+    let ([a, b], [wa, wb]) = data.element(e);
+    let xg = a * q.n[0] + b * q.n[1];
+    ((q.x - xg).norm_squared(), xg.norm_squared(), weight_at([wa, wb], q.n))
 }
 
 /// The per-iteration record of `frame` at the state `u` with the adjoint `adjoint` (fit
@@ -112,7 +118,7 @@ pub(crate) fn record(
     adjoint: &DVector<f64>,
     residual: Option<f64>,
 ) -> InverseRecord {
-    let m = measures(problem, p, frame.is_first(), u, adjoint, frame.x_g, alpha_prev);
+    let m = measures(problem, p, frame.is_first(), u, adjoint, frame.tracking(), alpha_prev);
     let (x_err_rel, tangent_misfit, objective) = (m.x_err_rel, m.tangent_misfit, m.objective);
     InverseRecord { iteration, rel_change, x_err_rel, tangent_misfit, objective, residual, certificate: None }
 }

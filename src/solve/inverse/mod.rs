@@ -19,7 +19,8 @@
 //!   to the solution ([`Start`]).
 //!
 //! Files: [`kkt`] (the element system of I4 and the boundary conditions of I5), [`measures`]
-//! (fit and objective (41), I2), [`fixed_point`], [`newton`].
+//! (fit and objective (41), I2), [`tracking`] (the data and nodal weights of the tracking term,
+//! I14), [`fixed_point`], [`newton`].
 //!
 //! ## References
 //! 1. Wang et al., Comput. Mech. 71 (2023), §3–4, eqs. (41), (52)–(61), Remark 6, Remark 10.
@@ -27,6 +28,9 @@ pub mod fixed_point;
 pub mod kkt;
 pub mod measures;
 pub mod newton;
+pub mod tracking;
+
+pub use tracking::Tracking;
 
 use nalgebra::{DVector, Vector3};
 
@@ -137,11 +141,18 @@ pub struct Frame<'a> {
     /// the previous frame's angles per node (the Λω term), or `None` on the first frame, which
     /// has α(0) = α0 instead and no Λω term (Remark 6)
     pub previous: Option<&'a [Angles]>,
+    /// the nodal weight `w_i` of the tracking term (`clip::missing`, I14); `None`: w ≡ 1
+    pub weight: Option<&'a [f64]>,
 }
 
-impl Frame<'_> {
+impl<'a> Frame<'a> {
     pub fn is_first(&self) -> bool {
         self.previous.is_none()
+    }
+
+    /// The data of the tracking term: positions and weights.
+    pub fn tracking(&self) -> Tracking<'a> {
+        Tracking { x_g: self.x_g, weight: self.weight }
     }
 }
 
@@ -401,6 +412,7 @@ impl<'p> FrameSolver<'p> {
         let fwd = self.problem.dofs();
         for (what, nodes) in [
             ("data x_g", frame.x_g.len()),
+            ("tracking weights", frame.weight.map_or(expected, <[f64]>::len)),
             ("previous frame's angles", frame.previous.map_or(expected, <[Angles]>::len)),
             ("initial state", if u0.len() == fwd.len() { expected } else { u0.len() / fwd.block() }),
         ] {
@@ -484,7 +496,7 @@ impl<'p> FrameSolver<'p> {
             &self.pattern,
             &mut self.values,
             u,
-            frame.x_g,
+            frame.tracking(),
             previous,
         );
         for &(d, v) in &self.fixed {

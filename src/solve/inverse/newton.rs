@@ -199,7 +199,7 @@ pub fn assemble_residual(
 ) -> DVector<f64> {
     let dofs = problem.mesh.kkt_dofs();
     let first = frame.is_first();
-    let x_g = frame.x_g;
+    let data = frame.tracking();
     let mut scratch = KktMat::zeros();
     let kernel = |e: usize, t: Option<&mut KktMat>| {
         let ue: KktVec = dofs.gather(big, e);
@@ -210,7 +210,7 @@ pub fn assemble_residual(
             scratch.as_mut_slice().fill(0.0);
             &mut scratch
         });
-        let (rhs, l) = element_system(problem, p, first, &uk, [x_g[e], x_g[e + 1]], ap, m);
+        let (rhs, l) = element_system(problem, p, first, &uk, data.element(e), ap, m);
         // by reference: `*m * ue` would copy the 24 × 24 matrix first
         #[allow(clippy::op_ref)]
         let r = &*m * ue - rhs;
@@ -412,7 +412,7 @@ fn solve_from(
         let last = k == params.max_iterations;
         let cert = (!lean || full || last).then(|| certify(&big));
         if lean && !full && !last {
-            let x_err = position_error(problem, &u, frame.x_g);
+            let x_err = position_error(problem, &u, frame.tracking());
             early_divergence(frame.index, k, rel_change, x_err, &u, &adjoint)?;
         } else {
             let residual = (!skip_residual).then_some(phi_t / phi0);
