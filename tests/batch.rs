@@ -154,7 +154,10 @@ fn an_interrupted_batch_stops_at_the_next_frame_and_says_what_it_kept() {
     for r in stopped {
         assert_eq!(r[2], "interrupted", "{r:?}");
         let n: usize = r[3].parse().expect("frames");
-        assert!((20..400).contains(&n), "{r:?}");
+        // the recording watched had 20 frames written; the other one started with it but may
+        // still have been choosing its weights (weights = "auto", docs/noise.md N2)
+        let least = if r[1] == "roll_000" { 20 } else { 0 };
+        assert!((least..400).contains(&n), "{r:?}");
         let m = std::fs::read_to_string(out.join(&r[1]).join("run.json")).expect("run.json");
         assert!(m.contains("\"status\": \"interrupted\"") && m.contains(&format!("\"frames_done\": {n}")), "{m}");
     }

@@ -138,7 +138,7 @@ fn run(case: &Path) -> Vec<ClipFrame> {
     let case = Case::from_file(case).expect("case");
     let (clip, truth) = load_clip(&case).expect("clip");
     let got = Arc::new(Mutex::new(Vec::new()));
-    let frames = ClipFrames::Loaded { clip: &clip, truth: truth.as_ref() };
+    let frames = ClipFrames::Loaded { clip: &clip, truth: truth.as_ref(), start: None };
     let out = run_clip(&case, frames, &[], Collect(got.clone()), |_, _| {}).expect("clip runs");
     assert!(out.stopped.is_none(), "{}: stopped: {:?}", case.name, out.stopped);
     let got = got.lock().expect("frames").clone();

@@ -76,7 +76,15 @@ fn label(p: &PointResult) -> String {
 }
 
 fn line(title: String, x_label: &str, y_label: &str, series: Vec<Series>, log: (bool, bool)) -> LinePlot {
-    LinePlot { title, x_label: x_label.into(), y_label: y_label.into(), series, log_x: log.0, log_y: log.1, legend: Default::default() }
+    LinePlot {
+        title,
+        x_label: x_label.into(),
+        y_label: y_label.into(),
+        series,
+        log_x: log.0,
+        log_y: log.1,
+        legend: Default::default(),
+    }
 }
 
 fn figure(spec: &Spec, p: &PlotSpec, runs: &[RunResults]) -> Option<Svg> {

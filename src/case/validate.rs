@@ -10,8 +10,8 @@ use nalgebra::Vector3;
 
 use super::raw::*;
 use super::{
-    Analysis, Case, CaseError, CompareOverrides, CompareSpec, DataSource, InverseSettings, Reference, WeightsRule, RodLength,
-    DEFAULT_COMPARE_FRAMES,
+    Analysis, Case, CaseError, CompareOverrides, CompareSpec, DataSource, InverseSettings, Reference, RodLength,
+    WeightsRule, DEFAULT_COMPARE_FRAMES,
 };
 use crate::expr::{Expr, ExprError, Node};
 use crate::model::material::{CrossSection, Material, RodProperties};

@@ -44,7 +44,8 @@ pub fn cmd_noise_study(a: NoiseStudyArgs) -> Result<ExitCode> {
     let plan = spec.plan(a.quick);
     let total = spec.meshes.len() * plan.noise_m.len() * spec.variants.len();
     let pb = Progress::new(&spec.title, "batches", total, a.quiet);
-    let rows = run_study(&spec, &a.out, a.quick, |_| pb.inc()).with_context(|| format!("noise study {}", a.spec.display()))?;
+    let rows =
+        run_study(&spec, &a.out, a.quick, |_| pb.inc()).with_context(|| format!("noise study {}", a.spec.display()))?;
     pb.finish();
     let svg = figure(&spec, &rows)?;
     write_atomic(&a.out.join("noise_study.svg"), svg.as_bytes())?;

@@ -19,7 +19,15 @@ impl FrameAxis {
         Series { label: label.into(), x: self.0.clone(), y }
     }
     fn plot(title: String, y_label: &str, series: Vec<Series>, log_y: bool) -> LinePlot {
-        LinePlot { title, x_label: "frame".into(), y_label: y_label.into(), series, log_x: false, log_y, legend: Default::default() }
+        LinePlot {
+            title,
+            x_label: "frame".into(),
+            y_label: y_label.into(),
+            series,
+            log_x: false,
+            log_y,
+            legend: Default::default(),
+        }
     }
 }
 

@@ -372,6 +372,9 @@ fn compare_single(case: &Case, dir: &Path, opts: &CompareOptions) -> Result<Comp
 
 fn compare_clip(case: &Case, dir: &Path, opts: &CompareOptions) -> Result<CompareReport, CompareError> {
     let (clip, _) = load_clip(case).map_err(EngineError::from)?;
+    // weights = "auto": λg chosen once (in Rust, docs/noise.md N2), then both engines use it
+    let auto = crate::run::weights::choose_weights(case, &clip.frames);
+    let case = auto.as_ref().map_or(case, |a| &a.case);
     let default = match opts.horizon {
         Horizon::Full => case.compare.frames,
         Horizon::Short => SHORT_FRAMES,

@@ -202,8 +202,13 @@ pub fn run_clip_to(
             Ok(run_clip(case, frames, &records, writer, progress)?)
         }),
         Input::Loaded(clip, truth) => {
-            let mut out =
-                run_clip(case, ClipFrames::Loaded { clip: &clip, truth: truth.as_ref(), start }, &records, writer, progress)?;
+            let mut out = run_clip(
+                case,
+                ClipFrames::Loaded { clip: &clip, truth: truth.as_ref(), start },
+                &records,
+                writer,
+                progress,
+            )?;
             out.run.weights = weights;
             Ok(out)
         }

@@ -72,6 +72,12 @@ impl JobEnd {
                 t.twist_per_m.first().copied().unwrap_or(0.0)
             );
         }
+        if let Some(w) = &run.weights {
+            out += &format!(
+                "{name} weights = \"auto\": noise level {:.3e} m per coordinate (median over the frames); lambda_g = {:.3e} (at most {:.1e}): the fit's RMS distance to the data {:.3e} m on the first {} frames ({} calibration solves; docs/noise.md)\n",
+                w.noise_m, w.lambda_g, w.lambda_g_max, w.fit_residual_m, w.calibration_frames, w.solves
+            );
+        }
         let n = run.reports.len();
         let its: Vec<usize> = run.reports.iter().map(|r| r.iterations).collect();
         // in body lengths (solve::fit): ‖x − x_g‖/‖x_g‖ would depend on where the clip sits

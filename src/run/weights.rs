@@ -115,20 +115,32 @@ struct Search<'a> {
 }
 
 impl Search<'_> {
-    /// `r(λg)` [m], 0 when the solve fails.
+    /// `r(λg)` [m], 0 when the solve fails. After a requested stop no solve runs (the clip's
+    /// own solve then stops at its first frame) and the search ends.
     fn residual(&mut self, lambda_g: f64) -> f64 {
+        if crate::interrupt::requested() {
+            self.solves = MAX_SOLVES;
+            return 0.0;
+        }
         self.solves += 1;
         let mut sp = self.sp;
         sp.inverse.weights.lambda_g = lambda_g;
         let problem = self.case.problem();
         let length = self.case.mesh.length_m;
         let mut first: Option<DVector<f64>> = None;
-        let solved = solve_sequence(&problem, &sp, self.calib, self.u0.as_ref(), |_, _| {}, |rep, sol| {
-            if rep.frame == sp.frame_offset {
-                first = Some(sol.state.clone());
-            }
-            Ok(())
-        });
+        let solved = solve_sequence(
+            &problem,
+            &sp,
+            self.calib,
+            self.u0.as_ref(),
+            |_, _| {},
+            |rep, sol| {
+                if rep.frame == sp.frame_offset {
+                    first = Some(sol.state.clone());
+                }
+                Ok(())
+            },
+        );
         match solved {
             Ok(reports) if !reports.is_empty() => {
                 if let Some(u) = &first {
@@ -146,7 +158,7 @@ impl Search<'_> {
     fn run(&mut self, sigma: f64, cap: f64) -> (f64, f64) {
         let f = |r: f64| if r > 0.0 { (r / sigma).ln() } else { f64::NEG_INFINITY };
         let floor = cap * MIN_RATIO;
-        if !(sigma > 0.0) {
+        if sigma.is_nan() || sigma <= 0.0 {
             return (cap, self.residual(cap));
         }
         // bracket r(lo) ≥ σ̂ > r(hi): up by 100 at a time from the smooth (easy) end, each solve

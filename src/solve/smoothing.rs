@@ -91,7 +91,8 @@ impl Smoother {
         let (dmin, dmax) = positive.iter().fold((f64::INFINITY, 0.0f64), |(a, b), &v| (a.min(v), b.max(v)));
         let (lo, hi) = ((1e-4 / dmax).ln(), (1e4 / dmin).ln());
         let at = |k: usize| lo + (hi - lo) * k as f64 / (GRID - 1) as f64;
-        let best = (0..GRID).min_by(|&a, &b| self.gcv(z, at(a).exp()).total_cmp(&self.gcv(z, at(b).exp()))).unwrap_or(0);
+        let best =
+            (0..GRID).min_by(|&a, &b| self.gcv(z, at(a).exp()).total_cmp(&self.gcv(z, at(b).exp()))).unwrap_or(0);
         let (mut a, mut b) = (at(best.saturating_sub(1)), at((best + 1).min(GRID - 1)));
         let phi = 0.5 * (5f64.sqrt() - 1.0);
         for _ in 0..GOLDEN_STEPS {
@@ -115,8 +116,7 @@ impl Smoother {
         let h = &self.h;
         let m = n - 2;
         let mut diag: Vec<f64> = (1..=m).map(|i| (h[i - 1] + h[i]) / 3.0).collect();
-        let mut rhs: Vec<f64> =
-            (1..=m).map(|i| (g[i + 1] - g[i]) / h[i] - (g[i] - g[i - 1]) / h[i - 1]).collect();
+        let mut rhs: Vec<f64> = (1..=m).map(|i| (g[i + 1] - g[i]) / h[i] - (g[i] - g[i - 1]) / h[i - 1]).collect();
         for j in 1..m {
             let w = (h[j] / 6.0) / diag[j - 1];
             diag[j] -= w * h[j] / 6.0;
@@ -155,7 +155,10 @@ impl SmoothingSpline {
 
     fn fit_at(points: &[Vector3<f64>], t: Vec<f64>) -> Option<Self> {
         let n = points.len();
-        if n < 4 || points.iter().any(|p| !p.iter().all(|v| v.is_finite())) || t.windows(2).any(|w| !(w[1] > w[0])) {
+        if n < 4
+            || points.iter().any(|p| !p.iter().all(|v| v.is_finite()))
+            || t.windows(2).any(|w| w[1].partial_cmp(&w[0]) != Some(std::cmp::Ordering::Greater))
+        {
             return None;
         }
         let s = Smoother::new(&t);
@@ -194,7 +197,8 @@ impl SmoothingSpline {
         let h = self.t[i + 1] - self.t[i];
         let (a, b) = ((self.t[i + 1] - t) / h, (t - self.t[i]) / h);
         let (m0, m1) = (self.gamma[i], self.gamma[i + 1]);
-        let d1 = (self.g[i + 1] - self.g[i]) / h - m0 * ((3.0 * a * a - 1.0) * h / 6.0) + m1 * ((3.0 * b * b - 1.0) * h / 6.0);
+        let d1 = (self.g[i + 1] - self.g[i]) / h - m0 * ((3.0 * a * a - 1.0) * h / 6.0)
+            + m1 * ((3.0 * b * b - 1.0) * h / 6.0);
         let d2 = m0 * a + m1 * b;
         (d1, d2)
     }

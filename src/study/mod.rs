@@ -23,8 +23,8 @@ use crate::io::corpus::{recording_path, write_corpus, CorpusParams};
 use crate::io::truth_file::{read_truth, truth_sidecar};
 use crate::io::{write_atomic, InputError, OutputError};
 use score::{
-    bending_error, median_and_worst, read_curvature, recovered_nodal, spline_bending, truth_bending, truth_bending_nodal,
-    ScoreError,
+    bending_error, median_and_worst, read_curvature, recovered_nodal, spline_bending, truth_bending,
+    truth_bending_nodal, ScoreError,
 };
 
 /// Errors of the study.
@@ -96,7 +96,10 @@ pub fn run_study(spec: &StudySpec, out: &Path, quick: bool, tick: impl Fn(&str))
             let started = Instant::now();
             rows.extend(spline_rows(mesh.nodes, noise_m, params.length_m, &recordings, spec.skip_elements)?);
             let spline_s = started.elapsed().as_secs_f64();
-            rows.iter_mut().rev().take(recordings.len()).for_each(|r| r.frames_per_s = r.frames as f64 / (spline_s / recordings.len() as f64));
+            rows.iter_mut()
+                .rev()
+                .take(recordings.len())
+                .for_each(|r| r.frames_per_s = r.frames as f64 / (spline_s / recordings.len() as f64));
             for variant in &spec.variants {
                 let case = spec.variant_case(mesh, variant, &out.join("cases"))?;
                 let runs = out.join("runs").join(&tag).join(&variant.name);
@@ -119,10 +122,11 @@ pub fn run_study(spec: &StudySpec, out: &Path, quick: bool, tick: impl Fn(&str))
     Ok(rows)
 }
 
+/// A recording's noisy frames (node positions [m]) and its truth.
+type Recorded = (Vec<Vec<nalgebra::Vector3<f64>>>, crate::clip::synthetic::GroundTruth);
+
 /// The truth of a recording and its noisy frames.
-fn recording_and_truth(
-    recording: &Path,
-) -> Result<(Vec<Vec<nalgebra::Vector3<f64>>>, crate::clip::synthetic::GroundTruth), StudyError> {
+fn recording_and_truth(recording: &Path) -> Result<Recorded, StudyError> {
     let clip = read_recording(recording, 1.0)?;
     let n = clip.node_count();
     let s: Vec<f64> = (0..n).map(|i| i as f64 / (n - 1) as f64).collect();
@@ -130,7 +134,13 @@ fn recording_and_truth(
     Ok((clip.frames, truth))
 }
 
-fn spline_rows(nodes: usize, noise_m: f64, length_m: f64, recordings: &[PathBuf], skip: usize) -> Result<Vec<StudyRow>, StudyError> {
+fn spline_rows(
+    nodes: usize,
+    noise_m: f64,
+    length_m: f64,
+    recordings: &[PathBuf],
+    skip: usize,
+) -> Result<Vec<StudyRow>, StudyError> {
     let mut rows = Vec::new();
     for recording in recordings {
         let (frames, truth) = recording_and_truth(recording)?;

@@ -103,12 +103,18 @@ impl StudySpec {
             return invalid("recordings must be >= 1 and frames >= 2 (also in [quick])".into());
         }
         if let Some(m) = spec.meshes.iter().find(|m| m.nodes < 2 * spec.skip_elements + 3) {
-            return invalid(format!("{} nodes leave no element after skipping {} at each end", m.nodes, spec.skip_elements));
+            return invalid(format!(
+                "{} nodes leave no element after skipping {} at each end",
+                m.nodes, spec.skip_elements
+            ));
         }
         let mut names: Vec<&str> = spec.variants.iter().map(|v| v.name.as_str()).collect();
         names.sort_unstable();
         if names.windows(2).any(|w| w[0] == w[1]) || names.contains(&super::SPLINE) || names.is_empty() {
-            return invalid(format!("variant names must be distinct, not `{}`, and at least one: {names:?}", super::SPLINE));
+            return invalid(format!(
+                "variant names must be distinct, not `{}`, and at least one: {names:?}",
+                super::SPLINE
+            ));
         }
         Ok(spec)
     }

@@ -15,8 +15,8 @@
 //! paper's scheme, so both modes converge to the same discrete solution. Remark 8's variant
 //! (an adjoint that also varies Q, A, B) is a different problem and is not used.
 //!
-//! Steps are damped by non-monotone backtracking on the equilibrated residual norm `‖D_r R‖₂`
-//! (D_r: Ruiz row factors of the first Jacobian, I6; [`NONMONOTONE_WINDOW`]). Stop when the full Newton step has
+//! Steps are damped by backtracking on the equilibrated residual norm `‖D_r R‖₂` (D_r: Ruiz
+//! row factors of the first Jacobian, I6). Stop when the full Newton step has
 //! `relative_change(x, α) ≤ tol` (D5) and the residual certificate of the new iterate
 //! (`kkt::certificate`, `docs/certificate.md`) is within its tolerance; that step is taken
 //! without line search. A step within the tolerance whose iterate is not certified does not
@@ -43,15 +43,8 @@ use crate::solve::{Problem, SolveError, Stop, CHORD_CONTRACTION};
 
 /// Smallest step fraction of the backtracking line search (2⁻¹⁰).
 const MIN_STEP: f64 = 1.0 / 1024.0;
-/// Armijo constant of the line search: accept `t` if `φ(U + t δ) ≤ (1 − c t) φ_ref`.
+/// Armijo constant of the line search: accept `t` if `φ(U + t δ) ≤ (1 − c t) φ(U)`.
 const ARMIJO: f64 = 1e-4;
-/// The non-monotone line search's window (Grippo, Lampariello & Lucidi, SIAM J. Numer. Anal.
-/// 23 (1986)): `φ_ref` is the largest merit of the last this many Newton iterations, not the
-/// current one. On noisy recordings with a data-chosen λg the monotone rule halved the step
-/// for 15–20 iterations in a row (σ = 3 µm, 33 nodes, λg = 1e4: 23–30 iterations per frame,
-/// 13–17 with the window; the same reconstruction). Where the full step decreases the merit
-/// (every clean clip and §5.2 case) nothing changes (`docs/inverse.md`, I8).
-const NONMONOTONE_WINDOW: usize = 5;
 /// Chord steps are taken where they converge nearly as fast as Newton's: while their
 /// contraction (the ratio of successive relative changes of `(x, α)`, D5) is at most this. A
 /// chord step from a Jacobian factorised one step ago contracts by about the square of that
@@ -366,9 +359,6 @@ fn solve_from(
             (false, _) => (change / previous).powi(2),
         };
         let chord_next = !full && rate <= CHORD_RATE;
-        // the Armijo reference: the largest merit of the last NONMONOTONE_WINDOW Newton
-        // iterations (a chord step's own merit: it is kept only where it contracts)
-        let reference = if chord { phi } else { phis.iter().rev().take(NONMONOTONE_WINDOW).fold(phi, |a, &b| a.max(b)) };
         let mut t = 1.0;
         let (mut trial, mut phi_t);
         let accepted = loop {
@@ -386,7 +376,7 @@ fn solve_from(
             }
             let r_t = assemble_residual(problem, params, frame, previous_angles, &trial, fixed, jacobian);
             phi_t = merit(&r_t);
-            if full || phi_t <= (1.0 - ARMIJO * t) * reference || t <= MIN_STEP {
+            if full || phi_t <= (1.0 - ARMIJO * t) * phi || t <= MIN_STEP {
                 if t == 1.0 && !full {
                     next = Some(r_t);
                 }
