@@ -10,12 +10,12 @@ use std::sync::mpsc::{channel, Sender};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
-use common::{short_roll_case, worm_data_present};
+use common::{short_roll_case, worm_data_present, Collect};
 use cosserat::case::Case;
 use cosserat::clip::synthetic::{FrameTruth, GroundTruth};
 use cosserat::clip::Clip;
 use cosserat::io::clip_files::load_clip;
-use cosserat::run::clip::{run_clip, ClipFrame, ClipFrames, ClipOutcome, FrameSink, StreamedFrame};
+use cosserat::run::clip::{run_clip, ClipFrame, ClipFrames, ClipOutcome, StreamedFrame};
 use cosserat::run::RunError;
 
 const FRAMES: usize = 20;
@@ -35,20 +35,6 @@ fn short_clip(test: &str) -> Option<(tempfile::TempDir, Case, Clip, GroundTruth)
 /// The clip without its frames, as a stream's header.
 fn header(clip: &Clip) -> Clip {
     Clip { frames: Vec::new(), ..clip.clone() }
-}
-
-/// Keeps every frame handed to it.
-struct Collect(Arc<Mutex<Vec<ClipFrame>>>);
-
-impl FrameSink for Collect {
-    type Error = std::convert::Infallible;
-    fn frame(&mut self, frame: &ClipFrame) -> Result<(), Self::Error> {
-        self.0.lock().expect("frames").push(frame.clone());
-        Ok(())
-    }
-    fn finish(&mut self) -> Result<(), Self::Error> {
-        Ok(())
-    }
 }
 
 /// Run the clip of `case` on `frames`; the outcome and the frames the sink received.

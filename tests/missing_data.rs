@@ -34,11 +34,11 @@ use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 
 use assert_cmd::Command;
-use common::{freefem_required, worm_data_present};
+use common::{freefem_required, worm_data_present, Collect};
 use cosserat::case::Case;
 use cosserat::io::clip_files::load_clip;
 use cosserat::io::npy::{read_npy, write_npy};
-use cosserat::run::clip::{run_clip, ClipFrame, ClipFrames, FrameSink};
+use cosserat::run::clip::{run_clip, ClipFrame, ClipFrames};
 use nalgebra::Vector3;
 
 const FRAMES: usize = 60;
@@ -117,20 +117,6 @@ fn write_masked(recording: &Path, dst: &Path, tracked: &[Vec<bool>]) {
     write_npy(dst, &a.shape, &a.data).expect("write");
     let truth = |p: &Path| p.with_file_name(format!("{}.truth.npy", p.file_stem().expect("stem").to_string_lossy()));
     std::fs::copy(truth(recording), truth(dst)).expect("truth sidecar");
-}
-
-/// Keeps every frame handed to it.
-struct Collect(Arc<Mutex<Vec<ClipFrame>>>);
-
-impl FrameSink for Collect {
-    type Error = std::convert::Infallible;
-    fn frame(&mut self, frame: &ClipFrame) -> Result<(), Self::Error> {
-        self.0.lock().expect("frames").push(frame.clone());
-        Ok(())
-    }
-    fn finish(&mut self) -> Result<(), Self::Error> {
-        Ok(())
-    }
 }
 
 /// Every frame of the case's clip, which must run whole.

@@ -255,3 +255,17 @@ pub fn error_chain(e: &dyn std::error::Error) -> String {
     }
     s
 }
+
+/// A clip sink that keeps every frame handed to it.
+pub struct Collect(pub std::sync::Arc<std::sync::Mutex<Vec<cosserat::run::clip::ClipFrame>>>);
+
+impl cosserat::run::clip::FrameSink for Collect {
+    type Error = std::convert::Infallible;
+    fn frame(&mut self, frame: &cosserat::run::clip::ClipFrame) -> Result<(), Self::Error> {
+        self.0.lock().expect("frames").push(frame.clone());
+        Ok(())
+    }
+    fn finish(&mut self) -> Result<(), Self::Error> {
+        Ok(())
+    }
+}
