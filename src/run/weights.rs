@@ -75,7 +75,7 @@ pub fn choose_weights(case: &Case, frames: &[Vec<Vector3<f64>>]) -> Option<Auto>
     let sigma = recording_noise(frames);
     let cap = sp.inverse.weights.lambda_g;
     let calib = &frames[..CALIBRATION_FRAMES.min(frames.len())];
-    let mut search = Search { case, sp, calib, u0: None, states: Vec::new(), solves: 0 };
+    let mut search = Search { case, sp, calib, states: Vec::new(), solves: 0 };
     let (lambda_g, r) = search.run(sigma, cap);
     let chosen = ChosenWeights {
         noise_m: sigma,
@@ -107,9 +107,8 @@ struct Search<'a> {
     case: &'a Case,
     sp: SequenceParams,
     calib: &'a [Vec<Vector3<f64>>],
-    /// frame 0's state of the last successful solve (continuation)
-    u0: Option<DVector<f64>>,
-    /// every successful solve's λg and frame 0's state
+    /// every successful solve's λg and frame 0's state; the last starts the next solve
+    /// (continuation)
     states: Vec<(f64, DVector<f64>)>,
     solves: usize,
 }
@@ -132,7 +131,7 @@ impl Search<'_> {
             &problem,
             &sp,
             self.calib,
-            self.u0.as_ref(),
+            self.states.last().map(|(_, u)| u),
             |_, _| {},
             |rep, sol| {
                 if rep.frame == sp.frame_offset {
@@ -143,10 +142,9 @@ impl Search<'_> {
         );
         match solved {
             Ok(reports) if !reports.is_empty() => {
-                if let Some(u) = &first {
-                    self.states.push((lambda_g, u.clone()));
+                if let Some(u) = first {
+                    self.states.push((lambda_g, u));
                 }
-                self.u0 = first;
                 let mean_p2 = reports.iter().map(|r| r.fit.position.powi(2)).sum::<f64>() / reports.len() as f64;
                 mean_p2.sqrt() * length / 3f64.sqrt()
             }
@@ -197,7 +195,7 @@ impl Search<'_> {
             let c = if fb.is_finite() { b - fb * (b - a) / (fb - fa) } else { 0.5 * (a + b) };
             let r = self.residual(c.exp());
             let fc = f(r);
-            if fc.abs() < best_gap(best.1, sigma) {
+            if fc.abs() < f(best.1).abs() {
                 best = (c.exp(), r);
             }
             if fc.abs() < MATCH.ln() {
@@ -218,14 +216,5 @@ impl Search<'_> {
             }
         }
         best
-    }
-}
-
-/// `|ln(r/σ̂)|`, infinite for a failed solve.
-fn best_gap(r: f64, sigma: f64) -> f64 {
-    if r > 0.0 {
-        (r / sigma).ln().abs()
-    } else {
-        f64::INFINITY
     }
 }

@@ -93,13 +93,7 @@ pub fn run_study(spec: &StudySpec, out: &Path, quick: bool, tick: impl Fn(&str))
             };
             let entries = write_corpus(&corpus, &spec.kymogram, &params)?;
             let recordings: Vec<PathBuf> = entries.iter().map(|e| recording_path(&corpus, &e.name)).collect();
-            let started = Instant::now();
             rows.extend(spline_rows(mesh.nodes, noise_m, params.length_m, &recordings, spec.skip_elements)?);
-            let spline_s = started.elapsed().as_secs_f64();
-            rows.iter_mut()
-                .rev()
-                .take(recordings.len())
-                .for_each(|r| r.frames_per_s = r.frames as f64 / (spline_s / recordings.len() as f64));
             for variant in &spec.variants {
                 let case = spec.variant_case(mesh, variant, &out.join("cases"))?;
                 let runs = out.join("runs").join(&tag).join(&variant.name);
@@ -143,13 +137,16 @@ fn spline_rows(
 ) -> Result<Vec<StudyRow>, StudyError> {
     let mut rows = Vec::new();
     for recording in recordings {
+        let started = Instant::now();
         let (frames, truth) = recording_and_truth(recording)?;
         let errors: Vec<f64> = frames
             .iter()
             .zip(&truth.frames)
             .map(|(f, t)| bending_error(&spline_bending(f, length_m), &truth_bending(t), skip))
             .collect();
-        rows.push(row(nodes, noise_m, SPLINE, recording, &errors));
+        let mut r = row(nodes, noise_m, SPLINE, recording, &errors);
+        r.frames_per_s = r.frames_reconstructed as f64 / started.elapsed().as_secs_f64().max(1e-9);
+        rows.push(r);
     }
     Ok(rows)
 }
