@@ -48,7 +48,7 @@ pub fn run_clip(
     let sp = case.sequence_params().ok_or_else(|| FreeFemError::NotInverse(case.name.clone()))?;
     std::fs::create_dir_all(workdir).map_err(io(workdir))?;
     let frames = clip.positions;
-    let charts = clip_charts(&sp, frames);
+    let charts = clip_charts(&sp, frames, case.mesh.length_m);
     let mut data = String::from("frame,s_m,x_m,y_m,z_m,w\n");
     for (f, x) in frames.iter().enumerate() {
         let w = clip.weights(f);
@@ -94,7 +94,7 @@ pub fn run_clip(
 /// the frames it solved, its failure message and, for a stalled frame, the Rust engine's error.
 pub fn read_clip_run(case: &Case, frames: &[Vec<Vector3<f64>>], workdir: &Path) -> Result<FreeFemFrames, FreeFemError> {
     let sp = case.sequence_params().ok_or_else(|| FreeFemError::NotInverse(case.name.clone()))?;
-    let charts = clip_charts(&sp, frames);
+    let charts = clip_charts(&sp, frames, case.mesh.length_m);
     let frames_out = read_frames(case, sp.frame_offset, frames, &charts, workdir)?;
     let info = read_info(&workdir.join("ff_info.csv")).ok();
     let get = |k: &str| info.as_ref().and_then(|i| i.get(k).copied());

@@ -16,7 +16,7 @@
 //! λg is the cap. Each calibration solve starts frame 0 from the previous solve's frame 0
 //! (continuation in λg). A calibration solve that fails above the first success counts as a fit
 //! that follows the noise (`r < σ̂`); one that fails at the smooth start (too little tracking to
-//! hold frame 0: λg = 1e3 on a 3 µm recording of 33 nodes) moves the start up by 10.
+//! hold frame 0: λg = 1e3 on a 3 µm recording of 33 nodes) moves the start up by 10, and the search then never goes below it.
 use nalgebra::{DVector, Vector3};
 
 use crate::case::{Analysis, Case, WeightsRule};
@@ -114,14 +114,28 @@ struct Search<'a> {
 }
 
 impl Search<'_> {
-    /// `r(λg)` [m], 0 when the solve fails. After a requested stop no solve runs (the clip's
-    /// own solve then stops at its first frame) and the search ends.
+    /// `r(λg)` [m], 0 when the solve fails. The solve continues from the last successful
+    /// one's frame 0; where that fails, it is solved once more from the data guess (a
+    /// continuation start from another λg can lead Newton astray on noisy frames, 10 µm on 128
+    /// nodes, where the guess does not). After a requested stop no solve runs (the clip's own
+    /// solve then stops at its first frame) and the search ends.
     fn residual(&mut self, lambda_g: f64) -> f64 {
         if crate::interrupt::requested() {
             self.solves = MAX_SOLVES;
             return 0.0;
         }
         self.solves += 1;
+        let last = self.states.last().map(|(_, u)| u.clone());
+        match self.attempt(lambda_g, last.as_ref()) {
+            Some(r) => r,
+            None if last.is_some() => self.attempt(lambda_g, None).unwrap_or(0.0),
+            None => 0.0,
+        }
+    }
+
+    /// One calibration solve at `lambda_g` from `u0` (`None`: the data guess): `r(λg)`, or
+    /// `None` when it fails; a success's frame 0 is kept for the next.
+    fn attempt(&mut self, lambda_g: f64, u0: Option<&DVector<f64>>) -> Option<f64> {
         let mut sp = self.sp;
         sp.inverse.weights.lambda_g = lambda_g;
         let problem = self.case.problem();
@@ -131,7 +145,7 @@ impl Search<'_> {
             &problem,
             &sp,
             self.calib,
-            self.states.last().map(|(_, u)| u),
+            u0,
             |_, _| {},
             |rep, sol| {
                 if rep.frame == sp.frame_offset {
@@ -140,16 +154,12 @@ impl Search<'_> {
                 Ok(())
             },
         );
-        match solved {
-            Ok(reports) if !reports.is_empty() => {
-                if let Some(u) = first {
-                    self.states.push((lambda_g, u));
-                }
-                let mean_p2 = reports.iter().map(|r| r.fit.position.powi(2)).sum::<f64>() / reports.len() as f64;
-                mean_p2.sqrt() * length / 3f64.sqrt()
-            }
-            _ => 0.0,
+        let reports = solved.ok().filter(|r| !r.is_empty())?;
+        if let Some(u) = first {
+            self.states.push((lambda_g, u));
         }
+        let mean_p2 = reports.iter().map(|r| r.fit.position.powi(2)).sum::<f64>() / reports.len() as f64;
+        Some(mean_p2.sqrt() * length / 3f64.sqrt())
     }
 
     /// `(λg, r(λg))` by the module doc's rule.
@@ -164,11 +174,14 @@ impl Search<'_> {
         let mut lo = cap * START_RATIO;
         let mut r_lo = self.residual(lo);
         // a failure at the smooth end (too little tracking to hold the frame): up by 10
+        let raised = r_lo == 0.0;
         while r_lo == 0.0 && lo < cap && self.solves < MAX_SOLVES {
             lo = (lo * 10.0).min(cap);
             r_lo = self.residual(lo);
         }
-        while r_lo > 0.0 && f(r_lo) < 0.0 && lo > floor && self.solves < MAX_SOLVES {
+        // down towards a smoother fit only where the smooth start itself solved: below a start
+        // that failed lie only failures
+        while !raised && r_lo > 0.0 && f(r_lo) < 0.0 && lo > floor && self.solves < MAX_SOLVES {
             lo = (lo * 1e-2).max(floor);
             r_lo = self.residual(lo);
         }

@@ -162,19 +162,43 @@ pub fn first_chart(sp: &SequenceParams) -> Chart {
 /// (`None`: the clip's first frame): [`first_chart`] for the first frame and for the global
 /// chart, else the chart whose axis is [`frame_axis`] of the data, signed against `prev`'s
 /// (R4). It depends on the data only, so [`clip_charts`] gives every frame's chart up front.
-pub fn frame_chart(sp: &SequenceParams, prev: Option<&Chart>, x_space: &[Vector3<f64>]) -> Chart {
+pub fn frame_chart(sp: &SequenceParams, prev: Option<&Chart>, x_space: &[Vector3<f64>], length_m: f64) -> Chart {
     match (sp.rotation, prev) {
         (RotationTreatment::GlobalEuler, _) | (_, None) => first_chart(sp),
-        (RotationTreatment::Rebased, Some(c)) => Chart::with_axis(&frame_axis(x_space, Some(&c.axis()))),
+        (RotationTreatment::Rebased, Some(c)) => {
+            Chart::with_axis(&frame_axis(&frame_geometry(x_space, length_m), Some(&c.axis())))
+        }
+    }
+}
+
+/// A frame's noise level over its node spacing above which its chart axis and its data guess
+/// are taken from its smoothed centreline ([`frame_geometry`], `docs/noise.md` N8).
+pub const NOISY_GEOMETRY: f64 = 0.1;
+
+/// The centreline a frame's chart axis ([`frame_chart`]) and data guess ([`data_frame_guess`])
+/// are taken from (`docs/noise.md` N8): the data `x`, or, where their noise level
+/// ([`crate::solve::fit::noise_level`]) exceeds [`NOISY_GEOMETRY`] times the node spacing of a
+/// rod of `length_m`, the knot values of their GCV smoothing spline (`solve::smoothing`). A
+/// noisy chord's direction is noise: at σ = 10 µm on 128 nodes of 1 mm (h = 7.9 µm) the raw
+/// tangents point anywhere, no chart axis keeps away from all of them, and the guess's angles
+/// are noise. The tracking term of (41) still sees the data themselves.
+pub fn frame_geometry(x: &[Vector3<f64>], length_m: f64) -> std::borrow::Cow<'_, [Vector3<f64>]> {
+    let h = length_m / (x.len().max(2) - 1) as f64;
+    if super::fit::noise_level(x) <= NOISY_GEOMETRY * h {
+        return std::borrow::Cow::Borrowed(x);
+    }
+    match super::smoothing::SmoothingSpline::fit_uniform(x, length_m) {
+        Some(s) => std::borrow::Cow::Owned(s.knot_values().to_vec()),
+        None => std::borrow::Cow::Borrowed(x),
     }
 }
 
 /// The chart of every frame of a clip, in order ([`frame_chart`]): what [`solve_sequence`]
 /// uses, for an engine that is handed the charts (the FreeFEM clip driver).
-pub fn clip_charts(sp: &SequenceParams, frames: &[Vec<Vector3<f64>>]) -> Vec<Chart> {
+pub fn clip_charts(sp: &SequenceParams, frames: &[Vec<Vector3<f64>>], length_m: f64) -> Vec<Chart> {
     let mut charts: Vec<Chart> = Vec::with_capacity(frames.len());
     for x in frames {
-        let c = frame_chart(sp, charts.last(), x);
+        let c = frame_chart(sp, charts.last(), x, length_m);
         charts.push(c);
     }
     charts
@@ -412,10 +436,10 @@ pub fn solve_sequence_from<'a>(
         }
         let k = i + sp.frame_offset;
         let start = std::time::Instant::now();
-        let chart = frame_chart(sp, prev.as_ref().map(|(c, _)| c), x_space);
+        let chart = frame_chart(sp, prev.as_ref().map(|(c, _)| c), x_space, problem.mesh.length_m);
         let x_g: Vec<Vector3<f64>> =
             if chart.is_identity() { x_space.clone() } else { x_space.iter().map(|x| chart.to_chart(x)).collect() };
-        let guess = || data_frame_guess(&x_g);
+        let guess = || data_frame_guess(&frame_geometry(&x_g, problem.mesh.length_m));
         // The previous frame's state in this frame's chart (R6); with two previous frames, the
         // linear predictor 2 u_{n−1} − u_{n−2} (the clip is sampled smoothly in time).
         // (Carrying the adjoint as well, instead of Newton's consistent-start solve, sent frame
