@@ -75,7 +75,8 @@ const SQRT_2_OVER_PI: f64 = 0.797_884_560_802_865_4;
 const MAD_TO_SIGMA: f64 = 1.482_602_218_505_602;
 /// Below this `λ`, `m(λ)` of eq. (1) is its limit `2√(2/π)` to within `λ²/3 < 4e-17`.
 const SMALL_LAMBDA: f64 = 1e-8;
-/// Bisection steps of eq. (2): the bracket `[0, P/n]` shrinks by 2⁻⁶⁴, below round-off.
+/// Most steps of eq. (2)'s safeguarded Newton: bisection alone shrinks the bracket `[0, q]` by
+/// 2⁻⁶⁴ in as many, below round-off.
 const BISECTION_STEPS: usize = 64;
 /// Where `erf` switches from its Maclaurin series to the asymptotic series of `erfc`.
 const ERF_SERIES_LIMIT: f64 = 4.0;
@@ -130,8 +131,22 @@ pub fn noisy_chord_mean(lambda: f64) -> f64 {
 /// doc.
 pub const MIN_CHORD_OVER_NOISE: f64 = 7.0;
 
+/// `m'(λ) = (1 − 1/λ²) erf(λ/√2) + √(2/π) e^{−λ²/2}/λ`, the slope of [`noisy_chord_mean`]
+/// (positive for `λ > 0`).
+pub fn noisy_chord_slope(lambda: f64) -> f64 {
+    let l = lambda.max(SMALL_LAMBDA);
+    (1.0 - 1.0 / (l * l)) * erf(l / std::f64::consts::SQRT_2) + SQRT_2_OVER_PI * (-0.5 * l * l).exp() / l
+}
+
+/// From this `λ` on, `m(λ) = λ + 1/λ` in double precision (the rest is below `e^{−λ²/2}`,
+/// 2.6e-18 at 9), and eq. (2) is solved in closed form.
+const CLOSED_FORM_LAMBDA: f64 = 9.0;
+
 /// `ℓ = s m⁻¹(c/s)` of eq. (2) of the module doc [m]: the chord whose expected noisy length
-/// is `c` [m] under noise `s` [m] per coordinate of the chord (`s = 0`: `c`).
+/// is `c` [m] under noise `s` [m] per coordinate of the chord (`s = 0`: `c`). A chord long
+/// against the noise has the closed form `λ = (q + √(q² − 4))/2` of `λ + 1/λ = q`, `q = c/s`;
+/// a shorter one is solved by Newton's method kept inside a bisection bracket (`m` increases,
+/// `m(λ) ≥ λ`: the root lies in `[0, q]`).
 pub fn denoised_chord(c: f64, s: f64) -> f64 {
     if !(s > 0.0 && s.is_finite() && c.is_finite()) {
         return c;
@@ -140,17 +155,28 @@ pub fn denoised_chord(c: f64, s: f64) -> f64 {
     if q <= noisy_chord_mean(0.0) {
         return 0.0;
     }
-    // m(λ) ≥ λ: the root lies in [0, q]
+    let asymptotic = (q > 2.0).then(|| 0.5 * (q + (q * q - 4.0).sqrt()));
+    if let Some(l) = asymptotic.filter(|l| *l >= CLOSED_FORM_LAMBDA) {
+        return s * l;
+    }
     let (mut lo, mut hi) = (0.0, q);
+    let mut l = asymptotic.unwrap_or(0.5 * q);
     for _ in 0..BISECTION_STEPS {
-        let mid = 0.5 * (lo + hi);
-        if noisy_chord_mean(mid) < q {
-            lo = mid;
+        let f = noisy_chord_mean(l) - q;
+        if f < 0.0 {
+            lo = l;
         } else {
-            hi = mid;
+            hi = l;
+        }
+        let newton = l - f / noisy_chord_slope(l);
+        let next = if newton > lo && newton < hi { newton } else { 0.5 * (lo + hi) };
+        let done = (next - l).abs() <= 1e-15 * l || hi - lo <= 1e-15 * hi;
+        l = next;
+        if done {
+            break;
         }
     }
-    s * 0.5 * (lo + hi)
+    s * l
 }
 
 /// The length of one recorded frame, measured and corrected for its noise.

@@ -51,6 +51,24 @@ pub struct ChosenWeights {
     pub calibration_frames: usize,
     /// calibration solves
     pub solves: usize,
+    /// the stabilisation ε of the λd term's rule (I11) the noise asked for, [`noise_stabilisation`]
+    #[serde(default)]
+    pub stabilisation: f64,
+}
+
+/// Largest stabilisation [`noise_stabilisation`] chooses.
+pub const MAX_NOISE_STABILISATION: f64 = 0.1;
+
+/// The stabilisation ε of the λd term's quadrature (I11) for a recording of noise level
+/// `sigma` [m] on `nodes` nodes of a rod of `length_m` [m], when the case asks for `case_eps`:
+/// `max(case_eps, min(σ̂/h, 0.1))` (`docs/noise.md` N10). The one-point rule leaves a zig-zag
+/// mode of the angles that only ε·λd holds (I13); noise excites it, and Newton then crawls along
+/// it with damped steps (3 µm on 33 nodes: 10.5 iterations per frame at ε = 1e-3, 5.4 at 0.1).
+/// Clean recordings (σ̂/h ≈ 0.003 at 33 nodes) keep the case's ε.
+pub fn noise_stabilisation(sigma: f64, nodes: usize, length_m: f64, case_eps: f64) -> f64 {
+    let h = length_m / (nodes.max(2) - 1) as f64;
+    let ratio = if sigma.is_finite() && sigma > 0.0 { sigma / h } else { 0.0 };
+    case_eps.max(ratio.min(MAX_NOISE_STABILISATION))
 }
 
 /// The noise level σ̂ of a recording [m]: the median of the frames' [`noise_level`].
@@ -74,6 +92,9 @@ pub fn choose_weights(case: &Case, frames: &[Vec<Vector3<f64>>]) -> Option<Auto>
     }
     let sigma = recording_noise(frames);
     let cap = sp.inverse.weights.lambda_g;
+    let mut sp = sp;
+    let eps = noise_stabilisation(sigma, frames[0].len(), case.mesh.length_m, sp.inverse.stabilisation);
+    sp.inverse.stabilisation = eps;
     let calib = &frames[..CALIBRATION_FRAMES.min(frames.len())];
     let mut search = Search { case, sp, calib, states: Vec::new(), solves: 0 };
     let (lambda_g, r) = search.run(sigma, cap);
@@ -84,10 +105,12 @@ pub fn choose_weights(case: &Case, frames: &[Vec<Vector3<f64>>]) -> Option<Auto>
         fit_residual_m: r,
         calibration_frames: calib.len(),
         solves: search.solves,
+        stabilisation: eps,
     };
     let mut out = case.clone();
     if let Analysis::Inverse(s) = &mut out.analysis {
         s.params.weights.lambda_g = lambda_g;
+        s.params.stabilisation = eps;
     }
     let start = search.states.into_iter().find(|(g, _)| *g == lambda_g).map(|(_, u)| u);
     Some(Auto { case: out, chosen, start })

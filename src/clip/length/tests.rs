@@ -67,7 +67,14 @@ fn noisy_chord_mean_is_the_mean_of_a_noisy_chord() {
     // m increases, so that eq. (2) has one root; denoised_chord inverts it
     let m: Vec<f64> = (0..200).map(|i| noisy_chord_mean(i as f64 * 0.05)).collect();
     assert!(m.windows(2).all(|w| w[1] > w[0]));
-    for lambda in [0.3, 1.0, 4.0, 12.0] {
+    // the slope of m, against central differences
+    for lambda in [0.05, 0.5, 2.0, 7.0, 9.5] {
+        let e = 1e-6 * lambda;
+        let fd = (noisy_chord_mean(lambda + e) - noisy_chord_mean(lambda - e)) / (2.0 * e);
+        assert!((noisy_chord_slope(lambda) - fd).abs() < 1e-7, "λ = {lambda}: {} vs {fd}", noisy_chord_slope(lambda));
+    }
+    // either side of the closed form's threshold (9) and far beyond it
+    for lambda in [0.3, 1.0, 4.0, 8.9, 9.1, 12.0, 300.0] {
         let s = 2e-6;
         let l = denoised_chord(s * noisy_chord_mean(lambda), s);
         assert!((l / (lambda * s) - 1.0).abs() < 1e-12, "λ = {lambda}: {l:e}");

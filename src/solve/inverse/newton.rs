@@ -304,6 +304,10 @@ fn solve_from(
     let mut next: Option<DVector<f64>> = None;
     // this iteration solves with the last factorisation (a chord step)
     let mut chord = false;
+    // the last step was damped by the line search: the next full step is then tried with its
+    // residual alone (its Jacobian is wasted if the merit rejects it, as after a damped step it
+    // often does)
+    let mut damped = false;
     // relative change of the last step
     let mut previous = f64::INFINITY;
     let mut k = 0;
@@ -367,7 +371,7 @@ fn solve_from(
             // residual comes with the Jacobian (unless a chord step follows), which the next
             // iteration then uses (the same element sums, so the same residual as assembling
             // it there).
-            let with_jacobian = t == 1.0 && !full && !chord_next;
+            let with_jacobian = t == 1.0 && !full && !chord_next && !damped;
             let jacobian = with_jacobian.then_some((&*pattern, values.as_mut_slice(), rows.as_slice()));
             // the last step is taken without its residual where no record needs it
             if skip_residual {
@@ -377,7 +381,7 @@ fn solve_from(
             let r_t = assemble_residual(problem, params, frame, previous_angles, &trial, fixed, jacobian);
             phi_t = merit(&r_t);
             if full || phi_t <= (1.0 - ARMIJO * t) * phi || t <= MIN_STEP {
-                if t == 1.0 && !full {
+                if t == 1.0 && !full && (with_jacobian || chord_next) {
                     next = Some(r_t);
                 }
                 break true;
@@ -393,6 +397,7 @@ fn solve_from(
             continue;
         }
         chord = chord_next && t == 1.0;
+        damped = t < 1.0;
         let u_old = dofs.kkt_state(&big);
         u = dofs.kkt_state(&trial);
         let rel_change = relative_change(&fwd, &u, &u_old);
