@@ -20,6 +20,7 @@ pub mod folder_lock;
 pub mod freefem;
 pub mod freefem_clip;
 pub mod freefem_include;
+pub mod freefem_progress;
 pub mod job;
 pub mod journal;
 pub mod manifest;
