@@ -133,24 +133,62 @@ w("")
 allf = names + derivs + ["c" + c for c in composites]
 w("Vq " + ", ".join("cq" + n for n in allf) + ";   // the container's values (prefix cq)")
 decl = ", ".join("P#" + n for n in allf)
-w(f"macro COEFDECL(P) Ch {decl}; real[int] P#CoefLast(9*coefNq); P#CoefLast = 1e300; //")
-upd = []
-upd.append("{ coefQa[] = coefIa*u; coefQb[] = coefIb*u; coefQg[] = coefIg*u;")
-for c, k in enumerate("123abg"):
-    upd.append(f"cqcD{k}[] = coefD[{c}]*u;")
-upd.append("real[int] coefNow(9*coefNq);")
-for c, v in enumerate(["coefQa", "coefQb", "coefQg"] + ["cqcD" + k for k in "123abg"]):
-    upd.append(f"coefNow({c}*coefNq:{c + 1}*coefNq - 1) = {v}[];")
-upd.append("real[int] coefDiff = coefNow - P#CoefLast;")
-upd.append("if (!(coefDiff.linfty == 0.)) {")
-for n in names:
-    upd.append(f"cq{n} = {formula[n]}(coefQa, coefQb, coefQg); P#{n}[] = coefMap*cq{n}[];")
-for d in derivs:
-    upd.append(f"P#{d}[] = coefMap*cq{d}[];")
-for c in composites:
-    upd.append(f"cqc{c} = {c}F(cq); P#c{c}[] = coefMap*cqc{c}[];")
-upd.append("P#CoefLast = coefNow; } }")
-w("macro COEFUPDATE(P, u) " + " ".join(upd) + " //")
+w(f"macro COEFDECL(P) Ch {decl}; real[int] P#CoefLast(9*coefNq), P#CoefLastQ(3*coefNq); P#CoefLast = 1e300; P#CoefLastQ = 1e300; //")
+
+
+def trig_statements(body, dst):
+    """Array statements that evaluate a rotation formula (a sum of signed products of cos/sin of a, b, c)
+    into the real[int] dst, factor by factor from the left as FreeFEM evaluates the expression."""
+    e = body.strip()
+    assert e[0] == "(" and e[-1] == ")", body
+    e = e[1:-1].strip()
+    terms = re.findall(r"([+-]?)\s*((?:(?:cos|sin)\([abc]\))(?:\*(?:cos|sin)\([abc]\))*)", e)
+    assert "".join(sg + t for sg, t in terms).replace(" ", "") == e.replace(" ", ""), body
+    out = []
+    for k, (sign, term) in enumerate(terms):
+        f = ["coef" + fn[0] + x for fn, x in re.findall(r"(cos|sin)\(([abc])\)", term)]
+        tgt = dst if k == 0 else "coefW"
+        out.append(f"{tgt} = {f[0]};" if len(f) == 1 else f"{tgt} = {f[0]} .* {f[1]};")
+        out += [f"{tgt} = {tgt} .* {g};" for g in f[2:]]
+        if k == 0 and sign == "-":
+            out.append(f"{dst} *= -1.;")
+        elif k > 0:
+            out.append(f"{dst} {sign}= coefW;")
+    return out
+
+
+def update_macro(name, cache, with_state):
+    """COEFUPDATE (every field) or COEFUPDATEQ (the rotation coefficients only): the fields of P at the state u,
+    unless u's angles (and, with_state, derivatives) are those of the last call (the cache P#cache)."""
+    upd = ["{ coefQa[] = coefIa*u; coefQb[] = coefIb*u; coefQg[] = coefIg*u;"]
+    nows = ["coefQa", "coefQb", "coefQg"]
+    if with_state:
+        for c, k in enumerate("123abg"):
+            upd.append(f"cqcD{k}[] = coefD[{c}]*u;")
+        nows += ["cqcD" + k for k in "123abg"]
+    upd.append(f"real[int] coefNow({len(nows)}*coefNq);")
+    for c, v in enumerate(nows):
+        upd.append(f"coefNow({c}*coefNq:{c + 1}*coefNq - 1) = {v}[];")
+    upd.append(f"real[int] coefDiff = coefNow - P#{cache};")
+    upd.append("if (!(coefDiff.linfty == 0.)) {")
+    for x, v in (("a", "a"), ("b", "b"), ("c", "g")):
+        upd.append(f"coefc{x} = cos(coefQ{v}[]); coefs{x} = sin(coefQ{v}[]);")
+    for n in names:
+        upd += trig_statements(macros[formula[n]], "coefV")
+        upd.append(f"cq{n}[] = coefV; P#{n}[] = coefMap*coefV;")
+    if with_state:
+        for d in derivs:
+            upd.append(f"P#{d}[] = coefMap*cq{d}[];")
+        for c in composites:
+            upd.append(f"cqc{c} = {c}F(cq); P#c{c}[] = coefMap*cqc{c}[];")
+    upd.append(f"P#{cache} = coefNow; }} }}")
+    w(f"macro {name}(P, u) " + " ".join(upd) + " //")
+
+
+w("real[int] coefca(coefNq), coefsa(coefNq), coefcb(coefNq), coefsb(coefNq), coefcc(coefNq), coefsc(coefNq);")
+w("real[int] coefV(coefNq), coefW(coefNq);       // a coefficient's values at the points, a product")
+update_macro("COEFUPDATE", "CoefLast", True)
+update_macro("COEFUPDATEQ", "CoefLastQ", False)
 w("")
 w("// the coefficient entries and state quantities read by kinematics.idp (a field of P, or a constant)")
 w("macro DP(P,k) P#cD#k //                      // d_s of the state's unknown k = 1, 2, 3, a, b, g")
