@@ -69,6 +69,27 @@ fn every_case_agrees_between_rust_and_freefem() {
     eprintln!("{compared} cases compared");
 }
 
+/// The whole delta-turn clip (300 frames, Newton per frame) in both engines, every compared row
+/// (per-frame differences, worst frame) within the tolerance `compare` derives for it
+/// (`cosserat compare cases/worm_delta_turn_ld1.toml --frames all`).
+#[test]
+#[ignore = "about 3 min of FreeFEM on 2 cores (0.5 s per frame), over the 2 min cargo test may add (issue 31): run with --ignored"]
+fn whole_delta_turn_clip_agrees_between_rust_and_freefem() {
+    if !common::freefem_required() {
+        return;
+    }
+    let case = Case::from_file(&common::cases_dir().join("worm_delta_turn_ld1.toml")).unwrap_or_else(|e| panic!("{e}"));
+    if !common::worm_data_present(&case.name) {
+        return;
+    }
+    let dir = tempfile::tempdir().expect("tempdir");
+    let opts = CompareOptions { horizon: Horizon::Full, frames: Some(usize::MAX) };
+    let report = compare_case(&case, dir.path(), &opts).unwrap_or_else(|e| panic!("{}", common::error_chain(&e)));
+    let mut failures = Vec::new();
+    common::report_failures(&report, &mut failures);
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
 /// How the certificates of a case were compared.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Agreement {
