@@ -38,7 +38,7 @@ for e in entries:
 names = list(formula)
 # state quantities of kinematics.idp (its macros NAME#F, in the order they depend on each other), evaluated
 # pointwise from the coefficients above and the state's derivatives DP(P, k)
-composites = [n + i for n in ("EPS", "NG", "XN", "KAP", "MG", "TMV") for i in "123"]
+composites = [n + i for n in ("EPS", "NG", "XN", "KAP", "MG", "TMV", "TMR") for i in "123"]
 derivs = ["cD" + k for k in "123abg"]
 out = []
 w = out.append
@@ -104,7 +104,7 @@ w("  matrix T = [I, J, C];")
 w("  T.resize(coefNq, nc*(nel + 1));")
 w("  return T;")
 w("}")
-w("Vq coefQa, coefQb, coefQg;                   // the angles at the points")
+w("Vq cqa, cqb, cqg;                   // the angles at the points")
 w("matrix coefIa, coefIb, coefIg;               // u -> the angles at the points (set by coefSetup)")
 w("matrix[int] coefD(6);                         // u -> d_s of unknown c = 0..5 at the points (set by coefSetup)")
 w("// d_s of unknown c0 at the points: (u[nc (k + 1) + c0] - u[nc k + c0])/h_k on element k")
@@ -160,8 +160,8 @@ def trig_statements(body, dst):
 def update_macro(name, cache, with_state):
     """COEFUPDATE (every field) or COEFUPDATEQ (the rotation coefficients only): the fields of P at the state u,
     unless u's angles (and, with_state, derivatives) are those of the last call (the cache P#cache)."""
-    upd = ["{ coefQa[] = coefIa*u; coefQb[] = coefIb*u; coefQg[] = coefIg*u;"]
-    nows = ["coefQa", "coefQb", "coefQg"]
+    upd = ["{ cqa[] = coefIa*u; cqb[] = coefIb*u; cqg[] = coefIg*u;"]
+    nows = ["cqa", "cqb", "cqg"]
     if with_state:
         for c, k in enumerate("123abg"):
             upd.append(f"cqcD{k}[] = coefD[{c}]*u;")
@@ -172,7 +172,7 @@ def update_macro(name, cache, with_state):
     upd.append(f"real[int] coefDiff = coefNow - P#{cache};")
     upd.append("if (!(coefDiff.linfty == 0.)) {")
     for x, v in (("a", "a"), ("b", "b"), ("c", "g")):
-        upd.append(f"coefc{x} = cos(coefQ{v}[]); coefs{x} = sin(coefQ{v}[]);")
+        upd.append(f"coefc{x} = cos(cq{v}[]); coefs{x} = sin(cq{v}[]);")
     for n in names:
         upd += trig_statements(macros[formula[n]], "coefV")
         upd.append(f"cq{n}[] = coefV; P#{n}[] = coefMap*coefV;")
