@@ -3,8 +3,8 @@
 //! point at Rust's iteration count; clips frame by frame), every row within the tolerance
 //! derived from the case's measured conditioning, and the two engines' residual certificates
 //! (docs/certificate.md) in agreement ([`certificates_agree`]). Here on the short horizon (200
-//! time steps, 40 fixed-point iterations, 3 clip frames); `scripts/compare_all.sh` runs every
-//! case in full.
+//! time steps, 40 fixed-point iterations, 3 clip frames), and one clip whole (the delta turn,
+//! 300 frames); `scripts/compare_all.sh` runs every case in full.
 //!
 //! FreeFEM must be installed (`apt-get install -y freefem++ libfreefem++`). For local work
 //! without it, `COSSERAT_SKIP_FREEFEM=1` skips this file; CI never sets it.
@@ -71,9 +71,9 @@ fn every_case_agrees_between_rust_and_freefem() {
 
 /// The whole delta-turn clip (300 frames, Newton per frame) in both engines, every compared row
 /// (per-frame differences, worst frame) within the tolerance `compare` derives for it
-/// (`cosserat compare cases/worm_delta_turn_ld1.toml --frames all`).
+/// (`cosserat compare cases/worm_delta_turn_ld1.toml --frames all`; FreeFEM ~0.33 s per frame,
+/// docs/results.md "The FreeFEM engine").
 #[test]
-#[ignore = "about 3 min of FreeFEM on 2 cores (0.5 s per frame), over the 2 min cargo test may add (issue 31): run with --ignored"]
 fn whole_delta_turn_clip_agrees_between_rust_and_freefem() {
     if !common::freefem_required() {
         return;
