@@ -16,7 +16,7 @@ use cosserat::solve::modes::modal_model;
 
 mod cli;
 
-use cli::progress::Progress;
+use cli::progress::{FreefemProgress, Progress};
 
 /// Forward Cosserat rods after Wang et al. (Comput. Mech. 71, 2023), in Rust and FreeFEM.
 #[derive(Parser, Debug)]
@@ -328,11 +328,15 @@ fn cmd_compare(
     for n in &folder.notes {
         eprintln!("note: {n}");
     }
-    // Without a terminal, a line every 10 s says the comparison is still running; on a
-    // terminal the engines' own output is left alone.
+    // FreeFEM's frames (a clip) or time steps (a dynamic case) as it runs: a bar on a terminal,
+    // elsewhere a line every 10 s and a final line. Other cases: without a terminal, a line
+    // every 10 s says the comparison is still running.
+    let counted = case.clip().is_some() || matches!(case.analysis, cosserat::case::Analysis::Dynamic(_));
     let on_terminal = std::io::IsTerminal::is_terminal(&std::io::stderr());
-    let pb = Progress::new(&format!("{} compare", case.name), "", 0, on_terminal);
+    let pb = Progress::new(&format!("{} compare", case.name), "", 0, on_terminal || counted);
+    let freefem = FreefemProgress::start(&format!("{} FreeFEM", case.name));
     let result = compare_into(&case, folder.dir(), &target, short, frames);
+    freefem.finish();
     pb.finish();
     let (status, message) = match &result {
         Ok(_) => (Status::Complete, None),

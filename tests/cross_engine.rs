@@ -3,8 +3,8 @@
 //! point at Rust's iteration count; clips frame by frame), every row within the tolerance
 //! derived from the case's measured conditioning, and the two engines' residual certificates
 //! (docs/certificate.md) in agreement ([`certificates_agree`]). Here on the short horizon (200
-//! time steps, 40 fixed-point iterations, 3 clip frames); `scripts/compare_all.sh` runs every
-//! case in full.
+//! time steps, 40 fixed-point iterations, 3 clip frames), and one clip whole (the delta turn,
+//! 300 frames); `scripts/compare_all.sh` runs every case in full.
 //!
 //! FreeFEM must be installed (`apt-get install -y freefem++ libfreefem++`). For local work
 //! without it, `COSSERAT_SKIP_FREEFEM=1` skips this file; CI never sets it.
@@ -67,6 +67,27 @@ fn every_case_agrees_between_rust_and_freefem() {
     }
     assert!(failures.is_empty(), "{failures:#?}");
     eprintln!("{compared} cases compared");
+}
+
+/// The whole delta-turn clip (300 frames, Newton per frame) in both engines, every compared row
+/// (per-frame differences, worst frame) within the tolerance `compare` derives for it
+/// (`cosserat compare cases/worm_delta_turn_ld1.toml --frames all`; FreeFEM ~0.33 s per frame,
+/// docs/results.md "The FreeFEM engine").
+#[test]
+fn whole_delta_turn_clip_agrees_between_rust_and_freefem() {
+    if !common::freefem_required() {
+        return;
+    }
+    let case = Case::from_file(&common::cases_dir().join("worm_delta_turn_ld1.toml")).unwrap_or_else(|e| panic!("{e}"));
+    if !common::worm_data_present(&case.name) {
+        return;
+    }
+    let dir = tempfile::tempdir().expect("tempdir");
+    let opts = CompareOptions { horizon: Horizon::Full, frames: Some(usize::MAX) };
+    let report = compare_case(&case, dir.path(), &opts).unwrap_or_else(|e| panic!("{}", common::error_chain(&e)));
+    let mut failures = Vec::new();
+    common::report_failures(&report, &mut failures);
+    assert!(failures.is_empty(), "{failures:#?}");
 }
 
 /// How the certificates of a case were compared.

@@ -47,8 +47,8 @@ const MUTATIONS: &[Mutation] = &[
     Mutation {
         what: "forward: the third component of d_s x cross n (eq. 35) with the wrong sign",
         file: "kinematics.idp",
-        from: "macro XN3(P) (dx(P#1)*NG2(P) - dx(P#2)*NG1(P)) //",
-        to: "macro XN3(P) (dx(P#1)*NG2(P) + dx(P#2)*NG1(P)) //",
+        from: "macro XN3F(P) (DP(P,1)*NG2(P) - DP(P,2)*NG1(P)) //",
+        to: "macro XN3F(P) (DP(P,1)*NG2(P) + DP(P,2)*NG1(P)) //",
         case: "follower_bend_twist_65",
         horizon: Horizon::Full,
         rows: &["nodewise_rel_diff_displacement"],

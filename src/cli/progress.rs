@@ -186,6 +186,44 @@ impl Drop for Progress {
     }
 }
 
+/// The progress of the FreeFEM runs of a command (`compare`): the frames of a clip or the time
+/// steps of a dynamic run as FreeFEM writes them (`cosserat::io::freefem_progress`), shown as
+/// [`Progress`] shows a command's own (a bar, or lines every 10 s and a final line).
+pub struct FreefemProgress {
+    shown: Arc<Mutex<Option<Progress>>>,
+}
+
+impl FreefemProgress {
+    /// Shows the counts of every FreeFEM run until [`FreefemProgress::finish`], as `label`.
+    pub fn start(label: &str) -> FreefemProgress {
+        use cosserat::io::freefem_progress::{observe, Count, Unit};
+        let shown: Arc<Mutex<Option<Progress>>> = Arc::new(Mutex::new(None));
+        let into = Arc::clone(&shown);
+        let label = label.to_string();
+        observe(Some(Arc::new(move |c: Count| {
+            let unit = match c.unit {
+                Unit::Frames => "frames",
+                Unit::Steps => "time steps",
+            };
+            let mut p = into.lock().unwrap_or_else(|e| e.into_inner());
+            p.get_or_insert_with(|| Progress::new(&label, unit, c.total, false)).set(c.done, c.total);
+        })));
+        FreefemProgress { shown }
+    }
+
+    /// The end: no more counts; the bar is cleared, or the final line printed.
+    pub fn finish(self) {}
+}
+
+impl Drop for FreefemProgress {
+    fn drop(&mut self) {
+        cosserat::io::freefem_progress::observe(None);
+        if let Some(p) = self.shown.lock().unwrap_or_else(|e| e.into_inner()).take() {
+            p.finish();
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -16,6 +16,7 @@ use nalgebra::Vector3;
 
 use super::files::{csv_reader, InputError};
 pub use super::freefem_include::{include_file, ClipInclude, RunOptions};
+use super::freefem_progress::Watch;
 use crate::case::{Analysis, Case};
 use crate::model::chart::Chart;
 use crate::run::{angles_known, Engine, InverseOutput, NodalState, RunResult, SolverStats};
@@ -310,6 +311,7 @@ pub(super) fn execute(
 ) -> Result<(), FreeFemError> {
     let exe = find_executable()?;
     let scripts = script_dir();
+    let script_name = script;
     let script = scripts.join(script);
     if !script.is_file() {
         return Err(FreeFemError::MissingScripts(scripts));
@@ -331,9 +333,16 @@ pub(super) fn execute(
     let log_file = std::fs::File::create(&log).map_err(io(&log))?;
     cmd.stdout(log_file.try_clone().map_err(io(&log))?).stderr(log_file);
     let mut child = cmd.spawn().map_err(io(&script))?;
+    let mut watch = Watch::new(case, script_name, workdir, opts);
     let status = loop {
         if let Some(status) = child.try_wait().map_err(io(&script))? {
+            if let Some(w) = watch.as_mut() {
+                w.poll(true);
+            }
             break status;
+        }
+        if let Some(w) = watch.as_mut() {
+            w.poll(false);
         }
         if crate::interrupt::requested() {
             let _ = child.kill();
