@@ -74,8 +74,8 @@ impl JobEnd {
         }
         if let Some(w) = &run.weights {
             out += &format!(
-                "{name} weights = \"auto\": noise level {:.3e} m per coordinate (median over the frames); lambda_g = {:.3e} (at most {:.1e}): the fit's RMS distance to the data {:.3e} m on the first {} frames ({} calibration solves; docs/noise.md)\n",
-                w.noise_m, w.lambda_g, w.lambda_g_max, w.fit_residual_m, w.calibration_frames, w.solves
+                "{name} weights = \"auto\": noise level {:.3e} m per coordinate (median over the frames); lambda_g = {:.3e} (at most {:.1e}): the fit's RMS distance to the data {:.3e} m on the first {} frames ({} calibration solves); stabilisation {:.3e} (docs/noise.md)\n",
+                w.noise_m, w.lambda_g, w.lambda_g_max, w.fit_residual_m, w.calibration_frames, w.solves, w.stabilisation
             );
         }
         let n = run.reports.len();
