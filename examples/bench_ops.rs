@@ -11,7 +11,7 @@ use cosserat::case::Case;
 use cosserat::io::clip_files::load_clip;
 use cosserat::linalg::LinearSolver;
 use cosserat::solve::inverse::{kkt, measures, newton, Frame};
-use cosserat::solve::sequence::{solve_sequence, FrameSolution};
+use cosserat::solve::sequence::{solve_sequence, FirstStart, FrameSolution};
 use nalgebra::{DVector, Vector3};
 
 fn main() -> Result<()> {
@@ -29,7 +29,7 @@ fn main() -> Result<()> {
         &problem,
         &sp,
         &frames,
-        None,
+        FirstStart::DataGuess,
         |_, _| {},
         |_, f: &FrameSolution| {
             state = Some(f.state.clone());

@@ -7,7 +7,9 @@ use cosserat::model::mesh::{DofMap, Field};
 use cosserat::solve::certificate::DEFAULT_CERTIFICATE_TOLERANCE;
 use cosserat::solve::fit::FitGate;
 use cosserat::solve::inverse::{InverseMethod, InverseParams, Records, Weights, DEFAULT_STABILISATION};
-use cosserat::solve::sequence::{solve_sequence, FrameStart, RotationTreatment, SequenceError, SequenceParams};
+use cosserat::solve::sequence::{
+    solve_sequence, FirstStart, FrameStart, RotationTreatment, SequenceError, SequenceParams,
+};
 use cosserat::solve::statics::{self, Method, StaticParams};
 use cosserat::solve::Problem;
 use nalgebra::{DVector, Vector3};
@@ -79,7 +81,7 @@ fn quasi_static_clip_is_recovered_frame_by_frame() {
         &p,
         &sp,
         &frames,
-        Some(&p.reference_state()),
+        FirstStart::Guess(&p.reference_state()),
         |_, _| {},
         |_, _| {
             streamed += 1;
@@ -146,7 +148,7 @@ fn chart_guard_names_frame_and_node() {
         &p,
         &sp,
         std::slice::from_ref(&x_g),
-        Some(&DVector::from(p.reference_state())),
+        FirstStart::Guess(&DVector::from(p.reference_state())),
         |_, _| {},
         |_, _| Ok(()),
     )
@@ -165,7 +167,8 @@ fn chart_guard_names_frame_and_node() {
     for gauge in [Vector3::x(), -Vector3::x()] {
         let sp = SequenceParams { rotation: RotationTreatment::Rebased, gauge, ..sp };
         let reports =
-            solve_sequence(&p, &sp, std::slice::from_ref(&x_g), None, |_, _| {}, |_, _| Ok(())).expect("rebased chart");
+            solve_sequence(&p, &sp, std::slice::from_ref(&x_g), FirstStart::DataGuess, |_, _| {}, |_, _| Ok(()))
+                .expect("rebased chart");
         eprintln!(
             "rebased, gauge {gauge:?}: {} iterations, x error {:.2e}, min |cos β| {}",
             reports[0].iterations, reports[0].x_err_rel, reports[0].min_cos_beta
@@ -269,7 +272,7 @@ fn rebased_and_global_charts_differ_at_second_order_on_a_3d_clip() {
                 &p,
                 &sp,
                 &frames,
-                None,
+                FirstStart::DataGuess,
                 |_, _| {},
                 |rep, f| {
                     let q: Vec<_> =

@@ -19,7 +19,7 @@ use crate::model::rotation::Angles;
 use crate::solve::inverse::measures::angular_velocity;
 use crate::solve::inverse::Records;
 use crate::solve::sequence::{
-    solve_sequence_from, vector_to_space, ClipData, FrameReport, ResumeFrom, SequenceError, SequenceParams,
+    solve_sequence_from, vector_to_space, ClipData, FirstStart, FrameReport, ResumeFrom, SequenceError, SequenceParams,
 };
 use crate::solve::SolveError;
 
@@ -417,7 +417,7 @@ pub fn run_clip<S: FrameSink>(
                 &problem,
                 &sp,
                 data,
-                frame0_start.take().as_ref(),
+                frame0_start.take().as_ref().map_or(FirstStart::DataGuess, FirstStart::Near),
                 from.take(),
                 |_, _| {},
                 |rep, frame| {

@@ -10,7 +10,7 @@ use super::{Engine, InverseOutput, NodalState, RunError, RunResult, SolverStats}
 use crate::case::Case;
 use crate::model::mesh::Field;
 use crate::solve::inverse::InverseRecord;
-use crate::solve::sequence::{solve_sequence, ClipData, SequenceError};
+use crate::solve::sequence::{solve_sequence, ClipData, FirstStart, SequenceError};
 
 /// One solved frame of a clip.
 #[derive(Clone, Debug)]
@@ -94,7 +94,7 @@ pub fn solve_frames<'a>(case: &Case, data: impl Into<ClipData<'a>>) -> Result<So
         &problem,
         &sp,
         data,
-        None,
+        FirstStart::DataGuess,
         |_, _| {},
         |rep, f| {
             let sol = f.solution;

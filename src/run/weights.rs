@@ -21,7 +21,7 @@ use nalgebra::{DVector, Vector3};
 
 use crate::case::{Analysis, Case, WeightsRule};
 use crate::solve::fit::noise_level;
-use crate::solve::sequence::{solve_sequence, SequenceParams};
+use crate::solve::sequence::{solve_sequence, FirstStart, SequenceParams};
 
 /// Frames of the clip's start on which `r(λg)` is measured.
 pub const CALIBRATION_FRAMES: usize = 3;
@@ -168,7 +168,7 @@ impl Search<'_> {
             &problem,
             &sp,
             self.calib,
-            u0,
+            u0.map_or(FirstStart::DataGuess, FirstStart::Near),
             |_, _| {},
             |rep, sol| {
                 if rep.frame == sp.frame_offset {

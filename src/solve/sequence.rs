@@ -374,9 +374,20 @@ fn continued(
     Ok(sol)
 }
 
-/// Solve every frame of `frames` (positions per node, the mesh's nodes) in order. `u0` is the
-/// initial iterate of the first frame in the chart of the first frame (e.g. [`data_frame_guess`]
-/// of the data in that chart; `None`: that guess). Later frames start from the previous frame's
+/// The initial iterate of a clip's first frame, in the chart of that frame.
+#[derive(Clone, Copy, Debug)]
+pub enum FirstStart<'a> {
+    /// [`data_frame_guess`] of the frame's data (from the fixed point's warm start, I8)
+    DataGuess,
+    /// a guess: the fixed point's warm start runs first (I8)
+    Guess(&'a DVector<f64>),
+    /// a state near the frame's solution (its solution at a nearby λg, `run::weights`): Newton
+    /// directly, as from a previous frame, and the data guess if that fails
+    Near(&'a DVector<f64>),
+}
+
+/// Solve every frame of `frames` (positions per node, the mesh's nodes) in order, the first
+/// from `first` ([`FirstStart`]). Later frames start from the previous frame's
 /// solution re-expressed in their chart (and, if that fails, once more from the data guess) or
 /// from the data guess, as `sp.start` says. `on_frame` receives each converged frame (e.g. to
 /// stream it to disk) and may stop the clip by returning an error message; `on_iteration` sees
@@ -385,11 +396,11 @@ pub fn solve_sequence<'a>(
     problem: &Problem,
     sp: &SequenceParams,
     frames: impl Into<ClipData<'a>>,
-    u0: Option<&DVector<f64>>,
+    first: FirstStart<'_>,
     on_iteration: impl FnMut(usize, &InverseRecord),
     on_frame: impl FnMut(&FrameReport, &FrameSolution) -> Result<(), String>,
 ) -> Result<Vec<FrameReport>, SequenceError> {
-    solve_sequence_from(problem, sp, frames, u0, None, on_iteration, on_frame)
+    solve_sequence_from(problem, sp, frames, first, None, on_iteration, on_frame)
 }
 
 /// Where a clip solve resumes: the number of frames already solved (≥ 1) and the states of
@@ -404,7 +415,8 @@ pub struct ResumeFrom {
     pub prev2: Option<(Chart, DVector<f64>)>,
 }
 
-/// [`solve_sequence`], optionally resumed after the frames of `resume`; the reports returned
+/// [`solve_sequence`] (the first frame from `start0`), optionally resumed after the frames of
+/// `resume`; the reports returned
 /// are those of the frames solved here. Before each frame it checks for a requested stop
 /// (`crate::interrupt`): the clip then ends with [`SolveError::Interrupted`], every frame before
 /// it handed to `on_frame`.
@@ -412,7 +424,7 @@ pub fn solve_sequence_from<'a>(
     problem: &Problem,
     sp: &SequenceParams,
     data: impl Into<ClipData<'a>>,
-    u0: Option<&DVector<f64>>,
+    start0: FirstStart<'_>,
     resume: Option<ResumeFrom>,
     mut on_iteration: impl FnMut(usize, &InverseRecord),
     mut on_frame: impl FnMut(&FrameReport, &FrameSolution) -> Result<(), String>,
@@ -454,8 +466,8 @@ pub fn solve_sequence_from<'a>(
                 None => u1,
             }
         });
-        let first_start = match (&carried, sp.start, u0) {
-            (None, _, Some(u0)) => u0.clone(),
+        let first_start = match (&carried, sp.start, start0) {
+            (None, _, FirstStart::Guess(u0) | FirstStart::Near(u0)) => u0.clone(),
             (Some(u), FrameStart::PreviousFrame, _) => u.clone(),
             _ => guess(),
         };
@@ -476,11 +488,12 @@ pub fn solve_sequence_from<'a>(
         // from the data guess (D13), and the restart is reported; one that does not converge
         // from there either is continued in λg from the smoothed data ([`continued`]).
         let from_previous = i > 0 && sp.start == FrameStart::PreviousFrame;
-        let first_kind = if from_previous { Start::Near } else { Start::Guess };
+        let near = from_previous || (carried.is_none() && matches!(start0, FirstStart::Near(_)));
+        let first_kind = if near { Start::Near } else { Start::Guess };
         let (sol, restarted) = match solve(&first_start, first_kind, lambda_g) {
             Ok(sol) => (sol, false),
             Err(e) if recoverable(&e) => {
-                let again = if from_previous { solve(&guess(), Start::Guess, lambda_g) } else { Err(e) };
+                let again = if near { solve(&guess(), Start::Guess, lambda_g) } else { Err(e) };
                 match again {
                     Ok(sol) => (sol, true),
                     Err(e) if recoverable(&e) => {
