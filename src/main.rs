@@ -459,7 +459,7 @@ fn cmd_audit(
     jobs: Option<usize>,
     quiet: bool,
 ) -> Result<ExitCode> {
-    use cosserat::audit::{run_audit, spec::read_spec, spec_files, AuditOptions, Verdict};
+    use cosserat::audit::{run_audit, spec::read_spec, spec_files, AuditOptions, AuditStatus, Verdict};
     let default = [PathBuf::from("cases/paper")];
     let mut files = Vec::new();
     for p in if paths.is_empty() { &default[..] } else { paths } {
@@ -494,25 +494,36 @@ fn cmd_audit(
     });
     pb.finish();
     let report = match report {
-        Ok(r) if !cosserat::interrupt::requested() => {
-            folder.finish(Status::Complete, None)?;
-            r
-        }
-        Ok(_) => {
-            let kept = cli::outcome::audit_points_kept(folder.dir(), points.load(std::sync::atomic::Ordering::SeqCst));
-            folder.finish(Status::Interrupted, Some(format!("interrupted by a signal: {kept}")))?;
-            eprintln!(
-                "audit interrupted: {kept}; REPORT.md judges the claims on what ran; {} holds run.json saying interrupted",
-                out.display()
-            );
-            return Ok(ExitCode::from(EXIT_INTERRUPTED));
-        }
+        Ok(r) => r,
         Err(e) => {
             let message = format!("{:#}", anyhow::Error::from(e));
             folder.finish(Status::Failed, Some(message.clone()))?;
             anyhow::bail!("audit: {message}; {} holds run.json saying failed", out.display());
         }
     };
+    let judged = format!("{} of {} claims judged", report.claims.len() - report.unjudged(), report.claims.len());
+    match &report.status {
+        AuditStatus::Complete => {
+            folder.finish(Status::Complete, None)?;
+        }
+        AuditStatus::Interrupted => {
+            let kept = cli::outcome::audit_points_kept(folder.dir(), points.load(std::sync::atomic::Ordering::SeqCst));
+            folder.finish(Status::Interrupted, Some(format!("interrupted by a signal: {kept}; {judged}")))?;
+            eprintln!(
+                "audit interrupted: {kept}; {judged}; REPORT.md is headed interrupted and marks the others not judged; {} holds run.json saying interrupted",
+                out.display()
+            );
+            return Ok(ExitCode::from(EXIT_INTERRUPTED));
+        }
+        AuditStatus::Failed(errors) => {
+            let message = format!("{judged}: {}", errors.join("; "));
+            folder.finish(Status::Failed, Some(message.clone()))?;
+            anyhow::bail!(
+                "audit failed: {message}; REPORT.md is headed failed; {} holds run.json saying failed",
+                out.display()
+            );
+        }
+    }
     let counts = report.counts();
     let summary: Vec<String> = Verdict::ALL.iter().zip(counts).map(|(v, n)| format!("{n} {}", v.as_str())).collect();
     println!(
@@ -524,13 +535,13 @@ fn cmd_audit(
         report.wall_time_s,
         out.join("REPORT.md").display()
     );
-    let unexpected: Vec<_> = report.claims.iter().filter(|c| c.verdict != c.claim.expect).collect();
+    let unexpected: Vec<_> = report.claims.iter().filter(|c| c.verdict != Some(c.claim.expect)).collect();
     for c in &unexpected {
         eprintln!(
             "  {} ({}): {} where the spec expects {}; ours: {}",
             c.claim.id,
             c.spec,
-            c.verdict.as_str(),
+            c.verdict.map_or("not judged", |v| v.as_str()),
             c.claim.expect.as_str(),
             c.ours
         );

@@ -6,7 +6,7 @@
 use std::path::Path;
 
 use cosserat::audit::spec::read_spec;
-use cosserat::audit::{run_audit, spec_files, AuditOptions, Verdict};
+use cosserat::audit::{run_audit, spec_files, AuditOptions, AuditStatus, Verdict};
 
 #[test]
 fn quick_audit_verdicts_are_the_recorded_ones() {
@@ -20,13 +20,13 @@ fn quick_audit_verdicts_are_the_recorded_ones() {
     let wrong: Vec<String> = report
         .claims
         .iter()
-        .filter(|c| c.verdict != c.claim.expect)
+        .filter(|c| c.verdict != Some(c.claim.expect))
         .map(|c| {
             format!(
                 "{} ({}): {} ≠ {}; ours: {}",
                 c.claim.id,
                 c.spec,
-                c.verdict.as_str(),
+                c.verdict.map_or("not judged", |v| v.as_str()),
                 c.claim.expect.as_str(),
                 c.ours
             )
@@ -35,7 +35,7 @@ fn quick_audit_verdicts_are_the_recorded_ones() {
     assert!(wrong.is_empty(), "verdicts that changed:\n{}", wrong.join("\n"));
     // Every verdict class occurs: the audit can tell them apart.
     for v in [Verdict::Reproduced, Verdict::Differs, Verdict::Refuted, Verdict::NotComputable] {
-        assert!(report.claims.iter().any(|c| c.verdict == v), "no claim is {}", v.as_str());
+        assert!(report.claims.iter().any(|c| c.verdict == Some(v)), "no claim is {}", v.as_str());
     }
     // Every figure of every spec was drawn, and the report names each.
     let planned: usize = specs.iter().map(|s| s.plots.len()).sum();
@@ -51,7 +51,7 @@ fn quick_audit_verdicts_are_the_recorded_ones() {
     let table: Vec<String> = report
         .claims
         .iter()
-        .map(|c| format!("{}/{}: {} | {}", c.spec, c.claim.id, c.verdict.as_str(), c.ours))
+        .map(|c| format!("{}/{}: {} | {}", c.spec, c.claim.id, c.verdict.map_or("not judged", |v| v.as_str()), c.ours))
         .collect();
     insta::assert_snapshot!("quick_audit_claims", table.join("\n"));
 }
@@ -90,7 +90,7 @@ fn tradeoff_figure_lists_every_point_with_its_time_and_error() {
     let out = tempfile::tempdir().expect("tempdir");
     let opts = AuditOptions { out: out.path().join("aps"), jobs: 1 };
     let report = run_audit(std::slice::from_ref(&spec), true, &opts, |_, _| {}).expect("audit");
-    assert!(report.claims.iter().all(|c| c.verdict == Verdict::Reproduced), "{:?}", report.claims[0].ours);
+    assert!(report.claims.iter().all(|c| c.verdict == Some(Verdict::Reproduced)), "{:?}", report.claims[0].ours);
     let csv = std::fs::read_to_string(opts.out.join("accuracy_per_second/accuracy_per_second.csv")).expect("csv");
     let rows: Vec<Vec<f64>> = csv
         .lines()
@@ -103,4 +103,46 @@ fn tradeoff_figure_lists_every_point_with_its_time_and_error() {
     assert!(rows.iter().all(|r| r[0] > 0.0 && r[1] > 0.0), "{csv}");
     assert!(rows[1][0] < rows[0][0] / 8.0, "{csv}");
     assert!(opts.out.join("accuracy_per_second/accuracy_per_second.svg").is_file());
+}
+
+/// A failed audit (here: a claim reading a metric no point reports, a typo in its spec) writes
+/// REPORT.md headed "failed: N of M claims judged", with the claim not judged and counted
+/// apart, not a verdict drawn from a number that does not exist.
+#[test]
+fn a_failed_audit_says_so_and_judges_nothing_it_could_not() {
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let case = Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/timoshenko_5pct.toml");
+    let spec = format!(
+        r#"title = "failed audit"
+section = "§5.2"
+[runs.t5]
+case = "{}"
+[[claims]]
+id = "good"
+where = "§5.2, Fig. 7"
+statement = "agrees very well"
+paper = "curves on top of each other"
+check = {{ kind = "below", run = "t5", metric = "eq63_curve_rel_error", limit = 0.02 }}
+expect = "reproduced"
+[[claims]]
+id = "typo"
+where = "§5.2, Fig. 7"
+statement = "agrees very well"
+paper = "curves on top of each other"
+check = {{ kind = "below", run = "t5", metric = "eq63_curve_rel_eror", limit = 0.02 }}
+expect = "reproduced"
+"#,
+        case.display()
+    );
+    let path = tmp.path().join("failed.toml");
+    std::fs::write(&path, spec).expect("spec");
+    let spec = read_spec(&path, true).expect("spec");
+    let opts = AuditOptions { out: tmp.path().join("out"), jobs: 1 };
+    let report = run_audit(&[spec], true, &opts, |_, _| {}).expect("report written");
+    assert!(matches!(&report.status, AuditStatus::Failed(e) if e.len() == 1 && e[0].contains("eq63_curve_rel_eror")));
+    assert_eq!((report.unjudged(), report.counts()), (1, [1, 0, 0, 0]));
+    let md = std::fs::read_to_string(opts.out.join("REPORT.md")).expect("REPORT.md");
+    assert!(md.lines().next().unwrap_or_default().ends_with("— failed: 1 of 2 claims judged"), "{md}");
+    let typo = md.lines().find(|l| l.starts_with("| typo |")).expect("typo row");
+    assert!(typo.contains("*not judged*") && !typo.contains("reproduced"), "{typo}");
 }

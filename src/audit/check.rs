@@ -4,7 +4,7 @@
 //! report's text changes only when a result does.
 use super::spec::{Check, Claim, Ref, Selector, Spec};
 use super::{ClaimResult, PointResult, RunResults, Verdict};
-use crate::io::sweep::RunStatus;
+use crate::io::sweep::{RunStatus, NOT_STARTED};
 
 /// How far a check holds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -326,8 +326,40 @@ pub fn history_of(p: &PointResult, name: &str) -> Option<Vec<f64>> {
     })
 }
 
-/// Judge `claim` of `spec` on its runs.
+/// A point that a signal stopped, or kept from starting: its outcome says nothing about the
+/// scheme (its "failed" is not a failure to converge).
+pub fn stopped(p: &PointResult) -> bool {
+    p.outcome.status == RunStatus::Interrupted
+        || p.outcome.error.as_deref().is_some_and(|e| e.contains("interrupted by a signal") || e.contains(NOT_STARTED))
+}
+
+/// Why `check` cannot be judged on `runs`: the points of its runs that a signal stopped.
+fn unjudgeable(check: &Check, runs: &[RunResults]) -> Option<String> {
+    let why: Vec<String> = check
+        .runs()
+        .iter()
+        .filter_map(|name| {
+            let r = runs.iter().find(|r| r.name == *name)?;
+            let n = r.points.iter().filter(|p| stopped(p)).count();
+            (n > 0).then(|| format!("{n} of {} points of run `{name}` stopped or never started", r.points.len()))
+        })
+        .collect();
+    (!why.is_empty()).then(|| format!("not judged: {}", why.join(", ")))
+}
+
+/// Judge `claim` of `spec` on its runs; not judged (verdict `None`) when a point it reads was
+/// stopped by a signal.
 pub fn judge(spec: &Spec, claim: &Claim, runs: &[RunResults]) -> ClaimResult {
+    let result = |verdict, ours| ClaimResult {
+        spec: spec.name.clone(),
+        claim: claim.clone(),
+        verdict,
+        ours,
+        figure: claim.figure.clone(),
+    };
+    if let Some(why) = unjudgeable(&claim.check, runs) {
+        return result(None, why);
+    }
     let (o, mut ours) = evaluate(&claim.check, runs);
     if let Some(s) = &claim.substitute {
         ours = format!("{ours} [on {s}]");
@@ -340,7 +372,7 @@ pub fn judge(spec: &Spec, claim: &Claim, runs: &[RunResults]) -> ClaimResult {
         (Outcome::Partly, _) => Verdict::Differs,
         (Outcome::Fails, _) => claim.if_fails,
     };
-    ClaimResult { spec: spec.name.clone(), claim: claim.clone(), verdict, ours, figure: claim.figure.clone() }
+    result(Some(verdict), ours)
 }
 
 #[cfg(test)]

@@ -58,13 +58,6 @@ pub enum AuditError {
         #[source]
         source: SweepError,
     },
-    #[error("spec {spec}: figure {file}")]
-    Figure {
-        spec: String,
-        file: String,
-        #[source]
-        source: Box<crate::io::OutputError>,
-    },
     #[error(
         "{path}: claim `{claim}`: unknown metric `{metric}`: no point of run `{run}` reports it (its points report: {known})"
     )]
@@ -132,16 +125,38 @@ impl RunResults {
     }
 }
 
-/// A judged claim.
+/// A claim of the report: judged, or not (its points were stopped or never ran).
 #[derive(Clone, Debug)]
 pub struct ClaimResult {
     pub spec: String,
     pub claim: Claim,
-    pub verdict: Verdict,
-    /// our numbers, two significant digits
+    /// the verdict; `None`: not judged (an interrupted or failed audit), `ours` says why
+    pub verdict: Option<Verdict>,
+    /// our numbers, two significant digits (not judged: why)
     pub ours: String,
     /// the figure illustrating the claim, relative to the audit folder
     pub figure: Option<String>,
+}
+
+/// How far an audit got. Only a complete audit's verdicts are the audit's; an unfinished one
+/// judges the claims whose points all finished and marks the others *not judged*.
+#[derive(Clone, Debug, PartialEq)]
+pub enum AuditStatus {
+    Complete,
+    /// stopped by a signal (SIGINT, SIGTERM): points stopped or never started; no figures
+    Interrupted,
+    /// the runs finished but something could not be judged or drawn (the errors)
+    Failed(Vec<String>),
+}
+
+impl AuditStatus {
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            AuditStatus::Complete => "complete",
+            AuditStatus::Interrupted => "interrupted",
+            AuditStatus::Failed(_) => "failed",
+        }
+    }
 }
 
 /// Everything an audit produced.
@@ -151,12 +166,17 @@ pub struct AuditReport {
     pub figures: Vec<String>,
     pub quick: bool,
     pub wall_time_s: f64,
+    pub status: AuditStatus,
 }
 
 impl AuditReport {
-    /// Claims per verdict, in the order of [`Verdict::ALL`].
+    /// Judged claims per verdict, in the order of [`Verdict::ALL`].
     pub fn counts(&self) -> [usize; 4] {
-        Verdict::ALL.map(|v| self.claims.iter().filter(|c| c.verdict == v).count())
+        Verdict::ALL.map(|v| self.claims.iter().filter(|c| c.verdict == Some(v)).count())
+    }
+    /// Claims not judged (their points were stopped, never ran, or the audit failed on them).
+    pub fn unjudged(&self) -> usize {
+        self.claims.iter().filter(|c| c.verdict.is_none()).count()
     }
 }
 
@@ -272,46 +292,71 @@ pub fn run_audit(
             rr.points.push(r);
         }
     }
-    check_metric_names(specs, &results)?;
-    let mut claims = Vec::new();
-    let mut figures = Vec::new();
-    for (spec, runs) in specs.iter().zip(&results) {
-        let written = figures::write_figures(spec, runs, &opts.out.join(&spec.name))
-            .map_err(|(file, source)| AuditError::Figure { spec: spec.name.clone(), file, source: Box::new(source) })?;
-        figures.extend(written.iter().map(|f| format!("{}/{f}", spec.name)));
-        for claim in &spec.claims {
-            claims.push(check::judge(spec, claim, runs));
-        }
-    }
-    let report = AuditReport { claims, figures, quick, wall_time_s: start.elapsed().as_secs_f64() };
+    let interrupted = crate::interrupt::requested();
+    let (claims, figures, failures) = judge_all(specs, &results, &opts.out, interrupted);
+    let status = if interrupted {
+        AuditStatus::Interrupted
+    } else if failures.is_empty() {
+        AuditStatus::Complete
+    } else {
+        AuditStatus::Failed(failures)
+    };
+    let report = AuditReport { claims, figures, quick, wall_time_s: start.elapsed().as_secs_f64(), status };
     report::write_report(&report, &opts.out)?;
     Ok(report)
 }
 
-/// Every metric a claim reads is reported by some point of its runs that has metrics (a typo
-/// in a spec is an error naming it, not a claim judged on a missing number).
-fn check_metric_names(specs: &[Spec], results: &[Vec<RunResults>]) -> Result<(), AuditError> {
+/// Judge every claim of `specs` on `results` and draw every figure (not after an interrupt:
+/// the runs are partial). A claim whose metric no point reports, or that reads a point a
+/// signal stopped, is not judged; the failures (metric typos, figures not written) are
+/// returned as text.
+fn judge_all(
+    specs: &[Spec],
+    results: &[Vec<RunResults>],
+    out: &Path,
+    interrupted: bool,
+) -> (Vec<ClaimResult>, Vec<String>, Vec<String>) {
+    let (mut claims, mut figures, mut failures) = (Vec::new(), Vec::new(), Vec::new());
     for (spec, runs) in specs.iter().zip(results) {
-        for claim in &spec.claims {
-            let Some(metric) = claim.check.metric() else { continue };
-            for run in claim.check.runs() {
-                let Some(rr) = runs.iter().find(|r| r.name == run) else { continue };
-                let reported: Vec<&crate::run::metrics::Metrics> =
-                    rr.points.iter().filter_map(|p| p.outcome.metrics.as_ref()).collect();
-                if reported.is_empty() || reported.iter().any(|m| m.contains_key(metric)) {
-                    continue;
-                }
-                let known: std::collections::BTreeSet<&str> =
-                    reported.iter().flat_map(|m| m.keys().map(String::as_str)).collect();
-                return Err(AuditError::UnknownMetric {
-                    path: spec.path.clone(),
-                    claim: claim.id.clone(),
-                    metric: metric.to_string(),
-                    run: run.to_string(),
-                    known: known.into_iter().collect::<Vec<_>>().join(", "),
-                });
+        if !interrupted {
+            match figures::write_figures(spec, runs, &out.join(&spec.name)) {
+                Ok(written) => figures.extend(written.iter().map(|f| format!("{}/{f}", spec.name))),
+                Err((file, e)) => failures.push(format!("spec {}: figure {file}: {e}", spec.name)),
             }
         }
+        for claim in &spec.claims {
+            let mut c = check::judge(spec, claim, runs);
+            if let Err(e) = check_metric_name(spec, claim, runs) {
+                c.ours = format!("not judged: {e}");
+                c.verdict = None;
+                failures.push(e.to_string());
+            }
+            claims.push(c);
+        }
+    }
+    (claims, figures, failures)
+}
+
+/// The metric a claim reads is reported by some point of its runs that has metrics (a typo
+/// in a spec is an error naming it, not a claim judged on a missing number).
+fn check_metric_name(spec: &Spec, claim: &Claim, runs: &[RunResults]) -> Result<(), AuditError> {
+    let Some(metric) = claim.check.metric() else { return Ok(()) };
+    for run in claim.check.runs() {
+        let Some(rr) = runs.iter().find(|r| r.name == run) else { continue };
+        let reported: Vec<&crate::run::metrics::Metrics> =
+            rr.points.iter().filter_map(|p| p.outcome.metrics.as_ref()).collect();
+        if reported.is_empty() || reported.iter().any(|m| m.contains_key(metric)) {
+            continue;
+        }
+        let known: std::collections::BTreeSet<&str> =
+            reported.iter().flat_map(|m| m.keys().map(String::as_str)).collect();
+        return Err(AuditError::UnknownMetric {
+            path: spec.path.clone(),
+            claim: claim.id.clone(),
+            metric: metric.to_string(),
+            run: run.to_string(),
+            known: known.into_iter().collect::<Vec<_>>().join(", "),
+        });
     }
     Ok(())
 }
