@@ -48,6 +48,12 @@ fn quick_audit_verdicts_are_the_recorded_ones() {
     let csv = std::fs::read_to_string(opts.out.join("report.csv")).expect("report.csv");
     assert_eq!(csv.lines().count(), report.claims.len() + 1);
 
+    // docs/audit.md and the causes of the specs hold no number the run does not give
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let doc = std::fs::read_to_string(root.join("docs/audit.md")).expect("docs/audit.md");
+    check_docs_numbers(&report, &doc, &spec_inputs(&dir));
+    check_causes_have_no_measured_numbers(&report, &spec_inputs(&dir));
+
     let table: Vec<String> = report
         .claims
         .iter()
@@ -145,4 +151,167 @@ expect = "reproduced"
     assert!(md.lines().next().unwrap_or_default().ends_with("— failed: 1 of 2 claims judged"), "{md}");
     let typo = md.lines().find(|l| l.starts_with("| typo |")).expect("typo row");
     assert!(typo.contains("*not judged*") && !typo.contains("reproduced"), "{typo}");
+}
+
+/// The numbers of a text: decimal or scientific tokens (`0.018`, `1.6e-5`, `-2.5e-3`, `361`)
+/// that stand alone: not part of a name (`eq64`, `A5`, `fig05`), a section (`§5.2`), an
+/// equation or reference number in brackets (`(61)`, `[12]`), a figure, remark or table
+/// number. Each with its byte offset and its text.
+fn numbers(text: &str) -> Vec<(usize, String)> {
+    let b = text.as_bytes();
+    let mut out = Vec::new();
+    let mut i = 0;
+    let word = |c: u8| c.is_ascii_alphanumeric() || matches!(c, b'.' | b'_' | b'/' | b'^' | b'#' | b'~');
+    while i < b.len() {
+        let prev = |k: usize| if k == 0 { b' ' } else { b[k - 1] };
+        let sign_ok = prev(i) == b'-' && !word(prev(i - 1)) && prev(i - 1) != b'-';
+        let starts =
+            b[i].is_ascii_digit() && (!word(prev(i)) && prev(i) != b'-' || sign_ok) && !text[..i].ends_with('§');
+        if !starts {
+            i += 1;
+            continue;
+        }
+        let s = if sign_ok { i - 1 } else { i };
+        while i < b.len() && b[i].is_ascii_digit() {
+            i += 1;
+        }
+        if i + 1 < b.len() && b[i] == b'.' && b[i + 1].is_ascii_digit() {
+            i += 1;
+            while i < b.len() && b[i].is_ascii_digit() {
+                i += 1;
+            }
+        }
+        if i + 1 < b.len() && b[i] == b'e' && (b[i + 1].is_ascii_digit() || b[i + 1] == b'-' && i + 2 < b.len()) {
+            let mut j = i + 1 + usize::from(b[i + 1] == b'-');
+            if j < b.len() && b[j].is_ascii_digit() {
+                while j < b.len() && b[j].is_ascii_digit() {
+                    j += 1;
+                }
+                i = j;
+            }
+        }
+        let before = text[..s].trim_end();
+        let integer = text[s..i].bytes().all(|c| c.is_ascii_digit());
+        let bracketed = integer
+            && ((before.ends_with('(') && text[i..].starts_with(')'))
+                || (before.ends_with('[') && text[i..].starts_with(']')));
+        let labelled = ["Fig.", "Figs.", "Figure", "Remark", "Table", "eq.", "Eq.", "issue", "frames", "Appendix"]
+            .iter()
+            .any(|w| before.ends_with(w));
+        let continues = i < b.len() && (b[i].is_ascii_alphabetic() && !text[i..].starts_with("e ") || b[i] == b'_');
+        if !(bracketed || labelled || continues) {
+            out.push((s, text[s..i].to_string()));
+        }
+    }
+    out
+}
+
+/// Does `shown` (our number as the report prints it) agree with `doc` (the number as
+/// docs/audit.md writes it) within the rounding of both (half a unit of the last digit of each)?
+fn same_within_rounding(doc: &str, shown: &str) -> bool {
+    let half_unit = |s: &str| {
+        let (mantissa, exp) = s.split_once('e').map_or((s, 0), |(m, e)| (m, e.parse::<i32>().unwrap_or(0)));
+        let decimals = mantissa.split_once('.').map_or(0, |(_, d)| d.len() as i32);
+        0.5 * 10f64.powi(exp - decimals)
+    };
+    match (doc.parse::<f64>(), shown.parse::<f64>()) {
+        (Ok(d), Ok(o)) => (d.abs() - o.abs()).abs() <= half_unit(doc) + half_unit(shown) + 1e-12 * d.abs(),
+        _ => false,
+    }
+}
+
+/// Every number of docs/audit.md comes from the quick audit or from the specs: a number the
+/// audit measures is written `NUMBER<!--q:ID-->` and must agree, within the rounding of both,
+/// with a number of claim ID's "ours" in this audit; any other number must be an input of the
+/// specs (a grid value, a limit, a weight, a count the paper gives) or a small count (≤ 10).
+/// So the document cannot keep a number the run no longer gives.
+fn check_docs_numbers(report: &cosserat::audit::AuditReport, doc: &str, specs_text: &str) {
+    let inputs: Vec<f64> = numbers(specs_text).iter().filter_map(|(_, n)| n.parse::<f64>().ok()).collect();
+    let mut problems = Vec::new();
+    let mut tagged = 0;
+    for (at, n) in numbers(doc) {
+        let tag = doc[at + n.len()..].strip_prefix("<!--q:").and_then(|t| t.split_once("-->")).map(|(id, _)| id);
+        match tag {
+            Some(id) => {
+                tagged += 1;
+                let Some(c) =
+                    report.claims.iter().find(|c| c.claim.id == id || format!("{}/{}", c.spec, c.claim.id) == id)
+                else {
+                    problems.push(format!("{n}: no claim `{id}` in the quick audit"));
+                    continue;
+                };
+                if !numbers(&c.ours).iter().any(|(_, o)| same_within_rounding(&n, o)) {
+                    problems.push(format!("{n} (claim {id}): the quick audit gives {}", c.ours));
+                }
+            }
+            None => {
+                let v: f64 = n.parse().unwrap_or(f64::NAN);
+                let input = inputs.iter().any(|x| (x.abs() - v.abs()).abs() <= 1e-9 * v.abs().max(1e-300));
+                if !(input || (v.fract() == 0.0 && v.abs() <= 10.0)) {
+                    let line = doc[..at].lines().count();
+                    problems.push(format!("line {line}: {n} is neither tagged <!--q:ID--> nor an input of the specs"));
+                }
+            }
+        }
+    }
+    // every tag follows a number (a tag after a word would check nothing)
+    assert_eq!(tagged, doc.matches("<!--q:").count(), "a <!--q:ID--> tag of docs/audit.md follows no number");
+    assert!(problems.is_empty(), "docs/audit.md:\n{}", problems.join("\n"));
+}
+
+/// The text of the specs' inputs: every line of `cases/paper/*.toml` but comments and the
+/// texts written by us about results (`cause`, `not_computable`, `substitute`, `partial`).
+fn spec_inputs(dir: &Path) -> String {
+    let mut text = String::new();
+    for f in spec_files(dir).expect("specs") {
+        for line in std::fs::read_to_string(&f).expect("spec").lines() {
+            let l = line.trim_start();
+            let ours = ["cause", "not_computable", "substitute", "partial", "scheme"]
+                .iter()
+                .any(|k| l.starts_with(&format!("{k} =")));
+            if !l.starts_with('#') && !ours {
+                text.push_str(line);
+                text.push('\n');
+            }
+        }
+    }
+    text
+}
+
+/// A cause text of a spec explains; it does not restate a measurement (which the next run may
+/// change: issue 30, A8). Its numbers are the specs' inputs or small counts; our numbers are
+/// in the row's "ours".
+fn check_causes_have_no_measured_numbers(report: &cosserat::audit::AuditReport, inputs: &str) {
+    let allowed: Vec<f64> = numbers(inputs).iter().filter_map(|(_, n)| n.parse::<f64>().ok()).collect();
+    let mut problems = Vec::new();
+    for c in &report.claims {
+        for text in c.claim.cause.iter() {
+            for (_, n) in numbers(text) {
+                let v: f64 = n.parse().unwrap_or(f64::NAN);
+                let ok = allowed.iter().any(|x| (x.abs() - v.abs()).abs() <= 1e-9 * v.abs().max(1e-300))
+                    || (v.fract() == 0.0 && v.abs() <= 10.0);
+                if !ok {
+                    problems.push(format!("{}/{}: {n} in \"{text}\"", c.spec, c.claim.id));
+                }
+            }
+        }
+    }
+    assert!(problems.is_empty(), "numbers in the causes of the specs that are not inputs:\n{}", problems.join("\n"));
+}
+
+#[test]
+fn numbers_are_found_and_compared_within_their_rounding() {
+    let found: Vec<String> = numbers(
+        "eq64-2 at §5.2 (61), Fig. 20, [1e-14]: 0.018 and -2.5e-3, A5, 361 iterations, [12], fig05.svg, 1e-3 I",
+    )
+    .into_iter()
+    .map(|(_, n)| n)
+    .collect();
+    assert_eq!(found, ["1e-14", "0.018", "-2.5e-3", "361", "1e-3"]);
+    assert!(same_within_rounding("0.018", "0.018"));
+    assert!(same_within_rounding("1.6e-5", "1.64e-5"));
+    assert!(!same_within_rounding("1.6e-5", "1.1e-5"));
+    assert!(!same_within_rounding("0.018", "0.039"));
+    assert!(same_within_rounding("360", "361"));
+    assert!(!same_within_rounding("18", "4"));
 }
