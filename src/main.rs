@@ -526,9 +526,10 @@ fn cmd_audit(
     }
     let counts = report.counts();
     let summary: Vec<String> = Verdict::ALL.iter().zip(counts).map(|(v, n)| format!("{n} {}", v.as_str())).collect();
+    let ours = report.claims.iter().filter(|c| c.claim.ours).count();
     println!(
-        "{} claims of {} specs: {}; {} figures; {:.0} s; wrote {}",
-        report.claims.len(),
+        "{} claims of the paper and {ours} checks of ours in {} specs: {}; {} figures; {:.0} s; wrote {}",
+        report.claims.len() - ours,
         specs.len(),
         summary.join(", "),
         report.figures.len(),

@@ -315,3 +315,60 @@ fn numbers_are_found_and_compared_within_their_rounding() {
     assert!(same_within_rounding("360", "361"));
     assert!(!same_within_rounding("18", "4"));
 }
+
+/// A check weaker than the paper's words (`partial`) yields at best "differs": a spec that
+/// expects more is refused when read, and a partial check that holds is judged "differs";
+/// a statement with our words inside the quotation ("(here: …)") is refused; a check of ours
+/// (`ours = true`) is counted apart from the paper's claims.
+#[test]
+fn partial_checks_and_our_words_are_kept_apart_from_the_paper() {
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let case = Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/timoshenko_5pct.toml");
+    let spec = |expect: &str, statement: &str, extra: &str| {
+        format!(
+            r#"title = "partial"
+section = "§5.2"
+[runs.t5]
+case = "{}"
+[[claims]]
+id = "c"
+where = "§5.2, Fig. 7"
+statement = "{statement}"
+paper = "curves on top of each other"
+check = {{ kind = "below", run = "t5", metric = "eq63_curve_rel_error", limit = 0.02 }}
+expect = "{expect}"
+partial = "the tip only"
+cause = "partial"
+[[claims]]
+id = "o"
+where = "§5.2, Fig. 7"
+statement = "agrees very well"
+paper = "ours"
+check = {{ kind = "below", run = "t5", metric = "eq63_curve_rel_error", limit = 0.02 }}
+expect = "reproduced"
+ours = true
+{extra}"#,
+            case.display()
+        )
+    };
+    let read = |text: String| {
+        let path = tmp.path().join("p.toml");
+        std::fs::write(&path, text).expect("spec");
+        read_spec(&path, true)
+    };
+    let err = read(spec("reproduced", "agrees very well", "")).err().expect("refused");
+    assert!(err.to_string().contains("at best \"differs\""), "{err}");
+    let err = read(spec("differs", "agrees very well (here: 2 %)", "")).err().expect("refused");
+    assert!(err.to_string().contains("verbatim"), "{err}");
+    let spec = read(spec("differs", "agrees very well", "")).expect("spec");
+    let opts = AuditOptions { out: tmp.path().join("out"), jobs: 1 };
+    let report = run_audit(&[spec], true, &opts, |_, _| {}).expect("audit");
+    // the same check, which holds (fig7-5pct): partial → differs; ours → reproduced, apart
+    assert_eq!(report.claims[0].verdict, Some(Verdict::Differs), "{}", report.claims[0].ours);
+    assert!(report.claims[0].ours.contains("[partial check: the tip only]"), "{}", report.claims[0].ours);
+    assert_eq!(report.claims[1].verdict, Some(Verdict::Reproduced));
+    assert_eq!((report.counts(), report.our_counts()), ([0, 1, 0, 0], [1, 0, 0, 0]));
+    let md = std::fs::read_to_string(opts.out.join("REPORT.md")).expect("REPORT.md");
+    let ours_table = md.split("## Our checks").nth(1).expect("a table of our checks");
+    assert!(ours_table.contains("| o |") && !ours_table.contains("| c |"), "{md}");
+}

@@ -11,6 +11,11 @@
 //!   and ‖l‖/‖l_design‖, L² norms over the rod, the design the loads of the `[data]` solve, and
 //!   `force_to_design_orders`, `torque_to_design_orders`: |log10| of those ratios (orders of
 //!   magnitude apart);
+//! - `force_to_design_orders_inner`, `torque_to_design_orders_inner`: the same over the nodes
+//!   without [`INNER_SKIP_ELEMENTS`] at each end, the rule of the curvature rows (the clamp's
+//!   spike in the first elements is not the distribution of Fig. 15), RMS over those nodes;
+//! - `torque_max_abs_inner_n_m_per_m`: max |l| = |α̂|/λl over the same nodes (eq. 64,
+//!   finding (2): "the control torque l = δα/λl always has a magnitude of 10⁻⁷");
 //! - clip runs ([`ClipSeries`]): RMS of the recovered κ1, κ2, κ3 and of the bending
 //!   `√(κ1² + κ2²)` over frames and inner elements [1/m] (Figs. 17, 23, 25), and the lag in
 //!   frames of the bending wave between s = L/4 and 3L/4 (> 0: from s = 0 towards s = L).
@@ -103,10 +108,40 @@ pub fn derived_metrics(case: &Case, run: Option<&RunResult>, series: Option<&Cli
                 m.insert("force_to_design_orders".into(), (fc / f).log10().abs());
                 m.insert("torque_to_design_orders".into(), (lc / l).log10().abs());
             }
+            m.extend(inner_control_metrics(case, r));
         }
     }
     if let Some(s) = series {
         m.extend(clip_series_metrics(s));
+    }
+    m
+}
+
+/// The controls f = x̂/λf, l = α̂/λl of an inverse run at the nodes without
+/// [`INNER_SKIP_ELEMENTS`] at each end (eq. 61): max |l|, and against the design loads of a
+/// synthetic case's `[data]` solve the orders of magnitude of the RMS ratios (Fig. 15).
+fn inner_control_metrics(case: &Case, r: &RunResult) -> Metrics {
+    let mut m = Metrics::new();
+    let Some(inv) = r.inverse.as_ref() else { return m };
+    let n = r.nodes.s.len();
+    if n <= 2 * INNER_SKIP_ELEMENTS + 1 {
+        return m;
+    }
+    let inner = INNER_SKIP_ELEMENTS..n - INNER_SKIP_ELEMENTS;
+    let l_max = inv.ahat[inner.clone()].iter().map(|a| a.norm() / inv.lambda_l).fold(0.0, f64::max);
+    m.insert("torque_max_abs_inner_n_m_per_m".into(), l_max);
+    let Some(data) = case.data_case() else { return m };
+    let rms = |v: &mut dyn Iterator<Item = f64>| {
+        let (sum, count) = v.fold((0.0, 0usize), |(a, c), x| (a + x * x, c + 1));
+        (sum / count.max(1) as f64).sqrt()
+    };
+    let design = |i: usize| data.loads.distributed(r.nodes.s[i], 0.0);
+    let f = rms(&mut inner.clone().map(|i| inv.xhat[i].norm() / inv.lambda_f));
+    let l = rms(&mut inner.clone().map(|i| inv.ahat[i].norm() / inv.lambda_l));
+    let (fd, ld) = (rms(&mut inner.clone().map(|i| design(i).0.norm())), rms(&mut inner.map(|i| design(i).1.norm())));
+    if fd > 0.0 && ld > 0.0 {
+        m.insert("force_to_design_orders_inner".into(), (f / fd).log10().abs());
+        m.insert("torque_to_design_orders_inner".into(), (l / ld).log10().abs());
     }
     m
 }

@@ -170,9 +170,14 @@ pub struct AuditReport {
 }
 
 impl AuditReport {
-    /// Judged claims per verdict, in the order of [`Verdict::ALL`].
+    /// Judged claims of the paper per verdict, in the order of [`Verdict::ALL`] (our own
+    /// checks, `ours = true`, are counted apart: [`AuditReport::our_counts`]).
     pub fn counts(&self) -> [usize; 4] {
-        Verdict::ALL.map(|v| self.claims.iter().filter(|c| c.verdict == Some(v)).count())
+        Verdict::ALL.map(|v| self.claims.iter().filter(|c| !c.claim.ours && c.verdict == Some(v)).count())
+    }
+    /// Judged checks of ours per verdict.
+    pub fn our_counts(&self) -> [usize; 4] {
+        Verdict::ALL.map(|v| self.claims.iter().filter(|c| c.claim.ours && c.verdict == Some(v)).count())
     }
     /// Claims not judged (their points were stopped, never ran, or the audit failed on them).
     pub fn unjudged(&self) -> usize {
