@@ -151,6 +151,14 @@ enum Command {
         /// Do not show progress (a bar on a terminal, else a line every 10 s)
         #[arg(long)]
         quiet: bool,
+        /// Clip points keep their per-node fields as one compact fields.npz and their own
+        /// figures [default: their tables only, so that the full audit stays within 200 MB]
+        #[arg(long, conflicts_with = "vtk")]
+        fields: bool,
+        /// Clip points keep fields.csv, curvature.csv, ParaView VTK files and their figures
+        /// (several GB for the full audit)
+        #[arg(long)]
+        vtk: bool,
     },
     /// Run a clip case over many recordings (here, or as a Slurm job array with --slurm).
     Batch(cli::BatchArgs),
@@ -243,7 +251,14 @@ fn dispatch(cli: Cli) -> Result<ExitCode> {
         Command::Sweep { case, set, out, force, limits, jobs, quiet } => {
             cmd_sweep(&case, &set, out, force, limits, jobs, quiet)
         }
-        Command::Audit { specs, quick, out, force, jobs, quiet } => cmd_audit(&specs, quick, out, force, jobs, quiet),
+        Command::Audit { specs, quick, out, force, jobs, quiet, fields, vtk } => {
+            let fields = match (fields, vtk) {
+                (_, true) => cosserat::audit::PointFields::Vtk,
+                (true, _) => cosserat::audit::PointFields::Compact,
+                _ => cosserat::audit::PointFields::Tables,
+            };
+            cmd_audit(&specs, quick, out, force, jobs, quiet, fields)
+        }
         Command::Batch(a) => cli::cmd_batch(a),
         Command::BatchTask(a) => cli::cmd_batch_task(a),
         Command::Gather { out } => cli::cmd_gather(&out),
@@ -458,6 +473,7 @@ fn cmd_audit(
     force: bool,
     jobs: Option<usize>,
     quiet: bool,
+    fields: cosserat::audit::PointFields,
 ) -> Result<ExitCode> {
     use cosserat::audit::{run_audit, spec::read_spec, spec_files, AuditOptions, AuditStatus, Verdict};
     let default = [PathBuf::from("cases/paper")];
@@ -486,7 +502,7 @@ fn cmd_audit(
     let folder = RunFolder::begin(&out, manifest, Mode::Fresh { force })
         .with_context(|| format!("audit: output folder {}", out.display()))?;
     let pb = Progress::new(if quick { "audit (quick)" } else { "audit" }, "points", 0, quiet);
-    let opts = AuditOptions { out: folder.dir().to_path_buf(), jobs: jobs.unwrap_or(0) };
+    let opts = AuditOptions { out: folder.dir().to_path_buf(), jobs: jobs.unwrap_or(0), fields };
     let points = std::sync::atomic::AtomicUsize::new(0);
     let report = run_audit(&specs, quick, &opts, |done, total| {
         points.store(total, std::sync::atomic::Ordering::SeqCst);
@@ -528,12 +544,13 @@ fn cmd_audit(
     let summary: Vec<String> = Verdict::ALL.iter().zip(counts).map(|(v, n)| format!("{n} {}", v.as_str())).collect();
     let ours = report.claims.iter().filter(|c| c.claim.ours).count();
     println!(
-        "{} claims of the paper and {ours} checks of ours in {} specs: {}; {} figures; {:.0} s; wrote {}",
+        "{} claims of the paper and {ours} checks of ours in {} specs: {}; {} figures; {:.0} s; {:.1} MB; wrote {}",
         report.claims.len() - ours,
         specs.len(),
         summary.join(", "),
         report.figures.len(),
         report.wall_time_s,
+        report.bytes as f64 / 1e6,
         out.join("REPORT.md").display()
     );
     let unexpected: Vec<_> = report.claims.iter().filter(|c| c.verdict != Some(c.claim.expect)).collect();

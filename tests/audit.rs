@@ -14,7 +14,7 @@ fn quick_audit_verdicts_are_the_recorded_ones() {
     let specs: Vec<_> = spec_files(&dir).expect("specs").iter().map(|f| read_spec(f, true).expect("spec")).collect();
     assert!(specs.len() >= 5, "the audit covers §5.1, §5.2 (three specs) and §6");
     let out = tempfile::tempdir().expect("tempdir");
-    let opts = AuditOptions { out: out.path().join("audit"), jobs: 0 };
+    let opts = AuditOptions { out: out.path().join("audit"), jobs: 0, fields: Default::default() };
     let report = run_audit(&specs, true, &opts, |_, _| {}).expect("audit");
 
     let wrong: Vec<String> = report
@@ -47,7 +47,20 @@ fn quick_audit_verdicts_are_the_recorded_ones() {
     }
     let csv = std::fs::read_to_string(opts.out.join("report.csv")).expect("report.csv");
     assert_eq!(csv.lines().count(), report.claims.len() + 1);
+    // Size: clip points keep their tables only (issue 30: the quick audit wrote 218 MB, the
+    // full one 2.9 GB, of per-node fields and VTK); the report prints time and size.
+    assert!(report.bytes <= cosserat::audit::FULL_AUDIT_BUDGET_BYTES / 4, "quick audit: {} bytes", report.bytes);
+    assert_eq!(report.bytes, cosserat::audit::folder_bytes(&opts.out) - (md.len() + csv.len()) as u64);
+    assert!(md.contains(&format!("{:.1} MB in this folder", report.bytes as f64 / 1e6)), "{md}");
 
+    // The claims inventory of §5–6 names only rows the audit has, and every claim of the paper
+    // judges some sentence of it; the report shows its coverage.
+    let cov = report.coverage.as_ref().expect("cases/paper/inventory.csv").as_ref().expect("inventory read");
+    assert!(cov.dangling.is_empty(), "inventory rows the audit does not have: {:?}", cov.dangling);
+    assert!(cov.unlisted.is_empty(), "rows judging no sentence of the inventory: {:?}", cov.unlisted);
+    let [rows, not_checkable, no_row] = cov.counts();
+    assert_eq!(rows + not_checkable + no_row, cov.entries.len());
+    assert!(md.contains(&format!("**{rows} are judged by rows above, {not_checkable} are not checkable here, {no_row} are checkable but have no row yet**")), "{md}");
     // docs/audit.md and the causes of the specs hold no number the run does not give
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let doc = std::fs::read_to_string(root.join("docs/audit.md")).expect("docs/audit.md");
@@ -69,7 +82,7 @@ fn audit_folder_is_replaced_whole_or_refused() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/paper");
     let spec = read_spec(&dir.join("fig07_timoshenko.toml"), true).expect("spec");
     let out = tempfile::tempdir().expect("tempdir");
-    let opts = AuditOptions { out: out.path().join("a"), jobs: 1 };
+    let opts = AuditOptions { out: out.path().join("a"), jobs: 1, fields: Default::default() };
     run_audit(std::slice::from_ref(&spec), true, &opts, |_, _| {}).expect("first audit");
     let stale = opts.out.join("fig07_timoshenko/stale.txt");
     std::fs::write(&stale, "from an older audit").expect("write");
@@ -79,9 +92,14 @@ fn audit_folder_is_replaced_whole_or_refused() {
     let foreign = out.path().join("mine");
     std::fs::create_dir_all(&foreign).expect("mkdir");
     std::fs::write(foreign.join("thesis.tex"), "keep me").expect("write");
-    let err = run_audit(&[spec], true, &AuditOptions { out: foreign.clone(), jobs: 1 }, |_, _| {})
-        .err()
-        .expect("a foreign folder is refused");
+    let err = run_audit(
+        &[spec],
+        true,
+        &AuditOptions { out: foreign.clone(), jobs: 1, fields: Default::default() },
+        |_, _| {},
+    )
+    .err()
+    .expect("a foreign folder is refused");
     assert!(err.to_string().contains("not an audit folder"), "{err}");
     assert!(foreign.join("thesis.tex").is_file());
 }
@@ -94,7 +112,7 @@ fn tradeoff_figure_lists_every_point_with_its_time_and_error() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/bench/accuracy_per_second.toml");
     let spec = read_spec(&path, true).expect("spec");
     let out = tempfile::tempdir().expect("tempdir");
-    let opts = AuditOptions { out: out.path().join("aps"), jobs: 1 };
+    let opts = AuditOptions { out: out.path().join("aps"), jobs: 1, fields: Default::default() };
     let report = run_audit(std::slice::from_ref(&spec), true, &opts, |_, _| {}).expect("audit");
     assert!(report.claims.iter().all(|c| c.verdict == Some(Verdict::Reproduced)), "{:?}", report.claims[0].ours);
     let csv = std::fs::read_to_string(opts.out.join("accuracy_per_second/accuracy_per_second.csv")).expect("csv");
@@ -143,7 +161,7 @@ expect = "reproduced"
     let path = tmp.path().join("failed.toml");
     std::fs::write(&path, spec).expect("spec");
     let spec = read_spec(&path, true).expect("spec");
-    let opts = AuditOptions { out: tmp.path().join("out"), jobs: 1 };
+    let opts = AuditOptions { out: tmp.path().join("out"), jobs: 1, fields: Default::default() };
     let report = run_audit(&[spec], true, &opts, |_, _| {}).expect("report written");
     assert!(matches!(&report.status, AuditStatus::Failed(e) if e.len() == 1 && e[0].contains("eq63_curve_rel_eror")));
     assert_eq!((report.unjudged(), report.counts()), (1, [1, 0, 0, 0]));
@@ -361,7 +379,7 @@ ours = true
     let err = read(spec("differs", "agrees very well (here: 2 %)", "")).err().expect("refused");
     assert!(err.to_string().contains("verbatim"), "{err}");
     let spec = read(spec("differs", "agrees very well", "")).expect("spec");
-    let opts = AuditOptions { out: tmp.path().join("out"), jobs: 1 };
+    let opts = AuditOptions { out: tmp.path().join("out"), jobs: 1, fields: Default::default() };
     let report = run_audit(&[spec], true, &opts, |_, _| {}).expect("audit");
     // the same check, which holds (fig7-5pct): partial → differs; ours → reproduced, apart
     assert_eq!(report.claims[0].verdict, Some(Verdict::Differs), "{}", report.claims[0].ours);

@@ -6,6 +6,7 @@
 //! paper's panels and [`report`] writes `REPORT.md` and `report.csv`.
 pub mod check;
 pub mod figures;
+pub mod inventory;
 pub mod measures;
 pub mod report;
 pub mod spec;
@@ -16,6 +17,7 @@ use rayon::prelude::*;
 use serde::Deserialize;
 
 use crate::case::sweep::{product, Point, SweepError};
+use crate::io::compact::OutputFormat;
 use crate::io::sweep::{point_manifest, run_clip_point, run_point, SweepOutcome};
 use measures::{derived_metrics, ClipRecorder, ClipSeries};
 use spec::{Claim, RunSpec, Spec};
@@ -167,6 +169,13 @@ pub struct AuditReport {
     pub quick: bool,
     pub wall_time_s: f64,
     pub status: AuditStatus,
+    /// size of the audit folder when the report was written [bytes]
+    pub bytes: u64,
+    /// what the clip points kept
+    pub fields: PointFields,
+    /// the claims inventory beside the specs (`inventory.csv`) against the rows, if there is
+    /// one; `Err`: it could not be read (the report says so)
+    pub coverage: Option<Result<inventory::Coverage, String>>,
 }
 
 impl AuditReport {
@@ -192,6 +201,56 @@ pub struct AuditOptions {
     pub out: PathBuf,
     /// parallel runs (0: one per core)
     pub jobs: usize,
+    /// what a clip point keeps beside its tables ([`PointFields`])
+    pub fields: PointFields,
+}
+
+/// What a clip point of the audit keeps in its folder. Its claims and the audit's figures
+/// read the series the audit records in memory ([`measures::ClipSeries`]), not these files.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum PointFields {
+    /// `frames.csv`, `truth.csv`, `run.json` only (the default, so that the full audit stays
+    /// within [`FULL_AUDIT_BUDGET_BYTES`]: 19 clip points of 1160 frames)
+    #[default]
+    Tables,
+    /// also the per-node fields as one compact `fields.npz` and the run's own figures
+    Compact,
+    /// also `fields.csv`, `curvature.csv`, ParaView VTK files and the run's own figures
+    Vtk,
+}
+
+impl PointFields {
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            PointFields::Tables => {
+                "clip points keep their tables only; `--fields` for compact fields, `--vtk` for CSV and VTK"
+            }
+            PointFields::Compact => "`--fields`: compact fields.npz and figures per clip point",
+            PointFields::Vtk => "`--vtk`: fields.csv, curvature.csv, VTK and figures per clip point",
+        }
+    }
+}
+
+/// The files a clip point of [`PointFields::Tables`] removes after its run: the per-node
+/// fields and the run's own figures (the audit draws its own).
+const BULKY: [&str; 5] = ["fields.npz", "kymograph.svg", "omega.svg", "truth.svg", "truth_errors.svg"];
+
+/// What the full audit may write by default [bytes]: 200 MB (issue 30; it wrote 2.9 GB with
+/// `fields.csv` and VTK for every frame of every clip point).
+pub const FULL_AUDIT_BUDGET_BYTES: u64 = 200_000_000;
+
+/// Bytes of the files under `dir` (the audit folder's size, printed in REPORT.md).
+pub fn folder_bytes(dir: &Path) -> u64 {
+    std::fs::read_dir(dir)
+        .into_iter()
+        .flatten()
+        .flatten()
+        .map(|e| match e.file_type() {
+            Ok(t) if t.is_dir() => folder_bytes(&e.path()),
+            Ok(_) => e.metadata().map(|m| m.len()).unwrap_or(0),
+            Err(_) => 0,
+        })
+        .sum()
 }
 
 /// The spec files of a folder (`*.toml`, sorted).
@@ -240,6 +299,7 @@ struct Job<'a> {
     point: Point,
     case: crate::case::Case,
     dir: PathBuf,
+    fields: PointFields,
 }
 
 /// Run every point of every run of `specs` in parallel (clip runs first: they are the longest),
@@ -260,7 +320,7 @@ pub fn run_audit(
             for (point, case) in points {
                 let label = if point.is_empty() { "run".to_string() } else { case.name.clone() };
                 let dir = opts.out.join(&spec.name).join(&run.name).join(&label);
-                jobs.push(Job { spec: i, run, point, case, dir });
+                jobs.push(Job { spec: i, run, point, case, dir, fields: opts.fields });
             }
         }
     }
@@ -306,9 +366,27 @@ pub fn run_audit(
     } else {
         AuditStatus::Failed(failures)
     };
-    let report = AuditReport { claims, figures, quick, wall_time_s: start.elapsed().as_secs_f64(), status };
+    let report = AuditReport {
+        claims,
+        figures,
+        quick,
+        wall_time_s: start.elapsed().as_secs_f64(),
+        status,
+        bytes: folder_bytes(&opts.out),
+        fields: opts.fields,
+        coverage: None,
+    };
+    let report = AuditReport { coverage: coverage(specs, &report.claims), ..report };
     report::write_report(&report, &opts.out)?;
     Ok(report)
+}
+
+/// The claims inventory beside the first spec, against the claims judged.
+fn coverage(specs: &[Spec], claims: &[ClaimResult]) -> Option<Result<inventory::Coverage, String>> {
+    let path = specs.first()?.path.parent()?.join(inventory::INVENTORY);
+    path.is_file().then(|| {
+        inventory::read_inventory(&path).map(|e| inventory::Coverage::new(e, claims)).map_err(|e| e.to_string())
+    })
 }
 
 /// Judge every claim of `specs` on `results` and draw every figure (not after an interrupt:
@@ -373,7 +451,13 @@ fn run_job(j: &Job) -> PointResult {
     let template = point_manifest("audit point", &j.case, &j.point);
     let (mut outcome, series) = if j.case.clip().is_some() {
         let mut recorder = ClipRecorder::new(&j.run.keep_frames);
-        let outcome = run_clip_point(&j.case, &j.dir, &template, |frame| recorder.record(frame));
+        let format = if j.fields == PointFields::Vtk { OutputFormat::Csv } else { OutputFormat::Compact };
+        let outcome = run_clip_point(&j.case, &j.dir, &template, format, |frame| recorder.record(frame));
+        if j.fields == PointFields::Tables {
+            for f in BULKY {
+                let _ = std::fs::remove_file(j.dir.join(f));
+            }
+        }
         (outcome, Some(recorder.finish()))
     } else {
         (run_point(&j.case, &j.dir, &template), None)

@@ -99,7 +99,21 @@ fn header(r: &AuditReport) -> String {
             );
         }
     }
+    let _ = writeln!(o, "{}\n", size_line(r));
     o
+}
+
+/// The audit's time and size: wall time on how many cores, bytes written, and the fields'
+/// format (compact by default; `--vtk` for CSV and ParaView files per clip point).
+fn size_line(r: &AuditReport) -> String {
+    let cores = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1);
+    format!(
+        "Time and size: {:.0} s wall time on {cores} cores (shared machines make it longer); {:.1} MB in this folder before this report ({}; the default budget of the full audit is {:.0} MB).",
+        r.wall_time_s,
+        r.bytes as f64 / 1e6,
+        r.fields.as_str(),
+        super::FULL_AUDIT_BUDGET_BYTES as f64 / 1e6
+    )
 }
 
 /// Markdown text of the report.
@@ -140,6 +154,7 @@ pub fn report_md(r: &AuditReport) -> String {
             row(&mut o, c);
         }
     }
+    coverage_section(&mut o, r);
     if !r.figures.is_empty() {
         let _ = writeln!(o, "\n## Figures\n");
         for f in &r.figures {
@@ -147,6 +162,36 @@ pub fn report_md(r: &AuditReport) -> String {
         }
     }
     o
+}
+
+/// The inventory's coverage: sentences with rows, not checkable here, checkable without a row
+/// (listed), and any mismatch between the inventory and the rows.
+fn coverage_section(o: &mut String, r: &AuditReport) {
+    use super::inventory::Status;
+    let Some(cov) = &r.coverage else { return };
+    let _ = writeln!(o, "\n## Coverage of §5–6 (`cases/paper/inventory.csv`)\n");
+    let cov = match cov {
+        Ok(c) => c,
+        Err(e) => {
+            let _ = writeln!(o, "The inventory could not be read: {}", md(e));
+            return;
+        }
+    };
+    let [rows, nc, none] = cov.counts();
+    let _ = writeln!(
+        o,
+        "{} sentences of §5–6 and the captions state something checkable: **{rows} are judged by rows above, {nc} are not checkable here, {none} are checkable but have no row yet**:\n",
+        cov.entries.len()
+    );
+    for e in cov.entries.iter().filter(|e| e.status == Status::NoRowYet) {
+        let _ = writeln!(o, "- {} ({}): “{}” — {}", e.id, md(&e.section), md(&e.sentence), md(&e.note));
+    }
+    for (id, row) in &cov.dangling {
+        let _ = writeln!(o, "- **inventory {id} names `{row}`, which this audit does not have**");
+    }
+    for k in &cov.unlisted {
+        let _ = writeln!(o, "- **the row `{k}` judges no sentence of the inventory**");
+    }
 }
 
 fn table_head(o: &mut String) {
