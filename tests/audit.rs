@@ -374,9 +374,9 @@ ours = true
         std::fs::write(&path, text).expect("spec");
         read_spec(&path, true)
     };
-    let err = read(spec("reproduced", "agrees very well", "")).err().expect("refused");
+    let err = read(spec("reproduced", "agrees very well", "")).expect_err("refused");
     assert!(err.to_string().contains("at best \"differs\""), "{err}");
-    let err = read(spec("differs", "agrees very well (here: 2 %)", "")).err().expect("refused");
+    let err = read(spec("differs", "agrees very well (here: 2 %)", "")).expect_err("refused");
     assert!(err.to_string().contains("verbatim"), "{err}");
     let spec = read(spec("differs", "agrees very well", "")).expect("spec");
     let opts = AuditOptions { out: tmp.path().join("out"), jobs: 1, fields: Default::default() };
