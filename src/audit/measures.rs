@@ -16,6 +16,12 @@
 //!   spike in the first elements is not the distribution of Fig. 15), RMS over those nodes;
 //! - `torque_max_abs_inner_n_m_per_m`: max |l| = |α̂|/λl over the same nodes (eq. 64,
 //!   finding (2): "the control torque l = δα/λl always has a magnitude of 10⁻⁷");
+//! - `frame_err_max_rad` (synthetic inverse runs): the largest rotation angle between the
+//!   recovered frame and the forward one over the nodes, `acos((Σᵢ dᵢ·dᵢᶠ − 1)/2)` (eq. 2;
+//!   chart-free), Remark 11: "converging to the same position vector x and rotation α";
+//! - `other_components_rel` (synthetic inverse runs): max |x₁| over max |x − (0, 0, s)| and
+//!   max(|κ2|, |κ3|) over max |κ1|, the larger (eq. 64: "all the other components of the
+//!   position vector and generalised curvature are zero");
 //! - clip runs ([`ClipSeries`]): RMS of the recovered κ1, κ2, κ3 and of the bending
 //!   `√(κ1² + κ2²)` over frames and inner elements [1/m] (Figs. 17, 23, 25), and the lag in
 //!   frames of the bending wave between s = L/4 and 3L/4 (> 0: from s = 0 towards s = L).
@@ -109,10 +115,34 @@ pub fn derived_metrics(case: &Case, run: Option<&RunResult>, series: Option<&Cli
                 m.insert("torque_to_design_orders".into(), (lc / l).log10().abs());
             }
             m.extend(inner_control_metrics(case, r));
+            m.extend(frame_metrics(r));
         }
     }
     if let Some(s) = series {
         m.extend(clip_series_metrics(s));
+    }
+    m
+}
+
+/// The recovered frames against the forward ones, and the components the planar test of
+/// eq. (64) leaves at zero (see the module documentation); none for a recording.
+fn frame_metrics(r: &RunResult) -> Metrics {
+    let mut m = Metrics::new();
+    let Some(inv) = r.inverse.as_ref().filter(|i| i.angles_known) else { return m };
+    let angle = |d: &[Vector3<f64>; 3], f: &[Vector3<f64>; 3]| {
+        let trace: f64 = (0..3).map(|i| d[i].dot(&f[i])).sum();
+        ((trace - 1.0) / 2.0).clamp(-1.0, 1.0).acos()
+    };
+    let worst = r.nodes.directors().iter().zip(inv.data.directors()).map(|(d, f)| angle(d, &f)).fold(0.0, f64::max);
+    m.insert("frame_err_max_rad".into(), worst);
+    let max = |v: &mut dyn Iterator<Item = f64>| v.fold(0.0, f64::max);
+    let disp = max(&mut r.nodes.displacement().iter().map(|d| d.norm()));
+    let x1 = max(&mut r.nodes.x.iter().map(|x| x[0].abs()));
+    let k = r.nodes.element_curvature();
+    let k1 = max(&mut k.iter().map(|(_, k)| k[0].abs()));
+    let k23 = max(&mut k.iter().map(|(_, k)| k[1].abs().max(k[2].abs())));
+    if disp > 0.0 && k1 > 0.0 {
+        m.insert("other_components_rel".into(), (x1 / disp).max(k23 / k1));
     }
     m
 }
