@@ -151,14 +151,15 @@ enum Command {
         /// Do not show progress (a bar on a terminal, else a line every 10 s)
         #[arg(long)]
         quiet: bool,
-        /// Clip points keep their per-node fields as one compact fields.npz and their own
-        /// figures [default: their tables only, so that the full audit stays within 200 MB]
+        /// Clip points keep compact fields.npz and figures [default: tables only, ≤ 200 MB]
         #[arg(long, conflicts_with = "vtk")]
         fields: bool,
-        /// Clip points keep fields.csv, curvature.csv, ParaView VTK files and their figures
-        /// (several GB for the full audit)
+        /// Clip points keep fields.csv, curvature.csv, VTK and figures (GBs for the full audit)
         #[arg(long)]
         vtk: bool,
+        /// Continue the unfinished audit of --out: keep the specs it judged whole, rerun the rest
+        #[arg(long, conflicts_with = "force")]
+        resume: bool,
     },
     /// Run a clip case over many recordings (here, or as a Slurm job array with --slurm).
     Batch(cli::BatchArgs),
@@ -251,13 +252,9 @@ fn dispatch(cli: Cli) -> Result<ExitCode> {
         Command::Sweep { case, set, out, force, limits, jobs, quiet } => {
             cmd_sweep(&case, &set, out, force, limits, jobs, quiet)
         }
-        Command::Audit { specs, quick, out, force, jobs, quiet, fields, vtk } => {
-            let fields = match (fields, vtk) {
-                (_, true) => cosserat::audit::PointFields::Vtk,
-                (true, _) => cosserat::audit::PointFields::Compact,
-                _ => cosserat::audit::PointFields::Tables,
-            };
-            cmd_audit(&specs, quick, out, force, jobs, quiet, fields)
+        Command::Audit { specs, quick, out, force, jobs, quiet, fields, vtk, resume } => {
+            let fields = cosserat::audit::PointFields::from_flags(fields, vtk);
+            cmd_audit(&specs, quick, out, (!resume).then_some(force), jobs, quiet, fields)
         }
         Command::Batch(a) => cli::cmd_batch(a),
         Command::BatchTask(a) => cli::cmd_batch_task(a),
@@ -470,7 +467,7 @@ fn cmd_audit(
     paths: &[PathBuf],
     quick: bool,
     out: Option<PathBuf>,
-    force: bool,
+    force: Option<bool>,
     jobs: Option<usize>,
     quiet: bool,
     fields: cosserat::audit::PointFields,
@@ -495,14 +492,16 @@ fn cmd_audit(
     let specs = files.iter().map(|f| read_spec(f, quick)).collect::<Result<Vec<_>, _>>()?;
     let out = out.unwrap_or_else(|| PathBuf::from(if quick { "out/audit-quick" } else { "out/audit" }));
     // an audit folder of an older version carries the audit's marker instead of run.json
-    let force = force || out.join(cosserat::audit::MARKER).is_file();
+    let marker = out.join(cosserat::audit::MARKER).is_file();
+    let mode = force.map_or(Mode::Resume, |f| Mode::Fresh { force: f || marker });
     let mut manifest = Manifest::new("audit");
     manifest.inputs = files.iter().map(|f| input_file(f)).collect::<Result<_, _>>()?;
     manifest.settings.insert("quick".into(), f64::from(u8::from(quick)).into());
-    let folder = RunFolder::begin(&out, manifest, Mode::Fresh { force })
-        .with_context(|| format!("audit: output folder {}", out.display()))?;
+    let resume = force.is_none();
+    let folder =
+        RunFolder::begin(&out, manifest, mode).with_context(|| format!("audit: output folder {}", out.display()))?;
     let pb = Progress::new(if quick { "audit (quick)" } else { "audit" }, "points", 0, quiet);
-    let opts = AuditOptions { out: folder.dir().to_path_buf(), jobs: jobs.unwrap_or(0), fields };
+    let opts = AuditOptions { out: folder.dir().to_path_buf(), jobs: jobs.unwrap_or(0), fields, resume };
     let points = std::sync::atomic::AtomicUsize::new(0);
     let report = run_audit(&specs, quick, &opts, |done, total| {
         points.store(total, std::sync::atomic::Ordering::SeqCst);

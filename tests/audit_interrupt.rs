@@ -3,24 +3,20 @@
 //! "stopped" as "the scheme does not converge": REPORT.md is headed "interrupted: N of M
 //! claims judged", the claim is *not judged* and counted apart, and run.json says interrupted.
 //! (Issue 30: before, such a run reported eq64-1 "reproduced" from "failed: interrupted by a
-//! signal".)
+//! signal".) `--resume` then keeps the spec judged whole and runs the other again.
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-/// A spec of two claims on the data of eq. (64): `fast` (the paper's set, about 1 s) and
-/// `slow` (finding (1), 1/λl → 0: 3000 iterations without converging, several seconds).
-fn two_claim_spec(dir: &Path) -> PathBuf {
+/// Two specs of one claim each on the data of eq. (64): `a` (the paper's set, about 1 s) and
+/// `b` (finding (1), 1/λl → 0: 3000 iterations without converging, several seconds).
+fn two_specs(dir: &Path) -> [PathBuf; 2] {
     let case = Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/inverse_bend.toml");
-    let spec = format!(
-        r#"title = "interrupt test"
+    let a = format!(
+        r#"title = "interrupt test, fast"
 section = "§5.2"
 
 [runs.a_fast]
 case = "{case}"
-
-[runs.b_slow]
-case = "{case}"
-set = {{ "inverse.lambda_l" = 1e30, "solver.max_iterations" = 3000 }}
 
 [[claims]]
 id = "fast"
@@ -29,6 +25,16 @@ statement = "both the position and the curvature can be recovered accurately"
 paper = "recovered x on the data"
 check = {{ kind = "below", run = "a_fast", metric = "x_err_rel", limit = 1e-3 }}
 expect = "reproduced"
+"#,
+        case = case.display()
+    );
+    let b = format!(
+        r#"title = "interrupt test, slow"
+section = "§5.2"
+
+[runs.b_slow]
+case = "{case}"
+set = {{ "inverse.lambda_l" = 1e30, "solver.max_iterations" = 3000 }}
 
 [[claims]]
 id = "slow"
@@ -40,9 +46,10 @@ expect = "reproduced"
 "#,
         case = case.display()
     );
-    let path = dir.join("two.toml");
-    std::fs::write(&path, spec).expect("spec");
-    path
+    let paths = [dir.join("a.toml"), dir.join("b.toml")];
+    std::fs::write(&paths[0], a).expect("spec a");
+    std::fs::write(&paths[1], b).expect("spec b");
+    paths
 }
 
 /// The first file named `name` under `dir` (any depth).
@@ -63,11 +70,11 @@ fn find(dir: &Path, name: &str) -> Option<PathBuf> {
 #[test]
 fn an_interrupted_audit_judges_only_what_finished() {
     let tmp = tempfile::tempdir().expect("tempdir");
-    let spec = two_claim_spec(tmp.path());
+    let specs = two_specs(tmp.path());
     let out = tmp.path().join("out");
     let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_cosserat"))
         .arg("audit")
-        .arg(&spec)
+        .args(&specs)
         .arg("--out")
         .arg(&out)
         .args(["--quiet", "--jobs", "1"])
@@ -103,4 +110,31 @@ fn an_interrupted_audit_judges_only_what_finished() {
     assert!(slow.contains(",not judged,"), "{slow}");
     let manifest = std::fs::read_to_string(out.join("run.json")).expect("run.json");
     assert!(manifest.contains("\"status\": \"interrupted\""), "{manifest}");
+
+    // --resume: spec a was judged whole and is kept (its point is not run again); spec b runs
+    assert!(out.join("a/judged.json").is_file() && !out.join("b/judged.json").exists());
+    let fast = out.join("a/a_fast/run/metrics.json");
+    // (its metrics hold its wall time: a run again would not write the same bytes)
+    let before = std::fs::read_to_string(&fast).expect("metrics");
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_cosserat"))
+        .arg("audit")
+        .args(&specs)
+        .arg("--out")
+        .arg(&out)
+        .args(["--quiet", "--jobs", "1", "--resume"])
+        .output()
+        .expect("resume");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let md = std::fs::read_to_string(out.join("REPORT.md")).expect("REPORT.md");
+    assert!(!md.lines().next().unwrap_or_default().contains("interrupted"), "{md}");
+    let row = |id: &str| md.lines().find(|l| l.starts_with(&format!("| {id} |"))).unwrap_or_default().to_string();
+    assert!(
+        row("slow").contains("**reproduced**") && row("slow").contains("not converged after 3000"),
+        "{}",
+        row("slow")
+    );
+    assert!(row("fast").contains("**reproduced**"), "{}", row("fast"));
+    assert_eq!(std::fs::read_to_string(&fast).expect("metrics"), before, "spec a ran again");
+    let manifest = std::fs::read_to_string(out.join("run.json")).expect("run.json");
+    assert!(manifest.contains("\"status\": \"complete\""), "{manifest}");
 }

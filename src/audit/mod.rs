@@ -9,6 +9,7 @@ pub mod figures;
 pub mod inventory;
 pub mod measures;
 pub mod report;
+pub mod resume;
 pub mod spec;
 
 use std::path::{Path, PathBuf};
@@ -23,7 +24,7 @@ use measures::{derived_metrics, ClipRecorder, ClipSeries};
 use spec::{Claim, RunSpec, Spec};
 
 /// The judgement of one claim.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Verdict {
     /// our numbers satisfy the paper's statement
@@ -203,6 +204,9 @@ pub struct AuditOptions {
     pub jobs: usize,
     /// what a clip point keeps beside its tables ([`PointFields`])
     pub fields: PointFields,
+    /// continue the audit of `out`: specs it judged whole ([`resume::JUDGED`]) are taken
+    /// from it, the others run again
+    pub resume: bool,
 }
 
 /// What a clip point of the audit keeps in its folder. Its claims and the audit's figures
@@ -220,6 +224,14 @@ pub enum PointFields {
 }
 
 impl PointFields {
+    /// From the flags `--fields` and `--vtk` of `cosserat audit`.
+    pub fn from_flags(fields: bool, vtk: bool) -> Self {
+        match (fields, vtk) {
+            (_, true) => PointFields::Vtk,
+            (true, _) => PointFields::Compact,
+            _ => PointFields::Tables,
+        }
+    }
     pub fn as_str(&self) -> &'static str {
         match self {
             PointFields::Tables => {
@@ -312,8 +324,10 @@ pub fn run_audit(
     progress: impl Fn(usize, usize) + Sync,
 ) -> Result<AuditReport, AuditError> {
     let start = std::time::Instant::now();
+    let reused: Vec<Option<(Vec<ClaimResult>, Vec<String>)>> =
+        specs.iter().map(|s| if opts.resume { resume::load(s, quick, &opts.out) } else { None }).collect();
     let mut jobs: Vec<Job> = Vec::new();
-    for (i, spec) in specs.iter().enumerate() {
+    for (i, spec) in specs.iter().enumerate().filter(|(i, _)| reused[*i].is_none()) {
         for run in &spec.runs {
             let grid_err = |source| AuditError::Grid { spec: spec.name.clone(), run: run.name.clone(), source };
             let points = product(&run.case, &run.grid).map_err(grid_err)?;
@@ -324,7 +338,11 @@ pub fn run_audit(
             }
         }
     }
-    prepare_folder(&opts.out)?;
+    if opts.resume {
+        resume_folder(&opts.out, specs, &reused)?;
+    } else {
+        prepare_folder(&opts.out)?;
+    }
     jobs.sort_by_key(|j| j.case.clip().is_none());
     let total = jobs.len();
     let done = std::sync::atomic::AtomicUsize::new(0);
@@ -358,7 +376,7 @@ pub fn run_audit(
         }
     }
     let interrupted = crate::interrupt::requested();
-    let (claims, figures, failures) = judge_all(specs, &results, &opts.out, interrupted);
+    let (claims, figures, failures) = judge_all(specs, &results, &opts.out, reused, quick);
     let status = if interrupted {
         AuditStatus::Interrupted
     } else if failures.is_empty() {
@@ -389,24 +407,33 @@ fn coverage(specs: &[Spec], claims: &[ClaimResult]) -> Option<Result<inventory::
     })
 }
 
-/// Judge every claim of `specs` on `results` and draw every figure (not after an interrupt:
-/// the runs are partial). A claim whose metric no point reports, or that reads a point a
-/// signal stopped, is not judged; the failures (metric typos, figures not written) are
-/// returned as text.
+/// Judge every claim of `specs` on `results` and draw every figure of the specs whose points
+/// all finished (none stopped by a signal); a spec taken from the audit being resumed
+/// (`reused`) keeps its claims and figures. A claim whose metric no point reports, or that
+/// reads a point a signal stopped, is not judged; the failures (metric typos, figures not
+/// written) are returned as text. A spec judged whole is recorded for `--resume`.
 fn judge_all(
     specs: &[Spec],
     results: &[Vec<RunResults>],
     out: &Path,
-    interrupted: bool,
+    reused: Vec<Option<(Vec<ClaimResult>, Vec<String>)>>,
+    quick: bool,
 ) -> (Vec<ClaimResult>, Vec<String>, Vec<String>) {
     let (mut claims, mut figures, mut failures) = (Vec::new(), Vec::new(), Vec::new());
-    for (spec, runs) in specs.iter().zip(results) {
-        if !interrupted {
+    for ((spec, runs), old) in specs.iter().zip(results).zip(reused) {
+        if let Some((c, f)) = old {
+            claims.extend(c);
+            figures.extend(f);
+            continue;
+        }
+        let whole = runs.iter().all(|r| r.points.iter().all(|p| !check::stopped(p)));
+        if whole {
             match figures::write_figures(spec, runs, &out.join(&spec.name)) {
                 Ok(written) => figures.extend(written.iter().map(|f| format!("{}/{f}", spec.name))),
                 Err((file, e)) => failures.push(format!("spec {}: figure {file}: {e}", spec.name)),
             }
         }
+        let first = claims.len();
         for claim in &spec.claims {
             let mut c = check::judge(spec, claim, runs);
             if let Err(e) = check_metric_name(spec, claim, runs) {
@@ -416,8 +443,32 @@ fn judge_all(
             }
             claims.push(c);
         }
+        if whole && failures.is_empty() {
+            if let Err(e) = resume::store(spec, &claims[first..], &figures, quick, out) {
+                failures.push(format!("spec {}: {e}", spec.name));
+            }
+        }
     }
     (claims, figures, failures)
+}
+
+/// The folder of an audit being resumed: the folders of the specs that run again are emptied
+/// (no point of the interrupted audit is mixed with new ones).
+fn resume_folder(
+    out: &Path,
+    specs: &[Spec],
+    reused: &[Option<(Vec<ClaimResult>, Vec<String>)>],
+) -> Result<(), AuditError> {
+    let io = |source| AuditError::Folder { path: out.to_path_buf(), source };
+    std::fs::create_dir_all(out).map_err(io)?;
+    std::fs::write(out.join(MARKER), "written by `cosserat audit`; replaced whole by the next audit\n").map_err(io)?;
+    for (spec, old) in specs.iter().zip(reused) {
+        let dir = out.join(&spec.name);
+        if old.is_none() && dir.exists() {
+            std::fs::remove_dir_all(&dir).map_err(io)?;
+        }
+    }
+    Ok(())
 }
 
 /// The metric a claim reads is reported by some point of its runs that has metrics (a typo
