@@ -146,7 +146,7 @@ pub struct ClaimResult {
 #[derive(Clone, Debug, PartialEq)]
 pub enum AuditStatus {
     Complete,
-    /// stopped by a signal (SIGINT, SIGTERM): points stopped or never started; no figures
+    /// stopped by a signal (SIGINT, SIGTERM): points stopped or never started
     Interrupted,
     /// the runs finished but something could not be judged or drawn (the errors)
     Failed(Vec<String>),

@@ -89,7 +89,7 @@ fn header(r: &AuditReport) -> String {
         AuditStatus::Interrupted | AuditStatus::Failed(_) => {
             let why = match &r.status {
                 AuditStatus::Failed(errors) => format!("failed: {}", errors.join("; ")),
-                _ => "was stopped by a signal before its runs finished; no figures were drawn".into(),
+                _ => "was stopped by a signal before its runs finished; figures are drawn only for the specs whose points all finished".into(),
             };
             let _ = writeln!(
                 o,
