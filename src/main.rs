@@ -151,6 +151,15 @@ enum Command {
         /// Do not show progress (a bar on a terminal, else a line every 10 s)
         #[arg(long)]
         quiet: bool,
+        /// Clip points keep compact fields.npz and figures [default: tables only, ≤ 200 MB]
+        #[arg(long, conflicts_with = "vtk")]
+        fields: bool,
+        /// Clip points keep fields.csv, curvature.csv, VTK and figures (GBs for the full audit)
+        #[arg(long)]
+        vtk: bool,
+        /// Continue the unfinished audit of --out: keep the specs it judged whole, rerun the rest
+        #[arg(long, conflicts_with = "force")]
+        resume: bool,
     },
     /// Run a clip case over many recordings (here, or as a Slurm job array with --slurm).
     Batch(cli::BatchArgs),
@@ -243,7 +252,10 @@ fn dispatch(cli: Cli) -> Result<ExitCode> {
         Command::Sweep { case, set, out, force, limits, jobs, quiet } => {
             cmd_sweep(&case, &set, out, force, limits, jobs, quiet)
         }
-        Command::Audit { specs, quick, out, force, jobs, quiet } => cmd_audit(&specs, quick, out, force, jobs, quiet),
+        Command::Audit { specs, quick, out, force, jobs, quiet, fields, vtk, resume } => {
+            let fields = cosserat::audit::PointFields::from_flags(fields, vtk);
+            cmd_audit(&specs, quick, out, (!resume).then_some(force), jobs, quiet, fields)
+        }
         Command::Batch(a) => cli::cmd_batch(a),
         Command::BatchTask(a) => cli::cmd_batch_task(a),
         Command::Gather { out } => cli::cmd_gather(&out),
@@ -459,11 +471,12 @@ fn cmd_audit(
     paths: &[PathBuf],
     quick: bool,
     out: Option<PathBuf>,
-    force: bool,
+    force: Option<bool>,
     jobs: Option<usize>,
     quiet: bool,
+    fields: cosserat::audit::PointFields,
 ) -> Result<ExitCode> {
-    use cosserat::audit::{run_audit, spec::read_spec, spec_files, AuditOptions, Verdict};
+    use cosserat::audit::{run_audit, spec::read_spec, spec_files, AuditOptions, AuditStatus, Verdict};
     let default = [PathBuf::from("cases/paper")];
     let mut files = Vec::new();
     for p in if paths.is_empty() { &default[..] } else { paths } {
@@ -483,14 +496,16 @@ fn cmd_audit(
     let specs = files.iter().map(|f| read_spec(f, quick)).collect::<Result<Vec<_>, _>>()?;
     let out = out.unwrap_or_else(|| PathBuf::from(if quick { "out/audit-quick" } else { "out/audit" }));
     // an audit folder of an older version carries the audit's marker instead of run.json
-    let force = force || out.join(cosserat::audit::MARKER).is_file();
+    let marker = out.join(cosserat::audit::MARKER).is_file();
+    let mode = force.map_or(Mode::Resume, |f| Mode::Fresh { force: f || marker });
     let mut manifest = Manifest::new("audit");
     manifest.inputs = files.iter().map(|f| input_file(f)).collect::<Result<_, _>>()?;
     manifest.settings.insert("quick".into(), f64::from(u8::from(quick)).into());
-    let folder = RunFolder::begin(&out, manifest, Mode::Fresh { force })
-        .with_context(|| format!("audit: output folder {}", out.display()))?;
+    let resume = force.is_none();
+    let folder =
+        RunFolder::begin(&out, manifest, mode).with_context(|| format!("audit: output folder {}", out.display()))?;
     let pb = Progress::new(if quick { "audit (quick)" } else { "audit" }, "points", 0, quiet);
-    let opts = AuditOptions { out: folder.dir().to_path_buf(), jobs: jobs.unwrap_or(0) };
+    let opts = AuditOptions { out: folder.dir().to_path_buf(), jobs: jobs.unwrap_or(0), fields, resume };
     let points = std::sync::atomic::AtomicUsize::new(0);
     let report = run_audit(&specs, quick, &opts, |done, total| {
         points.store(total, std::sync::atomic::Ordering::SeqCst);
@@ -498,43 +513,56 @@ fn cmd_audit(
     });
     pb.finish();
     let report = match report {
-        Ok(r) if !cosserat::interrupt::requested() => {
-            folder.finish(Status::Complete, None)?;
-            r
-        }
-        Ok(_) => {
-            let kept = cli::outcome::audit_points_kept(folder.dir(), points.load(std::sync::atomic::Ordering::SeqCst));
-            folder.finish(Status::Interrupted, Some(format!("interrupted by a signal: {kept}")))?;
-            eprintln!(
-                "audit interrupted: {kept}; REPORT.md judges the claims on what ran; {} holds run.json saying interrupted",
-                out.display()
-            );
-            return Ok(ExitCode::from(EXIT_INTERRUPTED));
-        }
+        Ok(r) => r,
         Err(e) => {
             let message = format!("{:#}", anyhow::Error::from(e));
             folder.finish(Status::Failed, Some(message.clone()))?;
             anyhow::bail!("audit: {message}; {} holds run.json saying failed", out.display());
         }
     };
+    let judged = format!("{} of {} claims judged", report.claims.len() - report.unjudged(), report.claims.len());
+    match &report.status {
+        AuditStatus::Complete => {
+            folder.finish(Status::Complete, None)?;
+        }
+        AuditStatus::Interrupted => {
+            let kept = cli::outcome::audit_points_kept(folder.dir(), points.load(std::sync::atomic::Ordering::SeqCst));
+            folder.finish(Status::Interrupted, Some(format!("interrupted by a signal: {kept}; {judged}")))?;
+            eprintln!(
+                "audit interrupted: {kept}; {judged}; REPORT.md is headed interrupted and marks the others not judged; {} holds run.json saying interrupted",
+                out.display()
+            );
+            return Ok(ExitCode::from(EXIT_INTERRUPTED));
+        }
+        AuditStatus::Failed(errors) => {
+            let message = format!("{judged}: {}", errors.join("; "));
+            folder.finish(Status::Failed, Some(message.clone()))?;
+            anyhow::bail!(
+                "audit failed: {message}; REPORT.md is headed failed; {} holds run.json saying failed",
+                out.display()
+            );
+        }
+    }
     let counts = report.counts();
     let summary: Vec<String> = Verdict::ALL.iter().zip(counts).map(|(v, n)| format!("{n} {}", v.as_str())).collect();
+    let ours = report.claims.iter().filter(|c| c.claim.ours).count();
     println!(
-        "{} claims of {} specs: {}; {} figures; {:.0} s; wrote {}",
-        report.claims.len(),
+        "{} claims of the paper and {ours} checks of ours in {} specs: {}; {} figures; {:.0} s; {:.1} MB; wrote {}",
+        report.claims.len() - ours,
         specs.len(),
         summary.join(", "),
         report.figures.len(),
         report.wall_time_s,
+        report.bytes as f64 / 1e6,
         out.join("REPORT.md").display()
     );
-    let unexpected: Vec<_> = report.claims.iter().filter(|c| c.verdict != c.claim.expect).collect();
+    let unexpected: Vec<_> = report.claims.iter().filter(|c| c.verdict != Some(c.claim.expect)).collect();
     for c in &unexpected {
         eprintln!(
             "  {} ({}): {} where the spec expects {}; ours: {}",
             c.claim.id,
             c.spec,
-            c.verdict.as_str(),
+            c.verdict.map_or("not judged", |v| v.as_str()),
             c.claim.expect.as_str(),
             c.ours
         );

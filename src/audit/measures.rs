@@ -11,6 +11,17 @@
 //!   and ‖l‖/‖l_design‖, L² norms over the rod, the design the loads of the `[data]` solve, and
 //!   `force_to_design_orders`, `torque_to_design_orders`: |log10| of those ratios (orders of
 //!   magnitude apart);
+//! - `force_to_design_orders_inner`, `torque_to_design_orders_inner`: the same over the nodes
+//!   without [`INNER_SKIP_ELEMENTS`] at each end, the rule of the curvature rows (the clamp's
+//!   spike in the first elements is not the distribution of Fig. 15), RMS over those nodes;
+//! - `torque_max_abs_inner_n_m_per_m`: max |l| = |α̂|/λl over the same nodes (eq. 64,
+//!   finding (2): "the control torque l = δα/λl always has a magnitude of 10⁻⁷");
+//! - `frame_err_max_rad` (synthetic inverse runs): the largest rotation angle between the
+//!   recovered frame and the forward one over the nodes, `acos((Σᵢ dᵢ·dᵢᶠ − 1)/2)` (eq. 2;
+//!   chart-free), Remark 11: "converging to the same position vector x and rotation α";
+//! - `other_components_rel` (synthetic inverse runs): max |x₁| over max |x − (0, 0, s)| and
+//!   max(|κ2|, |κ3|) over max |κ1|, the larger (eq. 64: "all the other components of the
+//!   position vector and generalised curvature are zero");
 //! - clip runs ([`ClipSeries`]): RMS of the recovered κ1, κ2, κ3 and of the bending
 //!   `√(κ1² + κ2²)` over frames and inner elements [1/m] (Figs. 17, 23, 25), and the lag in
 //!   frames of the bending wave between s = L/4 and 3L/4 (> 0: from s = 0 towards s = L).
@@ -103,10 +114,64 @@ pub fn derived_metrics(case: &Case, run: Option<&RunResult>, series: Option<&Cli
                 m.insert("force_to_design_orders".into(), (fc / f).log10().abs());
                 m.insert("torque_to_design_orders".into(), (lc / l).log10().abs());
             }
+            m.extend(inner_control_metrics(case, r));
+            m.extend(frame_metrics(r));
         }
     }
     if let Some(s) = series {
         m.extend(clip_series_metrics(s));
+    }
+    m
+}
+
+/// The recovered frames against the forward ones, and the components the planar test of
+/// eq. (64) leaves at zero (see the module documentation); none for a recording.
+fn frame_metrics(r: &RunResult) -> Metrics {
+    let mut m = Metrics::new();
+    let Some(inv) = r.inverse.as_ref().filter(|i| i.angles_known) else { return m };
+    let angle = |d: &[Vector3<f64>; 3], f: &[Vector3<f64>; 3]| {
+        let trace: f64 = (0..3).map(|i| d[i].dot(&f[i])).sum();
+        ((trace - 1.0) / 2.0).clamp(-1.0, 1.0).acos()
+    };
+    let worst = r.nodes.directors().iter().zip(inv.data.directors()).map(|(d, f)| angle(d, &f)).fold(0.0, f64::max);
+    m.insert("frame_err_max_rad".into(), worst);
+    let max = |v: &mut dyn Iterator<Item = f64>| v.fold(0.0, f64::max);
+    let disp = max(&mut r.nodes.displacement().iter().map(|d| d.norm()));
+    let x1 = max(&mut r.nodes.x.iter().map(|x| x[0].abs()));
+    let k = r.nodes.element_curvature();
+    let k1 = max(&mut k.iter().map(|(_, k)| k[0].abs()));
+    let k23 = max(&mut k.iter().map(|(_, k)| k[1].abs().max(k[2].abs())));
+    if disp > 0.0 && k1 > 0.0 {
+        m.insert("other_components_rel".into(), (x1 / disp).max(k23 / k1));
+    }
+    m
+}
+
+/// The controls f = x̂/λf, l = α̂/λl of an inverse run at the nodes without
+/// [`INNER_SKIP_ELEMENTS`] at each end (eq. 61): max |l|, and against the design loads of a
+/// synthetic case's `[data]` solve the orders of magnitude of the RMS ratios (Fig. 15).
+fn inner_control_metrics(case: &Case, r: &RunResult) -> Metrics {
+    let mut m = Metrics::new();
+    let Some(inv) = r.inverse.as_ref() else { return m };
+    let n = r.nodes.s.len();
+    if n <= 2 * INNER_SKIP_ELEMENTS + 1 {
+        return m;
+    }
+    let inner = INNER_SKIP_ELEMENTS..n - INNER_SKIP_ELEMENTS;
+    let l_max = inv.ahat[inner.clone()].iter().map(|a| a.norm() / inv.lambda_l).fold(0.0, f64::max);
+    m.insert("torque_max_abs_inner_n_m_per_m".into(), l_max);
+    let Some(data) = case.data_case() else { return m };
+    let rms = |v: &mut dyn Iterator<Item = f64>| {
+        let (sum, count) = v.fold((0.0, 0usize), |(a, c), x| (a + x * x, c + 1));
+        (sum / count.max(1) as f64).sqrt()
+    };
+    let design = |i: usize| data.loads.distributed(r.nodes.s[i], 0.0);
+    let f = rms(&mut inner.clone().map(|i| inv.xhat[i].norm() / inv.lambda_f));
+    let l = rms(&mut inner.clone().map(|i| inv.ahat[i].norm() / inv.lambda_l));
+    let (fd, ld) = (rms(&mut inner.clone().map(|i| design(i).0.norm())), rms(&mut inner.map(|i| design(i).1.norm())));
+    if fd > 0.0 && ld > 0.0 {
+        m.insert("force_to_design_orders_inner".into(), (f / fd).log10().abs());
+        m.insert("torque_to_design_orders_inner".into(), (l / ld).log10().abs());
     }
     m
 }

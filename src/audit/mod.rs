@@ -6,8 +6,10 @@
 //! paper's panels and [`report`] writes `REPORT.md` and `report.csv`.
 pub mod check;
 pub mod figures;
+pub mod inventory;
 pub mod measures;
 pub mod report;
+pub mod resume;
 pub mod spec;
 
 use std::path::{Path, PathBuf};
@@ -16,12 +18,13 @@ use rayon::prelude::*;
 use serde::Deserialize;
 
 use crate::case::sweep::{product, Point, SweepError};
+use crate::io::compact::OutputFormat;
 use crate::io::sweep::{point_manifest, run_clip_point, run_point, SweepOutcome};
 use measures::{derived_metrics, ClipRecorder, ClipSeries};
 use spec::{Claim, RunSpec, Spec};
 
 /// The judgement of one claim.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Verdict {
     /// our numbers satisfy the paper's statement
@@ -57,13 +60,6 @@ pub enum AuditError {
         run: String,
         #[source]
         source: SweepError,
-    },
-    #[error("spec {spec}: figure {file}")]
-    Figure {
-        spec: String,
-        file: String,
-        #[source]
-        source: Box<crate::io::OutputError>,
     },
     #[error(
         "{path}: claim `{claim}`: unknown metric `{metric}`: no point of run `{run}` reports it (its points report: {known})"
@@ -132,16 +128,38 @@ impl RunResults {
     }
 }
 
-/// A judged claim.
+/// A claim of the report: judged, or not (its points were stopped or never ran).
 #[derive(Clone, Debug)]
 pub struct ClaimResult {
     pub spec: String,
     pub claim: Claim,
-    pub verdict: Verdict,
-    /// our numbers, two significant digits
+    /// the verdict; `None`: not judged (an interrupted or failed audit), `ours` says why
+    pub verdict: Option<Verdict>,
+    /// our numbers, two significant digits (not judged: why)
     pub ours: String,
     /// the figure illustrating the claim, relative to the audit folder
     pub figure: Option<String>,
+}
+
+/// How far an audit got. Only a complete audit's verdicts are the audit's; an unfinished one
+/// judges the claims whose points all finished and marks the others *not judged*.
+#[derive(Clone, Debug, PartialEq)]
+pub enum AuditStatus {
+    Complete,
+    /// stopped by a signal (SIGINT, SIGTERM): points stopped or never started
+    Interrupted,
+    /// the runs finished but something could not be judged or drawn (the errors)
+    Failed(Vec<String>),
+}
+
+impl AuditStatus {
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            AuditStatus::Complete => "complete",
+            AuditStatus::Interrupted => "interrupted",
+            AuditStatus::Failed(_) => "failed",
+        }
+    }
 }
 
 /// Everything an audit produced.
@@ -151,12 +169,29 @@ pub struct AuditReport {
     pub figures: Vec<String>,
     pub quick: bool,
     pub wall_time_s: f64,
+    pub status: AuditStatus,
+    /// size of the audit folder when the report was written [bytes]
+    pub bytes: u64,
+    /// what the clip points kept
+    pub fields: PointFields,
+    /// the claims inventory beside the specs (`inventory.csv`) against the rows, if there is
+    /// one; `Err`: it could not be read (the report says so)
+    pub coverage: Option<Result<inventory::Coverage, String>>,
 }
 
 impl AuditReport {
-    /// Claims per verdict, in the order of [`Verdict::ALL`].
+    /// Judged claims of the paper per verdict, in the order of [`Verdict::ALL`] (our own
+    /// checks, `ours = true`, are counted apart: [`AuditReport::our_counts`]).
     pub fn counts(&self) -> [usize; 4] {
-        Verdict::ALL.map(|v| self.claims.iter().filter(|c| c.verdict == v).count())
+        Verdict::ALL.map(|v| self.claims.iter().filter(|c| !c.claim.ours && c.verdict == Some(v)).count())
+    }
+    /// Judged checks of ours per verdict.
+    pub fn our_counts(&self) -> [usize; 4] {
+        Verdict::ALL.map(|v| self.claims.iter().filter(|c| c.claim.ours && c.verdict == Some(v)).count())
+    }
+    /// Claims not judged (their points were stopped, never ran, or the audit failed on them).
+    pub fn unjudged(&self) -> usize {
+        self.claims.iter().filter(|c| c.verdict.is_none()).count()
     }
 }
 
@@ -167,6 +202,67 @@ pub struct AuditOptions {
     pub out: PathBuf,
     /// parallel runs (0: one per core)
     pub jobs: usize,
+    /// what a clip point keeps beside its tables ([`PointFields`])
+    pub fields: PointFields,
+    /// continue the audit of `out`: specs it judged whole ([`resume::JUDGED`]) are taken
+    /// from it, the others run again
+    pub resume: bool,
+}
+
+/// What a clip point of the audit keeps in its folder. Its claims and the audit's figures
+/// read the series the audit records in memory ([`measures::ClipSeries`]), not these files.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum PointFields {
+    /// `frames.csv`, `truth.csv`, `run.json` only (the default, so that the full audit stays
+    /// within [`FULL_AUDIT_BUDGET_BYTES`]: 19 clip points of 1160 frames)
+    #[default]
+    Tables,
+    /// also the per-node fields as one compact `fields.npz` and the run's own figures
+    Compact,
+    /// also `fields.csv`, `curvature.csv`, ParaView VTK files and the run's own figures
+    Vtk,
+}
+
+impl PointFields {
+    /// From the flags `--fields` and `--vtk` of `cosserat audit`.
+    pub fn from_flags(fields: bool, vtk: bool) -> Self {
+        match (fields, vtk) {
+            (_, true) => PointFields::Vtk,
+            (true, _) => PointFields::Compact,
+            _ => PointFields::Tables,
+        }
+    }
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            PointFields::Tables => {
+                "clip points keep their tables only; `--fields` for compact fields, `--vtk` for CSV and VTK"
+            }
+            PointFields::Compact => "`--fields`: compact fields.npz and figures per clip point",
+            PointFields::Vtk => "`--vtk`: fields.csv, curvature.csv, VTK and figures per clip point",
+        }
+    }
+}
+
+/// The files a clip point of [`PointFields::Tables`] removes after its run: the per-node
+/// fields and the run's own figures (the audit draws its own).
+const BULKY: [&str; 5] = ["fields.npz", "kymograph.svg", "omega.svg", "truth.svg", "truth_errors.svg"];
+
+/// What the full audit may write by default [bytes]: 200 MB (issue 30; it wrote 2.9 GB with
+/// `fields.csv` and VTK for every frame of every clip point).
+pub const FULL_AUDIT_BUDGET_BYTES: u64 = 200_000_000;
+
+/// Bytes of the files under `dir` (the audit folder's size, printed in REPORT.md).
+pub fn folder_bytes(dir: &Path) -> u64 {
+    std::fs::read_dir(dir)
+        .into_iter()
+        .flatten()
+        .flatten()
+        .map(|e| match e.file_type() {
+            Ok(t) if t.is_dir() => folder_bytes(&e.path()),
+            Ok(_) => e.metadata().map(|m| m.len()).unwrap_or(0),
+            Err(_) => 0,
+        })
+        .sum()
 }
 
 /// The spec files of a folder (`*.toml`, sorted).
@@ -215,6 +311,7 @@ struct Job<'a> {
     point: Point,
     case: crate::case::Case,
     dir: PathBuf,
+    fields: PointFields,
 }
 
 /// Run every point of every run of `specs` in parallel (clip runs first: they are the longest),
@@ -227,19 +324,25 @@ pub fn run_audit(
     progress: impl Fn(usize, usize) + Sync,
 ) -> Result<AuditReport, AuditError> {
     let start = std::time::Instant::now();
+    let reused: Vec<Option<(Vec<ClaimResult>, Vec<String>)>> =
+        specs.iter().map(|s| if opts.resume { resume::load(s, quick, &opts.out) } else { None }).collect();
     let mut jobs: Vec<Job> = Vec::new();
-    for (i, spec) in specs.iter().enumerate() {
+    for (i, spec) in specs.iter().enumerate().filter(|(i, _)| reused[*i].is_none()) {
         for run in &spec.runs {
             let grid_err = |source| AuditError::Grid { spec: spec.name.clone(), run: run.name.clone(), source };
             let points = product(&run.case, &run.grid).map_err(grid_err)?;
             for (point, case) in points {
                 let label = if point.is_empty() { "run".to_string() } else { case.name.clone() };
                 let dir = opts.out.join(&spec.name).join(&run.name).join(&label);
-                jobs.push(Job { spec: i, run, point, case, dir });
+                jobs.push(Job { spec: i, run, point, case, dir, fields: opts.fields });
             }
         }
     }
-    prepare_folder(&opts.out)?;
+    if opts.resume {
+        resume_folder(&opts.out, specs, &reused)?;
+    } else {
+        prepare_folder(&opts.out)?;
+    }
     jobs.sort_by_key(|j| j.case.clip().is_none());
     let total = jobs.len();
     let done = std::sync::atomic::AtomicUsize::new(0);
@@ -272,46 +375,122 @@ pub fn run_audit(
             rr.points.push(r);
         }
     }
-    check_metric_names(specs, &results)?;
-    let mut claims = Vec::new();
-    let mut figures = Vec::new();
-    for (spec, runs) in specs.iter().zip(&results) {
-        let written = figures::write_figures(spec, runs, &opts.out.join(&spec.name))
-            .map_err(|(file, source)| AuditError::Figure { spec: spec.name.clone(), file, source: Box::new(source) })?;
-        figures.extend(written.iter().map(|f| format!("{}/{f}", spec.name)));
-        for claim in &spec.claims {
-            claims.push(check::judge(spec, claim, runs));
-        }
-    }
-    let report = AuditReport { claims, figures, quick, wall_time_s: start.elapsed().as_secs_f64() };
+    let interrupted = crate::interrupt::requested();
+    let (claims, figures, failures) = judge_all(specs, &results, &opts.out, reused, quick);
+    let status = if interrupted {
+        AuditStatus::Interrupted
+    } else if failures.is_empty() {
+        AuditStatus::Complete
+    } else {
+        AuditStatus::Failed(failures)
+    };
+    let report = AuditReport {
+        claims,
+        figures,
+        quick,
+        wall_time_s: start.elapsed().as_secs_f64(),
+        status,
+        bytes: folder_bytes(&opts.out),
+        fields: opts.fields,
+        coverage: None,
+    };
+    let report = AuditReport { coverage: coverage(specs, &report.claims), ..report };
     report::write_report(&report, &opts.out)?;
     Ok(report)
 }
 
-/// Every metric a claim reads is reported by some point of its runs that has metrics (a typo
-/// in a spec is an error naming it, not a claim judged on a missing number).
-fn check_metric_names(specs: &[Spec], results: &[Vec<RunResults>]) -> Result<(), AuditError> {
-    for (spec, runs) in specs.iter().zip(results) {
-        for claim in &spec.claims {
-            let Some(metric) = claim.check.metric() else { continue };
-            for run in claim.check.runs() {
-                let Some(rr) = runs.iter().find(|r| r.name == run) else { continue };
-                let reported: Vec<&crate::run::metrics::Metrics> =
-                    rr.points.iter().filter_map(|p| p.outcome.metrics.as_ref()).collect();
-                if reported.is_empty() || reported.iter().any(|m| m.contains_key(metric)) {
-                    continue;
-                }
-                let known: std::collections::BTreeSet<&str> =
-                    reported.iter().flat_map(|m| m.keys().map(String::as_str)).collect();
-                return Err(AuditError::UnknownMetric {
-                    path: spec.path.clone(),
-                    claim: claim.id.clone(),
-                    metric: metric.to_string(),
-                    run: run.to_string(),
-                    known: known.into_iter().collect::<Vec<_>>().join(", "),
-                });
+/// The claims inventory beside the first spec, against the claims judged.
+fn coverage(specs: &[Spec], claims: &[ClaimResult]) -> Option<Result<inventory::Coverage, String>> {
+    let path = specs.first()?.path.parent()?.join(inventory::INVENTORY);
+    path.is_file().then(|| {
+        inventory::read_inventory(&path).map(|e| inventory::Coverage::new(e, claims)).map_err(|e| e.to_string())
+    })
+}
+
+/// Judge every claim of `specs` on `results` and draw every figure of the specs whose points
+/// all finished (none stopped by a signal); a spec taken from the audit being resumed
+/// (`reused`) keeps its claims and figures. A claim whose metric no point reports, or that
+/// reads a point a signal stopped, is not judged; the failures (metric typos, figures not
+/// written) are returned as text. A spec judged whole is recorded for `--resume`.
+fn judge_all(
+    specs: &[Spec],
+    results: &[Vec<RunResults>],
+    out: &Path,
+    reused: Vec<Option<(Vec<ClaimResult>, Vec<String>)>>,
+    quick: bool,
+) -> (Vec<ClaimResult>, Vec<String>, Vec<String>) {
+    let (mut claims, mut figures, mut failures) = (Vec::new(), Vec::new(), Vec::new());
+    for ((spec, runs), old) in specs.iter().zip(results).zip(reused) {
+        if let Some((c, f)) = old {
+            claims.extend(c);
+            figures.extend(f);
+            continue;
+        }
+        let whole = runs.iter().all(|r| r.points.iter().all(|p| !check::stopped(p)));
+        if whole {
+            match figures::write_figures(spec, runs, &out.join(&spec.name)) {
+                Ok(written) => figures.extend(written.iter().map(|f| format!("{}/{f}", spec.name))),
+                Err((file, e)) => failures.push(format!("spec {}: figure {file}: {e}", spec.name)),
             }
         }
+        let first = claims.len();
+        for claim in &spec.claims {
+            let mut c = check::judge(spec, claim, runs);
+            if let Err(e) = check_metric_name(spec, claim, runs) {
+                c.ours = format!("not judged: {e}");
+                c.verdict = None;
+                failures.push(e.to_string());
+            }
+            claims.push(c);
+        }
+        if whole && failures.is_empty() {
+            if let Err(e) = resume::store(spec, &claims[first..], &figures, quick, out) {
+                failures.push(format!("spec {}: {e}", spec.name));
+            }
+        }
+    }
+    (claims, figures, failures)
+}
+
+/// The folder of an audit being resumed: the folders of the specs that run again are emptied
+/// (no point of the interrupted audit is mixed with new ones).
+fn resume_folder(
+    out: &Path,
+    specs: &[Spec],
+    reused: &[Option<(Vec<ClaimResult>, Vec<String>)>],
+) -> Result<(), AuditError> {
+    let io = |source| AuditError::Folder { path: out.to_path_buf(), source };
+    std::fs::create_dir_all(out).map_err(io)?;
+    std::fs::write(out.join(MARKER), "written by `cosserat audit`; replaced whole by the next audit\n").map_err(io)?;
+    for (spec, old) in specs.iter().zip(reused) {
+        let dir = out.join(&spec.name);
+        if old.is_none() && dir.exists() {
+            std::fs::remove_dir_all(&dir).map_err(io)?;
+        }
+    }
+    Ok(())
+}
+
+/// The metric a claim reads is reported by some point of its runs that has metrics (a typo
+/// in a spec is an error naming it, not a claim judged on a missing number).
+fn check_metric_name(spec: &Spec, claim: &Claim, runs: &[RunResults]) -> Result<(), AuditError> {
+    let Some(metric) = claim.check.metric() else { return Ok(()) };
+    for run in claim.check.runs() {
+        let Some(rr) = runs.iter().find(|r| r.name == run) else { continue };
+        let reported: Vec<&crate::run::metrics::Metrics> =
+            rr.points.iter().filter_map(|p| p.outcome.metrics.as_ref()).collect();
+        if reported.is_empty() || reported.iter().any(|m| m.contains_key(metric)) {
+            continue;
+        }
+        let known: std::collections::BTreeSet<&str> =
+            reported.iter().flat_map(|m| m.keys().map(String::as_str)).collect();
+        return Err(AuditError::UnknownMetric {
+            path: spec.path.clone(),
+            claim: claim.id.clone(),
+            metric: metric.to_string(),
+            run: run.to_string(),
+            known: known.into_iter().collect::<Vec<_>>().join(", "),
+        });
     }
     Ok(())
 }
@@ -323,7 +502,13 @@ fn run_job(j: &Job) -> PointResult {
     let template = point_manifest("audit point", &j.case, &j.point);
     let (mut outcome, series) = if j.case.clip().is_some() {
         let mut recorder = ClipRecorder::new(&j.run.keep_frames);
-        let outcome = run_clip_point(&j.case, &j.dir, &template, |frame| recorder.record(frame));
+        let format = if j.fields == PointFields::Vtk { OutputFormat::Csv } else { OutputFormat::Compact };
+        let outcome = run_clip_point(&j.case, &j.dir, &template, format, |frame| recorder.record(frame));
+        if j.fields == PointFields::Tables {
+            for f in BULKY {
+                let _ = std::fs::remove_file(j.dir.join(f));
+            }
+        }
         (outcome, Some(recorder.finish()))
     } else {
         (run_point(&j.case, &j.dir, &template), None)

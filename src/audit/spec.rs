@@ -102,10 +102,17 @@ struct RawClaim {
     expect: Verdict,
     #[serde(default)]
     if_fails: Option<Verdict>,
+    #[serde(default)]
+    if_partly: Option<Verdict>,
     cause: Option<String>,
     not_computable: Option<String>,
     substitute: Option<String>,
     figure: Option<String>,
+    /// the check is weaker than the paper's words: why (the verdict is at best "differs")
+    partial: Option<String>,
+    /// a check of ours, not a claim of the paper (e.g. second order in time): its own table
+    #[serde(default)]
+    ours: bool,
 }
 
 /// A grid point by its values (`{ lambda_d = 1e-2 }`); empty: the run's only point.
@@ -159,6 +166,16 @@ pub enum Check {
         #[serde(default)]
         with: Vec<String>,
     },
+    /// `metric` has the order of magnitude of `value` at every selected point:
+    /// |log10(|metric| / value)| ≤ `orders`
+    Magnitude {
+        run: String,
+        metric: String,
+        value: f64,
+        orders: f64,
+        #[serde(default)]
+        at: Selector,
+    },
     /// the histories of `history` (an inverse run's per-iteration record) agree with the
     /// reference point's to a relative spread ≤ `limit` over their common iterations
     SameHistories { run: String, history: String, reference: Selector, limit: f64 },
@@ -173,7 +190,8 @@ impl Check {
             | Check::Increasing { metric, .. }
             | Check::RatioAbove { metric, .. }
             | Check::RatioBelow { metric, .. }
-            | Check::WithinFactor { metric, .. } => Some(metric),
+            | Check::WithinFactor { metric, .. }
+            | Check::Magnitude { metric, .. } => Some(metric),
             Check::Converges { .. } | Check::DoesNotConverge { .. } | Check::SameHistories { .. } => None,
         }
     }
@@ -186,6 +204,7 @@ impl Check {
             | Check::Below { run, .. }
             | Check::Above { run, .. }
             | Check::Increasing { run, .. }
+            | Check::Magnitude { run, .. }
             | Check::SameHistories { run, .. } => vec![run],
             Check::WithinFactor { run, with, .. } => std::iter::once(run).chain(with).map(|s| s.as_str()).collect(),
             Check::RatioAbove { numerator, denominator, .. } | Check::RatioBelow { numerator, denominator, .. } => {
@@ -296,6 +315,9 @@ pub struct Claim {
     pub expect: Verdict,
     /// the verdict when the check fails outright (default: differs)
     pub if_fails: Verdict,
+    /// the verdict when the check holds on some points of the paper's range only (default:
+    /// differs; "refuted" for a range the scheme fails on in part, e.g. eq. (65) finding (4))
+    pub if_partly: Verdict,
     /// why our number differs (reported with any verdict but reproduced)
     pub cause: Option<String>,
     /// what of the paper is not available here (its data, its code): the check runs on the
@@ -305,6 +327,10 @@ pub struct Claim {
     pub substitute: Option<String>,
     /// a figure file of the spec illustrating the claim
     pub figure: Option<String>,
+    /// the check is weaker than the paper's words: why. Such a claim is at best "differs".
+    pub partial: Option<String>,
+    /// a check of ours, not a claim of the paper: reported in its own table, counted apart
+    pub ours: bool,
 }
 
 /// A validated audit spec.
@@ -395,6 +421,18 @@ pub fn read_spec(path: &Path, quick: bool) -> Result<Spec, SpecError> {
                     .into(),
             ));
         }
+        if c.partial.is_some() && matches!(c.expect, Verdict::Reproduced | Verdict::NotComputable) {
+            return Err(invalid(
+                format!("claim `{}`", c.id),
+                "a partial check (weaker than the paper's words) yields at best \"differs\": expect cannot be reproduced or not computable".into(),
+            ));
+        }
+        if let Some(q) = ["(here", "(ours", "(our "].iter().find(|q| c.statement.contains(*q)) {
+            return Err(invalid(
+                format!("claim `{}`", c.id),
+                format!("the statement quotes the paper verbatim; `{q}…` is ours: put it in `paper` or `partial`"),
+            ));
+        }
         claims.push(Claim {
             id: c.id,
             location: c.location,
@@ -403,10 +441,13 @@ pub fn read_spec(path: &Path, quick: bool) -> Result<Spec, SpecError> {
             check: c.check,
             expect: c.expect,
             if_fails: c.if_fails.unwrap_or(Verdict::Differs),
+            if_partly: c.if_partly.unwrap_or(Verdict::Differs),
             cause: c.cause,
             not_computable: c.not_computable,
             substitute: c.substitute,
             figure: c.figure,
+            partial: c.partial,
+            ours: c.ours,
         });
     }
     for p in &raw.figures {

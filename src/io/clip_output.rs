@@ -123,9 +123,9 @@ impl ClipWriter {
     pub fn create(dir: &Path, truth: bool, journal: bool, format: OutputFormat) -> Result<Self, OutputError> {
         let err = |path: PathBuf| move |source| OutputError::Io { path: path.clone(), source };
         let compact = format == OutputFormat::Compact;
-        if !compact {
-            std::fs::create_dir_all(dir.join("vtk")).map_err(err(dir.join("vtk")))?;
-        }
+        // the folder itself too: a sweep's or an audit's point has none before its first file
+        let made = if compact { dir.to_path_buf() } else { dir.join("vtk") };
+        std::fs::create_dir_all(&made).map_err(err(made.clone()))?;
         let open = |name: &str, header: &str| -> Result<std::io::BufWriter<std::fs::File>, OutputError> {
             let p = dir.join(name);
             let mut f = std::io::BufWriter::new(std::fs::File::create(&p).map_err(err(p.clone()))?);

@@ -255,9 +255,12 @@ pub fn list_files(dir: &Path) -> Result<Vec<String>, FolderError> {
 }
 
 /// Can the run of `previous` be continued by the run described by `new`? The same command
-/// (`run`) on the same case file and inputs, a clip, not complete.
+/// (`run`) on the same case file and inputs, a clip, not complete; or an audit (`audit
+/// --resume`, `crate::audit::resume`) on the same specs, not complete.
 pub(super) fn check_resumable(previous: &Manifest, new: &Manifest) -> Result<(), String> {
-    if previous.command != "run" || previous.frames_done.is_none() {
+    let clip = previous.command == "run" && previous.frames_done.is_some();
+    let audit = previous.command == "audit" && new.command == "audit";
+    if !(clip || audit) {
         return Err(format!("it holds a `{}` run, not a clip run (only clips resume)", previous.command));
     }
     if previous.status.is_complete() {

@@ -116,9 +116,11 @@ pub fn run_clip_point(
     case: &Case,
     dir: &Path,
     template: &Manifest,
+    format: super::compact::OutputFormat,
     observer: impl FnMut(&ClipFrame) + Send,
 ) -> SweepOutcome {
-    finish_point(dir, template, case, solve_into(case, Engine::Rust, dir, ClipOptions::default(), observer, |_, _| {}))
+    let opts = ClipOptions { format, ..ClipOptions::default() };
+    finish_point(dir, template, case, solve_into(case, Engine::Rust, dir, opts, observer, |_, _| {}))
 }
 
 /// The `run.json` of a point of `command` (a sweep, an audit): the case and its file's hash,
