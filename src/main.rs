@@ -80,7 +80,7 @@ enum Command {
         short: bool,
         /// Clip cases: frames to compare, a number or `all` [default: the case's
         /// `[compare] frames`, 10]
-        #[arg(long, value_parser = parse_frames)]
+        #[arg(long, value_parser = cli::parse_frames)]
         frames: Option<usize>,
         /// Replace the output directory even if it holds files but no run.json
         #[arg(long)]
@@ -187,7 +187,7 @@ enum Command {
         /// Case file (TOML); loads and time settings are ignored
         case: PathBuf,
         /// How many modes to print (at least 1)
-        #[arg(long, default_value_t = 10, allow_hyphen_values = true, value_parser = parse_count)]
+        #[arg(long, default_value_t = 10, allow_hyphen_values = true, value_parser = cli::parse_count)]
         count: usize,
         #[command(flatten)]
         limits: Limits,
@@ -299,25 +299,6 @@ fn cmd_run(
         eprintln!("note: {n}");
     }
     cli::outcome::run_end(end, (&case, engine), path, &dir, strict)
-}
-
-/// `--count`: a positive number.
-fn parse_count(s: &str) -> Result<usize, String> {
-    match s.parse::<usize>() {
-        Ok(n) if n > 0 => Ok(n),
-        _ => Err(format!("expected a number of modes >= 1, got `{s}`")),
-    }
-}
-
-/// `--frames`: a positive count or `all`.
-fn parse_frames(s: &str) -> Result<usize, String> {
-    if s == "all" {
-        return Ok(usize::MAX);
-    }
-    match s.parse::<usize>() {
-        Ok(n) if n > 0 => Ok(n),
-        _ => Err(format!("expected a number of frames >= 1 or `all`, got `{s}`")),
-    }
 }
 
 fn cmd_compare(

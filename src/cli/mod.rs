@@ -269,3 +269,22 @@ pub fn keep_freed_memory() {
         }
     }
 }
+
+/// `--count`: a positive number.
+pub fn parse_count(s: &str) -> Result<usize, String> {
+    match s.parse::<usize>() {
+        Ok(n) if n > 0 => Ok(n),
+        _ => Err(format!("expected a number of modes >= 1, got `{s}`")),
+    }
+}
+
+/// `--frames`: a positive count or `all`.
+pub fn parse_frames(s: &str) -> Result<usize, String> {
+    if s == "all" {
+        return Ok(usize::MAX);
+    }
+    match s.parse::<usize>() {
+        Ok(n) if n > 0 => Ok(n),
+        _ => Err(format!("expected a number of frames >= 1 or `all`, got `{s}`")),
+    }
+}

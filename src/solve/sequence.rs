@@ -9,6 +9,7 @@
 //! the paper's chart. Either way every frame is guarded: a frame whose recovered β comes within
 //! `min_cos_beta` of ±π/2 at any node stops the clip with an error naming frame and node (the
 //! failure is otherwise silent: the fit stays good while α and κ3 explode, PAPER-NOTES).
+pub use super::smoothing::{frame_geometry, NOISY_GEOMETRY};
 use std::f64::consts::PI;
 
 use nalgebra::{DVector, Matrix3, Vector3};
@@ -168,28 +169,6 @@ pub fn frame_chart(sp: &SequenceParams, prev: Option<&Chart>, x_space: &[Vector3
         (RotationTreatment::Rebased, Some(c)) => {
             Chart::with_axis(&frame_axis(&frame_geometry(x_space, length_m), Some(&c.axis())))
         }
-    }
-}
-
-/// A frame's noise level over its node spacing above which its chart axis and its data guess
-/// are taken from its smoothed centreline ([`frame_geometry`], `docs/noise.md` N8).
-pub const NOISY_GEOMETRY: f64 = 0.1;
-
-/// The centreline a frame's chart axis ([`frame_chart`]) and data guess ([`data_frame_guess`])
-/// are taken from (`docs/noise.md` N8): the data `x`, or, where their noise level
-/// ([`crate::solve::fit::noise_level`]) exceeds [`NOISY_GEOMETRY`] times the node spacing of a
-/// rod of `length_m`, the knot values of their GCV smoothing spline (`solve::smoothing`). A
-/// noisy chord's direction is noise: at σ = 10 µm on 128 nodes of 1 mm (h = 7.9 µm) the raw
-/// tangents point anywhere, no chart axis keeps away from all of them, and the guess's angles
-/// are noise. The tracking term of (41) still sees the data themselves.
-pub fn frame_geometry(x: &[Vector3<f64>], length_m: f64) -> std::borrow::Cow<'_, [Vector3<f64>]> {
-    let h = length_m / (x.len().max(2) - 1) as f64;
-    if super::fit::noise_level(x) <= NOISY_GEOMETRY * h {
-        return std::borrow::Cow::Borrowed(x);
-    }
-    match super::smoothing::SmoothingSpline::fit_uniform(x, length_m) {
-        Some(s) => std::borrow::Cow::Owned(s.knot_values().to_vec()),
-        None => std::borrow::Cow::Borrowed(x),
     }
 }
 
