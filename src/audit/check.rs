@@ -39,6 +39,17 @@ pub fn sig2(x: f64) -> String {
     }
 }
 
+/// `metric` at each point, `label: value` joined by commas (no label for a single point).
+fn metric_list(pts: &[&PointResult], metric: &str) -> String {
+    pts.iter()
+        .map(|p| {
+            let label = if pts.len() == 1 { String::new() } else { format!("{}: ", point_label(p)) };
+            format!("{label}{}", metric_text(p, metric))
+        })
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
 /// A point's label for the report: `λd = 1e-2` style from its grid values (`key=value`).
 fn point_label(p: &PointResult) -> String {
     if p.point.is_empty() {
@@ -184,14 +195,7 @@ fn evaluate_inner(check: &Check, runs: &[RunResults]) -> Result<(Outcome, String
                 |p: &PointResult| p.metric(metric).is_some_and(|v| if below { v <= *limit } else { v >= *limit });
             let (ok, _) = split_by(&pts, pass);
             let rel = if below { "≤" } else { "≥" };
-            let list = pts
-                .iter()
-                .map(|p| {
-                    let label = if pts.len() == 1 { String::new() } else { format!("{}: ", point_label(p)) };
-                    format!("{label}{}", metric_text(p, metric))
-                })
-                .collect::<Vec<_>>()
-                .join(", ");
+            let list = metric_list(&pts, metric);
             (outcome(ok.len(), pts.len()), format!("{metric} {list} (claim: {rel} {})", sig2(*limit)))
         }
         Check::Increasing { run, metric } => {
@@ -276,14 +280,7 @@ fn evaluate_inner(check: &Check, runs: &[RunResults]) -> Result<(Outcome, String
             let pts = select(runs, run, at)?;
             let apart = |p: &PointResult| p.metric(metric).map(|v| (v.abs() / value).log10().abs());
             let (ok, _) = split_by(&pts, |p| apart(p).is_some_and(|o| o <= *orders));
-            let list = pts
-                .iter()
-                .map(|p| {
-                    let label = if pts.len() == 1 { String::new() } else { format!("{}: ", point_label(p)) };
-                    format!("{label}{}", metric_text(p, metric))
-                })
-                .collect::<Vec<_>>()
-                .join(", ");
+            let list = metric_list(&pts, metric);
             let text =
                 format!("{metric} {list} (claim: within {} orders of magnitude of {})", sig2(*orders), sig2(*value));
             (outcome(ok.len(), pts.len()), text)
