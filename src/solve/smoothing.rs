@@ -75,6 +75,24 @@ impl Smoother {
         Smoother { h, u: eig.eigenvectors, d }
     }
 
+    /// [`Smoother::new`] of the knots `t`, kept per thread for the last knots asked for: the
+    /// frames of one recording share their knots ([`SmoothingSpline::fit_uniform`]), so the
+    /// O(n³) eigen-decomposition runs once per recording, not once per frame (the same numbers).
+    fn cached(t: &[f64]) -> std::rc::Rc<Smoother> {
+        thread_local! {
+            static LAST: std::cell::RefCell<Option<(Vec<f64>, std::rc::Rc<Smoother>)>> = const { std::cell::RefCell::new(None) };
+        }
+        LAST.with(|last| {
+            let mut last = last.borrow_mut();
+            if let Some((_, s)) = last.as_ref().filter(|(knots, _)| knots.as_slice() == t) {
+                return s.clone();
+            }
+            let s = std::rc::Rc::new(Smoother::new(t));
+            *last = Some((t.to_vec(), s.clone()));
+            s
+        })
+    }
+
     fn gcv(&self, z: &DVector<f64>, p: f64) -> f64 {
         let (mut rss, mut tr) = (0.0, 0.0);
         for (dk, zk) in self.d.iter().zip(z.iter()) {
@@ -161,7 +179,7 @@ impl SmoothingSpline {
         {
             return None;
         }
-        let s = Smoother::new(&t);
+        let s = Smoother::cached(&t);
         let mut g = vec![Vector3::zeros(); n];
         let mut gamma = vec![Vector3::zeros(); n];
         let mut p = Vector3::zeros();
