@@ -176,7 +176,7 @@ pub struct AuditReport {
     pub fields: PointFields,
     /// the claims inventory beside the specs (`inventory.csv`) against the rows, if there is
     /// one; `Err`: it could not be read (the report says so)
-    pub coverage: Option<Result<inventory::Coverage, String>>,
+    pub coverage: Option<Result<inventory::Coverage, inventory::InventoryError>>,
 }
 
 impl AuditReport {
@@ -400,11 +400,9 @@ pub fn run_audit(
 }
 
 /// The claims inventory beside the first spec, against the claims judged.
-fn coverage(specs: &[Spec], claims: &[ClaimResult]) -> Option<Result<inventory::Coverage, String>> {
+fn coverage(specs: &[Spec], claims: &[ClaimResult]) -> Option<Result<inventory::Coverage, inventory::InventoryError>> {
     let path = specs.first()?.path.parent()?.join(inventory::INVENTORY);
-    path.is_file().then(|| {
-        inventory::read_inventory(&path).map(|e| inventory::Coverage::new(e, claims)).map_err(|e| e.to_string())
-    })
+    path.is_file().then(|| inventory::read_inventory(&path).map(|e| inventory::Coverage::new(e, claims)))
 }
 
 /// Judge every claim of `specs` on `results` and draw every figure of the specs whose points

@@ -28,6 +28,8 @@ pub enum OutputError {
     },
     #[error("cannot write {path}: {reason}")]
     Invalid { path: PathBuf, reason: String },
+    #[error("cannot write {path}: {reason}")]
+    Zip { path: PathBuf, reason: super::compact::ZipError },
     /// a part of the output (a sweep's point) could not be written for want of space
     #[error("{path}: {message}")]
     DiskFull { path: PathBuf, message: String },
@@ -54,9 +56,11 @@ pub enum InputError {
     #[error("{path}, row {row}: {reason}")]
     Row { path: PathBuf, row: usize, reason: String },
     #[error("{path}: not a little-endian float64 C-order .npy file: {reason}")]
-    Npy { path: PathBuf, reason: String },
+    Npy { path: PathBuf, reason: Box<super::npy::NpyError> },
     #[error("{path}: {reason}")]
     Shape { path: PathBuf, reason: String },
+    #[error("{path}: {reason}")]
+    Compact { path: PathBuf, reason: Box<super::compact::CompactError> },
     #[error("{path}, frame {frame}, joint {joint}: angle {value} is not finite")]
     NonFiniteAngle { path: PathBuf, frame: usize, joint: usize, value: f64 },
     #[error(
