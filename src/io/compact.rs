@@ -15,7 +15,8 @@ use std::path::{Path, PathBuf};
 use rayon::prelude::*;
 
 use super::files::{read_capped, write_atomic, InputError, OutputError};
-use super::npy::{npy_header, npy_payload, NpyError};
+pub use super::files::{CompactError, ZipError};
+use super::npy::{npy_header, npy_payload};
 
 /// The compact file in a clip's output folder.
 pub const COMPACT_FILE: &str = "fields.npz";
@@ -27,42 +28,6 @@ pub const RAW_CURVATURE: &str = "curvature.f64";
 pub const CURVATURE_COLUMNS: [&str; 4] = ["s_mid_m", "kappa1_per_m", "kappa2_per_m", "kappa3_per_m"];
 /// Largest `fields.npz` read [bytes]: 4 GiB (what a zip without its 64-bit extension holds).
 pub const COMPACT_FILE_CAP_BYTES: u64 = 1 << 32;
-
-/// Why `fields.npz` could not be made; the file's name is the caller's ([`OutputError::Zip`]).
-#[derive(Debug, thiserror::Error)]
-pub enum ZipError {
-    #[error("deflate: {0}")]
-    Deflate(flate2::CompressError),
-    /// `what`: a member's name, "the archive" or "the directory"
-    #[error("{what} exceeds 4 GiB (zip without Zip64)")]
-    TooLarge { what: String },
-    #[error("more than 65535 members ({count})")]
-    TooManyMembers { count: usize },
-}
-
-/// Why the bytes of a `fields.npz` are not a compact clip; the file's name is the caller's
-/// ([`InputError::Compact`]), the member's is in the variant.
-#[derive(Debug, thiserror::Error)]
-pub enum CompactError {
-    #[error("not a zip archive (no end of central directory)")]
-    NotZip,
-    #[error("truncated zip")]
-    Truncated,
-    #[error("corrupt zip central directory")]
-    CorruptDirectory,
-    #[error("{name}: truncated")]
-    MemberTruncated { name: String },
-    #[error("{name}: {error}")]
-    Inflate { name: String, error: std::io::Error },
-    #[error("{name}: compression method {method} (expected deflate)")]
-    Method { name: String, method: usize },
-    #[error("{name}: size or CRC does not match (corrupt archive)")]
-    Corrupt { name: String },
-    #[error("{name}: {reason}")]
-    Npy { name: String, reason: NpyError },
-    #[error("{name}: unexpected array {descr} {shape:?}")]
-    UnexpectedArray { name: String, descr: String, shape: Vec<usize> },
-}
 
 /// How the per-node output of a clip is written.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum, serde::Serialize, serde::Deserialize)]

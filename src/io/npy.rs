@@ -13,64 +13,14 @@
 //! is an error that says what was found; no value is guessed or converted.
 use std::path::Path;
 
-use super::files::{read_capped, write_atomic, InputError, OutputError};
+pub use super::files::NpyError;
+use super::files::{read_capped, write_atomic, InputError, OutputError, MAX_AXES};
 
 const MAGIC: &[u8] = b"\x93NUMPY";
 
 /// Largest `.npy` file read [bytes]: 1 GiB. The elegansbot kymograms are 58 KB and 115 KB; the
 /// paper's clip as a recording (1160 frames × 128 nodes × 3 float64) is 3.6 MB.
 pub const NPY_FILE_CAP_BYTES: u64 = 1 << 30;
-
-/// Why the bytes of an `.npy` file are not a C-order array this reader takes; the file's name
-/// is the caller's ([`InputError::Npy`]). Text from the file is shown by its first 40
-/// characters.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum NpyError {
-    #[error("missing the magic string \\x93NUMPY (not an .npy file, or truncated)")]
-    NoMagic,
-    #[error("truncated in the header length")]
-    TruncatedHeaderLength,
-    #[error("format version {major}.x is not supported (1.0, 2.0 or 3.0)")]
-    Version { major: u8 },
-    #[error("truncated: the header is {header_len} bytes, the file ends before it does")]
-    TruncatedHeader { header_len: usize },
-    #[error("the header is not text")]
-    HeaderNotText,
-    #[error("Fortran-order array (fortran_order: True); expected C order")]
-    FortranOrder,
-    #[error("dtype '{descr}', expected little-endian float64 '<f8'")]
-    Dtype { descr: String },
-    #[error("shape overflows")]
-    ShapeOverflow,
-    #[error("truncated: shape {shape:?} needs {expected} data bytes, the file has {found}")]
-    TruncatedData { shape: Vec<usize>, expected: usize, found: usize },
-    #[error("{extra} bytes after the data of shape {shape:?} ({expected} bytes)")]
-    TrailingBytes { extra: usize, shape: Vec<usize>, expected: usize },
-    #[error("header {header:?} is not a dictionary")]
-    NotDictionary { header: String },
-    #[error("header {header:?}: expected a quoted key at {at:?}")]
-    ExpectedKey { header: String, at: String },
-    #[error("header: key '{key}' given twice")]
-    DuplicateKey { key: String },
-    #[error("header: expected ':' after '{key}'")]
-    ExpectedColon { key: String },
-    #[error("header: 'descr' is not a quoted string (structured dtypes are not supported)")]
-    DescrNotString,
-    #[error("header: 'fortran_order' is neither True nor False at {at:?}")]
-    FortranNotBool { at: String },
-    #[error("header: 'shape' is not a tuple")]
-    ShapeNotTuple,
-    #[error("header: 'shape' tuple is not closed")]
-    ShapeNotClosed,
-    #[error("header: shape has more than {MAX_AXES} axes, the most an array has")]
-    TooManyAxes,
-    #[error("header: shape entry '{entry}' is not a non-negative integer")]
-    ShapeEntry { entry: String },
-    #[error("header: unknown key '{key}'")]
-    UnknownKey { key: String },
-    #[error("header has no '{key}'")]
-    MissingKey { key: &'static str },
-}
 
 /// A C-order float64 array read from an `.npy` file.
 #[derive(Debug, Clone, PartialEq)]
@@ -244,9 +194,6 @@ fn parse_header(header: &str) -> Result<(String, bool, Vec<usize>), NpyError> {
         shape.ok_or(NpyError::MissingKey { key: "shape" })?,
     ))
 }
-
-/// Most axes of an array (NumPy 2's `NPY_MAXDIMS`).
-const MAX_AXES: usize = 64;
 
 /// At most the first 40 characters of `s` (for messages about a malformed header).
 fn preview(s: &str) -> String {
