@@ -274,7 +274,7 @@ proptest! {
                 prop_assert_eq!(count, Some(a.data.len()));
                 prop_assert!(a.data.len() * 8 <= bytes.len());
             }
-            Err(reason) => prop_assert!(!reason.is_empty()),
+            Err(reason) => prop_assert!(!reason.to_string().is_empty()),
         }
         let file = scratch(&bytes, ".npy");
         match kymogram_rows(file.path()) {

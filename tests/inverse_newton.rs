@@ -269,7 +269,9 @@ fn newton_converges_on_eq65() {
 /// Measured: from the fixed point's iterate at 3e-6 every step is cut to t ≈ 1e-3 by the line
 /// search and the residual does not fall; the equilibrated Jacobian has σ ≈ 8e-10 (σ_max ≈ 3.9)
 /// for a nodal zig-zag of β that the one-point stretch–shear rule cannot see and Λκ1 = 0 does
-/// not penalise. This asserts the measured failure, as a clear error naming the frame.
+/// not penalise. This asserts the measured failure, as a clear error naming the frame. The
+/// spectrum itself: `SVD=1 cargo run --release --example newton_stall -- cases/inverse_bend.toml
+/// -1 3e-6 1`.
 #[test]
 fn newton_on_eq64_paper_parameters_fails_with_a_clear_error() {
     let case = case_from(&case_text("follower_bend_64"), "f64");
@@ -294,56 +296,6 @@ fn newton_on_eq64_paper_parameters_fails_with_a_clear_error() {
     assert!(text.contains("frame 7") && text.contains("after 15 iterations"), "{text}");
     let smallest = hist.iter().map(|r| r.residual.unwrap_or(f64::NAN)).fold(f64::INFINITY, f64::min);
     assert!(smallest > 1e-2, "the residual fell to {smallest:e}: Newton now converges, update I8");
-}
-
-#[test]
-#[ignore = "diagnostic: smallest singular values of the equilibrated Jacobian (dense SVD, slow)"]
-fn jacobian_spectrum_eq64() {
-    let case = case_from(&case_text("follower_bend_64"), "f64");
-    let p = case.problem();
-    let (_fwd, xg) = common::forward_data(&case, 5);
-    let n = case.mesh.nodes();
-    let prev = vec![Vector3::zeros(); n];
-    let params = paper_params_64();
-    let tol_fp: f64 = std::env::var("FPTOL").map(|s| s.parse().unwrap()).unwrap_or(3e-6);
-    let fp_params = InverseParams { tolerance: tol_fp, max_iterations: 20000, ..params };
-    let fp = solve_frame_any(&p, &fp_params, &xg, None, &p.reference_state(), Start::Guess, |_| {}).expect("fp");
-    eprintln!("fp iterations {}", fp.history.len());
-    let kd = case.mesh.kkt_dofs();
-    const BLOCK: usize = 12;
-    let big = kkt_vector(&kd, &fp.u, &fp.adjoint);
-    let pattern = kd.pattern();
-    let mut values = vec![0.0; pattern.nnz()];
-    let frame = Frame { index: 0, x_g: &xg, previous: None, weight: None };
-    let r = newton_residual(&p, &params, &frame, &prev, &big, Some((&pattern, &mut values)));
-    let (a, dr, dc) = LinearSolver::new(&pattern).equilibrate(&values);
-    let m = pattern.to_dense(&a);
-    let svd = m.clone().svd(true, true);
-    let mut idx: Vec<usize> = (0..svd.singular_values.len()).collect();
-    idx.sort_by(|&i, &j| svd.singular_values[i].partial_cmp(&svd.singular_values[j]).unwrap());
-    let rs = DVector::from_fn(r.len(), |i, _| r[i] * dr[i]);
-    eprintln!("|D_r R| {:.3e}, sigma max {:.3e}", rs.norm(), svd.singular_values.max());
-    let vt = svd.v_t.as_ref().unwrap();
-    let uu = svd.u.as_ref().unwrap();
-    for &k in idx.iter().take(6) {
-        let v = vt.row(k).transpose();
-        let kinds: Vec<String> =
-            (0..12).map(|c| format!("{:.2}", (0..n).map(|nd| v[BLOCK * nd + c].powi(2)).sum::<f64>().sqrt())).collect();
-        let proj = uu.column(k).dot(&rs);
-        let peak =
-            (0..n).max_by(|&a, &b| (v[BLOCK * a + 4].abs()).partial_cmp(&v[BLOCK * b + 4].abs()).unwrap()).unwrap();
-        if kinds[4] == "1.00" {
-            let shape: Vec<String> =
-                (0..n).map(|nd| format!("{:.3}", v[BLOCK * nd + 4] * dc[BLOCK * nd + 4] / dc[BLOCK * 4 + 4])).collect();
-            eprintln!("beta mode (unscaled): {}", shape.join(" "));
-        }
-        eprintln!(
-            "sigma {:.3e}: u_k·D_rR {proj:.3e}, weight per component {kinds:?}, beta peak node {peak}",
-            svd.singular_values[k]
-        );
-    }
-    let bd: Vec<String> = (0..n).map(|nd| format!("{:.2}", dc[BLOCK * nd + 4].log10())).collect();
-    eprintln!("log10 dc beta: {}", bd.join(" "));
 }
 
 /// The banded LU of `LinearSolver` on real KKT matrices of the inverse problem (the fixed

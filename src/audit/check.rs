@@ -98,21 +98,42 @@ fn metric_text(p: &PointResult, metric: &str) -> String {
     p.metric(metric).map(sig2).unwrap_or_else(|| "–".into())
 }
 
-/// The points of `run` selected by `at`, or an error text.
-fn select<'a>(runs: &'a [RunResults], run: &str, at: &Selector) -> Result<Vec<&'a PointResult>, String> {
-    let r = runs.iter().find(|r| r.name == run).ok_or_else(|| format!("no run `{run}`"))?;
+/// Why a check could not be evaluated on the runs' points (a spec that names a run, point,
+/// metric or history the runs do not have); the report says "not evaluated: …".
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum CheckError {
+    #[error("no run `{run}`")]
+    NoRun { run: String },
+    #[error("run `{run}` has no point {at:?}")]
+    NoPoint { run: String, at: Selector },
+    #[error("run `{run}` at {at:?} selects {count} points, not one")]
+    NotOnePoint { run: String, at: Selector, count: usize },
+    /// `point`: the point's label (`lambda_d = 1e-2`, `the run`)
+    #[error("`{metric}` missing at {point}")]
+    MissingMetric { metric: String, point: String },
+    #[error("`within_factor` needs two points or more (run `{run}` and `with`)")]
+    TooFewPoints { run: String },
+    #[error("`{metric}` missing at some points of `{run}`")]
+    MissingAtSomePoints { metric: String, run: String },
+    #[error("no `{history}` history at the reference point")]
+    NoHistory { history: String },
+}
+
+/// The points of `run` selected by `at`.
+fn select<'a>(runs: &'a [RunResults], run: &str, at: &Selector) -> Result<Vec<&'a PointResult>, CheckError> {
+    let r = runs.iter().find(|r| r.name == run).ok_or_else(|| CheckError::NoRun { run: run.to_string() })?;
     let pts: Vec<&PointResult> = r.select(at).collect();
     if pts.is_empty() {
-        return Err(format!("run `{run}` has no point {at:?}"));
+        return Err(CheckError::NoPoint { run: run.to_string(), at: at.clone() });
     }
     Ok(pts)
 }
 
-fn one<'a>(runs: &'a [RunResults], r: &Ref) -> Result<&'a PointResult, String> {
+fn one<'a>(runs: &'a [RunResults], r: &Ref) -> Result<&'a PointResult, CheckError> {
     let pts = select(runs, &r.run, &r.at)?;
     match pts.as_slice() {
         [p] => Ok(p),
-        _ => Err(format!("run `{}` at {:?} selects {} points, not one", r.run, r.at, pts.len())),
+        _ => Err(CheckError::NotOnePoint { run: r.run.clone(), at: r.at.clone(), count: pts.len() }),
     }
 }
 
@@ -157,170 +178,230 @@ fn iterations_range(pts: &[&PointResult], metric: &str) -> String {
     }
 }
 
-fn evaluate_inner(check: &Check, runs: &[RunResults]) -> Result<(Outcome, String), String> {
-    let empty = Selector::new();
-    Ok(match check {
-        Check::Converges { run } | Check::DoesNotConverge { run } => {
-            let pts = select(runs, run, &empty)?;
-            let (ok, bad) = split_by(&pts, |p| p.converged());
-            let count = if pts.iter().any(|p| p.outcome.clip.is_some()) { "frames" } else { "iterations" };
-            let mut text = String::new();
-            let key = key_of(&pts);
-            let named = |v: &[&PointResult]| {
-                if key.is_empty() {
-                    values(v)
-                } else {
-                    format!("{key} = {}", values(v))
-                }
-            };
-            if !ok.is_empty() {
-                text.push_str(&format!("converges for {}{}", named(&ok), iterations_range(&ok, count)));
-            }
-            for p in &bad {
-                if !text.is_empty() {
-                    text.push_str("; ");
-                }
-                text.push_str(&format!("{}: {}", named(&[p]), failure(p)));
-            }
-            let o = outcome(ok.len(), pts.len());
-            match check {
-                Check::DoesNotConverge { .. } => (outcome(bad.len(), pts.len()), text),
-                _ => (o, text),
-            }
+/// The outcome and text of `check`, one stage per kind of check.
+fn evaluate_inner(check: &Check, runs: &[RunResults]) -> Result<(Outcome, String), CheckError> {
+    match check {
+        Check::Converges { run } => converges(runs, run, false),
+        Check::DoesNotConverge { run } => converges(runs, run, true),
+        Check::Below { run, metric, limit, at } => threshold(runs, run, metric, *limit, at, true),
+        Check::Above { run, metric, limit, at } => threshold(runs, run, metric, *limit, at, false),
+        Check::Increasing { run, metric } => increasing(runs, run, metric),
+        Check::RatioAbove { metric, numerator, denominator, limit } => {
+            ratio(runs, metric, numerator, denominator, *limit, true)
         }
-        Check::Below { run, metric, limit, at } | Check::Above { run, metric, limit, at } => {
-            let below = matches!(check, Check::Below { .. });
-            let pts = select(runs, run, at)?;
-            let pass =
-                |p: &PointResult| p.metric(metric).is_some_and(|v| if below { v <= *limit } else { v >= *limit });
-            let (ok, _) = split_by(&pts, pass);
-            let rel = if below { "≤" } else { "≥" };
-            let list = metric_list(&pts, metric);
-            (outcome(ok.len(), pts.len()), format!("{metric} {list} (claim: {rel} {})", sig2(*limit)))
+        Check::RatioBelow { metric, numerator, denominator, limit } => {
+            ratio(runs, metric, numerator, denominator, *limit, false)
         }
-        Check::Increasing { run, metric } => {
-            let pts = select(runs, run, &empty)?;
-            let mut sorted = pts.clone();
-            sorted.sort_by(|a, b| {
-                let v = |p: &PointResult| p.point.first().and_then(|x| x.1.number()).unwrap_or(0.0);
-                v(a).total_cmp(&v(b))
-            });
-            let vals: Vec<Option<f64>> = sorted.iter().map(|p| p.metric(metric)).collect();
-            let rising = vals.windows(2).filter(|w| matches!((w[0], w[1]), (Some(a), Some(b)) if b > a)).count();
-            let text = format!(
-                "{metric} at {} = {}: {}",
-                key_of(&sorted),
-                values(&sorted),
-                sorted.iter().map(|p| metric_text(p, metric)).collect::<Vec<_>>().join(", ")
-            );
-            (outcome(rising, vals.len().saturating_sub(1)), text)
-        }
-        Check::RatioAbove { metric, numerator, denominator, limit }
-        | Check::RatioBelow { metric, numerator, denominator, limit } => {
-            let above = matches!(check, Check::RatioAbove { .. });
-            let (a, b) = (one(runs, numerator)?, one(runs, denominator)?);
-            let (va, vb) = (
-                a.metric(metric).ok_or_else(|| format!("`{metric}` missing at {}", point_label(a)))?,
-                b.metric(metric).ok_or_else(|| format!("`{metric}` missing at {}", point_label(b)))?,
-            );
-            let ratio = va / vb;
-            let pass = if above { ratio >= *limit } else { ratio <= *limit };
-            let text = format!(
-                "{metric}: {} ({}, {}) / {} ({}, {}) = {} (claim: {} {})",
-                sig2(va),
-                numerator.run,
-                point_label(a),
-                sig2(vb),
-                denominator.run,
-                point_label(b),
-                sig2(ratio),
-                if above { "≥" } else { "≤" },
-                sig2(*limit)
-            );
-            (if pass { Outcome::Holds } else { Outcome::Fails }, text)
-        }
-        Check::WithinFactor { run, metric, factor, with } => {
-            let mut pts = select(runs, run, &empty)?;
-            // (run, point) names for a check across runs
-            let mut names: Vec<String> = pts.iter().map(|p| format!("{run} {}", p.label)).collect();
-            for w in with {
-                let more = select(runs, w, &empty)?;
-                names.extend(more.iter().map(|p| format!("{w} {}", p.label)));
-                pts.extend(more);
-            }
-            if pts.len() < 2 {
-                return Err(format!("`within_factor` needs two points or more (run `{run}` and `with`)"));
-            }
-            // magnitudes: a deflection is negative
-            let v: Vec<f64> = pts.iter().filter_map(|p| p.metric(metric)).map(f64::abs).collect();
-            if v.len() != pts.len() {
-                return Err(format!("`{metric}` missing at some points of `{run}`"));
-            }
-            let (lo, hi) = v.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| (a.min(*x), b.max(*x)));
-            // The largest group of points within the factor of each other, for a partial answer.
-            let within = |x: f64| v.iter().filter(|y| **y >= x && **y <= x * factor).count();
-            let best = v.iter().map(|x| within(*x)).max().unwrap_or(0);
-            let at = if with.is_empty() { format!("{} = {}", key_of(&pts), values(&pts)) } else { names.join(", ") };
-            let text = format!(
-                "{metric} at {at}: {} (max/min of the magnitudes 1 + {}; claim: ≤ 1 + {})",
-                pts.iter().map(|p| metric_text(p, metric)).collect::<Vec<_>>().join(", "),
-                sig2(hi / lo - 1.0),
-                sig2(*factor - 1.0)
-            );
-            let o = if hi <= lo * factor {
-                Outcome::Holds
-            } else if best > 1 {
-                Outcome::Partly
-            } else {
-                Outcome::Fails
-            };
-            (o, text)
-        }
-        Check::Magnitude { run, metric, value, orders, at } => {
-            let pts = select(runs, run, at)?;
-            let apart = |p: &PointResult| p.metric(metric).map(|v| (v.abs() / value).log10().abs());
-            let (ok, _) = split_by(&pts, |p| apart(p).is_some_and(|o| o <= *orders));
-            let list = metric_list(&pts, metric);
-            let text =
-                format!("{metric} {list} (claim: within {} orders of magnitude of {})", sig2(*orders), sig2(*value));
-            (outcome(ok.len(), pts.len()), text)
-        }
+        Check::WithinFactor { run, metric, factor, with } => within_factor(runs, run, metric, *factor, with),
+        Check::Magnitude { run, metric, value, orders, at } => magnitude(runs, run, metric, *value, *orders, at),
         Check::SameHistories { run, history, reference, limit } => {
-            let pts = select(runs, run, &empty)?;
-            let base = one(runs, &Ref { run: run.clone(), at: reference.clone() })?;
-            let h = |p: &PointResult| -> Option<Vec<f64>> { history_of(p, history) };
-            let hb = h(base).ok_or_else(|| format!("no `{history}` history at the reference point"))?;
-            // (spread over the common iterations, iterations) per point; the same curve also
-            // stops at the same iteration (±1 %)
-            let mut spreads = Vec::new();
-            for p in pts.iter().filter(|p| !std::ptr::eq(**p, base)) {
-                let s = h(p).map(|hp| {
-                    let n = hp.len().min(hb.len());
-                    ((0..n).map(|i| (hp[i] - hb[i]).abs() / hb[i].abs()).fold(0.0, f64::max), hp.len())
-                });
-                spreads.push((p, s));
-            }
-            let same_length = |n: usize| n.abs_diff(hb.len()) as f64 <= (0.01 * hb.len() as f64).max(1.0);
-            let good = spreads.iter().filter(|(_, s)| s.is_some_and(|(s, n)| s <= *limit && same_length(n))).count();
-            let text = format!(
-                "max relative spread of the {history} history against {} ({} iterations): {} (claim: ≤ {} and the \
-                 same number of iterations ±1 %)",
-                point_label(base),
-                hb.len(),
-                spreads
-                    .iter()
-                    .map(|(p, s)| format!(
-                        "{}: {}",
-                        p.point.first().map(|x| x.1.to_string()).unwrap_or_default(),
-                        s.map(|(s, n)| format!("{} ({n} its)", sig2(s))).unwrap_or_else(|| "–".into())
-                    ))
-                    .collect::<Vec<_>>()
-                    .join(", "),
-                sig2(*limit)
-            );
-            (outcome(good, spreads.len()), text)
+            same_histories(runs, run, history, reference, *limit)
         }
-    })
+    }
+}
+
+/// `converges` (or, with `fails`, `does_not_converge`): the points that converge, with their
+/// iteration (or frame) range, and why each other did not.
+fn converges(runs: &[RunResults], run: &str, fails: bool) -> Result<(Outcome, String), CheckError> {
+    let pts = select(runs, run, &Selector::new())?;
+    let (ok, bad) = split_by(&pts, |p| p.converged());
+    let count = if pts.iter().any(|p| p.outcome.clip.is_some()) { "frames" } else { "iterations" };
+    let mut text = String::new();
+    let key = key_of(&pts);
+    let named = |v: &[&PointResult]| {
+        if key.is_empty() {
+            values(v)
+        } else {
+            format!("{key} = {}", values(v))
+        }
+    };
+    if !ok.is_empty() {
+        text.push_str(&format!("converges for {}{}", named(&ok), iterations_range(&ok, count)));
+    }
+    for p in &bad {
+        if !text.is_empty() {
+            text.push_str("; ");
+        }
+        text.push_str(&format!("{}: {}", named(&[p]), failure(p)));
+    }
+    if fails {
+        Ok((outcome(bad.len(), pts.len()), text))
+    } else {
+        Ok((outcome(ok.len(), pts.len()), text))
+    }
+}
+
+/// `below` (or `above`): `metric ≤ limit` (`≥`) at every selected point.
+fn threshold(
+    runs: &[RunResults],
+    run: &str,
+    metric: &str,
+    limit: f64,
+    at: &Selector,
+    below: bool,
+) -> Result<(Outcome, String), CheckError> {
+    let pts = select(runs, run, at)?;
+    let pass = |p: &PointResult| p.metric(metric).is_some_and(|v| if below { v <= limit } else { v >= limit });
+    let (ok, _) = split_by(&pts, pass);
+    let rel = if below { "≤" } else { "≥" };
+    let list = metric_list(&pts, metric);
+    Ok((outcome(ok.len(), pts.len()), format!("{metric} {list} (claim: {rel} {})", sig2(limit))))
+}
+
+/// `increasing`: `metric` rises along the run's single grid key.
+fn increasing(runs: &[RunResults], run: &str, metric: &str) -> Result<(Outcome, String), CheckError> {
+    let pts = select(runs, run, &Selector::new())?;
+    let mut sorted = pts.clone();
+    sorted.sort_by(|a, b| {
+        let v = |p: &PointResult| p.point.first().and_then(|x| x.1.number()).unwrap_or(0.0);
+        v(a).total_cmp(&v(b))
+    });
+    let vals: Vec<Option<f64>> = sorted.iter().map(|p| p.metric(metric)).collect();
+    let rising = vals.windows(2).filter(|w| matches!((w[0], w[1]), (Some(a), Some(b)) if b > a)).count();
+    let text = format!(
+        "{metric} at {} = {}: {}",
+        key_of(&sorted),
+        values(&sorted),
+        sorted.iter().map(|p| metric_text(p, metric)).collect::<Vec<_>>().join(", ")
+    );
+    Ok((outcome(rising, vals.len().saturating_sub(1)), text))
+}
+
+/// `ratio_above` (or `ratio_below`): `metric(numerator) / metric(denominator) ≥ limit` (`≤`).
+fn ratio(
+    runs: &[RunResults],
+    metric: &str,
+    numerator: &Ref,
+    denominator: &Ref,
+    limit: f64,
+    above: bool,
+) -> Result<(Outcome, String), CheckError> {
+    let (a, b) = (one(runs, numerator)?, one(runs, denominator)?);
+    let missing = |p: &PointResult| CheckError::MissingMetric { metric: metric.to_string(), point: point_label(p) };
+    let (va, vb) = (a.metric(metric).ok_or_else(|| missing(a))?, b.metric(metric).ok_or_else(|| missing(b))?);
+    let ratio = va / vb;
+    let pass = if above { ratio >= limit } else { ratio <= limit };
+    let text = format!(
+        "{metric}: {} ({}, {}) / {} ({}, {}) = {} (claim: {} {})",
+        sig2(va),
+        numerator.run,
+        point_label(a),
+        sig2(vb),
+        denominator.run,
+        point_label(b),
+        sig2(ratio),
+        if above { "≥" } else { "≤" },
+        sig2(limit)
+    );
+    Ok((if pass { Outcome::Holds } else { Outcome::Fails }, text))
+}
+
+/// `within_factor`: `max / min` of the magnitudes of `metric` over the points of `run` and of
+/// the runs `with` at most `factor`; partly when a group of two or more points is.
+fn within_factor(
+    runs: &[RunResults],
+    run: &str,
+    metric: &str,
+    factor: f64,
+    with: &[String],
+) -> Result<(Outcome, String), CheckError> {
+    let empty = Selector::new();
+    let mut pts = select(runs, run, &empty)?;
+    // (run, point) names for a check across runs
+    let mut names: Vec<String> = pts.iter().map(|p| format!("{run} {}", p.label)).collect();
+    for w in with {
+        let more = select(runs, w, &empty)?;
+        names.extend(more.iter().map(|p| format!("{w} {}", p.label)));
+        pts.extend(more);
+    }
+    if pts.len() < 2 {
+        return Err(CheckError::TooFewPoints { run: run.to_string() });
+    }
+    // magnitudes: a deflection is negative
+    let v: Vec<f64> = pts.iter().filter_map(|p| p.metric(metric)).map(f64::abs).collect();
+    if v.len() != pts.len() {
+        return Err(CheckError::MissingAtSomePoints { metric: metric.to_string(), run: run.to_string() });
+    }
+    let (lo, hi) = v.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| (a.min(*x), b.max(*x)));
+    // The largest group of points within the factor of each other, for a partial answer.
+    let within = |x: f64| v.iter().filter(|y| **y >= x && **y <= x * factor).count();
+    let best = v.iter().map(|x| within(*x)).max().unwrap_or(0);
+    let at = if with.is_empty() { format!("{} = {}", key_of(&pts), values(&pts)) } else { names.join(", ") };
+    let text = format!(
+        "{metric} at {at}: {} (max/min of the magnitudes 1 + {}; claim: ≤ 1 + {})",
+        pts.iter().map(|p| metric_text(p, metric)).collect::<Vec<_>>().join(", "),
+        sig2(hi / lo - 1.0),
+        sig2(factor - 1.0)
+    );
+    let o = if hi <= lo * factor {
+        Outcome::Holds
+    } else if best > 1 {
+        Outcome::Partly
+    } else {
+        Outcome::Fails
+    };
+    Ok((o, text))
+}
+
+/// `magnitude`: `metric` within `orders` orders of magnitude of `value` at every selected point.
+fn magnitude(
+    runs: &[RunResults],
+    run: &str,
+    metric: &str,
+    value: f64,
+    orders: f64,
+    at: &Selector,
+) -> Result<(Outcome, String), CheckError> {
+    let pts = select(runs, run, at)?;
+    let apart = |p: &PointResult| p.metric(metric).map(|v| (v.abs() / value).log10().abs());
+    let (ok, _) = split_by(&pts, |p| apart(p).is_some_and(|o| o <= orders));
+    let list = metric_list(&pts, metric);
+    let text = format!("{metric} {list} (claim: within {} orders of magnitude of {})", sig2(orders), sig2(value));
+    Ok((outcome(ok.len(), pts.len()), text))
+}
+
+/// `same_histories`: the `history` of every point of `run` against the `reference` point's,
+/// relative spread ≤ `limit` over their common iterations and the same length ±1 %.
+fn same_histories(
+    runs: &[RunResults],
+    run: &str,
+    history: &str,
+    reference: &Selector,
+    limit: f64,
+) -> Result<(Outcome, String), CheckError> {
+    let pts = select(runs, run, &Selector::new())?;
+    let base = one(runs, &Ref { run: run.to_string(), at: reference.clone() })?;
+    let h = |p: &PointResult| -> Option<Vec<f64>> { history_of(p, history) };
+    let hb = h(base).ok_or_else(|| CheckError::NoHistory { history: history.to_string() })?;
+    // (spread over the common iterations, iterations) per point; the same curve also
+    // stops at the same iteration (±1 %)
+    let mut spreads = Vec::new();
+    for p in pts.iter().filter(|p| !std::ptr::eq(**p, base)) {
+        let s = h(p).map(|hp| {
+            let n = hp.len().min(hb.len());
+            ((0..n).map(|i| (hp[i] - hb[i]).abs() / hb[i].abs()).fold(0.0, f64::max), hp.len())
+        });
+        spreads.push((p, s));
+    }
+    let same_length = |n: usize| n.abs_diff(hb.len()) as f64 <= (0.01 * hb.len() as f64).max(1.0);
+    let good = spreads.iter().filter(|(_, s)| s.is_some_and(|(s, n)| s <= limit && same_length(n))).count();
+    let text = format!(
+        "max relative spread of the {history} history against {} ({} iterations): {} (claim: ≤ {} and the \
+         same number of iterations ±1 %)",
+        point_label(base),
+        hb.len(),
+        spreads
+            .iter()
+            .map(|(p, s)| format!(
+                "{}: {}",
+                p.point.first().map(|x| x.1.to_string()).unwrap_or_default(),
+                s.map(|(s, n)| format!("{} ({n} its)", sig2(s))).unwrap_or_else(|| "–".into())
+            ))
+            .collect::<Vec<_>>()
+            .join(", "),
+        sig2(limit)
+    );
+    Ok((outcome(good, spreads.len()), text))
 }
 
 /// A per-iteration history of an inverse point: `x_err_rel`, `rel_change`, `tangent_misfit`,

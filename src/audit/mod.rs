@@ -176,7 +176,7 @@ pub struct AuditReport {
     pub fields: PointFields,
     /// the claims inventory beside the specs (`inventory.csv`) against the rows, if there is
     /// one; `Err`: it could not be read (the report says so)
-    pub coverage: Option<Result<inventory::Coverage, String>>,
+    pub coverage: Option<Result<inventory::Coverage, inventory::InventoryError>>,
 }
 
 impl AuditReport {
@@ -326,18 +326,7 @@ pub fn run_audit(
     let start = std::time::Instant::now();
     let reused: Vec<Option<(Vec<ClaimResult>, Vec<String>)>> =
         specs.iter().map(|s| if opts.resume { resume::load(s, quick, &opts.out) } else { None }).collect();
-    let mut jobs: Vec<Job> = Vec::new();
-    for (i, spec) in specs.iter().enumerate().filter(|(i, _)| reused[*i].is_none()) {
-        for run in &spec.runs {
-            let grid_err = |source| AuditError::Grid { spec: spec.name.clone(), run: run.name.clone(), source };
-            let points = product(&run.case, &run.grid).map_err(grid_err)?;
-            for (point, case) in points {
-                let label = if point.is_empty() { "run".to_string() } else { case.name.clone() };
-                let dir = opts.out.join(&spec.name).join(&run.name).join(&label);
-                jobs.push(Job { spec: i, run, point, case, dir, fields: opts.fields });
-            }
-        }
-    }
+    let mut jobs = plan_jobs(specs, &reused, opts)?;
     if opts.resume {
         resume_folder(&opts.out, specs, &reused)?;
     } else {
@@ -360,21 +349,7 @@ pub fn run_audit(
         Some(p) => p.install(work),
         None => work(),
     };
-    // Regroup by spec and run, in the specs' order.
-    let mut results: Vec<Vec<RunResults>> = specs
-        .iter()
-        .map(|s| {
-            s.runs
-                .iter()
-                .map(|r| RunResults { name: r.name.clone(), points: Vec::new(), case_name: r.case.name.clone() })
-                .collect()
-        })
-        .collect();
-    for (spec, run, r) in finished {
-        if let Some(rr) = results[spec].iter_mut().find(|x| x.name == run) {
-            rr.points.push(r);
-        }
-    }
+    let results = regroup(specs, finished);
     let interrupted = crate::interrupt::requested();
     let (claims, figures, failures) = judge_all(specs, &results, &opts.out, reused, quick);
     let status = if interrupted {
@@ -399,12 +374,51 @@ pub fn run_audit(
     Ok(report)
 }
 
+/// One job per point of every run of the specs not taken from the audit being resumed, each
+/// with its folder `out/<spec>/<run>/<point>` (`run` for a run without a grid).
+fn plan_jobs<'a>(
+    specs: &'a [Spec],
+    reused: &[Option<(Vec<ClaimResult>, Vec<String>)>],
+    opts: &AuditOptions,
+) -> Result<Vec<Job<'a>>, AuditError> {
+    let mut jobs: Vec<Job> = Vec::new();
+    for (i, spec) in specs.iter().enumerate().filter(|(i, _)| reused[*i].is_none()) {
+        for run in &spec.runs {
+            let grid_err = |source| AuditError::Grid { spec: spec.name.clone(), run: run.name.clone(), source };
+            let points = product(&run.case, &run.grid).map_err(grid_err)?;
+            for (point, case) in points {
+                let label = if point.is_empty() { "run".to_string() } else { case.name.clone() };
+                let dir = opts.out.join(&spec.name).join(&run.name).join(&label);
+                jobs.push(Job { spec: i, run, point, case, dir, fields: opts.fields });
+            }
+        }
+    }
+    Ok(jobs)
+}
+
+/// The finished points `(spec, run, result)` regrouped by spec and run, in the specs' order.
+fn regroup(specs: &[Spec], finished: Vec<(usize, String, PointResult)>) -> Vec<Vec<RunResults>> {
+    let mut results: Vec<Vec<RunResults>> = specs
+        .iter()
+        .map(|s| {
+            s.runs
+                .iter()
+                .map(|r| RunResults { name: r.name.clone(), points: Vec::new(), case_name: r.case.name.clone() })
+                .collect()
+        })
+        .collect();
+    for (spec, run, r) in finished {
+        if let Some(rr) = results[spec].iter_mut().find(|x| x.name == run) {
+            rr.points.push(r);
+        }
+    }
+    results
+}
+
 /// The claims inventory beside the first spec, against the claims judged.
-fn coverage(specs: &[Spec], claims: &[ClaimResult]) -> Option<Result<inventory::Coverage, String>> {
+fn coverage(specs: &[Spec], claims: &[ClaimResult]) -> Option<Result<inventory::Coverage, inventory::InventoryError>> {
     let path = specs.first()?.path.parent()?.join(inventory::INVENTORY);
-    path.is_file().then(|| {
-        inventory::read_inventory(&path).map(|e| inventory::Coverage::new(e, claims)).map_err(|e| e.to_string())
-    })
+    path.is_file().then(|| inventory::read_inventory(&path).map(|e| inventory::Coverage::new(e, claims)))
 }
 
 /// Judge every claim of `specs` on `results` and draw every figure of the specs whose points

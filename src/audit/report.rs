@@ -173,7 +173,7 @@ fn coverage_section(o: &mut String, r: &AuditReport) {
     let cov = match cov {
         Ok(c) => c,
         Err(e) => {
-            let _ = writeln!(o, "The inventory could not be read: {}", md(e));
+            let _ = writeln!(o, "The inventory could not be read: {}", md(&e.to_string()));
             return;
         }
     };

@@ -360,100 +360,16 @@ pub fn read_spec(path: &Path, quick: bool) -> Result<Spec, SpecError> {
     let text = read_capped_text(path, SPEC_FILE_CAP_BYTES, "audit spec")?;
     let raw: RawSpec =
         toml::from_str(&text).map_err(|e| SpecError::Syntax { path: path.to_path_buf(), message: e.to_string() })?;
-    let invalid = |what: String, reason: String| SpecError::Invalid { path: path.to_path_buf(), what, reason };
-    let dir = path.parent().unwrap_or(Path::new("."));
-    let mut runs = Vec::new();
-    for (name, r) in raw.runs {
-        let case_path = dir.join(&r.case);
-        let boxed = |e: Box<dyn std::error::Error + Send + Sync>| SpecError::Case {
-            path: path.to_path_buf(),
-            run: name.clone(),
-            case: case_path.clone(),
-            source: e,
-        };
-        let mut case = Case::from_file(&case_path).map_err(|e| boxed(Box::new(e)))?;
-        let mut set: Vec<(String, toml::Value)> = r.set.into_iter().collect();
-        if quick {
-            set.extend(r.quick_set);
-        }
-        if !set.is_empty() {
-            case = case.with_overrides(&set).map_err(|e| boxed(Box::new(e)))?;
-        }
-        let grid_table = if quick { r.quick_grid.unwrap_or(r.grid) } else { r.grid };
-        let known = known_keys(&case);
-        let mut grid = Vec::new();
-        for (key, values) in grid_table {
-            if !known.contains(&key.as_str()) {
-                return Err(invalid(
-                    format!("run `{name}` grid"),
-                    format!("unknown key `{key}` (known: {})", known.join(", ")),
-                ));
-            }
-            if values.is_empty() || values.iter().any(|v| !v.is_finite()) {
-                return Err(invalid(format!("run `{name}` grid `{key}`"), "needs finite values".into()));
-            }
-            grid.push(SweepParam { key, values: values.into_iter().map(SweepValue::Number).collect() });
-        }
-        if !r.keep_frames.is_empty() && case.clip().is_none() {
-            return Err(invalid(format!("run `{name}`"), "keep_frames needs a clip case".into()));
-        }
-        runs.push(RunSpec { name, case, grid, keep_frames: r.keep_frames });
-    }
-    let spec_runs = |names: Vec<&str>, what: String| -> Result<(), SpecError> {
-        match names.iter().find(|n| !runs.iter().any(|r| r.name == **n)) {
-            Some(n) => Err(invalid(what, format!("names no run `{n}`"))),
-            None => Ok(()),
-        }
-    };
+    let runs = raw.runs.into_iter().map(|(name, r)| read_run(path, name, r, quick)).collect::<Result<Vec<_>, _>>()?;
     let mut claims: Vec<Claim> = Vec::new();
     for c in raw.claims {
-        spec_runs(c.check.runs(), format!("claim `{}`", c.id))?;
-        if claims.iter().any(|o| o.id == c.id) {
-            return Err(invalid(format!("claim `{}`", c.id), "id given twice".into()));
-        }
-        if !matches!(c.expect, Verdict::Reproduced | Verdict::NotComputable) && c.cause.is_none() {
-            return Err(invalid(format!("claim `{}`", c.id), "a verdict other than reproduced needs a cause".into()));
-        }
-        if c.expect == Verdict::NotComputable && (c.not_computable.is_none() || c.substitute.is_none()) {
-            return Err(invalid(
-                format!("claim `{}`", c.id),
-                "expect = \"not_computable\" needs not_computable = \"<what is missing>\" and substitute = \"<what ran instead>\""
-                    .into(),
-            ));
-        }
-        if c.partial.is_some() && matches!(c.expect, Verdict::Reproduced | Verdict::NotComputable) {
-            return Err(invalid(
-                format!("claim `{}`", c.id),
-                "a partial check (weaker than the paper's words) yields at best \"differs\": expect cannot be reproduced or not computable".into(),
-            ));
-        }
-        if let Some(q) = ["(here", "(ours", "(our "].iter().find(|q| c.statement.contains(*q)) {
-            return Err(invalid(
-                format!("claim `{}`", c.id),
-                format!("the statement quotes the paper verbatim; `{q}…` is ours: put it in `paper` or `partial`"),
-            ));
-        }
-        claims.push(Claim {
-            id: c.id,
-            location: c.location,
-            statement: c.statement,
-            paper: c.paper,
-            check: c.check,
-            expect: c.expect,
-            if_fails: c.if_fails.unwrap_or(Verdict::Differs),
-            if_partly: c.if_partly.unwrap_or(Verdict::Differs),
-            cause: c.cause,
-            not_computable: c.not_computable,
-            substitute: c.substitute,
-            figure: c.figure,
-            partial: c.partial,
-            ours: c.ours,
-        });
+        let claim = read_claim(path, c, &claims, &runs)?;
+        claims.push(claim);
     }
     for p in &raw.figures {
-        spec_runs(p.show.runs(), format!("figure `{}`", p.file))?;
+        names_runs(path, &runs, p.show.runs(), format!("figure `{}`", p.file))?;
         if !p.file.ends_with(".svg") || p.file.contains('/') {
-            return Err(invalid(format!("figure `{}`", p.file), "must be a file name ending in .svg".into()));
+            return Err(invalid(path, format!("figure `{}`", p.file), "must be a file name ending in .svg".into()));
         }
     }
     let name = path.file_stem().and_then(|s| s.to_str()).unwrap_or("spec").to_string();
@@ -466,5 +382,111 @@ pub fn read_spec(path: &Path, quick: bool) -> Result<Spec, SpecError> {
         runs,
         claims,
         plots: raw.figures,
+    })
+}
+
+/// The error of a spec at `path`: `what` (a run, claim or figure) and why.
+fn invalid(path: &Path, what: String, reason: String) -> SpecError {
+    SpecError::Invalid { path: path.to_path_buf(), what, reason }
+}
+
+/// The run `name` of the spec at `path`: its case file (relative to the spec) with the run's
+/// `set` (and, `quick`, `quick_set`), and its grid of known keys and finite values.
+fn read_run(path: &Path, name: String, r: RawRun, quick: bool) -> Result<RunSpec, SpecError> {
+    let dir = path.parent().unwrap_or(Path::new("."));
+    let case_path = dir.join(&r.case);
+    let boxed = |e: Box<dyn std::error::Error + Send + Sync>| SpecError::Case {
+        path: path.to_path_buf(),
+        run: name.clone(),
+        case: case_path.clone(),
+        source: e,
+    };
+    let mut case = Case::from_file(&case_path).map_err(|e| boxed(Box::new(e)))?;
+    let mut set: Vec<(String, toml::Value)> = r.set.into_iter().collect();
+    if quick {
+        set.extend(r.quick_set);
+    }
+    if !set.is_empty() {
+        case = case.with_overrides(&set).map_err(|e| boxed(Box::new(e)))?;
+    }
+    let grid_table = if quick { r.quick_grid.unwrap_or(r.grid) } else { r.grid };
+    let known = known_keys(&case);
+    let mut grid = Vec::new();
+    for (key, values) in grid_table {
+        if !known.contains(&key.as_str()) {
+            return Err(invalid(
+                path,
+                format!("run `{name}` grid"),
+                format!("unknown key `{key}` (known: {})", known.join(", ")),
+            ));
+        }
+        if values.is_empty() || values.iter().any(|v| !v.is_finite()) {
+            return Err(invalid(path, format!("run `{name}` grid `{key}`"), "needs finite values".into()));
+        }
+        grid.push(SweepParam { key, values: values.into_iter().map(SweepValue::Number).collect() });
+    }
+    if !r.keep_frames.is_empty() && case.clip().is_none() {
+        return Err(invalid(path, format!("run `{name}`"), "keep_frames needs a clip case".into()));
+    }
+    Ok(RunSpec { name, case, grid, keep_frames: r.keep_frames })
+}
+
+/// `Err` naming `what` when one of `names` is not a run of `runs`.
+fn names_runs(path: &Path, runs: &[RunSpec], names: Vec<&str>, what: String) -> Result<(), SpecError> {
+    match names.iter().find(|n| !runs.iter().any(|r| r.name == **n)) {
+        Some(n) => Err(invalid(path, what, format!("names no run `{n}`"))),
+        None => Ok(()),
+    }
+}
+
+/// A claim of the spec at `path`, checked against the claims before it (`earlier`) and the
+/// runs: runs it names, a unique id, a cause for any verdict but reproduced, what is missing
+/// for not computable, no partial check that expects reproduced, no words of ours in the
+/// statement.
+fn read_claim(path: &Path, c: RawClaim, earlier: &[Claim], runs: &[RunSpec]) -> Result<Claim, SpecError> {
+    names_runs(path, runs, c.check.runs(), format!("claim `{}`", c.id))?;
+    if earlier.iter().any(|o| o.id == c.id) {
+        return Err(invalid(path, format!("claim `{}`", c.id), "id given twice".into()));
+    }
+    if !matches!(c.expect, Verdict::Reproduced | Verdict::NotComputable) && c.cause.is_none() {
+        return Err(invalid(path, format!("claim `{}`", c.id), "a verdict other than reproduced needs a cause".into()));
+    }
+    if c.expect == Verdict::NotComputable && (c.not_computable.is_none() || c.substitute.is_none()) {
+        return Err(invalid(
+            path,
+            format!("claim `{}`", c.id),
+            "expect = \"not_computable\" needs not_computable = \"<what is missing>\" and substitute = \"<what ran instead>\""
+                .into(),
+        ));
+    }
+    if c.partial.is_some() && matches!(c.expect, Verdict::Reproduced | Verdict::NotComputable) {
+        return Err(invalid(
+            path,
+            format!("claim `{}`", c.id),
+            "a partial check (weaker than the paper's words) yields at best \"differs\": expect cannot be reproduced or not computable".into(),
+        ));
+    }
+    if let Some(q) = ["(here", "(ours", "(our "].iter().find(|q| c.statement.contains(*q)) {
+        return Err(invalid(
+            path,
+            format!("claim `{}`", c.id),
+            format!("the statement quotes the paper verbatim; `{q}…` is ours: put it in `paper` or `partial`"),
+        ));
+    }
+    Ok(Claim {
+        id: c.id,
+        location: c.location,
+        statement: c.statement,
+        paper: c.paper,
+        check: c.check,
+        expect: c.expect,
+        if_fails: c.if_fails.unwrap_or(Verdict::Differs),
+        if_partly: c.if_partly.unwrap_or(Verdict::Differs),
+        cause: c.cause,
+        not_computable: c.not_computable,
+        substitute: c.substitute,
+        figure: c.figure,
+        partial: c.partial,
+        ours: c.ours,
     })
 }

@@ -41,6 +41,8 @@ pub fn at_start() {
 // SAFETY: every method forwards to `System` with the caller's arguments unchanged, so the
 // caller's contract of each `GlobalAlloc` method is `System`'s; a null result never returns.
 unsafe impl GlobalAlloc for Guarded {
+    /// # Safety
+    /// The contract of [`GlobalAlloc::alloc`], passed on to [`System`] unchanged.
     unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
         // SAFETY: the contract of `GlobalAlloc::alloc`, passed on (see the impl).
         let p = unsafe { System.alloc(layout) };
@@ -50,6 +52,8 @@ unsafe impl GlobalAlloc for Guarded {
         p
     }
 
+    /// # Safety
+    /// The contract of [`GlobalAlloc::alloc_zeroed`], passed on to [`System`] unchanged.
     unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
         // SAFETY: the contract of `GlobalAlloc::alloc_zeroed`, passed on.
         let p = unsafe { System.alloc_zeroed(layout) };
@@ -59,11 +63,15 @@ unsafe impl GlobalAlloc for Guarded {
         p
     }
 
+    /// # Safety
+    /// The contract of [`GlobalAlloc::dealloc`], passed on to [`System`] unchanged.
     unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
         // SAFETY: `ptr` was allocated by `System` (through this allocator) with `layout`.
         unsafe { System.dealloc(ptr, layout) }
     }
 
+    /// # Safety
+    /// The contract of [`GlobalAlloc::realloc`], passed on to [`System`] unchanged.
     unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
         // SAFETY: `ptr` was allocated by `System` with `layout`; the rest is the caller's.
         let p = unsafe { System.realloc(ptr, layout, new_size) };

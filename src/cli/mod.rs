@@ -270,21 +270,32 @@ pub fn keep_freed_memory() {
     }
 }
 
+/// A count option that is not a positive number; clap prints it after the option's name.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum CountError {
+    /// `--count` of `cosserat modes`
+    #[error("expected a number of modes >= 1, got `{given}`")]
+    Modes { given: String },
+    /// `--frames` of `cosserat compare`
+    #[error("expected a number of frames >= 1 or `all`, got `{given}`")]
+    Frames { given: String },
+}
+
 /// `--count`: a positive number.
-pub fn parse_count(s: &str) -> Result<usize, String> {
+pub fn parse_count(s: &str) -> Result<usize, CountError> {
     match s.parse::<usize>() {
         Ok(n) if n > 0 => Ok(n),
-        _ => Err(format!("expected a number of modes >= 1, got `{s}`")),
+        _ => Err(CountError::Modes { given: s.to_string() }),
     }
 }
 
 /// `--frames`: a positive count or `all`.
-pub fn parse_frames(s: &str) -> Result<usize, String> {
+pub fn parse_frames(s: &str) -> Result<usize, CountError> {
     if s == "all" {
         return Ok(usize::MAX);
     }
     match s.parse::<usize>() {
         Ok(n) if n > 0 => Ok(n),
-        _ => Err(format!("expected a number of frames >= 1 or `all`, got `{s}`")),
+        _ => Err(CountError::Frames { given: s.to_string() }),
     }
 }

@@ -15,6 +15,7 @@ use std::path::{Path, PathBuf};
 use rayon::prelude::*;
 
 use super::files::{read_capped, write_atomic, InputError, OutputError};
+pub use super::files::{CompactError, ZipError};
 use super::npy::{npy_header, npy_payload};
 
 /// The compact file in a clip's output folder.
@@ -98,7 +99,7 @@ fn entropy(b: &[u8]) -> f64 {
 /// `data` as deflate blocks ending on a byte boundary and not final (a sync flush), so that
 /// such segments, each compressed on its own, concatenate to one deflate stream. Noise (the low
 /// mantissa bytes, more than 7.9 bits per byte) is stored; the rest is deflated at level 3.
-fn deflate_segment(data: &[u8]) -> Result<Vec<u8>, String> {
+fn deflate_segment(data: &[u8]) -> Result<Vec<u8>, ZipError> {
     if entropy(data) > 7.9 {
         // stored blocks: a header byte (not final, type 00), LEN and its complement, the bytes
         let mut out = Vec::with_capacity(data.len() + 5 * (data.len() / 65535 + 1));
@@ -117,7 +118,7 @@ fn deflate_segment(data: &[u8]) -> Result<Vec<u8>, String> {
             out.reserve(out.capacity().max(4096));
         }
         let done = c.total_in() as usize;
-        c.compress_vec(&data[done..], &mut out, flate2::FlushCompress::Sync).map_err(|e| format!("deflate: {e}"))?;
+        c.compress_vec(&data[done..], &mut out, flate2::FlushCompress::Sync).map_err(ZipError::Deflate)?;
         if c.total_in() as usize == data.len() && out.len() < out.capacity() {
             return Ok(out);
         }
@@ -126,7 +127,7 @@ fn deflate_segment(data: &[u8]) -> Result<Vec<u8>, String> {
 
 /// Bytes of a zip archive of `members`, each deflated (in parallel), without the 64-bit
 /// extension; `Err` when a member or the archive exceeds its 4 GiB.
-fn zip_bytes(members: &[Member]) -> Result<Vec<u8>, String> {
+fn zip_bytes(members: &[Member]) -> Result<Vec<u8>, ZipError> {
     let packed: Vec<(u32, usize, Vec<u8>)> = members
         .par_iter()
         .map(|m| {
@@ -139,9 +140,8 @@ fn zip_bytes(members: &[Member]) -> Result<Vec<u8>, String> {
             data.extend([0x03, 0x00]); // an empty final block
             Ok((crc.finalize(), m.parts.iter().map(Vec::len).sum(), data))
         })
-        .collect::<Result<_, String>>()?;
-    let u32_of =
-        |n: usize, what: &str| u32::try_from(n).map_err(|_| format!("{what} exceeds 4 GiB (zip without Zip64)"));
+        .collect::<Result<_, ZipError>>()?;
+    let u32_of = |n: usize, what: &str| u32::try_from(n).map_err(|_| ZipError::TooLarge { what: what.to_string() });
     let (mut out, mut central) = (Vec::new(), Vec::new());
     for (m, (crc, plain, data)) in members.iter().zip(&packed) {
         let offset = u32_of(out.len(), "the archive")?;
@@ -172,7 +172,7 @@ fn zip_bytes(members: &[Member]) -> Result<Vec<u8>, String> {
     out.extend(central);
     out.extend(0x0605_4b50u32.to_le_bytes());
     out.extend([0u8; 4]);
-    let count = u16::try_from(members.len()).map_err(|_| "more than 65535 members".to_string())?;
+    let count = u16::try_from(members.len()).map_err(|_| ZipError::TooManyMembers { count: members.len() })?;
     out.extend(count.to_le_bytes());
     out.extend(count.to_le_bytes());
     out.extend(cd_size.to_le_bytes());
@@ -186,6 +186,7 @@ fn zip_bytes(members: &[Member]) -> Result<Vec<u8>, String> {
 pub fn write_compact(dir: &Path, frames: &[i64], field_columns: &[&str]) -> Result<PathBuf, OutputError> {
     let path = dir.join(COMPACT_FILE);
     let invalid = |reason: String| OutputError::Invalid { path: path.clone(), reason };
+    let zip_error = |reason: ZipError| OutputError::Zip { path: path.clone(), reason };
     let read = |name: &str| -> Result<Vec<f64>, OutputError> {
         let p = dir.join(name);
         let bytes = std::fs::read(&p).map_err(|source| OutputError::Io { path: p, source })?;
@@ -211,7 +212,7 @@ pub fn write_compact(dir: &Path, frames: &[i64], field_columns: &[&str]) -> Resu
             cols.par_iter().zip(columns.par_iter()).map(|(col, name)| column_member(name, col, nf, per)).collect();
         members.extend(cols);
     }
-    write_atomic(&path, &zip_bytes(&members).map_err(invalid)?)?;
+    write_atomic(&path, &zip_bytes(&members).map_err(zip_error)?)?;
     Ok(path)
 }
 
@@ -227,41 +228,39 @@ pub struct CompactClip {
 /// Read a `fields.npz` written by [`write_compact`].
 pub fn read_compact(path: &Path) -> Result<CompactClip, InputError> {
     let bytes = read_capped(path, COMPACT_FILE_CAP_BYTES, "compact clip file")?;
-    parse_compact(&bytes).map_err(|reason| InputError::Shape { path: path.to_path_buf(), reason })
+    parse_compact(&bytes).map_err(|reason| InputError::Compact { path: path.to_path_buf(), reason: Box::new(reason) })
 }
 
-fn u16_at(b: &[u8], at: usize) -> Result<usize, String> {
-    b.get(at..at + 2).map(|s| u16::from_le_bytes([s[0], s[1]]) as usize).ok_or_else(|| "truncated zip".into())
+fn u16_at(b: &[u8], at: usize) -> Result<usize, CompactError> {
+    b.get(at..at + 2).map(|s| u16::from_le_bytes([s[0], s[1]]) as usize).ok_or(CompactError::Truncated)
 }
 
-fn u32_at(b: &[u8], at: usize) -> Result<usize, String> {
-    b.get(at..at + 4)
-        .map(|s| u32::from_le_bytes([s[0], s[1], s[2], s[3]]) as usize)
-        .ok_or_else(|| "truncated zip".into())
+fn u32_at(b: &[u8], at: usize) -> Result<usize, CompactError> {
+    b.get(at..at + 4).map(|s| u32::from_le_bytes([s[0], s[1], s[2], s[3]]) as usize).ok_or(CompactError::Truncated)
 }
 
 /// The members of a zip archive (stored or deflated), by name.
-fn unzip(b: &[u8]) -> Result<BTreeMap<String, Vec<u8>>, String> {
+fn unzip(b: &[u8]) -> Result<BTreeMap<String, Vec<u8>>, CompactError> {
     let eocd = (0..b.len().saturating_sub(21))
         .rev()
         .take(1 << 16)
         .find(|&i| b[i..].starts_with(&0x0605_4b50u32.to_le_bytes()))
-        .ok_or("not a zip archive (no end of central directory)")?;
+        .ok_or(CompactError::NotZip)?;
     let (count, mut at) = (u16_at(b, eocd + 10)?, u32_at(b, eocd + 16)?);
     let mut out = BTreeMap::new();
     for _ in 0..count {
         if u32_at(b, at)? != 0x0201_4b50 {
-            return Err("corrupt zip central directory".into());
+            return Err(CompactError::CorruptDirectory);
         }
         let (method, crc, csize, usize_) =
             (u16_at(b, at + 10)?, u32_at(b, at + 16)?, u32_at(b, at + 20)?, u32_at(b, at + 24)?);
         let (nlen, xlen, clen, local) =
             (u16_at(b, at + 28)?, u16_at(b, at + 30)?, u16_at(b, at + 32)?, u32_at(b, at + 42)?);
-        let name = b.get(at + 46..at + 46 + nlen).ok_or("truncated zip")?;
+        let name = b.get(at + 46..at + 46 + nlen).ok_or(CompactError::Truncated)?;
         let name = String::from_utf8_lossy(name).into_owned();
         at += 46 + nlen + xlen + clen;
         let start = local + 30 + u16_at(b, local + 26)? + u16_at(b, local + 28)?;
-        let data = b.get(start..start + csize).ok_or_else(|| format!("{name}: truncated"))?;
+        let data = b.get(start..start + csize).ok_or_else(|| CompactError::MemberTruncated { name: name.clone() })?;
         let plain = match method {
             0 => data.to_vec(),
             8 => {
@@ -269,23 +268,25 @@ fn unzip(b: &[u8]) -> Result<BTreeMap<String, Vec<u8>>, String> {
                 // inflated without bound
                 let mut plain = Vec::new();
                 let mut d = std::io::Read::take(flate2::read::DeflateDecoder::new(data), usize_ as u64 + 1);
-                std::io::Read::read_to_end(&mut d, &mut plain).map_err(|e| format!("{name}: {e}"))?;
+                std::io::Read::read_to_end(&mut d, &mut plain)
+                    .map_err(|error| CompactError::Inflate { name: name.clone(), error })?;
                 plain
             }
-            m => return Err(format!("{name}: compression method {m} (expected deflate)")),
+            method => return Err(CompactError::Method { name, method }),
         };
         if plain.len() != usize_ || crc32fast::hash(&plain) as usize != crc {
-            return Err(format!("{name}: size or CRC does not match (corrupt archive)"));
+            return Err(CompactError::Corrupt { name });
         }
         out.insert(name, plain);
     }
     Ok(out)
 }
 
-fn parse_compact(bytes: &[u8]) -> Result<CompactClip, String> {
+fn parse_compact(bytes: &[u8]) -> Result<CompactClip, CompactError> {
     let mut clip = CompactClip::default();
     for (name, npy) in unzip(bytes)? {
-        let (descr, shape, data) = npy_payload(&npy).map_err(|e| format!("{name}: {e}"))?;
+        let (descr, shape, data) =
+            npy_payload(&npy).map_err(|reason| CompactError::Npy { name: name.clone(), reason })?;
         let stem = name.strip_suffix(".npy").unwrap_or(&name).to_string();
         match (stem.as_str(), descr.as_str(), shape.as_slice()) {
             ("frame", "<i8", [n]) if n.checked_mul(8) == Some(data.len()) => {
@@ -294,7 +295,7 @@ fn parse_compact(bytes: &[u8]) -> Result<CompactClip, String> {
             (_, "|u1", [8, f, per]) if f.checked_mul(*per).and_then(|n| n.checked_mul(8)) == Some(data.len()) => {
                 clip.columns.insert(stem, (*per, decode_column(data, *per)));
             }
-            _ => return Err(format!("{name}: unexpected array {descr} {shape:?}")),
+            _ => return Err(CompactError::UnexpectedArray { name, descr, shape }),
         }
     }
     Ok(clip)

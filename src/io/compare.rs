@@ -306,7 +306,7 @@ fn compare_single(case: &Case, dir: &Path, opts: &CompareOptions) -> Result<Comp
     let (rust, perturbed, ff, what) = if let Some(inv) = case.inverse() {
         let data = load_data(&case).map_err(CompareError::Engine)?;
         let path = dir.join("data.csv");
-        write_data(&path, &data).map_err(EngineError::from)?;
+        write_data(&path, &data).map_err(EngineError::DataOutput)?;
         let pert = NodalState { x: perturb_positions(&data.x, 11), ..data.clone() };
         let fixed_point = is_fixed_point_inverse(&case);
         let (rust, perturbed, exact) = if fixed_point {

@@ -31,9 +31,14 @@ pub enum EngineError {
     /// (a stalled FreeFEM run is [`EngineError::Run`], see the `From` impl)
     #[error("freefem engine")]
     FreeFem(#[source] FreeFemError),
-    #[error("inverse data")]
+    /// reading the data file of an inverse case (`data.csv`, I7)
+    #[error("reading the inverse data")]
     Input(#[from] InputError),
-    #[error("inverse data")]
+    /// writing the data file of an inverse case before a run reads it
+    #[error("writing the inverse data")]
+    DataOutput(#[source] OutputError),
+    /// writing a clip's files frame by frame
+    #[error("writing the clip's output")]
     Output(#[from] OutputError),
     #[error("clip")]
     Clip(#[from] ClipFileError),
@@ -87,7 +92,7 @@ pub fn run_case(
 ) -> Result<RunResult, EngineError> {
     if case.inverse().is_some() {
         let path = workdir.join("data.csv");
-        write_data(&path, &load_data(case)?)?;
+        write_data(&path, &load_data(case)?).map_err(EngineError::DataOutput)?;
         return run_inverse_on(case, engine, &path, workdir, progress);
     }
     match engine {

@@ -28,6 +28,8 @@ pub enum OutputError {
     },
     #[error("cannot write {path}: {reason}")]
     Invalid { path: PathBuf, reason: String },
+    #[error("cannot write {path}: {reason}")]
+    Zip { path: PathBuf, reason: ZipError },
     /// a part of the output (a sweep's point) could not be written for want of space
     #[error("{path}: {message}")]
     DiskFull { path: PathBuf, message: String },
@@ -54,9 +56,11 @@ pub enum InputError {
     #[error("{path}, row {row}: {reason}")]
     Row { path: PathBuf, row: usize, reason: String },
     #[error("{path}: not a little-endian float64 C-order .npy file: {reason}")]
-    Npy { path: PathBuf, reason: String },
+    Npy { path: PathBuf, reason: Box<NpyError> },
     #[error("{path}: {reason}")]
     Shape { path: PathBuf, reason: String },
+    #[error("{path}: {reason}")]
+    Compact { path: PathBuf, reason: Box<CompactError> },
     #[error("{path}, frame {frame}, joint {joint}: angle {value} is not finite")]
     NonFiniteAngle { path: PathBuf, frame: usize, joint: usize, value: f64 },
     #[error(
@@ -87,6 +91,96 @@ pub enum InputError {
     NotRegular { path: PathBuf, what: &'static str, kind: crate::file_kind::FileKind },
     #[error("{path}: {what} is not UTF-8 text (invalid byte at offset {offset})")]
     NotText { path: PathBuf, what: &'static str, offset: usize },
+}
+
+/// Why the bytes of an `.npy` file are not a C-order array [`super::npy`] takes; the file's
+/// name is the caller's ([`InputError::Npy`]). Text from the file is shown by its first 40
+/// characters. (Here, not in `npy`, so that `npy` imports `files` and not the other way.)
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum NpyError {
+    #[error("missing the magic string \\x93NUMPY (not an .npy file, or truncated)")]
+    NoMagic,
+    #[error("truncated in the header length")]
+    TruncatedHeaderLength,
+    #[error("format version {major}.x is not supported (1.0, 2.0 or 3.0)")]
+    Version { major: u8 },
+    #[error("truncated: the header is {header_len} bytes, the file ends before it does")]
+    TruncatedHeader { header_len: usize },
+    #[error("the header is not text")]
+    HeaderNotText,
+    #[error("Fortran-order array (fortran_order: True); expected C order")]
+    FortranOrder,
+    #[error("dtype '{descr}', expected little-endian float64 '<f8'")]
+    Dtype { descr: String },
+    #[error("shape overflows")]
+    ShapeOverflow,
+    #[error("truncated: shape {shape:?} needs {expected} data bytes, the file has {found}")]
+    TruncatedData { shape: Vec<usize>, expected: usize, found: usize },
+    #[error("{extra} bytes after the data of shape {shape:?} ({expected} bytes)")]
+    TrailingBytes { extra: usize, shape: Vec<usize>, expected: usize },
+    #[error("header {header:?} is not a dictionary")]
+    NotDictionary { header: String },
+    #[error("header {header:?}: expected a quoted key at {at:?}")]
+    ExpectedKey { header: String, at: String },
+    #[error("header: key '{key}' given twice")]
+    DuplicateKey { key: String },
+    #[error("header: expected ':' after '{key}'")]
+    ExpectedColon { key: String },
+    #[error("header: 'descr' is not a quoted string (structured dtypes are not supported)")]
+    DescrNotString,
+    #[error("header: 'fortran_order' is neither True nor False at {at:?}")]
+    FortranNotBool { at: String },
+    #[error("header: 'shape' is not a tuple")]
+    ShapeNotTuple,
+    #[error("header: 'shape' tuple is not closed")]
+    ShapeNotClosed,
+    #[error("header: shape has more than {MAX_AXES} axes, the most an array has")]
+    TooManyAxes,
+    #[error("header: shape entry '{entry}' is not a non-negative integer")]
+    ShapeEntry { entry: String },
+    #[error("header: unknown key '{key}'")]
+    UnknownKey { key: String },
+    #[error("header has no '{key}'")]
+    MissingKey { key: &'static str },
+}
+
+/// Most axes of an array (NumPy 2's `NPY_MAXDIMS`).
+pub(super) const MAX_AXES: usize = 64;
+
+/// Why `fields.npz` could not be made; the file's name is the caller's ([`OutputError::Zip`]).
+#[derive(Debug, thiserror::Error)]
+pub enum ZipError {
+    #[error("deflate: {0}")]
+    Deflate(flate2::CompressError),
+    /// `what`: a member's name, "the archive" or "the directory"
+    #[error("{what} exceeds 4 GiB (zip without Zip64)")]
+    TooLarge { what: String },
+    #[error("more than 65535 members ({count})")]
+    TooManyMembers { count: usize },
+}
+
+/// Why the bytes of a `fields.npz` are not a compact clip; the file's name is the caller's
+/// ([`InputError::Compact`]), the member's is in the variant.
+#[derive(Debug, thiserror::Error)]
+pub enum CompactError {
+    #[error("not a zip archive (no end of central directory)")]
+    NotZip,
+    #[error("truncated zip")]
+    Truncated,
+    #[error("corrupt zip central directory")]
+    CorruptDirectory,
+    #[error("{name}: truncated")]
+    MemberTruncated { name: String },
+    #[error("{name}: {error}")]
+    Inflate { name: String, error: std::io::Error },
+    #[error("{name}: compression method {method} (expected deflate)")]
+    Method { name: String, method: usize },
+    #[error("{name}: size or CRC does not match (corrupt archive)")]
+    Corrupt { name: String },
+    #[error("{name}: {reason}")]
+    Npy { name: String, reason: NpyError },
+    #[error("{name}: unexpected array {descr} {shape:?}")]
+    UnexpectedArray { name: String, descr: String, shape: Vec<usize> },
 }
 
 /// The message of `InputError::TooLarge`.

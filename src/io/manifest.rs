@@ -126,7 +126,7 @@ pub enum FolderError {
     )]
     Busy { path: PathBuf, pid: Option<u32> },
     #[error("{path}: cannot resume: {reason}")]
-    CannotResume { path: PathBuf, reason: String },
+    CannotResume { path: PathBuf, reason: ResumeRefusal },
     #[error("{path}")]
     Io {
         path: PathBuf,
@@ -254,35 +254,56 @@ pub fn list_files(dir: &Path) -> Result<Vec<String>, FolderError> {
     Ok(out)
 }
 
+/// Why the run in a folder cannot be continued by `--resume` ([`check_resumable`]); the folder
+/// is the caller's ([`FolderError::CannotResume`]).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ResumeRefusal {
+    #[error("it holds no run.json (no run to resume)")]
+    NoManifest,
+    #[error("it holds a `{command}` run, not a clip run (only clips resume)")]
+    NotClip { command: String },
+    #[error("its run is complete; nothing to resume")]
+    Complete,
+    #[error("it was written by cosserat {previous}, this is {now}")]
+    Version { previous: String, now: String },
+    #[error(
+        "its case file had SHA-256 {previous}, the case given now has {now}: a resumed clip must be the same case"
+    )]
+    CaseChanged { previous: String, now: String },
+    #[error("its clip file has changed since (SHA-256 differs)")]
+    InputsChanged,
+    #[error("it was run by the {previous} engine")]
+    Engine { previous: String },
+}
+
 /// Can the run of `previous` be continued by the run described by `new`? The same command
 /// (`run`) on the same case file and inputs, a clip, not complete; or an audit (`audit
 /// --resume`, `crate::audit::resume`) on the same specs, not complete.
-pub(super) fn check_resumable(previous: &Manifest, new: &Manifest) -> Result<(), String> {
+pub(super) fn check_resumable(previous: &Manifest, new: &Manifest) -> Result<(), ResumeRefusal> {
     let clip = previous.command == "run" && previous.frames_done.is_some();
     let audit = previous.command == "audit" && new.command == "audit";
     if !(clip || audit) {
-        return Err(format!("it holds a `{}` run, not a clip run (only clips resume)", previous.command));
+        return Err(ResumeRefusal::NotClip { command: previous.command.clone() });
     }
     if previous.status.is_complete() {
-        return Err("its run is complete; nothing to resume".into());
+        return Err(ResumeRefusal::Complete);
     }
     if previous.version != new.version {
-        return Err(format!("it was written by cosserat {}, this is {}", previous.version, new.version));
+        return Err(ResumeRefusal::Version { previous: previous.version.clone(), now: new.version.clone() });
     }
     let hash = |f: &Option<InputFile>| f.as_ref().map(|f| f.sha256.clone());
     if hash(&previous.case) != hash(&new.case) {
-        return Err(format!(
-            "its case file had SHA-256 {}, the case given now has {}: a resumed clip must be the same case",
-            hash(&previous.case).unwrap_or_default(),
-            hash(&new.case).unwrap_or_default()
-        ));
+        return Err(ResumeRefusal::CaseChanged {
+            previous: hash(&previous.case).unwrap_or_default(),
+            now: hash(&new.case).unwrap_or_default(),
+        });
     }
     let hashes = |m: &Manifest| m.inputs.iter().map(|f| f.sha256.clone()).collect::<Vec<_>>();
     if hashes(previous) != hashes(new) {
-        return Err("its clip file has changed since (SHA-256 differs)".into());
+        return Err(ResumeRefusal::InputsChanged);
     }
     if previous.engine != new.engine {
-        return Err(format!("it was run by the {} engine", previous.engine.clone().unwrap_or_default()));
+        return Err(ResumeRefusal::Engine { previous: previous.engine.clone().unwrap_or_default() });
     }
     Ok(())
 }

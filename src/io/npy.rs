@@ -13,7 +13,8 @@
 //! is an error that says what was found; no value is guessed or converted.
 use std::path::Path;
 
-use super::files::{read_capped, write_atomic, InputError, OutputError};
+pub use super::files::NpyError;
+use super::files::{read_capped, write_atomic, InputError, OutputError, MAX_AXES};
 
 const MAGIC: &[u8] = b"\x93NUMPY";
 
@@ -33,7 +34,7 @@ pub struct NpyArray {
 /// Read a little-endian float64, C-order `.npy` file of at most [`NPY_FILE_CAP_BYTES`].
 pub fn read_npy(path: &Path) -> Result<NpyArray, InputError> {
     let bytes = read_capped(path, NPY_FILE_CAP_BYTES, ".npy file")?;
-    parse_npy(&bytes).map_err(|reason| InputError::Npy { path: path.to_path_buf(), reason })
+    parse_npy(&bytes).map_err(|reason| InputError::Npy { path: path.to_path_buf(), reason: Box::new(reason) })
 }
 
 /// Write `data` (C order) with the given shape as a version 1.0 `.npy` file, atomically.
@@ -80,18 +81,18 @@ pub fn npy_header(descr: &str, shape: &[usize]) -> Vec<u8> {
 /// Parse the bytes of an `.npy` file; the error is the reason, without the file name. Every
 /// length read from the file (header length, shape) is checked against the bytes there are
 /// before anything is allocated or indexed.
-pub fn parse_npy(bytes: &[u8]) -> Result<NpyArray, String> {
+pub fn parse_npy(bytes: &[u8]) -> Result<NpyArray, NpyError> {
     let (descr, shape, body) = npy_payload(bytes)?;
     if descr != "<f8" {
-        return Err(format!("dtype '{}', expected little-endian float64 '<f8'", preview(&descr)));
+        return Err(NpyError::Dtype { descr: preview(&descr) });
     }
-    let count = shape.iter().try_fold(1usize, |a, &n| a.checked_mul(n)).ok_or("shape overflows")?;
-    let expected = count.checked_mul(8).ok_or("shape overflows")?;
+    let count = shape.iter().try_fold(1usize, |a, &n| a.checked_mul(n)).ok_or(NpyError::ShapeOverflow)?;
+    let expected = count.checked_mul(8).ok_or(NpyError::ShapeOverflow)?;
     if body.len() < expected {
-        return Err(format!("truncated: shape {shape:?} needs {expected} data bytes, the file has {}", body.len()));
+        return Err(NpyError::TruncatedData { shape, expected, found: body.len() });
     }
     if body.len() > expected {
-        return Err(format!("{} bytes after the data of shape {shape:?} ({expected} bytes)", body.len() - expected));
+        return Err(NpyError::TrailingBytes { extra: body.len() - expected, shape, expected });
     }
     let data = body.chunks_exact(8).map(|c| f64::from_le_bytes(c.try_into().expect("chunks of 8"))).collect();
     Ok(NpyArray { shape, data })
@@ -99,61 +100,60 @@ pub fn parse_npy(bytes: &[u8]) -> Result<NpyArray, String> {
 
 /// The dtype, shape and data bytes of a C-order `.npy` file (the data not checked against the
 /// shape).
-pub fn npy_payload(bytes: &[u8]) -> Result<(String, Vec<usize>, &[u8]), String> {
+pub fn npy_payload(bytes: &[u8]) -> Result<(String, Vec<usize>, &[u8]), NpyError> {
     if bytes.len() < MAGIC.len() + 2 || &bytes[..MAGIC.len()] != MAGIC {
-        return Err("missing the magic string \\x93NUMPY (not an .npy file, or truncated)".into());
+        return Err(NpyError::NoMagic);
     }
     let major = bytes[MAGIC.len()];
     let start = MAGIC.len() + 2;
     let (header_len, data_start) = match major {
         1 => {
-            let b = bytes.get(start..start + 2).ok_or("truncated in the header length")?;
+            let b = bytes.get(start..start + 2).ok_or(NpyError::TruncatedHeaderLength)?;
             (u16::from_le_bytes([b[0], b[1]]) as usize, start + 2)
         }
         2 | 3 => {
-            let b = bytes.get(start..start + 4).ok_or("truncated in the header length")?;
+            let b = bytes.get(start..start + 4).ok_or(NpyError::TruncatedHeaderLength)?;
             (u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize, start + 4)
         }
-        v => return Err(format!("format version {v}.x is not supported (1.0, 2.0 or 3.0)")),
+        major => return Err(NpyError::Version { major }),
     };
     let header = data_start
         .checked_add(header_len)
         .and_then(|end| bytes.get(data_start..end))
-        .ok_or_else(|| format!("truncated: the header is {header_len} bytes, the file ends before it does"))?;
-    let header = std::str::from_utf8(header).map_err(|_| "the header is not text".to_string())?;
+        .ok_or(NpyError::TruncatedHeader { header_len })?;
+    let header = std::str::from_utf8(header).map_err(|_| NpyError::HeaderNotText)?;
     let (descr, fortran, shape) = parse_header(header)?;
     if fortran {
-        return Err("Fortran-order array (fortran_order: True); expected C order".into());
+        return Err(NpyError::FortranOrder);
     }
     Ok((descr, shape, &bytes[data_start + header_len..]))
 }
 
 /// The three entries of the header dictionary: `descr`, `fortran_order`, `shape`.
-fn parse_header(header: &str) -> Result<(String, bool, Vec<usize>), String> {
+fn parse_header(header: &str) -> Result<(String, bool, Vec<usize>), NpyError> {
     let inner = header
         .trim()
         .strip_prefix('{')
         .and_then(|h| h.strip_suffix('}'))
-        .ok_or_else(|| format!("header {:?} is not a dictionary", preview(header)))?;
+        .ok_or_else(|| NpyError::NotDictionary { header: preview(header) })?;
     let (mut descr, mut fortran, mut shape) = (None, None, None);
     let mut rest = inner.trim();
     let mut seen: Vec<&str> = Vec::new();
     while !rest.is_empty() {
-        let (key, after) = quoted(rest)
-            .ok_or_else(|| format!("header {:?}: expected a quoted key at {:?}", preview(inner), preview(rest)))?;
+        let (key, after) =
+            quoted(rest).ok_or_else(|| NpyError::ExpectedKey { header: preview(inner), at: preview(rest) })?;
         if seen.contains(&key) {
-            return Err(format!("header: key '{}' given twice", preview(key)));
+            return Err(NpyError::DuplicateKey { key: preview(key) });
         }
         seen.push(key);
         let after = after
             .trim_start()
             .strip_prefix(':')
-            .ok_or_else(|| format!("header: expected ':' after '{}'", preview(key)))?
+            .ok_or_else(|| NpyError::ExpectedColon { key: preview(key) })?
             .trim_start();
         let after = match key {
             "descr" => {
-                let (v, a) = quoted(after)
-                    .ok_or("header: 'descr' is not a quoted string (structured dtypes are not supported)")?;
+                let (v, a) = quoted(after).ok_or(NpyError::DescrNotString)?;
                 descr = Some(v.to_string());
                 a
             }
@@ -163,43 +163,37 @@ fn parse_header(header: &str) -> Result<(String, bool, Vec<usize>), String> {
                 } else if let Some(a) = after.strip_prefix("False") {
                     (false, a)
                 } else {
-                    return Err(format!("header: 'fortran_order' is neither True nor False at {:?}", preview(after)));
+                    return Err(NpyError::FortranNotBool { at: preview(after) });
                 };
                 fortran = Some(v);
                 a
             }
             "shape" => {
-                let body = after.strip_prefix('(').ok_or("header: 'shape' is not a tuple")?;
-                let close = body.find(')').ok_or("header: 'shape' tuple is not closed")?;
+                let body = after.strip_prefix('(').ok_or(NpyError::ShapeNotTuple)?;
+                let close = body.find(')').ok_or(NpyError::ShapeNotClosed)?;
                 let entries: Vec<&str> =
                     body[..close].split(',').map(str::trim).filter(|t| !t.is_empty()).take(MAX_AXES + 1).collect();
                 if entries.len() > MAX_AXES {
-                    return Err(format!("header: shape has more than {MAX_AXES} axes, the most an array has"));
+                    return Err(NpyError::TooManyAxes);
                 }
                 let dims = entries
                     .into_iter()
-                    .map(|t| {
-                        t.parse::<usize>()
-                            .map_err(|_| format!("header: shape entry '{}' is not a non-negative integer", preview(t)))
-                    })
+                    .map(|t| t.parse::<usize>().map_err(|_| NpyError::ShapeEntry { entry: preview(t) }))
                     .collect::<Result<Vec<_>, _>>()?;
                 shape = Some(dims);
                 &body[close + 1..]
             }
-            other => return Err(format!("header: unknown key '{}'", preview(other))),
+            other => return Err(NpyError::UnknownKey { key: preview(other) }),
         };
         rest = after.trim_start();
         rest = rest.strip_prefix(',').unwrap_or(rest).trim_start();
     }
     Ok((
-        descr.ok_or("header has no 'descr'")?,
-        fortran.ok_or("header has no 'fortran_order'")?,
-        shape.ok_or("header has no 'shape'")?,
+        descr.ok_or(NpyError::MissingKey { key: "descr" })?,
+        fortran.ok_or(NpyError::MissingKey { key: "fortran_order" })?,
+        shape.ok_or(NpyError::MissingKey { key: "shape" })?,
     ))
 }
-
-/// Most axes of an array (NumPy 2's `NPY_MAXDIMS`).
-const MAX_AXES: usize = 64;
 
 /// At most the first 40 characters of `s` (for messages about a malformed header).
 fn preview(s: &str) -> String {
@@ -255,24 +249,24 @@ mod tests {
             assert_eq!(b.len(), good.len(), "{t}");
             b
         };
-        let e = parse_npy(&edit("<f8", ">f8")).unwrap_err();
+        let e = parse_npy(&edit("<f8", ">f8")).unwrap_err().to_string();
         assert!(e.contains("dtype '>f8'") && e.contains("'<f8'"), "{e}");
-        let e = parse_npy(&edit("<f8", "<f4")).unwrap_err();
+        let e = parse_npy(&edit("<f8", "<f4")).unwrap_err().to_string();
         assert!(e.contains("dtype '<f4'"), "{e}");
-        let e = parse_npy(&edit("False", "True ")).unwrap_err();
+        let e = parse_npy(&edit("False", "True ")).unwrap_err().to_string();
         assert!(e.contains("Fortran-order"), "{e}");
-        let e = parse_npy(&good[..good.len() - 5]).unwrap_err();
+        let e = parse_npy(&good[..good.len() - 5]).unwrap_err().to_string();
         assert!(e.contains("truncated") && e.contains("48 data bytes") && e.contains("has 43"), "{e}");
-        let e = parse_npy(&good[..20]).unwrap_err();
+        let e = parse_npy(&good[..20]).unwrap_err().to_string();
         assert!(e.contains("truncated"), "{e}");
-        let e = parse_npy(b"PK\x03\x04 not npy").unwrap_err();
+        let e = parse_npy(b"PK\x03\x04 not npy").unwrap_err().to_string();
         assert!(e.contains("magic"), "{e}");
         let mut long = good.clone();
         long.extend_from_slice(&[0; 8]);
-        assert!(parse_npy(&long).unwrap_err().contains("8 bytes after the data"));
-        let e = parse_npy(&edit("(2, 3)", "(2,-3)")).unwrap_err();
+        assert!(parse_npy(&long).unwrap_err().to_string().contains("8 bytes after the data"));
+        let e = parse_npy(&edit("(2, 3)", "(2,-3)")).unwrap_err().to_string();
         assert!(e.contains("'-3'"), "{e}");
-        let e = parse_npy(&edit("'fortran_order'", "'descr'        ")).unwrap_err();
+        let e = parse_npy(&edit("'fortran_order'", "'descr'        ")).unwrap_err().to_string();
         assert_eq!(e, "header: key 'descr' given twice");
     }
 
@@ -293,18 +287,24 @@ mod tests {
         let mut b = MAGIC.to_vec();
         b.extend_from_slice(&[2, 0, 0xff, 0xff, 0xff, 0xff]);
         assert_eq!(
-            parse_npy(&b).unwrap_err(),
+            parse_npy(&b).unwrap_err().to_string(),
             "truncated: the header is 4294967295 bytes, the file ends before it does"
         );
         let e = parse_npy(&header("{'descr': '<f8', 'fortran_order': False, 'shape': (4294967296, 4294967296, 2)}", 1));
-        assert_eq!(e.unwrap_err(), "shape overflows");
+        assert_eq!(e.unwrap_err().to_string(), "shape overflows");
         let e = parse_npy(&header("{'descr': '<f8', 'fortran_order': False, 'shape': (1000000000000,)}", 3));
-        assert_eq!(e.unwrap_err(), "truncated: shape [1000000000000] needs 8000000000000 data bytes, the file has 0");
+        assert_eq!(
+            e.unwrap_err().to_string(),
+            "truncated: shape [1000000000000] needs 8000000000000 data bytes, the file has 0"
+        );
         let axes = vec!["1"; 65].join(",");
         let e = parse_npy(&header(&format!("{{'descr': '<f8', 'fortran_order': False, 'shape': ({axes})}}"), 1));
-        assert_eq!(e.unwrap_err(), "header: shape has more than 64 axes, the most an array has");
+        assert_eq!(e.unwrap_err().to_string(), "header: shape has more than 64 axes, the most an array has");
         let long = "x".repeat(100_000);
         let e = parse_npy(&header(&format!("{{'descr': '{long}', 'fortran_order': False, 'shape': (1,)}}"), 2));
-        assert_eq!(e.unwrap_err(), format!("dtype '{}…', expected little-endian float64 '<f8'", "x".repeat(40)));
+        assert_eq!(
+            e.unwrap_err().to_string(),
+            format!("dtype '{}…', expected little-endian float64 '<f8'", "x".repeat(40))
+        );
     }
 }

@@ -5,7 +5,7 @@
 use std::path::{Path, PathBuf};
 
 use super::files::is_temporary;
-use super::manifest::{check_resumable, io_err, FolderError, Manifest, Status, MANIFEST};
+use super::manifest::{check_resumable, io_err, FolderError, Manifest, ResumeRefusal, Status, MANIFEST};
 
 /// A staging folder `.NAME.staging-PID` left beside an output folder by a run that ended
 /// before it put it in place (killed, or stopped by a full disk).
@@ -71,7 +71,7 @@ pub(super) fn resume_source(
     left: &[Leftover],
     new: &Manifest,
 ) -> Result<(ResumeSource, Manifest), FolderError> {
-    let cannot = |reason: String| FolderError::CannotResume { path: target.to_path_buf(), reason };
+    let cannot = |reason: ResumeRefusal| FolderError::CannotResume { path: target.to_path_buf(), reason };
     let mut best: Option<(usize, ResumeSource, Manifest)> = None;
     for (i, l) in left.iter().enumerate() {
         let m = l.manifest.clone().unwrap_or_else(|| new.clone());
@@ -83,19 +83,20 @@ pub(super) fn resume_source(
         }
     }
     let target_reason = match old {
-        None => "it holds no run.json (no run to resume)".to_string(),
+        None => Some(ResumeRefusal::NoManifest),
         Some(m) => match check_resumable(m, new) {
             Ok(()) => {
                 let frames = journal_frames(target);
                 if best.as_ref().is_none_or(|b| frames > b.0) {
                     best = Some((frames, ResumeSource::Target, m.clone()));
                 }
-                String::new()
+                None
             }
-            Err(reason) => reason,
+            Err(reason) => Some(reason),
         },
     };
-    best.map(|(_, source, m)| (source, m)).ok_or_else(|| cannot(target_reason))
+    // `best` is set when the target is resumable, so a missing `best` has a target reason
+    best.map(|(_, source, m)| (source, m)).ok_or_else(|| cannot(target_reason.unwrap_or(ResumeRefusal::NoManifest)))
 }
 
 /// Remove the temporary files of atomic writes under `dir`: a run killed while it wrote one

@@ -11,6 +11,7 @@
 //! Storage (column-major, as LAPACK's `AB`): entry `(i, j)` lives at
 //! `ab[j ld + kl + ku + i − j]`, `ld = 2 kl + ku + 1`; the first `kl` rows of each column
 //! hold the fill of the interchanges.
+use super::cpu::Avx2;
 use super::LinearError;
 
 /// A square band matrix and, after [`BandLu::factor`], its LU factors with the pivots.
@@ -126,23 +127,26 @@ impl BandLu {
     /// column) are zero already, e.g. written whole by the caller column by column.
     pub fn factor_cleared(&mut self) -> Result<(), LinearError> {
         #[cfg(target_arch = "x86_64")]
-        if simd::available() {
-            // SAFETY: the CPU has AVX2, checked just above.
-            return unsafe { self.factor_avx2() };
+        if let Some(cpu) = Avx2::detect() {
+            // SAFETY: the token `cpu` exists, so the CPU has AVX2.
+            return unsafe { self.factor_avx2(cpu) };
         }
-        self.factor_with(false)
+        self.factor_with(None)
     }
 
     /// [`BandLu::factor_cleared`] compiled for AVX2 (the divisions and interchanges too).
+    ///
+    /// # Safety
+    /// The CPU must have AVX2 (`cpu` proves it: a token is only made after the check).
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    unsafe fn factor_avx2(&mut self) -> Result<(), LinearError> {
-        self.factor_with(true)
+    unsafe fn factor_avx2(&mut self, cpu: Avx2) -> Result<(), LinearError> {
+        self.factor_with(Some(cpu))
     }
 
-    /// The body of [`BandLu::factor_cleared`]; `wide`: the CPU has AVX2.
+    /// The body of [`BandLu::factor_cleared`]; `wide`: the AVX2 token where the CPU has AVX2.
     #[inline(always)]
-    fn factor_with(&mut self, wide: bool) -> Result<(), LinearError> {
+    fn factor_with(&mut self, wide: Option<Avx2>) -> Result<(), LinearError> {
         let (n, ld) = (self.n, self.ld);
         let kv = self.kl + self.ku;
         // last column touched by an interchange so far (U's extent)
@@ -181,9 +185,9 @@ impl BandLu {
             let span = ju - j;
             macro_rules! fixed {
                 ($($k:literal)*) => {
-                    match km {
-                        $($k if wide => simd::update::<$k>(head, tail, col, kv, ld, span),)*
-                        $($k => update::<$k>(head, tail, col, kv, ld, span),)*
+                    match (km, wide) {
+                        $(($k, Some(cpu)) => simd::update::<$k>(cpu, head, tail, col, kv, ld, span),)*
+                        $(($k, None) => update::<$k>(head, tail, col, kv, ld, span),)*
                         _ => update_any(head, tail, col, kv, ld, span, km),
                     }
                 };
@@ -197,13 +201,17 @@ impl BandLu {
     /// chosen at run time; the same numbers).
     pub fn solve_in_place(&self, b: &mut [f64]) {
         #[cfg(target_arch = "x86_64")]
-        if simd::available() {
-            // SAFETY: the CPU has AVX2, checked just above.
+        if Avx2::detect().is_some() {
+            // SAFETY: an `Avx2` token was just made, so the CPU has AVX2.
             return unsafe { self.solve_avx2(b) };
         }
         self.solve_portable(b)
     }
 
+    /// [`BandLu::solve_portable`] compiled for AVX2.
+    ///
+    /// # Safety
+    /// The CPU must have AVX2 (an [`Avx2`] token was made).
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
     unsafe fn solve_avx2(&self, b: &mut [f64]) {
@@ -436,9 +444,9 @@ mod tests {
                 let mut general = band_from_dense(&a, 2 * b - 1, 2 * b - 1);
                 let mut general_portable = general.clone();
                 wide.factor().expect("factor");
-                portable.factor_with(false).expect("portable factor");
+                portable.factor_with(None).expect("portable factor");
                 general.factor().expect("factor");
-                general_portable.factor_with(false).expect("portable factor");
+                general_portable.factor_with(None).expect("portable factor");
                 assert_eq!((&wide.ab, &wide.piv), (&portable.ab, &portable.piv), "{nb}×{b}, dominant {dominant}");
                 assert_eq!((&general.ab, &general.piv), (&general_portable.ab, &general_portable.piv));
                 let mut r = rng(seed + 7);

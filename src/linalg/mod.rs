@@ -2,6 +2,7 @@
 //! sparsity [`Pattern`], a banded LU with partial pivoting ([`BandLu`]) and the direct solver
 //! with Ruiz equilibration ([`LinearSolver`]). Knows matrices, not meshes.
 mod band;
+mod cpu;
 mod pattern;
 mod solver;
 

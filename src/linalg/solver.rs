@@ -6,6 +6,8 @@
 //! zeroes the whole band.
 use nalgebra::DVector;
 
+#[cfg(target_arch = "x86_64")]
+use super::cpu::Avx2;
 use super::{BandLu, LinearError, Pattern};
 
 /// Passes of Ruiz equilibration.
@@ -238,14 +240,18 @@ fn inv_sqrt_all(v: &mut [f64]) {
             *x = if *x > 0.0 { 1.0 / x.sqrt() } else { 1.0 };
         }
     }
+    /// `body` compiled for AVX2.
+    ///
+    /// # Safety
+    /// The CPU must have AVX2 (an [`Avx2`] token was made).
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
     unsafe fn wide(v: &mut [f64]) {
         body(v)
     }
     #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") {
-        // SAFETY: the CPU has AVX2, checked just above.
+    if Avx2::detect().is_some() {
+        // SAFETY: an `Avx2` token was just made, so the CPU has AVX2.
         return unsafe { wide(v) };
     }
     body(v)
@@ -272,6 +278,9 @@ fn scale_column<const L: usize>(a: &mut [f64], r: &[f64], c: f64, next: &mut [f6
 /// `next_i ← max(next_i, |a_i|)`, and the column's maximum `|a_i|` returned, in one sweep (the
 /// scaled values are not read back). The same products, each rounded once, and the same maxima
 /// (`_mm256_max_pd(m, x)` keeps `x` where `m` is NaN, as `if m > x { m } else { x }` does).
+///
+/// # Safety
+/// The CPU must have AVX2 (an [`Avx2`] token was made). The slice lengths are checked.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 unsafe fn scale_and_measure_avx2(a: &mut [f64], r: &[f64], c: f64, next: &mut [f64]) -> f64 {
@@ -325,7 +334,7 @@ fn ruiz(
 ) {
     let n = cols.len.len();
     #[cfg(target_arch = "x86_64")]
-    let wide = std::arch::is_x86_feature_detected!("avx2");
+    let wide = Avx2::detect();
     dr.iter_mut().for_each(|v| *v = 1.0);
     dc.iter_mut().for_each(|v| *v = 1.0);
     // the rows of a column are contiguous (block-tridiagonal pattern): slices, no gathers
@@ -353,8 +362,8 @@ fn ruiz(
             // a block-tridiagonal pattern hold 2 or 3 blocks of rows (block 6 or 12): those
             // lengths have loops of fixed length
             #[cfg(target_arch = "x86_64")]
-            if !last && wide {
-                // SAFETY: `wide` says the CPU has AVX2.
+            if let (false, Some(_cpu)) = (last, wide) {
+                // SAFETY: the `Avx2` token `_cpu` exists, so the CPU has AVX2.
                 c[j] = unsafe { scale_and_measure_avx2(a, rows, cj, next) };
                 continue;
             }

@@ -14,6 +14,8 @@ use cosserat::solve::inverse::{
 use cosserat::solve::{Problem, SolveError};
 use nalgebra::{DVector, Vector3};
 
+pub mod fixed_point;
+
 pub fn cases_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("cases")
 }
@@ -50,16 +52,6 @@ pub fn case_from(text: &str, name: &str) -> Case {
 pub fn edit(text: &str, from: &str, to: &str) -> String {
     assert_eq!(text.matches(from).count(), 1, "pattern `{from}` must occur once");
     text.replacen(from, to, 1)
-}
-
-/// Round to `digits` significant digits (stable snapshot values across machines).
-pub fn sig(v: f64, digits: i32) -> f64 {
-    if v == 0.0 || !v.is_finite() {
-        return v;
-    }
-    let p = digits - 1 - v.abs().log10().floor() as i32;
-    let f = 10f64.powi(p);
-    (v * f).round() / f
 }
 
 /// A case file of `cases/` read from disk (relative paths inside it resolve against `cases/`).

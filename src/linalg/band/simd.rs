@@ -1,40 +1,55 @@
 //! The rank-1 update of [`super::BandLu::factor`] with AVX2 (or AVX-512) vectors where the CPU
 //! has them.
+use crate::linalg::cpu::Avx2;
+#[cfg(target_arch = "x86_64")]
+use crate::linalg::cpu::Avx512;
 
-/// Whether the CPU has AVX2 (detected once, then cached by the standard library).
-#[inline]
-pub fn available() -> bool {
-    #[cfg(target_arch = "x86_64")]
-    {
-        std::arch::is_x86_feature_detected!("avx2")
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        false
-    }
-}
+/// Most rows below a pivot that [`update`] takes (`KL`): the multipliers are held in
+/// `MAX_ROWS / 4` AVX2 or `MAX_ROWS / 8` AVX-512 registers. Block size 12, the largest of the
+/// solvers, has at most 23 rows below a pivot.
+pub const MAX_ROWS: usize = 24;
+/// AVX2 registers (4 lanes) that hold the multipliers of [`kernel`].
+const REGS_AVX2: usize = MAX_ROWS / 4;
+/// AVX-512 registers (8 lanes) that hold the full lanes of the multipliers of [`kernel512`].
+const REGS_AVX512: usize = MAX_ROWS / 8;
+const _: () = assert!(REGS_AVX2 * 4 == MAX_ROWS && REGS_AVX512 * 8 == MAX_ROWS, "MAX_ROWS fills whole registers");
 
 /// [`super::update`] four rows at a time ([`kernel`]), or eight with AVX-512 (e.g. AMD Zen 4,
 /// Intel Xeon), the last `KL mod 8` under a mask ([`kernel512`]): the `KL` multipliers stay in
 /// registers for all `span` columns, and each row is `d − l · u` with one rounding per
-/// operation, as there. Only called when [`available`].
+/// operation, as there. `KL ≤ MAX_ROWS`, checked at compile time.
 #[inline]
-pub fn update<const KL: usize>(head: &[f64], tail: &mut [f64], col: usize, kv: usize, ld: usize, span: usize) {
+pub fn update<const KL: usize>(
+    cpu: Avx2,
+    head: &[f64],
+    tail: &mut [f64],
+    col: usize,
+    kv: usize,
+    ld: usize,
+    span: usize,
+) {
+    const { assert!(KL <= MAX_ROWS, "more rows below the pivot than the kernels hold in registers") };
     #[cfg(target_arch = "x86_64")]
-    // SAFETY: called only when `available()` (the CPU has AVX2), and kernel512 only when it
-    // has AVX-512F.
-    unsafe {
-        if std::arch::is_x86_feature_detected!("avx512f") {
-            kernel512::<KL>(head, tail, col, kv, ld, span)
-        } else {
-            kernel::<KL>(head, tail, col, kv, ld, span)
-        }
+    if Avx512::detect().is_some() {
+        // SAFETY: an `Avx512` token was just made, so the CPU has AVX-512F; KL ≤ MAX_ROWS above.
+        unsafe { kernel512::<KL>(head, tail, col, kv, ld, span) }
+    } else {
+        let _: Avx2 = cpu;
+        // SAFETY: the `Avx2` token `cpu` exists, so the CPU has AVX2; KL ≤ MAX_ROWS above.
+        unsafe { kernel::<KL>(head, tail, col, kv, ld, span) }
     }
     #[cfg(not(target_arch = "x86_64"))]
-    super::update::<KL>(head, tail, col, kv, ld, span)
+    {
+        let _: Avx2 = cpu;
+        super::update::<KL>(head, tail, col, kv, ld, span)
+    }
 }
 
 /// [`kernel`] with 8-wide vectors; masked lanes are neither read nor written.
+///
+/// # Safety
+/// The CPU must have AVX-512F (an [`Avx512`] token was made), and `KL ≤ MAX_ROWS` (asserted
+/// by [`update`]; beyond it rows would be left out). The slice bounds are checked.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f")]
 unsafe fn kernel512<const KL: usize>(head: &[f64], tail: &mut [f64], col: usize, kv: usize, ld: usize, span: usize) {
@@ -47,7 +62,8 @@ unsafe fn kernel512<const KL: usize>(head: &[f64], tail: &mut [f64], col: usize,
     let mask = ((1u32 << rest) - 1) as u8;
     // SAFETY (loads and stores): full lanes 8v..8v + 8 ≤ KL, masked lanes < KL, of `l` and
     // of the KL-long `dst`.
-    let lv = [0, 1, 2].map(|v| if v < full { _mm512_loadu_pd(l.as_ptr().add(8 * v)) } else { _mm512_set1_pd(0.0) });
+    let lv: [_; REGS_AVX512] =
+        std::array::from_fn(|v| if v < full { _mm512_loadu_pd(l.as_ptr().add(8 * v)) } else { _mm512_set1_pd(0.0) });
     let lr = _mm512_maskz_loadu_pd(mask, l.as_ptr().add(8 * full));
     for (t, column) in tail.chunks_exact_mut(ld).take(span).enumerate() {
         let base = kv - 1 - t;
@@ -68,6 +84,11 @@ unsafe fn kernel512<const KL: usize>(head: &[f64], tail: &mut [f64], col: usize,
     }
 }
 
+/// [`super::update`] with 4-wide vectors, the last `KL mod 4` rows one at a time.
+///
+/// # Safety
+/// The CPU must have AVX2 (an [`Avx2`] token was made), and `KL ≤ MAX_ROWS` (asserted by
+/// [`update`]; beyond it rows would be left out). The slice bounds are checked.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 unsafe fn kernel<const KL: usize>(head: &[f64], tail: &mut [f64], col: usize, kv: usize, ld: usize, span: usize) {
@@ -75,8 +96,8 @@ unsafe fn kernel<const KL: usize>(head: &[f64], tail: &mut [f64], col: usize, kv
     let l: &[f64; KL] = head[col + 1..col + 1 + KL].try_into().expect("KL multipliers");
     let full = KL / 4;
     // SAFETY (loads and stores): lanes 4v..4v + 4 ≤ KL of `l` and of the KL-long `dst`.
-    let lv =
-        [0, 1, 2, 3, 4, 5].map(|v| if v < full { _mm256_loadu_pd(l.as_ptr().add(4 * v)) } else { _mm256_set1_pd(0.0) });
+    let lv: [_; REGS_AVX2] =
+        std::array::from_fn(|v| if v < full { _mm256_loadu_pd(l.as_ptr().add(4 * v)) } else { _mm256_set1_pd(0.0) });
     for (t, column) in tail.chunks_exact_mut(ld).take(span).enumerate() {
         let base = kv - 1 - t;
         let ujc = column[base];
