@@ -172,6 +172,8 @@ fn convergence(title: &str, r: &RunResults) -> Option<Svg> {
                 let h = history_of(p, name)?;
                 (!h.is_empty()).then(|| Series::new(label(p), (1..=h.len()).map(|k| k as f64).collect(), h))
             })
+            .enumerate()
+            .map(|(i, s)| s.nth_of_many(i))
             .collect();
         if series.is_empty() {
             continue;
@@ -447,16 +449,6 @@ fn points_of<'a>(spec: &Spec, runs: &'a [RunResults], names: &[String]) -> Vec<(
         .collect()
 }
 
-/// Curve `i` of a comparison of runs: every second one dashed, so that a curve lying on another
-/// stays visible.
-fn alternate(s: Series, i: usize) -> Series {
-    if i % 2 == 1 {
-        s.marked(Mark::Dashed)
-    } else {
-        s
-    }
-}
-
 /// Figs. 18–20: the terms of the objective (41) per frame against time and the fit, one curve
 /// per run (labelled by the weights in which they differ).
 fn objectives(spec: &Spec, title: &str, names: &[String], runs: &[RunResults]) -> Option<Svg> {
@@ -482,7 +474,7 @@ fn objectives(spec: &Spec, title: &str, names: &[String], runs: &[RunResults]) -
             let dt = frame_interval_s(spec, run_name);
             let x = clip.reports.iter().map(|r| r.frame as f64 * dt).collect();
             let curve = Series::new(label.clone(), x, clip.reports.iter().map(|r| f(r, sqrt_l)).collect());
-            series.push(alternate(curve, series.len()));
+            series.push(curve.nth_of_many(series.len()));
         }
         let positive = series.iter().any(|s| s.y.iter().any(|v| *v > 0.0));
         if series.is_empty() || !positive {
@@ -509,7 +501,7 @@ fn omega(spec: &Spec, title: &str, names: &[String], runs: &[RunResults]) -> Opt
         })
         .filter(|s| !s.x.is_empty())
         .enumerate()
-        .map(|(i, s)| alternate(s, i))
+        .map(|(i, s)| s.nth_of_many(i))
         .collect();
     (!series.is_empty()).then(|| {
         render_panels_svg(&[line(title.into(), "t [s]", "max |ω| over the body [rad/s]", series, (false, true))], 1)
@@ -576,7 +568,7 @@ fn profiles(all: &RunResults, frames: &[usize]) -> Option<LinePlot> {
             "lambda_kappa3" => k.kappa.iter().map(|(s, v)| (s * 1e3, v[2] * 1e-3)).unzip(),
             _ => return None,
         };
-        series.push(alternate(Series::new(label(p), x, y), series.len()));
+        series.push(Series::new(label(p), x, y).nth_of_many(series.len()));
     }
     let y_label = if key == "lambda_d" { "∠(d3, ∂s x) [°]" } else { "κ3 [1/mm]" };
     let what = if key == "lambda_d" { "the detachment of d3 from the tangent" } else { "the twist κ3" };

@@ -87,6 +87,8 @@ pub struct Series {
     pub mark: Mark,
     /// Palette index of its colour; `None`: the curve's position in the plot.
     pub colour: Option<usize>,
+    /// Line width [px]; 0: 2 px.
+    pub width: u32,
 }
 
 impl Series {
@@ -102,6 +104,15 @@ impl Series {
     /// The same curve in palette colour `i` (pairs of data and solution share one).
     pub fn coloured(mut self, i: usize) -> Self {
         self.colour = Some(i);
+        self
+    }
+    /// Curve `i` of a comparison of runs whose curves may lie on each other: each narrower than
+    /// the one before (4, 3, 2, 1 px …) and every second one dashed, so that all stay visible.
+    pub fn nth_of_many(mut self, i: usize) -> Self {
+        self.width = 4u32.saturating_sub(i as u32).max(1);
+        if i % 2 == 1 {
+            self.mark = Mark::Dashed;
+        }
         self
     }
 }
@@ -293,7 +304,7 @@ fn text_style(px: u32) -> TextStyle<'static> {
 
 /// The stroke of curve `i` of a plot.
 fn stroke(s: &Series, i: usize) -> ShapeStyle {
-    ShapeStyle::from(palette(s.colour.unwrap_or(i))).stroke_width(2)
+    ShapeStyle::from(palette(s.colour.unwrap_or(i))).stroke_width(if s.width == 0 { 2 } else { s.width })
 }
 
 /// Width of the legend strip of `plot` in a panel `width` px wide.

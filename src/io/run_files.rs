@@ -340,6 +340,9 @@ pub fn write_convergence_plot(runs: &[(&String, &RunResult)], path: &Path) -> Re
             ));
         }
     }
+    // the runs' curves may lie on each other: each narrower than the one before
+    let many = |v: Vec<Series>| v.into_iter().enumerate().map(|(i, s)| s.nth_of_many(i)).collect::<Vec<_>>();
+    let (xerr, kerr, change) = (many(xerr), many(kerr), many(change));
     let mut panels = Vec::new();
     if !xerr.is_empty() {
         panels.push(plot("|x - x_g| / |x_g|", "relative error", xerr));
