@@ -524,8 +524,8 @@ fn shown_frames<'a>(p: &'a PointResult, frames: &[usize]) -> Vec<&'a crate::run:
 /// d1 (ticks), d3 (arrows) and the tangent, the centreline coloured by |κ| [1/mm] (the node
 /// average of the element curvatures, `run::clip::nodal_curvature`). For a run with a grid,
 /// beneath them the quantity its swept weight penalises along the body at the first frame
-/// shown, one curve per grid point: the angle between d3 and the tangent ∂s x (λd, Fig. 21:
-/// the detachment) or κ3 (λκ3, Fig. 22).
+/// shown, one curve per grid point: the angle between d3 and the chord of each element (λd,
+/// Fig. 21: the detachment the λd term penalises) or κ3 (λκ3, Fig. 22).
 fn postures(title: &str, p: &PointResult, frames: &[usize], all: &RunResults) -> Option<Svg> {
     let panels: Vec<PosturePanel> = shown_frames(p, frames)
         .into_iter()
@@ -558,11 +558,16 @@ fn profiles(all: &RunResults, frames: &[usize]) -> Option<LinePlot> {
         frame_no.get_or_insert(k.report.frame);
         let (x, y): (Vec<f64>, Vec<f64>) = match key.as_str() {
             "lambda_d" => {
+                // per element: the chord (x_{i+1} − x_i) against the mean of its nodes' d3, the
+                // pair the λd term of (41) compares
                 let d = k.nodes.directors();
-                let t = crate::io::posture::tangents(&k.nodes.x);
-                let s_mm = k.nodes.s.iter().map(|s| s * 1e3);
-                s_mm.zip(t.iter().zip(&d))
-                    .map(|(s, (t, q))| (s, t.map_or(f64::NAN, |t| t.dot(&q[2]).clamp(-1.0, 1.0).acos().to_degrees())))
+                let (x, s) = (&k.nodes.x, &k.nodes.s);
+                (0..x.len() - 1)
+                    .map(|i| {
+                        let (c, m) = (x[i + 1] - x[i], d[i][2] + d[i + 1][2]);
+                        let cos = c.dot(&m) / (c.norm() * m.norm());
+                        (0.5 * (s[i] + s[i + 1]) * 1e3, cos.clamp(-1.0, 1.0).acos().to_degrees())
+                    })
                     .unzip()
             }
             "lambda_kappa3" => k.kappa.iter().map(|(s, v)| (s * 1e3, v[2] * 1e-3)).unzip(),
@@ -570,8 +575,8 @@ fn profiles(all: &RunResults, frames: &[usize]) -> Option<LinePlot> {
         };
         series.push(Series::new(label(p), x, y).nth_of_many(series.len()));
     }
-    let y_label = if key == "lambda_d" { "∠(d3, ∂s x) [°]" } else { "κ3 [1/mm]" };
-    let what = if key == "lambda_d" { "the detachment of d3 from the tangent" } else { "the twist κ3" };
+    let y_label = if key == "lambda_d" { "∠(d3, ∂s x) per element [°]" } else { "κ3 [1/mm]" };
+    let what = if key == "lambda_d" { "the detachment of d3 from the centreline's chord" } else { "the twist κ3" };
     let t = format!("{what} along the body at frame {}, for each {}", frame_no?, pretty_key(&key));
     (!series.is_empty()).then(|| line(t, "arc length s [mm] (0 = head)", y_label, series, (false, key == "lambda_d")))
 }

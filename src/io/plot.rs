@@ -297,6 +297,22 @@ fn wrap(text: &str, chars: usize) -> Vec<String> {
     lines
 }
 
+/// Writes `title` centred in a strip `height` px high at the top of `area` (at most `max_px`
+/// px, smaller for a long title) and returns the rest of `area`.
+pub(crate) fn title_strip<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    title: &str,
+    height: u32,
+    max_px: u32,
+) -> Result<DrawingArea<DB, Shift>, PlotError> {
+    let (w, _) = area.dim_in_pixel();
+    let (head, body) = area.split_vertically(height);
+    let style =
+        TextStyle::from(font(fit_font(title, w.saturating_sub(20), max_px))).pos(Pos::new(HPos::Center, VPos::Center));
+    head.draw_text(title, &style, (w as i32 / 2, height as i32 / 2)).map_err(|e| draw_err(title, e))?;
+    Ok(body)
+}
+
 /// Left-aligned, vertically centred text of `px` px.
 fn text_style(px: u32) -> TextStyle<'static> {
     TextStyle::from(font(px)).pos(Pos::new(HPos::Left, VPos::Center))
@@ -362,9 +378,7 @@ where
 {
     let t = plot.title.as_str();
     let (w, _) = area.dim_in_pixel();
-    let (head, body) = area.split_vertically(TITLE_STRIP);
-    let style = TextStyle::from(font(fit_font(t, w - 16, TITLE_PX))).pos(Pos::new(HPos::Center, VPos::Center));
-    head.draw_text(t, &style, (w as i32 / 2, TITLE_STRIP as i32 / 2)).map_err(|e| draw_err(t, e))?;
+    let body = title_strip(area, t, TITLE_STRIP, TITLE_PX)?;
     let lw = legend_width(plot, w);
     let (chart_area, legend_area) = body.split_horizontally(w - lw);
     let mut chart = ChartBuilder::on(&chart_area)
@@ -669,9 +683,7 @@ fn validate_maps(maps: &[Heatmap]) -> Result<(), PlotError> {
 fn draw_heatmap<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, m: &Heatmap) -> Result<(), PlotError> {
     let t = m.title.as_str();
     let (w, _) = area.dim_in_pixel();
-    let (head, body) = area.split_vertically(TITLE_STRIP);
-    let style = TextStyle::from(font(fit_font(t, w - 16, TITLE_PX))).pos(Pos::new(HPos::Center, VPos::Center));
-    head.draw_text(t, &style, (w as i32 / 2, TITLE_STRIP as i32 / 2)).map_err(|e| draw_err(t, e))?;
+    let body = title_strip(area, t, TITLE_STRIP, TITLE_PX)?;
     let (chart_area, _) = body.split_horizontally(w - COLOUR_BAR_STRIP);
     let (x0, x1) = (m.x[0], m.x[m.x.len() - 1]);
     let (y0, y1) = (m.y[0], m.y[m.y.len() - 1]);

@@ -7,7 +7,9 @@
 //! `∂s x − d3`, so the finite-difference tangent is drawn next to `d3` (thin red against black)
 //! to make a detachment of the frame from the centreline visible, as in Fig. 21.
 
-use super::plot::{draw_colour_bar, draw_err, draw_panels, font, LinePlot, PlotError, COLOUR_BAR_STRIP, PLOT_SIZE};
+use super::plot::{
+    draw_colour_bar, draw_err, draw_panels, font, title_strip, LinePlot, PlotError, COLOUR_BAR_STRIP, PLOT_SIZE,
+};
 use nalgebra::Vector3;
 use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
@@ -86,6 +88,15 @@ fn sample_step(n: usize) -> usize {
 /// Compact number for captions and tick labels (the line plots' tick format).
 fn fmt_num(v: f64) -> String {
     super::plot::format_tick(v)
+}
+
+/// `v` rounded to two significant digits (a caption's measure).
+fn sig2(v: f64) -> f64 {
+    if v == 0.0 || !v.is_finite() {
+        return v;
+    }
+    let p = 10f64.powi(1 - v.abs().log10().floor() as i32);
+    (v * p).round() / p
 }
 
 /// Tick label on an axis of half-width `half`: round-off next to 0 shows as "0".
@@ -182,7 +193,7 @@ impl<'a> Prepared<'a> {
         format!(
             "{} — ● head (s = 0); black arrows d3, grey ticks d1, red: tangent ∂s x — max ∠(d3, ∂s x) = {}°",
             self.panel.label,
-            fmt_num(self.max_angle_deg)
+            fmt_num(sig2(self.max_angle_deg))
         )
     }
 }
@@ -336,10 +347,7 @@ pub fn render_postures_svg(
     {
         let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
         root.fill(&WHITE).map_err(|e| draw_err(title, e))?;
-        let (top, body) = root.split_vertically(TITLE_H);
-        let title_px = super::plot::fit_font(title, width - 20, 20);
-        let style = TextStyle::from(font(title_px)).pos(Pos::new(HPos::Center, VPos::Center));
-        top.draw_text(title, &style, (size.0 as i32 / 2, TITLE_H as i32 / 2)).map_err(|e| draw_err(title, e))?;
+        let body = title_strip(&root, title, TITLE_H, 20)?;
         let (postures, below) = body.split_vertically(rows * (CAPTION_H + CELL));
         for (row, p) in postures.split_evenly((panels.len(), 1)).iter().zip(&prepared) {
             let (cap, cells) = row.split_vertically(CAPTION_H);
