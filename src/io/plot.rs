@@ -264,7 +264,7 @@ pub(crate) fn axis_tick(v: f64, span: f64) -> String {
 
 /// About `n` round ticks (1, 2, 2.5 or 5 × 10^k apart) within `[lo, hi]`; `[lo]` for an empty range.
 pub(crate) fn nice_ticks(lo: f64, hi: f64, n: usize) -> Vec<f64> {
-    if !(hi > lo) || !lo.is_finite() || !hi.is_finite() {
+    if !lo.is_finite() || !hi.is_finite() || hi <= lo {
         return vec![lo];
     }
     let raw = (hi - lo) / n.max(1) as f64;
