@@ -10,9 +10,8 @@ use super::spec::{PlotKind, PlotSpec, Selector, Spec};
 use super::{PointResult, RunResults};
 use crate::case::{Case, Reference};
 use crate::io::files::write_plot;
-use crate::io::plot::{
-    render_heatmaps_svg, render_panels_svg, render_svg, Band, Heatmap, Legend, LinePlot, Mark, Series,
-};
+use crate::io::heatmap::{render_heatmaps_svg, Heatmap};
+use crate::io::plot::{render_panels_svg, render_svg, Band, Legend, LinePlot, Mark, Series};
 use crate::io::posture::{render_postures_svg, PosturePanel};
 use crate::io::OutputError;
 use crate::model::loads::LoadFrame;

@@ -3,7 +3,8 @@
 use std::path::Path;
 
 use super::files::{write_plot, OutputError};
-use super::plot::{render_heatmaps_svg, render_panels_svg, ColourScale, Heatmap, LinePlot, Series};
+use super::heatmap::{render_heatmaps_svg, ColourScale, Heatmap};
+use super::plot::{render_panels_svg, LinePlot, Series};
 use crate::case::Case;
 use crate::run::clip::ClipRun;
 use crate::solve::sequence::FrameReport;

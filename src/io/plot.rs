@@ -1,11 +1,12 @@
-//! Thin helpers over plotters' SVG backend: line plots (optionally log axes), grids of
-//! sub-plots and heatmaps with a colour bar, rendered to SVG text (written by
-//! `io::files::write_atomic`).
+//! Thin helpers over plotters' SVG backend: line plots (optionally log axes) and grids of
+//! sub-plots, rendered to SVG text (written by `io::files::write_atomic`); the text, tick and
+//! title conventions that the heatmaps ([`super::heatmap`]) and posture figures share.
 //!
 //! Every figure follows the same rules: text at least [`MIN_TEXT_PX`] px at the saved size,
 //! the legend in a strip beside the data (never over it), tick labels without floating-point
 //! noise (a tick within 1e-9 of the axis span of 0 is "0"), and on every heatmap a colour bar
-//! with the quantity and its unit ([`draw_colour_bar`], shared with the posture figures).
+//! with the quantity and its unit ([`super::heatmap::draw_colour_bar`], shared with the posture
+//! figures).
 
 use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
 use plotters::coord::Shift;
@@ -18,27 +19,11 @@ use thiserror::Error;
 pub const PLOT_SIZE: (u32, u32) = (900, 600);
 /// Fractional margin added on each side of the data range (linear axes).
 pub const RANGE_MARGIN: f64 = 0.05;
-/// The smallest text of any figure [px at the saved size].
-pub const MIN_TEXT_PX: u32 = 13;
-/// The sans-serif font whose text is `px` px high in the saved SVG (plotters writes a size
-/// `s` as `s / 1.24` px).
-pub(crate) fn font(px: u32) -> FontDesc<'static> {
-    ("sans-serif", px as f64 * 1.24).into_font()
-}
-/// Panel titles at most this size [px]; a long title is set smaller, down to [`MIN_TEXT_PX`].
-const TITLE_PX: u32 = 19;
-/// Tick labels [px].
-const TICK_PX: u32 = 15;
-/// Axis descriptions [px].
-const DESC_PX: u32 = 16;
-/// Legend entries [px].
-const LEGEND_PX: u32 = 14;
-/// Height of a panel's title strip [px].
-const TITLE_STRIP: u32 = 34;
-/// Average advance of a sans-serif character as a fraction of its size (for layout).
-const CHAR_WIDTH: f64 = 0.56;
-/// Width of the strip right of a heatmap: head/tail labels, colour bar, its ticks and label [px].
-pub(crate) const COLOUR_BAR_STRIP: u32 = 170;
+pub use super::figure_text::MIN_TEXT_PX;
+pub(crate) use super::figure_text::{
+    axis_tick, fit_font, font, format_tick, nice_ticks, text_style, wrap, CHAR_WIDTH, DESC_PX, LEGEND_PX, TICK_PX,
+    TITLE_PX, TITLE_STRIP,
+};
 
 /// A qualitative palette (Tableau 10): distinct at a glance and in print.
 const PALETTE: [RGBColor; 10] = [
@@ -239,64 +224,6 @@ fn pad(lo: f64, hi: f64, log: bool) -> Range<f64> {
     }
 }
 
-/// Compact tick labels: plain decimals for moderate magnitudes, else `1.5e-3`.
-pub(crate) fn format_tick(v: f64) -> String {
-    let a = v.abs();
-    if a == 0.0 {
-        "0".to_string()
-    } else if (1e-3..1e4).contains(&a) {
-        let s = format!("{v:.4}");
-        s.trim_end_matches('0').trim_end_matches('.').to_string()
-    } else {
-        let s = format!("{v:.2e}");
-        match s.split_once('e') {
-            Some((m, e)) => format!("{}e{e}", m.trim_end_matches('0').trim_end_matches('.')),
-            None => s,
-        }
-    }
-}
-
-/// A tick label on a linear axis of width `span`: a value within 1e-9 `span` of 0 (the
-/// round-off of a tick computed as a sum) is "0".
-pub(crate) fn axis_tick(v: f64, span: f64) -> String {
-    format_tick(if v.abs() <= 1e-9 * span.abs() { 0.0 } else { v })
-}
-
-/// About `n` round ticks (1, 2, 2.5 or 5 × 10^k apart) within `[lo, hi]`; `[lo]` for an empty range.
-pub(crate) fn nice_ticks(lo: f64, hi: f64, n: usize) -> Vec<f64> {
-    if !lo.is_finite() || !hi.is_finite() || hi <= lo {
-        return vec![lo];
-    }
-    let raw = (hi - lo) / n.max(1) as f64;
-    let mag = 10f64.powf(raw.log10().floor());
-    let step = [1.0, 2.0, 2.5, 5.0, 10.0].iter().map(|m| m * mag).find(|s| *s >= raw).unwrap_or(10.0 * mag);
-    let first = (lo / step - 1e-9).ceil() as i64;
-    let last = (hi / step + 1e-9).floor() as i64;
-    (first..=last).map(|k| if k == 0 { 0.0 } else { k as f64 * step }).collect()
-}
-
-/// The largest font size ≤ `max` (and ≥ [`MIN_TEXT_PX`]) at which `text` fits in `width` px.
-pub(crate) fn fit_font(text: &str, width: u32, max: u32) -> u32 {
-    let chars = text.chars().count().max(1) as f64;
-    ((width as f64 / (CHAR_WIDTH * chars)).floor() as u32).clamp(MIN_TEXT_PX, max)
-}
-
-/// `text` broken at spaces into lines of at most `chars` characters (a longer word is kept
-/// whole).
-fn wrap(text: &str, chars: usize) -> Vec<String> {
-    let mut lines: Vec<String> = Vec::new();
-    for word in text.split(' ') {
-        match lines.last_mut() {
-            Some(l) if l.chars().count() + 1 + word.chars().count() <= chars => {
-                l.push(' ');
-                l.push_str(word);
-            }
-            _ => lines.push(word.to_string()),
-        }
-    }
-    lines
-}
-
 /// Writes `title` centred in a strip `height` px high at the top of `area` (at most `max_px`
 /// px, smaller for a long title) and returns the rest of `area`.
 pub(crate) fn title_strip<DB: DrawingBackend>(
@@ -311,11 +238,6 @@ pub(crate) fn title_strip<DB: DrawingBackend>(
         TextStyle::from(font(fit_font(title, w.saturating_sub(20), max_px))).pos(Pos::new(HPos::Center, VPos::Center));
     head.draw_text(title, &style, (w as i32 / 2, height as i32 / 2)).map_err(|e| draw_err(title, e))?;
     Ok(body)
-}
-
-/// Left-aligned, vertically centred text of `px` px.
-fn text_style(px: u32) -> TextStyle<'static> {
-    TextStyle::from(font(px)).pos(Pos::new(HPos::Left, VPos::Center))
 }
 
 /// The stroke of curve `i` of a plot.
@@ -489,7 +411,7 @@ fn draw_plot<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, plot: &LinePlot)
 }
 
 /// Renders `draw` into an in-memory SVG of `size` pixels.
-fn render(
+pub(crate) fn render(
     size: (u32, u32),
     title: &str,
     draw: impl FnOnce(&DrawingArea<SVGBackend, Shift>) -> Result<(), PlotError>,
@@ -542,211 +464,10 @@ pub(crate) fn draw_panels<DB: DrawingBackend>(
     Ok(())
 }
 
-/// How values map to colours on a heatmap.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum ColourScale {
-    /// Symmetric about 0: blue < 0 < red, clipped at ± the limit.
-    #[default]
-    Diverging,
-    /// From 0 (white) to the limit (dark red), for values ≥ 0.
-    Sequential,
-}
-
-impl ColourScale {
-    /// The colour of `v` on this scale clipped at `limit`.
-    fn colour(self, v: f64, limit: f64) -> RGBColor {
-        let t = if limit > 0.0 && v.is_finite() { v / limit } else { 0.0 };
-        match self {
-            ColourScale::Diverging => diverging(t.clamp(-1.0, 1.0)),
-            ColourScale::Sequential => diverging(t.clamp(0.0, 1.0)),
-        }
-    }
-    /// The range the colour bar shows.
-    fn range(self, limit: f64) -> (f64, f64) {
-        match self {
-            ColourScale::Diverging => (-limit, limit),
-            ColourScale::Sequential => (0.0, limit),
-        }
-    }
-}
-
-/// Blue (−1) through white (0) to dark red (+1); on [0, 1] the sequential scale.
-fn diverging(t: f64) -> RGBColor {
-    let (r, g, b) = if t >= 0.0 { (1.0 - 0.3 * t, 1.0 - t, 1.0 - t) } else { (1.0 + t, 1.0 + 0.7 * t, 1.0 - 0.3 * t) };
-    RGBColor((r * 255.0) as u8, (g * 255.0) as u8, (b * 255.0) as u8)
-}
-
-/// A value field over a regular grid drawn as coloured cells (a kymograph): `values[i][j]` at
-/// `(x[i], y[j])`, on `scale` clipped at `limit`, with a colour bar labelled `colour_label`.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Heatmap {
-    pub title: String,
-    pub x_label: String,
-    pub y_label: String,
-    pub x: Vec<f64>,
-    pub y: Vec<f64>,
-    pub values: Vec<Vec<f64>>,
-    /// The colour scale ends at ± this (a diverging scale) or at this (a sequential one).
-    pub limit: f64,
-    /// The colour bar's label: the quantity and its unit, e.g. `"κ2 [1/m]"`.
-    pub colour_label: String,
-    pub scale: ColourScale,
-    /// Labels of the bottom and top ends of the y axis (e.g. head and tail).
-    pub y_ends: Option<(String, String)>,
-}
-
-impl Heatmap {
-    /// A kymograph: time `t` [s] along x, arc length `s` [mm] along y from the head (s = 0) to
-    /// the tail; diverging colours about 0.
-    pub fn kymograph(
-        title: String,
-        times_s: Vec<f64>,
-        s_mm: Vec<f64>,
-        values: Vec<Vec<f64>>,
-        limit: f64,
-        colour_label: String,
-    ) -> Self {
-        Heatmap {
-            title,
-            x_label: "t [s]".into(),
-            y_label: "arc length s [mm]".into(),
-            x: times_s,
-            y: s_mm,
-            values,
-            limit,
-            colour_label,
-            scale: ColourScale::Diverging,
-            y_ends: Some(("head".into(), "tail".into())),
-        }
-    }
-}
-
-/// A vertical colour bar in `area` (coordinates relative to it) at `x`, spanning the pixel
-/// rows `y` (top to bottom: `hi` to `lo`), with round ticks and `label` (the quantity and its
-/// unit) written upwards beside them. `colour(t)` gives the colour of `t` in [0, 1].
-pub(crate) fn draw_colour_bar<DB: DrawingBackend>(
-    area: &DrawingArea<DB, Shift>,
-    x: i32,
-    y: Range<i32>,
-    colour: &dyn Fn(f64) -> RGBColor,
-    (lo, hi): (f64, f64),
-    label: &str,
-) -> Result<(), PlotError> {
-    let (bar_w, h) = (22, (y.end - y.start).max(1));
-    let steps = 64;
-    for k in 0..steps {
-        let (ya, yb) = (y.end - k * h / steps, y.end - (k + 1) * h / steps);
-        let c = colour((k as f64 + 0.5) / steps as f64);
-        area.draw(&Rectangle::new([(x, ya), (x + bar_w, yb)], c.filled())).map_err(|e| draw_err(label, e))?;
-    }
-    area.draw(&Rectangle::new([(x, y.start), (x + bar_w, y.end)], BLACK.stroke_width(1)))
-        .map_err(|e| draw_err(label, e))?;
-    let span = hi - lo;
-    let mut widest = 0;
-    for v in nice_ticks(lo, hi, 5) {
-        let py = if span > 0.0 { y.end - ((v - lo) / span * h as f64).round() as i32 } else { (y.start + y.end) / 2 };
-        area.draw(&PathElement::new(vec![(x + bar_w, py), (x + bar_w + 5, py)], BLACK.stroke_width(1)))
-            .map_err(|e| draw_err(label, e))?;
-        let s = axis_tick(v, span);
-        widest = widest.max(s.chars().count());
-        area.draw_text(&s, &text_style(TICK_PX), (x + bar_w + 8, py)).map_err(|e| draw_err(label, e))?;
-    }
-    let lx = x + bar_w + 14 + (widest as f64 * CHAR_WIDTH * TICK_PX as f64) as i32 + DESC_PX as i32 / 2;
-    let style = TextStyle::from(font(fit_font(label, h as u32, DESC_PX)).transform(FontTransform::Rotate270))
-        .pos(Pos::new(HPos::Center, VPos::Center));
-    area.draw_text(label, &style, (lx, (y.start + y.end) / 2)).map_err(|e| draw_err(label, e))
-}
-
-/// Checks the grid of every map.
-fn validate_maps(maps: &[Heatmap]) -> Result<(), PlotError> {
-    if maps.is_empty() {
-        return Err(PlotError::InvalidGrid { panels: 0, cols: 0 });
-    }
-    for m in maps {
-        if m.x.len() < 2
-            || m.y.len() < 2
-            || m.values.len() != m.x.len()
-            || m.values.iter().any(|r| r.len() != m.y.len())
-        {
-            return Err(PlotError::LengthMismatch {
-                title: m.title.clone(),
-                series: "values".into(),
-                x_len: m.x.len(),
-                y_len: m.y.len(),
-            });
-        }
-    }
-    Ok(())
-}
-
-/// One heatmap in `area`: title strip, cells, the y ends' labels and the colour bar.
-fn draw_heatmap<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, m: &Heatmap) -> Result<(), PlotError> {
-    let t = m.title.as_str();
-    let (w, _) = area.dim_in_pixel();
-    let body = title_strip(area, t, TITLE_STRIP, TITLE_PX)?;
-    let (chart_area, _) = body.split_horizontally(w - COLOUR_BAR_STRIP);
-    let (x0, x1) = (m.x[0], m.x[m.x.len() - 1]);
-    let (y0, y1) = (m.y[0], m.y[m.y.len() - 1]);
-    let mut chart = ChartBuilder::on(&chart_area)
-        .margin(10)
-        .x_label_area_size(58)
-        .y_label_area_size(80)
-        .build_cartesian_2d(x0..x1, y0..y1)
-        .map_err(|e| draw_err(t, e))?;
-    let (sx, sy) = (x1 - x0, y1 - y0);
-    chart
-        .configure_mesh()
-        .disable_mesh()
-        .x_desc(m.x_label.as_str())
-        .y_desc(m.y_label.as_str())
-        .label_style(font(TICK_PX))
-        .axis_desc_style(font(DESC_PX))
-        .x_label_formatter(&|v| axis_tick(*v, sx))
-        .y_label_formatter(&|v| axis_tick(*v, sy))
-        .draw()
-        .map_err(|e| draw_err(t, e))?;
-    let half = |v: &[f64], i: usize| -> (f64, f64) {
-        let lo = if i == 0 { v[0] } else { 0.5 * (v[i - 1] + v[i]) };
-        let hi = if i + 1 == v.len() { v[i] } else { 0.5 * (v[i] + v[i + 1]) };
-        (lo, hi)
-    };
-    let cells = (0..m.x.len()).flat_map(|i| (0..m.y.len()).map(move |j| (i, j))).map(|(i, j)| {
-        let (xa, xb) = half(&m.x, i);
-        let (ya, yb) = half(&m.y, j);
-        Rectangle::new([(xa, ya), (xb, yb)], m.scale.colour(m.values[i][j], m.limit).filled())
-    });
-    chart.draw_series(cells).map_err(|e| draw_err(t, e))?;
-    // the plotting area in the pixels of `area`
-    let (px, py) = chart.plotting_area().get_pixel_range();
-    let base = area.get_base_pixel();
-    let (right, rows) = (px.end - base.0, (py.start - base.1)..(py.end - base.1));
-    if let Some((bottom, top)) = &m.y_ends {
-        area.draw_text(top, &text_style(LEGEND_PX).pos(Pos::new(HPos::Left, VPos::Top)), (right + 6, rows.start))
-            .map_err(|e| draw_err(t, e))?;
-        area.draw_text(bottom, &text_style(LEGEND_PX).pos(Pos::new(HPos::Left, VPos::Bottom)), (right + 6, rows.end))
-            .map_err(|e| draw_err(t, e))?;
-    }
-    let (scale, limit) = (m.scale, m.limit);
-    let (lo, hi) = scale.range(limit);
-    let colour = move |u: f64| scale.colour(lo + u * (hi - lo), limit);
-    draw_colour_bar(area, right + 50, rows, &colour, (lo, hi), &m.colour_label)
-}
-
-/// Size of one heatmap [px]: wide, for a long time axis.
-pub const HEATMAP_SIZE: (u32, u32) = (1200, 440);
-
-/// Heatmaps from top to bottom (one column, as the paper's kymographs) in one SVG, each with its
-/// colour bar.
-pub fn render_heatmaps_svg(maps: &[Heatmap]) -> Result<String, PlotError> {
-    validate_maps(maps)?;
-    let size = (HEATMAP_SIZE.0, HEATMAP_SIZE.1 * maps.len() as u32);
-    let title = maps[0].title.clone();
-    render(size, &title, |root| {
-        for (m, area) in maps.iter().zip(root.split_evenly((maps.len(), 1))) {
-            draw_heatmap(&area, m)?;
-        }
-        Ok(())
-    })
+/// The smallest `font-size` of an SVG [px] (tests of the figures).
+#[cfg(test)]
+pub(crate) fn smallest_text(svg: &str) -> f64 {
+    svg.split("font-size=\"").skip(1).filter_map(|r| r.split('"').next()?.parse::<f64>().ok()).fold(f64::MAX, f64::min)
 }
 
 #[cfg(test)]
@@ -836,14 +557,6 @@ mod tests {
         assert!(svg.contains("width=\"1800\"") && svg.contains("height=\"1200\""));
     }
 
-    /// The smallest `font-size` of an SVG [px].
-    fn smallest_text(svg: &str) -> f64 {
-        svg.split("font-size=\"")
-            .skip(1)
-            .filter_map(|r| r.split('"').next()?.parse::<f64>().ok())
-            .fold(f64::MAX, f64::min)
-    }
-
     #[test]
     fn ticks_without_round_off_and_text_of_readable_size() {
         assert_eq!(axis_tick(-1.39e-17, 0.02), "0");
@@ -857,18 +570,5 @@ mod tests {
         let tiny = LinePlot { log_y: true, ..plot(vec![series("tiny", |x| 1e-22 * (1.0 + x))]) };
         let svg = render_svg(&tiny).unwrap();
         assert!(svg.contains("\n1e-22\n") && svg.contains("\n1e-21\n"), "decades missing");
-    }
-
-    #[test]
-    fn heatmap_has_a_colour_bar_with_its_unit_and_the_ends_labelled() {
-        let x = vec![0.0, 0.04, 0.08];
-        let y = vec![0.0, 0.5, 1.0];
-        let values = vec![vec![-1.0, 0.0, 1.0]; 3];
-        let m = Heatmap::kymograph("k".into(), x, y, values, 1.0, "κ2 [1/mm]".into());
-        let svg = render_heatmaps_svg(&[m]).unwrap();
-        for text in ["κ2 [1/mm]", "t [s]", "\nhead\n", "\ntail\n", "\n-1\n", "\n0\n", "\n1\n"] {
-            assert!(svg.contains(text), "missing {text}");
-        }
-        assert!(smallest_text(&svg) >= 12.0);
     }
 }

@@ -7,9 +7,8 @@
 //! `∂s x − d3`, so the finite-difference tangent is drawn next to `d3` (thin red against black)
 //! to make a detachment of the frame from the centreline visible, as in Fig. 21.
 
-use super::plot::{
-    draw_colour_bar, draw_err, draw_panels, font, title_strip, LinePlot, PlotError, COLOUR_BAR_STRIP, PLOT_SIZE,
-};
+use super::heatmap::{draw_colour_bar, COLOUR_BAR_STRIP};
+use super::plot::{draw_err, draw_panels, font, title_strip, LinePlot, PlotError, PLOT_SIZE};
 use nalgebra::Vector3;
 use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
