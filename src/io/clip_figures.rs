@@ -248,8 +248,9 @@ pub fn write_omega_kymographs(case: &Case, run: &ClipRun, path: &Path) -> Result
         .map(|k| {
             let limit = abs_percentile_99(run.omega[1..nf].iter().flatten().map(|w| w[k]));
             let name = if k == 0 { format!("{}: ", case.name) } else { String::new() };
+            let zero = if limit > 0.0 { "" } else { ": 0 everywhere" };
             kymograph(
-                format!("{name}ω{} (local frame)", k + 1),
+                format!("{name}ω{} (local frame){zero}", k + 1),
                 x.clone(),
                 y.clone(),
                 frames.iter().map(|&i| cols.iter().map(|&j| run.omega[i][j][k]).collect()).collect(),
