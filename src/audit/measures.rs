@@ -201,17 +201,26 @@ fn modal_tip_error(case: &Case, r: &RunResult) -> Option<f64> {
     let (mut err, mut scale) = (0.0f64, 0.0f64);
     for (rec, m) in r.tip.iter().zip(&modal) {
         for comp in 0..2 {
-            scale = scale.max(m[comp].abs());
-            err = err.max((rec.position_m[comp] - m[comp]).abs());
+            scale = scale.max(m.position_m[comp].abs());
+            err = err.max((rec.position_m[comp] - m.position_m[comp]).abs());
         }
     }
     (scale > 0.0).then_some(err / scale)
 }
 
-/// The tip's x, y [m] at the times of a dynamic run's tip records, from the exact-in-time
+/// The tip of the linearised discrete model at one record of a dynamic run.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ModalTip {
+    /// the tip's x, y [m]
+    pub position_m: [f64; 2],
+    /// the tip's angles α, β, γ [rad] (the increments about the straight reference)
+    pub angles_rad: [f64; 3],
+}
+
+/// The tip at the times of a dynamic run's tip records, from the exact-in-time
 /// response of the linearised discrete model (all modes) to the case's load, sampled twice per
 /// time step and linear in between; `None` for other runs.
-pub fn modal_tip_history(case: &Case, r: &RunResult) -> Option<Vec<[f64; 2]>> {
+pub fn modal_tip_history(case: &Case, r: &RunResult) -> Option<Vec<ModalTip>> {
     let Analysis::Dynamic(p) = &case.analysis else { return None };
     if r.tip.is_empty() {
         return None;
@@ -252,7 +261,10 @@ pub fn modal_tip_history(case: &Case, r: &RunResult) -> Option<Vec<[f64; 2]>> {
             }
         }
         step = target as usize;
-        out.push([0, 1].map(|comp| model.displacement(dofs.index(last, Field::X, comp), &q)));
+        out.push(ModalTip {
+            position_m: [0, 1].map(|comp| model.displacement(dofs.index(last, Field::X, comp), &q)),
+            angles_rad: [0, 1, 2].map(|comp| model.displacement(dofs.index(last, Field::Alpha, comp), &q)),
+        });
     }
     Some(out)
 }

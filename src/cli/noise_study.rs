@@ -7,7 +7,7 @@ use std::process::ExitCode;
 
 use anyhow::{Context, Result};
 
-use cosserat::io::plot::{render_panels_svg, Legend, LinePlot, Series};
+use cosserat::io::plot::{render_panels_svg, LinePlot, Series};
 use cosserat::io::write_atomic;
 use cosserat::study::{recovered_name, run_study, StudyRow, StudySpec, SPLINE};
 
@@ -136,18 +136,17 @@ fn figure(spec: &StudySpec, rows: &[StudyRow]) -> Result<String> {
         .collect();
     let mut panels = Vec::new();
     for mesh in &spec.meshes {
-        let panel = |what: &str, y_label: &str, log_y: bool, legend: Legend| LinePlot {
+        let panel = |what: &str, y_label: &str, log_y: bool| LinePlot {
             title: format!("{} nodes: {what}", mesh.nodes),
             x_label: "noise σ per coordinate [µm] (σ = 0: see the table)".into(),
             y_label: y_label.into(),
             log_x: true,
             log_y,
-            legend,
             ..LinePlot::default()
         };
-        let mut median = panel("bending error, median frame", "relative L² error of |κ| [–]", true, Legend::UpperLeft);
-        let mut worst = panel("bending error, worst frame", "relative L² error of |κ| [–]", true, Legend::UpperLeft);
-        let mut frac = panel("frames reconstructed", "fraction of frames [–]", false, Legend::LowerLeft);
+        let mut median = panel("bending error, median frame", "relative L² error of |κ| [–]", true);
+        let mut worst = panel("bending error, worst frame", "relative L² error of |κ| [–]", true);
+        let mut frac = panel("frames reconstructed", "fraction of frames [–]", false);
         for (name, label) in &shown {
             let pts: Vec<(f64, &Cell)> = cells
                 .iter()
@@ -156,7 +155,7 @@ fn figure(spec: &StudySpec, rows: &[StudyRow]) -> Result<String> {
                 .filter(|(s, _)| *s > 0.0)
                 .collect();
             let x: Vec<f64> = pts.iter().map(|p| p.0).collect();
-            let series = |y: Vec<f64>| Series { label: label.clone(), x: x.clone(), y };
+            let series = |y: Vec<f64>| Series::new(label.clone(), x.clone(), y);
             median.series.push(series(pts.iter().map(|p| p.1.median.1).collect()));
             worst.series.push(series(pts.iter().map(|p| p.1.worst.1).collect()));
             frac.series.push(series(pts.iter().map(|p| p.1.reconstructed as f64 / p.1.frames.max(1) as f64).collect()));

@@ -3,32 +3,49 @@
 use std::path::Path;
 
 use super::files::{write_plot, OutputError};
-use super::plot::{render_heatmaps_svg, render_panels_svg, Heatmap, LinePlot, Series};
+use super::heatmap::{render_heatmaps_svg, ColourScale, Heatmap};
+use super::plot::{render_panels_svg, LinePlot, Series};
 use crate::case::Case;
 use crate::run::clip::ClipRun;
 use crate::solve::sequence::FrameReport;
 
-/// The frame numbers of a clip run as the x axis of its per-frame figures.
+/// The times of a clip run's frames [s] (frame number × Δt) as the x axis of its per-frame
+/// figures and kymographs.
 struct FrameAxis(Vec<f64>);
 
 impl FrameAxis {
-    fn new(reports: &[FrameReport]) -> Self {
-        FrameAxis(reports.iter().map(|r| r.frame as f64).collect())
+    fn new(case: &Case, reports: &[FrameReport]) -> Self {
+        let dt = frame_interval_s(case);
+        FrameAxis(reports.iter().map(|r| r.frame as f64 * dt).collect())
     }
     fn series(&self, label: &str, y: Vec<f64>) -> Series {
-        Series { label: label.into(), x: self.0.clone(), y }
+        Series::new(label, self.0.clone(), y)
     }
     fn plot(title: String, y_label: &str, series: Vec<Series>, log_y: bool) -> LinePlot {
-        LinePlot {
-            title,
-            x_label: "frame".into(),
-            y_label: y_label.into(),
-            series,
-            log_x: false,
-            log_y,
-            legend: Default::default(),
-        }
+        LinePlot { title, x_label: "t [s]".into(), y_label: y_label.into(), series, log_y, ..Default::default() }
     }
+    /// The times of the frames `frames` (indices into the reports).
+    fn at(&self, frames: &[usize]) -> Vec<f64> {
+        frames.iter().map(|&i| self.0[i]).collect()
+    }
+}
+
+/// The clip's frame interval Δt [s].
+fn frame_interval_s(case: &Case) -> f64 {
+    case.inverse().map_or(1.0, |i| i.params.frame_interval_s)
+}
+
+/// A kymograph of a clip run: `values` (already in the unit of `colour_label`) over the frames'
+/// times and `s_mm`, clipped at ±`limit`.
+fn kymograph(
+    title: String,
+    t: Vec<f64>,
+    s_mm: Vec<f64>,
+    values: Vec<Vec<f64>>,
+    limit: f64,
+    colour_label: &str,
+) -> Heatmap {
+    Heatmap::kymograph(title, t, s_mm, values, limit, colour_label.into())
 }
 
 /// Recovered vs true for a synthetic clip (`truth.svg`): bending κ1² + κ2² kymographs (true,
@@ -39,7 +56,7 @@ pub fn write_truth_plot(case: &Case, run: &ClipRun, path: &Path) -> Result<(), O
     if nf < 2 {
         return Ok(());
     }
-    let axis = FrameAxis::new(&run.reports);
+    let axis = FrameAxis::new(case, &run.reports);
     let (s, plot) = (|l: &str, y| axis.series(l, y), FrameAxis::plot);
     let c = &t.comparisons;
     let panels = vec![
@@ -63,12 +80,12 @@ pub fn write_truth_plot(case: &Case, run: &ClipRun, path: &Path) -> Result<(), O
             false,
         ),
         plot(
-            "twist kappa_3".into(),
-            "kappa_3 [rad/m]",
+            "twist κ3".into(),
+            "κ3 [1/mm]",
             vec![
-                s("true", t.twist_per_m.clone()),
-                s("recovered (mean over inner nodes)", c.iter().map(|v| v.twist_mean_per_m).collect()),
-                s("rms error", c.iter().map(|v| v.twist_rms_error_per_m).collect()),
+                s("true", t.twist_per_m.iter().map(|v| v * 1e-3).collect()),
+                s("recovered (mean over inner nodes)", c.iter().map(|v| v.twist_mean_per_m * 1e-3).collect()),
+                s("rms error", c.iter().map(|v| v.twist_rms_error_per_m * 1e-3).collect()),
             ],
             false,
         ),
@@ -83,20 +100,24 @@ pub fn write_truth_plot(case: &Case, run: &ClipRun, path: &Path) -> Result<(), O
     write_plot(&lines, render_panels_svg(&panels, 2))?;
     let fs = nf.div_ceil(150);
     let frames: Vec<usize> = (0..nf).step_by(fs).collect();
-    let x: Vec<f64> = frames.iter().map(|&i| run.reports[i].frame as f64).collect();
+    let x = axis.at(&frames);
     let m = t.bending_true[0].len();
     let cols: Vec<usize> = (0..m).step_by(m.div_ceil(64)).collect();
     let y: Vec<f64> = cols.iter().map(|&j| j as f64 * case.mesh.h() * 1e3).collect();
+    // bending √(κ1² + κ2²) [1/mm]
     let grid = |field: &Vec<Vec<f64>>| -> Vec<Vec<f64>> {
-        frames.iter().map(|&i| cols.iter().map(|&j| field[i][j].sqrt()).collect()).collect()
+        frames.iter().map(|&i| cols.iter().map(|&j| field[i][j].sqrt() * 1e-3).collect()).collect()
     };
-    let limit = percentile_99(t.bending_true.iter().flatten().map(|v| v.sqrt()).collect());
-    let map = |title: String, values: Vec<Vec<f64>>| Heatmap::kymograph(title, x.clone(), y.clone(), values, limit);
+    let limit = percentile_99(t.bending_true.iter().flatten().map(|v| v.sqrt() * 1e-3).collect());
+    let map = |title: &str, values: Vec<Vec<f64>>| Heatmap {
+        scale: ColourScale::Sequential,
+        ..kymograph(title.into(), x.clone(), y.clone(), values, limit, "√(κ1² + κ2²) [1/mm]")
+    };
     write_plot(
         path,
         render_heatmaps_svg(&[
-            map(format!("true bending sqrt(k1^2+k2^2) [1/m], colour 0..{limit:.0}"), grid(&t.bending_true)),
-            map("recovered sqrt(k1^2+k2^2) [1/m]".into(), grid(&t.bending_recovered)),
+            map(&format!("{}: true bending", case.name), grid(&t.bending_true)),
+            map("recovered bending", grid(&t.bending_recovered)),
         ]),
     )
 }
@@ -111,7 +132,7 @@ pub fn write_clip_plot(
     if reports.is_empty() {
         return Ok(());
     }
-    let axis = FrameAxis::new(reports);
+    let axis = FrameAxis::new(case, reports);
     let (s, plot) = (|l: &str, y| axis.series(l, y), FrameAxis::plot);
     let panels = vec![
         plot(
@@ -122,7 +143,7 @@ pub fn write_clip_plot(
         ),
         plot(
             "fit per frame".into(),
-            "value",
+            "misfit (units in the legend)",
             vec![
                 s("position misfit [body lengths]", reports.iter().map(|r| r.fit.position).collect()),
                 s("|x' - d3| [m^1/2]", reports.iter().map(|r| r.tangent_misfit).collect()),
@@ -138,7 +159,7 @@ pub fn write_clip_plot(
         ),
         plot(
             "objective (41)".into(),
-            "J",
+            "J (41)",
             vec![
                 s("tracking", reports.iter().map(|r| r.objective.tracking).collect()),
                 s("total", reports.iter().map(|r| r.objective.total()).collect()),
@@ -147,9 +168,9 @@ pub fn write_clip_plot(
         ),
         plot(
             "roughness of the curvature (sign alternation of its differences)".into(),
-            "fraction of elements",
+            "fraction of elements [–]",
             vec![
-                s("recovered kappa_2", roughness.iter().map(|r| r.0).collect()),
+                s("recovered κ2", roughness.iter().map(|r| r.0).collect()),
                 s("data", roughness.iter().map(|r| r.1).collect()),
             ],
             false,
@@ -158,9 +179,10 @@ pub fn write_clip_plot(
     write_plot(path, render_panels_svg(&panels, 2))
 }
 
-/// Kymographs of a planar clip (Fig. 17 style): the data's curvature and the recovered κ2 over
-/// frames (x) and arc length (y), on one colour scale (±the 99th percentile of |data|). At most
-/// ~150 frames and 64 positions are drawn (strided) to keep the SVG small.
+/// Kymographs of a planar clip (Fig. 17 style): the data's curvature and the recovered κ2
+/// [1/mm] over time [s] (x) and arc length (y, head at 0), on one colour scale (±the 99th
+/// percentile of |data|, the colour bar beside each). At most ~150 frames and 64 positions are
+/// drawn (strided) to keep the SVG small.
 pub fn write_clip_kymographs(case: &Case, run: &ClipRun, path: &Path) -> Result<(), OutputError> {
     let nf = run.kappa2.len();
     if nf < 2 {
@@ -168,26 +190,25 @@ pub fn write_clip_kymographs(case: &Case, run: &ClipRun, path: &Path) -> Result<
     }
     let fs = nf.div_ceil(150);
     let frames: Vec<usize> = (0..nf).step_by(fs).collect();
-    let x: Vec<f64> = frames.iter().map(|&i| run.reports[i].frame as f64).collect();
+    let x = FrameAxis::new(case, &run.reports).at(&frames);
     let h = case.mesh.h();
     let grid = |field: &Vec<Vec<f64>>, s_of: &dyn Fn(usize) -> f64| {
         let m = field[0].len();
         let ss = m.div_ceil(64);
         let cols: Vec<usize> = (0..m).step_by(ss).collect();
         let y: Vec<f64> = cols.iter().map(|&j| s_of(j) * 1e3).collect();
-        let values: Vec<Vec<f64>> = frames.iter().map(|&i| cols.iter().map(|&j| field[i][j]).collect()).collect();
+        let values: Vec<Vec<f64>> =
+            frames.iter().map(|&i| cols.iter().map(|&j| field[i][j] * 1e-3).collect()).collect();
         (y, values)
     };
-    let limit = abs_percentile_99(run.data_kappa.iter().flatten().copied());
+    let limit = abs_percentile_99(run.data_kappa.iter().flatten().map(|k| k * 1e-3));
     let (yd, vd) = grid(&run.data_kappa, &|j| (j + 1) as f64 * h);
     let (yr, vr) = grid(&run.kappa2, &|j| (j as f64 + 0.5) * h);
-    let map =
-        |title: String, y: Vec<f64>, values: Vec<Vec<f64>>| Heatmap::kymograph(title, x.clone(), y, values, limit);
     write_plot(
         path,
         render_heatmaps_svg(&[
-            map(format!("{}: data curvature [1/m], colour ±{limit:.0}", case.name), yd, vd),
-            map("recovered kappa_2 [1/m]".into(), yr, vr),
+            kymograph(format!("{}: data curvature", case.name), x.clone(), yd, vd, limit, "κ data [1/mm]"),
+            kymograph("recovered κ2".into(), x.clone(), yr, vr, limit, "κ2 [1/mm]"),
         ]),
     )
 }
@@ -209,17 +230,17 @@ fn percentile_99(mut all: Vec<f64>) -> f64 {
 }
 
 /// Kymographs of the angular velocity (Fig. 24 style, `omega.svg`): ω1, ω2, ω3 [rad/s] in the
-/// local frame (eq. 27, [`ClipRun::omega`]) over frames (x) and the nodes' arc length (y), each
-/// on its own colour scale (±the 99th percentile of its |ω| over the frames after the first,
-/// which has none). Strided as [`write_clip_kymographs`]; nothing is written for fewer than two
-/// frames.
+/// local frame (eq. 27, [`ClipRun::omega`]) over time [s] (x) and the nodes' arc length (y),
+/// each on its own colour scale (±the 99th percentile of its |ω| over the frames after the
+/// first, which has none; the colour bar beside it). Strided as [`write_clip_kymographs`];
+/// nothing is written for fewer than two frames.
 pub fn write_omega_kymographs(case: &Case, run: &ClipRun, path: &Path) -> Result<(), OutputError> {
     let nf = run.omega.len().min(run.reports.len());
     if nf < 2 {
         return Ok(());
     }
     let frames: Vec<usize> = (0..nf).step_by(nf.div_ceil(150)).collect();
-    let x: Vec<f64> = frames.iter().map(|&i| run.reports[i].frame as f64).collect();
+    let x = FrameAxis::new(case, &run.reports).at(&frames);
     let m = run.omega[0].len();
     let cols: Vec<usize> = (0..m).step_by(m.div_ceil(64).max(1)).collect();
     let y: Vec<f64> = cols.iter().map(|&j| case.mesh.node_s(j) * 1e3).collect();
@@ -227,12 +248,14 @@ pub fn write_omega_kymographs(case: &Case, run: &ClipRun, path: &Path) -> Result
         .map(|k| {
             let limit = abs_percentile_99(run.omega[1..nf].iter().flatten().map(|w| w[k]));
             let name = if k == 0 { format!("{}: ", case.name) } else { String::new() };
-            Heatmap::kymograph(
-                format!("{name}omega_{} [rad/s], colour ±{limit:.3e}", k + 1),
+            let zero = if limit > 0.0 { "" } else { ": 0 everywhere" };
+            kymograph(
+                format!("{name}ω{} (local frame){zero}", k + 1),
                 x.clone(),
                 y.clone(),
                 frames.iter().map(|&i| cols.iter().map(|&j| run.omega[i][j][k]).collect()).collect(),
                 limit,
+                &format!("ω{} [rad/s]", k + 1),
             )
         })
         .collect();

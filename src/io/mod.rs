@@ -1,7 +1,7 @@
 //! Everything that touches files or other programs: atomic writes and CSV ([`files`]), the
 //! forward data file `data.csv` ([`data`]), clip files ([`clip_files`], [`npy`]), the outputs of
 //! a run ([`run_files`]) and of a clip ([`clip_output`], [`clip_figures`], [`vtk`], [`compact`], the resume [`journal`]),
-//! SVG figures ([`plot`]), numbers as text ([`number`]), the FreeFEM engine ([`freefem`], its progress [`freefem_progress`]), a case in either engine from its files ([`engine`]) and the
+//! SVG figures ([`plot`], [`heatmap`], [`posture`], their text [`figure_text`]), numbers as text ([`number`]), the FreeFEM engine ([`freefem`], its progress [`freefem_progress`]), a case in either engine from its files ([`engine`]) and the
 //! files of a sweep ([`sweep`]), a batch of recordings ([`batch`], on Slurm: [`slurm`]) and a
 //! corpus of synthetic recordings ([`corpus`]); the output-folder contract ([`run_folder`]: its
 //! lock [`folder_lock`], what runs leave beside a folder `staging`, a full disk [`disk`]).
@@ -15,12 +15,14 @@ pub mod corpus;
 pub mod data;
 pub mod disk;
 pub mod engine;
+pub mod figure_text;
 pub mod files;
 pub mod folder_lock;
 pub mod freefem;
 pub mod freefem_clip;
 pub mod freefem_include;
 pub mod freefem_progress;
+pub mod heatmap;
 pub mod job;
 pub mod journal;
 pub mod manifest;

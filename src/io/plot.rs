@@ -1,19 +1,66 @@
-//! Thin helpers over plotters' SVG backend: line plots (optionally log axes), grids of
-//! sub-plots and heatmaps, rendered to SVG text (written by `io::files::write_atomic`).
+//! Thin helpers over plotters' SVG backend: line plots (optionally log axes) and grids of
+//! sub-plots, rendered to SVG text (written by `io::files::write_atomic`); the text, tick and
+//! title conventions that the heatmaps ([`super::heatmap`]) and posture figures share.
+//!
+//! Every figure follows the same rules: text at least [`MIN_TEXT_PX`] px at the saved size,
+//! the legend in a strip beside the data (never over it), tick labels without floating-point
+//! noise (a tick within 1e-9 of the axis span of 0 is "0"), and on every heatmap a colour bar
+//! with the quantity and its unit ([`super::heatmap::draw_colour_bar`], shared with the posture
+//! figures).
 
 use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
 use plotters::coord::Shift;
 use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
 use std::ops::Range;
 use thiserror::Error;
 
 /// Size of a single plot in pixels (width, height).
 pub const PLOT_SIZE: (u32, u32) = (900, 600);
-/// Fractional margin added on each side of the data range.
+/// Fractional margin added on each side of the data range (linear axes).
 pub const RANGE_MARGIN: f64 = 0.05;
+pub use super::figure_text::MIN_TEXT_PX;
+pub(crate) use super::figure_text::{
+    axis_tick, fit_font, font, format_tick, nice_ticks, text_style, wrap, CHAR_WIDTH, DESC_PX, LEGEND_PX, TICK_PX,
+    TITLE_PX, TITLE_STRIP,
+};
+
+/// A qualitative palette (Tableau 10): distinct at a glance and in print.
+const PALETTE: [RGBColor; 10] = [
+    RGBColor(31, 119, 180),
+    RGBColor(255, 127, 14),
+    RGBColor(44, 160, 44),
+    RGBColor(214, 39, 40),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(127, 127, 127),
+    RGBColor(188, 189, 34),
+    RGBColor(23, 190, 207),
+];
+
+/// Colour `i` of the palette (cycling).
+pub(crate) fn palette(i: usize) -> RGBColor {
+    PALETTE[i % PALETTE.len()]
+}
+
+/// How a curve is drawn.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Mark {
+    /// A solid line (a solution).
+    #[default]
+    Line,
+    /// A dashed line (a reference).
+    Dashed,
+    /// Open circles, at most [`MAX_MARKERS`] per curve, drawn under the lines (data).
+    Markers,
+}
+
+/// At most this many markers per curve (every k-th point).
+pub const MAX_MARKERS: usize = 40;
 
 /// One curve: `y[i]` against `x[i]`.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct Series {
     /// Legend entry.
     pub label: String,
@@ -21,6 +68,49 @@ pub struct Series {
     pub x: Vec<f64>,
     /// Ordinates.
     pub y: Vec<f64>,
+    /// Line, dashed line or markers.
+    pub mark: Mark,
+    /// Palette index of its colour; `None`: the curve's position in the plot.
+    pub colour: Option<usize>,
+    /// Line width [px]; 0: 2 px.
+    pub width: u32,
+}
+
+impl Series {
+    /// A solid curve in the colour of its position.
+    pub fn new(label: impl Into<String>, x: Vec<f64>, y: Vec<f64>) -> Self {
+        Series { label: label.into(), x, y, ..Default::default() }
+    }
+    /// The same curve drawn as `mark`.
+    pub fn marked(mut self, mark: Mark) -> Self {
+        self.mark = mark;
+        self
+    }
+    /// The same curve in palette colour `i` (pairs of data and solution share one).
+    pub fn coloured(mut self, i: usize) -> Self {
+        self.colour = Some(i);
+        self
+    }
+    /// Curve `i` of a comparison of runs whose curves may lie on each other: each narrower than
+    /// the one before (4, 3, 2, 1 px …) and every second one dashed, so that all stay visible.
+    pub fn nth_of_many(mut self, i: usize) -> Self {
+        self.width = 4u32.saturating_sub(i as u32).max(1);
+        if i % 2 == 1 {
+            self.mark = Mark::Dashed;
+        }
+        self
+    }
+}
+
+/// A shaded interval of x with a label (e.g. the clamped end elements).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Band {
+    /// From this x …
+    pub from: f64,
+    /// … to this x (the plot's unit).
+    pub to: f64,
+    /// Written at the top of the band.
+    pub label: String,
 }
 
 /// A 2-D line chart. Non-finite points (and non-positive values on a log
@@ -33,23 +123,26 @@ pub struct LinePlot {
     pub x_label: String,
     /// y-axis description (include the unit).
     pub y_label: String,
-    /// Curves, drawn in order with distinct colours.
+    /// Curves, drawn in order with distinct colours (markers first, under the lines).
     pub series: Vec<Series>,
     /// Logarithmic x axis.
     pub log_x: bool,
-    /// Logarithmic y axis.
+    /// Logarithmic y axis (padded to whole decades, so that it always has labelled ticks).
     pub log_y: bool,
-    /// Where the legend goes (the corner the curves leave free).
+    /// Whether the legend strip is drawn.
     pub legend: Legend,
+    /// Shaded x intervals.
+    pub bands: Vec<Band>,
 }
 
-/// A corner of the plot for the legend.
+/// The legend of a plot: in a strip right of the data, or none.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Legend {
+    /// Beside the data, right of the axes.
     #[default]
-    UpperRight,
-    UpperLeft,
-    LowerLeft,
+    Right,
+    /// No legend (a single curve described by the axis).
+    Hidden,
 }
 
 /// Errors from the plotting helpers.
@@ -75,7 +168,7 @@ pub enum PlotError {
     Draw { title: String, detail: String },
 }
 
-fn draw_err(title: &str, e: impl std::fmt::Display) -> PlotError {
+pub(crate) fn draw_err(title: &str, e: impl std::fmt::Display) -> PlotError {
     PlotError::Draw { title: title.to_string(), detail: e.to_string() }
 }
 
@@ -113,12 +206,14 @@ fn ranges(plot: &LinePlot) -> Result<(Range<f64>, Range<f64>), PlotError> {
     Ok((pad(x0, x1, plot.log_x), pad(y0, y1, plot.log_y)))
 }
 
-/// Adds a margin (multiplicative on log axes); widens a zero-width range.
+/// Adds a margin; a log axis is widened to whole decades (at least one), so that it has
+/// labelled ticks; a zero-width linear range is widened.
 fn pad(lo: f64, hi: f64, log: bool) -> Range<f64> {
     if log {
-        let (a, b) = (lo.log10(), hi.log10());
-        let m = if b > a { RANGE_MARGIN * (b - a) } else { 0.5 };
-        return 10f64.powf(a - m)..10f64.powf(b + m);
+        let a = (lo.log10() + 1e-9).floor();
+        let b = (hi.log10() - 1e-9).ceil().max(a + 1.0);
+        // a hair beyond the decades, so that round-off keeps both end ticks inside
+        return 10f64.powf(a) * (1.0 - 1e-9)..10f64.powf(b) * (1.0 + 1e-9);
     }
     if hi > lo {
         let m = RANGE_MARGIN * (hi - lo);
@@ -129,8 +224,73 @@ fn pad(lo: f64, hi: f64, log: bool) -> Range<f64> {
     }
 }
 
-/// Draws one plot into `area` with the given coordinate specs.
-fn draw_with<DB, X, Y>(area: &DrawingArea<DB, Shift>, plot: &LinePlot, xs: X, ys: Y) -> Result<(), PlotError>
+/// Writes `title` centred in a strip `height` px high at the top of `area` (at most `max_px`
+/// px, smaller for a long title) and returns the rest of `area`.
+pub(crate) fn title_strip<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    title: &str,
+    height: u32,
+    max_px: u32,
+) -> Result<DrawingArea<DB, Shift>, PlotError> {
+    let (w, _) = area.dim_in_pixel();
+    let (head, body) = area.split_vertically(height);
+    let style =
+        TextStyle::from(font(fit_font(title, w.saturating_sub(20), max_px))).pos(Pos::new(HPos::Center, VPos::Center));
+    head.draw_text(title, &style, (w as i32 / 2, height as i32 / 2)).map_err(|e| draw_err(title, e))?;
+    Ok(body)
+}
+
+/// The stroke of curve `i` of a plot.
+fn stroke(s: &Series, i: usize) -> ShapeStyle {
+    ShapeStyle::from(palette(s.colour.unwrap_or(i))).stroke_width(if s.width == 0 { 2 } else { s.width })
+}
+
+/// Width of the legend strip of `plot` in a panel `width` px wide.
+fn legend_width(plot: &LinePlot, width: u32) -> u32 {
+    if plot.legend == Legend::Hidden {
+        return 0;
+    }
+    let longest = plot.series.iter().map(|s| s.label.chars().count()).max().unwrap_or(0) as f64;
+    ((longest * CHAR_WIDTH * LEGEND_PX as f64) as u32 + 60).clamp(140, (width * 2) / 5)
+}
+
+/// The legend of `plot` in its strip: a sample of each curve's mark and its label, wrapped.
+fn draw_legend<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, plot: &LinePlot, top: i32) -> Result<(), PlotError> {
+    let t = plot.title.as_str();
+    let (w, _) = area.dim_in_pixel();
+    let chars = ((w as f64 - 52.0) / (CHAR_WIDTH * LEGEND_PX as f64)).max(8.0) as usize;
+    let line_h = (LEGEND_PX as f64 * 1.25) as i32;
+    let mut y = top + line_h / 2;
+    for (i, s) in plot.series.iter().enumerate() {
+        let st = stroke(s, i);
+        match s.mark {
+            Mark::Line => area.draw(&PathElement::new(vec![(6, y), (38, y)], st)),
+            Mark::Dashed => [(6, 14), (20, 28), (34, 38)]
+                .iter()
+                .try_for_each(|&(a, b)| area.draw(&PathElement::new(vec![(a, y), (b, y)], st))),
+            Mark::Markers => [12, 30].iter().try_for_each(|&x| area.draw(&Circle::new((x, y), 4, st.stroke_width(2)))),
+        }
+        .map_err(|e| draw_err(t, e))?;
+        for (k, l) in wrap(&s.label, chars).iter().enumerate() {
+            area.draw_text(l, &text_style(LEGEND_PX), (46, y + k as i32 * line_h)).map_err(|e| draw_err(t, e))?;
+            if k > 0 {
+                y += line_h;
+            }
+        }
+        y += line_h + 4;
+    }
+    Ok(())
+}
+
+/// Draws one plot into `area` with the given coordinate specs: title strip, chart, legend
+/// strip on the right.
+fn draw_with<DB, X, Y>(
+    area: &DrawingArea<DB, Shift>,
+    plot: &LinePlot,
+    xs: X,
+    ys: Y,
+    (ax, ay): (Axis, Axis),
+) -> Result<(), PlotError>
 where
     DB: DrawingBackend,
     X: AsRangedCoord<Value = f64>,
@@ -139,87 +299,119 @@ where
     Y::CoordDescType: ValueFormatter<f64>,
 {
     let t = plot.title.as_str();
-    let mut chart = ChartBuilder::on(area)
-        .caption(t, ("sans-serif", 22))
-        .margin(12)
-        .x_label_area_size(45)
-        .y_label_area_size(75)
+    let (w, _) = area.dim_in_pixel();
+    let body = title_strip(area, t, TITLE_STRIP, TITLE_PX)?;
+    let lw = legend_width(plot, w);
+    let (chart_area, legend_area) = body.split_horizontally(w - lw);
+    let mut chart = ChartBuilder::on(&chart_area)
+        .margin(10)
+        .x_label_area_size(58)
+        .y_label_area_size(96)
         .build_cartesian_2d(xs, ys)
         .map_err(|e| draw_err(t, e))?;
     chart
         .configure_mesh()
         .x_desc(plot.x_label.as_str())
         .y_desc(plot.y_label.as_str())
-        .x_label_formatter(&|v| format_tick(*v))
-        .y_label_formatter(&|v| format_tick(*v))
+        .label_style(font(TICK_PX))
+        .axis_desc_style(font(DESC_PX))
+        .x_label_formatter(&|v| ax.label(*v))
+        .y_label_formatter(&|v| ay.label(*v))
+        .light_line_style(BLACK.mix(0.04))
+        .bold_line_style(BLACK.mix(0.12))
         .draw()
         .map_err(|e| draw_err(t, e))?;
-    for (i, s) in plot.series.iter().enumerate() {
-        let color = Palette99::pick(i).to_rgba();
+    let (yr, top) = (chart.y_range(), chart.plotting_area().get_pixel_range().1.start - body.get_base_pixel().1);
+    for b in &plot.bands {
+        let shade = Rectangle::new([(ax.to(b.from), yr.start), (ax.to(b.to), yr.end)], BLACK.mix(0.10).filled());
+        chart.draw_series(std::iter::once(shade)).map_err(|e| draw_err(t, e))?;
+        // the label inside the band's edge nearer the middle of the plot
+        let (left, _) = chart.backend_coord(&(ax.to(b.from), yr.end));
+        let (right, py) = chart.backend_coord(&(ax.to(b.to), yr.end));
+        let middle = chart.plotting_area().get_pixel_range().0;
+        let base = chart_area.get_base_pixel();
+        let (x, anchor) =
+            if left - middle.start < middle.end - right { (left + 4, HPos::Left) } else { (right - 4, HPos::Right) };
+        let style = text_style(LEGEND_PX).pos(Pos::new(anchor, VPos::Top));
+        chart_area.draw_text(&b.label, &style, (x - base.0, py - base.1 + 4)).map_err(|e| draw_err(t, e))?;
+    }
+    // markers first, so that the lines of the solution lie on the data
+    let order = (0..plot.series.len()).filter(|&i| plot.series[i].mark == Mark::Markers);
+    let order: Vec<usize> =
+        order.chain((0..plot.series.len()).filter(|&i| plot.series[i].mark != Mark::Markers)).collect();
+    for i in order {
+        let s = &plot.series[i];
+        let style = stroke(s, i);
         // Split into runs of plottable points so lines break at gaps.
         let mut runs: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
         for (&x, &y) in s.x.iter().zip(&s.y) {
             if keep(x, plot.log_x) && keep(y, plot.log_y) {
                 if let Some(r) = runs.last_mut() {
-                    r.push((x, y));
+                    r.push((ax.to(x), ay.to(y)));
                 }
             } else if runs.last().is_some_and(|r| !r.is_empty()) {
                 runs.push(Vec::new());
             }
         }
-        let mut labelled = false;
+        let every = s.x.len().div_ceil(MAX_MARKERS).max(1);
         for run in runs.into_iter().filter(|r| !r.is_empty()) {
-            let style = ShapeStyle::from(color).stroke_width(2);
-            let drawn = chart.draw_series(LineSeries::new(run, style)).map_err(|e| draw_err(t, e))?;
-            if !labelled {
-                drawn.label(s.label.as_str()).legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
-                labelled = true;
+            match s.mark {
+                Mark::Line => chart.draw_series(LineSeries::new(run, style)).map(|_| ()),
+                Mark::Dashed => chart.draw_series(DashedLineSeries::new(run, 9, 6, style)).map(|_| ()),
+                Mark::Markers => chart
+                    .draw_series(run.into_iter().step_by(every).map(|p| Circle::new(p, 4, style.stroke_width(2))))
+                    .map(|_| ()),
             }
+            .map_err(|e| draw_err(t, e))?;
         }
     }
-    chart
-        .configure_series_labels()
-        .position(match plot.legend {
-            Legend::UpperRight => SeriesLabelPosition::UpperRight,
-            Legend::UpperLeft => SeriesLabelPosition::UpperLeft,
-            Legend::LowerLeft => SeriesLabelPosition::LowerLeft,
-        })
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .draw()
-        .map_err(|e| draw_err(t, e))?;
+    if lw > 0 {
+        draw_legend(&legend_area, plot, top)?;
+    }
     Ok(())
 }
 
-/// Compact tick labels: plain decimals for moderate magnitudes, else `1.5e-3`.
-pub(crate) fn format_tick(v: f64) -> String {
-    let a = v.abs();
-    if a == 0.0 {
-        "0".to_string()
-    } else if (1e-3..1e4).contains(&a) {
-        let s = format!("{v:.4}");
-        s.trim_end_matches('0').trim_end_matches('.').to_string()
-    } else {
-        let s = format!("{v:.2e}");
-        match s.split_once('e') {
-            Some((m, e)) => format!("{}e{e}", m.trim_end_matches('0').trim_end_matches('.')),
-            None => s,
+/// How an axis's values are drawn: on a log axis scaled by `factor` so that its range starts at
+/// 1 (plotters draws no tick below 2.2e-16 on a log axis), labelled with the values themselves.
+#[derive(Clone, Copy)]
+struct Axis {
+    factor: f64,
+    span: f64,
+    log: bool,
+}
+
+impl Axis {
+    /// The axis of `range` (padded) and its drawn range.
+    fn new(range: Range<f64>, log: bool) -> (Self, Range<f64>) {
+        let factor = if log { 1.0 / range.start } else { 1.0 };
+        let axis = Axis { factor, span: range.end - range.start, log };
+        (axis, range.start * factor..range.end * factor)
+    }
+    fn to(self, v: f64) -> f64 {
+        v * self.factor
+    }
+    fn label(self, v: f64) -> String {
+        if self.log {
+            format_tick(v / self.factor)
+        } else {
+            axis_tick(v, self.span)
         }
     }
 }
 
 fn draw_plot<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, plot: &LinePlot) -> Result<(), PlotError> {
     let (xr, yr) = ranges(plot)?;
+    let ((ax, xr), (ay, yr)) = (Axis::new(xr, plot.log_x), Axis::new(yr, plot.log_y));
     match (plot.log_x, plot.log_y) {
-        (false, false) => draw_with(area, plot, xr, yr),
-        (true, false) => draw_with(area, plot, xr.log_scale(), yr),
-        (false, true) => draw_with(area, plot, xr, yr.log_scale()),
-        (true, true) => draw_with(area, plot, xr.log_scale(), yr.log_scale()),
+        (false, false) => draw_with(area, plot, xr, yr, (ax, ay)),
+        (true, false) => draw_with(area, plot, xr.log_scale(), yr, (ax, ay)),
+        (false, true) => draw_with(area, plot, xr, yr.log_scale(), (ax, ay)),
+        (true, true) => draw_with(area, plot, xr.log_scale(), yr.log_scale(), (ax, ay)),
     }
 }
 
 /// Renders `draw` into an in-memory SVG of `size` pixels.
-fn render(
+pub(crate) fn render(
     size: (u32, u32),
     title: &str,
     draw: impl FnOnce(&DrawingArea<SVGBackend, Shift>) -> Result<(), PlotError>,
@@ -242,8 +434,8 @@ pub fn render_svg(plot: &LinePlot) -> Result<String, PlotError> {
 }
 
 /// `panels` as a grid with `cols` columns (rows as needed) in one SVG; each panel is 900×600
-/// scaled to fit a width of at most 1800 px. Errors if any panel is invalid, `panels` is
-/// empty or `cols` is 0.
+/// (text keeps its size in px). Errors if any panel is invalid, `panels` is empty or `cols`
+/// is 0.
 pub fn render_panels_svg(panels: &[LinePlot], cols: usize) -> Result<String, PlotError> {
     if panels.is_empty() || cols == 0 {
         return Err(PlotError::InvalidGrid { panels: panels.len(), cols });
@@ -253,97 +445,29 @@ pub fn render_panels_svg(panels: &[LinePlot], cols: usize) -> Result<String, Plo
     }
     let cols = cols.min(panels.len());
     let rows = panels.len().div_ceil(cols);
-    let (pw, ph) = if cols <= 2 { PLOT_SIZE } else { (1800 / cols as u32, 1200 / cols as u32) };
+    let (pw, ph) = PLOT_SIZE;
     let size = (pw * cols as u32, ph * rows as u32);
     let title = panels.first().map_or("", |p| p.title.as_str());
-    render(size, title, |root| {
-        for (area, plot) in root.split_evenly((rows, cols)).iter().zip(panels) {
-            draw_plot(area, plot)?;
-        }
-        Ok(())
-    })
+    render(size, title, |root| draw_panels(root, panels, cols))
 }
 
-/// A value field over a regular grid drawn as coloured cells (a kymograph): `values[i][j]` at
-/// `(x[i], y[j])`, a diverging colour map symmetric about 0 (blue < 0 < red), clipped at
-/// `±limit`.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Heatmap {
-    pub title: String,
-    pub x_label: String,
-    pub y_label: String,
-    pub x: Vec<f64>,
-    pub y: Vec<f64>,
-    pub values: Vec<Vec<f64>>,
-    pub limit: f64,
-}
-
-impl Heatmap {
-    /// A kymograph: frames along x, arc length `s` [mm] along y.
-    pub fn kymograph(title: String, frames: Vec<f64>, s_mm: Vec<f64>, values: Vec<Vec<f64>>, limit: f64) -> Self {
-        Heatmap { title, x_label: "frame".into(), y_label: "s [mm]".into(), x: frames, y: s_mm, values, limit }
+/// `panels` in a grid of `cols` columns filling `area`.
+pub(crate) fn draw_panels<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    panels: &[LinePlot],
+    cols: usize,
+) -> Result<(), PlotError> {
+    let rows = panels.len().div_ceil(cols);
+    for (a, plot) in area.split_evenly((rows, cols)).iter().zip(panels) {
+        draw_plot(a, plot)?;
     }
+    Ok(())
 }
 
-fn diverging(v: f64, limit: f64) -> RGBColor {
-    let t = if limit > 0.0 && v.is_finite() { (v / limit).clamp(-1.0, 1.0) } else { 0.0 };
-    let (r, g, b) = if t >= 0.0 { (1.0, 1.0 - t, 1.0 - t) } else { (1.0 + t, 1.0 + t, 1.0) };
-    RGBColor((r * 255.0) as u8, (g * 255.0) as u8, (b * 255.0) as u8)
-}
-
-/// Heatmaps side by side (one row) in one SVG.
-pub fn render_heatmaps_svg(maps: &[Heatmap]) -> Result<String, PlotError> {
-    if maps.is_empty() {
-        return Err(PlotError::InvalidGrid { panels: 0, cols: 0 });
-    }
-    for m in maps {
-        if m.x.len() < 2
-            || m.y.len() < 2
-            || m.values.len() != m.x.len()
-            || m.values.iter().any(|r| r.len() != m.y.len())
-        {
-            return Err(PlotError::LengthMismatch {
-                title: m.title.clone(),
-                series: "values".into(),
-                x_len: m.x.len(),
-                y_len: m.y.len(),
-            });
-        }
-    }
-    let size = (PLOT_SIZE.0 * maps.len() as u32, PLOT_SIZE.1);
-    let title = maps[0].title.clone();
-    render(size, &title, |root| {
-        for (m, area) in maps.iter().zip(root.split_evenly((1, maps.len()))) {
-            let (x0, x1) = (m.x[0], m.x[m.x.len() - 1]);
-            let (y0, y1) = (m.y[0], m.y[m.y.len() - 1]);
-            let mut chart = ChartBuilder::on(&area)
-                .caption(&m.title, ("sans-serif", 20))
-                .margin(10)
-                .x_label_area_size(40)
-                .y_label_area_size(70)
-                .build_cartesian_2d(x0..x1, y0..y1)
-                .map_err(|e| draw_err(&m.title, e))?;
-            chart
-                .configure_mesh()
-                .disable_mesh()
-                .x_desc(m.x_label.as_str())
-                .y_desc(m.y_label.as_str())
-                .draw()
-                .map_err(|e| draw_err(&m.title, e))?;
-            let half = |v: &[f64], i: usize| -> (f64, f64) {
-                let lo = if i == 0 { v[0] } else { 0.5 * (v[i - 1] + v[i]) };
-                let hi = if i + 1 == v.len() { v[i] } else { 0.5 * (v[i] + v[i + 1]) };
-                (lo, hi)
-            };
-            let cells = (0..m.x.len()).flat_map(|i| (0..m.y.len()).map(move |j| (i, j))).map(|(i, j)| {
-                let (xa, xb) = half(&m.x, i);
-                let (ya, yb) = half(&m.y, j);
-                Rectangle::new([(xa, ya), (xb, yb)], diverging(m.values[i][j], m.limit).filled())
-            });
-            chart.draw_series(cells).map_err(|e| draw_err(&m.title, e))?;
-        }
-        Ok(())
-    })
+/// The smallest `font-size` of an SVG [px] (tests of the figures).
+#[cfg(test)]
+pub(crate) fn smallest_text(svg: &str) -> f64 {
+    svg.split("font-size=\"").skip(1).filter_map(|r| r.split('"').next()?.parse::<f64>().ok()).fold(f64::MAX, f64::min)
 }
 
 #[cfg(test)]
@@ -352,7 +476,8 @@ mod tests {
 
     fn series(label: &str, f: impl Fn(f64) -> f64) -> Series {
         let x: Vec<f64> = (0..50).map(|i| i as f64 * 0.1).collect();
-        Series { label: label.into(), y: x.iter().map(|&v| f(v)).collect(), x }
+        let y = x.iter().map(|&v| f(v)).collect();
+        Series::new(label, x, y)
     }
 
     fn plot(series: Vec<Series>) -> LinePlot {
@@ -391,12 +516,12 @@ mod tests {
 
     #[test]
     fn bad_input_errors() {
-        let empty = plot(vec![Series { label: "nothing".into(), x: vec![], y: vec![] }]);
+        let empty = plot(vec![Series::new("nothing", vec![], vec![])]);
         let e = render_svg(&empty).unwrap_err();
         assert!(matches!(e, PlotError::EmptySeries { .. }));
         assert!(e.to_string().contains("'nothing'") && e.to_string().contains("empty"), "{e}");
         assert!(matches!(render_svg(&plot(vec![])), Err(PlotError::NoSeries { .. })));
-        let mismatch = plot(vec![Series { label: "m".into(), x: vec![1.0, 2.0], y: vec![1.0] }]);
+        let mismatch = plot(vec![Series::new("m", vec![1.0, 2.0], vec![1.0])]);
         assert!(matches!(render_svg(&mismatch), Err(PlotError::LengthMismatch { x_len: 2, y_len: 1, .. })));
         assert!(matches!(render_panels_svg(&[], 2), Err(PlotError::InvalidGrid { .. })));
         assert!(matches!(render_panels_svg(&[plot(vec![series("a", |x| x)])], 0), Err(PlotError::InvalidGrid { .. })));
@@ -430,5 +555,20 @@ mod tests {
             assert!(svg.contains(n) && svg.contains(&format!("rust {n}")), "{n}");
         }
         assert!(svg.contains("width=\"1800\"") && svg.contains("height=\"1200\""));
+    }
+
+    #[test]
+    fn ticks_without_round_off_and_text_of_readable_size() {
+        assert_eq!(axis_tick(-1.39e-17, 0.02), "0");
+        assert_eq!(axis_tick(-1.39e-17, 1e-15), "-1.39e-17");
+        assert_eq!(nice_ticks(-2.2, 2.2, 5), vec![-2.0, -1.0, 0.0, 1.0, 2.0]);
+        let labels: Vec<String> = nice_ticks(705.80, 705.85, 5).iter().map(|v| axis_tick(*v, 0.05)).collect();
+        assert_eq!(labels, ["705.8", "705.82", "705.84"]);
+        let svg = render_svg(&plot(vec![series("a", |x| x - 2.0)])).unwrap();
+        assert!(smallest_text(&svg) >= 12.0, "{}", smallest_text(&svg));
+        // a log axis far below 1e-15 still has its decades labelled
+        let tiny = LinePlot { log_y: true, ..plot(vec![series("tiny", |x| 1e-22 * (1.0 + x))]) };
+        let svg = render_svg(&tiny).unwrap();
+        assert!(svg.contains("\n1e-22\n") && svg.contains("\n1e-21\n"), "decades missing");
     }
 }

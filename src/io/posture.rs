@@ -7,7 +7,8 @@
 //! `∂s x − d3`, so the finite-difference tangent is drawn next to `d3` (thin red against black)
 //! to make a detachment of the frame from the centreline visible, as in Fig. 21.
 
-use super::plot::PlotError;
+use super::heatmap::{draw_colour_bar, COLOUR_BAR_STRIP};
+use super::plot::{draw_err, draw_panels, font, title_strip, LinePlot, PlotError, PLOT_SIZE};
 use nalgebra::Vector3;
 use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
@@ -67,10 +68,6 @@ const VIRIDIS: [(u8, u8, u8); 9] = [
     (253, 231, 37),
 ];
 
-fn draw_err(title: &str, e: impl std::fmt::Display) -> PlotError {
-    PlotError::Draw { title: title.to_string(), detail: e.to_string() }
-}
-
 /// Viridis-like colour for `t` in [0, 1] (clamped; non-finite → the middle of the scale).
 fn viridis(t: f64) -> RGBColor {
     let t = if t.is_finite() { t.clamp(0.0, 1.0) } else { 0.5 };
@@ -90,6 +87,15 @@ fn sample_step(n: usize) -> usize {
 /// Compact number for captions and tick labels (the line plots' tick format).
 fn fmt_num(v: f64) -> String {
     super::plot::format_tick(v)
+}
+
+/// `v` rounded to two significant digits (a caption's measure).
+fn sig2(v: f64) -> f64 {
+    if v == 0.0 || !v.is_finite() {
+        return v;
+    }
+    let p = 10f64.powi(1 - v.abs().log10().floor() as i32);
+    (v * p).round() / p
 }
 
 /// Tick label on an axis of half-width `half`: round-off next to 0 shows as "0".
@@ -125,7 +131,7 @@ fn validate(p: &PosturePanel) -> Result<(), PlotError> {
 
 /// Finite-difference unit tangent `∂s x / |∂s x|` per node (central inside, one-sided at the
 /// ends); `None` where neighbouring nodes coincide.
-fn tangents(x: &[Vector3<f64>]) -> Vec<Option<Vector3<f64>>> {
+pub(crate) fn tangents(x: &[Vector3<f64>]) -> Vec<Option<Vector3<f64>>> {
     let n = x.len();
     (0..n)
         .map(|i| {
@@ -183,14 +189,10 @@ impl<'a> Prepared<'a> {
     }
 
     fn caption(&self) -> String {
-        let p = self.panel;
         format!(
-            "{} — colour: {} {} … {} — max ∠(d3, ∂s x) = {}°",
-            p.label,
-            p.colour_label,
-            fmt_num(self.range.0),
-            fmt_num(self.range.1),
-            fmt_num(self.max_angle_deg)
+            "{} — ● head (s = 0); black arrows d3, grey ticks d1, red: tangent ∂s x — max ∠(d3, ∂s x) = {}°",
+            self.panel.label,
+            fmt_num(sig2(self.max_angle_deg))
         )
     }
 }
@@ -233,6 +235,8 @@ fn draw_projection<DB: DrawingBackend>(
         .y_desc(desc_b.as_str())
         .x_labels(6)
         .y_labels(6)
+        .label_style(font(14))
+        .axis_desc_style(font(15))
         .x_label_formatter(&|v| tick(*v, half))
         .y_label_formatter(&|v| tick(*v, half))
         .light_line_style(WHITE)
@@ -292,44 +296,41 @@ fn draw_projection<DB: DrawingBackend>(
     Ok(())
 }
 
-/// Caption strip of one row: the caption text and a small colour bar.
+/// Caption strip of one row.
 fn draw_caption<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, p: &Prepared) -> Result<(), PlotError> {
-    let t = p.panel.label.as_str();
-    let (w, h) = area.dim_in_pixel();
-    let (w, h) = (w as i32, h as i32);
-    let bar_w = 160;
-    let style = TextStyle::from(("sans-serif", 17).into_font()).pos(Pos::new(HPos::Left, VPos::Center));
-    area.draw_text(&p.caption(), &style, (12, h / 2)).map_err(|e| draw_err(t, e))?;
-    let x0 = w - bar_w - 70;
-    let small = TextStyle::from(("sans-serif", 13).into_font());
-    let (lo, hi) = (fmt_num(p.range.0), fmt_num(p.range.1));
-    let left = small.pos(Pos::new(HPos::Right, VPos::Center));
-    area.draw_text(&lo, &left, (x0 - 6, h / 2)).map_err(|e| draw_err(t, e))?;
-    let right = small.pos(Pos::new(HPos::Left, VPos::Center));
-    area.draw_text(&hi, &right, (x0 + bar_w + 6, h / 2)).map_err(|e| draw_err(t, e))?;
-    let steps = 32;
-    for k in 0..steps {
-        let c = viridis((k as f64 + 0.5) / steps as f64);
-        let (xa, xb) = (x0 + k * bar_w / steps, x0 + (k + 1) * bar_w / steps);
-        area.draw(&Rectangle::new([(xa, h / 2 - 7), (xb, h / 2 + 7)], c.filled())).map_err(|e| draw_err(t, e))?;
-    }
-    Ok(())
+    let (_, h) = area.dim_in_pixel();
+    let style = TextStyle::from(font(15)).pos(Pos::new(HPos::Left, VPos::Center));
+    area.draw_text(&p.caption(), &style, (12, h as i32 / 2)).map_err(|e| draw_err(&p.panel.label, e))
+}
+
+/// The colour bar of one row, in the strip right of its projections, as tall as a projection.
+fn draw_row_colour_bar<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, p: &Prepared) -> Result<(), PlotError> {
+    let (_, h) = area.dim_in_pixel();
+    let rows = (MARGIN + 20) as i32..(h - MARGIN - X_LABEL_AREA - 20) as i32;
+    let (lo, hi) = p.range;
+    let colour = |t: f64| viridis(t);
+    draw_colour_bar(area, 10, rows, &colour, (lo, hi.max(lo)), &p.panel.colour_label)
 }
 
 /// Render panels (one row per panel, three orthogonal projections per row: x–y, x–z, y–z,
 /// each with equal aspect ratio axes in mm) to SVG text.
 ///
 /// Per projection: the centreline coloured segment by segment by `colour` (one scale per panel,
-/// its range in the row caption), at about 16 sampled nodes a black `d3` arrow, a grey `d1` tick
+/// its colour bar right of the row), at about 16 sampled nodes a black `d3` arrow, a grey `d1` tick
 /// through the node and a thin red finite-difference tangent (all ≈ 4 % of the rod's extent;
 /// `d3` off the tangent is what the `Λ`/`λ_d` term of eq. 41 penalises), and a filled circle at
 /// the head (node 0). A `d3` nearly normal to the projection plane is marked by a ring.
+/// `extra`, if given, is drawn beneath the rows (900 × 600 px high, the full width).
 ///
 /// Errors: no panels ([`PlotError::InvalidGrid`]), a panel without nodes
 /// ([`PlotError::EmptySeries`]), `d1`/`d3`/`colour` lengths differing from `x`
 /// ([`PlotError::LengthMismatch`]), fewer than 2 nodes or a non-finite value
 /// ([`PlotError::Draw`]).
-pub fn render_postures_svg(title: &str, panels: &[PosturePanel]) -> Result<String, PlotError> {
+pub fn render_postures_svg(
+    title: &str,
+    panels: &[PosturePanel],
+    extra: Option<&LinePlot>,
+) -> Result<String, PlotError> {
     if panels.is_empty() {
         return Err(PlotError::InvalidGrid { panels: 0, cols: PROJECTIONS.len() });
     }
@@ -338,20 +339,26 @@ pub fn render_postures_svg(title: &str, panels: &[PosturePanel]) -> Result<Strin
     }
     let prepared: Vec<Prepared> = panels.iter().map(Prepared::new).collect();
     let rows = panels.len() as u32;
-    let size = (CELL * PROJECTIONS.len() as u32, TITLE_H + rows * (CAPTION_H + CELL));
+    let width = CELL * PROJECTIONS.len() as u32 + COLOUR_BAR_STRIP;
+    let extra_h = if extra.is_some() { PLOT_SIZE.1 } else { 0 };
+    let size = (width, TITLE_H + rows * (CAPTION_H + CELL) + extra_h);
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
         root.fill(&WHITE).map_err(|e| draw_err(title, e))?;
-        let (top, body) = root.split_vertically(TITLE_H);
-        let style = TextStyle::from(("sans-serif", 24).into_font()).pos(Pos::new(HPos::Center, VPos::Center));
-        top.draw_text(title, &style, (size.0 as i32 / 2, TITLE_H as i32 / 2)).map_err(|e| draw_err(title, e))?;
-        for (row, p) in body.split_evenly((panels.len(), 1)).iter().zip(&prepared) {
+        let body = title_strip(&root, title, TITLE_H, 20)?;
+        let (postures, below) = body.split_vertically(rows * (CAPTION_H + CELL));
+        for (row, p) in postures.split_evenly((panels.len(), 1)).iter().zip(&prepared) {
             let (cap, cells) = row.split_vertically(CAPTION_H);
             draw_caption(&cap, p)?;
+            let (cells, bar) = cells.split_horizontally(CELL * PROJECTIONS.len() as u32);
             for (cell, pr) in cells.split_evenly((1, PROJECTIONS.len())).iter().zip(PROJECTIONS) {
                 draw_projection(cell, p, pr)?;
             }
+            draw_row_colour_bar(&bar, p)?;
+        }
+        if let Some(plot) = extra {
+            draw_panels(&below, std::slice::from_ref(plot), 1)?;
         }
         root.present().map_err(|e| draw_err(title, e))?;
     }
@@ -382,8 +389,8 @@ mod tests {
     #[test]
     fn straight_rod_draws_one_glyph_of_each_kind_per_sample_and_projection() {
         let n = 33;
-        let svg = render_postures_svg("Straight rod", &[straight(n)]).expect("renders");
-        assert!(svg.contains("Straight rod") && svg.contains("frame 7") && svg.contains("|kappa| [1/m] 0 … 32"));
+        let svg = render_postures_svg("Straight rod", &[straight(n)], None).expect("renders");
+        assert!(svg.contains("Straight rod") && svg.contains("frame 7") && svg.contains("|kappa| [1/m]"));
         let samples = (0..n).step_by(sample_step(n)).count();
         assert_eq!(samples, 17);
         assert_eq!(polylines(&svg, ARROW_COLOUR), 3 * samples);
@@ -398,10 +405,13 @@ mod tests {
     fn bad_input_is_an_error() {
         let mut p = straight(10);
         p.d3.pop();
-        assert!(matches!(render_postures_svg("t", &[p]), Err(PlotError::LengthMismatch { x_len: 10, y_len: 9, .. })));
-        assert!(matches!(render_postures_svg("t", &[]), Err(PlotError::InvalidGrid { .. })));
+        assert!(matches!(
+            render_postures_svg("t", &[p], None),
+            Err(PlotError::LengthMismatch { x_len: 10, y_len: 9, .. })
+        ));
+        assert!(matches!(render_postures_svg("t", &[], None), Err(PlotError::InvalidGrid { .. })));
         let mut p = straight(10);
         p.x[3].y = f64::NAN;
-        assert!(matches!(render_postures_svg("t", &[p]), Err(PlotError::Draw { .. })));
+        assert!(matches!(render_postures_svg("t", &[p], None), Err(PlotError::Draw { .. })));
     }
 }

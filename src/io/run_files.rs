@@ -3,7 +3,7 @@
 use std::path::{Path, PathBuf};
 
 use super::files::{csv_text, csv_text_int, write_atomic, write_plot, OutputError};
-use super::plot::{render_panels_svg, LinePlot, Series};
+use super::plot::{render_panels_svg, LinePlot, Mark, Series};
 use crate::case::Case;
 use crate::run::metrics::Metrics;
 use crate::run::{InverseOutput, RunResult};
@@ -167,15 +167,13 @@ fn write_inverse(
 /// The headline figure: tip history for dynamic runs (Fig. 5 analogue), deflection and
 /// curvature along the rod for static runs (Fig. 7 analogue).
 pub fn headline_panels(case: &Case, r: &RunResult) -> Vec<LinePlot> {
-    let series = |label: &str, x: Vec<f64>, y: Vec<f64>| Series { label: label.into(), x, y };
+    let series = |label: &str, x: Vec<f64>, y: Vec<f64>| Series::new(label, x, y);
     let plot = |title: &str, xl: &str, yl: &str, s: Vec<Series>| LinePlot {
         title: title.into(),
         x_label: xl.into(),
         y_label: yl.into(),
         series: s,
-        log_x: false,
-        log_y: false,
-        legend: Default::default(),
+        ..Default::default()
     };
     if let Some(inv) = &r.inverse {
         return inverse_panels(case, r, inv);
@@ -233,7 +231,10 @@ pub fn headline_panels(case: &Case, r: &RunResult) -> Vec<LinePlot> {
 /// Figs. 8/12/14 analogues (position and curvature, data vs recovered), Fig. 15 (controls f, l)
 /// and the convergence history (Figs. 9–11 style, log-log).
 fn inverse_panels(case: &Case, r: &RunResult, inv: &InverseOutput) -> Vec<LinePlot> {
-    let series = |label: String, x: Vec<f64>, y: Vec<f64>| Series { label, x, y };
+    let series = |label: String, x: Vec<f64>, y: Vec<f64>| Series::new(label, x, y);
+    // the data as markers under the inverse solution (solid), in the same colour
+    let data =
+        |label: String, x: Vec<f64>, y: Vec<f64>, c: usize| series(label, x, y).marked(Mark::Markers).coloured(c);
     let plot = |title: String, xl: &str, yl: &str, s: Vec<Series>, log: bool| LinePlot {
         title,
         x_label: xl.into(),
@@ -241,26 +242,32 @@ fn inverse_panels(case: &Case, r: &RunResult, inv: &InverseOutput) -> Vec<LinePl
         series: s,
         log_x: log,
         log_y: log,
-        legend: Default::default(),
+        ..Default::default()
     };
-    let s = r.nodes.s.clone();
+    // one length unit per figure: mm for a rod shorter than 10 cm (the worm's scale), else m
+    let (unit, to) = if case.mesh.length_m < 0.1 { ("mm", 1e3) } else { ("m", 1.0) };
+    let s: Vec<f64> = r.nodes.s.iter().map(|s| s * to).collect();
     let comp = ["x", "y", "z"];
     let mut pos = Vec::new();
     for k in 0..3 {
-        pos.push(series(format!("{} data", comp[k]), s.clone(), inv.data.x.iter().map(|v| v[k]).collect()));
-        pos.push(series(format!("{} inverse", comp[k]), s.clone(), r.nodes.x.iter().map(|v| v[k]).collect()));
+        let d = inv.data.x.iter().map(|v| v[k] * to).collect();
+        pos.push(data(format!("{} data", comp[k]), s.clone(), d, k));
+        let x = r.nodes.x.iter().map(|v| v[k] * to).collect();
+        pos.push(series(format!("{} inverse", comp[k]), s.clone(), x).coloured(k));
     }
     let (k, kf) = (r.nodes.element_curvature(), inv.data.element_curvature());
-    let sk: Vec<f64> = k.iter().map(|p| p.0).collect();
+    let sk: Vec<f64> = k.iter().map(|p| p.0 * to).collect();
     let mut curv = Vec::new();
     for c in 0..3 {
-        curv.push(series(format!("kappa_{} data", c + 1), sk.clone(), kf.iter().map(|p| p.1[c]).collect()));
-        curv.push(series(format!("kappa_{} inverse", c + 1), sk.clone(), k.iter().map(|p| p.1[c]).collect()));
+        curv.push(data(format!("κ{} data", c + 1), sk.clone(), kf.iter().map(|p| p.1[c] / to).collect(), c));
+        let rec = k.iter().map(|p| p.1[c] / to).collect();
+        curv.push(series(format!("κ{} inverse", c + 1), sk.clone(), rec).coloured(c));
     }
+    // f [N/m] → [N/unit]; l [N m/m] = [N unit/unit]
     let (f, l) = (inv.force(), inv.torque());
-    let ctrl = |v: &[nalgebra::Vector3<f64>], name: &str| {
+    let ctrl = |v: &[nalgebra::Vector3<f64>], name: &str, scale: f64| {
         (0..3)
-            .map(|c| series(format!("{name}_{}", comp[c]), s.clone(), v.iter().map(|x| x[c]).collect()))
+            .map(|c| series(format!("{name}{}", c + 1), s.clone(), v.iter().map(|x| x[c] * scale).collect()))
             .collect::<Vec<_>>()
     };
     let it: Vec<f64> = inv.history.iter().map(|h| h.iteration as f64).collect();
@@ -273,12 +280,31 @@ fn inverse_panels(case: &Case, r: &RunResult, inv: &InverseOutput) -> Vec<LinePl
     if inv.kappa_err.len() == it.len() {
         hist.push(series("|kappa - kappa_f|/|kappa_f|".into(), it, inv.kappa_err.iter().map(|k| k[0]).collect()));
     }
+    let s_label = format!("s [{unit}]");
     vec![
-        plot(format!("{}: centreline, data vs inverse", case.name), "s [m]", "position [m]", pos, false),
-        plot("curvature (eq. 28), data vs inverse".into(), "s [m]", "kappa [1/m]", curv, false),
-        plot("recovered force f = x^/lambda_f (eq. 54)".into(), "s [m]", "f [N/m]", ctrl(&f, "f"), false),
-        plot("recovered torque l = a^/lambda_l (eq. 54)".into(), "s [m]", "l [N m/m]", ctrl(&l, "l"), false),
-        plot("convergence history".into(), "iteration", "value", hist, true),
+        plot(
+            format!("{}: centreline, data vs inverse", case.name),
+            &s_label,
+            &format!("position [{unit}]"),
+            pos,
+            false,
+        ),
+        plot("curvature (eq. 28), data vs inverse".into(), &s_label, &format!("κ [1/{unit}]"), curv, false),
+        plot(
+            "recovered force f = x̂/λf (eq. 54), global frame".into(),
+            &s_label,
+            &format!("f [N/{unit}]"),
+            ctrl(&f, "f", 1.0 / to),
+            false,
+        ),
+        plot(
+            "recovered torque l = α̂/λl (eq. 54), global frame".into(),
+            &s_label,
+            &format!("l [N {unit}/{unit}]"),
+            ctrl(&l, "l", 1.0),
+            false,
+        ),
+        plot("convergence history".into(), "iteration", "change, error [–]; ‖x' − d3‖ [m^½]", hist, true),
     ]
 }
 
@@ -293,7 +319,7 @@ pub fn write_convergence_plot(runs: &[(&String, &RunResult)], path: &Path) -> Re
         series,
         log_x: true,
         log_y: true,
-        legend: Default::default(),
+        ..Default::default()
     };
     let mut xerr = Vec::new();
     let mut kerr = Vec::new();
@@ -302,30 +328,21 @@ pub fn write_convergence_plot(runs: &[(&String, &RunResult)], path: &Path) -> Re
         if let Some(inv) = &r.inverse {
             let it: Vec<f64> = inv.history.iter().map(|h| h.iteration as f64).collect();
             if inv.kappa_err.len() == it.len() {
-                kerr.push(Series {
-                    label: name.to_string(),
-                    x: it.clone(),
-                    y: inv.kappa_err.iter().map(|k| k[0]).collect(),
-                });
+                kerr.push(Series::new(name.to_string(), it.clone(), inv.kappa_err.iter().map(|k| k[0]).collect()));
             }
-            xerr.push(Series {
-                label: name.to_string(),
-                x: it.clone(),
-                y: inv.history.iter().map(|h| h.x_err_rel).collect(),
-            });
-            change.push(Series {
-                label: name.to_string(),
-                x: it,
-                y: inv.history.iter().map(|h| h.rel_change).collect(),
-            });
+            xerr.push(Series::new(name.to_string(), it.clone(), inv.history.iter().map(|h| h.x_err_rel).collect()));
+            change.push(Series::new(name.to_string(), it, inv.history.iter().map(|h| h.rel_change).collect()));
         } else if !r.history.is_empty() {
-            change.push(Series {
-                label: name.to_string(),
-                x: (1..=r.history.len()).map(|k| k as f64).collect(),
-                y: r.history.iter().map(|h| h.change).collect(),
-            });
+            change.push(Series::new(
+                name.to_string(),
+                (1..=r.history.len()).map(|k| k as f64).collect(),
+                r.history.iter().map(|h| h.change).collect(),
+            ));
         }
     }
+    // the runs' curves may lie on each other: each narrower than the one before
+    let many = |v: Vec<Series>| v.into_iter().enumerate().map(|(i, s)| s.nth_of_many(i)).collect::<Vec<_>>();
+    let (xerr, kerr, change) = (many(xerr), many(kerr), many(change));
     let mut panels = Vec::new();
     if !xerr.is_empty() {
         panels.push(plot("|x - x_g| / |x_g|", "relative error", xerr));
