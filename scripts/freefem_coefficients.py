@@ -160,6 +160,110 @@ def trig_statements(body, dst):
     return out
 
 
+kin = (root / "freefem" / "kinematics.idp").read_text()
+kin_macros = dict(re.findall(r"^macro (\w+)\(P\) (.*?) //", kin, re.M))
+
+
+def entry_ref(e):
+    """A rotation entry at the points: an array (the container's field) or a literal constant."""
+    return ("num", const[e].strip("()")) if e in const else ("arr", f"cq{field[e]}[]")
+
+
+def parse_composite(text):
+    """The formula of a state quantity (kinematics.idp's NAME#F(P) at P = cq) as a tree: ("sum", [(sign, product)]),
+    a product a list of factors ("arr", array) / ("num", literal) / ("var", scalar) / ("sum", ...), left to right."""
+    toks = re.findall(r"dQp\((\d\d),P,P\)|Qp\((\d\d),P\)|Ap\((\d\d),P\)|DP\(P,(\w)\)|([A-Z]+\d)\(P\)|"
+                      r"([A-Za-z_]\w*)|(\d+\.?\d*(?:e-?\d+)?)|([-+*()])|(\S)", text)
+    items = []
+    for dq, q, a, d, comp, ident, num, op, bad in toks:
+        assert not bad, (text, bad)
+        if dq:
+            ab = [(("+", [entry_ref("Q" + x + dq), ("arr", f"cq{v}[]")])) for x, v in (("A", "a"), ("B", "b"), ("G", "g"))]
+            items.append(("sum", ab))
+        elif q:
+            items.append(entry_ref("Q" + q))
+        elif a:
+            items.append(entry_ref("A" + a))
+        elif d:
+            items.append(("arr", f"cqcD{d}[]"))
+        elif comp:
+            items.append(("arr", f"cqc{comp}[]"))
+        elif ident:
+            items.append(("var", ident))
+        elif num:
+            items.append(("num", num))
+        else:
+            items.append(op)
+    pos = 0
+
+    def expr():
+        nonlocal pos
+        terms, sign = [], "+"
+        while True:
+            if items[pos] in ("+", "-"):
+                sign = items[pos]
+                pos += 1
+            prod = [factor()]
+            while pos < len(items) and items[pos] == "*":
+                pos += 1
+                prod.append(factor())
+            terms.append((sign, prod))
+            sign = "+"
+            if pos >= len(items) or items[pos] == ")":
+                return ("sum", terms)
+
+    def factor():
+        nonlocal pos
+        it = items[pos]
+        pos += 1
+        if it == "(":
+            e = expr()
+            assert items[pos] == ")", text
+            pos += 1
+            return e
+        return it
+
+    tree = expr()
+    assert pos == len(items), text
+    return tree
+
+
+def emit_sum(tree, dst, temps, out):
+    """Array statements that evaluate a sum of products into dst, in FreeFEM's order of evaluation (left to right,
+    the same bits as the expression at each point); temps: free scratch arrays for parenthesised sums."""
+    for k, (sign, prod) in enumerate(tree[1]):
+        tgt = dst if k == 0 else temps[0]
+        rest = temps if k == 0 else temps[1:]
+        first = prod[0]
+        if first[0] == "sum":
+            emit_sum(first, tgt, rest, out)
+        elif first[0] == "arr":
+            out.append(f"{tgt} = {first[1]};")
+        else:
+            out.append(f"{tgt} = {first[1]};")
+        for f in prod[1:]:
+            if f[0] == "arr":
+                out.append(f"{tgt} = {tgt} .* {f[1]};")
+            elif f[0] == "sum":
+                emit_sum(f, rest[0], rest[1:], out)
+                out.append(f"{tgt} = {tgt} .* {rest[0]};")
+            else:
+                out.append(f"{tgt} *= {f[1]};")
+        if k == 0 and sign == "-":
+            out.append(f"{dst} *= -1.;")
+        elif k > 0:
+            out.append(f"{dst} {sign}= {tgt};")
+
+
+def composite_statements(c):
+    """The state quantity c at the points into cqc<c>[] by array operations (was an interpolation of its formula:
+    ~0.1 ms each, now a few microseconds)."""
+    out = []
+    emit_sum(parse_composite(kin_macros[c + "F"]), "coefV", ["coefW", "coefX", "coefY"], out)
+    out.append(f"cqc{c}[] = coefV;")
+    return out
+
+
 def update_macro(name, cache, with_state):
     """COEFUPDATE (every field) or COEFUPDATEQ (the rotation coefficients only): the fields of P at the state u,
     unless u's angles (and, with_state, derivatives) are those of the last call (the cache P#cache)."""
@@ -183,13 +287,14 @@ def update_macro(name, cache, with_state):
         for d in derivs:
             upd.append(f"P#{d}[] = coefMap*cq{d}[];")
         for c in composites:
-            upd.append(f"cqc{c} = {c}F(cq); P#c{c}[] = coefMap*cqc{c}[];")
+            upd += composite_statements(c)
+            upd.append(f"P#c{c}[] = coefMap*cqc{c}[];")
     upd.append(f"P#{cache} = coefNow; }} }}")
     w(f"macro {name}(P, u) " + " ".join(upd) + " //")
 
 
 w("real[int] coefca(coefNq), coefsa(coefNq), coefcb(coefNq), coefsb(coefNq), coefcc(coefNq), coefsc(coefNq);")
-w("real[int] coefV(coefNq), coefW(coefNq);       // a coefficient's values at the points, a product")
+w("real[int] coefV(coefNq), coefW(coefNq), coefX(coefNq), coefY(coefNq);   // a coefficient's values at the points, products")
 update_macro("COEFUPDATE", "CoefLast", True)
 update_macro("COEFUPDATEQ", "CoefLastQ", False)
 w("")

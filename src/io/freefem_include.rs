@@ -102,6 +102,27 @@ fn write_quadrature(o: &mut String, case: &Case) {
     for (name, rule, what) in rules {
         let _ = writeln!(o, "macro {name} {} // {what}", rule_name(&rule));
     }
+    // One integral per rule (freefem/inverse_core.idp, forward.edp): IN1X(e) expands to e where integrand X has the
+    // 1-point rule, IN2X(e) where it has the 2-point rule, and to nothing otherwise; the Λκ term (K) is in neither
+    // when Λκ = 0.
+    let kappa_on = match &case.analysis {
+        Analysis::Inverse(inv) => inv.params.weights.lambda_kappa.iter().any(|&v| v != 0.0),
+        _ => false,
+    };
+    let groups = [
+        ("S", Some(scheme.stretch_shear())),
+        ("B", Some(scheme.bending())),
+        ("L", Some(scheme.loads())),
+        ("O", Some(scheme.objective())),
+        ("K", kappa_on.then(|| scheme.kappa())),
+    ];
+    for (tag, rule) in groups {
+        let points = rule.map_or(0, |r| r.points.len());
+        for n in 1..=2 {
+            let body = if points == n { "e" } else { "" };
+            let _ = writeln!(o, "macro IN{n}{tag}(e) {body} //");
+        }
+    }
     let _ = writeln!(
         o,
         "real certTol = {}; // tolerance of the residual certificate (docs/certificate.md)",
