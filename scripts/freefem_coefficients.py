@@ -39,6 +39,9 @@ names = list(formula)
 # state quantities of kinematics.idp (its macros NAME#F, in the order they depend on each other), evaluated
 # pointwise from the coefficients above and the state's derivatives DP(P, k)
 composites = [n + i for n in ("EPS", "NG", "XN", "KAP", "MG", "TMV", "TMR") for i in "123"]
+# the frozen operator's coefficients (S = Q^T K Q, symmetric; x' x S; Q^T J A), read by kinematics.idp's CU, XCU, EU, SW
+composites += ["SKQ" + i + j for i in "123" for j in "123" if i <= j]
+composites += [n + i + j for n in ("XSK", "QJA") for i in "123" for j in "123"]
 derivs = ["cD" + k for k in "123abg"]
 out = []
 w = out.append
@@ -172,7 +175,7 @@ def entry_ref(e):
 def parse_composite(text):
     """The formula of a state quantity (kinematics.idp's NAME#F(P) at P = cq) as a tree: ("sum", [(sign, product)]),
     a product a list of factors ("arr", array) / ("num", literal) / ("var", scalar) / ("sum", ...), left to right."""
-    toks = re.findall(r"dQp\((\d\d),P,P\)|Qp\((\d\d),P\)|Ap\((\d\d),P\)|DP\(P,(\w)\)|([A-Z]+\d)\(P\)|"
+    toks = re.findall(r"dQp\((\d\d),P,P\)|Qp\((\d\d),P\)|Ap\((\d\d),P\)|DP\(P,(\w)\)|([A-Z]+\d+)\(P\)|"
                       r"([A-Za-z_]\w*)|(\d+\.?\d*(?:e-?\d+)?)|([-+*()])|(\S)", text)
     items = []
     for dq, q, a, d, comp, ident, num, op, bad in toks:

@@ -288,12 +288,19 @@ fn cmd_run(
     let case = load(path)?;
     check_memory(&case, Footprint::Run, limits)?;
     let dir = out.unwrap_or_else(|| PathBuf::from("out").join(&case.name).join(engine.to_string()));
-    let pb = Progress::new(&format!("{} [{engine}]", case.name), cli::outcome::progress_unit(&case, engine), 0, quiet);
+    // FreeFEM's frames (a clip) or time steps (a dynamic case) as the script writes them; its other
+    // runs show the time elapsed
+    let counted = engine == Engine::Freefem
+        && (case.clip().is_some() || matches!(case.analysis, cosserat::case::Analysis::Dynamic(_)));
+    let label = format!("{} [{engine}]", case.name);
+    let pb = Progress::new(&label, cli::outcome::progress_unit(&case, engine), 0, quiet || counted);
+    let freefem = (counted && !quiet).then(|| FreefemProgress::start(&label));
     if engine == Engine::Freefem && !quiet {
         eprintln!("{} [freefem]: running FreeFEM in a staging folder beside {}", case.name, dir.display());
     }
-    let end = run_into(&case, engine, &dir, mode, |done, total| pb.set(done, total))
-        .with_context(|| format!("{}: output folder {}", case_label(&case), dir.display()))?;
+    let end = run_into(&case, engine, &dir, mode, |done, total| pb.set(done, total));
+    drop(freefem);
+    let end = end.with_context(|| format!("{}: output folder {}", case_label(&case), dir.display()))?;
     pb.finish();
     for n in &end.notes {
         eprintln!("note: {n}");

@@ -286,6 +286,36 @@ fn progress_without_a_terminal_is_a_line_every_interval_and_a_final_line() {
     assert!(quiet.status.success() && quiet.stderr.is_empty(), "{}", String::from_utf8_lossy(&quiet.stderr));
 }
 
+/// `run --engine freefem` shows FreeFEM's frames as the script writes them: without a terminal, a
+/// line every interval and a final line with the count.
+#[test]
+fn a_freefem_clip_run_shows_its_frames() {
+    if !std::path::Path::new("data/elegansbot/kymogram_delta-turn.npy").is_file() {
+        return;
+    }
+    let dir = tempfile::tempdir().expect("tempdir");
+    // the delta-turn clip cut to frames 0-2 (the case file's clip path is relative to it)
+    let case = std::fs::read_to_string("cases/worm_delta_turn_ld1.toml").expect("case");
+    let root = std::env::current_dir().expect("cwd");
+    let data = root.join("data/elegansbot/kymogram_delta-turn.npy");
+    let case = case
+        .replace("\"../data/elegansbot/kymogram_delta-turn.npy\"", &format!("{:?}", data.display().to_string()))
+        .replace("frame_interval_s = \"1/32\"", "frame_interval_s = \"1/32\"\nframes = [0, 3]");
+    let path = dir.path().join("three_frames.toml");
+    std::fs::write(&path, case).expect("write case");
+    let out = cosserat()
+        .env("COSSERAT_PROGRESS_INTERVAL_S", "0.1")
+        .args(["run", "--engine", "freefem", "--out"])
+        .arg(dir.path().join("ff"))
+        .arg(&path)
+        .output()
+        .expect("run");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    let lines: Vec<&str> = stderr.lines().filter(|l| l.starts_with("three_frames [freefem]: ")).collect();
+    assert!(lines.last().is_some_and(|l| l.contains("3/3 frames in ")), "{stderr}");
+}
+
 /// The flags of a piece of README text: `--name` at the start of a word (after `[` or `(`),
 /// up to `=` or the first character that cannot be in a flag's name.
 fn flags_in(text: &str) -> Vec<String> {

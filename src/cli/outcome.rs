@@ -75,7 +75,8 @@ pub fn audit_points_kept(dir: &Path, total: usize) -> String {
 }
 
 /// What the progress of a run of `case` in `engine` counts: clip frames, time steps or
-/// iterations ("" for FreeFEM, which reports no progress: the time elapsed is shown).
+/// iterations ("" for FreeFEM: its clip frames and time steps are shown by `FreefemProgress`, its
+/// other runs the time elapsed).
 pub fn progress_unit(case: &Case, engine: Engine) -> &'static str {
     use cosserat::case::Analysis;
     match (&case.analysis, engine) {
