@@ -42,6 +42,10 @@ composites = [n + i for n in ("EPS", "NG", "XN", "KAP", "MG", "TMV", "TMR") for 
 # the frozen operator's coefficients (S = Q^T K Q, symmetric; x' x S; Q^T J A), read by kinematics.idp's CU, XCU, EU, SW
 composites += ["SKQ" + i + j for i in "123" for j in "123" if i <= j]
 composites += [n + i + j for n in ("XSK", "QJA") for i in "123" for j in "123"]
+# the derivative coefficients of the forward tangent (kinematics.idp's dNGC, dXNC, dMGC), per angle direction
+composites += [n + k + i for n in ("WQ", "ND", "XND", "WA", "MD") for k in "ABG" for i in "123"]
+# rotation-only quantities (Q^T I A, read by the angular momentum HG): computed by COEFUPDATEQ too
+rot_composites = ["QIA" + i + j for i in "123" for j in "123"]
 derivs = ["cD" + k for k in "123abg"]
 out = []
 w = out.append
@@ -136,7 +140,7 @@ w("  for (int c = 0; c < 6; c++) coefD[c] = coefDeriv(nc, c);")
 w("  return 0;")
 w("}")
 w("")
-allf = names + derivs + ["c" + c for c in composites]
+allf = names + derivs + ["c" + c for c in rot_composites + composites]
 w("Vq " + ", ".join("cq" + n for n in allf) + ";   // the container's values (prefix cq)")
 decl = ", ".join("P#" + n for n in allf)
 w(f"macro COEFDECL(P) Ch {decl}; real[int] P#CoefLast(9*coefNq), P#CoefLastQ(3*coefNq); P#CoefLast = 1e300; P#CoefLastQ = 1e300; //")
@@ -175,12 +179,15 @@ def entry_ref(e):
 def parse_composite(text):
     """The formula of a state quantity (kinematics.idp's NAME#F(P) at P = cq) as a tree: ("sum", [(sign, product)]),
     a product a list of factors ("arr", array) / ("num", literal) / ("var", scalar) / ("sum", ...), left to right."""
-    toks = re.findall(r"dQp\((\d\d),P,P\)|Qp\((\d\d),P\)|Ap\((\d\d),P\)|DP\(P,(\w)\)|([A-Z]+\d+)\(P\)|"
+    toks = re.findall(r"C(QA|QB|QG|AA|AB|AG|Q|A)(\d\d)\(P\)|dQp\((\d\d),P,P\)|Qp\((\d\d),P\)|Ap\((\d\d),P\)|"
+                      r"DP\(P,(\w)\)|([A-Z]+\d+)\(P\)|"
                       r"([A-Za-z_]\w*)|(\d+\.?\d*(?:e-?\d+)?)|([-+*()])|(\S)", text)
     items = []
-    for dq, q, a, d, comp, ident, num, op, bad in toks:
+    for fam, fij, dq, q, a, d, comp, ident, num, op, bad in toks:
         assert not bad, (text, bad)
-        if dq:
+        if fam:
+            items.append(entry_ref(fam + fij))
+        elif dq:
             ab = [(("+", [entry_ref("Q" + x + dq), ("arr", f"cq{v}[]")])) for x, v in (("A", "a"), ("B", "b"), ("G", "g"))]
             items.append(("sum", ab))
         elif q:
@@ -231,10 +238,19 @@ def parse_composite(text):
     return tree
 
 
+def is_zero(factor):
+    return factor[0] == "num" and float(factor[1]) == 0.0
+
+
 def emit_sum(tree, dst, temps, out):
     """Array statements that evaluate a sum of products into dst, in FreeFEM's order of evaluation (left to right,
-    the same bits as the expression at each point); temps: free scratch arrays for parenthesised sums."""
-    for k, (sign, prod) in enumerate(tree[1]):
+    the same bits as the expression at each point, up to the sign of a zero); temps: free scratch arrays for
+    parenthesised sums. A product with a literal zero factor (a constant rotation entry 0) is left out."""
+    terms = [(sign, prod) for sign, prod in tree[1] if not any(is_zero(f) for f in prod)]
+    if not terms:
+        out.append(f"{dst} = 0.;")
+        return
+    for k, (sign, prod) in enumerate(terms):
         tgt = dst if k == 0 else temps[0]
         rest = temps if k == 0 else temps[1:]
         first = prod[0]
@@ -286,6 +302,9 @@ def update_macro(name, cache, with_state):
     for n in names:
         upd += trig_statements(macros[formula[n]], "coefV")
         upd.append(f"cq{n}[] = coefV; P#{n}[] = coefMap*coefV;")
+    for c in rot_composites:
+        upd += composite_statements(c)
+        upd.append(f"P#c{c}[] = coefMap*cqc{c}[];")
     if with_state:
         for d in derivs:
             upd.append(f"P#{d}[] = coefMap*cq{d}[];")
@@ -303,7 +322,7 @@ update_macro("COEFUPDATEQ", "CoefLastQ", False)
 w("")
 w("// the coefficient entries and state quantities read by kinematics.idp (a field of P, or a constant)")
 w("macro DP(P,k) P#cD#k //                      // d_s of the state's unknown k = 1, 2, 3, a, b, g")
-for c in composites:
+for c in rot_composites + composites:
     w(f"macro {c}(P) P#c{c} //")
 for e in entries:
     if e in const:
