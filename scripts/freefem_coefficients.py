@@ -44,6 +44,8 @@ composites += ["SKQ" + i + j for i in "123" for j in "123" if i <= j]
 composites += [n + i + j for n in ("XSK", "QJA") for i in "123" for j in "123"]
 # the derivative coefficients of the forward tangent (kinematics.idp's dNGC, dXNC, dMGC), per angle direction
 composites += [n + k + i for n in ("WQ", "ND", "XND", "WA", "MD") for k in "ABG" for i in "123"]
+# read only by the quantities after them (their values at the points, no field)
+intermediates = {n + k + i for n in ("WQ", "WA") for k in "ABG" for i in "123"}
 # rotation-only quantities (Q^T I A, read by the angular momentum HG): computed by COEFUPDATEQ too
 rot_composites = ["QIA" + i + j for i in "123" for j in "123"]
 derivs = ["cD" + k for k in "123abg"]
@@ -254,13 +256,18 @@ def emit_sum(tree, dst, temps, out):
         tgt = dst if k == 0 else temps[0]
         rest = temps if k == 0 else temps[1:]
         first = prod[0]
+        more = prod[1:]
         if first[0] == "sum":
             emit_sum(first, tgt, rest, out)
-        elif first[0] == "arr":
-            out.append(f"{tgt} = {first[1]};")
+        elif first[0] == "arr" and more and more[0][0] == "arr":
+            out.append(f"{tgt} = {first[1]} .* {more[0][1]};")
+            more = more[1:]
+        elif first[0] == "arr" and more and more[0][0] in ("var", "num"):
+            out.append(f"{tgt} = {first[1]} * {more[0][1]};")
+            more = more[1:]
         else:
             out.append(f"{tgt} = {first[1]};")
-        for f in prod[1:]:
+        for f in more:
             if f[0] == "arr":
                 out.append(f"{tgt} = {tgt} .* {f[1]};")
             elif f[0] == "sum":
@@ -278,8 +285,7 @@ def composite_statements(c):
     """The state quantity c at the points into cqc<c>[] by array operations (was an interpolation of its formula:
     ~0.1 ms each, now a few microseconds)."""
     out = []
-    emit_sum(parse_composite(kin_macros[c + "F"]), "coefV", ["coefW", "coefX", "coefY"], out)
-    out.append(f"cqc{c}[] = coefV;")
+    emit_sum(parse_composite(kin_macros[c + "F"]), f"cqc{c}[]", ["coefW", "coefX", "coefY"], out)
     return out
 
 
@@ -310,7 +316,8 @@ def update_macro(name, cache, with_state):
             upd.append(f"P#{d}[] = coefMap*cq{d}[];")
         for c in composites:
             upd += composite_statements(c)
-            upd.append(f"P#c{c}[] = coefMap*cqc{c}[];")
+            if c not in intermediates:
+                upd.append(f"P#c{c}[] = coefMap*cqc{c}[];")
     upd.append(f"P#{cache} = coefNow; }} }}")
     w(f"macro {name}(P, u) " + " ".join(upd) + " //")
 
