@@ -7,10 +7,12 @@ fields; the weak forms then read a field instead of re-evaluating the trigonomet
 every term of every varf (docs/results.md, "FreeFEM engine speed"). Constant entries stay literal
 constants, and entries with the same formula share one field.
 
-Run after any change of rotation.idp:  python3 scripts/freefem_coefficients.py
+Run after any change of rotation.idp or of the state quantities of kinematics.idp (the NAME#F formulas):
+    python3 scripts/freefem_coefficients.py           (--check: only compare, exit 1 if the file differs)
 """
 import pathlib
 import re
+import sys
 
 root = pathlib.Path(__file__).resolve().parent.parent
 rot = (root / "freefem" / "rotation.idp").read_text()
@@ -48,6 +50,10 @@ composites += [n + k + i for n in ("WQ", "ND", "XND", "WA", "MD") for k in "ABG"
 intermediates = {n + k + i for n in ("WQ", "WA") for k in "ABG" for i in "123"}
 # rotation-only quantities (Q^T I A, read by the angular momentum HG): computed by COEFUPDATEQ too
 rot_composites = ["QIA" + i + j for i in "123" for j in "123"]
+# the angular momentum's derivative at a velocity (MOMUPDATE); OMV and WV are intermediates
+vel_composites = ["OMV" + i for i in "123"] + ["WV" + k + i for k in "ABG" for i in "123"]
+vel_composites += ["HD" + k + i for k in "ABG" for i in "123"]
+intermediates |= {c for c in vel_composites if not c.startswith("HD")}
 derivs = ["cD" + k for k in "123abg"]
 out = []
 w = out.append
@@ -142,10 +148,12 @@ w("  for (int c = 0; c < 6; c++) coefD[c] = coefDeriv(nc, c);")
 w("  return 0;")
 w("}")
 w("")
-allf = names + derivs + ["c" + c for c in rot_composites + composites]
+allf = names + derivs + ["c" + c for c in rot_composites + composites + vel_composites]
 w("Vq " + ", ".join("cq" + n for n in allf) + ";   // the container's values (prefix cq)")
 decl = ", ".join("P#" + n for n in allf)
-w(f"macro COEFDECL(P) Ch {decl}; real[int] P#CoefLast(9*coefNq), P#CoefLastQ(3*coefNq); P#CoefLast = 1e300; P#CoefLastQ = 1e300; //")
+w(f"macro COEFDECL(P) Ch {decl}; real[int] P#CoefLast(9*coefNq), P#CoefLastQ(3*coefNq), P#CoefLastV(6*coefNq); "
+  "P#CoefLast = 1e300; P#CoefLastQ = 1e300; P#CoefLastV = 1e300; //")
+w("Vq cqVa, cqVb, cqVg;                          // MOMUPDATE's velocity: the angle rates at the points")
 
 
 def trig_statements(body, dst):
@@ -182,10 +190,10 @@ def parse_composite(text):
     """The formula of a state quantity (kinematics.idp's NAME#F(P) at P = cq) as a tree: ("sum", [(sign, product)]),
     a product a list of factors ("arr", array) / ("num", literal) / ("var", scalar) / ("sum", ...), left to right."""
     toks = re.findall(r"C(QA|QB|QG|AA|AB|AG|Q|A)(\d\d)\(P\)|dQp\((\d\d),P,P\)|Qp\((\d\d),P\)|Ap\((\d\d),P\)|"
-                      r"DP\(P,(\w)\)|([A-Z]+\d+)\(P\)|"
+                      r"DP\(P,(\w)\)|VV\(P,(\w)\)|([A-Z]+\d+)\(P\)|"
                       r"([A-Za-z_]\w*)|(\d+\.?\d*(?:e-?\d+)?)|([-+*()])|(\S)", text)
     items = []
-    for fam, fij, dq, q, a, d, comp, ident, num, op, bad in toks:
+    for fam, fij, dq, q, a, d, vv, comp, ident, num, op, bad in toks:
         assert not bad, (text, bad)
         if fam:
             items.append(entry_ref(fam + fij))
@@ -198,6 +206,8 @@ def parse_composite(text):
             items.append(entry_ref("A" + a))
         elif d:
             items.append(("arr", f"cqcD{d}[]"))
+        elif vv:
+            items.append(("arr", f"cqV{vv}[]"))
         elif comp:
             items.append(("arr", f"cqc{comp}[]"))
         elif ident:
@@ -289,11 +299,16 @@ def composite_statements(c):
     return out
 
 
-def update_macro(name, cache, with_state):
-    """COEFUPDATE (every field) or COEFUPDATEQ (the rotation coefficients only): the fields of P at the state u,
-    unless u's angles (and, with_state, derivatives) are those of the last call (the cache P#cache)."""
+def update_macro(name, cache, with_state, with_velocity=False):
+    """COEFUPDATE (every field), COEFUPDATEQ (the rotation coefficients only) or MOMUPDATE (the rotation
+    coefficients and the angular momentum's derivative at the velocity v): the fields of P at the state u,
+    unless u's angles (and, with_state, derivatives; with_velocity, v's angle rates) are those of the last call
+    (the cache P#cache; MOMUPDATE also sets COEFUPDATEQ's)."""
     upd = ["{ cqa[] = coefIa*u; cqb[] = coefIb*u; cqg[] = coefIg*u;"]
     nows = ["cqa", "cqb", "cqg"]
+    if with_velocity:
+        upd.append("cqVa[] = coefIa*v; cqVb[] = coefIb*v; cqVg[] = coefIg*v;")
+        nows += ["cqVa", "cqVb", "cqVg"]
     if with_state:
         for c, k in enumerate("123abg"):
             upd.append(f"cqcD{k}[] = coefD[{c}]*u;")
@@ -318,23 +333,39 @@ def update_macro(name, cache, with_state):
             upd += composite_statements(c)
             if c not in intermediates:
                 upd.append(f"P#c{c}[] = coefMap*cqc{c}[];")
+    if with_velocity:
+        for c in vel_composites:
+            upd += composite_statements(c)
+            if c not in intermediates:
+                upd.append(f"P#c{c}[] = coefMap*cqc{c}[];")
+        upd.append("P#CoefLastQ = coefNow(0:3*coefNq - 1);")
     upd.append(f"P#{cache} = coefNow; }} }}")
-    w(f"macro {name}(P, u) " + " ".join(upd) + " //")
+    args = "P, u, v" if with_velocity else "P, u"
+    w(f"macro {name}({args}) " + " ".join(upd) + " //")
 
 
 w("real[int] coefca(coefNq), coefsa(coefNq), coefcb(coefNq), coefsb(coefNq), coefcc(coefNq), coefsc(coefNq);")
 w("real[int] coefV(coefNq), coefW(coefNq), coefX(coefNq), coefY(coefNq);   // a coefficient's values at the points, products")
 update_macro("COEFUPDATE", "CoefLast", True)
 update_macro("COEFUPDATEQ", "CoefLastQ", False)
+update_macro("MOMUPDATE", "CoefLastV", False, with_velocity=True)
 w("")
 w("// the coefficient entries and state quantities read by kinematics.idp (a field of P, or a constant)")
 w("macro DP(P,k) P#cD#k //                      // d_s of the state's unknown k = 1, 2, 3, a, b, g")
-for c in rot_composites + composites:
+for c in rot_composites + composites + vel_composites:
     w(f"macro {c}(P) P#c{c} //")
 for e in entries:
     if e in const:
         w(f"macro C{e}(P) {const[e]} //")
     else:
         w(f"macro C{e}(P) P#{field[e]} //")
-(root / "freefem" / "coefficients.idp").write_text("\n".join(out) + "\n")
-print(f"{len(names)} fields, {len(const)} constants")
+target = root / "freefem" / "coefficients.idp"
+text = "\n".join(out) + "\n"
+if "--check" in sys.argv[1:]:
+    # tests/mutation.rs: the committed file is what this script writes from rotation.idp and kinematics.idp
+    if target.read_text() != text:
+        sys.exit("freefem/coefficients.idp is not what scripts/freefem_coefficients.py writes: run it again")
+    print("freefem/coefficients.idp is up to date")
+else:
+    target.write_text(text)
+    print(f"{len(names)} fields, {len(const)} constants")

@@ -44,11 +44,13 @@ const MUTATIONS: &[Mutation] = &[
         horizon: Horizon::Full,
         rows: &["nodewise_rel_diff_displacement", "tip_y_m"],
     },
+    // kinematics.idp's XN3F as scripts/freefem_coefficients.py writes it into coefficients.idp
+    // (array statements; the script FreeFEM runs)
     Mutation {
         what: "forward: the third component of d_s x cross n (eq. 35) with the wrong sign",
-        file: "kinematics.idp",
-        from: "macro XN3F(P) (DP(P,1)*NG2(P) - DP(P,2)*NG1(P)) //",
-        to: "macro XN3F(P) (DP(P,1)*NG2(P) + DP(P,2)*NG1(P)) //",
+        file: "coefficients.idp",
+        from: "cqcXN3[] = cqcD1[] .* cqcNG2[]; coefW = cqcD2[] .* cqcNG1[]; cqcXN3[] -= coefW;",
+        to: "cqcXN3[] = cqcD1[] .* cqcNG2[]; coefW = cqcD2[] .* cqcNG1[]; cqcXN3[] += coefW;",
         case: "follower_bend_twist_65",
         horizon: Horizon::Full,
         rows: &["nodewise_rel_diff_displacement"],
@@ -104,4 +106,17 @@ fn broken_freefem_scripts_make_compare_fail() {
         }
     }
     assert!(survived.is_empty(), "mutations the comparison did not catch: {survived:#?}");
+}
+
+/// The generated `coefficients.idp` (the state quantities of `kinematics.idp` as array
+/// statements) is what its generator writes from the committed formulas: a formula changed
+/// without running the generator would not reach FreeFEM.
+#[test]
+fn the_generated_coefficients_are_up_to_date() {
+    let out = std::process::Command::new("python3")
+        .arg("scripts/freefem_coefficients.py")
+        .arg("--check")
+        .output()
+        .expect("python3");
+    assert!(out.status.success(), "{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
 }
