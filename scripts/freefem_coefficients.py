@@ -45,7 +45,7 @@ composites = [n + i for n in ("EPS", "NG", "XN", "KAP", "MG", "TMV", "TMR") for 
 composites += ["SKQ" + i + j for i in "123" for j in "123" if i <= j]
 composites += [n + i + j for n in ("XSK", "QJA") for i in "123" for j in "123"]
 # the derivative coefficients of the forward tangent (kinematics.idp's dNGC, dXNC, dMGC), per angle direction
-composites += [n + k + i for n in ("WQ", "ND", "XND", "WA", "MD") for k in "ABG" for i in "123"]
+tangent_composites = [n + k + i for n in ("WQ", "ND", "XND", "WA", "MD") for k in "ABG" for i in "123"]
 # read only by the quantities after them (their values at the points, no field)
 intermediates = {n + k + i for n in ("WQ", "WA") for k in "ABG" for i in "123"}
 # rotation-only quantities (Q^T I A, read by the angular momentum HG): computed by COEFUPDATEQ too
@@ -148,11 +148,11 @@ w("  for (int c = 0; c < 6; c++) coefD[c] = coefDeriv(nc, c);")
 w("  return 0;")
 w("}")
 w("")
-allf = names + derivs + ["c" + c for c in rot_composites + composites + vel_composites]
+allf = names + derivs + ["c" + c for c in rot_composites + composites + tangent_composites + vel_composites]
 w("Vq " + ", ".join("cq" + n for n in allf) + ";   // the container's values (prefix cq)")
 decl = ", ".join("P#" + n for n in allf)
 w(f"macro COEFDECL(P) Ch {decl}; real[int] P#CoefLast(9*coefNq), P#CoefLastQ(3*coefNq), P#CoefLastV(6*coefNq); "
-  "P#CoefLast = 1e300; P#CoefLastQ = 1e300; P#CoefLastV = 1e300; //")
+  "P#CoefLast = 1e300; P#CoefLastQ = 1e300; P#CoefLastV = 1e300; real[int] P#CoefLastT(9*coefNq); P#CoefLastT = 1e300; //")
 w("Vq cqVa, cqVb, cqVg;                          // MOMUPDATE's velocity: the angle rates at the points")
 
 
@@ -299,6 +299,52 @@ def composite_statements(c):
     return out
 
 
+def base_statements():
+    """The rotation coefficients, the derivatives and the state quantities at the points into the container and
+    the fields of P (COEFUPDATE's work when the state changed)."""
+    upd = []
+    for x, v in (("a", "a"), ("b", "b"), ("c", "g")):
+        upd.append(f"coefc{x} = cos(cq{v}[]); coefs{x} = sin(cq{v}[]);")
+    for n in names:
+        upd += trig_statements(macros[formula[n]], "coefV")
+        upd.append(f"cq{n}[] = coefV; P#{n}[] = coefMap*coefV;")
+    for c in rot_composites:
+        upd += composite_statements(c)
+        upd.append(f"P#c{c}[] = coefMap*cqc{c}[];")
+    for d in derivs:
+        upd.append(f"P#{d}[] = coefMap*cq{d}[];")
+    for c in composites:
+        upd += composite_statements(c)
+        if c not in intermediates:
+            upd.append(f"P#c{c}[] = coefMap*cqc{c}[];")
+    return upd
+
+
+def tangent_macro():
+    """COEFUPDATET(P, u): COEFUPDATE's fields and the tangent's derivative coefficients (tangent_composites). When
+    P's state quantities are up to date and the container holds the values of this state (coefCqNow: the key of
+    the last COEFUPDATE that computed), only the derivative coefficients are computed."""
+    upd = ["{ cqa[] = coefIa*u; cqb[] = coefIb*u; cqg[] = coefIg*u;"]
+    nows = ["cqa", "cqb", "cqg"] + ["cqcD" + k for k in "123abg"]
+    for c, k in enumerate("123abg"):
+        upd.append(f"cqcD{k}[] = coefD[{c}]*u;")
+    upd.append(f"real[int] coefNow({len(nows)}*coefNq);")
+    for c, v in enumerate(nows):
+        upd.append(f"coefNow({c}*coefNq:{c + 1}*coefNq - 1) = {v}[];")
+    upd.append("real[int] coefDiff = coefNow - P#CoefLastT;")
+    upd.append("if (!(coefDiff.linfty == 0.)) {")
+    upd.append("real[int] coefDiffB = coefNow - P#CoefLast; real[int] coefDiffC = coefNow - coefCqNow;")
+    upd.append("if (!(coefDiffB.linfty == 0. && coefDiffC.linfty == 0.)) {")
+    upd += base_statements()
+    upd.append("P#CoefLast = coefNow; coefCqNow = coefNow; }")
+    for c in tangent_composites:
+        upd += composite_statements(c)
+        if c not in intermediates:
+            upd.append(f"P#c{c}[] = coefMap*cqc{c}[];")
+    upd.append("P#CoefLastT = coefNow; } }")
+    w("macro COEFUPDATET(P, u) " + " ".join(upd) + " //")
+
+
 def update_macro(name, cache, with_state, with_velocity=False):
     """COEFUPDATE (every field), COEFUPDATEQ (the rotation coefficients only) or MOMUPDATE (the rotation
     coefficients and the angular momentum's derivative at the velocity v): the fields of P at the state u,
@@ -318,21 +364,19 @@ def update_macro(name, cache, with_state, with_velocity=False):
         upd.append(f"coefNow({c}*coefNq:{c + 1}*coefNq - 1) = {v}[];")
     upd.append(f"real[int] coefDiff = coefNow - P#{cache};")
     upd.append("if (!(coefDiff.linfty == 0.)) {")
-    for x, v in (("a", "a"), ("b", "b"), ("c", "g")):
-        upd.append(f"coefc{x} = cos(cq{v}[]); coefs{x} = sin(cq{v}[]);")
-    for n in names:
-        upd += trig_statements(macros[formula[n]], "coefV")
-        upd.append(f"cq{n}[] = coefV; P#{n}[] = coefMap*coefV;")
-    for c in rot_composites:
-        upd += composite_statements(c)
-        upd.append(f"P#c{c}[] = coefMap*cqc{c}[];")
     if with_state:
-        for d in derivs:
-            upd.append(f"P#{d}[] = coefMap*cq{d}[];")
-        for c in composites:
+        upd += base_statements()
+        upd.append("coefCqNow = coefNow;")
+    else:
+        for x, v in (("a", "a"), ("b", "b"), ("c", "g")):
+            upd.append(f"coefc{x} = cos(cq{v}[]); coefs{x} = sin(cq{v}[]);")
+        for n in names:
+            upd += trig_statements(macros[formula[n]], "coefV")
+            upd.append(f"cq{n}[] = coefV; P#{n}[] = coefMap*coefV;")
+        for c in rot_composites:
             upd += composite_statements(c)
-            if c not in intermediates:
-                upd.append(f"P#c{c}[] = coefMap*cqc{c}[];")
+            upd.append(f"P#c{c}[] = coefMap*cqc{c}[];")
+        upd.append("coefCqNow = 1e300;")      # the container's rotation values are no longer a full state's
     if with_velocity:
         for c in vel_composites:
             upd += composite_statements(c)
@@ -346,13 +390,16 @@ def update_macro(name, cache, with_state, with_velocity=False):
 
 w("real[int] coefca(coefNq), coefsa(coefNq), coefcb(coefNq), coefsb(coefNq), coefcc(coefNq), coefsc(coefNq);")
 w("real[int] coefV(coefNq), coefW(coefNq), coefX(coefNq), coefY(coefNq);   // a coefficient's values at the points, products")
+w("real[int] coefCqNow(9*coefNq);               // the state key whose values the container holds (1e300: none)")
+w("coefCqNow = 1e300;")
 update_macro("COEFUPDATE", "CoefLast", True)
+tangent_macro()
 update_macro("COEFUPDATEQ", "CoefLastQ", False)
 update_macro("MOMUPDATE", "CoefLastV", False, with_velocity=True)
 w("")
 w("// the coefficient entries and state quantities read by kinematics.idp (a field of P, or a constant)")
 w("macro DP(P,k) P#cD#k //                      // d_s of the state's unknown k = 1, 2, 3, a, b, g")
-for c in rot_composites + composites + vel_composites:
+for c in rot_composites + composites + tangent_composites + vel_composites:
     w(f"macro {c}(P) P#c{c} //")
 for e in entries:
     if e in const:
