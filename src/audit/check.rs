@@ -183,8 +183,8 @@ fn evaluate_inner(check: &Check, runs: &[RunResults]) -> Result<(Outcome, String
     match check {
         Check::Converges { run } => converges(runs, run, false),
         Check::DoesNotConverge { run } => converges(runs, run, true),
-        Check::Below { run, metric, limit, at } => threshold(runs, run, metric, *limit, at, true),
-        Check::Above { run, metric, limit, at } => threshold(runs, run, metric, *limit, at, false),
+        Check::Below { run, metric, limit, at, with } => threshold(runs, (run, with), metric, *limit, at, true),
+        Check::Above { run, metric, limit, at, with } => threshold(runs, (run, with), metric, *limit, at, false),
         Check::Increasing { run, metric } => increasing(runs, run, metric),
         Check::RatioAbove { metric, numerator, denominator, limit } => {
             ratio(runs, metric, numerator, denominator, *limit, true)
@@ -192,7 +192,19 @@ fn evaluate_inner(check: &Check, runs: &[RunResults]) -> Result<(Outcome, String
         Check::RatioBelow { metric, numerator, denominator, limit } => {
             ratio(runs, metric, numerator, denominator, *limit, false)
         }
-        Check::WithinFactor { run, metric, factor, with } => within_factor(runs, run, metric, *factor, with),
+        Check::WithinFactor { run, metric, factor, with, also } => {
+            let mut worst = within_factor(runs, run, metric, *factor, with)?;
+            for m in also {
+                let (o, text) = within_factor(runs, run, m, *factor, with)?;
+                worst.1.push_str(&format!("; {text}"));
+                worst.0 = match (worst.0, o) {
+                    (Outcome::Fails, _) | (_, Outcome::Fails) => Outcome::Fails,
+                    (Outcome::Partly, _) | (_, Outcome::Partly) => Outcome::Partly,
+                    _ => Outcome::Holds,
+                };
+            }
+            Ok(worst)
+        }
         Check::Magnitude { run, metric, value, orders, at } => magnitude(runs, run, metric, *value, *orders, at),
         Check::SameHistories { run, history, reference, limit } => {
             same_histories(runs, run, history, reference, *limit)
@@ -231,20 +243,26 @@ fn converges(runs: &[RunResults], run: &str, fails: bool) -> Result<(Outcome, St
     }
 }
 
-/// `below` (or `above`): `metric ≤ limit` (`≥`) at every selected point.
+/// `below` (or `above`): `metric ≤ limit` (`≥`) at every selected point of `run` and every
+/// point of the runs `with`.
 fn threshold(
     runs: &[RunResults],
-    run: &str,
+    (run, with): (&str, &[String]),
     metric: &str,
     limit: f64,
     at: &Selector,
     below: bool,
 ) -> Result<(Outcome, String), CheckError> {
-    let pts = select(runs, run, at)?;
+    let mut pts = select(runs, run, at)?;
+    let mut list = metric_list(&pts, metric);
+    for w in with {
+        let more = select(runs, w, &Selector::new())?;
+        list.push_str(&format!("; {w}: {}", metric_list(&more, metric)));
+        pts.extend(more);
+    }
     let pass = |p: &PointResult| p.metric(metric).is_some_and(|v| if below { v <= limit } else { v >= limit });
     let (ok, _) = split_by(&pts, pass);
     let rel = if below { "≤" } else { "≥" };
-    let list = metric_list(&pts, metric);
     Ok((outcome(ok.len(), pts.len()), format!("{metric} {list} (claim: {rel} {})", sig2(limit))))
 }
 
@@ -330,10 +348,11 @@ fn within_factor(
     let text = format!(
         "{metric} at {at}: {} (max/min of the magnitudes 1 + {}; claim: ≤ 1 + {})",
         pts.iter().map(|p| metric_text(p, metric)).collect::<Vec<_>>().join(", "),
-        sig2(hi / lo - 1.0),
+        if hi == 0.0 { "0".to_string() } else { sig2(hi / lo - 1.0) },
         sig2(factor - 1.0)
     );
-    let o = if hi <= lo * factor {
+    // every value 0 (a term whose weight is 0): the same everywhere
+    let o = if hi <= lo * factor || hi == 0.0 {
         Outcome::Holds
     } else if best > 1 {
         Outcome::Partly
