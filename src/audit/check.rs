@@ -83,7 +83,7 @@ fn failure(p: &PointResult) -> String {
         _ => {
             // the innermost cause: after the last ": " of the error chain
             let short = e.rsplit(": ").take(2).collect::<Vec<_>>().into_iter().rev().collect::<Vec<_>>().join(": ");
-            let mut short = short.replace('\n', " ");
+            let mut short = round_numbers(&short.replace('\n', " "));
             if short.len() > 140 {
                 let cut = (0..=140).rev().find(|&i| short.is_char_boundary(i)).unwrap_or(0);
                 short.truncate(cut);
@@ -92,6 +92,25 @@ fn failure(p: &PointResult) -> String {
             format!("failed: {short}")
         }
     }
+}
+
+/// `text` with every number of more than two significant digits written as [`sig2`] (an
+/// error's `9.378712387458614e-8` is `9.4e-8`), so that the report's text changes only when a
+/// result does.
+fn round_numbers(text: &str) -> String {
+    text.split(' ')
+        .map(|word| {
+            let end = word.trim_end_matches([',', ';', ')', ':']);
+            let start = end.trim_start_matches('(');
+            match start.parse::<f64>() {
+                Ok(x) if start.contains('.') && start.len() > 6 => {
+                    format!("{}{}{}", &end[..end.len() - start.len()], sig2(x), &word[end.len()..])
+                }
+                _ => word.to_string(),
+            }
+        })
+        .collect::<Vec<_>>()
+        .join(" ")
 }
 
 fn metric_text(p: &PointResult, metric: &str) -> String {
@@ -534,7 +553,7 @@ pub fn judge(spec: &Spec, claim: &Claim, runs: &[RunResults]) -> ClaimResult {
 
 #[cfg(test)]
 mod tests {
-    use super::sig2;
+    use super::{round_numbers, sig2};
 
     #[test]
     fn two_significant_digits() {
@@ -545,5 +564,15 @@ mod tests {
         assert_eq!(sig2(12.4), "12");
         assert_eq!(sig2(2.5e6), "2.5e6");
         assert_eq!(sig2(-0.0025), "-2.5e-3");
+    }
+
+    #[test]
+    fn long_numbers_of_an_error_are_rounded() {
+        assert_eq!(
+            round_numbers(
+                "change (x, α) is 9.378712387458614e-8, but 1e-10 (after 3000 iterations: 1.0245671838684249e-1)"
+            ),
+            "change (x, α) is 9.4e-8, but 1e-10 (after 3000 iterations: 0.10)"
+        );
     }
 }
