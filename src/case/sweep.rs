@@ -225,7 +225,8 @@ impl Case {
             }
             // `solver.method = "fixed_point"` over a Newton case: its warm start (used by Newton
             // only, and refused with the fixed point) goes with it, unless set here too.
-            let to_fixed_point = overrides.iter().any(|(k, v)| k == "solver.method" && v.as_str() == Some("fixed_point"));
+            let to_fixed_point =
+                overrides.iter().any(|(k, v)| k == "solver.method" && v.as_str() == Some("fixed_point"));
             if to_fixed_point && !overrides.iter().any(|(k, _)| k == "solver.warm_start_tolerance") {
                 if let Some(s) = table.get_mut("solver").and_then(|s| s.as_table_mut()) {
                     s.remove("warm_start_tolerance");
