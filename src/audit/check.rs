@@ -201,7 +201,19 @@ fn iterations_range(pts: &[&PointResult], metric: &str) -> String {
 fn evaluate_inner(check: &Check, runs: &[RunResults]) -> Result<(Outcome, String), CheckError> {
     match check {
         Check::Converges { run } => converges(runs, run, false),
-        Check::DoesNotConverge { run } => converges(runs, run, true),
+        Check::DoesNotConverge { run, with } => {
+            let mut all = converges(runs, run, true)?;
+            for w in with {
+                let (o, text) = converges(runs, w, true)?;
+                all.1.push_str(&format!("; {w}: {text}"));
+                all.0 = match (all.0, o) {
+                    (Outcome::Holds, Outcome::Holds) => Outcome::Holds,
+                    (Outcome::Fails, Outcome::Fails) => Outcome::Fails,
+                    _ => Outcome::Partly,
+                };
+            }
+            Ok(all)
+        }
         Check::Below { run, metric, limit, at, with } => threshold(runs, (run, with), metric, *limit, at, true),
         Check::Above { run, metric, limit, at, with } => threshold(runs, (run, with), metric, *limit, at, false),
         Check::Increasing { run, metric } => increasing(runs, run, metric),

@@ -134,7 +134,12 @@ pub enum Check {
     /// every point of `run` meets its stopping rule (partly: some points do)
     Converges { run: String },
     /// no point of `run` converges (the paper says the scheme fails there)
-    DoesNotConverge { run: String },
+    /// (and of each run `with`: every weight the paper calls necessary, removed in turn)
+    DoesNotConverge {
+        run: String,
+        #[serde(default)]
+        with: Vec<String>,
+    },
     /// `metric ≤ limit` at every selected point (of `run`, and every point of the runs `with`)
     Below {
         run: String,
@@ -205,11 +210,10 @@ impl Check {
     /// The runs the check reads.
     pub fn runs(&self) -> Vec<&str> {
         match self {
-            Check::Below { run, with, .. } | Check::Above { run, with, .. } => {
+            Check::Below { run, with, .. } | Check::Above { run, with, .. } | Check::DoesNotConverge { run, with } => {
                 std::iter::once(run).chain(with).map(|s| s.as_str()).collect()
             }
             Check::Converges { run }
-            | Check::DoesNotConverge { run }
             | Check::Increasing { run, .. }
             | Check::Magnitude { run, .. }
             | Check::SameHistories { run, .. } => vec![run],
