@@ -83,7 +83,7 @@ fn failure(p: &PointResult) -> String {
         _ => {
             // the innermost cause: after the last ": " of the error chain
             let short = e.rsplit(": ").take(2).collect::<Vec<_>>().into_iter().rev().collect::<Vec<_>>().join(": ");
-            let mut short = short.replace('\n', " ");
+            let mut short = round_numbers(&short.replace('\n', " "));
             if short.len() > 140 {
                 let cut = (0..=140).rev().find(|&i| short.is_char_boundary(i)).unwrap_or(0);
                 short.truncate(cut);
@@ -92,6 +92,25 @@ fn failure(p: &PointResult) -> String {
             format!("failed: {short}")
         }
     }
+}
+
+/// `text` with every number of more than two significant digits written as [`sig2`] (an
+/// error's `9.378712387458614e-8` is `9.4e-8`), so that the report's text changes only when a
+/// result does.
+fn round_numbers(text: &str) -> String {
+    text.split(' ')
+        .map(|word| {
+            let end = word.trim_end_matches([',', ';', ')', ':']);
+            let start = end.trim_start_matches('(');
+            match start.parse::<f64>() {
+                Ok(x) if start.contains('.') && start.len() > 6 => {
+                    format!("{}{}{}", &end[..end.len() - start.len()], sig2(x), &word[end.len()..])
+                }
+                _ => word.to_string(),
+            }
+        })
+        .collect::<Vec<_>>()
+        .join(" ")
 }
 
 fn metric_text(p: &PointResult, metric: &str) -> String {
@@ -182,9 +201,21 @@ fn iterations_range(pts: &[&PointResult], metric: &str) -> String {
 fn evaluate_inner(check: &Check, runs: &[RunResults]) -> Result<(Outcome, String), CheckError> {
     match check {
         Check::Converges { run } => converges(runs, run, false),
-        Check::DoesNotConverge { run } => converges(runs, run, true),
-        Check::Below { run, metric, limit, at } => threshold(runs, run, metric, *limit, at, true),
-        Check::Above { run, metric, limit, at } => threshold(runs, run, metric, *limit, at, false),
+        Check::DoesNotConverge { run, with } => {
+            let mut all = converges(runs, run, true)?;
+            for w in with {
+                let (o, text) = converges(runs, w, true)?;
+                all.1.push_str(&format!("; {w}: {text}"));
+                all.0 = match (all.0, o) {
+                    (Outcome::Holds, Outcome::Holds) => Outcome::Holds,
+                    (Outcome::Fails, Outcome::Fails) => Outcome::Fails,
+                    _ => Outcome::Partly,
+                };
+            }
+            Ok(all)
+        }
+        Check::Below { run, metric, limit, at, with } => threshold(runs, (run, with), metric, *limit, at, true),
+        Check::Above { run, metric, limit, at, with } => threshold(runs, (run, with), metric, *limit, at, false),
         Check::Increasing { run, metric } => increasing(runs, run, metric),
         Check::RatioAbove { metric, numerator, denominator, limit } => {
             ratio(runs, metric, numerator, denominator, *limit, true)
@@ -192,7 +223,19 @@ fn evaluate_inner(check: &Check, runs: &[RunResults]) -> Result<(Outcome, String
         Check::RatioBelow { metric, numerator, denominator, limit } => {
             ratio(runs, metric, numerator, denominator, *limit, false)
         }
-        Check::WithinFactor { run, metric, factor, with } => within_factor(runs, run, metric, *factor, with),
+        Check::WithinFactor { run, metric, factor, with, also } => {
+            let mut worst = within_factor(runs, run, metric, *factor, with)?;
+            for m in also {
+                let (o, text) = within_factor(runs, run, m, *factor, with)?;
+                worst.1.push_str(&format!("; {text}"));
+                worst.0 = match (worst.0, o) {
+                    (Outcome::Fails, _) | (_, Outcome::Fails) => Outcome::Fails,
+                    (Outcome::Partly, _) | (_, Outcome::Partly) => Outcome::Partly,
+                    _ => Outcome::Holds,
+                };
+            }
+            Ok(worst)
+        }
         Check::Magnitude { run, metric, value, orders, at } => magnitude(runs, run, metric, *value, *orders, at),
         Check::SameHistories { run, history, reference, limit } => {
             same_histories(runs, run, history, reference, *limit)
@@ -231,20 +274,26 @@ fn converges(runs: &[RunResults], run: &str, fails: bool) -> Result<(Outcome, St
     }
 }
 
-/// `below` (or `above`): `metric ≤ limit` (`≥`) at every selected point.
+/// `below` (or `above`): `metric ≤ limit` (`≥`) at every selected point of `run` and every
+/// point of the runs `with`.
 fn threshold(
     runs: &[RunResults],
-    run: &str,
+    (run, with): (&str, &[String]),
     metric: &str,
     limit: f64,
     at: &Selector,
     below: bool,
 ) -> Result<(Outcome, String), CheckError> {
-    let pts = select(runs, run, at)?;
+    let mut pts = select(runs, run, at)?;
+    let mut list = metric_list(&pts, metric);
+    for w in with {
+        let more = select(runs, w, &Selector::new())?;
+        list.push_str(&format!("; {w}: {}", metric_list(&more, metric)));
+        pts.extend(more);
+    }
     let pass = |p: &PointResult| p.metric(metric).is_some_and(|v| if below { v <= limit } else { v >= limit });
     let (ok, _) = split_by(&pts, pass);
     let rel = if below { "≤" } else { "≥" };
-    let list = metric_list(&pts, metric);
     Ok((outcome(ok.len(), pts.len()), format!("{metric} {list} (claim: {rel} {})", sig2(limit))))
 }
 
@@ -330,10 +379,11 @@ fn within_factor(
     let text = format!(
         "{metric} at {at}: {} (max/min of the magnitudes 1 + {}; claim: ≤ 1 + {})",
         pts.iter().map(|p| metric_text(p, metric)).collect::<Vec<_>>().join(", "),
-        sig2(hi / lo - 1.0),
+        if hi == 0.0 { "0".to_string() } else { sig2(hi / lo - 1.0) },
         sig2(factor - 1.0)
     );
-    let o = if hi <= lo * factor {
+    // every value 0 (a term whose weight is 0): the same everywhere
+    let o = if hi <= lo * factor || hi == 0.0 {
         Outcome::Holds
     } else if best > 1 {
         Outcome::Partly
@@ -515,7 +565,7 @@ pub fn judge(spec: &Spec, claim: &Claim, runs: &[RunResults]) -> ClaimResult {
 
 #[cfg(test)]
 mod tests {
-    use super::sig2;
+    use super::{round_numbers, sig2};
 
     #[test]
     fn two_significant_digits() {
@@ -526,5 +576,15 @@ mod tests {
         assert_eq!(sig2(12.4), "12");
         assert_eq!(sig2(2.5e6), "2.5e6");
         assert_eq!(sig2(-0.0025), "-2.5e-3");
+    }
+
+    #[test]
+    fn long_numbers_of_an_error_are_rounded() {
+        assert_eq!(
+            round_numbers(
+                "change (x, α) is 9.378712387458614e-8, but 1e-10 (after 3000 iterations: 1.0245671838684249e-1)"
+            ),
+            "change (x, α) is 9.4e-8, but 1e-10 (after 3000 iterations: 0.10)"
+        );
     }
 }

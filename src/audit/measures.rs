@@ -5,6 +5,14 @@
 //! - `modal_tip_rel_error` (dynamic runs, Fig. 5): the tip history against the exact-in-time
 //!   response of the linearised discrete model (`solve::modes`) to the same load, sampled
 //!   twice per time step and linear in between;
+//!   `modal_tip_angle_rel_error`: the same for the tip's angles α, β, γ relative to their
+//!   largest, and `modal_tip_worst_rel_error` the larger of the two (Fig. 5: "the displacement
+//!   and rotation"); `first_frequency_rad_per_s`: the lowest natural frequency of the discrete
+//!   rod (§5.1: "the natural frequency of the system ω0");
+//! - `tip_deflection_rel_length` (tip-loaded cantilevers): |y(L)| / L (Fig. 7: "5% deflection");
+//! - `adjoint_alpha_max_abs` (inverse runs): max |α̂| over the nodes, the paper's δα, and
+//!   `adjoint_alpha_orders_from_paper`: its orders of magnitude from the paper's line
+//!   δα = 10⁷ λl (eq. 64, finding (2): "from 10⁻¹³ to 10¹⁰" as λl goes from 10⁻²⁰ to 10³);
 //! - `kappa3_max_abs_per_m` (inverse runs): max |κ3| without the end elements (eq. 65,
 //!   finding (4): "a too large κ3 could be generated");
 //! - `force_to_design_l2`, `torque_to_design_l2` (synthetic inverse runs, Fig. 15): ‖f‖/‖f_design‖
@@ -24,7 +32,10 @@
 //!   position vector and generalised curvature are zero");
 //! - clip runs ([`ClipSeries`]): RMS of the recovered κ1, κ2, κ3 and of the bending
 //!   `√(κ1² + κ2²)` over frames and inner elements [1/m] (Figs. 17, 23, 25), and the lag in
-//!   frames of the bending wave between s = L/4 and 3L/4 (> 0: from s = 0 towards s = L).
+//!   frames of the bending wave between s = L/4 and 3L/4 (> 0: from s = 0 towards s = L), with
+//!   the coherence of the bending and of the twist at their best lag (`bending_wave_coherence`,
+//!   `twist_wave_coherence`: a wave that keeps its shape, 1, none, 0), and `x_err_rel_jitter`:
+//!   the largest frame-to-frame oscillation of ‖x − x_g‖/‖x_g‖ over its median (Fig. 20 (i)).
 use nalgebra::{DVector, Vector3};
 
 use crate::case::{Analysis, Case, Reference};
@@ -46,6 +57,8 @@ pub struct ClipSeries {
     pub kappa: Vec<Vec<Vector3<f64>>>,
     /// per frame: max over the nodes of |ω| [rad/s] (eq. 27 between frames; 0 on the first)
     pub omega_max: Vec<f64>,
+    /// per frame: the real objective ‖x − x_g‖/‖x_g‖
+    pub x_err_rel: Vec<f64>,
     /// the frames asked for (posture figures)
     pub kept: Vec<ClipFrame>,
     /// the last frame solved
@@ -71,6 +84,7 @@ impl ClipRecorder {
         self.series
             .omega_max
             .push(frame.omega.as_ref().map_or(0.0, |w| w.iter().map(|v| v.norm()).fold(0.0, f64::max)));
+        self.series.x_err_rel.push(frame.report.x_err_rel);
         if self.keep.contains(&frame.report.frame) {
             self.series.kept.push(frame.clone());
         }
@@ -97,9 +111,19 @@ pub fn derived_metrics(case: &Case, run: Option<&RunResult>, series: Option<&Cli
                 .map(|(s, x)| (x[1] - timoshenko_deflection(*s, force_n, l, kga, ei)).abs())
                 .fold(0.0, f64::max);
             m.insert("eq63_curve_rel_error".into(), worst / tip);
+            if let Some(x) = r.nodes.x.last() {
+                m.insert("tip_deflection_rel_length".into(), x[1].abs() / l);
+            }
         }
-        if let Some(e) = modal_tip_error(case, r) {
-            m.insert("modal_tip_rel_error".into(), e);
+        if let Some((x, a)) = modal_tip_errors(case, r) {
+            m.insert("modal_tip_rel_error".into(), x);
+            m.insert("modal_tip_angle_rel_error".into(), a);
+            m.insert("modal_tip_worst_rel_error".into(), x.max(a));
+        }
+        if matches!(case.analysis, Analysis::Dynamic(_)) {
+            if let Some(w) = modal_model(&case.problem()).ok().and_then(|m| m.omegas.first().copied()) {
+                m.insert("first_frequency_rad_per_s".into(), w);
+            }
         }
         if r.inverse.is_some() {
             let k = r.nodes.element_curvature();
@@ -116,6 +140,11 @@ pub fn derived_metrics(case: &Case, run: Option<&RunResult>, series: Option<&Cli
             }
             m.extend(inner_control_metrics(case, r));
             m.extend(frame_metrics(r));
+            if let Some(inv) = r.inverse.as_ref() {
+                let a = inv.ahat.iter().map(|a| a.norm()).fold(0.0, f64::max);
+                m.insert("adjoint_alpha_max_abs".into(), a);
+                m.insert("adjoint_alpha_orders_from_paper".into(), (a / (1e7 * inv.lambda_l)).log10().abs());
+            }
         }
     }
     if let Some(s) = series {
@@ -194,18 +223,29 @@ fn design_norms(case: &Case) -> Option<(f64, f64)> {
     Some((f2.sqrt(), l2.sqrt()))
 }
 
-/// Max over the time steps and the tip's x, y of |x_tip − x_modal| / max |x_modal| for a
-/// dynamic run; `None` for other runs or when the modal model cannot be built.
-fn modal_tip_error(case: &Case, r: &RunResult) -> Option<f64> {
+/// Max over the time steps of the tip's gap to the modal solution, relative to the modal
+/// solution's largest value: of the displacement (x, y) and of the rotation (α, β, γ);
+/// `None` for other runs or when the modal model cannot be built.
+fn modal_tip_errors(case: &Case, r: &RunResult) -> Option<(f64, f64)> {
     let modal = modal_tip_history(case, r)?;
-    let (mut err, mut scale) = (0.0f64, 0.0f64);
-    for (rec, m) in r.tip.iter().zip(&modal) {
-        for comp in 0..2 {
-            scale = scale.max(m.position_m[comp].abs());
-            err = err.max((rec.position_m[comp] - m.position_m[comp]).abs());
+    let gap = |rec: &dyn Fn(usize) -> [f64; 3], m: &dyn Fn(usize) -> [f64; 3], comps: usize| {
+        let (mut err, mut scale) = (0.0f64, 0.0f64);
+        for i in 0..modal.len().min(r.tip.len()) {
+            let (a, b) = (rec(i), m(i));
+            for c in 0..comps {
+                scale = scale.max(b[c].abs());
+                err = err.max((a[c] - b[c]).abs());
+            }
         }
-    }
-    (scale > 0.0).then_some(err / scale)
+        (scale > 0.0).then_some(err / scale)
+    };
+    let x = gap(
+        &|i| [r.tip[i].position_m[0], r.tip[i].position_m[1], 0.0],
+        &|i| [modal[i].position_m[0], modal[i].position_m[1], 0.0],
+        2,
+    )?;
+    let a = gap(&|i| r.tip[i].angles_rad.into(), &|i| modal[i].angles_rad, 3)?;
+    Some((x, a))
 }
 
 /// The tip of the linearised discrete model at one record of a dynamic run.
@@ -287,28 +327,64 @@ fn clip_series_metrics(s: &ClipSeries) -> Metrics {
     m.insert("kappa3_rms_per_m".into(), rms(&|k| k[2] * k[2]));
     m.insert("bending_rms_per_m".into(), rms(&|k| k[0] * k[0] + k[1] * k[1]));
     m.insert("omega_max_rad_per_s".into(), s.omega_max.iter().copied().fold(0.0, f64::max));
-    if let Some(lag) = bending_wave_lag(s) {
+    if let Some((lag, coherence)) = wave_lag(s, &|k| (k[0], k[1]), false) {
         m.insert("bending_wave_lag_frames".into(), lag as f64);
+        m.insert("bending_wave_coherence".into(), coherence);
+    }
+    if let Some((_, coherence)) = wave_lag(s, &|k| (k[2], 0.0), true) {
+        m.insert("twist_wave_coherence".into(), coherence);
+    }
+    if let Some(j) = x_err_jitter(&s.x_err_rel) {
+        m.insert("x_err_rel_jitter".into(), j);
     }
     m
 }
 
-/// The lag τ (frames) maximising `|Σ_t z_a(t) conj(z_b(t + τ))|` with `z = κ1 + i κ2` at the
-/// elements nearest s = L/4 (a) and 3L/4 (b), |τ| ≤ a quarter of the clip: positive when the
-/// bending travels from s = 0 towards s = L. A roll of the material frame multiplies both
-/// signals by the same phase and does not change the magnitude.
-fn bending_wave_lag(s: &ClipSeries) -> Option<i64> {
+/// The frame-to-frame oscillation of the real objective e = ‖x − x_g‖/‖x_g‖ (Fig. 20 (i)):
+/// `max_n |e_n − (e_{n−1} + e_{n+1})/2|` over the median of e; `None` below 3 frames.
+fn x_err_jitter(e: &[f64]) -> Option<f64> {
+    if e.len() < 3 {
+        return None;
+    }
+    let mut sorted = e.to_vec();
+    sorted.sort_by(f64::total_cmp);
+    let median = sorted[sorted.len() / 2];
+    let worst = e.windows(3).map(|w| (w[1] - 0.5 * (w[0] + w[2])).abs()).fold(0.0, f64::max);
+    (median > 0.0).then_some(worst / median)
+}
+
+/// The lag τ (frames) maximising `|Σ_t z_a(t) conj(z_b(t + τ))|` with `z` a complex signal of
+/// κ (`κ1 + i κ2` for the bending, `κ3` for the twist) at the elements nearest s = L/4 (a)
+/// and 3L/4 (b), |τ| ≤ a quarter of the clip: positive when the wave travels from s = 0
+/// towards s = L. A roll of the material frame multiplies both bending signals by the same
+/// phase and does not change the magnitude. With it, the coherence at that lag,
+/// `|Σ z_a conj(z_b)| / √(Σ|z_a|² Σ|z_b|²)` over the overlap, in [0, 1]: 1 for a wave that
+/// keeps its shape between the probes, near 0 when there is no such wave. `centred`: each
+/// probe's mean over the frames is taken out first (the twist: a steady κ3 is no wave).
+fn wave_lag(s: &ClipSeries, signal: &dyn Fn(&Vector3<f64>) -> (f64, f64), centred: bool) -> Option<(i64, f64)> {
     let nf = s.kappa.len();
     if nf < 8 {
         return None;
     }
     let ne = s.s_mid.len();
     let (a, b) = (ne / 4, 3 * ne / 4);
-    let z = |f: usize, e: usize| (s.kappa[f][e][0], s.kappa[f][e][1]);
+    let mean = |e: usize| {
+        let sum = (0..nf).map(|f| signal(&s.kappa[f][e])).fold((0.0, 0.0), |m, v| (m.0 + v.0, m.1 + v.1));
+        if centred {
+            (sum.0 / nf as f64, sum.1 / nf as f64)
+        } else {
+            (0.0, 0.0)
+        }
+    };
+    let (ma, mb) = (mean(a), mean(b));
+    let z = |f: usize, e: usize| {
+        let (v, m) = (signal(&s.kappa[f][e]), if e == a { ma } else { mb });
+        (v.0 - m.0, v.1 - m.1)
+    };
     let max_lag = (nf / 4) as i64;
-    let mut best = (0i64, -1.0f64);
+    let mut best = (0i64, -1.0f64, 0.0f64);
     for tau in -max_lag..=max_lag {
-        let (mut re, mut im) = (0.0, 0.0);
+        let (mut re, mut im, mut pa, mut pb) = (0.0, 0.0, 0.0, 0.0);
         for t in 0..nf as i64 {
             let u = t + tau;
             if u < 0 || u >= nf as i64 {
@@ -318,13 +394,17 @@ fn bending_wave_lag(s: &ClipSeries) -> Option<i64> {
             // x · conj(y)
             re += x.0 * y.0 + x.1 * y.1;
             im += x.1 * y.0 - x.0 * y.1;
+            pa += x.0 * x.0 + x.1 * x.1;
+            pb += y.0 * y.0 + y.1 * y.1;
         }
-        let mag = (re * re + im * im).sqrt() / (nf as i64 - tau.abs()) as f64;
+        let cross = (re * re + im * im).sqrt();
+        let mag = cross / (nf as i64 - tau.abs()) as f64;
         if mag > best.1 {
-            best = (tau, mag);
+            let coherence = if pa > 0.0 && pb > 0.0 { cross / (pa * pb).sqrt() } else { 0.0 };
+            best = (tau, mag, coherence);
         }
     }
-    Some(best.0)
+    Some((best.0, best.2))
 }
 
 #[cfg(test)]
@@ -349,8 +429,8 @@ mod tests {
             })
             .collect();
         let series = ClipSeries { frames: (0..nf).collect(), s_mid, kappa, ..Default::default() };
-        assert_eq!(bending_wave_lag(&series), Some(50));
+        assert_eq!(wave_lag(&series, &|k| (k[0], k[1]), false).map(|w| w.0), Some(50));
         let back = ClipSeries { kappa: series.kappa.iter().rev().cloned().collect(), ..series.clone() };
-        assert_eq!(bending_wave_lag(&back), Some(-50));
+        assert_eq!(wave_lag(&back, &|k| (k[0], k[1]), false).map(|w| w.0), Some(-50));
     }
 }

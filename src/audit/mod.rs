@@ -169,6 +169,8 @@ pub struct AuditReport {
     pub figures: Vec<String>,
     pub quick: bool,
     pub wall_time_s: f64,
+    /// CPU time of the audit's process (user + system) [s], `None` where /proc is not there
+    pub cpu_time_s: Option<f64>,
     pub status: AuditStatus,
     /// size of the audit folder when the report was written [bytes]
     pub bytes: u64,
@@ -314,6 +316,19 @@ struct Job<'a> {
     fields: PointFields,
 }
 
+/// User + system CPU time of this process so far [s], from `/proc/self/stat` (fields 14 and 15,
+/// in clock ticks of 1/100 s, Linux's USER_HZ); `None` elsewhere. The audit's points run in
+/// this process's threads, so this is the audit's CPU time.
+fn process_cpu_time_s() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // the command name (field 2) is in parentheses and may hold spaces
+    let rest = stat.rsplit_once(')')?.1;
+    let fields: Vec<&str> = rest.split_whitespace().collect();
+    // `rest` starts at field 3
+    let ticks = |n: usize| fields.get(n - 3)?.parse::<f64>().ok();
+    Some((ticks(14)? + ticks(15)?) / 100.0)
+}
+
 /// Run every point of every run of `specs` in parallel (clip runs first: they are the longest),
 /// judge every claim, draw every figure and write `REPORT.md` and `report.csv` into
 /// `opts.out`. `progress(done, total)` after each point.
@@ -324,6 +339,7 @@ pub fn run_audit(
     progress: impl Fn(usize, usize) + Sync,
 ) -> Result<AuditReport, AuditError> {
     let start = std::time::Instant::now();
+    let cpu_start = process_cpu_time_s();
     let reused: Vec<Option<(Vec<ClaimResult>, Vec<String>)>> =
         specs.iter().map(|s| if opts.resume { resume::load(s, quick, &opts.out) } else { None }).collect();
     let mut jobs = plan_jobs(specs, &reused, opts)?;
@@ -364,6 +380,7 @@ pub fn run_audit(
         figures,
         quick,
         wall_time_s: start.elapsed().as_secs_f64(),
+        cpu_time_s: process_cpu_time_s().zip(cpu_start).map(|(end, start)| end - start),
         status,
         bytes: folder_bytes(&opts.out),
         fields: opts.fields,

@@ -108,8 +108,9 @@ fn header(r: &AuditReport) -> String {
 fn size_line(r: &AuditReport) -> String {
     let cores = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1);
     format!(
-        "Time and size: {:.0} s wall time on {cores} cores (shared machines make it longer); {:.1} MB in this folder before this report ({}; the default budget of the full audit is {:.0} MB).",
+        "Time and size: {:.0} s wall time on {cores} cores (shared machines make it longer){}; {:.1} MB in this folder before this report ({}; the default budget of the full audit is {:.0} MB).",
         r.wall_time_s,
+        r.cpu_time_s.map(|c| format!(", {c:.0} s CPU time (user + system)")).unwrap_or_default(),
         r.bytes as f64 / 1e6,
         r.fields.as_str(),
         super::FULL_AUDIT_BUDGET_BYTES as f64 / 1e6

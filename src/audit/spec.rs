@@ -134,22 +134,31 @@ pub enum Check {
     /// every point of `run` meets its stopping rule (partly: some points do)
     Converges { run: String },
     /// no point of `run` converges (the paper says the scheme fails there)
-    DoesNotConverge { run: String },
-    /// `metric ≤ limit` at every selected point
+    /// (and of each run `with`: every weight the paper calls necessary, removed in turn)
+    DoesNotConverge {
+        run: String,
+        #[serde(default)]
+        with: Vec<String>,
+    },
+    /// `metric ≤ limit` at every selected point (of `run`, and every point of the runs `with`)
     Below {
         run: String,
         metric: String,
         limit: f64,
         #[serde(default)]
         at: Selector,
+        #[serde(default)]
+        with: Vec<String>,
     },
-    /// `metric ≥ limit` at every selected point
+    /// `metric ≥ limit` at every selected point (of `run`, and every point of the runs `with`)
     Above {
         run: String,
         metric: String,
         limit: f64,
         #[serde(default)]
         at: Selector,
+        #[serde(default)]
+        with: Vec<String>,
     },
     /// `metric` increases (strictly) along the run's single grid key
     Increasing { run: String, metric: String },
@@ -158,13 +167,15 @@ pub enum Check {
     /// `metric(numerator) / metric(denominator) ≤ limit`
     RatioBelow { metric: String, numerator: Ref, denominator: Ref, limit: f64 },
     /// `max / min` of `metric` over the points of `run` and of the runs `with` ≤ `factor`
-    /// (the same value everywhere); at least two points
+    /// (the same value everywhere), and so of each metric of `also`; at least two points
     WithinFactor {
         run: String,
         metric: String,
         factor: f64,
         #[serde(default)]
         with: Vec<String>,
+        #[serde(default)]
+        also: Vec<String>,
     },
     /// `metric` has the order of magnitude of `value` at every selected point:
     /// |log10(|metric| / value)| ≤ `orders`
@@ -199,10 +210,10 @@ impl Check {
     /// The runs the check reads.
     pub fn runs(&self) -> Vec<&str> {
         match self {
+            Check::Below { run, with, .. } | Check::Above { run, with, .. } | Check::DoesNotConverge { run, with } => {
+                std::iter::once(run).chain(with).map(|s| s.as_str()).collect()
+            }
             Check::Converges { run }
-            | Check::DoesNotConverge { run }
-            | Check::Below { run, .. }
-            | Check::Above { run, .. }
             | Check::Increasing { run, .. }
             | Check::Magnitude { run, .. }
             | Check::SameHistories { run, .. } => vec![run],
@@ -316,7 +327,7 @@ pub struct Claim {
     /// the verdict when the check fails outright (default: differs)
     pub if_fails: Verdict,
     /// the verdict when the check holds on some points of the paper's range only (default:
-    /// differs; "refuted" for a range the scheme fails on in part, e.g. eq. (65) finding (4))
+    /// differs; "refuted" is refused when a spec is read: the audit runs the Rust engine only)
     pub if_partly: Verdict,
     /// why our number differs (reported with any verdict but reproduced)
     pub cause: Option<String>,
@@ -464,6 +475,15 @@ fn read_claim(path: &Path, c: RawClaim, earlier: &[Claim], runs: &[RunSpec]) -> 
             path,
             format!("claim `{}`", c.id),
             "a partial check (weaker than the paper's words) yields at best \"differs\": expect cannot be reproduced or not computable".into(),
+        ));
+    }
+    // "refuted" needs the failure in the paper's scheme under both one-rule readings and in
+    // both engines (docs/audit.md); the audit runs the Rust engine only, so no spec may ask for it.
+    if [Some(c.expect), c.if_fails, c.if_partly].contains(&Some(Verdict::Refuted)) {
+        return Err(invalid(
+            path,
+            format!("claim `{}`", c.id),
+            "\"refuted\" needs the failure under both one-rule readings and in both engines (Rust and FreeFEM); the audit runs the Rust engine only: use \"differs\" and say so in the cause".into(),
         ));
     }
     if let Some(q) = ["(here", "(ours", "(our "].iter().find(|q| c.statement.contains(*q)) {

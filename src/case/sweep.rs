@@ -200,6 +200,7 @@ impl Case {
     /// The case with any keys of its file set, by dotted path (`"clip.frames"`,
     /// `"inverse.lambda_omega"`, `"solver.max_iterations"`) to TOML values, validated again
     /// as a whole. Missing tables are created; a path through a non-table is an error.
+    /// `solver.method = "fixed_point"` drops the case's Newton-only `solver.warm_start_tolerance`.
     pub fn with_overrides(&self, overrides: &[(String, toml::Value)]) -> Result<Case, SweepError> {
         let label = overrides.iter().map(|o| o.0.as_str()).collect::<Vec<_>>().join(", ");
         self.revalidated(&label, |table| {
@@ -221,6 +222,15 @@ impl Case {
                         })?;
                 }
                 t.insert(last.to_string(), value.clone());
+            }
+            // `solver.method = "fixed_point"` over a Newton case: its warm start (used by Newton
+            // only, and refused with the fixed point) goes with it, unless set here too.
+            let to_fixed_point =
+                overrides.iter().any(|(k, v)| k == "solver.method" && v.as_str() == Some("fixed_point"));
+            if to_fixed_point && !overrides.iter().any(|(k, _)| k == "solver.warm_start_tolerance") {
+                if let Some(s) = table.get_mut("solver").and_then(|s| s.as_table_mut()) {
+                    s.remove("warm_start_tolerance");
+                }
             }
             Ok(())
         })
