@@ -13,7 +13,7 @@ use super::compact::{write_compact, OutputFormat, CURVATURE_COLUMNS, RAW_CURVATU
 use super::files::OutputError;
 use super::journal::{Entry, Journal, Offsets, JOURNAL};
 use super::vtk::{write_pvd, write_vtp, PolylineFields};
-use crate::run::clip::{nodal_curvature, ClipFrame, FrameSink};
+use crate::run::clip::{nodal_curvature, ClipFrame, Controls, FrameSink};
 
 /// Streams a clip solve to disk, one frame at a time (`frames.csv`, `fields.csv`,
 /// `curvature.csv`, ParaView `vtk/frame_NNNNN.vtp` + `clip.pvd`). Every line is flushed with
@@ -239,9 +239,10 @@ impl ClipWriter {
     /// Append one converged frame: its report row, nodal fields, element curvature, truth row
     /// and VTK file.
     pub fn write_frame(&mut self, frame: &ClipFrame) -> Result<(), OutputError> {
-        let ClipFrame { report, time_s, nodes, force, torque, data, omega, kappa, roughness, .. } = frame;
+        let ClipFrame { report, time_s, nodes, controls, data, omega, kappa, planar, .. } = frame;
+        let Controls { force, torque } = controls;
         let omega = omega.clone().unwrap_or_else(|| vec![Vector3::zeros(); nodes.s.len()]);
-        let (time_s, roughness) = (*time_s, *roughness);
+        let (time_s, roughness) = (*time_s, planar.roughness);
         let dir = self.dir.clone();
         let err = |name: &str| {
             let p = dir.join(name);
@@ -338,8 +339,8 @@ impl ClipWriter {
                     ("d1", &d1),
                     ("d2", &d2),
                     ("d3", &d3),
-                    ("f_n_per_m", &frame.force),
-                    ("l_nm_per_m", &frame.torque),
+                    ("f_n_per_m", &frame.controls.force),
+                    ("l_nm_per_m", &frame.controls.torque),
                     ("kappa_per_m", &kn),
                     ("data_position_m", &frame.data),
                     ("omega_rad_per_s", omega),

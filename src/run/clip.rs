@@ -10,7 +10,8 @@ use nalgebra::{DVector, Vector3};
 
 use super::clip_frame::{frame_data, ClipFrameError, Converged, Deriver};
 pub use super::clip_frame::{
-    nodal_curvature, planar_xz_curvature, sign_alternation, ClipFrame, FrameRecord, TruthFrame, TRUTH_SKIP_NODES,
+    nodal_curvature, planar_xz_curvature, sign_alternation, ClipFrame, Controls, FrameRecord, PlanarCurvature,
+    TruthFrame, TRUTH_SKIP_NODES,
 };
 use super::RunError;
 use crate::case::Case;
@@ -414,9 +415,9 @@ impl Summary {
     fn push(&mut self, f: &ClipFrame) {
         let r = &mut self.run;
         r.reports.push(f.report);
-        r.roughness.push(f.roughness);
-        r.kappa2.push(f.kappa2.clone());
-        r.data_kappa.push(f.data_kappa.clone());
+        r.roughness.push(f.planar.roughness);
+        r.kappa2.push(f.planar.kappa2.clone());
+        r.data_kappa.push(f.planar.data_kappa.clone());
         r.omega.push(f.omega.clone().unwrap_or_else(|| vec![Vector3::zeros(); f.nodes.alpha.len()]));
         if let (Some(tr), Some(t)) = (&mut r.truth, &f.truth) {
             tr.comparisons.push(t.comparison);

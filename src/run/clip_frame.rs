@@ -77,9 +77,8 @@ pub struct ClipFrame {
     pub time_s: f64,
     /// the recovered state (angles in the frame's chart)
     pub nodes: NodalState,
-    /// controls f = x̂/λf [N/m] and l = α̂/λl [N m/m] per node (eq. 54)
-    pub force: Vec<Vector3<f64>>,
-    pub torque: Vec<Vector3<f64>>,
+    /// controls f and l per node (eq. 54)
+    pub controls: Controls,
     /// the frame's data positions [m]
     pub data: Vec<Vector3<f64>>,
     /// angular velocity ωˡ = A(α)(α − α_{n−1})/Δt per node [rad/s], components in the local
@@ -90,16 +89,30 @@ pub struct ClipFrame {
     /// element-midpoint curvature `(s [m], κ = A ∂sα [1/m])` (eq. 28), computed once for every
     /// consumer of the frame
     pub kappa: Vec<(f64, Vector3<f64>)>,
-    /// recovered κ2 at the element midpoints and the data's planar curvature at the interior
-    /// nodes [1/m] ([`super::clip::ClipRun::kappa2`], [`super::clip::ClipRun::data_kappa`])
-    pub kappa2: Vec<f64>,
-    pub data_kappa: Vec<f64>,
-    /// sign alternation of the recovered κ2 and of the data's planar curvature
-    pub roughness: (f64, f64),
+    /// recovered κ2 and the data's planar curvature, and their roughness
+    pub planar: PlanarCurvature,
     /// synthetic clips: the frame against its ground truth
     pub truth: Option<TruthFrame>,
     /// what the frame is derived from (the resume journal)
     pub record: FrameRecord,
+}
+
+/// The controls of a frame per node: f = x̂/λf [N/m] and l = α̂/λl [N m/m] (eq. 54).
+#[derive(Clone, Debug)]
+pub struct Controls {
+    pub force: Vec<Vector3<f64>>,
+    pub torque: Vec<Vector3<f64>>,
+}
+
+/// A frame's planar curvature: the recovered κ2 at the element midpoints and the data's planar
+/// curvature at the interior nodes [1/m] ([`super::clip::ClipRun::kappa2`],
+/// [`super::clip::ClipRun::data_kappa`]), and the sign alternation of each ([`sign_alternation`]).
+#[derive(Clone, Debug)]
+pub struct PlanarCurvature {
+    pub kappa2: Vec<f64>,
+    pub data_kappa: Vec<f64>,
+    /// sign alternation of the recovered κ2 and of the data's planar curvature
+    pub roughness: (f64, f64),
 }
 
 /// A frame of a synthetic clip against its ground truth.
@@ -203,14 +216,11 @@ impl Deriver<'_> {
             report: rep,
             time_s: rep.frame as f64 * self.dt_s,
             nodes,
-            force,
-            torque,
+            controls: Controls { force, torque },
             data,
             omega,
             kappa,
-            kappa2: k2,
-            data_kappa: kd,
-            roughness,
+            planar: PlanarCurvature { kappa2: k2, data_kappa: kd, roughness },
             truth: truth_frame,
             record: FrameRecord { report: rep, chart, state, adjoint, previous },
         })
