@@ -314,8 +314,8 @@ fn cmd_compare(
     check_memory(&case, Footprint::Run, limits)?;
     let target = out.unwrap_or_else(|| default_dir(&case));
     let mut manifest = run_manifest(&case, Engine::Rust)?;
-    manifest.command = "compare".into();
-    manifest.engine = Some("rust and freefem".into());
+    manifest.writer.command = "compare".into();
+    manifest.input.engine = Some("rust and freefem".into());
     let folder = RunFolder::begin(&target, manifest, Mode::Fresh { force })
         .with_context(|| format!("{}: output folder {}", case_label(&case), target.display()))?;
     for n in &folder.notes {
@@ -387,7 +387,7 @@ fn cmd_sweep(
     }
     let target = out.unwrap_or_else(|| PathBuf::from("out").join(&case.name).join("sweep"));
     let mut manifest = run_manifest(&case, Engine::Rust)?;
-    manifest.command = "sweep".into();
+    manifest.writer.command = "sweep".into();
     let folder = RunFolder::begin(&target, manifest, Mode::Fresh { force })
         .with_context(|| format!("{}: output folder {}", case_label(&case), target.display()))?;
     for n in &folder.notes {
@@ -480,8 +480,8 @@ fn cmd_audit(
     let marker = out.join(cosserat::audit::MARKER).is_file();
     let mode = force.map_or(Mode::Resume, |f| Mode::Fresh { force: f || marker });
     let mut manifest = Manifest::new("audit");
-    manifest.inputs = files.iter().map(|f| input_file(f)).collect::<Result<_, _>>()?;
-    manifest.settings.insert("quick".into(), f64::from(u8::from(quick)).into());
+    manifest.input.inputs = files.iter().map(|f| input_file(f)).collect::<Result<_, _>>()?;
+    manifest.input.settings.insert("quick".into(), f64::from(u8::from(quick)).into());
     let resume = force.is_none();
     let folder =
         RunFolder::begin(&out, manifest, mode).with_context(|| format!("audit: output folder {}", out.display()))?;
