@@ -10,8 +10,8 @@ use nalgebra::Vector3;
 
 use super::raw::*;
 use super::{
-    Analysis, Case, CaseError, CompareOverrides, CompareSpec, DataSource, InverseSettings, Reference, RodLength,
-    WeightsRule, DEFAULT_COMPARE_FRAMES,
+    Analysis, Case, CaseError, CaseOrigin, CompareOverrides, CompareSpec, DataSource, InverseSettings, Reference,
+    RodGiven, RodLength, WeightsRule, DEFAULT_COMPARE_FRAMES,
 };
 use crate::expr::{Expr, ExprError, Node};
 use crate::model::material::{CrossSection, Material, RodProperties};
@@ -150,21 +150,21 @@ impl<'a> Validator<'a> {
         Ok(Case {
             reference,
             name: name.to_string(),
-            description: raw.description,
-            source: None,
-            source_sha256: None,
-            constants: self.constants,
+            origin: CaseOrigin {
+                description: raw.description,
+                source: None,
+                source_sha256: None,
+                constants: self.constants,
+                raw: None,
+            },
             mesh,
-            rod_length,
-            material,
-            section,
             props: RodProperties::new(&material, &section),
+            rod: RodGiven { length: rod_length, material, density_given: raw.material.density_kg_m3.is_some() },
+            section,
             quadrature,
             loads,
             analysis,
             compare,
-            density_given: raw.material.density_kg_m3.is_some(),
-            raw: None,
         })
     }
 

@@ -131,8 +131,8 @@ pub fn run_manifest(case: &Case, engine: Engine) -> Result<Manifest, FolderError
 /// The case file with the SHA-256 of the bytes that were read (also of a case piped in through
 /// standard input), or hashed now for a case that was not read from a file by `Case::from_file`.
 pub fn case_file(case: &Case) -> Result<Option<InputFile>, FolderError> {
-    let Some(path) = &case.source else { return Ok(None) };
-    Ok(Some(match &case.source_sha256 {
+    let Some(path) = &case.origin.source else { return Ok(None) };
+    Ok(Some(match &case.origin.source_sha256 {
         Some(sha256) => InputFile { path: path.display().to_string(), sha256: sha256.clone() },
         None => input_file_as(path, "case file")?,
     }))
