@@ -14,6 +14,7 @@ use super::files::OutputError;
 use super::journal::{Entry, Journal, Offsets, JOURNAL};
 use super::vtk::{write_pvd, write_vtp, PolylineFields};
 use crate::run::clip::{nodal_curvature, ClipFrame, Controls, FrameSink};
+use crate::solve::sequence::FrameReport;
 
 /// Streams a clip solve to disk, one frame at a time (`frames.csv`, `fields.csv`,
 /// `curvature.csv`, ParaView `vtk/frame_NNNNN.vtp` + `clip.pvd`). Every line is flushed with
@@ -249,21 +250,7 @@ impl ClipWriter {
             move |source| OutputError::Io { path: p.clone(), source }
         };
         let r = report;
-        let mut row = vec![r.frame as f64, time_s, r.iterations as f64, r.last_change, r.x_err_rel, r.tangent_misfit];
-        row.extend(r.objective.values());
-        row.extend([
-            r.min_cos_beta,
-            r.min_cos_beta_node as f64,
-            r.max_stretch_deviation,
-            roughness.0,
-            roughness.1,
-            f64::from(u8::from(r.restarted)),
-        ]);
-        row.extend(r.chart_axis.iter());
-        row.push(omega.iter().map(|w| w.norm()).fold(0.0, f64::max));
-        row.push(r.certificate);
-        row.extend([r.fit.noise_m, r.fit.position, r.fit.tangent, f64::from(u8::from(r.fit.flagged))]);
-        row.push(r.nodes_tracked as f64);
+        let row = report_row(r, time_s, roughness, &omega);
         writeln!(self.frames, "{}", frames_row(&row)).and_then(|_| self.frames.flush()).map_err(err("frames.csv"))?;
         let d = nodes.directors();
         let [fields, curvature] = row_files(self.format());
@@ -459,4 +446,24 @@ fn push_csv(s: &mut String, values: &[f64]) {
         }
         super::number::push_exp(s, *v, 10);
     }
+}
+
+/// The row of `frames.csv` of a frame: its report, time [s], roughness and largest |ω| [rad/s].
+fn report_row(r: &FrameReport, time_s: f64, roughness: (f64, f64), omega: &[Vector3<f64>]) -> Vec<f64> {
+    let mut row = vec![r.frame as f64, time_s, r.iterations as f64, r.last_change, r.x_err_rel, r.tangent_misfit];
+    row.extend(r.objective.values());
+    row.extend([
+        r.min_cos_beta,
+        r.min_cos_beta_node as f64,
+        r.max_stretch_deviation,
+        roughness.0,
+        roughness.1,
+        f64::from(u8::from(r.restarted)),
+    ]);
+    row.extend(r.chart_axis.iter());
+    row.push(omega.iter().map(|w| w.norm()).fold(0.0, f64::max));
+    row.push(r.certificate);
+    row.extend([r.fit.noise_m, r.fit.position, r.fit.tangent, f64::from(u8::from(r.fit.flagged))]);
+    row.push(r.nodes_tracked as f64);
+    row
 }
