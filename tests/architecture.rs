@@ -401,7 +401,6 @@ fn functions(code: &str) -> Vec<(String, usize, usize)> {
 const LONG_FUNCTIONS_LEFT: &[&str] = &[
     "src/io/freefem.rs:run_inverse",
     "src/case/validate/clip.rs:clip",
-    "src/main.rs:cmd_audit",
     "src/io/compare.rs:compare_clip",
     "src/io/posture.rs:draw_projection",
     "src/solve/inverse/kkt.rs:element_system",
