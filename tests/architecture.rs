@@ -406,8 +406,6 @@ const LONG_FUNCTIONS_LEFT: &[&str] = &[
     "src/solve/inverse/kkt.rs:element_system",
     "src/case/validate.rs:inverse",
     "src/io/plot.rs:draw_with",
-    "src/run/metrics.rs:differences",
-    "src/run/weights.rs:search_lambda_g",
 ];
 
 #[test]
