@@ -404,7 +404,6 @@ const LONG_FUNCTIONS_LEFT: &[&str] = &[
     "src/io/compare.rs:compare_clip",
     "src/io/posture.rs:draw_projection",
     "src/solve/inverse/kkt.rs:element_system",
-    "src/case/validate.rs:inverse",
     "src/io/plot.rs:draw_with",
 ];
 
