@@ -54,7 +54,7 @@ fn bits(f: &ClipFrame) -> Vec<u64> {
         .collect();
     v.push(r.iterations as u64);
     v.extend(f.record.state.iter().chain(f.record.adjoint.iter()).map(|x| x.to_bits()));
-    v.extend(f.kappa2.iter().map(|x| x.to_bits()));
+    v.extend(f.planar.kappa2.iter().map(|x| x.to_bits()));
     v.extend(f.truth.iter().flat_map(|t| t.bending_recovered.iter().map(|x| x.to_bits())));
     v
 }

@@ -165,7 +165,7 @@ fn dynamic_cantilever_against_modal_superposition() {
     let base = dynamic_case(1000);
     let problem = base.problem();
     let model = modal_model(&problem).expect("modes");
-    let omega_load = 8.0 * base.constants["omega0"];
+    let omega_load = 8.0 * base.origin.constants["omega0"];
     // Spatial load vector: F(t) = F_s sin(Ω t); evaluate where sin(Ω t) = 1.
     let f_s = problem.external_force(std::f64::consts::FRAC_PI_2 / omega_load);
     let g = model.project(&f_s);

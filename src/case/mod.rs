@@ -235,15 +235,11 @@ pub enum Reference {
 #[derive(Clone, Debug)]
 pub struct Case {
     pub name: String,
-    pub description: String,
-    pub source: Option<PathBuf>,
-    /// the SHA-256 (hex) of the case file's bytes as they were read (also of a case piped in)
-    pub source_sha256: Option<String>,
-    pub constants: BTreeMap<String, f64>,
+    /// where the case comes from: its file, text and named constants
+    pub origin: CaseOrigin,
     pub mesh: Mesh,
-    /// where `mesh.length_m` comes from
-    pub rod_length: RodLength,
-    pub material: Material,
+    /// how the rod was given: its length's source and its material
+    pub rod: RodGiven,
     pub section: CrossSection,
     pub props: RodProperties,
     pub quadrature: QuadratureScheme,
@@ -251,18 +247,36 @@ pub struct Case {
     pub analysis: Analysis,
     pub compare: CompareSpec,
     pub reference: Option<Reference>,
+}
+
+/// Where a [`Case`] comes from.
+#[derive(Clone, Debug)]
+pub struct CaseOrigin {
+    pub description: String,
+    pub source: Option<PathBuf>,
+    /// the SHA-256 (hex) of the case file's bytes as they were read (also of a case piped in)
+    pub source_sha256: Option<String>,
+    pub constants: BTreeMap<String, f64>,
+    /// the case file's tables and the path it was validated with, for [`sweep`]'s overrides
+    pub(crate) raw: Option<(toml::Table, PathBuf)>,
+}
+
+/// How the rod of a [`Case`] was given.
+#[derive(Clone, Debug)]
+pub struct RodGiven {
+    /// where `mesh.length_m` comes from
+    pub length: RodLength,
+    pub material: Material,
     /// whether the case file gave `material.density_kg_m3` (static and inverse analyses run
     /// with 1 kg/m³ when it does not: their equations never use it)
-    density_given: bool,
-    /// the case file's tables and the path it was validated with, for [`sweep`]'s overrides
-    raw: Option<(toml::Table, PathBuf)>,
+    pub(crate) density_given: bool,
 }
 
 impl Case {
     /// The case file's tables as validated (with any overrides applied), if it was read from
     /// TOML.
     pub fn toml_table(&self) -> Option<&toml::Table> {
-        self.raw.as_ref().map(|(t, _)| t)
+        self.origin.raw.as_ref().map(|(t, _)| t)
     }
 
     /// Read and validate a case file (at most [`CASE_FILE_CAP_BYTES`]).
@@ -270,8 +284,8 @@ impl Case {
         let text = file::read_case_file(path)?;
         let name = path.file_stem().and_then(|s| s.to_str()).unwrap_or("case").to_string();
         let mut case = Case::from_toml(&text, &name, path)?;
-        case.source = Some(path.to_path_buf());
-        case.source_sha256 = Some(file::sha256_hex(text.as_bytes()));
+        case.origin.source = Some(path.to_path_buf());
+        case.origin.source_sha256 = Some(file::sha256_hex(text.as_bytes()));
         Ok(case)
     }
 
@@ -284,7 +298,7 @@ impl Case {
         };
         let raw: raw::RawCase = toml::from_str(text).map_err(syntax)?;
         let mut case = Validator::new(path).case(raw, name)?;
-        case.raw = Some((toml::from_str(text).map_err(syntax)?, path.to_path_buf()));
+        case.origin.raw = Some((toml::from_str(text).map_err(syntax)?, path.to_path_buf()));
         Ok(case)
     }
 
@@ -331,7 +345,7 @@ impl Case {
 
     /// The body length estimated from the recording (`rod.length_m = "from_data"`, resolved).
     pub fn body_length(&self) -> Option<BodyLength> {
-        match self.rod_length {
+        match self.rod.length {
             RodLength::FromData(b) => b,
             RodLength::Given => None,
         }
@@ -342,7 +356,7 @@ impl Case {
     /// otherwise, which only a static or inverse analysis may use: their equations never
     /// involve the density).
     pub fn density_given(&self) -> bool {
-        self.density_given
+        self.rod.density_given
     }
 
     pub fn clip(&self) -> Option<&ClipSource> {

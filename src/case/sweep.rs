@@ -243,7 +243,7 @@ impl Case {
         label: &str,
         edit: impl FnOnce(&mut toml::Table) -> Result<(), SweepError>,
     ) -> Result<Case, SweepError> {
-        let (mut table, path) = self.raw.clone().ok_or_else(|| SweepError::Invalid {
+        let (mut table, path) = self.origin.raw.clone().ok_or_else(|| SweepError::Invalid {
             key: label.to_string(),
             reason: format!("case `{}` was not read from TOML", self.name),
         })?;
@@ -255,13 +255,13 @@ impl Case {
             CaseError::Invalid { key, reason, .. } => invalid(format!("{reason} (case file key `{key}`)")),
             other => invalid(other.to_string()),
         })?;
-        case.source = self.source.clone();
-        case.raw = Some((table, path));
+        case.origin.source = self.origin.source.clone();
+        case.origin.raw = Some((table, path));
         // a body length estimated from the recording stays with the case while its length does
         // (`rod.length_m = "from_data"` resolved: the tables hold the estimate as a number)
-        if case.rod_length == RodLength::Given && case.mesh.length_m == self.mesh.length_m {
-            if let RodLength::FromData(Some(b)) = self.rod_length {
-                case.rod_length = RodLength::FromData(Some(b));
+        if case.rod.length == RodLength::Given && case.mesh.length_m == self.mesh.length_m {
+            if let RodLength::FromData(Some(b)) = self.rod.length {
+                case.rod.length = RodLength::FromData(Some(b));
             }
         }
         Ok(case)

@@ -37,7 +37,7 @@ fn good_case_parses() {
     let c = parse(GOOD).unwrap();
     assert_eq!(c.mesh.elements, 10);
     assert!((c.mesh.length_m - 1e-3).abs() < 1e-18);
-    assert!((c.material.shear_correction - 4.0 / 3.0).abs() < 1e-15);
+    assert!((c.rod.material.shear_correction - 4.0 / 3.0).abs() < 1e-15);
     assert!(
         matches!(c.analysis, Analysis::Static(StaticParams { method: Method::FixedPoint { relaxation }, .. }) if relaxation == 0.5)
     );
@@ -180,7 +180,7 @@ fn non_numbers_and_unknown_names_say_what_is_allowed() {
 #[test]
 fn constants_resolve_in_dependency_order_and_cycles_are_named() {
     let c = parse(&GOOD.replace("F = 1e-8", "F = 1e-8\nza = 2\nyb = \"za*2\"\nxc = \"yb*2\"")).unwrap();
-    assert_eq!(c.constants["xc"], 8.0);
+    assert_eq!(c.origin.constants["xc"], 8.0);
     let e = reason(&GOOD.replace("F = 1e-8", "F = \"G\"\nG = \"2*F\""));
     let cycle = "refer to themselves or to one another in a cycle";
     assert_eq!(e, format!("t.toml: key `constants.F`: cannot be evaluated: the constants F, G {cycle}"));
@@ -226,10 +226,10 @@ fn length_from_data_is_for_recordings_only() {
     let batch = std::fs::read_to_string(root.join("cases/batch/roll_recording.toml")).unwrap();
     let c = parse(&batch.replace("length_m = \"L\"", "length_m = \"from_data\"")).unwrap();
     assert_eq!(
-        (c.rod_length, c.mesh.length_m, c.body_length()),
+        (c.rod.length, c.mesh.length_m, c.body_length()),
         (RodLength::FromData(None), FROM_DATA_PLACEHOLDER_M, None)
     );
-    assert_eq!(parse(&batch).unwrap().rod_length, RodLength::Given);
+    assert_eq!(parse(&batch).unwrap().rod.length, RodLength::Given);
     let tail = "\"from_data\" estimates the body length from a recording: only for an inverse case with [clip] kind = \
                 \"recording\", but this is";
     let e = reason(&GOOD.replace("length_m = \"L0\"", "length_m = \"from_data\""));

@@ -10,8 +10,8 @@ use nalgebra::Vector3;
 
 use super::raw::*;
 use super::{
-    Analysis, Case, CaseError, CompareOverrides, CompareSpec, DataSource, InverseSettings, Reference, RodLength,
-    WeightsRule, DEFAULT_COMPARE_FRAMES,
+    Analysis, Case, CaseError, CaseOrigin, CompareOverrides, CompareSpec, DataSource, InverseSettings, Reference,
+    RodGiven, RodLength, WeightsRule, DEFAULT_COMPARE_FRAMES,
 };
 use crate::expr::{Expr, ExprError, Node};
 use crate::model::material::{CrossSection, Material, RodProperties};
@@ -150,21 +150,21 @@ impl<'a> Validator<'a> {
         Ok(Case {
             reference,
             name: name.to_string(),
-            description: raw.description,
-            source: None,
-            source_sha256: None,
-            constants: self.constants,
+            origin: CaseOrigin {
+                description: raw.description,
+                source: None,
+                source_sha256: None,
+                constants: self.constants,
+                raw: None,
+            },
             mesh,
-            rod_length,
-            material,
-            section,
             props: RodProperties::new(&material, &section),
+            rod: RodGiven { length: rod_length, material, density_given: raw.material.density_kg_m3.is_some() },
+            section,
             quadrature,
             loads,
             analysis,
             compare,
-            density_given: raw.material.density_kg_m3.is_some(),
-            raw: None,
         })
     }
 
@@ -338,12 +338,9 @@ impl<'a> Validator<'a> {
         })
     }
 
-    /// `[solver]`, `[inverse]` and `[data]` or `[clip]` of an inverse analysis.
-    fn inverse(&self, raw: &RawCase, mesh: &Mesh, props: &RodProperties) -> Result<InverseSettings, CaseError> {
-        let s = &raw.solver;
-        // Both methods need the relaxation: Newton starts from the fixed point (I8).
-        let relaxation = self.relaxation("solver", s.relaxation)?;
-        let method = match s.method {
+    /// The method of an inverse analysis (`solver.method`, with its warm start for Newton).
+    fn inverse_method(&self, s: &RawSolver) -> Result<InverseMethod, CaseError> {
+        Ok(match s.method {
             RawMethod::FixedPoint => {
                 if s.warm_start_tolerance.is_some() {
                     return Err(self.err("solver.warm_start_tolerance", "only used by method = \"newton\""));
@@ -359,11 +356,12 @@ impl<'a> Validator<'a> {
                 })?;
                 InverseMethod::Newton { warm_start_tolerance: self.unit_open("solver.warm_start_tolerance", w)? }
             }
-        };
-        if s.continuation_steps != 1 {
-            return Err(self.err("solver.continuation_steps", "not used by an inverse analysis"));
-        }
-        let data = match (&raw.data, &raw.clip) {
+        })
+    }
+
+    /// Where an inverse analysis's data come from: `[data]` (a forward solve) or `[clip]`.
+    fn data_source(&self, raw: &RawCase, mesh: &Mesh) -> Result<DataSource, CaseError> {
+        Ok(match (&raw.data, &raw.clip) {
             (Some(d), None) => DataSource::Forward(self.data(d)?),
             (None, Some(cl)) => DataSource::Clip(Box::new(self.clip(cl, mesh)?)),
             (Some(_), Some(_)) => {
@@ -373,7 +371,19 @@ impl<'a> Validator<'a> {
                 "data",
                 "an inverse case needs [data] (a forward solve generating the centreline) or [clip] (a recorded clip)",
             )),
-        };
+        })
+    }
+
+    /// `[solver]`, `[inverse]` and `[data]` or `[clip]` of an inverse analysis.
+    fn inverse(&self, raw: &RawCase, mesh: &Mesh, props: &RodProperties) -> Result<InverseSettings, CaseError> {
+        let s = &raw.solver;
+        // Both methods need the relaxation: Newton starts from the fixed point (I8).
+        let relaxation = self.relaxation("solver", s.relaxation)?;
+        let method = self.inverse_method(s)?;
+        if s.continuation_steps != 1 {
+            return Err(self.err("solver.continuation_steps", "not used by an inverse analysis"));
+        }
+        let data = self.data_source(raw, mesh)?;
         let inv = raw.inverse.as_ref().ok_or_else(|| {
             self.err("inverse", "required when solver.analysis = \"inverse\" (the weights of eq. 41)")
         })?;

@@ -15,7 +15,7 @@ pub fn cmd_list(dir: &Path) -> Result<ExitCode> {
     let mut invalid = 0;
     for f in files {
         match Case::from_file(&f) {
-            Ok(c) => println!("{:<24} {}", c.name, c.description),
+            Ok(c) => println!("{:<24} {}", c.name, c.origin.description),
             Err(e) => {
                 invalid += 1;
                 let stem = f.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();

@@ -2,6 +2,8 @@
 //! (locally or as a Slurm job array), the hidden
 //! `batch-task` of an array task, `gather` and `synth`.
 pub mod alloc;
+pub mod args;
+pub mod commands;
 pub mod list;
 pub mod noise_study;
 pub mod outcome;

@@ -49,7 +49,7 @@ pub fn sweep_interrupted_summary(rows: &[cosserat::io::sweep::SummaryRow], targe
 pub fn audit_points_kept(dir: &Path, total: usize) -> String {
     fn walk(dir: &Path, depth: usize, out: &mut Vec<Status>) {
         if let Ok(Some(m)) = Manifest::read(dir) {
-            if m.command == "audit point" {
+            if m.writer.command == "audit point" {
                 out.push(m.status);
                 return;
             }

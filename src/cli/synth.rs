@@ -98,7 +98,7 @@ pub fn cmd_synth(a: SynthArgs) -> Result<ExitCode> {
         );
     }
     let mut manifest = Manifest::new("synth");
-    manifest.inputs.push(input_file_as(&kymogram, "kymogram")?);
+    manifest.input.inputs.push(input_file_as(&kymogram, "kymogram")?);
     for (k, v) in [
         ("count", params.count as f64),
         ("frames", params.frames as f64),
@@ -108,7 +108,7 @@ pub fn cmd_synth(a: SynthArgs) -> Result<ExitCode> {
         ("noise_m", params.noise_m),
         ("frame_interval_s", params.dt_s),
     ] {
-        manifest.settings.insert(k.into(), v.into());
+        manifest.input.settings.insert(k.into(), v.into());
     }
     let folder = RunFolder::begin(&a.out, manifest, Mode::Fresh { force: a.force })
         .with_context(|| format!("synth into {}", a.out.display()))?;

@@ -331,26 +331,26 @@ fn recording_manifest(
         OutputFormat::Csv => "batch",
         OutputFormat::Compact => "batch --output-format compact",
     });
-    m.case_name = Some(case.name.clone());
-    m.case = Some(case_file.clone());
-    m.inputs.push(input_file_as(recording, "recording")?);
+    m.input.case_name = Some(case.name.clone());
+    m.input.case = Some(case_file.clone());
+    m.input.inputs.push(input_file_as(recording, "recording")?);
     let sidecar = truth_sidecar(recording);
     if sidecar.is_file() {
-        m.inputs.push(input_file_as(&sidecar, "ground-truth sidecar")?);
+        m.input.inputs.push(input_file_as(&sidecar, "ground-truth sidecar")?);
     }
-    m.engine = Some(Engine::Rust.to_string());
-    m.frames_done = Some(0);
+    m.input.engine = Some(Engine::Rust.to_string());
+    m.frames.frames_done = Some(0);
     Ok(m)
 }
 
 /// The row of a complete run of the same case and inputs in `dir`, if there is one.
 fn complete_row(dir: &Path, wanted: &Manifest) -> Option<BatchRow> {
     let m = Manifest::read(dir).ok()??;
-    let hashes = |m: &Manifest| m.inputs.iter().map(|f| f.sha256.clone()).collect::<Vec<_>>();
+    let hashes = |m: &Manifest| m.input.inputs.iter().map(|f| f.sha256.clone()).collect::<Vec<_>>();
     let same = m.status.is_complete()
-        && m.command == wanted.command
-        && m.version == wanted.version
-        && m.case.as_ref().map(|c| &c.sha256) == wanted.case.as_ref().map(|c| &c.sha256)
+        && m.writer.command == wanted.writer.command
+        && m.writer.version == wanted.writer.version
+        && m.input.case.as_ref().map(|c| &c.sha256) == wanted.input.case.as_ref().map(|c| &c.sha256)
         && hashes(&m) == hashes(wanted);
     if !same {
         return None;
@@ -433,8 +433,8 @@ pub fn run_recording(case: &Case, case_file: &InputFile, entry: &PlanEntry, out:
         reason: solved.error.clone(),
         wall_time_s: start.elapsed().as_secs_f64(),
     };
-    folder.manifest.frames_done = solved.frames.map(|f| f.0);
-    folder.manifest.frames_total = solved.frames.map(|f| f.1);
+    folder.manifest.frames.frames_done = solved.frames.map(|f| f.0);
+    folder.manifest.frames.frames_total = solved.frames.map(|f| f.1);
     folder.manifest.certificate = solved.certificate(&case);
     let written = serde_json::to_vec_pretty(&row)
         .map_err(|e| OutputError::Invalid { path: folder.dir().join(ROW), reason: e.to_string() })

@@ -166,7 +166,7 @@ fn glitch(pts: &[Vector3<f64>]) -> String {
 /// ([`super::truth_file`]). The frame range and the orientation of the
 /// case are applied to both.
 pub fn load_clip(case: &Case) -> Result<(Clip, Option<GroundTruth>), ClipFileError> {
-    if case.rod_length == RodLength::FromData(None) {
+    if case.rod.length == RodLength::FromData(None) {
         return Err(ClipFileError::LengthNotResolved { case: case.name.clone() });
     }
     let src = clip_source(case)?;
@@ -231,7 +231,7 @@ pub fn load_clip(case: &Case) -> Result<(Clip, Option<GroundTruth>), ClipFileErr
 /// clip file is written as an absolute path (a batch's recording replaces the file's). Any other
 /// case is returned as it is.
 pub fn resolve_length(case: &Case) -> Result<Case, ClipFileError> {
-    if case.rod_length != RodLength::FromData(None) {
+    if case.rod.length != RodLength::FromData(None) {
         return Ok(case.clone());
     }
     let src = clip_source(case)?;
@@ -251,8 +251,8 @@ pub fn resolve_length(case: &Case) -> Result<Case, ClipFileError> {
         length_m: body.length_m,
         source,
     })?;
-    resolved.rod_length = RodLength::FromData(Some(body));
-    resolved.source_sha256.clone_from(&case.source_sha256);
+    resolved.rod.length = RodLength::FromData(Some(body));
+    resolved.origin.source_sha256.clone_from(&case.origin.source_sha256);
     Ok(resolved)
 }
 

@@ -13,7 +13,8 @@ use super::compact::{write_compact, OutputFormat, CURVATURE_COLUMNS, RAW_CURVATU
 use super::files::OutputError;
 use super::journal::{Entry, Journal, Offsets, JOURNAL};
 use super::vtk::{write_pvd, write_vtp, PolylineFields};
-use crate::run::clip::{nodal_curvature, ClipFrame, FrameSink};
+use crate::run::clip::{nodal_curvature, ClipFrame, Controls, FrameSink};
+use crate::solve::sequence::FrameReport;
 
 /// Streams a clip solve to disk, one frame at a time (`frames.csv`, `fields.csv`,
 /// `curvature.csv`, ParaView `vtk/frame_NNNNN.vtp` + `clip.pvd`). Every line is flushed with
@@ -239,30 +240,17 @@ impl ClipWriter {
     /// Append one converged frame: its report row, nodal fields, element curvature, truth row
     /// and VTK file.
     pub fn write_frame(&mut self, frame: &ClipFrame) -> Result<(), OutputError> {
-        let ClipFrame { report, time_s, nodes, force, torque, data, omega, kappa, roughness, .. } = frame;
+        let ClipFrame { report, time_s, nodes, controls, data, omega, kappa, planar, .. } = frame;
+        let Controls { force, torque } = controls;
         let omega = omega.clone().unwrap_or_else(|| vec![Vector3::zeros(); nodes.s.len()]);
-        let (time_s, roughness) = (*time_s, *roughness);
+        let (time_s, roughness) = (*time_s, planar.roughness);
         let dir = self.dir.clone();
         let err = |name: &str| {
             let p = dir.join(name);
             move |source| OutputError::Io { path: p.clone(), source }
         };
         let r = report;
-        let mut row = vec![r.frame as f64, time_s, r.iterations as f64, r.last_change, r.x_err_rel, r.tangent_misfit];
-        row.extend(r.objective.values());
-        row.extend([
-            r.min_cos_beta,
-            r.min_cos_beta_node as f64,
-            r.max_stretch_deviation,
-            roughness.0,
-            roughness.1,
-            f64::from(u8::from(r.restarted)),
-        ]);
-        row.extend(r.chart_axis.iter());
-        row.push(omega.iter().map(|w| w.norm()).fold(0.0, f64::max));
-        row.push(r.certificate);
-        row.extend([r.fit.noise_m, r.fit.position, r.fit.tangent, f64::from(u8::from(r.fit.flagged))]);
-        row.push(r.nodes_tracked as f64);
+        let row = report_row(r, time_s, roughness, &omega);
         writeln!(self.frames, "{}", frames_row(&row)).and_then(|_| self.frames.flush()).map_err(err("frames.csv"))?;
         let d = nodes.directors();
         let [fields, curvature] = row_files(self.format());
@@ -338,8 +326,8 @@ impl ClipWriter {
                     ("d1", &d1),
                     ("d2", &d2),
                     ("d3", &d3),
-                    ("f_n_per_m", &frame.force),
-                    ("l_nm_per_m", &frame.torque),
+                    ("f_n_per_m", &frame.controls.force),
+                    ("l_nm_per_m", &frame.controls.torque),
                     ("kappa_per_m", &kn),
                     ("data_position_m", &frame.data),
                     ("omega_rad_per_s", omega),
@@ -458,4 +446,24 @@ fn push_csv(s: &mut String, values: &[f64]) {
         }
         super::number::push_exp(s, *v, 10);
     }
+}
+
+/// The row of `frames.csv` of a frame: its report, time [s], roughness and largest |ω| [rad/s].
+fn report_row(r: &FrameReport, time_s: f64, roughness: (f64, f64), omega: &[Vector3<f64>]) -> Vec<f64> {
+    let mut row = vec![r.frame as f64, time_s, r.iterations as f64, r.last_change, r.x_err_rel, r.tangent_misfit];
+    row.extend(r.objective.values());
+    row.extend([
+        r.min_cos_beta,
+        r.min_cos_beta_node as f64,
+        r.max_stretch_deviation,
+        roughness.0,
+        roughness.1,
+        f64::from(u8::from(r.restarted)),
+    ]);
+    row.extend(r.chart_axis.iter());
+    row.push(omega.iter().map(|w| w.norm()).fold(0.0, f64::max));
+    row.push(r.certificate);
+    row.extend([r.fit.noise_m, r.fit.position, r.fit.tangent, f64::from(u8::from(r.fit.flagged))]);
+    row.push(r.nodes_tracked as f64);
+    row
 }

@@ -54,7 +54,7 @@ pub struct ClipInclude {
 /// the quadrature, the loads, the solver settings and, for an inverse case, its weights and
 /// solver, in that order.
 pub fn include_file(case: &Case, opts: &RunOptions) -> String {
-    let names = constant_names(&case.constants);
+    let names = constant_names(&case.origin.constants);
     let mut o = String::new();
     write_rod(&mut o, case, &names);
     write_quadrature(&mut o, case);
@@ -81,7 +81,7 @@ fn write_rod(o: &mut String, case: &Case, names: &BTreeMap<String, String>) {
         let _ = writeln!(o, "real I{} = {};", k + 1, num(p.rotary_inertia_kg_m[k]));
     }
     let _ = writeln!(o, "real rhoA = {};", num(p.mass_per_length_kg_m));
-    for (k, v) in &case.constants {
+    for (k, v) in &case.origin.constants {
         let _ = writeln!(o, "real {} = {}; // constant `{k}`", names[k], num(*v));
     }
 }

@@ -116,14 +116,14 @@ fn stopped_by_full_disk(folder: RunFolder, mut end: JobEnd, out: &Path) -> JobEn
 /// The `run.json` of `cosserat run` on `case` in `engine`.
 pub fn run_manifest(case: &Case, engine: Engine) -> Result<Manifest, FolderError> {
     let mut m = Manifest::new("run");
-    m.case_name = Some(case.name.clone());
-    m.case = case_file(case)?;
-    m.inputs = case_inputs(case)?;
+    m.input.case_name = Some(case.name.clone());
+    m.input.case = case_file(case)?;
+    m.input.inputs = case_inputs(case)?;
     if case.clip().is_some() {
         // a clip's folder counts frames from the start (what makes it resumable)
-        m.frames_done = Some(0);
+        m.frames.frames_done = Some(0);
     }
-    m.engine = Some(engine.to_string());
+    m.input.engine = Some(engine.to_string());
     m.body_length = case.body_length();
     Ok(m)
 }
@@ -131,8 +131,8 @@ pub fn run_manifest(case: &Case, engine: Engine) -> Result<Manifest, FolderError
 /// The case file with the SHA-256 of the bytes that were read (also of a case piped in through
 /// standard input), or hashed now for a case that was not read from a file by `Case::from_file`.
 pub fn case_file(case: &Case) -> Result<Option<InputFile>, FolderError> {
-    let Some(path) = &case.source else { return Ok(None) };
-    Ok(Some(match &case.source_sha256 {
+    let Some(path) = &case.origin.source else { return Ok(None) };
+    Ok(Some(match &case.origin.source_sha256 {
         Some(sha256) => InputFile { path: path.display().to_string(), sha256: sha256.clone() },
         None => input_file_as(path, "case file")?,
     }))
@@ -188,8 +188,8 @@ pub fn run_into(
     end.clip = solved.clip;
     folder.manifest.weights = end.clip.as_ref().and_then(|c| c.weights);
     end.frames = solved.frames;
-    folder.manifest.frames_done = end.frames.map(|f| f.0);
-    folder.manifest.frames_total = end.frames.map(|f| f.1);
+    folder.manifest.frames.frames_done = end.frames.map(|f| f.0);
+    folder.manifest.frames.frames_total = end.frames.map(|f| f.1);
     if solved.disk_full {
         return Ok(stopped_by_full_disk(folder, end, out));
     }

@@ -67,27 +67,19 @@ pub struct CertificateSummary {
     pub flagged_frames: Option<usize>,
 }
 
-/// `run.json`.
+/// `run.json`; the groups are flattened into it, so its keys keep their order: program,
+/// version, command, case_name, case, inputs, settings, engine, status, frames_done,
+/// frames_total, message, certificate, weights, body_length, pid, started_unix_s,
+/// finished_unix_s, files.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Manifest {
-    /// "cosserat"
-    pub program: String,
-    /// the program's version (Cargo.toml)
-    pub version: String,
-    /// the subcommand: run, sweep, compare, audit
-    pub command: String,
-    /// the case's name and file (with its SHA-256), where the command has one
-    pub case_name: Option<String>,
-    pub case: Option<InputFile>,
-    /// other inputs the results depend on (a clip's recording or kymogram)
-    pub inputs: Vec<InputFile>,
-    /// settings that differ from the case file (a sweep point)
-    pub settings: BTreeMap<String, SweepValue>,
-    pub engine: Option<String>,
+    #[serde(flatten)]
+    pub writer: Writer,
+    #[serde(flatten)]
+    pub input: RunInputs,
     pub status: Status,
-    /// clips: converged frames written, and frames of the clip
-    pub frames_done: Option<usize>,
-    pub frames_total: Option<usize>,
+    #[serde(flatten)]
+    pub frames: FrameProgress,
     /// why the run failed or stopped
     pub message: Option<String>,
     /// the residual certificate of the result, where the run has one
@@ -100,13 +92,49 @@ pub struct Manifest {
     /// spread and range of its frames (`clip::length`)
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub body_length: Option<BodyLength>,
-    /// the process that wrote the folder
-    pub pid: u32,
-    /// seconds since the Unix epoch
-    pub started_unix_s: u64,
-    pub finished_unix_s: Option<u64>,
+    #[serde(flatten)]
+    pub process: Process,
     /// every file of the folder (relative paths, `/`-separated), `run.json` excepted
     pub files: Vec<String>,
+}
+
+/// What wrote a run folder.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Writer {
+    /// "cosserat"
+    pub program: String,
+    /// the program's version (Cargo.toml)
+    pub version: String,
+    /// the subcommand: run, sweep, compare, audit
+    pub command: String,
+}
+
+/// What a run's results depend on, and the engine that made them.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct RunInputs {
+    /// the case's name and file (with its SHA-256), where the command has one
+    pub case_name: Option<String>,
+    pub case: Option<InputFile>,
+    /// other inputs the results depend on (a clip's recording or kymogram)
+    pub inputs: Vec<InputFile>,
+    /// settings that differ from the case file (a sweep point)
+    pub settings: BTreeMap<String, SweepValue>,
+    pub engine: Option<String>,
+}
+
+/// Clips: converged frames written, and frames of the clip.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct FrameProgress {
+    pub frames_done: Option<usize>,
+    pub frames_total: Option<usize>,
+}
+
+/// The process that wrote the folder, and when [s since the Unix epoch].
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Process {
+    pub pid: u32,
+    pub started_unix_s: u64,
+    pub finished_unix_s: Option<u64>,
 }
 
 /// Errors of the output-folder contract; each names the folder.
@@ -172,24 +200,25 @@ impl Manifest {
     /// A running manifest of `command` in this process.
     pub fn new(command: &str) -> Self {
         Manifest {
-            program: "cosserat".into(),
-            version: env!("CARGO_PKG_VERSION").into(),
-            command: command.into(),
-            case_name: None,
-            case: None,
-            inputs: Vec::new(),
-            settings: BTreeMap::new(),
-            engine: None,
+            writer: Writer {
+                program: "cosserat".into(),
+                version: env!("CARGO_PKG_VERSION").into(),
+                command: command.into(),
+            },
+            input: RunInputs {
+                case_name: None,
+                case: None,
+                inputs: Vec::new(),
+                settings: BTreeMap::new(),
+                engine: None,
+            },
             status: Status::Running,
-            frames_done: None,
-            frames_total: None,
+            frames: FrameProgress { frames_done: None, frames_total: None },
             message: None,
             certificate: None,
             weights: None,
             body_length: None,
-            pid: std::process::id(),
-            started_unix_s: now_unix_s(),
-            finished_unix_s: None,
+            process: Process { pid: std::process::id(), started_unix_s: now_unix_s(), finished_unix_s: None },
             files: Vec::new(),
         }
     }
@@ -221,7 +250,7 @@ impl Manifest {
     pub fn finish(&mut self, dir: &Path, status: Status, message: Option<String>) -> Result<(), FolderError> {
         self.status = status;
         self.message = message;
-        self.finished_unix_s = Some(now_unix_s());
+        self.process.finished_unix_s = Some(now_unix_s());
         self.files = list_files(dir)?;
         self.write(dir)
     }
@@ -280,30 +309,33 @@ pub enum ResumeRefusal {
 /// (`run`) on the same case file and inputs, a clip, not complete; or an audit (`audit
 /// --resume`, `crate::audit::resume`) on the same specs, not complete.
 pub(super) fn check_resumable(previous: &Manifest, new: &Manifest) -> Result<(), ResumeRefusal> {
-    let clip = previous.command == "run" && previous.frames_done.is_some();
-    let audit = previous.command == "audit" && new.command == "audit";
+    let clip = previous.writer.command == "run" && previous.frames.frames_done.is_some();
+    let audit = previous.writer.command == "audit" && new.writer.command == "audit";
     if !(clip || audit) {
-        return Err(ResumeRefusal::NotClip { command: previous.command.clone() });
+        return Err(ResumeRefusal::NotClip { command: previous.writer.command.clone() });
     }
     if previous.status.is_complete() {
         return Err(ResumeRefusal::Complete);
     }
-    if previous.version != new.version {
-        return Err(ResumeRefusal::Version { previous: previous.version.clone(), now: new.version.clone() });
-    }
-    let hash = |f: &Option<InputFile>| f.as_ref().map(|f| f.sha256.clone());
-    if hash(&previous.case) != hash(&new.case) {
-        return Err(ResumeRefusal::CaseChanged {
-            previous: hash(&previous.case).unwrap_or_default(),
-            now: hash(&new.case).unwrap_or_default(),
+    if previous.writer.version != new.writer.version {
+        return Err(ResumeRefusal::Version {
+            previous: previous.writer.version.clone(),
+            now: new.writer.version.clone(),
         });
     }
-    let hashes = |m: &Manifest| m.inputs.iter().map(|f| f.sha256.clone()).collect::<Vec<_>>();
+    let hash = |f: &Option<InputFile>| f.as_ref().map(|f| f.sha256.clone());
+    if hash(&previous.input.case) != hash(&new.input.case) {
+        return Err(ResumeRefusal::CaseChanged {
+            previous: hash(&previous.input.case).unwrap_or_default(),
+            now: hash(&new.input.case).unwrap_or_default(),
+        });
+    }
+    let hashes = |m: &Manifest| m.input.inputs.iter().map(|f| f.sha256.clone()).collect::<Vec<_>>();
     if hashes(previous) != hashes(new) {
         return Err(ResumeRefusal::InputsChanged);
     }
-    if previous.engine != new.engine {
-        return Err(ResumeRefusal::Engine { previous: previous.engine.clone().unwrap_or_default() });
+    if previous.input.engine != new.input.engine {
+        return Err(ResumeRefusal::Engine { previous: previous.input.engine.clone().unwrap_or_default() });
     }
     Ok(())
 }

@@ -124,7 +124,7 @@ impl RunFolder {
                     }
                 }
                 remove_temporaries(&staging)?;
-                manifest.started_unix_s = previous.started_unix_s;
+                manifest.process.started_unix_s = previous.process.started_unix_s;
                 Some(previous)
             }
         };

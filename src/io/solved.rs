@@ -257,7 +257,7 @@ fn flag_message(case: &Case, flagged: &[&FrameReport], done: usize) -> String {
 
 /// The case's name and file, for messages.
 pub fn case_label(case: &Case) -> String {
-    match &case.source {
+    match &case.origin.source {
         Some(p) => format!("case {} ({})", case.name, p.display()),
         None => format!("case {}", case.name),
     }

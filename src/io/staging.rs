@@ -23,7 +23,7 @@ impl Leftover {
     /// a run holds the previous output folder (finished, written by another process) for an
     /// instant, and is no run's work.
     pub(super) fn in_progress(&self) -> bool {
-        self.manifest.as_ref().is_some_and(|m| m.status == Status::Running || m.pid == self.pid)
+        self.manifest.as_ref().is_some_and(|m| m.status == Status::Running || m.process.pid == self.pid)
     }
 }
 

@@ -127,11 +127,11 @@ pub fn run_clip_point(
 /// the point's settings, the Rust engine.
 pub fn point_manifest(command: &str, case: &Case, point: &Point) -> Manifest {
     let mut m = Manifest::new(command);
-    m.case_name = Some(case.name.clone());
-    m.case = super::job::case_file(case).ok().flatten();
-    m.inputs = super::job::case_inputs(case).unwrap_or_default();
-    m.settings = point.iter().cloned().collect();
-    m.engine = Some("rust".into());
+    m.input.case_name = Some(case.name.clone());
+    m.input.case = super::job::case_file(case).ok().flatten();
+    m.input.inputs = super::job::case_inputs(case).unwrap_or_default();
+    m.input.settings = point.iter().cloned().collect();
+    m.input.engine = Some("rust".into());
     m.body_length = case.body_length();
     m
 }
@@ -144,7 +144,7 @@ fn finish_point(dir: &Path, template: &Manifest, case: &Case, outcome: Solved) -
     let mut m = template.clone();
     m.certificate = outcome.certificate(case);
     if let Some(c) = &outcome.clip {
-        m.frames_done = Some(c.reports.len());
+        m.frames.frames_done = Some(c.reports.len());
     }
     match m.finish(dir, outcome.status.folder_status(), outcome.error.clone()) {
         Ok(()) => outcome,

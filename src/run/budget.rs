@@ -152,7 +152,7 @@ pub fn check(case: &Case, what: Footprint, limit_bytes: f64) -> Result<(), Budge
             Footprint::Run => "the run",
             Footprint::Modes => "the modal model",
         };
-        let case = case.source.as_ref().map(|p| p.display().to_string()).unwrap_or_else(|| case.name.clone());
+        let case = case.origin.source.as_ref().map(|p| p.display().to_string()).unwrap_or_else(|| case.name.clone());
         return Err(BudgetError { case, what, bytes, limit: limit_bytes, basis, key, address_space });
     }
     Ok(())

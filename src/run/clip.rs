@@ -3,75 +3,26 @@
 //! [`ClipFrame`] (curvature, truth comparison, summary) and given to a [`FrameSink`] (which
 //! `crate::io` implements with the streamed files). The frames themselves may arrive while the
 //! clip is solved ([`ClipFrames::Streamed`]).
-use std::sync::mpsc::Receiver;
+use std::sync::mpsc::{Receiver, SyncSender};
 use std::time::Instant;
 
-use nalgebra::{DVector, Matrix3, Vector3};
+use nalgebra::{DVector, Vector3};
 
-use super::metrics::INNER_SKIP_ELEMENTS;
-use super::{NodalState, RunError};
+use super::clip_frame::{frame_data, ClipFrameError, Converged, Deriver};
+pub use super::clip_frame::{
+    nodal_curvature, planar_xz_curvature, sign_alternation, ClipFrame, Controls, FrameRecord, PlanarCurvature,
+    TruthFrame, TRUTH_SKIP_NODES,
+};
+use super::RunError;
 use crate::case::Case;
-use crate::clip::synthetic::{compare_frame, FrameComparison, FrameTruth, GroundTruth, RecoveredFrame};
+use crate::clip::synthetic::{FrameComparison, FrameTruth, GroundTruth};
 use crate::clip::Clip;
-use crate::model::chart::Chart;
-use crate::model::mesh::Field;
 use crate::model::rotation::Angles;
-use crate::solve::inverse::measures::angular_velocity;
 use crate::solve::inverse::Records;
 use crate::solve::sequence::{
     solve_sequence_from, vector_to_space, ClipData, FirstStart, FrameReport, ResumeFrom, SequenceError, SequenceParams,
 };
-use crate::solve::SolveError;
-
-/// Nodes skipped at each end when scoring curvature against a ground truth (the curvature of
-/// the inverse solution is least reliable at the free ends; as `metrics::INNER_SKIP_ELEMENTS`).
-pub const TRUTH_SKIP_NODES: usize = INNER_SKIP_ELEMENTS;
-
-/// One converged frame of a clip, in space coordinates.
-#[derive(Clone, Debug)]
-pub struct ClipFrame {
-    pub report: FrameReport,
-    /// frame time [s]
-    pub time_s: f64,
-    /// the recovered state (angles in the frame's chart)
-    pub nodes: NodalState,
-    /// controls f = x̂/λf [N/m] and l = α̂/λl [N m/m] per node (eq. 54)
-    pub force: Vec<Vector3<f64>>,
-    pub torque: Vec<Vector3<f64>>,
-    /// the frame's data positions [m]
-    pub data: Vec<Vector3<f64>>,
-    /// angular velocity ωˡ = A(α)(α − α_{n−1})/Δt per node [rad/s], components in the local
-    /// frame (d1, d2, d3) as κ (eq. 27; [`angular_velocity`]): exactly what the Λω term of (41)
-    /// penalised, α_{n−1} the previous frame's angles in this frame's chart. `None` on the
-    /// first frame, which has no previous frame (Remark 6)
-    pub omega: Option<Vec<Vector3<f64>>>,
-    /// element-midpoint curvature `(s [m], κ = A ∂sα [1/m])` (eq. 28), computed once for every
-    /// consumer of the frame
-    pub kappa: Vec<(f64, Vector3<f64>)>,
-    /// recovered κ2 at the element midpoints and the data's planar curvature at the interior
-    /// nodes [1/m] ([`ClipRun::kappa2`], [`ClipRun::data_kappa`])
-    pub kappa2: Vec<f64>,
-    pub data_kappa: Vec<f64>,
-    /// sign alternation of the recovered κ2 and of the data's planar curvature
-    pub roughness: (f64, f64),
-    /// synthetic clips: the frame against its ground truth
-    pub truth: Option<TruthFrame>,
-    /// what the frame is derived from (the resume journal)
-    pub record: FrameRecord,
-}
-
-/// A frame of a synthetic clip against its ground truth.
-#[derive(Clone, Debug)]
-pub struct TruthFrame {
-    /// true roll ψ of the bending plane [rad]
-    pub roll_rad: f64,
-    /// true twist κ3, mean over the nodes [rad/m]
-    pub twist_per_m: f64,
-    pub comparison: FrameComparison,
-    /// true and recovered bending `κ1² + κ2²` per node [1/m²]
-    pub bending_true: Vec<f64>,
-    pub bending_recovered: Vec<f64>,
-}
+use crate::solve::{Problem, SolveError};
 
 /// Where the frames of a clip go (`crate::io::clip_files::ClipWriter` streams them to disk).
 /// Called from a second thread, in frame order.
@@ -116,56 +67,6 @@ pub struct TruthRun {
     pub twist_per_m: Vec<f64>,
     pub bending_true: Vec<Vec<f64>>,
     pub bending_recovered: Vec<Vec<f64>>,
-}
-
-/// Curvature at the nodes from element-midpoint values: the mean of the adjacent elements
-/// (the end element at the ends).
-pub fn nodal_curvature(kappa: &[(f64, Vector3<f64>)]) -> Vec<Vector3<f64>> {
-    let m = kappa.len();
-    (0..=m).map(|i| (kappa[i.saturating_sub(1).min(m - 1)].1 + kappa[i.min(m - 1)].1) * 0.5).collect()
-}
-
-/// Planar curvature of a centreline in the x–z plane at interior nodes [1/m]:
-/// `(θ_e − θ_{e−1})/h`, θ the tangent angle from e3 towards e1. For a frame with α = β = 0 this
-/// is κ2 of eq. (28) (κ = A ∂sα with A(0) gives κ2 = −∂sγ = ∂sθ).
-pub fn planar_xz_curvature(x: &[Vector3<f64>], h: f64) -> Vec<f64> {
-    let theta: Vec<f64> = x.windows(2).map(|w| (w[1][0] - w[0][0]).atan2(w[1][2] - w[0][2])).collect();
-    theta
-        .windows(2)
-        .map(|t| {
-            let d = t[1] - t[0];
-            let d = (d + std::f64::consts::PI).rem_euclid(2.0 * std::f64::consts::PI) - std::f64::consts::PI;
-            d / h
-        })
-        .collect()
-}
-
-/// Roughness of a sequence: the fraction of interior points where the first difference changes
-/// sign (a local extremum). A smooth curvature profile of a worm has a handful of extrema; a
-/// nodal zig-zag has one at almost every point (roughness → 1).
-pub fn sign_alternation(k: &[f64]) -> f64 {
-    if k.len() < 3 {
-        return 0.0;
-    }
-    let d: Vec<f64> = k.windows(2).map(|w| w[1] - w[0]).collect();
-    let flips = d.windows(2).filter(|w| w[0] * w[1] < 0.0).count();
-    flips as f64 / (k.len() - 2) as f64
-}
-
-/// Everything a converged frame of a clip is derived from, exactly (the resume journal of
-/// `crate::io` stores one per frame): with the records of frames `0..n` a clip resumes at frame
-/// `n` and continues bit for bit as the uninterrupted solve (`solve::sequence::ResumeFrom`),
-/// and the summary of frames `0..n` is derived again from them without solving.
-#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
-pub struct FrameRecord {
-    pub report: FrameReport,
-    pub chart: Chart,
-    /// the state `(x, α)` in the frame's chart (forward layout)
-    pub state: DVector<f64>,
-    /// the adjoint `(x̂, α̂)` in space coordinates (forward layout)
-    pub adjoint: DVector<f64>,
-    /// the previous frame's angles in this frame's chart (`None` on the first frame)
-    pub previous: Option<Vec<Angles>>,
 }
 
 /// How a clip run ended: its summary over the frames it solved (all of them, or those before
@@ -259,105 +160,87 @@ pub fn run_clip<S: FrameSink>(
     case: &Case,
     frames: ClipFrames<'_>,
     resume: &[FrameRecord],
-    mut sink: S,
+    sink: S,
     mut progress: impl FnMut(usize, usize),
 ) -> Result<ClipOutcome, RunError> {
     let sp = case.sequence_params().ok_or_else(|| RunError::Kind { case: case.name.clone(), what: "a clip case" })?;
     // a clip keeps each frame's report, not its iteration history
     let sp = SequenceParams { records: Records::Last, ..sp };
     let problem = case.problem();
-    let dofs = problem.dofs();
-    let w8 = sp.inverse.weights;
-    let first_frame = sp.frame_offset;
     // frame 0's initial iterate, for the first run of frames only
-    let mut frame0_start = match &frames {
+    let frame0_start = match &frames {
         ClipFrames::Loaded { start, .. } => start.cloned(),
         ClipFrames::Streamed { .. } => None,
     };
     let mut arrivals = Arrivals { input: frames, frames: Vec::new(), truth: Vec::new() };
     let (header, total, has_truth) = arrivals.header();
     let (dt_s, source) = (header.dt_s, header.source.clone());
-    let h = case.mesh.h();
+    let deriver = Deriver {
+        case,
+        dofs: problem.dofs(),
+        weights: sp.inverse.weights,
+        h: case.mesh.h(),
+        dt: sp.inverse.frame_interval_s,
+        dt_s,
+    };
     let start = Instant::now();
-    let dt = sp.inverse.frame_interval_s;
     let mut summary = Summary::new(has_truth);
-    // A converged frame in space coordinates with everything its consumers need (on the
-    // output thread).
-    let derive = |c: Converged| -> Result<ClipFrame, String> {
-        let Converged { report: rep, u, adjoint, chart, previous, state, data, truth } = c;
-        let nodes = NodalState { chart, ..NodalState::from_vector(&case.mesh, &u) };
-        let (force, torque): (Vec<_>, Vec<_>) = (0..nodes.s.len())
-            .map(|i| {
-                let (xh, ah) = (dofs.get(&adjoint, i, Field::X), dofs.get(&adjoint, i, Field::Alpha));
-                (xh / w8.lambda_f, ah / w8.lambda_l)
-            })
-            .unzip();
-        let kappa = nodes.element_curvature();
-        let k2: Vec<f64> = kappa.iter().map(|(_, k)| k[1]).collect();
-        // The data's curvature in the plane normal to the chart's axis (exactly the x–z
-        // curvature for an x–z clip; rotates with the data, R5).
-        let in_chart: Vec<Vector3<f64>> = data.iter().map(|x| chart.to_chart(x)).collect();
-        let kd = planar_xz_curvature(&in_chart, h);
-        let mut truth_frame = None;
-        if let Some(ft) = &truth {
-            let q: Vec<Matrix3<f64>> = nodes.alpha.iter().map(|a| nodes.chart.rotation(a)).collect();
-            let kn = nodal_curvature(&kappa);
-            let c = compare_frame(&data, ft, &RecoveredFrame { x: &nodes.x, q: &q, kappa: &kn }, TRUTH_SKIP_NODES)
-                .map_err(|e| e.to_string())?;
-            let twist = ft.kappa.iter().map(|k| k.z).sum::<f64>() / ft.kappa.len() as f64;
-            let bend = |k: &Vector3<f64>| k.x * k.x + k.y * k.y;
-            truth_frame = Some(TruthFrame {
-                roll_rad: ft.roll_rad,
-                twist_per_m: twist,
-                comparison: c,
-                bending_true: ft.kappa.iter().map(bend).collect(),
-                bending_recovered: kn.iter().map(bend).collect(),
-            });
+    resume_summary(&deriver, &mut arrivals, resume, sp.frame_offset, &mut summary)?;
+    // room for about 0.1 s of frames: the output thread falls behind while a streamed clip's
+    // generator shares its core (the first 0.25 s of worm_roll_3d), and catches up after
+    let (tx, rx) = std::sync::mpsc::sync_channel::<Converged>(64);
+    let (result, (summary, written)) = std::thread::scope(|scope| {
+        let deriver = &deriver;
+        // The output thread: each frame derived, summarised and handed to the sink.
+        let io = scope.spawn(move || {
+            let written = write_frames(deriver, rx, sink, &mut summary);
+            (summary, written)
+        });
+        let runs = Runs { problem: &problem, sp: &sp, total };
+        let result = runs.solve(&mut arrivals, frame0_start, resume, tx, &mut progress);
+        let written = io.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+        (result, written)
+    });
+    // A write error explains a stopped clip better than the stop itself.
+    let stopped = match (written, result) {
+        (Err(OutputStop::Sink(e)), _) => Some(RunError::Sink(Box::new(e))),
+        (Err(OutputStop::Derive { frame, error }), _) => {
+            Some(RunError::Sequence(SequenceError::Callback { frame, stop: Box::new(error) }))
         }
-        let omega: Option<Vec<Vector3<f64>>> = previous
-            .as_ref()
-            .map(|prev| nodes.alpha.iter().zip(prev).map(|(a, p)| angular_velocity(a, p, dt)).collect());
-        let roughness = (sign_alternation(&k2), sign_alternation(&kd));
-        Ok(ClipFrame {
-            report: rep,
-            time_s: rep.frame as f64 * dt_s,
-            nodes,
-            force,
-            torque,
-            data,
-            omega,
-            kappa,
-            kappa2: k2,
-            data_kappa: kd,
-            roughness,
-            truth: truth_frame,
-            record: FrameRecord { report: rep, chart, state, adjoint, previous },
-        })
+        (Ok(()), Err(e)) => Some(e),
+        (Ok(()), Ok(())) => None,
     };
-    // The data (and ground truth) of frame `rep.frame` among the frames at hand.
-    let frame_data = |rep: &FrameReport,
-                      (frames, truth): (&[Vec<Vector3<f64>>], Option<&[FrameTruth]>)|
-     -> Result<(Vec<Vector3<f64>>, Option<FrameTruth>), String> {
-        let index = rep.frame.checked_sub(first_frame).filter(|i| *i < frames.len());
-        let index = index.ok_or_else(|| format!("frame {} is outside the clip", rep.frame))?;
-        Ok((frames[index].clone(), truth.map(|t| t[index].clone())))
-    };
-    // The frames of an earlier run: their summary again, from their records.
+    let run = summary.finish(start.elapsed().as_secs_f64(), source);
+    let stopped = stopped.map(|e| with_degradation(e, &run.reports));
+    Ok(ClipOutcome { run, stopped, total })
+}
+
+/// The frames of an earlier run (`resume`): checked against the case and summarised again
+/// from their records.
+fn resume_summary(
+    deriver: &Deriver,
+    arrivals: &mut Arrivals<'_>,
+    resume: &[FrameRecord],
+    first_frame: usize,
+    summary: &mut Summary,
+) -> Result<(), RunError> {
     arrivals.wait(resume.len())?;
+    let unknowns = deriver.dofs.len();
     for (i, r) in resume.iter().enumerate() {
-        if r.report.frame != first_frame + i || r.state.len() != dofs.len() || r.adjoint.len() != dofs.len() {
-            return Err(RunError::Resume(format!(
-                "record {i} is frame {} with {} unknowns; expected frame {} with {}",
-                r.report.frame,
-                r.state.len(),
-                first_frame + i,
-                dofs.len()
-            )));
+        if r.report.frame != first_frame + i || r.state.len() != unknowns || r.adjoint.len() != unknowns {
+            return Err(RunError::Resume(ResumeError::Record {
+                index: i,
+                frame: r.report.frame,
+                unknowns: r.state.len(),
+                expected_frame: first_frame + i,
+                expected_unknowns: unknowns,
+            }));
         }
-        let (data, truth) = frame_data(&r.report, arrivals.frames()).map_err(RunError::Resume)?;
+        let frame_error = |e: ClipFrameError| RunError::Resume(ResumeError::Frame(e));
+        let (data, truth) = frame_data(first_frame, &r.report, arrivals.frames()).map_err(frame_error)?;
         let c = Converged {
             report: r.report,
-            u: vector_to_space(&dofs, &r.chart, &r.state, false),
+            u: vector_to_space(&deriver.dofs, &r.chart, &r.state, false),
             adjoint: r.adjoint.clone(),
             chart: r.chart,
             previous: r.previous.clone(),
@@ -365,9 +248,14 @@ pub fn run_clip<S: FrameSink>(
             data,
             truth,
         };
-        summary.push(&derive(c).map_err(RunError::Resume)?);
+        summary.push(&deriver.derive(c).map_err(frame_error)?);
     }
-    let mut from = match resume {
+    Ok(())
+}
+
+/// Where the solve resumes after the frames of `resume` (the last two states).
+fn resume_from(resume: &[FrameRecord]) -> Option<ResumeFrom> {
+    match resume {
         [] => None,
         [.., a, b] => Some(ResumeFrom {
             next: resume.len(),
@@ -375,54 +263,67 @@ pub fn run_clip<S: FrameSink>(
             prev2: Some((a.chart, a.state.clone())),
         }),
         [b] => Some(ResumeFrom { next: 1, prev: (b.chart, b.state.clone()), prev2: None }),
-    };
-    // room for about 0.1 s of frames: the output thread falls behind while a streamed clip's
-    // generator shares its core (the first 0.25 s of worm_roll_3d), and catches up after
-    let (tx, rx) = std::sync::mpsc::sync_channel::<Converged>(64);
-    let (result, (summary, written)) = std::thread::scope(|scope| {
-        let derive = &derive;
-        // The output thread: each frame derived, summarised and handed to the sink.
-        let io = scope.spawn(move || {
-            let out = || -> Result<(), OutputStop<S::Error>> {
-                for c in rx {
-                    let frame = c.report.frame;
-                    let f = derive(c).map_err(|message| OutputStop::Derive { frame, message })?;
-                    // counted once written whole: the frames of the summary are the folder's
-                    sink.frame(&f).map_err(OutputStop::Sink)?;
-                    summary.push(&f);
-                }
-                sink.finish().map_err(OutputStop::Sink)
-            };
-            let written = out();
-            (summary, written)
-        });
-        let mut result = Ok(());
+    }
+}
+
+/// The output thread's work: each converged frame derived, handed to the sink and summarised
+/// (counted once written whole: the frames of the summary are the folder's).
+fn write_frames<S: FrameSink>(
+    deriver: &Deriver,
+    rx: Receiver<Converged>,
+    mut sink: S,
+    summary: &mut Summary,
+) -> Result<(), OutputStop<S::Error>> {
+    for c in rx {
+        let frame = c.report.frame;
+        let f = deriver.derive(c).map_err(|error| OutputStop::Derive { frame, error })?;
+        sink.frame(&f).map_err(OutputStop::Sink)?;
+        summary.push(&f);
+    }
+    sink.finish().map_err(OutputStop::Sink)
+}
+
+/// The solve of a clip of `total` frames in runs of the frames at hand.
+struct Runs<'a, 'p> {
+    problem: &'a Problem<'p>,
+    sp: &'a SequenceParams,
+    total: usize,
+}
+
+impl Runs<'_, '_> {
+    /// Solve the frames after those of `resume` in runs of the frames at hand, each run resumed
+    /// from the last two states of the one before, every converged frame sent on `tx` (dropped
+    /// at the end, which ends the output thread).
+    fn solve(
+        &self,
+        arrivals: &mut Arrivals<'_>,
+        mut frame0_start: Option<DVector<f64>>,
+        resume: &[FrameRecord],
+        tx: SyncSender<Converged>,
+        progress: &mut impl FnMut(usize, usize),
+    ) -> Result<(), RunError> {
+        let (first_frame, total) = (self.sp.frame_offset, self.total);
         let mut solved = resume.len();
+        let mut from = resume_from(resume);
         // the last two states solved, to resume the next run of frames from
         let (mut last, mut last2) = match &from {
             Some(r) => (Some(r.prev.clone()), r.prev2.clone()),
             None => (None, None),
         };
         while solved < total {
-            let at_hand = match arrivals.wait(solved + 1) {
-                Ok(n) => n,
-                Err(e) => {
-                    result = Err(e);
-                    break;
-                }
-            };
+            let at_hand = arrivals.wait(solved + 1)?;
             let view = arrivals.frames();
             let data = ClipData { positions: &view.0[..at_hand], tracked: arrivals.tracked().map(|t| &t[..at_hand]) };
             let run = solve_sequence_from(
-                &problem,
-                &sp,
+                self.problem,
+                self.sp,
                 data,
                 frame0_start.take().as_ref().map_or(FirstStart::DataGuess, FirstStart::Near),
                 from.take(),
                 |_, _| {},
                 |rep, frame| {
                     last2 = last.replace((frame.chart, frame.state.clone()));
-                    let (data, truth) = frame_data(rep, view)?;
+                    let (data, truth) = frame_data(first_frame, rep, view)?;
                     let c = Converged {
                         report: *rep,
                         u: frame.solution.u.clone(),
@@ -433,34 +334,17 @@ pub fn run_clip<S: FrameSink>(
                         data,
                         truth,
                     };
-                    tx.send(c).map_err(|_| "the output thread stopped (see the write error)".to_string())?;
+                    tx.send(c).map_err(|_| ClipFrameError::OutputStopped)?;
                     progress(rep.frame - first_frame + 1, total);
                     Ok(())
                 },
             );
-            if let Err(e) = run {
-                result = Err(RunError::from(clip_total(e, total)));
-                break;
-            }
+            run.map_err(|e| RunError::from(clip_total(e, total)))?;
             solved = at_hand;
             from = last.clone().map(|prev| ResumeFrom { next: solved, prev, prev2: last2.clone() });
         }
-        drop(tx);
-        let written = io.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic));
-        (result, written)
-    });
-    // A write error explains a stopped clip better than the stop itself.
-    let stopped = match (written, result) {
-        (Err(OutputStop::Sink(e)), _) => Some(RunError::Sink(Box::new(e))),
-        (Err(OutputStop::Derive { frame, message }), _) => {
-            Some(RunError::Sequence(SequenceError::Callback { frame, message }))
-        }
-        (Ok(()), Err(e)) => Some(e),
-        (Ok(()), Ok(())) => None,
-    };
-    let run = summary.finish(start.elapsed().as_secs_f64(), source);
-    let stopped = stopped.map(|e| with_degradation(e, &run.reports));
-    Ok(ClipOutcome { run, stopped, total })
+        Ok(())
+    }
 }
 
 /// A chart-guard stop with the frames before it that were over the fit-quality gate, counted
@@ -478,27 +362,21 @@ fn with_degradation(e: RunError, reports: &[FrameReport]) -> RunError {
     }
 }
 
-/// A converged frame as the solve hands it over (owned: the output thread derives the
-/// [`ClipFrame`] from it while the next frame is solved).
-struct Converged {
-    report: FrameReport,
-    /// state and adjoint in space coordinates (forward layout; angles in the frame's chart)
-    u: DVector<f64>,
-    adjoint: DVector<f64>,
-    chart: Chart,
-    /// the previous frame's angles in this frame's chart (`None` on the first frame)
-    previous: Option<Vec<Angles>>,
-    /// the state in the frame's chart
-    state: DVector<f64>,
-    /// the frame's data positions [m] and, for a synthetic clip, its ground truth
-    data: Vec<Vector3<f64>>,
-    truth: Option<FrameTruth>,
-}
-
 /// Why the output thread stopped: the sink's error, or a frame that could not be derived.
 enum OutputStop<E> {
     Sink(E),
-    Derive { frame: usize, message: String },
+    Derive { frame: usize, error: ClipFrameError },
+}
+
+/// Why the frames of an earlier run cannot be resumed from.
+#[derive(Debug, thiserror::Error)]
+pub enum ResumeError {
+    /// A record does not fit the case: another frame, or another number of unknowns.
+    #[error("record {index} is frame {frame} with {unknowns} unknowns; expected frame {expected_frame} with {expected_unknowns}")]
+    Record { index: usize, frame: usize, unknowns: usize, expected_frame: usize, expected_unknowns: usize },
+    /// A recorded frame could not be derived again.
+    #[error(transparent)]
+    Frame(#[from] ClipFrameError),
 }
 
 /// An interrupt of a run of a streamed clip's frames, counted against the whole clip's
@@ -537,9 +415,9 @@ impl Summary {
     fn push(&mut self, f: &ClipFrame) {
         let r = &mut self.run;
         r.reports.push(f.report);
-        r.roughness.push(f.roughness);
-        r.kappa2.push(f.kappa2.clone());
-        r.data_kappa.push(f.data_kappa.clone());
+        r.roughness.push(f.planar.roughness);
+        r.kappa2.push(f.planar.kappa2.clone());
+        r.data_kappa.push(f.planar.data_kappa.clone());
         r.omega.push(f.omega.clone().unwrap_or_else(|| vec![Vector3::zeros(); f.nodes.alpha.len()]));
         if let (Some(tr), Some(t)) = (&mut r.truth, &f.truth) {
             tr.comparisons.push(t.comparison);

@@ -99,7 +99,7 @@ pub fn solve_frames<'a>(case: &Case, data: impl Into<ClipData<'a>>) -> Result<So
         |rep, f| {
             let sol = f.solution;
             let nodes = NodalState { chart: f.chart, ..NodalState::from_vector(&case.mesh, &sol.u) };
-            let last = *sol.history.last().ok_or("no iteration ran")?;
+            let last = *sol.history.last().ok_or(SequenceError::NoIteration { frame: rep.frame })?;
             let result = frame_result(
                 case,
                 Engine::Rust,

@@ -4,6 +4,7 @@ use std::collections::BTreeMap;
 
 use nalgebra::{DVector, Vector3};
 
+use super::result::InverseOutput;
 use super::{NodalState, RunResult};
 use crate::case::{Case, Reference};
 use crate::model::mesh::Mesh;
@@ -185,15 +186,106 @@ pub struct Difference {
 /// errors and, with `iterations`, the iteration counts.
 pub fn differences(a: &RunResult, b: &RunResult, iterations: bool) -> Vec<Difference> {
     let mut rows = Vec::new();
-    let field = |name: &str, group: Group, difference: f64| Difference {
-        name: name.into(),
-        group,
-        a: None,
-        b: None,
-        difference: if difference.is_nan() { f64::INFINITY } else { difference },
-        bound: None,
-    };
-    let scalar = |name: &str, group: Group, x: Option<f64>, y: Option<f64>, bound: Option<(Group, f64)>| {
+    let amax = |v: &[Vector3<f64>]| v.iter().fold(0.0_f64, |m, v| m.max(v.amax()));
+    let disp_scale = amax(&a.nodes.displacement()).max(amax(&a.tip.iter().map(|t| t.position_m).collect::<Vec<_>>()));
+    let angle_scale = amax(&a.nodes.alpha).max(amax(&a.tip.iter().map(|t| t.angles_rad).collect::<Vec<_>>()));
+    let nodes_match = a.nodes.s.len() == b.nodes.s.len();
+    if nodes_match {
+        rows.push(Difference::field(
+            "nodewise_rel_diff_displacement",
+            Group::Displacement,
+            max_relative_difference(&a.nodes.displacement(), &b.nodes.displacement()),
+        ));
+        rows.push(Difference::field(
+            "nodewise_rel_diff_angles",
+            Group::Angles,
+            max_relative_difference(&a.nodes.alpha, &b.nodes.alpha),
+        ));
+    } else {
+        rows.push(Difference::field("node_count", Group::Displacement, f64::INFINITY));
+    }
+    let (ma, mb) = (physical_metrics(a), physical_metrics(b));
+    for (name, &x) in &ma {
+        let bound =
+            if name.ends_with("_rad") { (Group::Angles, angle_scale) } else { (Group::Displacement, disp_scale) };
+        rows.push(Difference::scalar(name, Group::Metric, Some(x), mb.get(name).copied(), Some(bound)));
+    }
+    if a.tip.len() == b.tip.len() && !a.tip.is_empty() {
+        let p: Vec<_> = a.tip.iter().map(|t| t.position_m - a.tip[0].position_m).collect();
+        let q: Vec<_> = b.tip.iter().map(|t| t.position_m - b.tip[0].position_m).collect();
+        rows.push(Difference::field("tip_history_rel_diff", Group::Displacement, max_relative_difference(&p, &q)));
+    } else if a.tip.len() != b.tip.len() {
+        rows.push(Difference::field("tip_history_length", Group::Displacement, f64::INFINITY));
+    }
+    if let (Some(x), Some(y)) = (&a.inverse, &b.inverse) {
+        if nodes_match {
+            rows.push(Difference::field(
+                "nodewise_rel_diff_xhat",
+                Group::Adjoint,
+                max_relative_difference(&x.xhat, &y.xhat),
+            ));
+            rows.push(Difference::field(
+                "nodewise_rel_diff_ahat",
+                Group::Adjoint,
+                max_relative_difference(&x.ahat, &y.ahat),
+            ));
+        }
+        rows.extend(recovery_differences(a, b, x, angle_scale));
+    }
+    if a.stats.certificate.is_some() || b.stats.certificate.is_some() {
+        rows.push(Difference::scalar(
+            "certificate",
+            Group::Certificate,
+            a.stats.certificate,
+            b.stats.certificate,
+            None,
+        ));
+    }
+    if iterations {
+        let (x, y) = (a.stats.iterations as f64, b.stats.iterations as f64);
+        rows.push(Difference::scalar("iterations", Group::Iterations, Some(x), Some(y), None));
+    }
+    rows
+}
+
+/// The recovery errors of two inverse runs (`x`: the first run's inverse output), each judged
+/// against its own scale.
+fn recovery_differences(a: &RunResult, b: &RunResult, x: &InverseOutput, angle_scale: f64) -> Vec<Difference> {
+    let mut rows = Vec::new();
+    // Recovery errors (κ amplifies angle differences by ~1/h).
+    // x_err_rel moves with the displacement relative to the data's size (scale 1); the
+    // curvature errors with ∂sα: 2 max|Δα|/h against the data's rms curvature.
+    let (ma, mb) = (inverse_metrics(a), inverse_metrics(b));
+    let kf: Vec<f64> = x.data.element_curvature().iter().map(|(_, k)| k.norm_squared()).collect();
+    let k_rms = (kf.iter().sum::<f64>() / kf.len().max(1) as f64).sqrt();
+    let h = a.nodes.s.get(1).copied().unwrap_or(1.0) - a.nodes.s.first().copied().unwrap_or(0.0);
+    for name in ["x_err_rel", "kappa_err_rel", "kappa_err_rel_inner"].into_iter().filter(|n| ma.contains_key(*n)) {
+        let bound = if name == "x_err_rel" {
+            (Group::Displacement, 1.0)
+        } else {
+            (Group::Angles, 2.0 * angle_scale / (h * k_rms))
+        };
+        rows.push(Difference::scalar(name, Group::Metric, ma.get(name).copied(), mb.get(name).copied(), Some(bound)));
+    }
+    rows
+}
+
+impl Difference {
+    /// A node-wise or history difference without values of its own (NaN counts as infinite).
+    fn field(name: &str, group: Group, difference: f64) -> Difference {
+        Difference {
+            name: name.into(),
+            group,
+            a: None,
+            b: None,
+            difference: if difference.is_nan() { f64::INFINITY } else { difference },
+            bound: None,
+        }
+    }
+
+    /// The difference `|x − y|` of a scalar of both runs (infinite if either lacks it or it is
+    /// NaN), with the scale `bound` it is judged against.
+    fn scalar(name: &str, group: Group, x: Option<f64>, y: Option<f64>, bound: Option<(Group, f64)>) -> Difference {
         let d = match (x, y) {
             (Some(x), Some(y)) => (x - y).abs(),
             _ => f64::INFINITY,
@@ -206,67 +298,7 @@ pub fn differences(a: &RunResult, b: &RunResult, iterations: bool) -> Vec<Differ
             difference: if d.is_nan() { f64::INFINITY } else { d },
             bound,
         }
-    };
-    let amax = |v: &[Vector3<f64>]| v.iter().fold(0.0_f64, |m, v| m.max(v.amax()));
-    let disp_scale = amax(&a.nodes.displacement()).max(amax(&a.tip.iter().map(|t| t.position_m).collect::<Vec<_>>()));
-    let angle_scale = amax(&a.nodes.alpha).max(amax(&a.tip.iter().map(|t| t.angles_rad).collect::<Vec<_>>()));
-    let nodes_match = a.nodes.s.len() == b.nodes.s.len();
-    if nodes_match {
-        rows.push(field(
-            "nodewise_rel_diff_displacement",
-            Group::Displacement,
-            max_relative_difference(&a.nodes.displacement(), &b.nodes.displacement()),
-        ));
-        rows.push(field(
-            "nodewise_rel_diff_angles",
-            Group::Angles,
-            max_relative_difference(&a.nodes.alpha, &b.nodes.alpha),
-        ));
-    } else {
-        rows.push(field("node_count", Group::Displacement, f64::INFINITY));
     }
-    let (ma, mb) = (physical_metrics(a), physical_metrics(b));
-    for (name, &x) in &ma {
-        let bound =
-            if name.ends_with("_rad") { (Group::Angles, angle_scale) } else { (Group::Displacement, disp_scale) };
-        rows.push(scalar(name, Group::Metric, Some(x), mb.get(name).copied(), Some(bound)));
-    }
-    if a.tip.len() == b.tip.len() && !a.tip.is_empty() {
-        let p: Vec<_> = a.tip.iter().map(|t| t.position_m - a.tip[0].position_m).collect();
-        let q: Vec<_> = b.tip.iter().map(|t| t.position_m - b.tip[0].position_m).collect();
-        rows.push(field("tip_history_rel_diff", Group::Displacement, max_relative_difference(&p, &q)));
-    } else if a.tip.len() != b.tip.len() {
-        rows.push(field("tip_history_length", Group::Displacement, f64::INFINITY));
-    }
-    if let (Some(x), Some(y)) = (&a.inverse, &b.inverse) {
-        if nodes_match {
-            rows.push(field("nodewise_rel_diff_xhat", Group::Adjoint, max_relative_difference(&x.xhat, &y.xhat)));
-            rows.push(field("nodewise_rel_diff_ahat", Group::Adjoint, max_relative_difference(&x.ahat, &y.ahat)));
-        }
-        // Recovery errors (κ amplifies angle differences by ~1/h).
-        // x_err_rel moves with the displacement relative to the data's size (scale 1); the
-        // curvature errors with ∂sα: 2 max|Δα|/h against the data's rms curvature.
-        let (ma, mb) = (inverse_metrics(a), inverse_metrics(b));
-        let kf: Vec<f64> = x.data.element_curvature().iter().map(|(_, k)| k.norm_squared()).collect();
-        let k_rms = (kf.iter().sum::<f64>() / kf.len().max(1) as f64).sqrt();
-        let h = a.nodes.s.get(1).copied().unwrap_or(1.0) - a.nodes.s.first().copied().unwrap_or(0.0);
-        for name in ["x_err_rel", "kappa_err_rel", "kappa_err_rel_inner"].into_iter().filter(|n| ma.contains_key(*n)) {
-            let bound = if name == "x_err_rel" {
-                (Group::Displacement, 1.0)
-            } else {
-                (Group::Angles, 2.0 * angle_scale / (h * k_rms))
-            };
-            rows.push(scalar(name, Group::Metric, ma.get(name).copied(), mb.get(name).copied(), Some(bound)));
-        }
-    }
-    if a.stats.certificate.is_some() || b.stats.certificate.is_some() {
-        rows.push(scalar("certificate", Group::Certificate, a.stats.certificate, b.stats.certificate, None));
-    }
-    if iterations {
-        let (x, y) = (a.stats.iterations as f64, b.stats.iterations as f64);
-        rows.push(scalar("iterations", Group::Iterations, Some(x), Some(y), None));
-    }
-    rows
 }
 
 /// One row of `cosserat compare`.

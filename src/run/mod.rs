@@ -4,6 +4,7 @@
 //! Files (case data, clips, outputs) and the FreeFEM engine are `crate::io`'s.
 pub mod budget;
 pub mod clip;
+pub mod clip_frame;
 pub mod clip_metrics;
 pub mod frames;
 pub mod metrics;
@@ -42,7 +43,7 @@ pub enum RunError {
     #[error("writing the clip")]
     Sink(#[source] Box<dyn std::error::Error + Send + Sync>),
     #[error("resuming the clip: {0}")]
-    Resume(String),
+    Resume(clip::ResumeError),
     #[error("the clip's frame generator stopped after {received} of {total} frames")]
     Generator { received: usize, total: usize },
     /// A forward solve diverged: the error, with the largest load of the case named (a load

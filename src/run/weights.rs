@@ -265,7 +265,14 @@ fn search_lambda_g(search: &mut impl Residual, sigma: f64, cap: f64) -> (f64, f6
     if smooth_enough(r_lo) {
         return (lo, r_lo);
     }
-    // Illinois regula falsi in ln λg on ln r − ln σ̂ (decreasing)
+    regula_falsi(search, sigma, (lo, r_lo), (hi, r_hi))
+}
+
+/// Illinois regula falsi in ln λg on ln r − ln σ̂ (decreasing) between the bracket's ends
+/// `(λg, r)` `lo` (r ≥ σ̂) and `hi` (r < σ̂): the first λg within MATCH of the noise, or the
+/// closest one when the solves run out.
+fn regula_falsi(search: &mut impl Residual, sigma: f64, (lo, r_lo): (f64, f64), (hi, r_hi): (f64, f64)) -> (f64, f64) {
+    let f = |r: f64| if r > 0.0 { (r / sigma).ln() } else { f64::NEG_INFINITY };
     let (mut a, mut fa, mut b, mut fb) = (lo.ln(), f(r_lo), hi.ln(), f(r_hi));
     let mut best = (lo, r_lo);
     let mut side = 0;

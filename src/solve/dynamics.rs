@@ -62,114 +62,51 @@ pub fn solve(
 ) -> Result<DynamicSolution, SolveError> {
     let dofs = problem.dofs();
     let pattern = dofs.pattern();
-    let mut solver = LinearSolver::new(&pattern);
-    let fixed = problem.clamped_dofs();
     let dt = params.end_time_s / params.steps as f64;
     let last = problem.mesh.nodes() - 1;
-
-    let mut u_prev = problem.reference_state();
-    let mut v_prev = DVector::zeros(u_prev.len());
-    let mut p_prev = problem.momentum(&u_prev, &v_prev, None);
-    let mut f_prev = problem.loads_at(&u_prev, 0.0, None);
-    let mut values = vec![0.0; pattern.nnz()];
+    let u0 = problem.reference_state();
+    let v0 = DVector::zeros(u0.len());
+    let mut prev = StepState { p: problem.momentum(&u0, &v0, None), f: problem.loads_at(&u0, 0.0, None), u: u0, v: v0 };
     let record = |t: f64, u: &DVector<f64>, it: usize, certificate: f64| {
         let (x, a) = (dofs.get(u, last, Field::X), dofs.get(u, last, Field::Alpha));
         TipRecord { time_s: t, position_m: x, angles_rad: a, newton_iterations: it, certificate }
     };
-    let mut tip = vec![record(0.0, &u_prev, 0, 0.0)];
+    let mut tip = vec![record(0.0, &prev.u, 0, 0.0)];
     let mut cert_values = vec![0.0; pattern.nnz()];
     let mut max_certificate: f64 = 0.0;
     let (mut total, mut max_it) = (0, 0);
     // Global-frame (or no distributed) loads do not depend on the state: F(t_n) once per step
     // instead of once per Newton iteration and again after it (the same numbers).
     let state_free_loads = !(problem.loads.has_distributed() && matches!(problem.loads.frame, LoadFrame::Local));
-
-    // Chord steps (simplified Newton): the factorisation of the last Jacobian is reused across
-    // iterations and time steps while the increments contract; an increment larger than
-    // CHORD_CONTRACTION times the previous one of the step has the next iteration assemble and
-    // factor the Jacobian at its iterate (a Newton step). The stopping rule is unchanged.
-    let mut factored = false;
-    let mut refactor = true;
+    let mut stepper = Stepper {
+        problem,
+        params,
+        solver: LinearSolver::new(&pattern),
+        values: vec![0.0; pattern.nnz()],
+        pattern,
+        fixed: problem.clamped_dofs(),
+        dt,
+        factored: false,
+        refactor: true,
+    };
     for n in 1..=params.steps {
         if crate::interrupt::requested() {
             return Err(SolveError::Interrupted { what: "time steps", done: n - 1, total: params.steps });
         }
         let t = n as f64 * dt;
-        let mut u = &u_prev + &v_prev * dt;
-        let mut converged = None;
-        let mut increment = f64::NAN;
-        let mut previous = f64::INFINITY;
+        let u = &prev.u + &prev.v * dt;
         let f_step = if state_free_loads { Some(problem.loads_at(&u, t, None)) } else { None };
-        for it in 1..=params.newton_max_iterations {
-            let v = (&u - &u_prev) * (2.0 / dt) - &v_prev;
-            let u_mid = (&u + &u_prev) * 0.5;
-            let newton = refactor || !factored;
-            if newton {
-                values.iter_mut().for_each(|x| *x = 0.0);
-            }
-            fn tangent<'a>(on: bool, pattern: &'a Pattern, values: &'a mut [f64], scale: f64) -> Option<Tangent<'a>> {
-                on.then(|| Tangent::new(pattern, values, scale))
-            }
-            let p = problem.momentum(
-                &u,
-                &v,
-                tangent(newton, &pattern, &mut values, 1.0 / dt).map(|t| (t, 2.0 / (dt * dt))),
-            );
-            let g = problem.internal_force(&u_mid, tangent(newton, &pattern, &mut values, 0.5));
-            // ½[F(t_n, u_n) + F(t_{n−1}, u_{n−1})]: only the first half depends on u_n.
-            let f_state;
-            let f_n = match &f_step {
-                Some(f) => f,
-                None => {
-                    f_state = problem.loads_at(&u, t, tangent(newton, &pattern, &mut values, -0.5));
-                    &f_state
-                }
-            };
-            let mut r = (p - &p_prev) / dt + g - (f_n + &f_prev) * 0.5;
-            for &d in &fixed {
-                r[d] = 0.0;
-            }
-            let du = if newton {
-                pattern.set_identity_rows(&mut values, &fixed);
-                let du = solver.solve(&values, &(-r))?;
-                (factored, refactor) = (true, false);
-                du
-            } else {
-                solver.solve_factored(&(-r))?
-            };
-            u += &du;
-            increment = problem.increment_measure(&du);
-            if let Some((quantity, value)) = divergence(problem, &u, increment) {
-                return Err(SolveError::Diverged { step: Some(Step::Time(n)), iteration: it, quantity, value });
-            }
-            if increment <= params.newton_tolerance {
-                converged = Some(it);
-                break;
-            }
-            if !newton && increment > CHORD_CONTRACTION * previous {
-                refactor = true;
-            }
-            previous = increment;
-        }
-        let it = converged.ok_or(SolveError::NewtonNotConverged {
-            step: Some(Step::Time(n)),
-            iterations: params.newton_max_iterations,
-            increment,
-        })?;
+        let (u, it, increment) = stepper.newton(n, t, u, &prev, f_step.as_ref())?;
         total += it;
         max_it = max_it.max(it);
-        let v = (&u - &u_prev) * (2.0 / dt) - &v_prev;
+        let v = (&u - &prev.u) * (2.0 / dt) - &prev.v;
         let p_n = problem.momentum(&u, &v, None);
         let f_n = match f_step {
             Some(f) => f,
             None => problem.loads_at(&u, t, None),
         };
-        let certificate = step_certificate(
-            problem,
-            StepTerms { u: &u, u_prev: &u_prev, p: &p_n, p_prev: &p_prev, f: &f_n, f_prev: &f_prev, dt },
-            &pattern,
-            &mut cert_values,
-        );
+        let terms = StepTerms { u: &u, u_prev: &prev.u, p: &p_n, p_prev: &prev.p, f: &f_n, f_prev: &prev.f, dt };
+        let certificate = step_certificate(problem, terms, &stepper.pattern, &mut cert_values);
         if !certificate.within(params.certificate_tolerance) {
             return Err(SolveError::StepNotCertified {
                 step: n,
@@ -181,20 +118,121 @@ pub fn solve(
             });
         }
         max_certificate = max_certificate.max(certificate.value);
-        p_prev = p_n;
-        f_prev = f_n;
         tip.push(record(t, &u, it, certificate.value));
-        u_prev = u;
-        v_prev = v;
+        prev = StepState { u, v, p: p_n, f: f_n };
         progress(n, params.steps);
     }
     Ok(DynamicSolution {
-        u: u_prev,
+        u: prev.u,
         tip,
         total_newton_iterations: total,
         max_newton_iterations: max_it,
         max_certificate,
     })
+}
+
+/// The state of a time step: `u_n`, `u̇_n`, the momentum `P(u_n, u̇_n)` and the loads `F(t_n)`.
+struct StepState {
+    u: DVector<f64>,
+    v: DVector<f64>,
+    p: DVector<f64>,
+    f: DVector<f64>,
+}
+
+/// The Newton iteration of the time steps, with what it keeps across them: the pattern, the
+/// Jacobian's values and its LU.
+///
+/// Chord steps (simplified Newton): the factorisation of the last Jacobian is reused across
+/// iterations and time steps while the increments contract; an increment larger than
+/// CHORD_CONTRACTION times the previous one of the step has the next iteration assemble and
+/// factor the Jacobian at its iterate (a Newton step). The stopping rule is unchanged.
+struct Stepper<'a, 'p> {
+    problem: &'a Problem<'p>,
+    params: &'a DynamicParams,
+    pattern: Pattern,
+    solver: LinearSolver,
+    values: Vec<f64>,
+    fixed: Vec<usize>,
+    /// time step Δt [s]
+    dt: f64,
+    /// a factorisation exists, and the next iteration should make a new one
+    factored: bool,
+    refactor: bool,
+}
+
+impl Stepper<'_, '_> {
+    /// Time step `n` (at `t`) from the predictor `u` after the step `prev` (`f_step`: the loads
+    /// `F(t_n)` if they do not depend on the state): the state, the iterations and the last
+    /// increment.
+    fn newton(
+        &mut self,
+        n: usize,
+        t: f64,
+        mut u: DVector<f64>,
+        prev: &StepState,
+        f_step: Option<&DVector<f64>>,
+    ) -> Result<(DVector<f64>, usize, f64), SolveError> {
+        let (problem, dt) = (self.problem, self.dt);
+        let mut increment = f64::NAN;
+        let mut previous = f64::INFINITY;
+        for it in 1..=self.params.newton_max_iterations {
+            let v = (&u - &prev.u) * (2.0 / dt) - &prev.v;
+            let u_mid = (&u + &prev.u) * 0.5;
+            let newton = self.refactor || !self.factored;
+            if newton {
+                self.values.iter_mut().for_each(|x| *x = 0.0);
+            }
+            let p = problem.momentum(
+                &u,
+                &v,
+                tangent(newton, &self.pattern, &mut self.values, 1.0 / dt).map(|t| (t, 2.0 / (dt * dt))),
+            );
+            let g = problem.internal_force(&u_mid, tangent(newton, &self.pattern, &mut self.values, 0.5));
+            // ½[F(t_n, u_n) + F(t_{n−1}, u_{n−1})]: only the first half depends on u_n.
+            let f_state;
+            let f_n = match f_step {
+                Some(f) => f,
+                None => {
+                    f_state = problem.loads_at(&u, t, tangent(newton, &self.pattern, &mut self.values, -0.5));
+                    &f_state
+                }
+            };
+            let mut r = (p - &prev.p) / dt + g - (f_n + &prev.f) * 0.5;
+            for &d in &self.fixed {
+                r[d] = 0.0;
+            }
+            let du = if newton {
+                self.pattern.set_identity_rows(&mut self.values, &self.fixed);
+                let du = self.solver.solve(&self.values, &(-r))?;
+                (self.factored, self.refactor) = (true, false);
+                du
+            } else {
+                self.solver.solve_factored(&(-r))?
+            };
+            u += &du;
+            increment = problem.increment_measure(&du);
+            if let Some((quantity, value)) = divergence(problem, &u, increment) {
+                return Err(SolveError::Diverged { step: Some(Step::Time(n)), iteration: it, quantity, value });
+            }
+            if increment <= self.params.newton_tolerance {
+                return Ok((u, it, increment));
+            }
+            if !newton && increment > CHORD_CONTRACTION * previous {
+                self.refactor = true;
+            }
+            previous = increment;
+        }
+        Err(SolveError::NewtonNotConverged {
+            step: Some(Step::Time(n)),
+            iterations: self.params.newton_max_iterations,
+            increment,
+        })
+    }
+}
+
+/// The assembly target of one term of the Jacobian, if one is assembled.
+fn tangent<'a>(on: bool, pattern: &'a Pattern, values: &'a mut [f64], scale: f64) -> Option<Tangent<'a>> {
+    on.then(|| Tangent::new(pattern, values, scale))
 }
 
 /// What the certificate of a time step is made of: the step's state and the previous one, their

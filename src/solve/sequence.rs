@@ -14,7 +14,11 @@ use std::f64::consts::PI;
 
 use nalgebra::{DVector, Matrix3, Vector3};
 
-use crate::model::chart::{frame_axis, Chart, Converted};
+mod carry;
+pub use carry::vector_to_space;
+use carry::{carry_converted, carry_state, to_space};
+
+use crate::model::chart::{frame_axis, Chart};
 use crate::model::mesh::{DofMap, Field};
 use crate::model::rotation::{angles_from_rotation, skew, Angles};
 
@@ -146,9 +150,16 @@ pub enum SequenceError {
     },
     #[error(transparent)]
     Solve(#[from] SolveError),
-    #[error("frame {frame}: {message}")]
-    Callback { frame: usize, message: String },
+    /// The frame's callback stopped the clip (`stop` says why).
+    #[error("frame {frame}: {stop}")]
+    Callback { frame: usize, stop: FrameStop },
+    /// The frame's solve returned without an iteration record.
+    #[error("frame {frame}: no iteration ran")]
+    NoIteration { frame: usize },
 }
+
+/// Why the callback of a clip solve stopped the clip: the caller's own error type.
+pub type FrameStop = Box<dyn std::error::Error + Send + Sync>;
 
 /// The chart of a clip's first frame: the paper's global chart, or the rebased chart whose
 /// singular axis is the gauge (R7).
@@ -369,7 +380,7 @@ pub enum FirstStart<'a> {
 /// from `first` ([`FirstStart`]). Later frames start from the previous frame's
 /// solution re-expressed in their chart (and, if that fails, once more from the data guess) or
 /// from the data guess, as `sp.start` says. `on_frame` receives each converged frame (e.g. to
-/// stream it to disk) and may stop the clip by returning an error message; `on_iteration` sees
+/// stream it to disk) and may stop the clip by returning an error ([`FrameStop`]); `on_iteration` sees
 /// every iteration's record.
 pub fn solve_sequence<'a>(
     problem: &Problem,
@@ -377,7 +388,7 @@ pub fn solve_sequence<'a>(
     frames: impl Into<ClipData<'a>>,
     first: FirstStart<'_>,
     on_iteration: impl FnMut(usize, &InverseRecord),
-    on_frame: impl FnMut(&FrameReport, &FrameSolution) -> Result<(), String>,
+    on_frame: impl FnMut(&FrameReport, &FrameSolution) -> Result<(), FrameStop>,
 ) -> Result<Vec<FrameReport>, SequenceError> {
     solve_sequence_from(problem, sp, frames, first, None, on_iteration, on_frame)
 }
@@ -406,7 +417,7 @@ pub fn solve_sequence_from<'a>(
     start0: FirstStart<'_>,
     resume: Option<ResumeFrom>,
     mut on_iteration: impl FnMut(usize, &InverseRecord),
-    mut on_frame: impl FnMut(&FrameReport, &FrameSolution) -> Result<(), String>,
+    mut on_frame: impl FnMut(&FrameReport, &FrameSolution) -> Result<(), FrameStop>,
 ) -> Result<Vec<FrameReport>, SequenceError> {
     let data = data.into();
     let frames = data.positions;
@@ -427,33 +438,9 @@ pub fn solve_sequence_from<'a>(
         }
         let k = i + sp.frame_offset;
         let start = std::time::Instant::now();
-        let chart = frame_chart(sp, prev.as_ref().map(|(c, _)| c), x_space, problem.mesh.length_m);
-        let x_g: Vec<Vector3<f64>> =
-            if chart.is_identity() { x_space.clone() } else { x_space.iter().map(|x| chart.to_chart(x)).collect() };
+        let FramePrep { chart, x_g, first_start, alpha_prev, carried } =
+            prepare(sp, problem, x_space, prev.as_ref(), prev2.as_ref(), start0);
         let guess = || data_frame_guess(&frame_geometry(&x_g, problem.mesh.length_m));
-        // The previous frame's state in this frame's chart (R6); with two previous frames, the
-        // linear predictor 2 u_{n−1} − u_{n−2} (the clip is sampled smoothly in time).
-        // (Carrying the adjoint as well, instead of Newton's consistent-start solve, sent frame
-        // 659 of worm_roll_3d to a wrong root: not done.)
-        // the previous frame's angles converted to this chart once, unwrapped twice (along the
-        // rod for the carried state, against the start for the Λω term)
-        let prev_angles = prev.as_ref().map(|(c, u)| chart.converted(c, &dofs.field(u, Field::Alpha)));
-        let carried = prev.as_ref().map(|(c, u)| {
-            let u1 = carry_converted(&dofs, &chart, c, u, prev_angles.as_ref(), None);
-            match &prev2 {
-                Some((c2, u2)) => &u1 * 2.0 - carry_state(&dofs, &chart, c2, u2, Some(&u1)),
-                None => u1,
-            }
-        });
-        let first_start = match (&carried, sp.start, start0) {
-            (None, _, FirstStart::Guess(u0) | FirstStart::Near(u0)) => u0.clone(),
-            (Some(u), FrameStart::PreviousFrame, _) => u.clone(),
-            _ => guess(),
-        };
-        let alpha_prev: Option<Vec<Angles>> = prev_angles.as_ref().map(|converted| {
-            let near = dofs.field(&first_start, Field::Alpha);
-            converted.unwrapped(Some(&near))
-        });
         let (weight, tracked) = (data.weights(i), data.tracked(i));
         let frame = Frame { index: k, x_g: &x_g, previous: alpha_prev.as_deref(), weight: weight.as_deref() };
         // From the previous frame's solution (already close) Newton runs directly; from a guess
@@ -463,44 +450,14 @@ pub fn solve_sequence_from<'a>(
             solver.params.weights.lambda_g = lambda;
             solver.solve(&frame, u0, start, |r, _, _| on_iteration(k, r))?.converged(k)
         };
-        // A frame that does not converge from the previous frame's solution is solved again
-        // from the data guess (D13), and the restart is reported; one that does not converge
-        // from there either is continued in λg from the smoothed data ([`continued`]).
+        // restarts from the data guess (D13) and continuation in λg: [`with_restarts`]
         let from_previous = i > 0 && sp.start == FrameStart::PreviousFrame;
         let near = from_previous || (carried.is_none() && matches!(start0, FirstStart::Near(_)));
-        let first_kind = if near { Start::Near } else { Start::Guess };
-        let (sol, restarted) = match solve(&first_start, first_kind, lambda_g) {
-            Ok(sol) => (sol, false),
-            Err(e) if recoverable(&e) => {
-                let again = if near { solve(&guess(), Start::Guess, lambda_g) } else { Err(e) };
-                match again {
-                    Ok(sol) => (sol, true),
-                    Err(e) if recoverable(&e) => {
-                        let smooth = smoothed_guess(&x_g, problem.mesh.length_m).unwrap_or_else(guess);
-                        (continued(&mut solve, &smooth, lambda_g).map_err(|_| e)?, true)
-                    }
-                    Err(e) => return Err(e.into()),
-                }
-            }
-            Err(e) => return Err(e.into()),
-        };
+        let smooth = || smoothed_guess(&x_g, problem.mesh.length_m);
+        let (sol, restarted) = with_restarts(&mut solve, &first_start, near, &guess, &smooth, lambda_g)?;
         let (cos_beta, node) = min_cos_beta(&dofs, &sol.u);
-        if cos_beta < sp.min_cos_beta {
-            let flagged: Vec<usize> = reports.iter().filter(|r| r.fit.flagged).map(|r| r.frame).collect();
-            return Err(SequenceError::SingularChart {
-                frame: k,
-                node,
-                cos_beta,
-                guard: sp.min_cos_beta,
-                axis: chart.axis().into(),
-                degraded: flagged.first().map(|&first| (flagged.len(), first, reports[0].frame)),
-            });
-        }
-        let last = sol
-            .history
-            .last()
-            .copied()
-            .ok_or(SequenceError::Callback { frame: k, message: "no iteration ran".into() })?;
+        chart_guard(sp, &reports, k, &chart, (cos_beta, node))?;
+        let last = sol.history.last().copied().ok_or(SequenceError::NoIteration { frame: k })?;
         let rep = FrameReport {
             frame: k,
             iterations: last.iteration,
@@ -525,7 +482,7 @@ pub fn solve_sequence_from<'a>(
             previous: frame.previous,
             state: &sol.u,
         };
-        on_frame(&rep, &solution).map_err(|message| SequenceError::Callback { frame: k, message })?;
+        on_frame(&rep, &solution).map_err(|stop| SequenceError::Callback { frame: k, stop })?;
         prev2 = prev.take();
         prev = Some((chart, sol.u));
         reports.push(rep);
@@ -533,63 +490,104 @@ pub fn solve_sequence_from<'a>(
     Ok(reports)
 }
 
-/// A state `(x, α)` of chart `from` in chart `to` (R6): positions rotated by `B_to B_fromᵀ`,
-/// angles re-expressed node by node without 2π jumps along the rod (or against `near`).
-/// `near`: a state in chart `to` whose angles the result's are unwrapped against (R6).
-fn carry_state(dofs: &DofMap, to: &Chart, from: &Chart, u: &DVector<f64>, near: Option<&DVector<f64>>) -> DVector<f64> {
-    carry_converted(dofs, to, from, u, None, near)
+/// What a frame's solve starts from: its chart, its data in that chart, the initial iterate,
+/// the previous frame's angles in this chart (the Λω term) and the carried previous state.
+struct FramePrep {
+    chart: Chart,
+    x_g: Vec<Vector3<f64>>,
+    first_start: DVector<f64>,
+    alpha_prev: Option<Vec<Angles>>,
+    carried: Option<DVector<f64>>,
 }
 
-/// [`carry_state`] with `u`'s angles already converted to `to` (`Chart::converted`), if given.
-fn carry_converted(
-    dofs: &DofMap,
-    to: &Chart,
-    from: &Chart,
-    u: &DVector<f64>,
-    converted: Option<&Converted>,
-    near: Option<&DVector<f64>>,
-) -> DVector<f64> {
-    if to.base == from.base {
-        return u.clone();
-    }
-    let near: Option<Vec<Angles>> = near.map(|v| dofs.field(v, Field::Alpha));
-    let alpha = match converted {
-        Some(c) => c.unwrapped(near.as_deref()),
-        None => to.converted(from, &dofs.field(u, Field::Alpha)).unwrapped(near.as_deref()),
+/// The start of a frame with data `x_space` after the frames with states `prev` and `prev2`
+/// (each in its chart): the chart follows the data ([`frame_chart`]); the previous frame's state
+/// is carried to this chart (R6) and, with two previous frames, extrapolated by the linear
+/// predictor 2 u_{n−1} − u_{n−2} (the clip is sampled smoothly in time). (Carrying the adjoint
+/// as well, instead of Newton's consistent-start solve, sent frame 659 of worm_roll_3d to a
+/// wrong root: not done.) The previous frame's angles are converted to this chart once,
+/// unwrapped twice (along the rod for the carried state, against the start for the Λω term).
+fn prepare(
+    sp: &SequenceParams,
+    problem: &Problem,
+    x_space: &[Vector3<f64>],
+    prev: Option<&(Chart, DVector<f64>)>,
+    prev2: Option<&(Chart, DVector<f64>)>,
+    start0: FirstStart<'_>,
+) -> FramePrep {
+    let dofs = problem.dofs();
+    let chart = frame_chart(sp, prev.map(|(c, _)| c), x_space, problem.mesh.length_m);
+    let x_g: Vec<Vector3<f64>> =
+        if chart.is_identity() { x_space.to_vec() } else { x_space.iter().map(|x| chart.to_chart(x)).collect() };
+    let prev_angles = prev.map(|(c, u)| chart.converted(c, &dofs.field(u, Field::Alpha)));
+    let carried = prev.map(|(c, u)| {
+        let u1 = carry_converted(&dofs, &chart, c, u, prev_angles.as_ref(), None);
+        match prev2 {
+            Some((c2, u2)) => &u1 * 2.0 - carry_state(&dofs, &chart, c2, u2, Some(&u1)),
+            None => u1,
+        }
+    });
+    let first_start = match (&carried, sp.start, start0) {
+        (None, _, FirstStart::Guess(u0) | FirstStart::Near(u0)) => u0.clone(),
+        (Some(u), FrameStart::PreviousFrame, _) => u.clone(),
+        _ => data_frame_guess(&frame_geometry(&x_g, problem.mesh.length_m)),
     };
-    let mut out = dofs.zeros();
-    for j in 0..dofs.nodes() {
-        dofs.set(&mut out, j, Field::X, &to.to_chart(&from.to_space(&dofs.get(u, j, Field::X))));
-        dofs.set(&mut out, j, Field::Alpha, &alpha[j]);
-    }
-    out
+    let alpha_prev: Option<Vec<Angles>> = prev_angles.as_ref().map(|converted| {
+        let near = dofs.field(&first_start, Field::Alpha);
+        converted.unwrapped(Some(&near))
+    });
+    FramePrep { chart, x_g, first_start, alpha_prev, carried }
 }
 
-/// The solution with positions and adjoints in space coordinates (R3); angles unchanged.
-fn to_space(dofs: &DofMap, chart: &Chart, sol: &InverseSolution) -> InverseSolution {
-    InverseSolution {
-        u: vector_to_space(dofs, chart, &sol.u, false),
-        adjoint: vector_to_space(dofs, chart, &sol.adjoint, true),
-        history: sol.history.clone(),
-        stop: sol.stop,
-        certificate: sol.certificate,
-        certificate_tolerance: sol.certificate_tolerance,
+/// A frame solved from `first_start` (`near`: a start near its solution); one that does not
+/// converge from there is solved again from the data `guess` (D13), and one that does not
+/// converge from there either is continued in λg from the `smooth`ed data ([`continued`]).
+/// Whether it was restarted.
+fn with_restarts(
+    solve: &mut impl FnMut(&DVector<f64>, Start, f64) -> Result<InverseSolution, SolveError>,
+    first_start: &DVector<f64>,
+    near: bool,
+    guess: &dyn Fn() -> DVector<f64>,
+    smooth: &dyn Fn() -> Option<DVector<f64>>,
+    lambda_g: f64,
+) -> Result<(InverseSolution, bool), SolveError> {
+    let first_kind = if near { Start::Near } else { Start::Guess };
+    match solve(first_start, first_kind, lambda_g) {
+        Ok(sol) => Ok((sol, false)),
+        Err(e) if recoverable(&e) => {
+            let again = if near { solve(&guess(), Start::Guess, lambda_g) } else { Err(e) };
+            match again {
+                Ok(sol) => Ok((sol, true)),
+                Err(e) if recoverable(&e) => {
+                    let smooth = smooth().unwrap_or_else(guess);
+                    Ok((continued(solve, &smooth, lambda_g).map_err(|_| e)?, true))
+                }
+                Err(e) => Err(e),
+            }
+        }
+        Err(e) => Err(e),
     }
 }
 
-/// A forward-layout vector of chart `chart` in space coordinates (R3): the position block
-/// rotated, the angle block rotated too if `both` (an adjoint), else unchanged (angles stay the
-/// chart's). What [`FrameSolution::solution`] holds, from the chart's state and adjoint.
-pub fn vector_to_space(dofs: &DofMap, chart: &Chart, v: &DVector<f64>, both: bool) -> DVector<f64> {
-    if chart.is_identity() {
-        return v.clone();
+/// The chart guard: an error if the frame's smallest |cos β| (at `node`) is below
+/// `sp.min_cos_beta`, naming the frames among `reports` that were over the fit-quality gate.
+fn chart_guard(
+    sp: &SequenceParams,
+    reports: &[FrameReport],
+    k: usize,
+    chart: &Chart,
+    (cos_beta, node): (f64, usize),
+) -> Result<(), SequenceError> {
+    if cos_beta < sp.min_cos_beta {
+        let flagged: Vec<usize> = reports.iter().filter(|r| r.fit.flagged).map(|r| r.frame).collect();
+        return Err(SequenceError::SingularChart {
+            frame: k,
+            node,
+            cos_beta,
+            guard: sp.min_cos_beta,
+            axis: chart.axis().into(),
+            degraded: flagged.first().map(|&first| (flagged.len(), first, reports[0].frame)),
+        });
     }
-    let mut out = v.clone();
-    for j in 0..dofs.nodes() {
-        let (a, b) = (dofs.get(v, j, Field::X), dofs.get(v, j, Field::Alpha));
-        let (a, b) = (chart.to_space(&a), if both { chart.to_space(&b) } else { b });
-        dofs.set(&mut out, j, Field::X, &a);
-        dofs.set(&mut out, j, Field::Alpha, &b);
-    }
-    out
+    Ok(())
 }

@@ -319,7 +319,7 @@ fn from_data_is_resolved_from_the_frames_of_the_recording() {
     assert!((b.min_m / 1.15e-3 - 1.0).abs() < 1e-14 && (b.max_m / 1.25e-3 - 1.0).abs() < 1e-14, "{b:?}");
     assert_eq!(load_clip(&resolved).map(|(c, _)| c.frame_count()).map_err(|e| e.to_string()), Ok(3));
     // resolved once: returned as it is; a sweep point of it keeps the estimate
-    assert_eq!(resolve_length(&resolved).unwrap().rod_length, resolved.rod_length);
+    assert_eq!(resolve_length(&resolved).unwrap().rod.length, resolved.rod.length);
     let point = resolved.with_values(&[("lambda_d", 2.0.into())]).unwrap();
     assert_eq!(point.body_length(), Some(b));
     // the whole file: frame 0 is 2e-3 m, 1.67× the median of the four (1.225e-3 m)

@@ -35,9 +35,11 @@ use super::{early_divergence, Frame, FrameSolver, InverseParams, InverseRecord, 
 use crate::assemble::{assemble, Tangent};
 use crate::linalg::Pattern;
 use crate::model::element::{internal_force, interpolate, LocalMat};
+use crate::model::mesh::DofMap;
 use crate::model::rotation::{
     a_matrix, a_matrix_derivatives, d3, d3_second_derivatives, rotation, rotation_derivatives, skew, PointFrame,
 };
+use crate::solve::certificate::Certificate;
 use crate::solve::statics::relative_change;
 use crate::solve::{Problem, SolveError, Stop, CHORD_CONTRACTION};
 
@@ -90,7 +92,6 @@ fn coefficient_derivative(
     let mut t = LocalMat::zeros();
     internal_force(props, problem.scheme, h, &state, Some(&mut t));
     add_operator_blocks(e, &(t - l), false);
-    let columns = |c: [Vector3<f64>; 3]| Matrix3::from_columns(&c);
     let K = Matrix3::from_diagonal(&props.shear_stretch_n);
     let Jm = Matrix3::from_diagonal(&props.bend_twist_nm2);
     // Stretch–shear rule: L(u)ᵀ û on the x rows, and the λd term.
@@ -101,44 +102,27 @@ fn coefficient_derivative(
         let dQ = rotation_derivatives(&q.alpha);
         let S = Q.transpose() * K * Q;
         let v = qa.dx + q.dx.cross(&qa.alpha);
-        // ∂S/∂α_j v = dQ_jᵀ K (Q v) + Qᵀ K (dQ_j v), as matrix–vector products
-        let kqv = K * (Q * v);
-        let dS_v = columns([0, 1, 2].map(|j| dQ[j].transpose() * kqv + Q.transpose() * (K * (dQ[j] * v))));
+        // ∂S/∂α_j v = dQ_jᵀ K (Q v) + Qᵀ K (dQ_j v)
+        let dS_v = product_rule((&Q, &dQ), &K, (&Q, &dQ), &v);
         let dS_dx = -S * skew(&qa.alpha);
-        for c in 0..2 {
-            for b in 0..2 {
-                add3(e, X[c], AL[b], &(dS_v * (wh * q.dn[c] * q.n[b])));
-                add3(e, X[c], X[b], &(dS_dx * (wh * q.dn[c] * q.dn[b])));
-            }
-        }
+        add_node_pairs(e, (X, AL), &dS_v, wh, (&q.dn, &q.n));
+        add_node_pairs(e, (X, X), &dS_dx, wh, (&q.dn, &q.dn));
     }
     // The λd term's rule (I11): the second derivative of d3 in −λd ∫ δα·D(α)ᵀ(∂s x − d3).
     for (xi, w) in PointRule::tangent(problem, p.stabilisation).iter() {
         let q = interpolate(&state, h, xi);
-        let wh = w * h;
         let dd = d3_second_derivatives(&q.alpha);
         let mis = q.dx - d3(&q.alpha);
         let H2 = Matrix3::from_fn(|i, j| mis.dot(&dd[i][j])) * (-w8.lambda_d);
-        for c in 0..2 {
-            for b in 0..2 {
-                add3(e, AL[c], AL[b], &(H2 * (wh * q.n[c] * q.n[b])));
-            }
-        }
+        add_node_pairs(e, (AL, AL), &H2, w * h, (&q.n, &q.n));
     }
     // Bending rule: L(u)ᵀ û on the α rows.
     for (xi, w) in problem.scheme.bending().iter() {
         let (q, qa) = (interpolate(&state, h, xi), interpolate(&adj, h, xi));
-        let wh = w * h;
         let f = PointFrame::new(&q.alpha, true);
-        let (Q, A, dQ, dA) = (f.q, f.a, f.dq, f.da);
-        // (dQ_jᵀ J A + Qᵀ J dA_j)ᵀ w = Aᵀ J (dQ_j w) + dA_jᵀ J (Q w), w = ∂s α̂
-        let jqw = Jm * (Q * qa.dalpha);
-        let blk = columns([0, 1, 2].map(|j| A.transpose() * (Jm * (dQ[j] * qa.dalpha)) + dA[j].transpose() * jqw));
-        for c in 0..2 {
-            for b in 0..2 {
-                add3(e, AL[c], AL[b], &(blk * (wh * q.dn[c] * q.n[b])));
-            }
-        }
+        // (dQ_jᵀ J A + Qᵀ J dA_j)ᵀ w = dA_jᵀ J (Q w) + Aᵀ J (dQ_j w), w = ∂s α̂
+        let blk = product_rule((&f.a, &f.da), &Jm, (&f.q, &f.dq), &qa.dalpha);
+        add_node_pairs(e, (AL, AL), &blk, w * h, (&q.dn, &q.n));
     }
     // The Λκ term's rule (I12).
     if w8.lambda_kappa.amax() > 0.0 {
@@ -146,13 +130,8 @@ fn coefficient_derivative(
         for (xi, w) in problem.scheme.kappa().iter() {
             let q = interpolate(&state, h, xi);
             let (A, dA) = (a_matrix(&q.alpha), a_matrix_derivatives(&q.alpha));
-            let lka = Lk * (A * q.dalpha);
-            let blk = columns([0, 1, 2].map(|j| dA[j].transpose() * lka + A.transpose() * (Lk * (dA[j] * q.dalpha))));
-            for c in 0..2 {
-                for b in 0..2 {
-                    add3(e, AL[c], AL[b], &(blk * (w * h * q.dn[c] * q.n[b])));
-                }
-            }
+            let blk = product_rule((&A, &dA), &Lk, (&A, &dA), &q.dalpha);
+            add_node_pairs(e, (AL, AL), &blk, w * h, (&q.dn, &q.n));
         }
     }
     // Load rule: the Λω term (as in `element_system`).
@@ -161,17 +140,40 @@ fn coefficient_derivative(
         let Lw = Matrix3::from_diagonal(&w8.lambda_omega) / (dt * dt);
         for (xi, w) in problem.scheme.objective().iter() {
             let q = interpolate(&state, h, xi);
-            let wh = w * h;
-            let A = a_matrix(&q.alpha);
-            let dA = a_matrix_derivatives(&q.alpha);
+            let (A, dA) = (a_matrix(&q.alpha), a_matrix_derivatives(&q.alpha));
             let da = q.alpha - (alpha_prev[0] * q.n[0] + alpha_prev[1] * q.n[1]);
-            let lwa = Lw * (A * da);
-            let blk = columns([0, 1, 2].map(|j| dA[j].transpose() * lwa + A.transpose() * (Lw * (dA[j] * da))));
-            for c in 0..2 {
-                for b in 0..2 {
-                    add3(e, AL[c], AL[b], &(blk * (wh * q.n[c] * q.n[b])));
-                }
-            }
+            let blk = product_rule((&A, &dA), &Lw, (&A, &dA), &da);
+            add_node_pairs(e, (AL, AL), &blk, w * h, (&q.n, &q.n));
+        }
+    }
+}
+
+/// The product rule of every coefficient derivative above: the 3 × 3 block whose column j is
+/// `∂/∂α_j [Pᵀ M R] v = dP_jᵀ (M R v) + Pᵀ M (dR_j v)` (`(P, dP)`, `(R, dR)`: a matrix of the
+/// angles and its derivatives in α_1, α_2, α_3; `M R v` formed once).
+fn product_rule(
+    (p, dp): (&Matrix3<f64>, &[Matrix3<f64>; 3]),
+    m: &Matrix3<f64>,
+    (r, dr): (&Matrix3<f64>, &[Matrix3<f64>; 3]),
+    v: &Vector3<f64>,
+) -> Matrix3<f64> {
+    let mrv = m * (r * v);
+    Matrix3::from_columns(&[0, 1, 2].map(|j| dp[j].transpose() * mrv + p.transpose() * (m * (dr[j] * v))))
+}
+
+/// `e[rows[c], cols[b]] += blk · (wh f_c g_b)` for the element's two nodes c and b (`rows`,
+/// `cols`: the local offsets of a field at the two nodes; `f`, `g`: shape functions or their
+/// derivatives at the point).
+fn add_node_pairs(
+    e: &mut KktMat,
+    (rows, cols): ([usize; 2], [usize; 2]),
+    blk: &Matrix3<f64>,
+    wh: f64,
+    (f, g): (&[f64; 2], &[f64; 2]),
+) {
+    for c in 0..2 {
+        for b in 0..2 {
+            add3(e, rows[c], cols[b], &(blk * (wh * f[c] * g[b])));
         }
     }
 }
@@ -250,6 +252,8 @@ pub(crate) fn solve(
 
 /// [`solve`]; `rescale`: the frame's Ruiz factors exist already (the warm start's fixed point
 /// computed them), so the consistent start is scaled by them instead of equilibrating again.
+/// Each iteration is one [`Newton::attempt`], or two when a chord step is rejected and the
+/// iteration is redone as Newton's ([`Mode`]).
 fn solve_from(
     s: &mut FrameSolver,
     params: &InverseParams,
@@ -259,178 +263,301 @@ fn solve_from(
     observer: &mut impl FnMut(&InverseRecord, &DVector<f64>, &DVector<f64>),
 ) -> Result<InverseSolution, SolveError> {
     // Consistent start: one linear solve of the fixed point at u0.
-    let mut big = s.solve_linearised(params, frame, u0, rescale)?;
-    let problem = s.problem;
-    let fwd = problem.dofs();
-    let FrameSolver {
-        dofs,
-        pattern,
-        solver,
-        fixed,
-        rows,
-        values,
-        merit_weights,
-        no_previous,
-        records,
-        cert_values,
-        ..
-    } = s;
-    cert_values.resize(pattern.nnz(), 0.0);
-    let lean = *records == Records::Last;
-    let previous_angles = frame.previous.unwrap_or(no_previous.as_slice());
+    let big = s.solve_linearised(params, frame, u0, rescale)?;
+    let fwd = s.problem.dofs();
+    s.cert_values.resize(s.pattern.nnz(), 0.0);
+    let lean = s.records == Records::Last;
     // the Ruiz row factors of the start's matrix weigh the merit of the whole frame (I6)
-    merit_weights.clear();
-    merit_weights.extend_from_slice(solver.row_factors());
-    let merit = |r: &DVector<f64>| r.iter().zip(merit_weights.iter()).map(|(a, b)| (a * b).powi(2)).sum::<f64>().sqrt();
-    let mut history = Vec::new();
-    let mut phi0 = f64::NAN;
-    // the merit at the start of each iteration (stall detection)
-    let mut phis: Vec<f64> = Vec::new();
-    let mut certify = |big: &DVector<f64>| {
-        super::kkt::certificate(problem, params, frame, previous_angles, big, pattern, cert_values)
+    s.merit_weights.clear();
+    s.merit_weights.extend_from_slice(s.solver.row_factors());
+    let mut it = Iterate {
+        u: s.dofs.kkt_state(&big),
+        big,
+        adjoint: fwd.zeros(),
+        next: None,
+        mode: Mode::Newton,
+        damped: false,
+        previous: f64::INFINITY,
+        phi0: f64::NAN,
+        phis: Vec::new(),
+        history: Vec::new(),
     };
-    let done = |u, adjoint, history, stop, certificate| InverseSolution {
-        u,
-        adjoint,
-        history,
-        stop,
-        certificate,
-        certificate_tolerance: params.certificate_tolerance,
-    };
-    let mut adjoint = fwd.zeros();
-    let mut u = dofs.kkt_state(&big);
-    // the residual at `big` when the line search already assembled it (with the Jacobian,
-    // unless the next iteration is a chord step)
-    let mut next: Option<DVector<f64>> = None;
-    // this iteration solves with the last factorisation (a chord step)
-    let mut chord = false;
-    // the last step was damped by the line search: the next full step is then tried with its
-    // residual alone (its Jacobian is wasted if the merit rejects it, as after a damped step it
-    // often does)
-    let mut damped = false;
-    // relative change of the last step
-    let mut previous = f64::INFINITY;
-    let mut k = 0;
-    while k < params.max_iterations {
-        k += 1;
-        let r = match next.take() {
-            Some(r) => r,
-            None => {
-                let jacobian = (!chord).then_some((&*pattern, values.as_mut_slice(), rows.as_slice()));
-                assemble_residual(problem, params, frame, previous_angles, &big, fixed, jacobian)
+    let mut newton = Newton { s, params, frame, fwd, lean };
+    for k in 1..=params.max_iterations {
+        loop {
+            match newton.attempt(&mut it, k, observer)? {
+                // too weak a contraction for the frozen Jacobian, or a step the merit rejects:
+                // the iteration is Newton's
+                Attempt::ChordRejected => it.mode = Mode::Newton,
+                Attempt::Taken => break,
+                Attempt::Done(stop, c) => return Ok(newton.done(it, stop, c)),
             }
+        }
+    }
+    let c = newton.certify(&it.big);
+    Ok(newton.done(it, Stop::MaxIterations, c))
+}
+
+/// How an iteration of [`solve_from`] solves for its step.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Mode {
+    /// with the Jacobian at the iterate (assembled here, or by the last line search)
+    Newton,
+    /// with the last factorisation (a chord step)
+    Chord,
+}
+
+/// What became of an attempt at an iteration.
+enum Attempt {
+    /// a chord step rejected: the iteration is attempted again as Newton's
+    ChordRejected,
+    /// the step was taken; the next iteration follows
+    Taken,
+    /// the solve ends with this stop and the certificate of its iterate
+    Done(Stop, Certificate),
+}
+
+/// The iterate of [`solve_from`] and what one iteration hands to the next.
+struct Iterate {
+    /// the KKT vector `(x, α, x̂, α̂)` and its state and adjoint parts (forward layout)
+    big: DVector<f64>,
+    u: DVector<f64>,
+    adjoint: DVector<f64>,
+    /// the residual at `big` when the line search already assembled it (with the Jacobian,
+    /// unless the next iteration is a chord step)
+    next: Option<DVector<f64>>,
+    mode: Mode,
+    /// the last step was damped by the line search: the next full step is then tried with its
+    /// residual alone (its Jacobian is wasted if the merit rejects it, as after a damped step it
+    /// often does)
+    damped: bool,
+    /// relative change of the last step
+    previous: f64,
+    /// the merit at the start, and at the start of each Newton iteration (stall detection)
+    phi0: f64,
+    phis: Vec<f64>,
+    history: Vec<InverseRecord>,
+}
+
+/// What stays fixed over a frame's Newton iteration: the solver (pattern, LU, Dirichlet rows,
+/// merit weights) and the frame.
+struct Newton<'a, 'p, 'f> {
+    s: &'a mut FrameSolver<'p>,
+    params: &'a InverseParams,
+    frame: &'a Frame<'f>,
+    fwd: DofMap,
+    /// only the last record is kept ([`Records::Last`])
+    lean: bool,
+}
+
+impl Newton<'_, '_, '_> {
+    /// The merit: the residual's norm weighted by the start's Ruiz row factors (I6).
+    fn merit(&self, r: &DVector<f64>) -> f64 {
+        r.iter().zip(self.s.merit_weights.iter()).map(|(a, b)| (a * b).powi(2)).sum::<f64>().sqrt()
+    }
+
+    /// The residual at `big` ([`assemble_residual`]), with the Jacobian into the solver's
+    /// values if `jacobian`.
+    fn residual(&mut self, big: &DVector<f64>, jacobian: bool) -> DVector<f64> {
+        let s = &mut *self.s;
+        let previous = self.frame.previous.unwrap_or(s.no_previous.as_slice());
+        let jacobian = jacobian.then_some((&s.pattern, s.values.as_mut_slice(), s.rows.as_slice()));
+        assemble_residual(s.problem, self.params, self.frame, previous, big, &s.fixed, jacobian)
+    }
+
+    /// The residual certificate of `big` (`kkt::certificate`).
+    fn certify(&mut self, big: &DVector<f64>) -> Certificate {
+        let s = &mut *self.s;
+        let previous = self.frame.previous.unwrap_or(s.no_previous.as_slice());
+        super::kkt::certificate(s.problem, self.params, self.frame, previous, big, &s.pattern, &mut s.cert_values)
+    }
+
+    /// The record of iteration `k` (`measures::record`).
+    fn record(
+        &self,
+        k: usize,
+        change: f64,
+        u: &DVector<f64>,
+        adjoint: &DVector<f64>,
+        residual: Option<f64>,
+    ) -> InverseRecord {
+        let previous = self.frame.previous.unwrap_or(self.s.no_previous.as_slice());
+        record(self.s.problem, self.params, self.frame, previous, k, change, u, adjoint, residual)
+    }
+
+    fn done(&self, it: Iterate, stop: Stop, certificate: Certificate) -> InverseSolution {
+        InverseSolution {
+            u: it.u,
+            adjoint: it.adjoint,
+            history: it.history,
+            stop,
+            certificate,
+            certificate_tolerance: self.params.certificate_tolerance,
+        }
+    }
+
+    /// Iteration `k` in the iterate's mode: the step, the stall test, the chord step's
+    /// contraction test, the line search and the step taken.
+    fn attempt(
+        &mut self,
+        it: &mut Iterate,
+        k: usize,
+        observer: &mut impl FnMut(&InverseRecord, &DVector<f64>, &DVector<f64>),
+    ) -> Result<Attempt, SolveError> {
+        let chord = it.mode == Mode::Chord;
+        let r = match it.next.take() {
+            Some(r) => r,
+            None => self.residual(&it.big, !chord),
         };
-        let delta = if chord { solver.solve_factored(&(-&r))? } else { solver.solve_rescaled(values, &(-&r))? };
-        let phi = merit(&r);
+        let delta = if chord {
+            self.s.solver.solve_factored(&(-&r))?
+        } else {
+            self.s.solver.solve_rescaled(&self.s.values, &(-&r))?
+        };
+        let phi = self.merit(&r);
         if k == 1 {
-            phi0 = phi;
+            it.phi0 = phi;
         }
         if !chord {
-            phis.push(phi);
+            it.phis.push(phi);
         }
         // stalled: the merit fell by less than STALL_DECREASE over STALL_WINDOW iterations
-        let n = phis.len();
-        if !chord && n > STALL_WINDOW && phi > (1.0 - STALL_DECREASE) * phis[n - 1 - STALL_WINDOW] {
-            let c = certify(&big);
-            let stop = if c.within(params.certificate_tolerance) { Stop::Converged } else { Stop::Stalled };
-            if lean {
-                // a lean solve kept no record of the iterate it returns: its report is this one
-                let rec = InverseRecord {
-                    certificate: Some(c.value),
-                    ..record(problem, params, frame, previous_angles, k - 1, previous, &u, &adjoint, Some(phi / phi0))
-                };
-                observer(&rec, &u, &adjoint);
-                history.push(rec);
-            }
-            return Ok(done(u, adjoint, history, stop, c));
+        let n = it.phis.len();
+        if !chord && n > STALL_WINDOW && phi > (1.0 - STALL_DECREASE) * it.phis[n - 1 - STALL_WINDOW] {
+            let (stop, c) = self.stall(it, k, phi, observer);
+            return Ok(Attempt::Done(stop, c));
         }
-        let change = relative_change(&fwd, &dofs.kkt_state(&(&big + &delta)), &dofs.kkt_state(&big));
+        let dofs = self.s.dofs;
+        let change = relative_change(&self.fwd, &dofs.kkt_state(&(&it.big + &delta)), &dofs.kkt_state(&it.big));
         // A full step whose relative change is within the tolerance is taken without the
         // line search: the merit is then at its round-off floor and cannot decrease reliably.
-        let full = change <= params.tolerance;
-        let skip_residual = full && lean;
-        if chord && !full && change > CHORD_CONTRACTION * previous {
-            // too weak a contraction for the frozen Jacobian: this iteration is Newton's
-            (chord, k) = (false, k - 1);
-            continue;
+        let full = change <= self.params.tolerance;
+        if chord && !full && change > CHORD_CONTRACTION * it.previous {
+            return Ok(Attempt::ChordRejected);
         }
         // the next iteration reuses this factorisation if a chord step is predicted to
         // contract by CHORD_RATE: the square of this Newton step's contraction, or a chord
         // step's own
         let rate = match (chord, k) {
             (_, 1) => f64::INFINITY,
-            (true, _) => change / previous,
-            (false, _) => (change / previous).powi(2),
+            (true, _) => change / it.previous,
+            (false, _) => (change / it.previous).powi(2),
         };
         let chord_next = !full && rate <= CHORD_RATE;
+        let Some((t, trial, phi_t)) = self.line_search(it, &delta, phi, full, chord_next) else {
+            return Ok(Attempt::ChordRejected);
+        };
+        it.mode = if chord_next && t == 1.0 { Mode::Chord } else { Mode::Newton };
+        it.damped = t < 1.0;
+        self.take_step(it, k, trial, full, phi_t, observer)
+    }
+
+    /// A stalled iteration `k` (merit `phi`): converged if its iterate is certified; a lean
+    /// solve records the iterate it returns (it kept no record of it).
+    fn stall(
+        &mut self,
+        it: &mut Iterate,
+        k: usize,
+        phi: f64,
+        observer: &mut impl FnMut(&InverseRecord, &DVector<f64>, &DVector<f64>),
+    ) -> (Stop, Certificate) {
+        let c = self.certify(&it.big);
+        let stop = if c.within(self.params.certificate_tolerance) { Stop::Converged } else { Stop::Stalled };
+        if self.lean {
+            let rec = InverseRecord {
+                certificate: Some(c.value),
+                ..self.record(k - 1, it.previous, &it.u, &it.adjoint, Some(phi / it.phi0))
+            };
+            observer(&rec, &it.u, &it.adjoint);
+            it.history.push(rec);
+        }
+        (stop, c)
+    }
+
+    /// The backtracking line search along `delta` from the iterate (merit `phi`): the step
+    /// length, the trial iterate and its merit (NaN where its residual was not assembled);
+    /// `None`: a chord step the merit rejects.
+    fn line_search(
+        &mut self,
+        it: &mut Iterate,
+        delta: &DVector<f64>,
+        phi: f64,
+        full: bool,
+        chord_next: bool,
+    ) -> Option<(f64, DVector<f64>, f64)> {
+        let chord = it.mode == Mode::Chord;
         let mut t = 1.0;
-        let (mut trial, mut phi_t);
-        let accepted = loop {
-            trial = &big + &delta * t;
+        loop {
+            let trial = &it.big + delta * t;
             // The full step of an iteration that is not the last is usually accepted: its
             // residual comes with the Jacobian (unless a chord step follows), which the next
             // iteration then uses (the same element sums, so the same residual as assembling
             // it there).
-            let with_jacobian = t == 1.0 && !full && !chord_next && !damped;
-            let jacobian = with_jacobian.then_some((&*pattern, values.as_mut_slice(), rows.as_slice()));
+            let with_jacobian = t == 1.0 && !full && !chord_next && !it.damped;
             // the last step is taken without its residual where no record needs it
-            if skip_residual {
-                phi_t = f64::NAN;
-                break true;
+            if full && self.lean {
+                return Some((t, trial, f64::NAN));
             }
-            let r_t = assemble_residual(problem, params, frame, previous_angles, &trial, fixed, jacobian);
-            phi_t = merit(&r_t);
+            let r_t = self.residual(&trial, with_jacobian);
+            let phi_t = self.merit(&r_t);
             if full || phi_t <= (1.0 - ARMIJO * t) * phi || t <= MIN_STEP {
                 if t == 1.0 && !full && (with_jacobian || chord_next) {
-                    next = Some(r_t);
+                    it.next = Some(r_t);
                 }
-                break true;
+                return Some((t, trial, phi_t));
             }
             if chord {
-                break false;
+                return None;
             }
             t *= 0.5;
-        };
-        if !accepted {
-            // a chord step the merit rejects: this iteration is Newton's
-            (chord, k) = (false, k - 1);
-            continue;
-        }
-        chord = chord_next && t == 1.0;
-        damped = t < 1.0;
-        let u_old = dofs.kkt_state(&big);
-        u = dofs.kkt_state(&trial);
-        let rel_change = relative_change(&fwd, &u, &u_old);
-        previous = rel_change;
-        big = trial;
-        adjoint = dofs.kkt_adjoint(&big);
-        let last = k == params.max_iterations;
-        let cert = (!lean || full || last).then(|| certify(&big));
-        if lean && !full && !last {
-            let x_err = position_error(problem, &u, frame.tracking());
-            early_divergence(frame.index, k, rel_change, x_err, &u, &adjoint)?;
-        } else {
-            let residual = (!skip_residual).then_some(phi_t / phi0);
-            let rec = InverseRecord {
-                certificate: cert.map(|c| c.value),
-                ..record(problem, params, frame, previous_angles, k, rel_change, &u, &adjoint, residual)
-            };
-            rec.divergence(frame.index, &u, &adjoint)?;
-            observer(&rec, &u, &adjoint);
-            history.push(rec);
-        }
-        match cert {
-            Some(c) if full && c.within(params.certificate_tolerance) => {
-                return Ok(done(u, adjoint, history, Stop::Converged, c));
-            }
-            Some(c) if last => return Ok(done(u, adjoint, history, Stop::MaxIterations, c)),
-            // a step within the tolerance whose iterate is not certified: go on with Newton
-            _ if full => (next, chord) = (None, false),
-            _ => {}
         }
     }
-    let c = certify(&big);
-    Ok(done(u, adjoint, history, Stop::MaxIterations, c))
+
+    /// Take the step to `trial` (merit `phi_t`) as iteration `k`: record it (a lean solve only
+    /// checks for divergence until the last iteration) and stop if it is certified within the
+    /// tolerance, or the last.
+    fn take_step(
+        &mut self,
+        it: &mut Iterate,
+        k: usize,
+        trial: DVector<f64>,
+        full: bool,
+        phi_t: f64,
+        observer: &mut impl FnMut(&InverseRecord, &DVector<f64>, &DVector<f64>),
+    ) -> Result<Attempt, SolveError> {
+        let dofs = self.s.dofs;
+        let u_old = dofs.kkt_state(&it.big);
+        it.u = dofs.kkt_state(&trial);
+        let rel_change = relative_change(&self.fwd, &it.u, &u_old);
+        it.previous = rel_change;
+        it.big = trial;
+        it.adjoint = dofs.kkt_adjoint(&it.big);
+        let last = k == self.params.max_iterations;
+        let cert = (!self.lean || full || last).then(|| self.certify(&it.big));
+        if self.lean && !full && !last {
+            let x_err = position_error(self.s.problem, &it.u, self.frame.tracking());
+            early_divergence(self.frame.index, k, rel_change, x_err, &it.u, &it.adjoint)?;
+        } else {
+            let residual = (!(full && self.lean)).then_some(phi_t / it.phi0);
+            let rec = InverseRecord {
+                certificate: cert.map(|c| c.value),
+                ..self.record(k, rel_change, &it.u, &it.adjoint, residual)
+            };
+            rec.divergence(self.frame.index, &it.u, &it.adjoint)?;
+            observer(&rec, &it.u, &it.adjoint);
+            it.history.push(rec);
+        }
+        match cert {
+            Some(c) if full && c.within(self.params.certificate_tolerance) => {
+                return Ok(Attempt::Done(Stop::Converged, c));
+            }
+            Some(c) if last => return Ok(Attempt::Done(Stop::MaxIterations, c)),
+            // a step within the tolerance whose iterate is not certified: go on with Newton
+            _ if full => (it.next, it.mode) = (None, Mode::Newton),
+            _ => {}
+        }
+        Ok(Attempt::Taken)
+    }
 }
 
 /// Newton started from the paper's fixed point (I8): the fixed point (relaxation

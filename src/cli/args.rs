@@ -1,0 +1,192 @@
+//! The command line: [`Cli`] and its subcommands ([`Command`]), parsed by clap.
+use std::path::PathBuf;
+
+use clap::{Parser, Subcommand};
+
+use cosserat::io::compact::OutputFormat;
+use cosserat::run::Engine;
+
+/// Forward Cosserat rods after Wang et al. (Comput. Mech. 71, 2023), in Rust and FreeFEM.
+#[derive(Parser, Debug)]
+#[command(name = "cosserat", version, about, long_about = None)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// Run a case and write fields (CSV), metrics.json and plot.svg.
+    Run {
+        /// Case file (TOML), e.g. cases/timoshenko_10pct.toml
+        case: PathBuf,
+        /// Which engine to run
+        #[arg(long, value_enum, default_value_t = Engine::Rust)]
+        engine: Engine,
+        /// Output directory [default: out/<case name>/<engine>]. The run writes into a staging
+        /// folder beside it that replaces it whole at the end; run.json says what it holds
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Replace the output directory even if it holds files but no run.json
+        #[arg(long)]
+        force: bool,
+        /// Continue the interrupted, failed or killed clip of the output directory from its
+        /// last converged frame (same case file and clip file), in a staging folder of its own;
+        /// the CSVs are then byte for byte those of an uninterrupted run
+        #[arg(long, conflicts_with = "force")]
+        resume: bool,
+        /// Clips: per-node fields as CSV + ParaView VTK, or all in one fields.npz (docs/output.md)
+        #[arg(long, value_enum, default_value_t = OutputFormat::Csv)]
+        output_format: OutputFormat,
+        #[command(flatten)]
+        limits: Limits,
+        /// Do not show progress (a bar on a terminal, else a line every 10 s)
+        #[arg(long)]
+        quiet: bool,
+        /// Clips: exit with status 1 when frames are over the fit-quality gate (run.json then
+        /// says complete_with_warnings either way)
+        #[arg(long)]
+        strict: bool,
+    },
+    /// Run both engines and compare them; exit status 1 if any row fails.
+    ///
+    /// Newton runs are compared at their roots, an inverse fixed point at the same iteration
+    /// (FreeFEM runs exactly the iterations Rust needed), a clip frame by frame over its first
+    /// frames. Each tolerance is derived from the case's conditioning: the Rust engine runs the
+    /// case again with its input perturbed by 1e-13 (relative), and a row passes when the
+    /// engines differ by less than 10 x (that change + the solver tolerance) + 1e-12. Values in
+    /// the case's [compare] table override them (with a `reason`). Writes compare.csv, the
+    /// engines' outputs (single runs) and FreeFEM's work folder to --out.
+    Compare {
+        /// Case file (TOML)
+        case: PathBuf,
+        /// Directory for both engines' outputs [default: out/<case name>]
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Short horizon: 200 time steps, 40 fixed-point iterations, 3 clip frames
+        #[arg(long)]
+        short: bool,
+        /// Clip cases: frames to compare, a number or `all` [default: the case's
+        /// `[compare] frames`, 10]
+        #[arg(long, value_parser = super::parse_frames)]
+        frames: Option<usize>,
+        /// Replace the output directory even if it holds files but no run.json
+        #[arg(long)]
+        force: bool,
+        #[command(flatten)]
+        limits: Limits,
+    },
+    /// Run a case for every point of a parameter grid (in parallel) and summarise.
+    ///
+    /// Writes one folder per run (the files of `run`), `summary.csv` (one row per run: the swept
+    /// values, status, iterations, recovery errors, objective, wall time, error message) and
+    /// `convergence.svg` (log-log histories, one curve per run; Figs. 9-11 of the paper). A run
+    /// that reaches its iteration limit is `not_converged`: its folder holds the last iterate
+    /// with a run.json saying failed, and its curve is plotted. A clip case solves its whole clip for every
+    /// point (the folder holds the files of `run` on the clip; the summary has one row per
+    /// point: frames, iterations, worst fit, tangent misfit, |j - 1|, objective). Exit status 1
+    /// if any run failed or did not converge (after writing everything).
+    Sweep {
+        /// Case file (TOML)
+        case: PathBuf,
+        /// Parameter and values, e.g. `--set lambda_d=1e-6,1e-4`; repeat for a cartesian
+        /// product. Each value is set in the case file's table and the case validated again.
+        /// Inverse cases: lambda_g, lambda_f, lambda_l, lambda_d, lambda_kappa1..3,
+        /// lambda_omega1..3, relaxation, warm_start_tolerance, tolerance, max_iterations,
+        /// elements, stabilisation. Static: relaxation, tolerance, max_iterations,
+        /// continuation_steps, elements. Dynamic: tolerance, max_iterations, steps, elements
+        #[arg(long = "set", value_name = "KEY=V1,V2,...", required = true)]
+        set: Vec<String>,
+        /// Output directory [default: out/<case name>/sweep]
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Replace the output directory even if it holds files but no run.json
+        #[arg(long)]
+        force: bool,
+        #[command(flatten)]
+        limits: Limits,
+        /// Parallel runs [default: number of cores]
+        #[arg(long)]
+        jobs: Option<usize>,
+        /// Do not show progress (a bar on a terminal, else a line every 10 s)
+        #[arg(long)]
+        quiet: bool,
+    },
+    /// Audit the paper: regenerate its figures and judge its claims (§5-6).
+    ///
+    /// Reads the audit specs (default: every *.toml of cases/paper/), runs every point of every
+    /// run in parallel (one folder per point, the files of `run`/`sweep`), draws the paper's
+    /// figures and writes REPORT.md (one row per claim: the paper's words and number, ours, the
+    /// verdict - reproduced, differs, refuted, not computable here - and its cause) and
+    /// report.csv. `--quick` runs the specs' short grids and clip excerpts (the subset asserted by
+    /// `cargo test`). Exit status 1 if a claim's verdict is not the one its spec expects (the
+    /// report is written first).
+    Audit {
+        /// Audit specs (TOML) or folders of them [default: cases/paper]
+        specs: Vec<PathBuf>,
+        /// Short grids and clip excerpts (`quick_grid`, `quick_set` of the specs)
+        #[arg(long)]
+        quick: bool,
+        /// Output directory [default: out/audit, out/audit-quick with --quick]; replaced whole
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Replace the output directory even if it holds files but no run.json
+        #[arg(long)]
+        force: bool,
+        /// Parallel runs [default: number of cores]
+        #[arg(long)]
+        jobs: Option<usize>,
+        /// Do not show progress (a bar on a terminal, else a line every 10 s)
+        #[arg(long)]
+        quiet: bool,
+        /// Clip points keep compact fields.npz and figures [default: tables only, ≤ 200 MB]
+        #[arg(long, conflicts_with = "vtk")]
+        fields: bool,
+        /// Clip points keep fields.csv, curvature.csv, VTK and figures (GBs for the full audit)
+        #[arg(long)]
+        vtk: bool,
+        /// Continue the unfinished audit of --out: keep the specs it judged whole, rerun the rest
+        #[arg(long, conflicts_with = "force")]
+        resume: bool,
+    },
+    /// Run a clip case over many recordings (here, or as a Slurm job array with --slurm).
+    Batch(super::BatchArgs),
+    /// Run one task of a batch's Slurm job array (called by the job script).
+    #[command(hide = true)]
+    BatchTask(super::TaskArgs),
+    /// Write OUT/summary.csv from the recordings' folders of a batch (after a Slurm job array).
+    Gather {
+        /// Output folder of the batch (`--out` of `cosserat batch`: holds batch.json and one
+        /// folder per recording); summary.csv is written there
+        out: PathBuf,
+    },
+    /// Write a corpus of synthetic 3D recordings with their ground truth.
+    Synth(super::synth::SynthArgs),
+    /// Reconstruct synthetic recordings at several noise levels beside a smoothing spline.
+    NoiseStudy(super::noise_study::NoiseStudyArgs),
+    /// List the cases of a directory with their descriptions.
+    List {
+        /// Directory holding *.toml case files
+        #[arg(default_value = "cases")]
+        dir: PathBuf,
+    },
+    /// Natural frequencies of the rod linearised about its rest state (clamped at s = 0).
+    Modes {
+        /// Case file (TOML); loads and time settings are ignored
+        case: PathBuf,
+        /// How many modes to print (at least 1)
+        #[arg(long, default_value_t = 10, allow_hyphen_values = true, value_parser = super::parse_count)]
+        count: usize,
+        #[command(flatten)]
+        limits: Limits,
+    },
+}
+
+/// Resource limits of a run.
+#[derive(clap::Args, Debug, Clone, Copy)]
+pub struct Limits {
+    /// Refuse a run whose estimated memory exceeds this [GiB] [default: half the machine's
+    /// memory]
+    #[arg(long, value_name = "GIB")]
+    pub max_memory_gib: Option<f64>,
+}

@@ -1,0 +1,348 @@
+//! The commands on one case or one set of specs: `run`, `compare`, `sweep`, `audit` and
+//! `modes` (the commands of many recordings are in [`super`]).
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use anyhow::{Context, Result};
+
+use super::args::Limits;
+use super::progress::{FreefemProgress, Progress};
+use cosserat::case::Case;
+use cosserat::io::compact::OutputFormat;
+use cosserat::io::job::{case_label, run_into, run_manifest};
+use cosserat::io::run_folder::{input_file, Manifest, Mode, RunFolder, Status};
+use cosserat::io::sweep::RunStatus;
+use cosserat::run::budget::{self, default_limit_bytes, Footprint, GIB};
+use cosserat::run::Engine;
+use cosserat::solve::modes::modal_model;
+
+/// The case of `path`, its `rod.length_m = "from_data"` resolved from its recording.
+fn load(path: &Path) -> Result<Case> {
+    Ok(cosserat::io::clip_files::resolve_length(&Case::from_file(path)?)?)
+}
+
+/// Refuse a run whose estimated memory exceeds the limit (`--max-memory-gib`).
+fn check_memory(case: &Case, what: Footprint, limits: Limits) -> Result<()> {
+    let limit = limits.max_memory_gib.map(|g| g * GIB).unwrap_or_else(default_limit_bytes);
+    Ok(budget::check(case, what, limit)?)
+}
+
+pub fn cmd_run(
+    path: &Path,
+    engine: Engine,
+    out: Option<PathBuf>,
+    mode: (Mode, OutputFormat),
+    limits: Limits,
+    (quiet, strict): (bool, bool),
+) -> Result<ExitCode> {
+    let case = load(path)?;
+    check_memory(&case, Footprint::Run, limits)?;
+    let dir = out.unwrap_or_else(|| PathBuf::from("out").join(&case.name).join(engine.to_string()));
+    // FreeFEM's frames (a clip) or time steps (a dynamic case) as the script writes them; its other
+    // runs show the time elapsed
+    let counted = engine == Engine::Freefem
+        && (case.clip().is_some() || matches!(case.analysis, cosserat::case::Analysis::Dynamic(_)));
+    let label = format!("{} [{engine}]", case.name);
+    let pb = Progress::new(&label, super::outcome::progress_unit(&case, engine), 0, quiet || counted);
+    let freefem = (counted && !quiet).then(|| FreefemProgress::start(&label));
+    if engine == Engine::Freefem && !quiet {
+        eprintln!("{} [freefem]: running FreeFEM in a staging folder beside {}", case.name, dir.display());
+    }
+    let end = run_into(&case, engine, &dir, mode, |done, total| pb.set(done, total));
+    drop(freefem);
+    let end = end.with_context(|| format!("{}: output folder {}", case_label(&case), dir.display()))?;
+    pb.finish();
+    for n in &end.notes {
+        eprintln!("note: {n}");
+    }
+    super::outcome::run_end(end, (&case, engine), path, &dir, strict)
+}
+
+pub fn cmd_compare(
+    path: &Path,
+    out: Option<PathBuf>,
+    short: bool,
+    frames: Option<usize>,
+    force: bool,
+    limits: Limits,
+) -> Result<ExitCode> {
+    use cosserat::io::compare::default_dir;
+    let case = load(path)?;
+    check_memory(&case, Footprint::Run, limits)?;
+    let target = out.unwrap_or_else(|| default_dir(&case));
+    let mut manifest = run_manifest(&case, Engine::Rust)?;
+    manifest.writer.command = "compare".into();
+    manifest.input.engine = Some("rust and freefem".into());
+    let folder = RunFolder::begin(&target, manifest, Mode::Fresh { force })
+        .with_context(|| format!("{}: output folder {}", case_label(&case), target.display()))?;
+    for n in &folder.notes {
+        eprintln!("note: {n}");
+    }
+    // FreeFEM's frames (a clip) or time steps (a dynamic case) as it runs: a bar on a terminal,
+    // elsewhere a line every 10 s and a final line. Other cases: without a terminal, a line
+    // every 10 s says the comparison is still running.
+    let counted = case.clip().is_some() || matches!(case.analysis, cosserat::case::Analysis::Dynamic(_));
+    let on_terminal = std::io::IsTerminal::is_terminal(&std::io::stderr());
+    let pb = Progress::new(&format!("{} compare", case.name), "", 0, on_terminal || counted);
+    let freefem = FreefemProgress::start(&format!("{} FreeFEM", case.name));
+    let result = compare_into(&case, folder.dir(), &target, short, frames);
+    freefem.finish();
+    pb.finish();
+    let (status, message) = match &result {
+        Ok(_) => (Status::Complete, None),
+        Err(_) if cosserat::interrupt::requested() => (Status::Interrupted, Some("interrupted by a signal".into())),
+        Err(e) => (Status::Failed, Some(format!("{e:#}"))),
+    };
+    folder.finish(status, message)?;
+    match (status, result) {
+        (Status::Interrupted, _) => {
+            eprintln!("{}: interrupted; {} holds run.json saying interrupted", case.name, target.display());
+            Ok(ExitCode::from(crate::EXIT_INTERRUPTED))
+        }
+        (_, Err(e)) => Err(e.context(format!("{} holds run.json saying failed", target.display()))),
+        (_, Ok(code)) => Ok(code),
+    }
+}
+
+/// Both engines on `case` and their comparison, written into `dir` (the staging folder).
+fn compare_into(case: &Case, dir: &Path, target: &Path, short: bool, frames: Option<usize>) -> Result<ExitCode> {
+    use cosserat::io::compare::{compare_case, report_table, write_compare, CompareOptions, Horizon};
+    let opts = CompareOptions { horizon: if short { Horizon::Short } else { Horizon::Full }, frames };
+    eprintln!(
+        "{}: rust engine (twice: as given and with its input perturbed by 1e-13), then FreeFEM in {}",
+        case.name,
+        target.join("freefem_work").display()
+    );
+    let report = compare_case(case, dir, &opts).with_context(|| case_label(case))?;
+    write_compare(case, &report, dir)?;
+    print!("{}", report_table(case, &report));
+    println!("wrote {}", target.join("compare.csv").display());
+    let failed = report.failed();
+    if failed > 0 {
+        eprintln!("{}: {failed} of {} rows FAILED", case.name, report.rows.len());
+    }
+    Ok(if failed == 0 { ExitCode::SUCCESS } else { ExitCode::from(1) })
+}
+
+#[allow(clippy::too_many_arguments)]
+pub fn cmd_sweep(
+    path: &Path,
+    set: &[String],
+    out: Option<PathBuf>,
+    force: bool,
+    limits: Limits,
+    jobs: Option<usize>,
+    quiet: bool,
+) -> Result<ExitCode> {
+    use cosserat::case::sweep::{parse_set, product};
+    use cosserat::io::sweep::sweep_into;
+    let case = load(path)?;
+    let params = set.iter().map(|s| parse_set(s)).collect::<Result<Vec<_>, _>>()?;
+    let points = product(&case, &params)?;
+    for (_, c) in &points {
+        check_memory(c, Footprint::Run, limits).with_context(|| format!("sweep point {}", c.name))?;
+    }
+    let target = out.unwrap_or_else(|| PathBuf::from("out").join(&case.name).join("sweep"));
+    let mut manifest = run_manifest(&case, Engine::Rust)?;
+    manifest.writer.command = "sweep".into();
+    let folder = RunFolder::begin(&target, manifest, Mode::Fresh { force })
+        .with_context(|| format!("{}: output folder {}", case_label(&case), target.display()))?;
+    for n in &folder.notes {
+        eprintln!("note: {n}");
+    }
+    let pb = Progress::new(&format!("{} sweep", case.name), "points", points.len(), quiet);
+    let keys: Vec<String> = params.iter().map(|p| p.key.clone()).collect();
+    let result = sweep_into(&case, &keys, &points, folder.dir(), jobs.unwrap_or(0), || pb.inc());
+    pb.finish();
+    let rows = match result {
+        Ok(rows) => rows,
+        Err(e) if cosserat::io::disk::is_full(&e) => {
+            folder.abandon();
+            anyhow::bail!("{}: sweep: {}", case_label(&case), super::outcome::disk_full_text(&e, &target, "sweep"));
+        }
+        Err(e) => {
+            let message = cosserat::io::sweep::chain(&e);
+            folder.finish(Status::Failed, Some(message.clone()))?;
+            anyhow::bail!("{}: sweep: {message}; {} holds run.json saying failed", case_label(&case), target.display());
+        }
+    };
+    let count = |s: RunStatus| rows.iter().filter(|r| r.status == s).count();
+    let complete = rows.iter().filter(|r| r.status.is_complete()).count();
+    let (interrupted, failed) = (count(RunStatus::Interrupted), rows.len() - complete);
+    let status = if interrupted > 0 {
+        Status::Interrupted
+    } else if failed > 0 {
+        Status::Failed
+    } else {
+        Status::Complete
+    };
+    let message = (failed > 0).then(|| {
+        format!("{failed} of {} points failed, did not converge or were interrupted (summary.csv)", rows.len())
+    });
+    folder.finish(status, message)?;
+    println!(
+        "{}: {} runs, {} failed or not converged, {interrupted} interrupted; wrote {} and one folder per run to {}",
+        case.name,
+        rows.len(),
+        failed - interrupted,
+        target.join("summary.csv").display(),
+        target.display()
+    );
+    for r in rows.iter().filter(|r| r.error.as_deref() != Some(cosserat::io::sweep::NOT_STARTED)) {
+        if let Some(e) = &r.error {
+            eprintln!("  {}: {}: {e}", r.name, r.status.as_str());
+        }
+    }
+    if interrupted > 0 {
+        eprintln!("{}", super::outcome::sweep_interrupted_summary(&rows, &target));
+    }
+    Ok(if interrupted > 0 {
+        ExitCode::from(crate::EXIT_INTERRUPTED)
+    } else if failed == 0 {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    })
+}
+
+pub fn cmd_audit(
+    paths: &[PathBuf],
+    quick: bool,
+    out: Option<PathBuf>,
+    force: Option<bool>,
+    jobs: Option<usize>,
+    quiet: bool,
+    fields: cosserat::audit::PointFields,
+) -> Result<ExitCode> {
+    use cosserat::audit::{run_audit, spec::read_spec, AuditOptions, AuditStatus};
+    let files = audit_spec_files(paths)?;
+    let specs = files.iter().map(|f| read_spec(f, quick)).collect::<Result<Vec<_>, _>>()?;
+    let out = out.unwrap_or_else(|| PathBuf::from(if quick { "out/audit-quick" } else { "out/audit" }));
+    // an audit folder of an older version carries the audit's marker instead of run.json
+    let marker = out.join(cosserat::audit::MARKER).is_file();
+    let mode = force.map_or(Mode::Resume, |f| Mode::Fresh { force: f || marker });
+    let mut manifest = Manifest::new("audit");
+    manifest.input.inputs = files.iter().map(|f| input_file(f)).collect::<Result<_, _>>()?;
+    manifest.input.settings.insert("quick".into(), f64::from(u8::from(quick)).into());
+    let resume = force.is_none();
+    let folder =
+        RunFolder::begin(&out, manifest, mode).with_context(|| format!("audit: output folder {}", out.display()))?;
+    let pb = Progress::new(if quick { "audit (quick)" } else { "audit" }, "points", 0, quiet);
+    let opts = AuditOptions { out: folder.dir().to_path_buf(), jobs: jobs.unwrap_or(0), fields, resume };
+    let points = std::sync::atomic::AtomicUsize::new(0);
+    let report = run_audit(&specs, quick, &opts, |done, total| {
+        points.store(total, std::sync::atomic::Ordering::SeqCst);
+        pb.set(done, total);
+    });
+    pb.finish();
+    let report = match report {
+        Ok(r) => r,
+        Err(e) => {
+            let message = format!("{:#}", anyhow::Error::from(e));
+            folder.finish(Status::Failed, Some(message.clone()))?;
+            anyhow::bail!("audit: {message}; {} holds run.json saying failed", out.display());
+        }
+    };
+    let judged = format!("{} of {} claims judged", report.claims.len() - report.unjudged(), report.claims.len());
+    match &report.status {
+        AuditStatus::Complete => {
+            folder.finish(Status::Complete, None)?;
+        }
+        AuditStatus::Interrupted => {
+            let kept =
+                super::outcome::audit_points_kept(folder.dir(), points.load(std::sync::atomic::Ordering::SeqCst));
+            folder.finish(Status::Interrupted, Some(format!("interrupted by a signal: {kept}; {judged}")))?;
+            eprintln!(
+                "audit interrupted: {kept}; {judged}; REPORT.md is headed interrupted and marks the others not judged; {} holds run.json saying interrupted",
+                out.display()
+            );
+            return Ok(ExitCode::from(crate::EXIT_INTERRUPTED));
+        }
+        AuditStatus::Failed(errors) => {
+            let message = format!("{judged}: {}", errors.join("; "));
+            folder.finish(Status::Failed, Some(message.clone()))?;
+            anyhow::bail!(
+                "audit failed: {message}; REPORT.md is headed failed; {} holds run.json saying failed",
+                out.display()
+            );
+        }
+    }
+    Ok(audit_summary(&report, specs.len(), &out))
+}
+
+/// The spec files of `paths` (a folder: its `*.toml`; none given: `cases/paper`).
+fn audit_spec_files(paths: &[PathBuf]) -> Result<Vec<PathBuf>> {
+    let default = [PathBuf::from("cases/paper")];
+    let mut files = Vec::new();
+    for p in if paths.is_empty() { &default[..] } else { paths } {
+        if p.is_dir() {
+            files.extend(cosserat::audit::spec_files(p)?);
+        } else {
+            files.push(p.clone());
+        }
+    }
+    if files.is_empty() {
+        let given: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
+        anyhow::bail!(
+            "no audit specs (*.toml) in {}",
+            if given.is_empty() { "cases/paper".to_string() } else { given.join(", ") }
+        );
+    }
+    Ok(files)
+}
+
+/// The one-line summary of a finished audit on stdout and each claim whose verdict is not the
+/// one its spec expects on stderr; status 1 if there is one.
+fn audit_summary(report: &cosserat::audit::AuditReport, specs: usize, out: &Path) -> ExitCode {
+    use cosserat::audit::Verdict;
+    let counts = report.counts();
+    let summary: Vec<String> = Verdict::ALL.iter().zip(counts).map(|(v, n)| format!("{n} {}", v.as_str())).collect();
+    let ours = report.claims.iter().filter(|c| c.claim.ours).count();
+    println!(
+        "{} claims of the paper and {ours} checks of ours in {} specs: {}; {} figures; {:.0} s; {:.1} MB; wrote {}",
+        report.claims.len() - ours,
+        specs,
+        summary.join(", "),
+        report.figures.len(),
+        report.wall_time_s,
+        report.bytes as f64 / 1e6,
+        out.join("REPORT.md").display()
+    );
+    let unexpected: Vec<_> = report.claims.iter().filter(|c| c.verdict != Some(c.claim.expect)).collect();
+    for c in &unexpected {
+        eprintln!(
+            "  {} ({}): {} where the spec expects {}; ours: {}",
+            c.claim.id,
+            c.spec,
+            c.verdict.map_or("not judged", |v| v.as_str()),
+            c.claim.expect.as_str(),
+            c.ours
+        );
+    }
+    if unexpected.is_empty() {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    }
+}
+
+pub fn cmd_modes(path: &Path, count: usize, limits: Limits) -> Result<ExitCode> {
+    let case = load(path)?;
+    if !case.density_given() {
+        anyhow::bail!(
+            "{}: material.density_kg_m3 [kg/m^3] is required by `modes` (the natural frequencies scale as 1/sqrt(density)) and is missing from this case",
+            path.display()
+        );
+    }
+    check_memory(&case, Footprint::Modes, limits)?;
+    let model = modal_model(&case.problem())?;
+    println!(
+        "{}: natural frequencies of the linearised rod (clamped at s = 0, {} elements)",
+        case.name, case.mesh.elements
+    );
+    println!("{:>4} {:>16} {:>14}", "mode", "omega_rad_per_s", "f_hz");
+    for (i, w) in model.omegas.iter().take(count).enumerate() {
+        println!("{:>4} {:>16.6} {:>14.6}", i + 1, w, w / (2.0 * std::f64::consts::PI));
+    }
+    Ok(ExitCode::SUCCESS)
+}
