@@ -12,12 +12,13 @@ use cosserat::case::Case;
 use cosserat::io::compare::{compare_case, CompareOptions, Horizon};
 use cosserat::io::freefem::{script_dir, SCRIPT_DIR_ENV};
 
-/// One mutation: a script of `freefem/`, the exact text replaced (it must occur once), its
-/// replacement, the case and horizon it is run on, and the rows that must fail.
+/// One mutation: a script of `freefem/`, the exact text replaced (at each of its `occurrences`),
+/// its replacement, the case and horizon it is run on, and the rows that must fail.
 struct Mutation {
     what: &'static str,
     file: &'static str,
     from: &'static str,
+    occurrences: usize,
     to: &'static str,
     case: &'static str,
     horizon: Horizon,
@@ -30,6 +31,7 @@ const MUTATIONS: &[Mutation] = &[
         what: "inverse: the lambda_d right-hand side (linearised d3 of eq. 60) with the wrong sign",
         file: "inverse_core.idp",
         from: "+ (1. - stab)*lambdaD*(TMS1(uc,te)*TMR1(uc)",
+        occurrences: 1,
         to: "- (1. - stab)*lambdaD*(TMS1(uc,te)*TMR1(uc)",
         case: "inverse_bend_twist",
         horizon: Horizon::Short,
@@ -39,17 +41,19 @@ const MUTATIONS: &[Mutation] = &[
         what: "forward: the follower load's f2 term (f^g = Q^T f^l) with the wrong sign",
         file: "forward.edp",
         from: "macro FLG2(P,T) (Qp(12,P)*F1(x,T) + Qp(22,P)*F2(x,T)",
+        occurrences: 1,
         to: "macro FLG2(P,T) (Qp(12,P)*F1(x,T) - Qp(22,P)*F2(x,T)",
         case: "follower_bend_64",
         horizon: Horizon::Full,
         rows: &["nodewise_rel_diff_displacement", "tip_y_m"],
     },
     // kinematics.idp's XN3F as scripts/freefem_coefficients.py writes it into coefficients.idp
-    // (array statements; the script FreeFEM runs)
+    // (array statements; the script FreeFEM runs), in COEFUPDATE and in COEFUPDATET
     Mutation {
         what: "forward: the third component of d_s x cross n (eq. 35) with the wrong sign",
         file: "coefficients.idp",
         from: "cqcXN3[] = cqcD1[] .* cqcNG2[]; coefW = cqcD2[] .* cqcNG1[]; cqcXN3[] -= coefW;",
+        occurrences: 2,
         to: "cqcXN3[] = cqcD1[] .* cqcNG2[]; coefW = cqcD2[] .* cqcNG1[]; cqcXN3[] += coefW;",
         case: "follower_bend_twist_65",
         horizon: Horizon::Full,
@@ -77,8 +81,9 @@ fn broken_freefem_scripts_make_compare_fail() {
         copy_scripts(dir.path());
         let path = dir.path().join(m.file);
         let text = std::fs::read_to_string(&path).expect("script");
-        assert_eq!(text.matches(m.from).count(), 1, "{}: `{}` must occur once in {}", m.what, m.from, m.file);
-        std::fs::write(&path, text.replacen(m.from, m.to, 1)).expect("write");
+        let found = text.matches(m.from).count();
+        assert_eq!(found, m.occurrences, "{}: `{}` must occur {} times in {}", m.what, m.from, m.occurrences, m.file);
+        std::fs::write(&path, text.replace(m.from, m.to)).expect("write");
         std::env::set_var(SCRIPT_DIR_ENV, dir.path());
         let case = Case::from_file(&common::cases_dir().join(format!("{}.toml", m.case))).expect("case");
         let out = tempfile::tempdir().expect("tempdir");
