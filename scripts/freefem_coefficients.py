@@ -299,57 +299,39 @@ def composite_statements(c):
     return out
 
 
-def base_statements():
-    """The rotation coefficients, the derivatives and the state quantities at the points into the container and
-    the fields of P (COEFUPDATE's work when the state changed)."""
+def quantity_statements(quantities):
+    """Each quantity at the points (composite_statements) and, unless an intermediate, into its field of P."""
     upd = []
-    for x, v in (("a", "a"), ("b", "b"), ("c", "g")):
-        upd.append(f"coefc{x} = cos(cq{v}[]); coefs{x} = sin(cq{v}[]);")
-    for n in names:
-        upd += trig_statements(macros[formula[n]], "coefV")
-        upd.append(f"cq{n}[] = coefV; P#{n}[] = coefMap*coefV;")
-    for c in rot_composites:
-        upd += composite_statements(c)
-        upd.append(f"P#c{c}[] = coefMap*cqc{c}[];")
-    for d in derivs:
-        upd.append(f"P#{d}[] = coefMap*cq{d}[];")
-    for c in composites:
+    for c in quantities:
         upd += composite_statements(c)
         if c not in intermediates:
             upd.append(f"P#c{c}[] = coefMap*cqc{c}[];")
     return upd
 
 
-def tangent_macro():
-    """COEFUPDATET(P, u): COEFUPDATE's fields and the tangent's derivative coefficients (tangent_composites). When
-    P's state quantities are up to date and the container holds the values of this state (coefCqNow: the key of
-    the last COEFUPDATE that computed), only the derivative coefficients are computed."""
-    upd = ["{ cqa[] = coefIa*u; cqb[] = coefIb*u; cqg[] = coefIg*u;"]
-    nows = ["cqa", "cqb", "cqg"] + ["cqcD" + k for k in "123abg"]
-    for c, k in enumerate("123abg"):
-        upd.append(f"cqcD{k}[] = coefD[{c}]*u;")
-    upd.append(f"real[int] coefNow({len(nows)}*coefNq);")
-    for c, v in enumerate(nows):
-        upd.append(f"coefNow({c}*coefNq:{c + 1}*coefNq - 1) = {v}[];")
-    upd.append("real[int] coefDiff = coefNow - P#CoefLastT;")
-    upd.append("if (!(coefDiff.linfty == 0.)) {")
-    upd.append("real[int] coefDiffB = coefNow - P#CoefLast; real[int] coefDiffC = coefNow - coefCqNow;")
-    upd.append("if (!(coefDiffB.linfty == 0. && coefDiffC.linfty == 0.)) {")
-    upd += base_statements()
-    upd.append("P#CoefLast = coefNow; coefCqNow = coefNow; }")
-    for c in tangent_composites:
-        upd += composite_statements(c)
-        if c not in intermediates:
-            upd.append(f"P#c{c}[] = coefMap*cqc{c}[];")
-    upd.append("P#CoefLastT = coefNow; } }")
-    w("macro COEFUPDATET(P, u) " + " ".join(upd) + " //")
+def rotation_statements():
+    """The rotation coefficients and the rotation-only quantities of the container's angles, into the fields of P."""
+    upd = []
+    for x, v in (("a", "a"), ("b", "b"), ("c", "g")):
+        upd.append(f"coefc{x} = cos(cq{v}[]); coefs{x} = sin(cq{v}[]);")
+    for n in names:
+        upd += trig_statements(macros[formula[n]], "coefV")
+        upd.append(f"cq{n}[] = coefV; P#{n}[] = coefMap*coefV;")
+    return upd + quantity_statements(rot_composites)
 
 
-def update_macro(name, cache, with_state, with_velocity=False):
-    """COEFUPDATE (every field), COEFUPDATEQ (the rotation coefficients only) or MOMUPDATE (the rotation
-    coefficients and the angular momentum's derivative at the velocity v): the fields of P at the state u,
-    unless u's angles (and, with_state, derivatives; with_velocity, v's angle rates) are those of the last call
-    (the cache P#cache; MOMUPDATE also sets COEFUPDATEQ's)."""
+def base_statements():
+    """The rotation coefficients, the derivatives and the state quantities at the points into the container and
+    the fields of P (COEFUPDATE's work when the state changed)."""
+    upd = rotation_statements()
+    for d in derivs:
+        upd.append(f"P#{d}[] = coefMap*cq{d}[];")
+    return upd + quantity_statements(composites)
+
+
+def key_statements(with_state, with_velocity):
+    """The start of an update macro: the container's angles (v's angle rates, the state's derivatives) at the points
+    and coefNow, the key its caches compare."""
     upd = ["{ cqa[] = coefIa*u; cqb[] = coefIb*u; cqg[] = coefIg*u;"]
     nows = ["cqa", "cqb", "cqg"]
     if with_velocity:
@@ -362,26 +344,41 @@ def update_macro(name, cache, with_state, with_velocity=False):
     upd.append(f"real[int] coefNow({len(nows)}*coefNq);")
     for c, v in enumerate(nows):
         upd.append(f"coefNow({c}*coefNq:{c + 1}*coefNq - 1) = {v}[];")
+    return upd
+
+
+def tangent_macro():
+    """COEFUPDATET(P, u): COEFUPDATE's fields and the tangent's derivative coefficients (tangent_composites). When
+    P's state quantities are up to date and the container holds the values of this state (coefCqNow: the key of
+    the last COEFUPDATE that computed), only the derivative coefficients are computed."""
+    upd = key_statements(True, False)
+    upd.append("real[int] coefDiff = coefNow - P#CoefLastT;")
+    upd.append("if (!(coefDiff.linfty == 0.)) {")
+    upd.append("real[int] coefDiffB = coefNow - P#CoefLast; real[int] coefDiffC = coefNow - coefCqNow;")
+    upd.append("if (!(coefDiffB.linfty == 0. && coefDiffC.linfty == 0.)) {")
+    upd += base_statements()
+    upd.append("P#CoefLast = coefNow; coefCqNow = coefNow; }")
+    upd += quantity_statements(tangent_composites)
+    upd.append("P#CoefLastT = coefNow; } }")
+    w("macro COEFUPDATET(P, u) " + " ".join(upd) + " //")
+
+
+def update_macro(name, cache, with_state, with_velocity=False):
+    """COEFUPDATE (every field), COEFUPDATEQ (the rotation coefficients only) or MOMUPDATE (the rotation
+    coefficients and the angular momentum's derivative at the velocity v): the fields of P at the state u,
+    unless u's angles (and, with_state, derivatives; with_velocity, v's angle rates) are those of the last call
+    (the cache P#cache; MOMUPDATE also sets COEFUPDATEQ's)."""
+    upd = key_statements(with_state, with_velocity)
     upd.append(f"real[int] coefDiff = coefNow - P#{cache};")
     upd.append("if (!(coefDiff.linfty == 0.)) {")
     if with_state:
         upd += base_statements()
         upd.append("coefCqNow = coefNow;")
     else:
-        for x, v in (("a", "a"), ("b", "b"), ("c", "g")):
-            upd.append(f"coefc{x} = cos(cq{v}[]); coefs{x} = sin(cq{v}[]);")
-        for n in names:
-            upd += trig_statements(macros[formula[n]], "coefV")
-            upd.append(f"cq{n}[] = coefV; P#{n}[] = coefMap*coefV;")
-        for c in rot_composites:
-            upd += composite_statements(c)
-            upd.append(f"P#c{c}[] = coefMap*cqc{c}[];")
+        upd += rotation_statements()
         upd.append("coefCqNow = 1e300;")      # the container's rotation values are no longer a full state's
     if with_velocity:
-        for c in vel_composites:
-            upd += composite_statements(c)
-            if c not in intermediates:
-                upd.append(f"P#c{c}[] = coefMap*cqc{c}[];")
+        upd += quantity_statements(vel_composites)
         upd.append("P#CoefLastQ = coefNow(0:3*coefNq - 1);")
     upd.append(f"P#{cache} = coefNow; }} }}")
     args = "P, u, v" if with_velocity else "P, u"
