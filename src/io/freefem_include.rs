@@ -91,16 +91,17 @@ fn write_quadrature(o: &mut String, case: &Case) {
     // One rule macro per integral (D4; docs/inverse.md I2, I11, I12), from the scheme's own rules.
     let scheme = case.quadrature;
     let _ = writeln!(o, "// quadrature scheme `{}`", scheme.name());
+    // (macro, group tag, rule, integrand); the group tag names the IN1X / IN2X macros below
     let rules = [
-        ("QFS", scheme.stretch_shear(), "stretch-shear integrand"),
-        ("QFB", scheme.bending(), "bending integrand"),
-        ("QFL", scheme.loads(), "loads and inertia"),
-        ("QFO", scheme.objective(), "inverse: tracking, control costs, Lambda_omega"),
-        ("QFK", scheme.kappa(), "inverse: Lambda_kappa term"),
-        ("QFD", scheme.stretch_shear(), "inverse: lambda_d term's base rule, blended with stab * qf2pE"),
+        ("QFS", Some("S"), scheme.stretch_shear(), "stretch-shear integrand"),
+        ("QFB", Some("B"), scheme.bending(), "bending integrand"),
+        ("QFL", Some("L"), scheme.loads(), "loads and inertia"),
+        ("QFO", Some("O"), scheme.objective(), "inverse: tracking, control costs, Lambda_omega"),
+        ("QFK", Some("K"), scheme.kappa(), "inverse: Lambda_kappa term"),
+        ("QFD", None, scheme.stretch_shear(), "inverse: lambda_d term's base rule, blended with stab * qf2pE"),
     ];
-    for (name, rule, what) in rules {
-        let _ = writeln!(o, "macro {name} {} // {what}", rule_name(&rule));
+    for (name, _, rule, what) in &rules {
+        let _ = writeln!(o, "macro {name} {} // {what}", rule_name(rule));
     }
     // One integral per rule (freefem/inverse_core.idp, forward.edp): IN1X(e) expands to e where integrand X has the
     // 1-point rule, IN2X(e) where it has the 2-point rule, and to nothing otherwise; the Λκ term (K) is in neither
@@ -109,15 +110,9 @@ fn write_quadrature(o: &mut String, case: &Case) {
         Analysis::Inverse(inv) => inv.params.weights.lambda_kappa.iter().any(|&v| v != 0.0),
         _ => false,
     };
-    let groups = [
-        ("S", Some(scheme.stretch_shear())),
-        ("B", Some(scheme.bending())),
-        ("L", Some(scheme.loads())),
-        ("O", Some(scheme.objective())),
-        ("K", kappa_on.then(|| scheme.kappa())),
-    ];
-    for (tag, rule) in groups {
-        let points = rule.map_or(0, |r| r.points.len());
+    for (_, tag, rule, _) in &rules {
+        let Some(tag) = tag else { continue };
+        let points = if *tag == "K" && !kappa_on { 0 } else { rule.points.len() };
         for n in 1..=2 {
             let body = if points == n { "e" } else { "" };
             let _ = writeln!(o, "macro IN{n}{tag}(e) {body} //");
