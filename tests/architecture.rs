@@ -402,7 +402,6 @@ const LONG_FUNCTIONS_LEFT: &[&str] = &[
     "src/io/freefem.rs:run_inverse",
     "src/io/compare.rs:compare_clip",
     "src/io/posture.rs:draw_projection",
-    "src/solve/inverse/kkt.rs:element_system",
     "src/io/plot.rs:draw_with",
 ];
 
