@@ -252,7 +252,16 @@ pub struct Case {
     pub quadrature: QuadratureScheme,
     pub loads: Loads,
     pub analysis: Analysis,
+    /// what the case is checked against: FreeFEM and independent theory
+    pub checks: CaseChecks,
+}
+
+/// What a [`Case`] is checked against.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CaseChecks {
+    /// the Rust–FreeFEM comparison (`[compare]`, D14)
     pub compare: CompareSpec,
+    /// independent theory (`[reference]`), if any
     pub reference: Option<Reference>,
 }
 
