@@ -332,22 +332,7 @@ fn functions(code: &str) -> Vec<(String, usize, usize)> {
     let ident = |c: char| c.is_alphanumeric() || c == '_';
     let line_at = |i: usize| 1 + chars[..i].iter().filter(|c| **c == '\n').count();
     // the closing brace matching the opening one at `open`
-    let close = |open: usize| {
-        let mut depth = 0usize;
-        for (k, c) in chars.iter().enumerate().skip(open) {
-            match c {
-                '{' => depth += 1,
-                '}' => {
-                    depth -= 1;
-                    if depth == 0 {
-                        return k;
-                    }
-                }
-                _ => {}
-            }
-        }
-        chars.len() - 1
-    };
+    let close = |open: usize| block_end(chars.iter().copied().enumerate().skip(open)).unwrap_or(chars.len() - 1);
     let mut out = Vec::new();
     let mut i = 0;
     while i < chars.len() {
@@ -406,33 +391,47 @@ const LONG_FUNCTIONS_LEFT: &[&str] = &[
     "src/io/plot.rs:draw_with",
 ];
 
-#[test]
-fn no_function_is_longer_than_80_lines_outside_tests() {
+/// The items that `items` finds (name, line, size) in the source files of `src/` outside
+/// tests and whose size is over `max`, against a may-only-shrink list `left` of `file:name`
+/// keys: the unlisted ones (largest first, `"file:line `name` (size unit)"`), and the listed
+/// ones that are no longer over (or gone).
+fn over_limit(
+    items: fn(&str) -> Vec<(String, usize, usize)>,
+    max: usize,
+    left: &[&str],
+    unit: &str,
+) -> (Vec<String>, Vec<String>) {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let src = root.join("src");
     let mut files = Vec::new();
     rust_files(&src, &mut files);
     files.sort();
-    let mut long = Vec::new();
-    let mut left: BTreeSet<String> = BTreeSet::new();
+    let mut over = Vec::new();
+    let mut still: BTreeSet<String> = BTreeSet::new();
     for f in &files {
         if module_of(&src, f).rsplit("::").next() == Some("tests") {
             continue;
         }
         let text = std::fs::read_to_string(f).expect("source");
-        for (name, line, n) in functions(&code_only(&text)) {
-            let key = format!("{}:{name}", f.strip_prefix(root).unwrap_or(f).display());
-            if n > MAX_FN_LINES && LONG_FUNCTIONS_LEFT.contains(&key.as_str()) {
-                left.insert(key);
-            } else if n > MAX_FN_LINES {
-                long.push((n, format!("{}:{line} `{name}` ({n} lines)", f.strip_prefix(root).unwrap_or(f).display())));
+        let rel = f.strip_prefix(root).unwrap_or(f).display().to_string();
+        for (name, line, n) in items(&code_only(&text)) {
+            let key = format!("{rel}:{name}");
+            if n > max && left.contains(&key.as_str()) {
+                still.insert(key);
+            } else if n > max {
+                over.push((n, format!("{rel}:{line} `{name}` ({n} {unit})")));
             }
         }
     }
-    long.sort_by_key(|b| std::cmp::Reverse(b.0));
-    let list: Vec<&str> = long.iter().map(|(_, s)| s.as_str()).collect();
-    assert!(long.is_empty(), "{} functions over {MAX_FN_LINES} lines:\n{}", long.len(), list.join("\n"));
-    let done: Vec<&&str> = LONG_FUNCTIONS_LEFT.iter().filter(|k| !left.contains(**k)).collect();
+    over.sort_by_key(|b| std::cmp::Reverse(b.0));
+    let done = left.iter().filter(|k| !still.contains(**k)).map(|k| k.to_string()).collect();
+    (over.into_iter().map(|(_, s)| s).collect(), done)
+}
+
+#[test]
+fn no_function_is_longer_than_80_lines_outside_tests() {
+    let (long, done) = over_limit(functions, MAX_FN_LINES, LONG_FUNCTIONS_LEFT, "lines");
+    assert!(long.is_empty(), "{} functions over {MAX_FN_LINES} lines:\n{}", long.len(), long.join("\n"));
     assert!(done.is_empty(), "now short (or gone), remove from LONG_FUNCTIONS_LEFT: {done:?}");
 }
 
@@ -467,7 +466,11 @@ fn pub_structs(code: &str) -> Vec<(String, usize, usize)> {
         if rest.starts_with("#[cfg(test)]") {
             // skip the item that follows up to the end of its block
             let open = rest.find(['{', ';']).unwrap_or(rest.len());
-            skip_to = i + if rest[open..].starts_with('{') { block_end(&rest[open..]) + open } else { open };
+            skip_to = i + if rest[open..].starts_with('{') {
+                block_end(rest.char_indices()).unwrap_or(rest.len())
+            } else {
+                open
+            };
             continue;
         }
         let word_start = code[..i].chars().next_back().is_none_or(|c| !(c.is_alphanumeric() || c == '_'));
@@ -484,7 +487,7 @@ fn pub_structs(code: &str) -> Vec<(String, usize, usize)> {
         let name: String = decl.trim_start().chars().take_while(|c| c.is_alphanumeric() || *c == '_').collect();
         // named fields: a `{` before any `;` or `(` (a unit or tuple struct has none)
         let Some(open) = decl.find(['{', ';', '(']).filter(|&k| decl[k..].starts_with('{')) else { continue };
-        let body = &decl[open + 1..open + block_end(&decl[open..])];
+        let body = &decl[open + 1..block_end(decl.char_indices().skip_while(|&(k, _)| k < open)).unwrap_or(decl.len())];
         let (mut depth, mut commas, mut prev) = (0i32, 0, ' ');
         for c in body.chars() {
             match c {
@@ -503,50 +506,28 @@ fn pub_structs(code: &str) -> Vec<(String, usize, usize)> {
     out
 }
 
-/// The offset of the `}` that closes the `{` at the start of `s`.
-fn block_end(s: &str) -> usize {
+/// The position (as `chars` numbers it) of the `}` that closes the first `{` of `chars`, if any.
+fn block_end(chars: impl Iterator<Item = (usize, char)>) -> Option<usize> {
     let mut depth = 0usize;
-    for (k, c) in s.char_indices() {
+    for (k, c) in chars {
         match c {
             '{' => depth += 1,
             '}' => {
                 depth -= 1;
                 if depth == 0 {
-                    return k;
+                    return Some(k);
                 }
             }
             _ => {}
         }
     }
-    s.len()
+    None
 }
 
 #[test]
 fn no_pub_struct_has_more_than_10_fields_outside_tests() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let src = root.join("src");
-    let mut files = Vec::new();
-    rust_files(&src, &mut files);
-    files.sort();
-    let mut large = Vec::new();
-    let mut left: BTreeSet<String> = BTreeSet::new();
-    for f in &files {
-        if module_of(&src, f).rsplit("::").next() == Some("tests") {
-            continue;
-        }
-        let text = std::fs::read_to_string(f).expect("source");
-        let rel = f.strip_prefix(root).unwrap_or(f).display().to_string();
-        for (name, line, n) in pub_structs(&code_only(&text)) {
-            let key = format!("{rel}:{name}");
-            if n > MAX_STRUCT_FIELDS && LARGE_STRUCTS_LEFT.contains(&key.as_str()) {
-                left.insert(key);
-            } else if n > MAX_STRUCT_FIELDS {
-                large.push(format!("{rel}:{line} `{name}` ({n} fields)"));
-            }
-        }
-    }
-    assert!(large.is_empty(), "pub structs over {MAX_STRUCT_FIELDS} fields:\n{}", large.join("\n"));
-    let done: Vec<&&str> = LARGE_STRUCTS_LEFT.iter().filter(|k| !left.contains(**k)).collect();
+    let (large, done) = over_limit(pub_structs, MAX_STRUCT_FIELDS, LARGE_STRUCTS_LEFT, "fields");
+    assert!(large.is_empty(), "{} pub structs over {MAX_STRUCT_FIELDS} fields:\n{}", large.len(), large.join("\n"));
     assert!(done.is_empty(), "now small (or gone), remove from LARGE_STRUCTS_LEFT: {done:?}");
 }
 
