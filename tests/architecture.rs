@@ -1,7 +1,8 @@
 //! The module structure of `src/` (see the layers in `src/lib.rs`): every `crate::`, `super::`
 //! and (in `main.rs`) `cosserat::` path is resolved to the module it names; the resulting graph
 //! has no cycle, no module imports a module of a higher layer, no source file is longer
-//! than 600 lines and no function outside tests longer than 80. `cargo test --test architecture -- --nocapture` prints the graph's size.
+//! than 600 lines, no function outside tests longer than 80 and no `pub struct` outside tests
+//! with more than 10 named fields. `cargo test --test architecture -- --nocapture` prints the graph's size.
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
@@ -331,22 +332,7 @@ fn functions(code: &str) -> Vec<(String, usize, usize)> {
     let ident = |c: char| c.is_alphanumeric() || c == '_';
     let line_at = |i: usize| 1 + chars[..i].iter().filter(|c| **c == '\n').count();
     // the closing brace matching the opening one at `open`
-    let close = |open: usize| {
-        let mut depth = 0usize;
-        for (k, c) in chars.iter().enumerate().skip(open) {
-            match c {
-                '{' => depth += 1,
-                '}' => {
-                    depth -= 1;
-                    if depth == 0 {
-                        return k;
-                    }
-                }
-                _ => {}
-            }
-        }
-        chars.len() - 1
-    };
+    let close = |open: usize| block_end(chars.iter().copied().enumerate().skip(open)).unwrap_or(chars.len() - 1);
     let mut out = Vec::new();
     let mut i = 0;
     while i < chars.len() {
@@ -400,41 +386,149 @@ fn functions(code: &str) -> Vec<(String, usize, usize)> {
 /// (a listed function that became short must leave it).
 const LONG_FUNCTIONS_LEFT: &[&str] = &[
     "src/io/freefem.rs:run_inverse",
-    "src/case/validate/clip.rs:clip",
     "src/io/compare.rs:compare_clip",
     "src/io/posture.rs:draw_projection",
-    "src/solve/inverse/kkt.rs:element_system",
     "src/io/plot.rs:draw_with",
 ];
 
-#[test]
-fn no_function_is_longer_than_80_lines_outside_tests() {
+/// The items that `items` finds (name, line, size) in the source files of `src/` outside
+/// tests and whose size is over `max`, against a may-only-shrink list `left` of `file:name`
+/// keys: the unlisted ones (largest first, `"file:line `name` (size unit)"`), and the listed
+/// ones that are no longer over (or gone).
+fn over_limit(
+    items: fn(&str) -> Vec<(String, usize, usize)>,
+    max: usize,
+    left: &[&str],
+    unit: &str,
+) -> (Vec<String>, Vec<String>) {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let src = root.join("src");
     let mut files = Vec::new();
     rust_files(&src, &mut files);
     files.sort();
-    let mut long = Vec::new();
-    let mut left: BTreeSet<String> = BTreeSet::new();
+    let mut over = Vec::new();
+    let mut still: BTreeSet<String> = BTreeSet::new();
     for f in &files {
         if module_of(&src, f).rsplit("::").next() == Some("tests") {
             continue;
         }
         let text = std::fs::read_to_string(f).expect("source");
-        for (name, line, n) in functions(&code_only(&text)) {
-            let key = format!("{}:{name}", f.strip_prefix(root).unwrap_or(f).display());
-            if n > MAX_FN_LINES && LONG_FUNCTIONS_LEFT.contains(&key.as_str()) {
-                left.insert(key);
-            } else if n > MAX_FN_LINES {
-                long.push((n, format!("{}:{line} `{name}` ({n} lines)", f.strip_prefix(root).unwrap_or(f).display())));
+        let rel = f.strip_prefix(root).unwrap_or(f).display().to_string();
+        for (name, line, n) in items(&code_only(&text)) {
+            let key = format!("{rel}:{name}");
+            if n > max && left.contains(&key.as_str()) {
+                still.insert(key);
+            } else if n > max {
+                over.push((n, format!("{rel}:{line} `{name}` ({n} {unit})")));
             }
         }
     }
-    long.sort_by_key(|b| std::cmp::Reverse(b.0));
-    let list: Vec<&str> = long.iter().map(|(_, s)| s.as_str()).collect();
-    assert!(long.is_empty(), "{} functions over {MAX_FN_LINES} lines:\n{}", long.len(), list.join("\n"));
-    let done: Vec<&&str> = LONG_FUNCTIONS_LEFT.iter().filter(|k| !left.contains(**k)).collect();
+    over.sort_by_key(|b| std::cmp::Reverse(b.0));
+    let done = left.iter().filter(|k| !still.contains(**k)).map(|k| k.to_string()).collect();
+    (over.into_iter().map(|(_, s)| s).collect(), done)
+}
+
+#[test]
+fn no_function_is_longer_than_80_lines_outside_tests() {
+    let (long, done) = over_limit(functions, MAX_FN_LINES, LONG_FUNCTIONS_LEFT, "lines");
+    assert!(long.is_empty(), "{} functions over {MAX_FN_LINES} lines:\n{}", long.len(), long.join("\n"));
     assert!(done.is_empty(), "now short (or gone), remove from LONG_FUNCTIONS_LEFT: {done:?}");
+}
+
+/// Most named fields a `pub struct` outside tests may have.
+const MAX_STRUCT_FIELDS: usize = 10;
+
+/// Structs still over [`MAX_STRUCT_FIELDS`] (`file:name`): the list may only shrink (a listed
+/// struct that became small must leave it). Most mirror a file format field by field: the
+/// case file's tables (`raw`), command-line options, and the columns of a CSV row.
+const LARGE_STRUCTS_LEFT: &[&str] = &[
+    "src/audit/spec.rs:Claim",
+    "src/case/raw.rs:RawCase",
+    "src/case/raw.rs:RawClip",
+    "src/cli/mod.rs:BatchArgs",
+    "src/io/batch.rs:BatchRow",
+    "src/solve/inverse/mod.rs:FrameSolver",
+    "src/solve/sequence.rs:FrameReport",
+    "src/study/mod.rs:StudyRow",
+];
+
+/// Every `pub struct` with named fields in `code` (as given by [`code_only`]) outside
+/// `#[cfg(test)]` items: its name, line (1-based) and number of named fields (the commas at
+/// the top level of its braces, plus one for a last field without a trailing comma).
+fn pub_structs(code: &str) -> Vec<(String, usize, usize)> {
+    let mut out = Vec::new();
+    let mut skip_to = 0;
+    for (i, _) in code.char_indices() {
+        if i < skip_to {
+            continue;
+        }
+        let rest = &code[i..];
+        if rest.starts_with("#[cfg(test)]") {
+            // skip the item that follows up to the end of its block
+            let open = rest.find(['{', ';']).unwrap_or(rest.len());
+            skip_to = i + if rest[open..].starts_with('{') {
+                block_end(rest.char_indices()).unwrap_or(rest.len())
+            } else {
+                open
+            };
+            continue;
+        }
+        let word_start = code[..i].chars().next_back().is_none_or(|c| !(c.is_alphanumeric() || c == '_'));
+        if !word_start || !rest.starts_with("pub") {
+            continue;
+        }
+        let after_vis = rest[3..].trim_start();
+        let after_vis = if after_vis.starts_with('(') {
+            after_vis[after_vis.find(')').map_or(0, |k| k + 1)..].trim_start()
+        } else {
+            after_vis
+        };
+        let Some(decl) = after_vis.strip_prefix("struct ") else { continue };
+        let name: String = decl.trim_start().chars().take_while(|c| c.is_alphanumeric() || *c == '_').collect();
+        // named fields: a `{` before any `;` or `(` (a unit or tuple struct has none)
+        let Some(open) = decl.find(['{', ';', '(']).filter(|&k| decl[k..].starts_with('{')) else { continue };
+        let body = &decl[open + 1..block_end(decl.char_indices().skip_while(|&(k, _)| k < open)).unwrap_or(decl.len())];
+        let (mut depth, mut commas, mut prev) = (0i32, 0, ' ');
+        for c in body.chars() {
+            match c {
+                '(' | '[' | '{' | '<' => depth += 1,
+                ')' | ']' | '}' => depth -= 1,
+                '>' if prev != '-' => depth -= 1,
+                ',' if depth == 0 => commas += 1,
+                _ => {}
+            }
+            prev = c;
+        }
+        let trailing = body.trim_end().ends_with(',') || body.trim().is_empty();
+        let line = 1 + code[..i].matches('\n').count();
+        out.push((name, line, commas + usize::from(!trailing)));
+    }
+    out
+}
+
+/// The position (as `chars` numbers it) of the `}` that closes the first `{` of `chars`, if any.
+fn block_end(chars: impl Iterator<Item = (usize, char)>) -> Option<usize> {
+    let mut depth = 0usize;
+    for (k, c) in chars {
+        match c {
+            '{' => depth += 1,
+            '}' => {
+                depth -= 1;
+                if depth == 0 {
+                    return Some(k);
+                }
+            }
+            _ => {}
+        }
+    }
+    None
+}
+
+#[test]
+fn no_pub_struct_has_more_than_10_fields_outside_tests() {
+    let (large, done) = over_limit(pub_structs, MAX_STRUCT_FIELDS, LARGE_STRUCTS_LEFT, "fields");
+    assert!(large.is_empty(), "{} pub structs over {MAX_STRUCT_FIELDS} fields:\n{}", large.len(), large.join("\n"));
+    assert!(done.is_empty(), "now small (or gone), remove from LARGE_STRUCTS_LEFT: {done:?}");
 }
 
 /// The checker itself: it finds a cycle and an upward import when there is one, and reads
@@ -475,4 +569,8 @@ fn the_checker_sees_imports_and_cycles() {
         "fn a() {\n}\n#[cfg(test)]\nmod tests {\n    fn b() {\n    }\n}\nfn c(x: Vec<u8>) -> Result<(), ()> {\n    let s = \"}\n\";\n}\ntrait T { fn d(&self); }",
     ));
     assert_eq!(f, vec![("a".to_string(), 1, 2), ("c".to_string(), 8, 4)]);
+    let s = pub_structs(&code_only(
+        "pub struct A {\n    pub x: fn(u8) -> u8,\n    /// a, b\n    y: Vec<(u8, u8)>,\n    z: [f64; 2]\n}\npub(crate) struct B { f: HashMap<K, V>, }\npub struct U;\npub struct T(u8, u8);\n#[cfg(test)]\nmod tests {\n    pub struct C { a: u8 }\n}",
+    ));
+    assert_eq!(s, vec![("A".to_string(), 1, 3), ("B".to_string(), 7, 1)]);
 }

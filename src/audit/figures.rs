@@ -319,7 +319,7 @@ fn tip_history(title: &str, case: &Case, p: &PointResult) -> Option<Svg> {
 fn deflection(title: &str, pts: &[(&Case, &PointResult)]) -> Option<Svg> {
     let mut series = Vec::new();
     for (case, p) in pts {
-        let Some(Reference::TipLoadedCantilever { force_n }) = case.reference else { continue };
+        let Some(Reference::TipLoadedCantilever { force_n }) = case.checks.reference else { continue };
         let Some(r) = p.outcome.single.as_ref() else { continue };
         let (l, kga, ea, ei) = (
             case.mesh.length_m,

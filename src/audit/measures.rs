@@ -100,7 +100,7 @@ impl ClipRecorder {
 pub fn derived_metrics(case: &Case, run: Option<&RunResult>, series: Option<&ClipSeries>) -> Metrics {
     let mut m = Metrics::new();
     if let Some(r) = run {
-        if let Some(Reference::TipLoadedCantilever { force_n }) = case.reference {
+        if let Some(Reference::TipLoadedCantilever { force_n }) = case.checks.reference {
             let (l, kga, ei) = (case.mesh.length_m, case.props.shear_stretch_n[0], case.props.bend_twist_nm2[0]);
             let tip = timoshenko_deflection(l, force_n, l, kga, ei).abs();
             let worst = r

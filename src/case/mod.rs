@@ -143,6 +143,17 @@ pub struct ClipSource {
     pub start: FrameStart,
     /// angle chart per frame (`docs/rotation.md`)
     pub rotation: RotationTreatment,
+    /// where the frames are placed in space (`clip.plane`, `clip.orientation`, `clip.gauge`)
+    pub placement: ClipPlacement,
+    /// the fit-quality gate (`clip.gate_*`, `solve::fit`)
+    pub gate: FitGate,
+    /// what marks an untracked node of a recording (`clip.missing`, `clip::missing`)
+    pub missing: crate::clip::missing::MissingData,
+}
+
+/// Where a clip's frames are placed in space, and the gauge vector placed with them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ClipPlacement {
     /// plane of a kymogram's placement (`crate::clip`)
     pub plane: ClipPlane,
     /// rigid rotation applied to every frame after the placement (`clip.orientation`, a
@@ -151,10 +162,6 @@ pub struct ClipSource {
     /// unit gauge vector of the first frame in space coordinates (R7): `clip.gauge` rotated by
     /// `orientation`; default the placement plane's normal (e2 for x–z, e3 for x–y)
     pub gauge: Vector3<f64>,
-    /// the fit-quality gate (`clip.gate_*`, `solve::fit`)
-    pub gate: FitGate,
-    /// what marks an untracked node of a recording (`clip.missing`, `clip::missing`)
-    pub missing: crate::clip::missing::MissingData,
 }
 
 /// An inverse analysis (Problem 2, eq. 61): the solver's params and the data.
@@ -245,7 +252,16 @@ pub struct Case {
     pub quadrature: QuadratureScheme,
     pub loads: Loads,
     pub analysis: Analysis,
+    /// what the case is checked against: FreeFEM and independent theory
+    pub checks: CaseChecks,
+}
+
+/// What a [`Case`] is checked against.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CaseChecks {
+    /// the Rust–FreeFEM comparison (`[compare]`, D14)
     pub compare: CompareSpec,
+    /// independent theory (`[reference]`), if any
     pub reference: Option<Reference>,
 }
 
@@ -381,7 +397,7 @@ impl Case {
             length_m: self.mesh.length_m,
             nodes: self.mesh.nodes(),
             dt_s: inv.params.frame_interval_s,
-            plane: clip.plane,
+            plane: clip.placement.plane,
             scale_to_length: true,
         })
     }
@@ -404,7 +420,7 @@ impl Case {
             frame_offset: clip.frames.map(|f| f.0).unwrap_or(0),
             start: clip.start,
             rotation: clip.rotation,
-            gauge: clip.gauge,
+            gauge: clip.placement.gauge,
             records: Records::Every,
             gate: clip.gate,
         })

@@ -41,8 +41,8 @@ fn good_case_parses() {
     assert!(
         matches!(c.analysis, Analysis::Static(StaticParams { method: Method::FixedPoint { relaxation }, .. }) if relaxation == 0.5)
     );
-    assert_eq!(c.compare.frames, 4);
-    assert_eq!(c.compare.overrides, CompareOverrides::default());
+    assert_eq!(c.checks.compare.frames, 4);
+    assert_eq!(c.checks.compare.overrides, CompareOverrides::default());
 }
 
 #[test]
@@ -50,7 +50,7 @@ fn compare_overrides_need_a_reason() {
     let text = GOOD.replace("frames = 4", "frames = 4\nangles_rel = 1e-6");
     expect_key(&text, "compare.angles_rel");
     let ok = parse(&text.replace("frames = 4", "frames = 4\nreason = \"measured: the twist is held by 1e-10 only\""));
-    assert_eq!(ok.unwrap().compare.overrides.angles_rel, Some(1e-6));
+    assert_eq!(ok.unwrap().checks.compare.overrides.angles_rel, Some(1e-6));
     expect_key(&GOOD.replace("frames = 4", "frames = 0"), "compare.frames");
     expect_key(&GOOD.replace("frames = 4", "metric_abs = -1\nreason = \"x\""), "compare.metric_abs");
 }

@@ -10,8 +10,8 @@ use nalgebra::Vector3;
 
 use super::raw::*;
 use super::{
-    Analysis, Case, CaseError, CaseOrigin, CompareOverrides, CompareSpec, DataSource, InverseSettings, Reference,
-    RodGiven, RodLength, WeightsRule, DEFAULT_COMPARE_FRAMES,
+    Analysis, Case, CaseChecks, CaseError, CaseOrigin, CompareOverrides, CompareSpec, DataSource, InverseSettings,
+    Reference, RodGiven, RodLength, WeightsRule, DEFAULT_COMPARE_FRAMES,
 };
 use crate::expr::{Expr, ExprError, Node};
 use crate::model::material::{CrossSection, Material, RodProperties};
@@ -148,7 +148,6 @@ impl<'a> Validator<'a> {
         let compare = self.compare(&raw.compare)?;
         let reference = self.reference(raw.reference.as_ref(), kind, &loads)?;
         Ok(Case {
-            reference,
             name: name.to_string(),
             origin: CaseOrigin {
                 description: raw.description,
@@ -164,7 +163,7 @@ impl<'a> Validator<'a> {
             quadrature,
             loads,
             analysis,
-            compare,
+            checks: CaseChecks { compare, reference },
         })
     }
 

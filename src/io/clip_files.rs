@@ -215,10 +215,10 @@ pub fn load_clip(case: &Case) -> Result<(Clip, Option<GroundTruth>), ClipFileErr
         // (a bridged frame, too few tracked nodes, is an interpolation of checked ones)
         check_lengths(&src.file, &clip, src.frames.map_or(0, |f| f.0), case.mesh.length_m)?;
     }
-    if src.orientation != Matrix3::identity() {
-        clip.rotate(&src.orientation);
+    if src.placement.orientation != Matrix3::identity() {
+        clip.rotate(&src.placement.orientation);
         if let Some(t) = &mut truth {
-            t.rotate(&src.orientation);
+            t.rotate(&src.placement.orientation);
         }
     }
     Ok((clip, truth))
@@ -325,7 +325,7 @@ pub fn roll_stream(case: &Case) -> Result<Option<RollStream>, ClipFileError> {
     }
     let (first, end) = src.frames.unwrap_or((0, params.frames));
     check_frame_range(first, end, params.frames)?;
-    Ok(Some(RollStream { generator, first, len: end - first, orientation: src.orientation }))
+    Ok(Some(RollStream { generator, first, len: end - first, orientation: src.placement.orientation }))
 }
 
 /// The rows (frames × joint angles [rad]) of a kymogram `.npy`, every angle finite.

@@ -198,8 +198,8 @@ fn is_fixed_point_inverse(case: &Case) -> bool {
 
 /// The tolerance of one row and how it was found; `sens` the perturbed run's differences.
 fn tolerance(d: &Difference, sens: &[Difference], tau: f64, case: &Case) -> (f64, String) {
-    let o: &CompareOverrides = &case.compare.overrides;
-    let reason = || format!("override: {}", case.compare.reason.as_deref().unwrap_or(""));
+    let o: &CompareOverrides = &case.checks.compare.overrides;
+    let reason = || format!("override: {}", case.checks.compare.reason.as_deref().unwrap_or(""));
     let value = d.a.unwrap_or(0.0).abs();
     let over = match d.group {
         Group::Displacement => o.displacement_rel,
@@ -376,7 +376,7 @@ fn compare_clip(case: &Case, dir: &Path, opts: &CompareOptions) -> Result<Compar
     let auto = crate::run::weights::choose_weights(case, &clip.frames);
     let case = auto.as_ref().map_or(case, |a| &a.case);
     let default = match opts.horizon {
-        Horizon::Full => case.compare.frames,
+        Horizon::Full => case.checks.compare.frames,
         Horizon::Short => SHORT_FRAMES,
     };
     let n = opts.frames.unwrap_or(default).min(clip.frames.len()).max(1);

@@ -95,7 +95,7 @@ pub fn curvature_error(mesh: &Mesh, u: &DVector<f64>, truth: &DVector<f64>, skip
 /// * `reissner_*`: planar Reissner rod with the case's kGA and EA, which is exactly the planar
 ///   restriction of the model solved here (the remaining error is the discretisation).
 pub fn reference_metrics(case: &Case, r: &RunResult, m: &mut Metrics) -> Result<(), ReferenceError> {
-    let Some(Reference::TipLoadedCantilever { force_n }) = case.reference else {
+    let Some(Reference::TipLoadedCantilever { force_n }) = case.checks.reference else {
         return Ok(());
     };
     let tip_y = r.nodes.x.last().map(|x| x[1]).unwrap_or(f64::NAN);

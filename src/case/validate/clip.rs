@@ -5,7 +5,7 @@ use std::path::Path;
 use nalgebra::{Rotation3, Vector3};
 
 use super::super::raw::{RawClip, RawClipKind, RawMissing, RawPlane, RawRotation, RawStart};
-use super::super::{CaseError, ClipKind, ClipSource, SyntheticClip};
+use super::super::{CaseError, ClipKind, ClipPlacement, ClipSource, SyntheticClip};
 use super::Validator;
 use crate::clip::missing::MissingData;
 use crate::clip::synthetic::RollClipParams;
@@ -15,33 +15,72 @@ use crate::solve::fit::FitGate;
 use crate::solve::sequence::{FrameStart, RotationTreatment};
 
 impl Validator<'_> {
-    /// `[clip]`: a recorded or synthetic clip.
+    /// `[clip]`: a recorded or synthetic clip. The stages, in the order their errors are
+    /// reported: the mesh, the frame range and chart guard, the placement, the kind (with the
+    /// `roll_3d` keys), the treatment of untracked nodes, the fit-quality gate.
     pub(super) fn clip(&self, cl: &RawClip, mesh: &Mesh) -> Result<ClipSource, CaseError> {
-        if mesh.elements < MIN_CLIP_ELEMENTS {
-            return Err(self.err(
-                "rod.elements",
-                format!(
-                    "a clip case needs at least {MIN_CLIP_ELEMENTS} elements ({} nodes per frame of clip.file `{}`), \
-                     got {} ({} nodes): the clip's measures leave out {CLIP_SKIP_ELEMENTS} elements at each end \
-                     (curvature errors, ground truth) and the roughness needs 3 curvature values",
-                    MIN_CLIP_ELEMENTS + 1,
-                    cl.file.display(),
-                    mesh.elements,
-                    mesh.nodes()
-                ),
-            ));
-        }
+        self.clip_mesh(cl, mesh)?;
         let base = self.path.parent().unwrap_or(Path::new(""));
-        let frames = match cl.frames {
-            Some([a, b]) if a < b => Some((a, b)),
-            Some([a, b]) => {
-                return Err(self.err("clip.frames", format!("expected [first, end) with first < end, got [{a}, {b}]")))
-            }
-            None => None,
-        };
+        let frames = self.clip_frames(cl)?;
         if !(cl.min_cos_beta >= 0.0 && cl.min_cos_beta < 1.0) {
             return Err(self.err("clip.min_cos_beta", format!("must lie in [0, 1), got {}", cl.min_cos_beta)));
         }
+        let placement = self.clip_placement(cl)?;
+        let kind = self.clip_kind(cl, mesh)?;
+        let missing = self.clip_missing(cl, &kind)?;
+        let gate = self.clip_gate(cl)?;
+        Ok(ClipSource {
+            kind,
+            file: base.join(&cl.file),
+            gate,
+            missing,
+            frames,
+            min_cos_beta: cl.min_cos_beta,
+            start: match cl.start {
+                RawStart::PreviousFrame => FrameStart::PreviousFrame,
+                RawStart::DataGuess => FrameStart::DataGuess,
+            },
+            rotation: match cl.rotation {
+                RawRotation::Rebased => RotationTreatment::Rebased,
+                RawRotation::GlobalEuler => RotationTreatment::GlobalEuler,
+            },
+            placement,
+        })
+    }
+
+    /// A clip case's mesh has at least [`MIN_CLIP_ELEMENTS`] elements.
+    fn clip_mesh(&self, cl: &RawClip, mesh: &Mesh) -> Result<(), CaseError> {
+        if mesh.elements >= MIN_CLIP_ELEMENTS {
+            return Ok(());
+        }
+        Err(self.err(
+            "rod.elements",
+            format!(
+                "a clip case needs at least {MIN_CLIP_ELEMENTS} elements ({} nodes per frame of clip.file `{}`), \
+                 got {} ({} nodes): the clip's measures leave out {CLIP_SKIP_ELEMENTS} elements at each end \
+                 (curvature errors, ground truth) and the roughness needs 3 curvature values",
+                MIN_CLIP_ELEMENTS + 1,
+                cl.file.display(),
+                mesh.elements,
+                mesh.nodes()
+            ),
+        ))
+    }
+
+    /// `clip.frames`: the `[first, end)` frame range, all frames if absent.
+    fn clip_frames(&self, cl: &RawClip) -> Result<Option<(usize, usize)>, CaseError> {
+        match cl.frames {
+            Some([a, b]) if a < b => Ok(Some((a, b))),
+            Some([a, b]) => {
+                Err(self.err("clip.frames", format!("expected [first, end) with first < end, got [{a}, {b}]")))
+            }
+            None => Ok(None),
+        }
+    }
+
+    /// `clip.plane`, `clip.orientation` (a rotation vector [rad]) and `clip.gauge` (R7): where
+    /// the frames are placed in space and the gauge vector rotated with them.
+    fn clip_placement(&self, cl: &RawClip) -> Result<ClipPlacement, CaseError> {
         let plane = match cl.plane {
             RawPlane::Xz => ClipPlane::Xz,
             RawPlane::Xy => ClipPlane::Xy,
@@ -58,7 +97,8 @@ impl Validator<'_> {
         }
         let gauge = match cl.gauge {
             Some(g) => {
-                let (v, norm) = (Vector3::from(g), Vector3::from(g).norm());
+                let v = Vector3::from(g);
+                let norm = v.norm();
                 if !(norm.is_finite() && norm > 1e-12) {
                     return Err(self.err("clip.gauge", format!("must be a finite non-zero vector, got {g:?}")));
                 }
@@ -69,62 +109,55 @@ impl Validator<'_> {
                 ClipPlane::Xy => Vector3::z(),
             },
         };
+        Ok(ClipPlacement { plane, orientation, gauge: orientation * gauge })
+    }
+
+    /// `clip.kind` with `clip.frame_interval_s` [s]; the `roll_3d` keys belong to that kind
+    /// only.
+    fn clip_kind(&self, cl: &RawClip, mesh: &Mesh) -> Result<ClipKind, CaseError> {
         let frame_interval_s = self.positive("clip.frame_interval_s", &cl.frame_interval_s)?;
         let kind = match cl.kind {
             RawClipKind::Kymogram => ClipKind::Kymogram,
             RawClipKind::Recording => ClipKind::Recording,
             RawClipKind::Roll3d => ClipKind::Roll3d(self.synthetic(cl, mesh, frame_interval_s)?),
         };
-        if !matches!(kind, ClipKind::Roll3d(_))
-            && (cl.roll_total_rad.is_some()
-                || cl.twist_per_m.is_some()
-                || cl.clip_frames.is_some()
-                || cl.substeps.is_some())
-        {
+        let roll_keys = cl.roll_total_rad.is_some()
+            || cl.twist_per_m.is_some()
+            || cl.clip_frames.is_some()
+            || cl.substeps.is_some();
+        if !matches!(kind, ClipKind::Roll3d(_)) && roll_keys {
             return Err(self.err(
                 "clip",
                 "roll_total_rad, twist_per_m, clip_frames and substeps apply to kind = \"roll_3d\" only",
             ));
         }
-        let missing = match (cl.missing, &kind) {
-            (None, _) => MissingData::Error,
-            (Some(RawMissing::Nan), ClipKind::Recording) => MissingData::Nan,
-            (Some(_), _) => {
-                return Err(self.err(
-                    "clip.missing",
-                    "applies to kind = \"recording\" only (kymograms and synthetic clips have no untracked nodes)",
-                ))
-            }
-        };
+        Ok(kind)
+    }
+
+    /// `clip.missing`: what marks an untracked node (recordings only).
+    fn clip_missing(&self, cl: &RawClip, kind: &ClipKind) -> Result<MissingData, CaseError> {
+        match (cl.missing, kind) {
+            (None, _) => Ok(MissingData::Error),
+            (Some(RawMissing::Nan), ClipKind::Recording) => Ok(MissingData::Nan),
+            (Some(_), _) => Err(self.err(
+                "clip.missing",
+                "applies to kind = \"recording\" only (kymograms and synthetic clips have no untracked nodes)",
+            )),
+        }
+    }
+
+    /// `clip.gate_*`: the fit-quality gate, each bound positive, the default where absent.
+    fn clip_gate(&self, cl: &RawClip) -> Result<FitGate, CaseError> {
         let d = FitGate::default();
         let gate_key = |key: &str, v: Option<f64>, default: f64| match v {
             None => Ok(default),
             Some(v) if v > 0.0 && v.is_finite() => Ok(v),
             Some(v) => Err(self.err(key, format!("must be a positive number, got {v}"))),
         };
-        let gate = FitGate {
+        Ok(FitGate {
             noise_multiple: gate_key("clip.gate_noise_multiple", cl.gate_noise_multiple, d.noise_multiple)?,
             position_min: gate_key("clip.gate_position", cl.gate_position, d.position_min)?,
             tangent_min: gate_key("clip.gate_tangent", cl.gate_tangent, d.tangent_min)?,
-        };
-        Ok(ClipSource {
-            kind,
-            file: base.join(&cl.file),
-            gate,
-            missing,
-            frames,
-            min_cos_beta: cl.min_cos_beta,
-            start: match cl.start {
-                RawStart::PreviousFrame => FrameStart::PreviousFrame,
-                RawStart::DataGuess => FrameStart::DataGuess,
-            },
-            rotation: match cl.rotation {
-                RawRotation::Rebased => RotationTreatment::Rebased,
-                RawRotation::GlobalEuler => RotationTreatment::GlobalEuler,
-            },
-            plane,
-            orientation,
-            gauge: orientation * gauge,
         })
     }
 

@@ -155,12 +155,13 @@ fn add_diagonal3(m: &mut KktMat, ro: usize, co: usize, s: f64) {
 }
 
 /// Local KKT matrix (added into `m`, which the caller zeroes) and right-hand side (returned)
-/// of one element (I4), coefficients frozen at the element's state `uk`; `xg`, `alpha_prev`:
-/// the data and the previous frame's angles at its nodes (`first_frame`: no Λω term), `wg`
-/// the nodal weights of the tracking term (I14: `λg ∫ w δx·(x − x_g)`, w P1). Also
-/// returns the frozen operator `L(u)` of the element (`element::frozen_operator`), which the
-/// Newton Jacobian needs again.
-#[allow(non_snake_case)] // paper symbols W, D, A, Kk
+/// of one element of eq. (61) (`docs/inverse.md`, I4), coefficients frozen at the element's
+/// state `uk`; `xg`, `alpha_prev`: the data and the previous frame's angles at its nodes
+/// (`first_frame`: no Λω term), `wg` the nodal weights of the tracking term (I14:
+/// `λg ∫ w δx·(x − x_g)`, w P1). Also returns the frozen operator `L(u)` of the element
+/// (`element::frozen_operator`), which the Newton Jacobian needs again. The terms are added in
+/// this order: the frozen operator, the objective rule's terms ([`objective_terms`]), the λd
+/// term ([`lambda_d_term`], I11), the Λκ term ([`lambda_kappa_term`], I12).
 pub(crate) fn element_system(
     problem: &Problem,
     p: &InverseParams,
@@ -171,7 +172,6 @@ pub(crate) fn element_system(
     m: &mut KktMat,
 ) -> (KktVec, LocalMat) {
     let h = problem.mesh.h();
-    let w8 = &p.weights;
     let mut r = KktVec::zeros();
     // Frozen operator: primal rows (hat test) × state columns, and its transpose.
     let (l, b) = frozen_operator(&problem.props, problem.scheme, h, uk);
@@ -179,16 +179,48 @@ pub(crate) fn element_system(
         r[kkt(i, true)] += b[i];
     }
     add_operator_blocks(m, &l, true);
+    let nodal = NodalData { xg, wg, alpha_prev };
+    objective_terms(problem, p, first_frame, uk, &nodal, m, &mut r);
+    lambda_d_term(problem, p, uk, m, &mut r);
+    lambda_kappa_term(problem, p, uk, m);
+    (r, l)
+}
+
+/// What an element's terms of eq. (61) know of the frame at its two nodes.
+struct NodalData {
+    /// the data x_g [m]
+    xg: [Vector3<f64>; 2],
+    /// the weights w of the tracking term (I14, dimensionless)
+    wg: [f64; 2],
+    /// the previous frame's angles α_{n−1} [rad] (the Λω term)
+    alpha_prev: [Vector3<f64>; 2],
+}
+
+/// Mass-type terms of eq. (61) on the objective rule: the tracking term
+/// `λg ∫ w δx·(x − x_g)` (I14), the control costs `−∫ δx̂·x̂ / λf` and `−∫ δα̂·α̂ / λl`, and the
+/// Λω term `∫ δα·AᵀΛωA (α − α_{n−1}) / Δt²` (none on the first frame).
+#[allow(non_snake_case)] // paper symbols W, A
+fn objective_terms(
+    problem: &Problem,
+    p: &InverseParams,
+    first_frame: bool,
+    uk: &LocalVec,
+    nodal: &NodalData,
+    m: &mut KktMat,
+    r: &mut KktVec,
+) {
+    let h = problem.mesh.h();
+    let w8 = &p.weights;
+    let NodalData { xg, wg, alpha_prev } = nodal;
     let omega_on = !first_frame && w8.lambda_omega.amax() > 0.0;
     let dt = p.frame_interval_s;
-    // Mass-type terms (the objective rule): tracking, control costs, Λω.
     for (xi, w) in problem.scheme.objective().iter() {
         let q = interpolate(uk, h, xi);
         let n = q.n;
         let wh = w * h;
         let xg_q = xg[0] * n[0] + xg[1] * n[1];
         // λg w at the point: the one place the tracking weight enters (I14)
-        let lg = w8.lambda_g * weight_at(wg, n);
+        let lg = w8.lambda_g * weight_at(*wg, n);
         let ap_q = alpha_prev[0] * n[0] + alpha_prev[1] * n[1];
         let W = if omega_on {
             let A = a_matrix(&q.alpha);
@@ -209,14 +241,21 @@ pub(crate) fn element_system(
                 add_diagonal3(m, X[a], X[c], lg * nn);
                 add_diagonal3(m, XH[a], XH[c], -nn / w8.lambda_f);
                 add_diagonal3(m, ALH[a], ALH[c], -nn / w8.lambda_l);
-                add3(m, AL[a], AL[c], &(W * nn));
             }
         }
+        // the (α, α) blocks W · wh n_a n_c
+        add_node_pairs(m, (AL, AL), &W, wh, (&n, &n));
     }
-    // λd term (its rule, I11): λd ∫ (∂sδx − D δα)·(∂s x − D α − d3^k + D α_k).
+}
+
+/// λd term of eq. (61) on its rule (I11): `λd ∫ (∂sδx − D δα)·(∂s x − D α − d3^k + D α_k)`,
+/// `D = ∂d3/∂α` frozen at the element's state.
+#[allow(non_snake_case)] // paper symbol D
+fn lambda_d_term(problem: &Problem, p: &InverseParams, uk: &LocalVec, m: &mut KktMat, r: &mut KktVec) {
+    let h = problem.mesh.h();
     for (xi, w) in PointRule::tangent(problem, p.stabilisation).iter() {
         let q = interpolate(uk, h, xi);
-        let wh = w * h * w8.lambda_d;
+        let wh = w * h * p.weights.lambda_d;
         let D = d3_jacobian(&q.alpha);
         let c = d3(&q.alpha) - D * q.alpha;
         // test operator of node a: (∂sδx, −D δα) = (dn_a I, −n_a D) applied to (δx, δα)
@@ -238,20 +277,39 @@ pub(crate) fn element_system(
             }
         }
     }
-    // Λκ term (its rule, I12): ∫ ∂sδα · Aᵀ Λκ A ∂sα.
-    if w8.lambda_kappa.amax() > 0.0 {
+}
+
+/// Λκ term of eq. (61) on its rule (I12): `∫ ∂sδα · Aᵀ Λκ A ∂sα` (none when Λκ = 0).
+#[allow(non_snake_case)] // paper symbols A, Kk
+fn lambda_kappa_term(problem: &Problem, p: &InverseParams, uk: &LocalVec, m: &mut KktMat) {
+    let lambda_kappa = &p.weights.lambda_kappa;
+    if lambda_kappa.amax() > 0.0 {
+        let h = problem.mesh.h();
         for (xi, w) in problem.scheme.kappa().iter() {
             let q = interpolate(uk, h, xi);
             let A = a_matrix(&q.alpha);
-            let Kk = A.transpose() * Matrix3::from_diagonal(&w8.lambda_kappa) * A * (w * h);
-            for a in 0..2 {
-                for c in 0..2 {
-                    add3(m, AL[a], AL[c], &(Kk * (q.dn[a] * q.dn[c])));
-                }
-            }
+            let Kk = A.transpose() * Matrix3::from_diagonal(lambda_kappa) * A * (w * h);
+            // Kk carries the weight w h: the blocks Kk · dn_a dn_c
+            add_node_pairs(m, (AL, AL), &Kk, 1.0, (&q.dn, &q.dn));
         }
     }
-    (r, l)
+}
+
+/// `m[rows[c], cols[b]] += blk · (wh f_c g_b)` for the element's two nodes c and b (`rows`,
+/// `cols`: the local offsets of a field at the two nodes; `f`, `g`: shape functions or their
+/// derivatives at the point).
+pub(crate) fn add_node_pairs(
+    m: &mut KktMat,
+    (rows, cols): ([usize; 2], [usize; 2]),
+    blk: &Matrix3<f64>,
+    wh: f64,
+    (f, g): (&[f64; 2], &[f64; 2]),
+) {
+    for c in 0..2 {
+        for b in 0..2 {
+            add3(m, rows[c], cols[b], &(blk * (wh * f[c] * g[b])));
+        }
+    }
 }
 
 /// Dirichlet unknowns of I5 (KKT layout) with their values: `x = x_g` and `x̂ = α̂ = 0` at

@@ -29,7 +29,7 @@
 //! 1. Wang et al., Comput. Mech. 71 (2023), §3–4, eqs. (52)–(61), Remark 8, Remark 10.
 use nalgebra::{DVector, Matrix3, Vector3};
 
-use super::kkt::{add3, add_operator_blocks, element_part, element_system, KktMat, KktVec, PointRule, AL, X};
+use super::kkt::{add_node_pairs, add_operator_blocks, element_part, element_system, KktMat, KktVec, PointRule, AL, X};
 use super::measures::{position_error, record};
 use super::{early_divergence, Frame, FrameSolver, InverseParams, InverseRecord, InverseSolution, Records};
 use crate::assemble::{assemble, Tangent};
@@ -159,23 +159,6 @@ fn product_rule(
 ) -> Matrix3<f64> {
     let mrv = m * (r * v);
     Matrix3::from_columns(&[0, 1, 2].map(|j| dp[j].transpose() * mrv + p.transpose() * (m * (dr[j] * v))))
-}
-
-/// `e[rows[c], cols[b]] += blk · (wh f_c g_b)` for the element's two nodes c and b (`rows`,
-/// `cols`: the local offsets of a field at the two nodes; `f`, `g`: shape functions or their
-/// derivatives at the point).
-fn add_node_pairs(
-    e: &mut KktMat,
-    (rows, cols): ([usize; 2], [usize; 2]),
-    blk: &Matrix3<f64>,
-    wh: f64,
-    (f, g): (&[f64; 2], &[f64; 2]),
-) {
-    for c in 0..2 {
-        for b in 0..2 {
-            add3(e, rows[c], cols[b], &(blk * (wh * f[c] * g[b])));
-        }
-    }
 }
 
 /// Newton residual `R(U) = K(u) U − r(u)` of I8 (KKT layout, Dirichlet rows `U_d − v_d` of
