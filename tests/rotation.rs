@@ -8,8 +8,9 @@ mod common;
 
 use common::{case_from, case_text_with_data, edit, worm_data_present};
 use cosserat::case::Case;
+use cosserat::io::clip_run::run_clip_case;
 use cosserat::io::engine::run_case;
-use cosserat::io::engine::{run_clip_case, EngineError};
+use cosserat::io::engine::EngineError;
 use cosserat::run::Engine;
 use cosserat::run::RunError;
 use cosserat::solve::sequence::SequenceError;

@@ -5,7 +5,7 @@ mod common;
 
 use common::{case_file, worm_data_present};
 use cosserat::case::{Analysis, Case, DataSource};
-use cosserat::io::engine::run_clip_case;
+use cosserat::io::clip_run::run_clip_case;
 use cosserat::io::sweep::chain;
 use cosserat::run::clip::ClipRun;
 use cosserat::solve::inverse::InverseMethod;

@@ -14,8 +14,8 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+use super::clip_run::ClipOptions;
 use super::compact::OutputFormat;
-use super::engine::ClipOptions;
 use super::files::{write_atomic, OutputError};
 use super::run_folder::{input_file_as, sha256_file, FolderError, InputFile, Manifest, Mode, RunFolder, Status};
 use super::solved::{chain, solve_into, RunStatus};

@@ -35,6 +35,20 @@ pub enum OutputError {
     DiskFull { path: PathBuf, message: String },
 }
 
+/// Errors of reading the resume journal of a clip run (`super::journal`). (Here, not in
+/// `journal`, so that the engines' error can name it without importing the output folder.)
+#[derive(Debug, thiserror::Error)]
+pub enum JournalError {
+    #[error("{path} does not exist: this folder holds no clip run that can be resumed")]
+    Missing { path: PathBuf },
+    #[error("cannot read {path}")]
+    Io {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+}
+
 /// Errors reading an input file; each names the file and, where it applies, the row, frame,
 /// node or joint.
 #[derive(Debug, thiserror::Error)]

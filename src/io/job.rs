@@ -7,8 +7,8 @@
 //! `data.csv`), on non-convergence the last iterate with `run.json` saying failed.
 use std::path::{Path, PathBuf};
 
+use super::clip_run::ClipOptions;
 use super::compact::OutputFormat;
-use super::engine::ClipOptions;
 use super::run_folder::{input_file_as, FolderError, InputFile, Manifest, Mode, RunFolder, Status};
 pub use super::solved::case_label;
 use super::solved::solve_into;

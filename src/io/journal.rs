@@ -9,7 +9,7 @@
 use std::io::{BufRead, Write};
 use std::path::{Path, PathBuf};
 
-use super::files::OutputError;
+use super::files::{JournalError, OutputError};
 use crate::run::clip::FrameRecord;
 
 /// File name of the journal in a clip's output folder.
@@ -32,19 +32,6 @@ pub struct Entry {
     pub time_s: f64,
     pub offsets: Offsets,
     pub record: FrameRecord,
-}
-
-/// Errors of reading a journal.
-#[derive(Debug, thiserror::Error)]
-pub enum JournalError {
-    #[error("{path} does not exist: this folder holds no clip run that can be resumed")]
-    Missing { path: PathBuf },
-    #[error("cannot read {path}")]
-    Io {
-        path: PathBuf,
-        #[source]
-        source: std::io::Error,
-    },
 }
 
 /// The journal being appended to.

@@ -9,6 +9,7 @@ pub mod batch;
 pub mod clip_figures;
 pub mod clip_files;
 pub mod clip_output;
+pub mod clip_run;
 pub mod compact;
 pub mod compare;
 pub mod corpus;

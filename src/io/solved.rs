@@ -6,8 +6,9 @@
 use std::path::Path;
 
 use super::clip_output::remove_raw;
+use super::clip_run::{run_clip_to, write_clip_figures, ClipOptions};
 use super::data::write_data;
-use super::engine::{load_data, run_case, run_clip_to, run_inverse_on, write_clip_figures, ClipOptions, EngineError};
+use super::engine::{load_data, run_case, run_inverse_on, EngineError};
 use super::journal::remove_journal;
 use super::run_files::write_run;
 use super::run_folder::{CertificateSummary, Status};

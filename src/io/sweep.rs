@@ -5,7 +5,7 @@
 //! of `run` on a clip, its row the metrics of `run::clip_metrics`).
 use std::path::Path;
 
-use super::engine::ClipOptions;
+use super::clip_run::ClipOptions;
 use super::files::OutputError;
 use super::run_folder::Manifest;
 pub use super::solved::{case_label, chain, RunStatus, Solved as SweepOutcome};
