@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-use cosserat::io::run_folder::sha256_file;
+use cosserat::output::run_folder::sha256_file;
 
 /// Kills per campaign.
 const KILLS: usize = 20;

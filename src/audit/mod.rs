@@ -19,7 +19,7 @@ use serde::Deserialize;
 
 use crate::case::sweep::{product, Point, SweepError};
 use crate::io::compact::OutputFormat;
-use crate::io::sweep::{point_manifest, run_clip_point, run_point, SweepOutcome};
+use crate::jobs::sweep::{point_manifest, run_clip_point, run_point, SweepOutcome};
 use measures::{derived_metrics, ClipRecorder, ClipSeries};
 use spec::{Claim, RunSpec, Spec};
 
@@ -293,7 +293,7 @@ fn prepare_folder(out: &Path) -> Result<(), AuditError> {
         let empty = std::fs::read_dir(out)
             .map_err(io)?
             .filter_map(Result::ok)
-            .all(|e| e.file_name() == crate::io::run_folder::MANIFEST);
+            .all(|e| e.file_name() == crate::output::run_folder::MANIFEST);
         if empty {
             return std::fs::write(out.join(MARKER), "written by `cosserat audit`\n").map_err(io);
         }
@@ -508,7 +508,7 @@ fn check_metric_name(spec: &Spec, claim: &Claim, runs: &[RunResults]) -> Result<
     let Some(metric) = claim.check.metric() else { return Ok(()) };
     for run in claim.check.runs() {
         let Some(rr) = runs.iter().find(|r| r.name == run) else { continue };
-        let reported: Vec<&crate::run::metrics::Metrics> =
+        let reported: Vec<&crate::engine::rust::metrics::Metrics> =
             rr.points.iter().filter_map(|p| p.outcome.metrics.as_ref()).collect();
         if reported.is_empty() || reported.iter().any(|m| m.contains_key(metric)) {
             continue;

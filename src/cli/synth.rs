@@ -6,8 +6,8 @@ use std::process::ExitCode;
 
 use anyhow::{Context, Result};
 
-use cosserat::io::corpus::{write_corpus, CorpusParams};
-use cosserat::io::run_folder::{input_file_as, Manifest, Mode, RunFolder, Status};
+use cosserat::engine::input::corpus::{write_corpus, CorpusParams};
+use cosserat::output::run_folder::{input_file_as, Manifest, Mode, RunFolder, Status};
 
 /// `cosserat synth`.
 #[derive(clap::Args, Debug)]

@@ -9,7 +9,7 @@ use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use super::plot::PlotError;
+use crate::figures::plot::PlotError;
 
 /// Errors while writing outputs; each names the file.
 #[derive(Debug, thiserror::Error)]
@@ -35,7 +35,7 @@ pub enum OutputError {
     DiskFull { path: PathBuf, message: String },
 }
 
-/// Errors of reading the resume journal of a clip run (`super::journal`). (Here, not in
+/// Errors of reading the resume journal of a clip run (`crate::output::journal`). (Here, not in
 /// `journal`, so that the engines' error can name it without importing the output folder.)
 #[derive(Debug, thiserror::Error)]
 pub enum JournalError {
@@ -303,7 +303,7 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
     Ok(())
 }
 
-/// Write an SVG rendered by `crate::io::plot`; a rendering error names the file.
+/// Write an SVG rendered by `crate::figures::plot`; a rendering error names the file.
 pub fn write_plot(path: &Path, svg: Result<String, PlotError>) -> Result<(), OutputError> {
     let svg = svg.map_err(|source| OutputError::Plot { path: path.to_path_buf(), source })?;
     write_atomic(path, svg.as_bytes())

@@ -2,11 +2,11 @@
 //! and an SVG plot of the headline result, each written atomically (`io::files`).
 use std::path::{Path, PathBuf};
 
-use super::files::{csv_text, csv_text_int, write_atomic, write_plot, OutputError};
-use super::plot::{render_panels_svg, LinePlot, Mark, Series};
 use crate::case::Case;
-use crate::run::metrics::Metrics;
-use crate::run::{InverseOutput, RunResult};
+use crate::engine::rust::metrics::Metrics;
+use crate::engine::rust::{InverseOutput, RunResult};
+use crate::figures::plot::{render_panels_svg, LinePlot, Mark, Series};
+use crate::io::files::{csv_text, csv_text_int, write_atomic, write_plot, OutputError};
 use crate::solve::inverse::ObjectiveTerms;
 
 /// Write every output of a run into `dir`; returns the written paths.

@@ -1,6 +1,6 @@
 //! One clip case over many recordings (`cosserat batch`): the recording replaces the case's
 //! `clip.file`, each recording runs into its own folder `OUT/NAME` under the output-folder
-//! contract ([`super::run_folder`], `run.json` with command `batch`), and `OUT/summary.csv` has
+//! contract ([`crate::output::run_folder`], `run.json` with command `batch`), and `OUT/summary.csv` has
 //! one row per recording ([`SUMMARY_COLUMNS`]).
 //!
 //! The batch is described once by its plan, `OUT/batch.json` ([`Plan`]: the case file and every
@@ -14,15 +14,17 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use super::clip_run::ClipOptions;
-use super::compact::OutputFormat;
-use super::files::{write_atomic, OutputError};
-use super::run_folder::{input_file_as, sha256_file, FolderError, InputFile, Manifest, Mode, RunFolder, Status};
 use super::solved::{chain, solve_into, RunStatus};
-use super::truth_file::{is_truth_sidecar, truth_sidecar};
 use crate::case::{Analysis, Case, CaseError, DataSource};
-use crate::run::clip_metrics::clip_metrics;
-use crate::run::Engine;
+use crate::engine::input::truth_file::{is_truth_sidecar, truth_sidecar};
+use crate::engine::rust::clip_metrics::clip_metrics;
+use crate::engine::rust::Engine;
+use crate::io::compact::OutputFormat;
+use crate::io::files::{write_atomic, OutputError};
+use crate::output::clip_run::ClipOptions;
+use crate::output::run_folder::{
+    input_file_as, sha256_file, FolderError, InputFile, Manifest, Mode, RunFolder, Status,
+};
 
 /// The plan of a batch in its output folder.
 pub const PLAN: &str = "batch.json";
@@ -77,7 +79,7 @@ pub enum BatchError {
     #[error(transparent)]
     Folder(#[from] FolderError),
     #[error(transparent)]
-    Input(#[from] super::files::InputError),
+    Input(#[from] crate::io::files::InputError),
     #[error(transparent)]
     Output(#[from] OutputError),
     #[error("{path}: {reason}")]
@@ -201,7 +203,7 @@ pub fn list_recordings(input: &Path) -> Result<Vec<PathBuf>, BatchError> {
         }
         out.sort();
     } else {
-        let text = super::files::read_capped_text(input, LIST_FILE_CAP_BYTES, "list of recordings")?;
+        let text = crate::io::files::read_capped_text(input, LIST_FILE_CAP_BYTES, "list of recordings")?;
         let base = input.parent().unwrap_or(Path::new(""));
         out = text
             .lines()
@@ -397,7 +399,7 @@ pub fn run_recording(case: &Case, case_file: &InputFile, entry: &PlanEntry, out:
         Err(e) => return failed(chain(&e)),
     };
     // rod.length_m = "from_data": this recording's body length
-    let case = match super::clip_files::resolve_length(&case) {
+    let case = match crate::engine::input::clip_files::resolve_length(&case) {
         Ok(c) => c,
         Err(e) => return failed(chain(&e)),
     };
@@ -411,7 +413,7 @@ pub fn run_recording(case: &Case, case_file: &InputFile, entry: &PlanEntry, out:
     if solved.disk_full {
         // the recording's previous folder stays; its staging folder goes, freeing its space
         folder.abandon();
-        return failed(format!("{}: {}", super::disk::full_text(&dir), solved.error.unwrap_or_default()));
+        return failed(format!("{}: {}", crate::io::disk::full_text(&dir), solved.error.unwrap_or_default()));
     }
     let metrics = solved.clip.as_ref().filter(|c| !c.reports.is_empty()).map(|c| clip_metrics(&case, c));
     let get = |k: &str| metrics.as_ref().and_then(|m| m.get(k)).copied();
@@ -546,7 +548,7 @@ pub fn gather(out: &Path) -> Result<Vec<BatchRow>, BatchError> {
 pub fn summary_csv(rows: &[BatchRow]) -> Result<String, csv::Error> {
     let mut w = csv::Writer::from_writer(Vec::new());
     w.write_record(SUMMARY_COLUMNS)?;
-    let num = |v: Option<f64>| v.map(|v| super::number::exp(v, 10)).unwrap_or_default();
+    let num = |v: Option<f64>| v.map(|v| crate::io::number::exp(v, 10)).unwrap_or_default();
     for r in rows {
         w.write_record([
             r.recording.clone(),

@@ -24,7 +24,7 @@ use crate::solve::sequence::{
 };
 use crate::solve::{Problem, SolveError};
 
-/// Where the frames of a clip go (`crate::io::clip_files::ClipWriter` streams them to disk).
+/// Where the frames of a clip go (`crate::engine::input::clip_files::ClipWriter` streams them to disk).
 /// Called from a second thread, in frame order.
 pub trait FrameSink: Send {
     type Error: std::error::Error + Send + Sync + 'static;

@@ -1,4 +1,4 @@
-//! A clip case run into its output folder: the Rust engine ([`super::engine::run_clip_into`])
+//! A clip case run into its output folder: the Rust engine ([`crate::engine::run_clip_into`])
 //! streams every converged frame to a [`ClipWriter`] (rows, fields, VTK file, the resume
 //! journal), fresh or resumed after the journal's frames; then the clip's summary figures.
 use std::path::Path;
@@ -6,12 +6,12 @@ use std::path::Path;
 use super::clip_output::{
     write_clip_kymographs, write_clip_plot, write_omega_kymographs, write_truth_plot, ClipWriter,
 };
-use super::compact::OutputFormat;
-use super::engine::{run_clip_into, ClipInput, EngineError};
-use super::files::{JournalError, OutputError};
 use super::journal::read_journal;
 use crate::case::Case;
-use crate::run::clip::{ClipFrame, ClipOutcome, ClipRun, FrameSink};
+use crate::engine::rust::clip::{ClipFrame, ClipOutcome, ClipRun, FrameSink};
+use crate::engine::{run_clip_into, ClipInput, EngineError};
+use crate::io::compact::OutputFormat;
+use crate::io::files::{JournalError, OutputError};
 
 /// Solve the clip of a clip case frame by frame in the Rust engine, streaming every converged
 /// frame into `dir` ([`ClipWriter`]); on failure the converged frames stay there and the error
@@ -42,7 +42,7 @@ pub struct ClipOptions {
     pub journal: bool,
     /// continue the run whose journal `dir` holds, after its last complete frame
     pub resume: bool,
-    /// how the per-node fields are written (`super::compact`)
+    /// how the per-node fields are written (`crate::io::compact`)
     pub format: OutputFormat,
 }
 

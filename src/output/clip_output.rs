@@ -1,7 +1,7 @@
 //! The files of a clip run: `frames.csv`, `fields.csv`, `curvature.csv`, `truth.csv`
 //! (synthetic clips), ParaView `vtk/frame_NNNNN.vtp` + `clip.pvd` streamed frame by frame
 //! ([`ClipWriter`], the [`FrameSink`] of `run::clip`), or in the compact format one
-//! `fields.npz` (`super::compact`); the summary figures are `super::clip_figures`.
+//! `fields.npz` (`crate::io::compact`); the summary figures are `super::clip_figures`.
 use std::io::{Seek, Write};
 use std::path::{Path, PathBuf};
 
@@ -9,11 +9,11 @@ use nalgebra::Vector3;
 
 pub(crate) use super::clip_figures::abs_percentile_99;
 pub use super::clip_figures::{write_clip_kymographs, write_clip_plot, write_omega_kymographs, write_truth_plot};
-use super::compact::{write_compact, OutputFormat, CURVATURE_COLUMNS, RAW_CURVATURE, RAW_FIELDS};
-use super::files::OutputError;
 use super::journal::{Entry, Journal, Offsets, JOURNAL};
-use super::vtk::{write_pvd, write_vtp, PolylineFields};
-use crate::run::clip::{nodal_curvature, ClipFrame, Controls, FrameSink};
+use crate::engine::rust::clip::{nodal_curvature, ClipFrame, Controls, FrameSink};
+use crate::io::compact::{write_compact, OutputFormat, CURVATURE_COLUMNS, RAW_CURVATURE, RAW_FIELDS};
+use crate::io::files::OutputError;
+use crate::io::vtk::{write_pvd, write_vtp, PolylineFields};
 use crate::solve::sequence::FrameReport;
 
 /// Streams a clip solve to disk, one frame at a time (`frames.csv`, `fields.csv`,
@@ -30,7 +30,7 @@ pub struct ClipWriter {
     /// the resume journal, if kept
     journal: Option<Journal>,
     /// compact: the per-node rows go raw to `fields.f64` / `curvature.f64` (no VTK), and
-    /// `fields.npz` is written at the end (`super::compact`); the frame numbers written so far
+    /// `fields.npz` is written at the end (`crate::io::compact`); the frame numbers written so far
     compact: Option<Vec<i64>>,
 }
 
@@ -365,7 +365,7 @@ impl FrameSink for ClipWriter {
     }
 }
 
-/// Remove the raw rows of a compact clip (`super::compact`), once its journal goes.
+/// Remove the raw rows of a compact clip (`crate::io::compact`), once its journal goes.
 pub fn remove_raw(dir: &Path) -> Result<(), OutputError> {
     for name in [RAW_FIELDS, RAW_CURVATURE] {
         match std::fs::remove_file(dir.join(name)) {
@@ -380,7 +380,7 @@ pub fn remove_raw(dir: &Path) -> Result<(), OutputError> {
 
 /// Append one row of a per-node or per-element file to `out`: raw little-endian `values` in
 /// the compact format, else the CSV line `index,…,value,…` (values `{:.10e}`,
-/// [`super::number::push_exp`]).
+/// [`crate::io::number::push_exp`]).
 fn push_row(out: &mut Vec<u8>, compact: bool, index: &[usize], values: &[f64]) {
     if compact {
         out.extend(values.iter().flat_map(|x| x.to_le_bytes()));
@@ -423,28 +423,28 @@ fn frames_row(values: &[f64]) -> String {
             s.push(',');
         }
         if CLIP_FRAME_COLUMNS.get(k).is_some_and(|c| CLIP_FRAME_INTEGER_COLUMNS.contains(c)) {
-            super::number::push_integer(&mut s, *v, 10);
+            crate::io::number::push_integer(&mut s, *v, 10);
         } else {
-            super::number::push_exp(&mut s, *v, 10);
+            crate::io::number::push_exp(&mut s, *v, 10);
         }
     }
     s
 }
 
-/// Numbers as one CSV row, `{:.10e}` each ([`super::number::push_exp`]).
+/// Numbers as one CSV row, `{:.10e}` each ([`crate::io::number::push_exp`]).
 fn csv_row(values: &[f64]) -> String {
     let mut s = String::with_capacity(18 * values.len());
     push_csv(&mut s, values);
     s
 }
 
-/// Append `values` comma-separated, `{:.10e}` each ([`super::number::push_exp`]).
+/// Append `values` comma-separated, `{:.10e}` each ([`crate::io::number::push_exp`]).
 fn push_csv(s: &mut String, values: &[f64]) {
     for (k, v) in values.iter().enumerate() {
         if k > 0 {
             s.push(',');
         }
-        super::number::push_exp(s, *v, 10);
+        crate::io::number::push_exp(s, *v, 10);
     }
 }
 

@@ -8,10 +8,10 @@ use std::path::Path;
 
 use nalgebra::Vector3;
 
-use super::files::{csv_reader_capped, write_atomic, InputError, OutputError};
+use crate::engine::rust::NodalState;
+use crate::io::files::{csv_reader_capped, write_atomic, InputError, OutputError};
 use crate::model::chart::Chart;
 use crate::model::mesh::Mesh;
-use crate::run::NodalState;
 
 /// Column names of `data.csv`.
 pub const DATA_HEADER: [&str; 7] = ["s_m", "x_m", "y_m", "z_m", "alpha_rad", "beta_rad", "gamma_rad"];

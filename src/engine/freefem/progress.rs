@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
-use super::freefem_include::RunOptions;
+use super::include::RunOptions;
 use crate::case::{Analysis, Case};
 
 /// What a count counts.

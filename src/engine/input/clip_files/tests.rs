@@ -340,7 +340,7 @@ fn ratio_in(e: &str) -> f64 {
 /// length, are refused. Skipped with a notice without the elegansbot data.
 #[test]
 fn synthetic_recordings_pass_the_length_check_at_any_noise() {
-    use crate::io::corpus::{recording_path, write_corpus, CorpusParams};
+    use crate::engine::input::corpus::{recording_path, write_corpus, CorpusParams};
     let kymogram = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/elegansbot/kymogram_omega-turn.npy");
     if !kymogram.is_file() {
         println!("SKIPPED: {} is absent (run scripts/fetch_worm_data.sh)", kymogram.display());
@@ -403,8 +403,8 @@ fn a_missing_clip_file_names_the_case_key() {
 #[test]
 fn the_minimum_clip_mesh_matches_the_measures() {
     use crate::clip::{CLIP_SKIP_ELEMENTS, MIN_CLIP_ELEMENTS};
-    use crate::run::clip::{planar_xz_curvature, sign_alternation, TRUTH_SKIP_NODES};
-    use crate::run::metrics::INNER_SKIP_ELEMENTS;
+    use crate::engine::rust::clip::{planar_xz_curvature, sign_alternation, TRUTH_SKIP_NODES};
+    use crate::engine::rust::metrics::INNER_SKIP_ELEMENTS;
     assert_eq!((CLIP_SKIP_ELEMENTS, TRUTH_SKIP_NODES), (INNER_SKIP_ELEMENTS, INNER_SKIP_ELEMENTS));
     assert_eq!((MIN_CLIP_ELEMENTS, 2 * INNER_SKIP_ELEMENTS + 1, 2 * TRUTH_SKIP_NODES + 1), (11, 11, 11));
     // A zig-zag centreline on the smallest mesh: its data curvature alternates in sign.

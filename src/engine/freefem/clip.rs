@@ -9,11 +9,13 @@ use std::path::Path;
 
 use nalgebra::Vector3;
 
-use super::freefem::{execute, info_certificate, io, read_info, read_table, ClipInclude, FreeFemError, RunOptions};
 use crate::case::Case;
+use crate::engine::freefem::{
+    execute, info_certificate, io, read_info, read_table, ClipInclude, FreeFemError, RunOptions,
+};
+use crate::engine::rust::frames::{frame_result, SolvedFrame};
+use crate::engine::rust::{Engine, NodalState};
 use crate::model::chart::Chart;
-use crate::run::frames::{frame_result, SolvedFrame};
-use crate::run::{Engine, NodalState};
 use crate::solve::certificate::Certificate;
 use crate::solve::inverse::{InverseRecord, ObjectiveTerms};
 use crate::solve::sequence::{clip_charts, ClipData, FrameStart};

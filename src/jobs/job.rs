@@ -1,20 +1,20 @@
-//! `cosserat run` on a case, under the output-folder contract ([`super::run_folder`]): the run
+//! `cosserat run` on a case, under the output-folder contract ([`crate::output::run_folder`]): the run
 //! writes into its staging folder, and whatever happens after the folder was claimed — success,
 //! a solver failure, a write error, an interrupt — ends in a `run.json` saying so and the folder
 //! put in place. A clip keeps its converged frames with figures over exactly them and a resume
-//! journal ([`super::journal`]); a single run (forward, one inverse frame) keeps its result
+//! journal ([`crate::output::journal`]); a single run (forward, one inverse frame) keeps its result
 //! only when it has one: on an interrupt nothing but `run.json` (and an inverse case's
 //! `data.csv`), on non-convergence the last iterate with `run.json` saying failed.
 use std::path::{Path, PathBuf};
 
-use super::clip_run::ClipOptions;
-use super::compact::OutputFormat;
-use super::run_folder::{input_file_as, FolderError, InputFile, Manifest, Mode, RunFolder, Status};
 pub use super::solved::case_label;
 use super::solved::solve_into;
 use crate::case::Case;
-use crate::run::clip::ClipRun;
-use crate::run::{Engine, RunResult};
+use crate::engine::rust::clip::ClipRun;
+use crate::engine::rust::{Engine, RunResult};
+use crate::io::compact::OutputFormat;
+use crate::output::clip_run::ClipOptions;
+use crate::output::run_folder::{input_file_as, FolderError, InputFile, Manifest, Mode, RunFolder, Status};
 
 /// How a run ended.
 #[derive(Debug)]
@@ -102,7 +102,7 @@ impl JobEnd {
 /// run with nothing to keep removes it (and so frees its space).
 fn stopped_by_full_disk(folder: RunFolder, mut end: JobEnd, out: &Path) -> JobEnd {
     end.status = Status::Failed;
-    end.message = Some(format!("{}: {}", super::disk::full_text(out), end.message.unwrap_or_default()));
+    end.message = Some(format!("{}: {}", crate::io::disk::full_text(out), end.message.unwrap_or_default()));
     end.disk_full = Some(match end.frames {
         Some((n, _)) if n > 0 => Some(folder.keep_staging(Status::Failed, end.message.clone())),
         _ => {
@@ -148,7 +148,7 @@ pub fn case_inputs(case: &Case) -> Result<Vec<InputFile>, FolderError> {
     let Some(c) = case.clip() else { return Ok(inputs) };
     if std::fs::metadata(&c.file).is_ok() {
         inputs.push(input_file_as(&c.file, "clip file")?);
-        let sidecar = super::truth_file::truth_sidecar(&c.file);
+        let sidecar = crate::engine::input::truth_file::truth_sidecar(&c.file);
         if c.kind == crate::case::ClipKind::Recording && sidecar.is_file() {
             inputs.push(input_file_as(&sidecar, "ground-truth sidecar")?);
         }

@@ -5,8 +5,6 @@ use std::path::{Path, PathBuf};
 
 use nalgebra::{Matrix3, Vector3};
 
-use super::files::{csv_reader_capped, InputError};
-use super::npy::read_npy;
 use super::truth_file::{read_truth, truth_sidecar};
 use crate::case::sweep::SweepError;
 use crate::case::{Case, ClipKind, RodLength, FROM_DATA};
@@ -17,6 +15,8 @@ use crate::clip::{
     check_frame_range, clip_from_angles, polyline_length, rotate_frame, Clip, ClipError, KymogramParams,
     MAX_CLIP_POSITIONS, MAX_LENGTH_DEVIATION,
 };
+use crate::io::files::{csv_reader_capped, InputError};
+use crate::io::npy::read_npy;
 
 /// Column names of a CSV recording.
 pub const RECORDING_HEADER: [&str; 5] = ["frame", "node", "x_m", "y_m", "z_m"];

@@ -8,11 +8,11 @@ use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
 
 use super::clip_files::{kymogram_rows, ClipFileError};
-use super::files::{write_atomic, OutputError};
-use super::npy::write_npy;
 use super::truth_file::{truth_sidecar, write_truth};
 use crate::clip::synthetic::{roll_clip, RollClipParams, TimeMapping};
 use crate::clip::ClipError;
+use crate::io::files::{write_atomic, OutputError};
+use crate::io::npy::write_npy;
 
 /// Frames per kymogram row played.
 const ROWS_PER_FRAME_INV: usize = 2;

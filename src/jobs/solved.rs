@@ -2,21 +2,21 @@
 //! points of a sweep or an audit ([`super::sweep`]) and a batch of recordings: a forward or
 //! single-frame inverse run writes its files (the last iterate's too, when it stops at its
 //! iteration limit), a clip streams its frames and then its figures over the frames solved.
-//! The caller owns the folder and its `run.json` ([`super::run_folder`]).
+//! The caller owns the folder and its `run.json` ([`crate::output::run_folder`]).
 use std::path::Path;
 
-use super::clip_output::remove_raw;
-use super::clip_run::{run_clip_to, write_clip_figures, ClipOptions};
-use super::data::write_data;
-use super::engine::{load_data, run_case, run_inverse_on, EngineError};
-use super::journal::remove_journal;
-use super::run_files::write_run;
-use super::run_folder::{CertificateSummary, Status};
 use crate::case::Case;
-use crate::run::clip::{ClipFrame, ClipRun};
-use crate::run::clip_metrics::clip_metrics;
-use crate::run::metrics::{all_metrics, Metrics};
-use crate::run::{Engine, RunError, RunResult};
+use crate::engine::input::data::write_data;
+use crate::engine::rust::clip::{ClipFrame, ClipRun};
+use crate::engine::rust::clip_metrics::clip_metrics;
+use crate::engine::rust::metrics::{all_metrics, Metrics};
+use crate::engine::rust::{Engine, RunError, RunResult};
+use crate::engine::{load_data, run_case, run_inverse_on, EngineError};
+use crate::output::clip_output::remove_raw;
+use crate::output::clip_run::{run_clip_to, write_clip_figures, ClipOptions};
+use crate::output::journal::remove_journal;
+use crate::output::run_files::write_run;
+use crate::output::run_folder::{CertificateSummary, Status};
 use crate::solve::sequence::FrameReport;
 use crate::solve::SolveError;
 
@@ -80,7 +80,7 @@ pub struct Solved {
     pub clip: Option<ClipRun>,
     /// clips: frames in the folder and frames of the clip
     pub frames: Option<(usize, usize)>,
-    /// it stopped because the disk (or quota) was full (`super::disk`)
+    /// it stopped because the disk (or quota) was full (`crate::io::disk`)
     pub disk_full: bool,
 }
 
@@ -113,7 +113,7 @@ impl Solved {
 
     /// A run that produced nothing, with its error `e` described as `error`.
     fn failed_by(error: String, e: &(dyn std::error::Error + 'static)) -> Self {
-        Solved { disk_full: super::disk::is_full(e), ..Solved::failed(error) }
+        Solved { disk_full: crate::io::disk::is_full(e), ..Solved::failed(error) }
     }
 
     /// A run stopped (or not started) by a signal.
@@ -213,7 +213,7 @@ fn solve_clip(
     };
     let (done, total) = (out.run.reports.len(), out.total);
     let flagged: Vec<&FrameReport> = out.run.reports.iter().filter(|r| r.fit.flagged).collect();
-    let mut disk_full = out.stopped.as_ref().is_some_and(|e| super::disk::is_full(e));
+    let mut disk_full = out.stopped.as_ref().is_some_and(|e| crate::io::disk::is_full(e));
     let (mut status, mut error) = match &out.stopped {
         None if !flagged.is_empty() => (RunStatus::Warnings, Some(flag_message(case, &flagged, done))),
         None => (RunStatus::Ok, None),
@@ -226,7 +226,7 @@ fn solve_clip(
     // A clip whose figures cannot be written keeps its frames (and says so).
     let figures = if done > 0 { write_clip_figures(case, &out.run, dir) } else { Ok(()) };
     if let Err(e) = figures {
-        disk_full |= super::disk::is_full(&e);
+        disk_full |= crate::io::disk::is_full(&e);
         error = Some(match error {
             Some(m) => format!("{m}; then {}", chain(&e)),
             None => format!("{}: {}", case_label(case), chain(&e)),

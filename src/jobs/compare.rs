@@ -6,7 +6,7 @@
 //!   compared at the same iterate: FreeFEM runs exactly the iterations Rust needed
 //!   (`exactIters`), and the iteration at which FreeFEM first met the tolerance is a row of
 //!   its own. Clips: the first `frames` frames, consecutive, warm-started and re-based by
-//!   both engines ([`super::freefem_clip`]).
+//!   both engines ([`crate::engine::freefem::clip`]).
 //! - **Tolerances.** The Rust engine runs the case a second time with its input perturbed at
 //!   [`PERTURBATION`] (relative): the data x_g of an inverse case or a clip, the stiffnesses
 //!   and inertias of a forward case. For every compared quantity q, with σ_q the perturbed
@@ -23,17 +23,17 @@ use std::path::{Path, PathBuf};
 
 use nalgebra::Vector3;
 
-use super::clip_files::load_clip;
-use super::data::write_data;
-use super::engine::{load_data, EngineError};
-use super::files::{write_atomic, OutputError};
-use super::freefem::{self, RunOptions};
-use super::freefem_clip::run_clip;
-use super::run_files::write_run;
 use crate::case::{Analysis, Case, CompareOverrides};
-use crate::run::frames::{solve_frames, SolvedFrame};
-use crate::run::metrics::{all_metrics, differences, ComparisonRow, Difference, Group};
-use crate::run::{run_forward, run_inverse, NodalState, RunError, RunResult};
+use crate::engine::freefem::clip::run_clip;
+use crate::engine::freefem::{self, RunOptions};
+use crate::engine::input::clip_files::load_clip;
+use crate::engine::input::data::write_data;
+use crate::engine::rust::frames::{solve_frames, SolvedFrame};
+use crate::engine::rust::metrics::{all_metrics, differences, ComparisonRow, Difference, Group};
+use crate::engine::rust::{run_forward, run_inverse, NodalState, RunError, RunResult};
+use crate::engine::{load_data, EngineError};
+use crate::io::files::{write_atomic, OutputError};
+use crate::output::run_files::write_run;
 use crate::solve::certificate::CERTIFICATE_FLOOR;
 use crate::solve::inverse::InverseMethod;
 use crate::solve::sequence::ClipData;
@@ -373,7 +373,7 @@ fn compare_single(case: &Case, dir: &Path, opts: &CompareOptions) -> Result<Comp
 fn compare_clip(case: &Case, dir: &Path, opts: &CompareOptions) -> Result<CompareReport, CompareError> {
     let (clip, _) = load_clip(case).map_err(EngineError::from)?;
     // weights = "auto": λg chosen once (in Rust, docs/noise.md N2), then both engines use it
-    let auto = crate::run::weights::choose_weights(case, &clip.frames);
+    let auto = crate::engine::rust::weights::choose_weights(case, &clip.frames);
     let case = auto.as_ref().map_or(case, |a| &a.case);
     let default = match opts.horizon {
         Horizon::Full => case.compare.frames,

@@ -6,9 +6,9 @@ use std::path::{Path, PathBuf};
 
 use sha2::{Digest, Sha256};
 
-use super::files::{is_temporary, write_atomic};
 use crate::case::sweep::SweepValue;
 use crate::clip::length::BodyLength;
+use crate::io::files::{is_temporary, write_atomic};
 
 /// File name of the manifest in an output folder.
 pub const MANIFEST: &str = "run.json";
@@ -87,7 +87,7 @@ pub struct Manifest {
     pub certificate: Option<CertificateSummary>,
     /// clips with `[inverse] weights = "auto"`: the noise level and the weights chosen
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub weights: Option<crate::run::weights::ChosenWeights>,
+    pub weights: Option<crate::engine::rust::weights::ChosenWeights>,
     /// `rod.length_m = "from_data"`: the body length estimated from the recording, with the
     /// spread and range of its frames (`clip::length`)
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -164,7 +164,7 @@ pub enum FolderError {
     #[error("{path}: {reason}")]
     Manifest { path: PathBuf, reason: String },
     #[error(transparent)]
-    Input(#[from] super::files::InputError),
+    Input(#[from] crate::io::files::InputError),
 }
 
 pub(super) fn io_err(path: &Path) -> impl Fn(std::io::Error) -> FolderError + '_ {
@@ -186,9 +186,9 @@ pub fn input_file(path: &Path) -> Result<InputFile, FolderError> {
 
 /// The input file `path` (`what` names it in messages: "clip file", "recording") with its
 /// hash; anything but a regular file is refused before it is opened (a pipe's open would
-/// block: `super::files::check_regular`).
+/// block: `crate::io::files::check_regular`).
 pub fn input_file_as(path: &Path, what: &'static str) -> Result<InputFile, FolderError> {
-    super::files::check_regular(path, what)?;
+    crate::io::files::check_regular(path, what)?;
     Ok(InputFile { path: path.display().to_string(), sha256: sha256_file(path).map_err(io_err(path))? })
 }
 

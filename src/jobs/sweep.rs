@@ -5,16 +5,16 @@
 //! of `run` on a clip, its row the metrics of `run::clip_metrics`).
 use std::path::Path;
 
-use super::clip_run::ClipOptions;
-use super::files::OutputError;
-use super::run_folder::Manifest;
 pub use super::solved::{case_label, chain, RunStatus, Solved as SweepOutcome};
 use super::solved::{solve_into, Solved};
 use crate::case::sweep::Point;
 use crate::case::Case;
-use crate::run::clip::ClipFrame;
-use crate::run::metrics::Metrics;
-use crate::run::{Engine, RunResult};
+use crate::engine::rust::clip::ClipFrame;
+use crate::engine::rust::metrics::Metrics;
+use crate::engine::rust::{Engine, RunResult};
+use crate::io::files::OutputError;
+use crate::output::clip_run::ClipOptions;
+use crate::output::run_folder::Manifest;
 
 /// Columns of the summary table after the swept keys.
 pub const SUMMARY_METRICS: [&str; 12] = [
@@ -92,9 +92,9 @@ pub const SUMMARY_INTEGER_METRICS: [&str; 3] = ["iterations", "frames", "iterati
 fn summary_number(column: &str, v: f64) -> String {
     let mut s = String::new();
     if SUMMARY_INTEGER_METRICS.contains(&column) {
-        super::number::push_integer(&mut s, v, 10);
+        crate::io::number::push_integer(&mut s, v, 10);
     } else {
-        super::number::push_exp(&mut s, v, 10);
+        crate::io::number::push_exp(&mut s, v, 10);
     }
     s
 }
@@ -116,7 +116,7 @@ pub fn run_clip_point(
     case: &Case,
     dir: &Path,
     template: &Manifest,
-    format: super::compact::OutputFormat,
+    format: crate::io::compact::OutputFormat,
     observer: impl FnMut(&ClipFrame) + Send,
 ) -> SweepOutcome {
     let opts = ClipOptions { format, ..ClipOptions::default() };
@@ -203,11 +203,11 @@ pub fn sweep_into(
     let columns: &[&str] = if case.clip().is_some() { &CLIP_SUMMARY_METRICS } else { &SUMMARY_METRICS };
     let text = summary_csv(keys, columns, &rows)
         .map_err(|e| OutputError::Invalid { path: dir.join("summary.csv"), reason: e.to_string() })?;
-    super::files::write_atomic(&dir.join("summary.csv"), text.as_bytes())?;
+    crate::io::files::write_atomic(&dir.join("summary.csv"), text.as_bytes())?;
     let curves: Vec<(&String, &RunResult)> =
         results.iter().filter_map(|(name, _, o)| o.single.as_ref().map(|run| (name, run))).collect();
     if !curves.is_empty() {
-        super::run_files::write_convergence_plot(&curves, &dir.join("convergence.svg"))?;
+        crate::output::run_files::write_convergence_plot(&curves, &dir.join("convergence.svg"))?;
     }
     Ok(rows)
 }
@@ -228,7 +228,7 @@ pub const NOT_STARTED: &str = "not started: a stop was requested before its turn
 fn with_kept_frames(case: &Case, outcome: Solved) -> Solved {
     match (&outcome.metrics, &outcome.clip) {
         (None, Some(c)) if !c.reports.is_empty() => {
-            Solved { metrics: Some(crate::run::clip_metrics::clip_metrics(case, c)), ..outcome }
+            Solved { metrics: Some(crate::engine::rust::clip_metrics::clip_metrics(case, c)), ..outcome }
         }
         _ => outcome,
     }

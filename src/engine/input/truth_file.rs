@@ -1,7 +1,7 @@
 //! The ground-truth sidecar of a synthetic recording: `NAME.truth.npy` next to `NAME.npy` (or
 //! `NAME.csv`), written by `cosserat synth` ([`super::corpus`]). When a recording has one, the
 //! clip is scored against it exactly as the `roll_3d` clip is against its generator
-//! (`crate::run::clip::TruthRun`): recovered curvature, frames and positions.
+//! (`crate::engine::rust::clip::TruthRun`): recovered curvature, frames and positions.
 //!
 //! Layout: float64, frames × nodes × 13, per node the rows of the frame `Q` (`d1`, `d2`, `d3`:
 //! 9 values [–]), the local curvature `κˡ` (3 values [1/m]) and the frame's roll angle `ψ` of
@@ -10,9 +10,9 @@ use std::path::{Path, PathBuf};
 
 use nalgebra::{Matrix3, Vector3};
 
-use super::files::{InputError, OutputError};
-use super::npy::{read_npy, write_npy};
 use crate::clip::synthetic::{FrameTruth, GroundTruth};
+use crate::io::files::{InputError, OutputError};
+use crate::io::npy::{read_npy, write_npy};
 
 /// Values per node in a truth sidecar.
 pub const TRUTH_VALUES_PER_NODE: usize = 13;

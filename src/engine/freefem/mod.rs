@@ -7,19 +7,23 @@
 //! above `solver.certificate_tolerance` with exit status 3 and `STALLED: …`, a static or inverse
 //! run at its iteration limit with 4; both are read back as [`FreeFemError::Incomplete`] with the
 //! error the Rust engine gives ([`SolveError::Stalled`], `…NotConverged`) and the last iterate
-//! (`crate::io::engine` turns it into `RunError::Incomplete`).
+//! (`crate::engine` turns it into `RunError::Incomplete`).
+pub mod clip;
+pub mod include;
+pub mod progress;
+
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use nalgebra::Vector3;
 
-use super::files::{csv_reader, InputError};
-pub use super::freefem_include::{include_file, ClipInclude, RunOptions};
-use super::freefem_progress::Watch;
+pub use self::include::{include_file, ClipInclude, RunOptions};
+use self::progress::Watch;
 use crate::case::{Analysis, Case};
+use crate::engine::rust::{angles_known, Engine, InverseOutput, NodalState, RunResult, SolverStats};
+use crate::io::files::{csv_reader, InputError};
 use crate::model::chart::Chart;
-use crate::run::{angles_known, Engine, InverseOutput, NodalState, RunResult, SolverStats};
 use crate::solve::certificate::Certificate;
 use crate::solve::dynamics::TipRecord;
 use crate::solve::inverse::{InverseRecord, ObjectiveTerms};

@@ -2,11 +2,11 @@
 //! `kymograph.svg`, `omega.svg`, `truth.svg` and `truth_errors.svg`.
 use std::path::Path;
 
-use super::files::{write_plot, OutputError};
-use super::heatmap::{render_heatmaps_svg, ColourScale, Heatmap};
-use super::plot::{render_panels_svg, LinePlot, Series};
 use crate::case::Case;
-use crate::run::clip::ClipRun;
+use crate::engine::rust::clip::ClipRun;
+use crate::figures::heatmap::{render_heatmaps_svg, ColourScale, Heatmap};
+use crate::figures::plot::{render_panels_svg, LinePlot, Series};
+use crate::io::files::{write_plot, OutputError};
 use crate::solve::sequence::FrameReport;
 
 /// The times of a clip run's frames [s] (frame number × Δt) as the x axis of its per-frame

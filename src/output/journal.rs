@@ -9,8 +9,8 @@
 use std::io::{BufRead, Write};
 use std::path::{Path, PathBuf};
 
-use super::files::{JournalError, OutputError};
-use crate::run::clip::FrameRecord;
+use crate::engine::rust::clip::FrameRecord;
+use crate::io::files::{JournalError, OutputError};
 
 /// File name of the journal in a clip's output folder.
 pub const JOURNAL: &str = "resume.jsonl";

@@ -262,7 +262,7 @@ struct StopRequested {
 
 /// Run `case` in the Rust engine from memory: a forward case, or a synthetic inverse case on
 /// its forward data generated here (identical to what `data.csv` holds: the file round-trips
-/// `f64` exactly). Clips are read from files: `crate::io::engine`.
+/// `f64` exactly). Clips are read from files: `crate::engine`.
 pub fn run_rust(case: &Case, progress: impl FnMut(usize, usize)) -> Result<RunResult, RunError> {
     match &case.analysis {
         Analysis::Inverse(_) => run_inverse(case, &forward_data(case)?, progress),

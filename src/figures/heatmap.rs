@@ -225,7 +225,7 @@ pub fn render_heatmaps_svg(maps: &[Heatmap]) -> Result<String, PlotError> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::io::plot::smallest_text;
+    use crate::figures::plot::smallest_text;
 
     #[test]
     fn heatmap_has_a_colour_bar_with_its_unit_and_the_ends_labelled() {

@@ -4,8 +4,8 @@
 //! in place.
 use std::path::{Path, PathBuf};
 
-use super::files::is_temporary;
 use super::manifest::{check_resumable, io_err, FolderError, Manifest, ResumeRefusal, Status, MANIFEST};
+use crate::io::files::is_temporary;
 
 /// A staging folder `.NAME.staging-PID` left beside an output folder by a run that ended
 /// before it put it in place (killed, or stopped by a full disk).

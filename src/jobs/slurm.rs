@@ -9,7 +9,7 @@ use std::process::Command;
 use std::time::Duration;
 
 use super::batch::Plan;
-use super::files::{write_atomic, OutputError};
+use crate::io::files::{write_atomic, OutputError};
 
 /// The job script in the output folder.
 pub const SCRIPT: &str = "batch.sbatch";
