@@ -24,11 +24,11 @@ use std::path::{Path, PathBuf};
 use nalgebra::Vector3;
 
 use crate::case::{Analysis, Case, CompareOverrides};
-use crate::engine::freefem::clip::run_clip;
+use crate::engine::freefem::clip::{run_clip, FreeFemFrames};
 use crate::engine::freefem::{self, RunOptions};
 use crate::engine::input::clip_files::load_clip;
 use crate::engine::input::data::write_data;
-use crate::engine::rust::frames::{solve_frames, SolvedFrame};
+use crate::engine::rust::frames::{solve_frames, SolvedFrame, SolvedFrames};
 use crate::engine::rust::metrics::{all_metrics, differences, ComparisonRow, Difference, Group};
 use crate::engine::rust::{run_forward, run_inverse, NodalState, RunError, RunResult};
 use crate::engine::{load_data, EngineError};
@@ -380,76 +380,22 @@ fn compare_clip(case: &Case, dir: &Path, opts: &CompareOptions) -> Result<Compar
         Horizon::Short => SHORT_FRAMES,
     };
     let n = opts.frames.unwrap_or(default).min(clip.frames.len()).max(1);
-    let frames = &clip.frames[..n];
     let tracked = clip.tracked.as_deref().map(|t| &t[..n]);
+    let runs = solve_clip_both(case, ClipData { positions: &clip.frames[..n], tracked }, dir)?;
     let tau = stop_tolerance(case);
     let fixed_point = is_fixed_point_inverse(case);
-    let rust = solve_frames(case, ClipData { positions: frames, tracked })?;
-    let pert: Vec<Vec<Vector3<f64>>> =
-        frames.iter().enumerate().map(|(f, x)| perturb_positions(x, 1000 + f as u64)).collect();
-    let perturbed =
-        solve_frames(case, ClipData { positions: &pert, tracked }).map_err(|e| CompareError::Perturbed(e.into()))?;
-    let exact: Option<Vec<(usize, bool)>> =
-        fixed_point.then(|| rust.frames.iter().map(|f| (f.result.stats.iterations, f.restarted)).collect());
-    let work = dir.join("freefem_work");
-    let ff =
-        run_clip(case, ClipData { positions: frames, tracked }, exact.as_deref(), &work).map_err(EngineError::from)?;
-    let mut out = Vec::new();
-    // per quantity: the row of the frame with the largest difference/tolerance ratio
-    let mut worst: Vec<(ComparisonRow, usize, f64)> = Vec::new();
-    let mut restarts = 0.0;
-    let mut frame_times = Vec::new();
-    for (r, f) in rust.frames.iter().zip(&ff.frames) {
-        let p: Option<&SolvedFrame> = perturbed.frames.iter().find(|p| p.frame == r.frame);
-        let counts = !fixed_point;
-        let sens = p.map(|p| differences(&r.result, &p.result, counts)).unwrap_or_default();
-        for row in rows(case, tau, &differences(&r.result, &f.result, counts), &sens) {
-            let ratio = if row.tolerance > 0.0 { row.difference / row.tolerance } else { f64::INFINITY };
-            match worst.iter_mut().find(|w| w.0.name == row.name) {
-                Some(w) if w.2 >= ratio => {}
-                Some(w) => *w = (row, r.frame, ratio),
-                None => worst.push((row, r.frame, ratio)),
-            }
-        }
-        restarts += f64::from(u8::from(r.restarted != f.restarted));
-        frame_times.push(FrameTime {
-            frame: r.frame,
-            rust_s: r.result.stats.wall_time_s,
-            freefem_s: f.result.stats.wall_time_s,
-            rust_iterations: r.result.stats.iterations,
-            freefem_iterations: f.result.stats.iterations,
-        });
-    }
-    for (mut row, frame, _) in worst {
-        row.basis = format!("{} (worst: frame {frame})", row.basis);
-        out.push(row);
-    }
-    let count = |x: usize| Some(x as f64);
-    // every requested frame solved by both engines
-    let solved = |name: &str, a: usize, b: usize, basis: String| ComparisonRow {
-        name: name.into(),
-        rust: count(a),
-        freefem: count(b),
-        difference: (n - a.min(b)) as f64 + (a as f64 - b as f64).abs(),
-        tolerance: 0.0,
-        basis,
-    };
-    let why = |e: Option<String>| e.unwrap_or_else(|| "all frames solved".into());
-    out.push(solved(
-        "frames_solved",
-        rust.frames.len(),
-        ff.frames.len(),
-        format!("rust: {}; freefem: {}", why(rust.error.as_ref().map(|e| e.to_string())), why(ff.error.clone())),
-    ));
+    let per_frame = compare_frames(case, tau, !fixed_point, &runs);
+    let mut out = per_frame.worst;
+    out.push(frames_solved_row(n, &runs));
     out.push(ComparisonRow {
         name: "restarted_frames_differing".into(),
         rust: None,
         freefem: None,
-        difference: restarts,
+        difference: per_frame.restarts,
         tolerance: 0.0,
         basis: "restart from the data guess in one engine only".into(),
     });
-    let first = rust.frames.first().map_or(0, |f| f.frame);
+    let first = runs.rust.frames.first().map_or(0, |f| f.frame);
     let what = format!(
         "clip frames {first}-{} ({n} frames), {}",
         first + n - 1,
@@ -463,11 +409,98 @@ fn compare_clip(case: &Case, dir: &Path, opts: &CompareOptions) -> Result<Compar
         case: case.name.clone(),
         rows: out,
         what,
-        rust_wall_s: rust.wall_time_s,
-        freefem_wall_s: ff.wall_time_s,
-        frame_times,
+        rust_wall_s: runs.rust.wall_time_s,
+        freefem_wall_s: runs.freefem.wall_time_s,
+        frame_times: per_frame.times,
         runs: None,
     })
+}
+
+/// A clip's frames solved by both engines, and by Rust again on perturbed data (the
+/// sensitivity a difference is judged against).
+struct ClipRuns {
+    rust: SolvedFrames,
+    perturbed: SolvedFrames,
+    freefem: FreeFemFrames,
+}
+
+/// Solve `clip` in Rust, in Rust on perturbed positions, and in FreeFEM (in
+/// `dir/freefem_work`; a fixed point at Rust's iteration count and restarts per frame).
+fn solve_clip_both(case: &Case, clip: ClipData<'_>, dir: &Path) -> Result<ClipRuns, CompareError> {
+    let (frames, tracked) = (clip.positions, clip.tracked);
+    let rust = solve_frames(case, ClipData { positions: frames, tracked })?;
+    let pert: Vec<Vec<Vector3<f64>>> =
+        frames.iter().enumerate().map(|(f, x)| perturb_positions(x, 1000 + f as u64)).collect();
+    let perturbed =
+        solve_frames(case, ClipData { positions: &pert, tracked }).map_err(|e| CompareError::Perturbed(e.into()))?;
+    let exact: Option<Vec<(usize, bool)>> = is_fixed_point_inverse(case)
+        .then(|| rust.frames.iter().map(|f| (f.result.stats.iterations, f.restarted)).collect());
+    let work = dir.join("freefem_work");
+    let freefem =
+        run_clip(case, ClipData { positions: frames, tracked }, exact.as_deref(), &work).map_err(EngineError::from)?;
+    Ok(ClipRuns { rust, perturbed, freefem })
+}
+
+/// The frames of both engines compared: per quantity the row of the frame with the largest
+/// difference/tolerance ratio, the frames restarted in one engine only, each frame's cost.
+struct FrameComparison {
+    worst: Vec<ComparisonRow>,
+    restarts: f64,
+    times: Vec<FrameTime>,
+}
+
+/// Compare the frames of `runs` (`counts`: iteration counts are compared too).
+fn compare_frames(case: &Case, tau: f64, counts: bool, runs: &ClipRuns) -> FrameComparison {
+    let mut worst: Vec<(ComparisonRow, usize, f64)> = Vec::new();
+    let mut restarts = 0.0;
+    let mut times = Vec::new();
+    for (r, f) in runs.rust.frames.iter().zip(&runs.freefem.frames) {
+        let p: Option<&SolvedFrame> = runs.perturbed.frames.iter().find(|p| p.frame == r.frame);
+        let sens = p.map(|p| differences(&r.result, &p.result, counts)).unwrap_or_default();
+        for row in rows(case, tau, &differences(&r.result, &f.result, counts), &sens) {
+            let ratio = if row.tolerance > 0.0 { row.difference / row.tolerance } else { f64::INFINITY };
+            match worst.iter_mut().find(|w| w.0.name == row.name) {
+                Some(w) if w.2 >= ratio => {}
+                Some(w) => *w = (row, r.frame, ratio),
+                None => worst.push((row, r.frame, ratio)),
+            }
+        }
+        restarts += f64::from(u8::from(r.restarted != f.restarted));
+        times.push(FrameTime {
+            frame: r.frame,
+            rust_s: r.result.stats.wall_time_s,
+            freefem_s: f.result.stats.wall_time_s,
+            rust_iterations: r.result.stats.iterations,
+            freefem_iterations: f.result.stats.iterations,
+        });
+    }
+    let worst = worst
+        .into_iter()
+        .map(|(mut row, frame, _)| {
+            row.basis = format!("{} (worst: frame {frame})", row.basis);
+            row
+        })
+        .collect();
+    FrameComparison { worst, restarts, times }
+}
+
+/// The row `frames_solved`: every one of the `n` requested frames solved by both engines, else
+/// why not.
+fn frames_solved_row(n: usize, runs: &ClipRuns) -> ComparisonRow {
+    let (a, b) = (runs.rust.frames.len(), runs.freefem.frames.len());
+    let why = |e: Option<String>| e.unwrap_or_else(|| "all frames solved".into());
+    ComparisonRow {
+        name: "frames_solved".into(),
+        rust: Some(a as f64),
+        freefem: Some(b as f64),
+        difference: (n - a.min(b)) as f64 + (a as f64 - b as f64).abs(),
+        tolerance: 0.0,
+        basis: format!(
+            "rust: {}; freefem: {}",
+            why(runs.rust.error.as_ref().map(|e| e.to_string())),
+            why(runs.freefem.error.clone())
+        ),
+    }
 }
 
 /// `compare.csv` of a report: one row per compared quantity.

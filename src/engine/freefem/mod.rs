@@ -141,6 +141,9 @@ pub fn find_executable() -> Result<PathBuf, FreeFemError> {
     std::env::split_paths(&path).map(|d| d.join(EXECUTABLE)).find(|p| p.is_file()).ok_or(FreeFemError::NotInstalled)
 }
 
+/// The outputs of `inverse.edp`.
+const INVERSE_OUTPUTS: [&str; 3] = ["ff_inverse_nodes.csv", "ff_inverse_history.csv", "ff_info.csv"];
+
 /// Run `freefem/inverse.edp` on an inverse case with the data file `data_path` (copied into
 /// `workdir` as `data.csv` unless it is already there). `data` is the parsed content of that file.
 pub fn run_inverse(
@@ -151,7 +154,39 @@ pub fn run_inverse(
     opts: &RunOptions,
 ) -> Result<RunResult, FreeFemError> {
     let inv = case.inverse().ok_or_else(|| FreeFemError::NotInverse(case.name.clone()))?;
+    stage_data(data_path, workdir)?;
+    let end = execute_to_end(case, workdir, "inverse.edp", &INVERSE_OUTPUTS, opts)?;
+    let nodes = read_inverse_nodes(case, workdir)?;
+    let history = read_inverse_history(workdir)?;
+    let (stats, certificate) = read_inverse_info(workdir)?;
+    let stop = inverse_stop(end, &history, certificate, inv.params.certificate_tolerance);
+    let w = inv.params.weights;
+    let result = RunResult {
+        engine: Engine::Freefem,
+        nodes: nodes.state,
+        history: Vec::new(),
+        tip: Vec::new(),
+        stats,
+        inverse: Some(InverseOutput {
+            data,
+            angles_known: angles_known(case),
+            xhat: nodes.xhat,
+            ahat: nodes.ahat,
+            history,
+            kappa_err: Vec::new(),
+            lambda_f: w.lambda_f,
+            lambda_l: w.lambda_l,
+        }),
+    };
+    match stop {
+        Some(source) => Err(FreeFemError::Incomplete { source, partial: Box::new(result) }),
+        None => Ok(result),
+    }
+}
 
+/// Copy the data file `data_path` into `workdir` as `data.csv` (which `inverse.edp` reads),
+/// unless it is that file already.
+fn stage_data(data_path: &Path, workdir: &Path) -> Result<(), FreeFemError> {
     std::fs::create_dir_all(workdir).map_err(io(workdir))?;
     let target = workdir.join("data.csv");
     let same = std::fs::canonicalize(data_path)
@@ -162,13 +197,18 @@ pub fn run_inverse(
     if !same {
         std::fs::copy(data_path, &target).map_err(io(&target))?;
     }
-    let end = execute_to_end(
-        case,
-        workdir,
-        "inverse.edp",
-        &["ff_inverse_nodes.csv", "ff_inverse_history.csv", "ff_info.csv"],
-        opts,
-    )?;
+    Ok(())
+}
+
+/// The node table of `inverse.edp`: the state and the adjoints `x̂`, `α̂` per node.
+struct InverseNodes {
+    state: NodalState,
+    xhat: Vec<Vector3<f64>>,
+    ahat: Vec<Vector3<f64>>,
+}
+
+/// Read `ff_inverse_nodes.csv` of `workdir`, one row per node of the case's mesh.
+fn read_inverse_nodes(case: &Case, workdir: &Path) -> Result<InverseNodes, FreeFemError> {
     let nodes_path = workdir.join("ff_inverse_nodes.csv");
     let mut header = vec!["s_m", "x_m", "y_m", "z_m", "alpha_rad", "beta_rad", "gamma_rad"];
     header.extend(["xhat_1", "xhat_2", "xhat_3", "ahat_1", "ahat_2", "ahat_3"]);
@@ -179,17 +219,18 @@ pub fn run_inverse(
             reason: format!("{} rows, expected {}", rows.len(), case.mesh.nodes()),
         });
     }
-    let v3 = |r: &Vec<f64>, k: usize| Vector3::new(r[k], r[k + 1], r[k + 2]);
-    let nodes = NodalState {
-        s: rows.iter().map(|r| r[0]).collect(),
-        x: rows.iter().map(|r| v3(r, 1)).collect(),
-        alpha: rows.iter().map(|r| v3(r, 4)).collect(),
-        chart: Chart::default(),
-    };
-    let mut hist_header = vec!["iteration", "rel_change", "x_err_rel", "tangent_misfit"];
-    hist_header.extend(ObjectiveTerms::NAMES);
-    hist_header.extend(["newton_residual", "certificate"]);
-    let history: Vec<InverseRecord> = read_table(&workdir.join("ff_inverse_history.csv"), &hist_header)?
+    let v3 = |k: usize| rows.iter().map(|r| Vector3::new(r[k], r[k + 1], r[k + 2])).collect();
+    let state = NodalState { s: rows.iter().map(|r| r[0]).collect(), x: v3(1), alpha: v3(4), chart: Chart::default() };
+    Ok(InverseNodes { state, xhat: v3(7), ahat: v3(10) })
+}
+
+/// Read the iteration history `ff_inverse_history.csv` of `workdir`.
+fn read_inverse_history(workdir: &Path) -> Result<Vec<InverseRecord>, FreeFemError> {
+    let mut header = vec!["iteration", "rel_change", "x_err_rel", "tangent_misfit"];
+    header.extend(ObjectiveTerms::NAMES);
+    header.extend(["newton_residual", "certificate"]);
+    let rows = read_table(&workdir.join("ff_inverse_history.csv"), &header)?;
+    Ok(rows
         .into_iter()
         .map(|r| InverseRecord {
             iteration: r[0] as usize,
@@ -208,7 +249,11 @@ pub fn run_inverse(
             residual: (r[11] >= 0.0).then_some(r[11]),
             certificate: optional_certificate(r[12]),
         })
-        .collect();
+        .collect())
+}
+
+/// The solver statistics and the certificate of an inverse run from `ff_info.csv` of `workdir`.
+fn read_inverse_info(workdir: &Path) -> Result<(SolverStats, Option<Certificate>), FreeFemError> {
     let info = read_info(&workdir.join("ff_info.csv"))?;
     let certificate = info_certificate(&info);
     let stats = SolverStats {
@@ -219,21 +264,31 @@ pub fn run_inverse(
         certificate: certificate.map(|c| c.value),
         wall_time_s: info.get("wall_time_s").copied().unwrap_or(f64::NAN),
     };
-    let w = inv.params.weights;
-    // the error the Rust engine gives for a frame that did not converge (`InverseSolution::converged`)
+    Ok((stats, certificate))
+}
+
+/// The error the Rust engine gives for a frame that did not converge
+/// (`InverseSolution::converged`), from how `inverse.edp` ended and its history; `None`:
+/// converged and certified.
+fn inverse_stop(
+    end: End,
+    history: &[InverseRecord],
+    certificate: Option<Certificate>,
+    tolerance: f64,
+) -> Option<SolveError> {
     let last = history.last();
     let iterations = last.map_or(0, |r| r.iteration);
     let rel_change = last.map_or(f64::NAN, |r| r.rel_change);
     let newton = history.iter().any(|r| r.residual.is_some());
     let c = certificate.unwrap_or(Certificate { value: f64::NAN, blocks: [f64::NAN; 4] });
-    let stop = match (end, last.and_then(|r| r.residual)) {
+    match (end, last.and_then(|r| r.residual)) {
         (End::Converged, _) => None,
         (End::Stalled, _) => Some(SolveError::Stalled(Box::new(crate::solve::Stall {
             solver: format!("inverse {} of frame 0", if newton { "Newton" } else { "fixed point" }),
             iterations,
             rel_change,
             certificate: c.value,
-            tolerance: inv.params.certificate_tolerance,
+            tolerance,
             block: c.worst_block(true),
         }))),
         (End::IterationLimit, Some(residual)) => {
@@ -246,27 +301,6 @@ pub fn run_inverse(
             certificate: c.value,
         }),
         (End::IterationLimit, None) => Some(SolveError::InverseNotConverged { frame: 0, iterations, rel_change }),
-    };
-    let result = RunResult {
-        engine: Engine::Freefem,
-        nodes,
-        history: Vec::new(),
-        tip: Vec::new(),
-        stats,
-        inverse: Some(InverseOutput {
-            data,
-            angles_known: angles_known(case),
-            xhat: rows.iter().map(|r| v3(r, 7)).collect(),
-            ahat: rows.iter().map(|r| v3(r, 10)).collect(),
-            history,
-            kappa_err: Vec::new(),
-            lambda_f: w.lambda_f,
-            lambda_l: w.lambda_l,
-        }),
-    };
-    match stop {
-        Some(source) => Err(FreeFemError::Incomplete { source, partial: Box::new(result) }),
-        None => Ok(result),
     }
 }
 
