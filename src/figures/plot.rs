@@ -335,26 +335,11 @@ where
         let style = text_style(LEGEND_PX).pos(Pos::new(anchor, VPos::Top));
         chart_area.draw_text(&b.label, &style, (x - base.0, py - base.1 + 4)).map_err(|e| draw_err(t, e))?;
     }
-    // markers first, so that the lines of the solution lie on the data
-    let order = (0..plot.series.len()).filter(|&i| plot.series[i].mark == Mark::Markers);
-    let order: Vec<usize> =
-        order.chain((0..plot.series.len()).filter(|&i| plot.series[i].mark != Mark::Markers)).collect();
-    for i in order {
+    for i in drawing_order(plot) {
         let s = &plot.series[i];
         let style = stroke(s, i);
-        // Split into runs of plottable points so lines break at gaps.
-        let mut runs: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
-        for (&x, &y) in s.x.iter().zip(&s.y) {
-            if keep(x, plot.log_x) && keep(y, plot.log_y) {
-                if let Some(r) = runs.last_mut() {
-                    r.push((ax.to(x), ay.to(y)));
-                }
-            } else if runs.last().is_some_and(|r| !r.is_empty()) {
-                runs.push(Vec::new());
-            }
-        }
         let every = s.x.len().div_ceil(MAX_MARKERS).max(1);
-        for run in runs.into_iter().filter(|r| !r.is_empty()) {
+        for run in plottable_runs(plot, s, (ax, ay)) {
             match s.mark {
                 Mark::Line => chart.draw_series(LineSeries::new(run, style)).map(|_| ()),
                 Mark::Dashed => chart.draw_series(DashedLineSeries::new(run, 9, 6, style)).map(|_| ()),
@@ -369,6 +354,30 @@ where
         draw_legend(&legend_area, plot, top)?;
     }
     Ok(())
+}
+
+/// The order the series of `plot` are drawn in: markers first, so that the lines of the
+/// solution lie on the data.
+fn drawing_order(plot: &LinePlot) -> Vec<usize> {
+    let order = (0..plot.series.len()).filter(|&i| plot.series[i].mark == Mark::Markers);
+    order.chain((0..plot.series.len()).filter(|&i| plot.series[i].mark != Mark::Markers)).collect()
+}
+
+/// The points of `s` in drawing coordinates, split into runs of plottable points (finite, and
+/// positive on a log axis) so that lines break at gaps; no run is empty.
+fn plottable_runs(plot: &LinePlot, s: &Series, (ax, ay): (Axis, Axis)) -> Vec<Vec<(f64, f64)>> {
+    let mut runs: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
+    for (&x, &y) in s.x.iter().zip(&s.y) {
+        if keep(x, plot.log_x) && keep(y, plot.log_y) {
+            if let Some(r) = runs.last_mut() {
+                r.push((ax.to(x), ay.to(y)));
+            }
+        } else if runs.last().is_some_and(|r| !r.is_empty()) {
+            runs.push(Vec::new());
+        }
+    }
+    runs.retain(|r| !r.is_empty());
+    runs
 }
 
 /// How an axis's values are drawn: on a log axis scaled by `factor` so that its range starts at

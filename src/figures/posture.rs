@@ -205,6 +205,18 @@ fn draw_projection<DB: DrawingBackend>(
     p: &Prepared,
     (a, b, name_a, name_b): (usize, usize, &str, &str),
 ) -> Result<(), PlotError> {
+    let mut chart = projection_chart(area, p, (a, b, name_a, name_b))?;
+    draw_rod(&mut chart, p, |v: &Vector3<f64>| (v[a], v[b]))
+}
+
+/// The square chart of one projection (axes `a`, `b` of the positions, named `name_a`,
+/// `name_b`) with its mesh drawn: the data's bounds in both coordinates with a common half-width
+/// (and room for the glyphs), the surplus pixels spread over the margins.
+fn projection_chart<'a, DB: DrawingBackend>(
+    area: &'a DrawingArea<DB, Shift>,
+    p: &Prepared,
+    (a, b, name_a, name_b): (usize, usize, &str, &str),
+) -> Result<Chart<'a, DB>, PlotError> {
     let t = p.panel.label.as_str();
     // Square plotting area: spread the surplus pixels over the margins.
     let (w, h) = area.dim_in_pixel();
@@ -243,7 +255,17 @@ fn draw_projection<DB: DrawingBackend>(
         .bold_line_style(BLACK.mix(0.08))
         .draw()
         .map_err(|e| draw_err(t, e))?;
-    let proj = |v: &Vector3<f64>| (v[a], v[b]);
+    Ok(chart)
+}
+
+/// The rod in `chart`, projected by `proj` [mm]: the coloured centreline, the d1 ribbon ticks,
+/// the d3 arrows, the finite-difference tangents and the head.
+fn draw_rod<DB: DrawingBackend>(
+    chart: &mut Chart<'_, DB>,
+    p: &Prepared,
+    proj: impl Fn(&Vector3<f64>) -> (f64, f64),
+) -> Result<(), PlotError> {
+    let t = p.panel.label.as_str();
     let n = p.x_mm.len();
     // Centreline, segment by segment, coloured by the mean of its end values.
     let segments = (0..n - 1).map(|i| {
@@ -258,9 +280,30 @@ fn draw_projection<DB: DrawingBackend>(
         PathElement::new(vec![proj(&(x - 0.5 * g * d1)), proj(&(x + 0.5 * g * d1))], RIBBON_COLOUR.stroke_width(2))
     });
     chart.draw_series(ribbons).map_err(|e| draw_err(t, e))?;
-    // d3 arrows: one polyline each (shaft and head); an out-of-plane d3 also gets a ring.
+    let (arrows, rings) = d3_arrows(p, &proj);
+    chart.draw_series(arrows).map_err(|e| draw_err(t, e))?;
+    chart.draw_series(rings).map_err(|e| draw_err(t, e))?;
+    // Finite-difference tangent (unit, same length as the d3 arrows), on top of the arrows.
+    let tangents = p.samples.iter().filter_map(|&i| p.tangent[i].map(|tv| (i, tv))).map(|(i, tv)| {
+        let x = p.x_mm[i];
+        PathElement::new(vec![proj(&x), proj(&(x + g * tv))], TANGENT_COLOUR.stroke_width(1))
+    });
+    chart.draw_series(tangents).map_err(|e| draw_err(t, e))?;
+    // Head (node 0).
+    let head = Circle::new(proj(&p.x_mm[0]), 5, BLACK.filled());
+    chart.draw_series(std::iter::once(head)).map_err(|e| draw_err(t, e))?;
+    Ok(())
+}
+
+/// The d3 arrows at the sampled nodes, projected by `proj`: one polyline each (shaft and head);
+/// an out-of-plane d3 (projected shorter than a quarter glyph) also gets a ring.
+fn d3_arrows(
+    p: &Prepared,
+    proj: &impl Fn(&Vector3<f64>) -> (f64, f64),
+) -> (Vec<PathElement<(f64, f64)>>, Vec<Circle<(f64, f64), i32>>) {
+    let g = p.glyph;
     let mut rings = Vec::new();
-    let arrows: Vec<_> = p
+    let arrows = p
         .samples
         .iter()
         .map(|&i| {
@@ -282,18 +325,7 @@ fn draw_projection<DB: DrawingBackend>(
             PathElement::new(pts, ARROW_COLOUR.stroke_width(2))
         })
         .collect();
-    chart.draw_series(arrows).map_err(|e| draw_err(t, e))?;
-    chart.draw_series(rings).map_err(|e| draw_err(t, e))?;
-    // Finite-difference tangent (unit, same length as the d3 arrows), on top of the arrows.
-    let tangents = p.samples.iter().filter_map(|&i| p.tangent[i].map(|tv| (i, tv))).map(|(i, tv)| {
-        let x = p.x_mm[i];
-        PathElement::new(vec![proj(&x), proj(&(x + g * tv))], TANGENT_COLOUR.stroke_width(1))
-    });
-    chart.draw_series(tangents).map_err(|e| draw_err(t, e))?;
-    // Head (node 0).
-    let head = Circle::new(proj(&p.x_mm[0]), 5, BLACK.filled());
-    chart.draw_series(std::iter::once(head)).map_err(|e| draw_err(t, e))?;
-    Ok(())
+    (arrows, rings)
 }
 
 /// Caption strip of one row.
