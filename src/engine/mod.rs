@@ -125,7 +125,7 @@ pub fn run_inverse_on(
 /// solve, N2), are read at once with the weights chosen on them.
 pub enum ClipInput {
     Streamed(RollStream),
-    Loaded { clip: Clip, truth: Option<GroundTruth>, chosen: Option<Auto> },
+    Loaded { clip: Clip, truth: Option<GroundTruth>, chosen: Option<Box<Auto>> },
 }
 
 impl ClipInput {
@@ -136,7 +136,7 @@ impl ClipInput {
             Some(stream) => ClipInput::Streamed(stream),
             None => {
                 let (clip, truth) = load_clip(case)?;
-                let chosen = choose_weights(case, &clip.frames);
+                let chosen = choose_weights(case, &clip.frames).map(Box::new);
                 ClipInput::Loaded { clip, truth, chosen }
             }
         })

@@ -280,9 +280,9 @@ fn draw_rod<DB: DrawingBackend>(
         PathElement::new(vec![proj(&(x - 0.5 * g * d1)), proj(&(x + 0.5 * g * d1))], RIBBON_COLOUR.stroke_width(2))
     });
     chart.draw_series(ribbons).map_err(|e| draw_err(t, e))?;
-    let (arrows, rings) = d3_arrows(p, &proj);
-    chart.draw_series(arrows).map_err(|e| draw_err(t, e))?;
-    chart.draw_series(rings).map_err(|e| draw_err(t, e))?;
+    let d3 = d3_arrows(p, &proj);
+    chart.draw_series(d3.arrows).map_err(|e| draw_err(t, e))?;
+    chart.draw_series(d3.rings).map_err(|e| draw_err(t, e))?;
     // Finite-difference tangent (unit, same length as the d3 arrows), on top of the arrows.
     let tangents = p.samples.iter().filter_map(|&i| p.tangent[i].map(|tv| (i, tv))).map(|(i, tv)| {
         let x = p.x_mm[i];
@@ -295,12 +295,16 @@ fn draw_rod<DB: DrawingBackend>(
     Ok(())
 }
 
-/// The d3 arrows at the sampled nodes, projected by `proj`: one polyline each (shaft and head);
-/// an out-of-plane d3 (projected shorter than a quarter glyph) also gets a ring.
-fn d3_arrows(
-    p: &Prepared,
-    proj: &impl Fn(&Vector3<f64>) -> (f64, f64),
-) -> (Vec<PathElement<(f64, f64)>>, Vec<Circle<(f64, f64), i32>>) {
+/// The d3 arrows of a projection.
+struct D3Arrows {
+    /// one polyline per sampled node: shaft and head
+    arrows: Vec<PathElement<(f64, f64)>>,
+    /// a ring at each node whose d3 is out of the plane (projected shorter than a quarter glyph)
+    rings: Vec<Circle<(f64, f64), i32>>,
+}
+
+/// The d3 arrows at the sampled nodes, projected by `proj`.
+fn d3_arrows(p: &Prepared, proj: &impl Fn(&Vector3<f64>) -> (f64, f64)) -> D3Arrows {
     let g = p.glyph;
     let mut rings = Vec::new();
     let arrows = p
@@ -325,7 +329,7 @@ fn d3_arrows(
             PathElement::new(pts, ARROW_COLOUR.stroke_width(2))
         })
         .collect();
-    (arrows, rings)
+    D3Arrows { arrows, rings }
 }
 
 /// Caption strip of one row.
