@@ -1,7 +1,9 @@
 //! The module structure of `src/` (see the layers in `src/lib.rs`): every `crate::`, `super::`
 //! and (in `main.rs`) `cosserat::` path is resolved to the module it names; the resulting graph
-//! has no cycle, no module imports a module of a higher layer, no source file is longer
-//! than 600 lines and no function outside tests longer than 80. `cargo test --test architecture -- --nocapture` prints the graph's size.
+//! has no cycle, no module imports a module of a higher layer ([`LAYERS`]) or of a higher
+//! sub-layer of its own folder ([`SUBLAYERS`]), no source file is longer than 600 lines and no
+//! function outside tests longer than 80. `cargo test --test architecture -- --nocapture`
+//! prints the graph's size.
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
@@ -22,12 +24,30 @@ const LAYERS: &[&[&str]] = &[
     &["main", "cli"],
 ];
 
+/// The same rule inside a folder, between its sub-folders (lowest first; a module in none of
+/// them is its folder's top): the Rust engine knows neither FreeFEM nor the files the engines
+/// read; the FreeFEM engine gives the Rust engine's results; `engine` itself (`run_case`) is
+/// the interface above both.
+const SUBLAYERS: &[&[&str]] = &[&["engine::rust"], &["engine::input"], &["engine::freefem"], &["engine"]];
+
 /// Longest source file allowed [lines].
 const MAX_LINES: usize = 600;
 
 fn layer(module: &str) -> usize {
     let top = module.split("::").next().unwrap_or(module);
     LAYERS.iter().position(|l| l.contains(&top)).unwrap_or_else(|| panic!("module `{module}` is in no layer"))
+}
+
+/// The sub-layer of `module` in [`SUBLAYERS`], if its folder has them.
+fn sublayer(module: &str) -> Option<usize> {
+    SUBLAYERS.iter().position(|l| l.iter().any(|p| module == *p || module.starts_with(&format!("{p}::"))))
+}
+
+/// Does an import `from` → `to` go up: to a higher layer, or to a higher sub-layer of the same
+/// folder?
+fn goes_up(from: &str, to: &str) -> bool {
+    let sub_up = matches!((sublayer(from), sublayer(to)), (Some(f), Some(t)) if t > f);
+    layer(to) > layer(from) || (layer(to) == layer(from) && sub_up)
 }
 
 /// Module path of a source file: `src/a/b.rs` and `src/a/b/mod.rs` are `a::b`; `main.rs` is `main`.
@@ -288,7 +308,7 @@ fn layers_are_imported_downward_only_without_cycles_and_files_are_short() {
                 continue; // a module and its own submodules
             }
             graph.entry(from.clone()).or_default().insert(to.clone());
-            if layer(&to) > layer(&from) {
+            if goes_up(&from, &to) {
                 upward.push(format!("{from} → {to} ({})", p.join("::")));
             }
         }
@@ -467,6 +487,10 @@ fn the_checker_sees_imports_and_cycles() {
     g.entry("d".into()).or_default().insert("a".into());
     assert_eq!(cycles(&g), vec![vec!["a".to_string(), "b".to_string(), "c".to_string()]]);
     assert!(layer("output::journal") > layer("engine::rust::clip") && layer("model::mesh") < layer("assemble"));
+    assert!(
+        goes_up("engine::rust::clip", "engine::freefem") && !goes_up("engine::freefem::clip", "engine::rust::frames")
+    );
+    assert!(goes_up("engine::input::data", "engine") && !goes_up("engine", "engine::input::data"));
     let f = functions(&code_only(
         "fn a() {\n}\n#[cfg(test)]\nmod tests {\n    fn b() {\n    }\n}\nfn c(x: Vec<u8>) -> Result<(), ()> {\n    let s = \"}\n\";\n}\ntrait T { fn d(&self); }",
     ));
