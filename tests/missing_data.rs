@@ -47,7 +47,7 @@ const NODES: usize = 33;
 const SIGMA_M: f64 = 1e-7;
 /// rod length of the batch case [m]
 const LENGTH_M: f64 = 1e-3;
-/// nodes left out at each end by the bending scores (`run::clip::TRUTH_SKIP_NODES`)
+/// nodes left out at each end by the bending scores (`engine::rust::clip::TRUTH_SKIP_NODES`)
 const SKIP: usize = 5;
 
 fn root() -> &'static Path {

@@ -521,7 +521,7 @@ fn shown_frames<'a>(p: &'a PointResult, frames: &[usize]) -> Vec<&'a crate::engi
 
 /// Figs. 16, 21, 22: the kept frames of a clip run, three projections each, with the directors
 /// d1 (ticks), d3 (arrows) and the tangent, the centreline coloured by |κ| [1/mm] (the node
-/// average of the element curvatures, `run::clip::nodal_curvature`). For a run with a grid,
+/// average of the element curvatures, `engine::rust::clip::nodal_curvature`). For a run with a grid,
 /// beneath them the quantity its swept weight penalises along the body at the first frame
 /// shown, one curve per grid point: the angle between d3 and the chord of each element (λd,
 /// Fig. 21: the detachment the λd term penalises) or κ3 (λκ3, Fig. 22).

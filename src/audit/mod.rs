@@ -1,7 +1,7 @@
 //! The audit of the paper (`cosserat audit`): every figure, table and claim of §5–6 that can
 //! be computed here, regenerated from the specs of `cases/paper/` ([`spec`]) and judged with
 //! numbers ([`check`]): *reproduced*, *differs*, *refuted* or *not computable here*. Runs go
-//! through the same path as `cosserat sweep` (`io::sweep::run_point`), one folder per point;
+//! through the same path as `cosserat sweep` (`jobs::sweep::run_point`), one folder per point;
 //! [`measures`] adds the numbers a claim needs beyond a run's metrics, [`figures`] draws the
 //! paper's panels and [`report`] writes `REPORT.md` and `report.csv`.
 pub mod check;
@@ -288,7 +288,7 @@ pub const MARKER: &str = ".cosserat-audit";
 fn prepare_folder(out: &Path) -> Result<(), AuditError> {
     let io = |source| AuditError::Folder { path: out.to_path_buf(), source };
     if out.exists() {
-        // empty, or a staging folder of the output-folder contract (`io::run_folder`) holding
+        // empty, or a staging folder of the output-folder contract (`output::run_folder`) holding
         // only its run.json
         let empty = std::fs::read_dir(out)
             .map_err(io)?

@@ -1,4 +1,4 @@
-//! `cosserat synth`: a corpus of synthetic recordings (`io::corpus`) written into a folder of
+//! `cosserat synth`: a corpus of synthetic recordings (`engine::input::corpus`) written into a folder of
 //! its own under the output-folder contract (staged, `run.json`), from the omega-turn kymogram
 //! of the source tree wherever the command runs.
 use std::path::{Path, PathBuf};

@@ -64,7 +64,7 @@ impl From<FreeFemError> for EngineError {
 /// The data of an inverse case: the Rust forward engine on its `[data]` solve (I7), or the
 /// first frame of its clip (its range's first), with zero angles (a recording has no frame):
 /// `run`/`compare` treat that frame alone, as the first frame of the clip is treated (Remark
-/// 6); `run::clip::run_clip` solves the whole clip.
+/// 6); `engine::rust::clip::run_clip` solves the whole clip.
 pub fn load_data(case: &Case) -> Result<NodalState, EngineError> {
     let inv = case.inverse().ok_or_else(|| EngineError::NotInverse(case.name.clone()))?;
     match &inv.data {

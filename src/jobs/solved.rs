@@ -72,7 +72,7 @@ pub struct Solved {
     /// why it failed or stopped (the error and its causes, prefixed by the case)
     pub error: Option<String>,
     /// the metrics of a single run (also of the last iterate of one that did not converge) or
-    /// of a complete clip (`run::clip_metrics`)
+    /// of a complete clip (`engine::rust::clip_metrics`)
     pub metrics: Option<Metrics>,
     /// a single run's result
     pub single: Option<RunResult>,

@@ -2,7 +2,7 @@
 //! last iterate when the point did not converge, and the point's `run.json` saying which) and
 //! `summary.csv`. The
 //! grid itself is `case::sweep`'s. A point of a clip case solves the whole clip (the frames
-//! of `run` on a clip, its row the metrics of `run::clip_metrics`).
+//! of `run` on a clip, its row the metrics of `engine::rust::clip_metrics`).
 use std::path::Path;
 
 pub use super::solved::{case_label, chain, RunStatus, Solved as SweepOutcome};
@@ -44,7 +44,7 @@ pub struct SummaryRow {
     pub error: Option<String>,
 }
 
-/// Columns of the summary table of a clip case after the swept keys (`run::clip_metrics`).
+/// Columns of the summary table of a clip case after the swept keys (`engine::rust::clip_metrics`).
 pub const CLIP_SUMMARY_METRICS: [&str; 12] = [
     "frames",
     "certificate",

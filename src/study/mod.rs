@@ -3,9 +3,9 @@
 //! the batch case under several weight settings, and scored beside a generic smoothing spline
 //! of the same noisy frames, in one run.
 //!
-//! For each mesh (node count) and noise level σ a corpus is written (`io::corpus`, the same
+//! For each mesh (node count) and noise level σ a corpus is written (`engine::input::corpus`, the same
 //! seed for every σ, so the recordings differ only by their noise), each variant of the case
-//! (its `set` keys applied to the mesh's case) runs as a batch over it (`io::batch`), and every
+//! (its `set` keys applied to the mesh's case) runs as a batch over it (`jobs::batch`), and every
 //! frame is scored ([`score`]). `noise_study.csv` has one row per mesh, σ, method and
 //! recording; `noise_study.svg` draws the bending error (median and worst frame, the worst
 //! recording) and the reconstructed fraction against σ.

@@ -3,7 +3,7 @@
 //! arrays the solvers allocate: per forward unknown the band LU (`linalg::band`, `2 kl + ku + 1`
 //! rows, `kl = ku = 2 b − 1` for blocks of `b` unknowns per node), per element the pattern's
 //! values, scaled copy and slots (`linalg::pattern`), a few dozen work vectors; a clip's frames
-//! and per-frame summary (`run::clip::ClipRun`); the dense matrices of the modal model
+//! and per-frame summary (`engine::rust::clip::ClipRun`); the dense matrices of the modal model
 //! (`solve::modes`, about twelve `n × n`). Checked against the peak resident size of real runs in
 //! `docs/results.md`: it errs high, never low by more than the process's fixed few MB.
 use crate::case::{Analysis, Case, ClipKind};

@@ -1,7 +1,7 @@
 //! A clip case frame by frame in the Rust engine (`solve::sequence`), every converged frame
 //! handed to a second thread while the next frame is solved: there it is derived into a
 //! [`ClipFrame`] (curvature, truth comparison, summary) and given to a [`FrameSink`] (which
-//! `crate::io` implements with the streamed files). The frames themselves may arrive while the
+//! `crate::output::clip_output::ClipWriter` implements with the streamed files). The frames themselves may arrive while the
 //! clip is solved ([`ClipFrames::Streamed`]).
 use std::sync::mpsc::{Receiver, SyncSender};
 use std::time::Instant;

@@ -54,7 +54,7 @@ pub fn sign_alternation(k: &[f64]) -> f64 {
 }
 
 /// Everything a converged frame of a clip is derived from, exactly (the resume journal of
-/// `crate::io` stores one per frame): with the records of frames `0..n` a clip resumes at frame
+/// `crate::output::journal` stores one per frame): with the records of frames `0..n` a clip resumes at frame
 /// `n` and continues bit for bit as the uninterrupted solve (`solve::sequence::ResumeFrom`),
 /// and the summary of frames `0..n` is derived again from them without solving.
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]

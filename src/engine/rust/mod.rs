@@ -1,7 +1,8 @@
 //! Running a case in the Rust engine on data in memory: a forward case, the forward data of a
 //! synthetic inverse case, one inverse frame ([`run_inverse`]) or a whole clip
 //! ([`clip::run_clip`]), each producing the engine-agnostic [`RunResult`] of [`result`].
-//! Files (case data, clips, outputs) and the FreeFEM engine are `crate::io`'s.
+//! The files a case runs on are `super::input`'s, the FreeFEM engine `super::freefem`, the output
+//! folder `crate::output`'s.
 pub mod budget;
 pub mod clip;
 pub mod clip_frame;
