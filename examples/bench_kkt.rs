@@ -7,7 +7,7 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use cosserat::case::Case;
-use cosserat::io::clip_files::load_clip;
+use cosserat::engine::input::clip_files::load_clip;
 use cosserat::linalg::LinearSolver;
 use cosserat::model::mesh::Field;
 use cosserat::solve::inverse::kkt::dirichlet;

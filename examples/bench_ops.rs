@@ -8,7 +8,7 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use cosserat::case::Case;
-use cosserat::io::clip_files::load_clip;
+use cosserat::engine::input::clip_files::load_clip;
 use cosserat::linalg::LinearSolver;
 use cosserat::solve::inverse::{kkt, measures, newton, Frame};
 use cosserat::solve::sequence::{solve_sequence, FirstStart, FrameSolution};

@@ -1,7 +1,7 @@
 fn main() {
     let path = std::env::args().nth(1).expect("case");
     let case = cosserat::case::Case::from_file(std::path::Path::new(&path)).expect("case");
-    let r = cosserat::run::run_rust(&case, |_, _| {}).expect("run");
+    let r = cosserat::engine::rust::run_rust(&case, |_, _| {}).expect("run");
     let inv = r.inverse.as_ref().unwrap();
     for h in inv.history.iter().filter(|h| h.iteration % 50 == 0 || h.iteration < 4) {
         eprintln!(

@@ -3,8 +3,8 @@
 //! `cargo run --release --example inv_sens -- cases/inverse_bend.toml [eps]`
 use anyhow::{Context, Result};
 use cosserat::case::{Analysis, Case};
-use cosserat::run::metrics::max_relative_difference;
-use cosserat::run::{forward_data, run_inverse};
+use cosserat::engine::rust::metrics::max_relative_difference;
+use cosserat::engine::rust::{forward_data, run_inverse};
 
 fn main() -> Result<()> {
     let path = std::env::args().nth(1).context("usage: inv_sens CASE [eps]")?;

@@ -30,7 +30,7 @@ fn main() {
     let lk3: f64 = args[2].parse().unwrap();
     let fptol: f64 = args[3].parse().unwrap();
     let nits: usize = args[4].parse().unwrap();
-    let data = cosserat::run::forward_data(&case).expect("data");
+    let data = cosserat::engine::rust::forward_data(&case).expect("data");
     let p = case.problem();
     let mut params = case.inverse().unwrap().params;
     if lk3 >= 0.0 {

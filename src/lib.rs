@@ -19,16 +19,22 @@
 //! 1. foundation: [`expr`] (load expressions), [`linalg`] (block-tridiagonal systems),
 //!    [`reference`] (analytic solutions), [`interrupt`] (the stop requested by a signal),
 //!    [`file_kind`] (regular file, pipe, device: an input's kind, found without opening it);
-//! 2. [`model`]: material, rotation kinematics and charts, mesh and the layout of the unknowns
+//! 2. [`figures`]: SVG line plots, heatmaps and postures, knowing nothing of rods;
+//! 3. [`io`]: readers and writers of file formats (capped reads, CSV, `.npy`, VTK, numbers);
+//! 4. [`model`]: material, rotation kinematics and charts, mesh and the layout of the unknowns
 //!    ([`model::mesh::DofMap`]), loads, the element kernels;
-//! 3. [`assemble`]: the one element loop and the integration of functionals;
-//! 4. [`solve`]: statics, dynamics, modes, the inverse problem of a frame, clips of frames;
-//! 5. [`clip`]: clips of centrelines (kymogram geometry, the synthetic 3D clip);
-//! 6. [`case`]: case files, validated into the solvers' params;
-//! 7. [`run`]: running a case in the Rust engine, results and metrics;
-//! 8. [`io`]: files, figures, the FreeFEM engine;
-//! 9. [`audit`]: the audit of the paper's §5–6 (specs, checks, figures, report); then the
-//!    `cosserat` binary (CLI).
+//! 5. [`assemble`]: the one element loop and the integration of functionals;
+//! 6. [`solve`]: statics, dynamics, modes, the inverse problem of a frame, clips of frames;
+//! 7. [`clip`]: clips of centrelines (kymogram geometry, the synthetic 3D clip);
+//! 8. [`case`]: case files, validated into the solvers' params;
+//! 9. [`engine`]: a case in either engine behind one interface: the Rust engine
+//!    ([`engine::rust`]: results and metrics), the FreeFEM engine ([`engine::freefem`]) and the
+//!    files both read ([`engine::input`]);
+//! 10. [`output`]: the output-folder contract (a run's and a clip's files, journal, lock,
+//!     manifest);
+//! 11. [`jobs`]: a case solved into its folder, sweeps, comparisons of the engines, batches;
+//! 12. [`audit`]: the audit of the paper's §5–6 (specs, checks, figures, report), [`study`];
+//!     then the `cosserat` binary (CLI).
 //!
 //! ## Notation
 //! | symbol | Rust name | unit |
@@ -58,13 +64,16 @@ pub mod assemble;
 pub mod audit;
 pub mod case;
 pub mod clip;
+pub mod engine;
 pub mod expr;
+pub mod figures;
 pub mod file_kind;
 pub mod interrupt;
 pub mod io;
+pub mod jobs;
 pub mod linalg;
 pub mod model;
+pub mod output;
 pub mod reference;
-pub mod run;
 pub mod solve;
 pub mod study;

@@ -6,7 +6,7 @@ use std::process::ExitCode;
 use anyhow::Result;
 use clap::Parser;
 
-use cosserat::io::run_folder::Mode;
+use cosserat::output::run_folder::Mode;
 
 mod cli;
 

@@ -10,11 +10,11 @@ use std::path::{Path, PathBuf};
 
 use assert_cmd::Command;
 use common::{short_roll_case, worm_data_present};
-use cosserat::io::clip_output::CLIP_FIELD_COLUMNS;
+use cosserat::engine::rust::clip::nodal_curvature;
 use cosserat::io::compact::{read_compact, CompactClip, OutputFormat, COMPACT_FILE, CURVATURE_COLUMNS, RAW_FIELDS};
-use cosserat::io::engine::{run_clip_to, ClipOptions};
-use cosserat::io::journal::JOURNAL;
-use cosserat::run::clip::nodal_curvature;
+use cosserat::output::clip_output::CLIP_FIELD_COLUMNS;
+use cosserat::output::clip_run::{run_clip_to, ClipOptions};
+use cosserat::output::journal::JOURNAL;
 use nalgebra::Vector3;
 
 const FRAMES: usize = 20;

@@ -13,15 +13,15 @@ mod common;
 use std::path::Path;
 
 use cosserat::case::{case_files, Analysis, Case};
-use cosserat::io::clip_files::load_clip;
-use cosserat::io::compare::{
+use cosserat::engine::freefem::clip::read_clip_run;
+use cosserat::engine::input::clip_files::load_clip;
+use cosserat::engine::load_data;
+use cosserat::engine::rust::frames::solve_frames;
+use cosserat::engine::rust::{run_forward, run_inverse, NodalState, RunError, RunResult};
+use cosserat::jobs::compare::{
     compare_case, perturb_material, perturb_positions, CompareOptions, CompareReport, Horizon, SAFETY, SHORT_FRAMES,
     SHORT_STEPS,
 };
-use cosserat::io::engine::load_data;
-use cosserat::io::freefem_clip::read_clip_run;
-use cosserat::run::frames::solve_frames;
-use cosserat::run::{run_forward, run_inverse, NodalState, RunError, RunResult};
 use cosserat::solve::certificate::CERTIFICATE_FLOOR;
 use cosserat::solve::inverse::InverseMethod;
 use cosserat::solve::sequence::SequenceError;
@@ -201,7 +201,7 @@ fn single_certificates(case: &Case, report: &CompareReport, failures: &mut Vec<S
         certificate(rust),
         certificate(ff),
         certificate(&perturbed),
-        cosserat::io::compare::stop_tolerance(case),
+        cosserat::jobs::compare::stop_tolerance(case),
     ) {
         failures.push(e);
     }
@@ -219,7 +219,7 @@ fn clip_certificates(case: &Case, dir: &Path, failures: &mut Vec<String>) -> Agr
     let rust = solve_frames(case, frames).expect("rust frames");
     let perturbed = solve_frames(case, &pert).expect("perturbed frames");
     let ff = read_clip_run(case, frames, &dir.join("freefem_work")).expect("freefem frames");
-    let tau = cosserat::io::compare::stop_tolerance(case);
+    let tau = cosserat::jobs::compare::stop_tolerance(case);
     let mut out = Agreement::Compared;
     for ((r, f), p) in rust.frames.iter().zip(&ff.frames).zip(&perturbed.frames) {
         let c = |x: &RunResult| x.stats.certificate.unwrap_or(f64::NAN);

@@ -14,9 +14,9 @@ use std::path::Path;
 
 use cosserat::case::{Case, MAX_ELEMENTS};
 use cosserat::clip::MIN_CLIP_ELEMENTS;
+use cosserat::engine::input::clip_files::{kymogram_rows, read_recording, RECORDING_HEADER};
+use cosserat::engine::input::data::{read_data, DATA_HEADER};
 use cosserat::expr::Expr;
-use cosserat::io::clip_files::{kymogram_rows, read_recording, RECORDING_HEADER};
-use cosserat::io::data::{read_data, DATA_HEADER};
 use cosserat::io::npy::parse_npy;
 use cosserat::model::mesh::Mesh;
 use proptest::prelude::*;

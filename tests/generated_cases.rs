@@ -16,8 +16,8 @@ mod common;
 use std::path::PathBuf;
 
 use cosserat::case::Case;
-use cosserat::io::compare::{compare_case, CompareError, CompareOptions, Horizon};
-use cosserat::io::engine::EngineError;
+use cosserat::engine::EngineError;
+use cosserat::jobs::compare::{compare_case, CompareError, CompareOptions, Horizon};
 use toml::{Table, Value};
 
 /// One case per generator in `cargo test`.

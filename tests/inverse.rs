@@ -2,8 +2,8 @@
 mod common;
 
 use common::{case_from, case_text};
+use cosserat::engine::rust::metrics::curvature_error;
 use cosserat::model::mesh::Field;
-use cosserat::run::metrics::curvature_error;
 use cosserat::solve::inverse::{InverseRecord, Start};
 
 /// Paper §5.2, first test: λf = 1, λl = 1e-10, λd = 1e-6, Λκ = diag(0, 0, 1e-10), Λω = 0.
@@ -172,7 +172,7 @@ fn adjoint_gradient_matches_finite_differences() {
 /// 0.066 / 0.005). Asserted with a margin of about 1.5×.
 #[test]
 fn recovers_eq65_bend_and_twist_from_the_case_file() {
-    use cosserat::run::metrics::inverse_metrics;
+    use cosserat::engine::rust::metrics::inverse_metrics;
     let case = case_from(&case_text("inverse_bend_twist"), "inverse_bend_twist");
     let (r, stop) = common::run_any(&case);
     assert!(matches!(stop, Some(cosserat::solve::SolveError::Stalled(_))), "{stop:?}");

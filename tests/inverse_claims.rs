@@ -7,9 +7,9 @@
 mod common;
 
 use common::fixed_point::{paper, run, Data};
+use cosserat::engine::rust::NodalState;
 use cosserat::model::mesh::{DofMap, Field};
 use cosserat::model::rotation::{angles_from_rotation, rotation};
-use cosserat::run::NodalState;
 use cosserat::solve::inverse::InverseParams;
 use cosserat::solve::Problem;
 use nalgebra::{DVector, Matrix3, Rotation3, Unit, Vector3};

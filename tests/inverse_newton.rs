@@ -2,10 +2,10 @@
 mod common;
 
 use common::{case_from, case_text, solve_frame_any, solve_newton, with_weights};
+use cosserat::engine::rust::metrics::curvature_error;
+use cosserat::engine::rust::NodalState;
 use cosserat::linalg::{LinearSolver, Pattern};
 use cosserat::model::mesh::{DofMap, Field, Mesh};
-use cosserat::run::metrics::curvature_error;
-use cosserat::run::NodalState;
 use cosserat::solve::inverse::kkt::{assemble_system, dirichlet};
 use cosserat::solve::inverse::newton::assemble_residual;
 use cosserat::solve::inverse::{Frame, InverseParams, InverseRecord, Start};

@@ -1,4 +1,4 @@
-//! Every kill point survivable (`io::run_folder`, `io::folder_lock`): a clip run, and a
+//! Every kill point survivable (`output::run_folder`, `output::folder_lock`): a clip run, and a
 //! `--resume` of an interrupted clip, each killed with SIGKILL at 20 moments drawn at random
 //! (seeded) over its duration. After every kill the output folder is either the previous one,
 //! byte for byte, or the new one, whole; and `--resume` then completes the clip with the CSVs,
@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-use cosserat::io::run_folder::sha256_file;
+use cosserat::output::run_folder::sha256_file;
 
 /// Kills per campaign.
 const KILLS: usize = 20;

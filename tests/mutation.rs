@@ -9,8 +9,8 @@ mod common;
 use std::path::Path;
 
 use cosserat::case::Case;
-use cosserat::io::compare::{compare_case, CompareOptions, Horizon};
-use cosserat::io::freefem::{script_dir, SCRIPT_DIR_ENV};
+use cosserat::engine::freefem::{script_dir, SCRIPT_DIR_ENV};
+use cosserat::jobs::compare::{compare_case, CompareOptions, Horizon};
 
 /// One mutation: a script of `freefem/`, the exact text replaced (at each of its `occurrences`),
 /// its replacement, the case and horizon it is run on, and the rows that must fail.

@@ -8,10 +8,11 @@ mod common;
 
 use common::{case_from, case_text_with_data, edit, worm_data_present};
 use cosserat::case::Case;
-use cosserat::io::engine::run_case;
-use cosserat::io::engine::{run_clip_case, EngineError};
-use cosserat::run::Engine;
-use cosserat::run::RunError;
+use cosserat::engine::run_case;
+use cosserat::engine::rust::Engine;
+use cosserat::engine::rust::RunError;
+use cosserat::engine::EngineError;
+use cosserat::output::clip_run::run_clip_case;
 use cosserat::solve::sequence::SequenceError;
 use nalgebra::{Matrix3, Rotation3, Vector3};
 use std::path::Path;

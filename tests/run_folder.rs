@@ -1,4 +1,4 @@
-//! The output-folder contract of the binary (`io::run_folder`): `run.json` in every folder, no
+//! The output-folder contract of the binary (`output::run_folder`): `run.json` in every folder, no
 //! folder ever mixing two runs, a foreign folder refused, SIGINT/SIGTERM ending a run with
 //! consistent files and exit status 130, and a clip resumed byte for byte — after a real SIGINT
 //! and after a SIGKILL — identical to an uninterrupted run.

@@ -8,9 +8,9 @@ mod common;
 use std::collections::BTreeMap;
 
 use cosserat::case::{case_files, Case};
-use cosserat::io::engine::{run_case, EngineError};
-use cosserat::run::metrics::all_metrics;
-use cosserat::run::{Engine, RunError};
+use cosserat::engine::rust::metrics::all_metrics;
+use cosserat::engine::rust::{Engine, RunError};
+use cosserat::engine::{run_case, EngineError};
 use cosserat::solve::SolveError;
 
 /// Significant digits kept for physical metrics of static cases (deterministic to ~1e-10).

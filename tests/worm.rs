@@ -5,9 +5,9 @@ mod common;
 
 use common::{case_file, worm_data_present};
 use cosserat::case::{Analysis, Case, DataSource};
-use cosserat::io::engine::run_clip_case;
-use cosserat::io::sweep::chain;
-use cosserat::run::clip::ClipRun;
+use cosserat::engine::rust::clip::ClipRun;
+use cosserat::jobs::sweep::chain;
+use cosserat::output::clip_run::run_clip_case;
 use cosserat::solve::inverse::InverseMethod;
 
 fn run(case: &Case) -> ClipRun {

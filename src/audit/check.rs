@@ -4,7 +4,7 @@
 //! report's text changes only when a result does.
 use super::spec::{Check, Claim, Ref, Selector, Spec};
 use super::{ClaimResult, PointResult, RunResults, Verdict};
-use crate::io::sweep::{RunStatus, NOT_STARTED};
+use crate::jobs::sweep::{RunStatus, NOT_STARTED};
 
 /// How far a check holds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

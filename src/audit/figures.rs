@@ -9,14 +9,14 @@ use super::measures::modal_tip_history;
 use super::spec::{PlotKind, PlotSpec, Selector, Spec};
 use super::{PointResult, RunResults};
 use crate::case::{Case, Reference};
+use crate::engine::rust::metrics::INNER_SKIP_ELEMENTS;
+use crate::figures::heatmap::{render_heatmaps_svg, Heatmap};
+use crate::figures::plot::{render_panels_svg, render_svg, Band, Legend, LinePlot, Mark, Series};
+use crate::figures::posture::{render_postures_svg, PosturePanel};
 use crate::io::files::write_plot;
-use crate::io::heatmap::{render_heatmaps_svg, Heatmap};
-use crate::io::plot::{render_panels_svg, render_svg, Band, Legend, LinePlot, Mark, Series};
-use crate::io::posture::{render_postures_svg, PosturePanel};
 use crate::io::OutputError;
 use crate::model::loads::LoadFrame;
 use crate::reference::{timoshenko_deflection, tip_loaded_cantilever, PlanarRod};
-use crate::run::metrics::INNER_SKIP_ELEMENTS;
 
 /// Write every figure of `spec` into `dir`; returns the files written. A figure whose runs
 /// produced nothing to draw (every point failed) is skipped.
@@ -56,7 +56,7 @@ fn tradeoff_csv(r: &RunResults, metric: &str) -> String {
     out
 }
 
-type Svg = Result<String, crate::io::plot::PlotError>;
+type Svg = Result<String, crate::figures::plot::PlotError>;
 
 fn run<'a>(runs: &'a [RunResults], name: &str) -> Option<&'a RunResults> {
     runs.iter().find(|r| r.name == name)
@@ -384,7 +384,7 @@ fn kymograph(title: &str, p: &PointResult, dt_s: f64) -> Option<Svg> {
         .map(|c| {
             let values: Vec<Vec<f64>> =
                 frames.iter().map(|&i| cols.iter().map(|&j| s.kappa[i][j][c] * 1e-3).collect()).collect();
-            let limit = Some(crate::io::clip_output::abs_percentile_99(values.iter().flatten().copied()))
+            let limit = Some(crate::output::clip_output::abs_percentile_99(values.iter().flatten().copied()))
                 .filter(|v| *v > 0.0)
                 .unwrap_or(1.0);
             let t = if c == 0 { format!("{title}: κ{}", c + 1) } else { format!("κ{}", c + 1) };
@@ -509,9 +509,9 @@ fn omega(spec: &Spec, title: &str, names: &[String], runs: &[RunResults]) -> Opt
 
 /// The frames of a clip point to draw: those asked for, else (a clip excerpt in --quick that
 /// ends before them) its last frame.
-fn shown_frames<'a>(p: &'a PointResult, frames: &[usize]) -> Vec<&'a crate::run::clip::ClipFrame> {
+fn shown_frames<'a>(p: &'a PointResult, frames: &[usize]) -> Vec<&'a crate::engine::rust::clip::ClipFrame> {
     let Some(s) = p.series.as_ref() else { return Vec::new() };
-    let mut shown: Vec<&crate::run::clip::ClipFrame> =
+    let mut shown: Vec<&crate::engine::rust::clip::ClipFrame> =
         frames.iter().filter_map(|f| s.kept.iter().find(|k| k.report.frame == *f)).collect();
     if shown.is_empty() {
         shown.extend(s.last.as_ref());
@@ -521,7 +521,7 @@ fn shown_frames<'a>(p: &'a PointResult, frames: &[usize]) -> Vec<&'a crate::run:
 
 /// Figs. 16, 21, 22: the kept frames of a clip run, three projections each, with the directors
 /// d1 (ticks), d3 (arrows) and the tangent, the centreline coloured by |κ| [1/mm] (the node
-/// average of the element curvatures, `run::clip::nodal_curvature`). For a run with a grid,
+/// average of the element curvatures, `engine::rust::clip::nodal_curvature`). For a run with a grid,
 /// beneath them the quantity its swept weight penalises along the body at the first frame
 /// shown, one curve per grid point: the angle between d3 and the chord of each element (λd,
 /// Fig. 21: the detachment the λd term penalises) or κ3 (λκ3, Fig. 22).
@@ -530,9 +530,9 @@ fn postures(title: &str, p: &PointResult, frames: &[usize], all: &RunResults) ->
         .into_iter()
         .map(|k| {
             let d = k.nodes.directors();
-            let colour = crate::run::clip::nodal_curvature(&k.kappa).iter().map(|v| v.norm() * 1e-3).collect();
+            let colour = crate::engine::rust::clip::nodal_curvature(&k.kappa).iter().map(|v| v.norm() * 1e-3).collect();
             PosturePanel {
-                label: format!("frame {} (t = {} s)", k.report.frame, crate::io::plot::format_tick(k.time_s)),
+                label: format!("frame {} (t = {} s)", k.report.frame, crate::figures::plot::format_tick(k.time_s)),
                 x: k.nodes.x.clone(),
                 d1: d.iter().map(|q| q[0]).collect(),
                 d3: d.iter().map(|q| q[2]).collect(),

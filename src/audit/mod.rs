@@ -1,7 +1,7 @@
 //! The audit of the paper (`cosserat audit`): every figure, table and claim of §5–6 that can
 //! be computed here, regenerated from the specs of `cases/paper/` ([`spec`]) and judged with
 //! numbers ([`check`]): *reproduced*, *differs*, *refuted* or *not computable here*. Runs go
-//! through the same path as `cosserat sweep` (`io::sweep::run_point`), one folder per point;
+//! through the same path as `cosserat sweep` (`jobs::sweep::run_point`), one folder per point;
 //! [`measures`] adds the numbers a claim needs beyond a run's metrics, [`figures`] draws the
 //! paper's panels and [`report`] writes `REPORT.md` and `report.csv`.
 pub mod check;
@@ -19,7 +19,7 @@ use serde::Deserialize;
 
 use crate::case::sweep::{product, Point, SweepError};
 use crate::io::compact::OutputFormat;
-use crate::io::sweep::{point_manifest, run_clip_point, run_point, SweepOutcome};
+use crate::jobs::sweep::{point_manifest, run_clip_point, run_point, SweepOutcome};
 use measures::{derived_metrics, ClipRecorder, ClipSeries};
 use spec::{Claim, RunSpec, Spec};
 
@@ -288,12 +288,12 @@ pub const MARKER: &str = ".cosserat-audit";
 fn prepare_folder(out: &Path) -> Result<(), AuditError> {
     let io = |source| AuditError::Folder { path: out.to_path_buf(), source };
     if out.exists() {
-        // empty, or a staging folder of the output-folder contract (`io::run_folder`) holding
+        // empty, or a staging folder of the output-folder contract (`output::run_folder`) holding
         // only its run.json
         let empty = std::fs::read_dir(out)
             .map_err(io)?
             .filter_map(Result::ok)
-            .all(|e| e.file_name() == crate::io::run_folder::MANIFEST);
+            .all(|e| e.file_name() == crate::output::run_folder::MANIFEST);
         if empty {
             return std::fs::write(out.join(MARKER), "written by `cosserat audit`\n").map_err(io);
         }
@@ -508,7 +508,7 @@ fn check_metric_name(spec: &Spec, claim: &Claim, runs: &[RunResults]) -> Result<
     let Some(metric) = claim.check.metric() else { return Ok(()) };
     for run in claim.check.runs() {
         let Some(rr) = runs.iter().find(|r| r.name == run) else { continue };
-        let reported: Vec<&crate::run::metrics::Metrics> =
+        let reported: Vec<&crate::engine::rust::metrics::Metrics> =
             rr.points.iter().filter_map(|p| p.outcome.metrics.as_ref()).collect();
         if reported.is_empty() || reported.iter().any(|m| m.contains_key(metric)) {
             continue;

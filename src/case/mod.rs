@@ -65,7 +65,7 @@ pub const CASE_FILE_CAP_BYTES: u64 = 1 << 20;
 pub const FROM_DATA: &str = "from_data";
 
 /// The mesh length of a case whose `rod.length_m = "from_data"` is not resolved yet [m]: a
-/// placeholder that nothing solves with (`io::clip_files::load_clip` refuses such a case).
+/// placeholder that nothing solves with (`engine::input::clip_files::load_clip` refuses such a case).
 pub const FROM_DATA_PLACEHOLDER_M: f64 = 1.0;
 
 /// Where the rod length `mesh.length_m` comes from (`rod.length_m`).
@@ -74,7 +74,7 @@ pub enum RodLength {
     /// a number or an expression of the case file
     Given,
     /// `"from_data"`: the body length of the recording, estimated when it is read
-    /// (`io::clip_files::resolve_length`, `clip::length`); `None` until then, when the mesh's
+    /// (`engine::input::clip_files::resolve_length`, `clip::length`); `None` until then, when the mesh's
     /// length is [`FROM_DATA_PLACEHOLDER_M`]
     FromData(Option<BodyLength>),
 }
@@ -234,7 +234,7 @@ pub const DEFAULT_COMPARE_FRAMES: usize = 10;
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Reference {
     /// Eq. (63), the Kirchhoff elastica and the planar Reissner rod for a dead end force of
-    /// magnitude `force_n` [N] along −e2 (see `run::metrics`).
+    /// magnitude `force_n` [N] along −e2 (see `engine::rust::metrics`).
     TipLoadedCantilever { force_n: f64 },
 }
 

@@ -8,17 +8,17 @@ use anyhow::{Context, Result};
 use super::args::Limits;
 use super::progress::{FreefemProgress, Progress};
 use cosserat::case::Case;
+use cosserat::engine::rust::budget::{self, default_limit_bytes, Footprint, GIB};
+use cosserat::engine::rust::Engine;
 use cosserat::io::compact::OutputFormat;
-use cosserat::io::job::{case_label, run_into, run_manifest};
-use cosserat::io::run_folder::{input_file, Manifest, Mode, RunFolder, Status};
-use cosserat::io::sweep::RunStatus;
-use cosserat::run::budget::{self, default_limit_bytes, Footprint, GIB};
-use cosserat::run::Engine;
+use cosserat::jobs::job::{case_label, run_into, run_manifest};
+use cosserat::jobs::sweep::RunStatus;
+use cosserat::output::run_folder::{input_file, Manifest, Mode, RunFolder, Status};
 use cosserat::solve::modes::modal_model;
 
 /// The case of `path`, its `rod.length_m = "from_data"` resolved from its recording.
 fn load(path: &Path) -> Result<Case> {
-    Ok(cosserat::io::clip_files::resolve_length(&Case::from_file(path)?)?)
+    Ok(cosserat::engine::input::clip_files::resolve_length(&Case::from_file(path)?)?)
 }
 
 /// Refuse a run whose estimated memory exceeds the limit (`--max-memory-gib`).
@@ -66,7 +66,7 @@ pub fn cmd_compare(
     force: bool,
     limits: Limits,
 ) -> Result<ExitCode> {
-    use cosserat::io::compare::default_dir;
+    use cosserat::jobs::compare::default_dir;
     let case = load(path)?;
     check_memory(&case, Footprint::Run, limits)?;
     let target = out.unwrap_or_else(|| default_dir(&case));
@@ -106,7 +106,7 @@ pub fn cmd_compare(
 
 /// Both engines on `case` and their comparison, written into `dir` (the staging folder).
 fn compare_into(case: &Case, dir: &Path, target: &Path, short: bool, frames: Option<usize>) -> Result<ExitCode> {
-    use cosserat::io::compare::{compare_case, report_table, write_compare, CompareOptions, Horizon};
+    use cosserat::jobs::compare::{compare_case, report_table, write_compare, CompareOptions, Horizon};
     let opts = CompareOptions { horizon: if short { Horizon::Short } else { Horizon::Full }, frames };
     eprintln!(
         "{}: rust engine (twice: as given and with its input perturbed by 1e-13), then FreeFEM in {}",
@@ -135,7 +135,7 @@ pub fn cmd_sweep(
     quiet: bool,
 ) -> Result<ExitCode> {
     use cosserat::case::sweep::{parse_set, product};
-    use cosserat::io::sweep::sweep_into;
+    use cosserat::jobs::sweep::sweep_into;
     let case = load(path)?;
     let params = set.iter().map(|s| parse_set(s)).collect::<Result<Vec<_>, _>>()?;
     let points = product(&case, &params)?;
@@ -161,7 +161,7 @@ pub fn cmd_sweep(
             anyhow::bail!("{}: sweep: {}", case_label(&case), super::outcome::disk_full_text(&e, &target, "sweep"));
         }
         Err(e) => {
-            let message = cosserat::io::sweep::chain(&e);
+            let message = cosserat::jobs::sweep::chain(&e);
             folder.finish(Status::Failed, Some(message.clone()))?;
             anyhow::bail!("{}: sweep: {message}; {} holds run.json saying failed", case_label(&case), target.display());
         }
@@ -188,7 +188,7 @@ pub fn cmd_sweep(
         target.join("summary.csv").display(),
         target.display()
     );
-    for r in rows.iter().filter(|r| r.error.as_deref() != Some(cosserat::io::sweep::NOT_STARTED)) {
+    for r in rows.iter().filter(|r| r.error.as_deref() != Some(cosserat::jobs::sweep::NOT_STARTED)) {
         if let Some(e) = &r.error {
             eprintln!("  {}: {}: {e}", r.name, r.status.as_str());
         }

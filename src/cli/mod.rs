@@ -16,9 +16,9 @@ use std::time::Duration;
 
 use anyhow::{Context, Result};
 
-use cosserat::io::batch::{self, gather, list_recordings, run_batch, run_task, BatchRow, Plan, SUMMARY};
 use cosserat::io::compact::OutputFormat;
-use cosserat::io::slurm;
+use cosserat::jobs::batch::{self, gather, list_recordings, run_batch, run_task, BatchRow, Plan, SUMMARY};
+use cosserat::jobs::slurm;
 
 use progress::Progress;
 
@@ -160,8 +160,8 @@ pub fn cmd_batch(a: BatchArgs) -> Result<ExitCode> {
 
 /// The lock of a batch's output folder while this process writes its plan and runs or submits
 /// it: a second `cosserat batch` into the same folder is refused at once.
-fn lock_batch(out: &Path) -> Result<cosserat::io::folder_lock::FolderLock> {
-    use cosserat::io::folder_lock::{FolderLock, LockError};
+fn lock_batch(out: &Path) -> Result<cosserat::output::folder_lock::FolderLock> {
+    use cosserat::output::folder_lock::{FolderLock, LockError};
     let name = out.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "batch".into());
     let parent = out.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
     std::fs::create_dir_all(parent).with_context(|| format!("cannot create {}", parent.display()))?;

@@ -7,7 +7,7 @@ use std::process::ExitCode;
 
 use anyhow::{Context, Result};
 
-use cosserat::io::plot::{render_panels_svg, LinePlot, Series};
+use cosserat::figures::plot::{render_panels_svg, LinePlot, Series};
 use cosserat::io::write_atomic;
 use cosserat::study::{recovered_name, run_study, StudyRow, StudySpec, SPLINE};
 

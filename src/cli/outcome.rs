@@ -4,12 +4,12 @@
 use std::path::Path;
 
 use cosserat::case::Case;
-use cosserat::io::run_folder::{Manifest, Status};
-use cosserat::io::sweep::RunStatus;
-use cosserat::run::Engine;
+use cosserat::engine::rust::Engine;
+use cosserat::jobs::sweep::RunStatus;
+use cosserat::output::run_folder::{Manifest, Status};
 
 /// What a run stopped by a full disk left, and how to go on.
-pub fn full_disk_note(end: &cosserat::io::job::JobEnd, case: &Path, dir: &Path) -> String {
+pub fn full_disk_note(end: &cosserat::jobs::job::JobEnd, case: &Path, dir: &Path) -> String {
     let previous = format!("\n{} is left as it was", dir.display());
     match (&end.disk_full, end.frames) {
         (Some(Some(staging)), Some((n, _))) => format!(
@@ -24,8 +24,8 @@ pub fn full_disk_note(end: &cosserat::io::job::JobEnd, case: &Path, dir: &Path) 
 
 /// What an interrupted sweep kept: points complete, stopped (their folders, a clip's converged
 /// frames) and not started.
-pub fn sweep_interrupted_summary(rows: &[cosserat::io::sweep::SummaryRow], target: &Path) -> String {
-    use cosserat::io::sweep::NOT_STARTED;
+pub fn sweep_interrupted_summary(rows: &[cosserat::jobs::sweep::SummaryRow], target: &Path) -> String {
+    use cosserat::jobs::sweep::NOT_STARTED;
     let not_started = rows.iter().filter(|r| r.error.as_deref() == Some(NOT_STARTED)).count();
     let stopped: Vec<_> =
         rows.iter().filter(|r| r.status == RunStatus::Interrupted && r.error.as_deref() != Some(NOT_STARTED)).collect();
@@ -93,7 +93,7 @@ pub fn disk_full_text(e: &(dyn std::error::Error + 'static), target: &Path, what
     format!(
         "{}: {}\n{} is left as it was; nothing of this {what} was kept (its staging folder is removed)",
         cosserat::io::disk::full_text(target),
-        cosserat::io::sweep::chain(e),
+        cosserat::jobs::sweep::chain(e),
         target.display()
     )
 }
@@ -102,7 +102,7 @@ pub fn disk_full_text(e: &(dyn std::error::Error + 'static), target: &Path, what
 /// (`--strict`: exit 1), the interrupt's exit status 130 with what was kept, or the error with
 /// what the folder holds.
 pub fn run_end(
-    end: cosserat::io::job::JobEnd,
+    end: cosserat::jobs::job::JobEnd,
     (case, engine): (&Case, Engine),
     path: &Path,
     dir: &Path,

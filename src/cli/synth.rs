@@ -1,4 +1,4 @@
-//! `cosserat synth`: a corpus of synthetic recordings (`io::corpus`) written into a folder of
+//! `cosserat synth`: a corpus of synthetic recordings (`engine::input::corpus`) written into a folder of
 //! its own under the output-folder contract (staged, `run.json`), from the omega-turn kymogram
 //! of the source tree wherever the command runs.
 use std::path::{Path, PathBuf};
@@ -6,8 +6,8 @@ use std::process::ExitCode;
 
 use anyhow::{Context, Result};
 
-use cosserat::io::corpus::{write_corpus, CorpusParams};
-use cosserat::io::run_folder::{input_file_as, Manifest, Mode, RunFolder, Status};
+use cosserat::engine::input::corpus::{write_corpus, CorpusParams};
+use cosserat::output::run_folder::{input_file_as, Manifest, Mode, RunFolder, Status};
 
 /// `cosserat synth`.
 #[derive(clap::Args, Debug)]

@@ -29,11 +29,11 @@
 //! origin with the same head-segment direction.
 //!
 //! ## User recordings
-//! `io::clip_files::read_recording`: CSV with header `frame,node,x_m,y_m,z_m` (0-based,
+//! `engine::input::clip_files::read_recording`: CSV with header `frame,node,x_m,y_m,z_m` (0-based,
 //! contiguous frames and nodes, rows in any order, every frame with the same node count ≥ 3)
 //! or NPY of shape `frames × nodes × 3` [m]. Positions are used as given (no resampling, no
 //! rigid motion). This module holds the clips and their geometry; the files are read in
-//! `crate::io`.
+//! `crate::engine::input`.
 //!
 //! ## Stretch
 //! Remark 9 of [R1]: the data give the current arc length, so `j = ∂_s̃ s` is known. Per frame,
@@ -56,11 +56,11 @@ pub const KYMOGRAM_FPS: f64 = 32.0;
 pub const PAPER_NODES: usize = 128;
 
 /// Elements left out at each end by the measures of a clip run: the inner curvature errors
-/// (`run::metrics::INNER_SKIP_ELEMENTS`) and the ground-truth scores (`run::clip::TRUTH_SKIP_NODES`
-/// nodes); equal to both (tested in `io::clip_files`).
+/// (`engine::rust::metrics::INNER_SKIP_ELEMENTS`) and the ground-truth scores (`engine::rust::clip::TRUTH_SKIP_NODES`
+/// nodes); equal to both (tested in `engine::input::clip_files`).
 pub const CLIP_SKIP_ELEMENTS: usize = 5;
 /// Fewest elements of a clip case's mesh: the measures leave out [`CLIP_SKIP_ELEMENTS`] at
-/// each end and must keep one, and the roughness (`run::clip::sign_alternation`) of the data's
+/// each end and must keep one, and the roughness (`engine::rust::clip::sign_alternation`) of the data's
 /// curvature at the `elements − 1` interior nodes needs 3 values. A smaller mesh would run and
 /// write results without these measures.
 pub const MIN_CLIP_ELEMENTS: usize = 2 * CLIP_SKIP_ELEMENTS + 1;
@@ -75,7 +75,7 @@ pub const MAX_CLIP_POSITIONS: usize = 1 << 25;
 /// ([`length::FrameLength`], docs/decisions.md D18): noise of σ per coordinate lengthens a
 /// polyline of node spacing h by about 2σ²/h², 20 % for 10 µm at 33 nodes on 1 mm.
 ///
-/// Measured, max over all frames of every clip case of `cases/` on its own mesh (`io::clip_files`
+/// Measured, max over all frames of every clip case of `cases/` on its own mesh (`engine::input::clip_files`
 /// test `length_ratios_of_the_clip_cases`, polyline lengths: these clips have no noise):
 ///
 /// | clip | frames | max deviation | without `scale_to_length` |
@@ -103,7 +103,7 @@ pub const MAX_CLIP_POSITIONS: usize = 1 << 25;
 /// not for k = 0.95 or 1.05 with Table 1's λd = 1e2.
 pub const MAX_LENGTH_DEVIATION: f64 = 0.10;
 
-/// Errors of building, cutting and scoring clips (reading their files is `crate::io`'s).
+/// Errors of building, cutting and scoring clips (reading their files is `crate::engine::input`'s).
 #[derive(Debug, thiserror::Error)]
 pub enum ClipError {
     #[error("clip.frames = [{first}, {end}) but the clip has {frames} frames")]

@@ -9,7 +9,7 @@ use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use super::plot::PlotError;
+use crate::figures::plot::PlotError;
 
 /// Errors while writing outputs; each names the file.
 #[derive(Debug, thiserror::Error)]
@@ -33,6 +33,20 @@ pub enum OutputError {
     /// a part of the output (a sweep's point) could not be written for want of space
     #[error("{path}: {message}")]
     DiskFull { path: PathBuf, message: String },
+}
+
+/// Errors of reading the resume journal of a clip run (`crate::output::journal`). (Here, not in
+/// `journal`, so that the engines' error can name it without importing the output folder.)
+#[derive(Debug, thiserror::Error)]
+pub enum JournalError {
+    #[error("{path} does not exist: this folder holds no clip run that can be resumed")]
+    Missing { path: PathBuf },
+    #[error("cannot read {path}")]
+    Io {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
 }
 
 /// Errors reading an input file; each names the file and, where it applies, the row, frame,
@@ -213,12 +227,32 @@ pub fn human_bytes(n: u64) -> String {
 /// refused by its size before it is read, and read through `Read::take(cap + 1)` in case it
 /// grows meanwhile. The caps are chosen per reader, far above any real input of its kind.
 pub fn read_capped(path: &Path, cap: u64, what: &'static str) -> Result<Vec<u8>, InputError> {
+    check_regular(path, what)?;
+    read_opened_capped(path, cap, what, false)
+}
+
+/// [`read_capped`] that also takes the pipe of this process's standard input
+/// (`cosserat run /dev/stdin < case.toml`), read to its end as piped, within the same cap: a
+/// named pipe would still block its open, a device never end, so both are refused.
+pub fn read_capped_or_stdin(path: &Path, cap: u64, what: &'static str) -> Result<Vec<u8>, InputError> {
+    use crate::file_kind::{is_standard_input, kind, FileKind};
+    let piped = match kind(path) {
+        Ok(FileKind::Regular) => false,
+        Ok(FileKind::Fifo) if is_standard_input(path) => true,
+        Ok(kind) => return Err(InputError::NotRegular { path: path.to_path_buf(), what, kind }),
+        Err(source) => return Err(InputError::Open { path: path.to_path_buf(), source }),
+    };
+    read_opened_capped(path, cap, what, piped)
+}
+
+/// The reading of [`read_capped`] once the kind of `path` was accepted (`piped`: the standard
+/// input's pipe, which is not a regular file).
+fn read_opened_capped(path: &Path, cap: u64, what: &'static str, piped: bool) -> Result<Vec<u8>, InputError> {
     let open = |source| InputError::Open { path: path.to_path_buf(), source };
     let too_large = |size| InputError::TooLarge { path: path.to_path_buf(), what, size, cap };
-    check_regular(path, what)?;
     let file = std::fs::File::open(path).map_err(open)?;
     let meta = file.metadata().map_err(open)?;
-    if !meta.is_file() {
+    if !meta.is_file() && !piped {
         // replaced between the check and the open
         let kind = crate::file_kind::FileKind::of(&meta);
         return Err(InputError::NotRegular { path: path.to_path_buf(), what, kind });
@@ -289,7 +323,7 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
     Ok(())
 }
 
-/// Write an SVG rendered by `crate::io::plot`; a rendering error names the file.
+/// Write an SVG rendered by `crate::figures::plot`; a rendering error names the file.
 pub fn write_plot(path: &Path, svg: Result<String, PlotError>) -> Result<(), OutputError> {
     let svg = svg.map_err(|source| OutputError::Plot { path: path.to_path_buf(), source })?;
     write_atomic(path, svg.as_bytes())

@@ -3,9 +3,9 @@
 //! the batch case under several weight settings, and scored beside a generic smoothing spline
 //! of the same noisy frames, in one run.
 //!
-//! For each mesh (node count) and noise level σ a corpus is written (`io::corpus`, the same
+//! For each mesh (node count) and noise level σ a corpus is written (`engine::input::corpus`, the same
 //! seed for every σ, so the recordings differ only by their noise), each variant of the case
-//! (its `set` keys applied to the mesh's case) runs as a batch over it (`io::batch`), and every
+//! (its `set` keys applied to the mesh's case) runs as a batch over it (`jobs::batch`), and every
 //! frame is scored ([`score`]). `noise_study.csv` has one row per mesh, σ, method and
 //! recording; `noise_study.svg` draws the bending error (median and worst frame, the worst
 //! recording) and the reconstructed fraction against σ.
@@ -17,11 +17,11 @@ use std::time::Instant;
 
 pub use spec::{Mesh, StudySpec, Variant};
 
-use crate::io::batch::{run_batch, Plan};
-use crate::io::clip_files::read_recording;
-use crate::io::corpus::{recording_path, write_corpus, CorpusParams};
-use crate::io::truth_file::{read_truth, truth_sidecar};
+use crate::engine::input::clip_files::read_recording;
+use crate::engine::input::corpus::{recording_path, write_corpus, CorpusParams};
+use crate::engine::input::truth_file::{read_truth, truth_sidecar};
 use crate::io::{write_atomic, InputError, OutputError};
+use crate::jobs::batch::{run_batch, Plan};
 use score::{
     bending_error, median_and_worst, read_curvature, recovered_nodal, spline_bending, truth_bending,
     truth_bending_nodal, ScoreError,
@@ -39,11 +39,11 @@ pub enum StudyError {
     #[error(transparent)]
     Score(#[from] ScoreError),
     #[error("corpus: {0}")]
-    Corpus(#[from] crate::io::corpus::CorpusError),
+    Corpus(#[from] crate::engine::input::corpus::CorpusError),
     #[error("batch: {0}")]
-    Batch(#[from] crate::io::batch::BatchError),
+    Batch(#[from] crate::jobs::batch::BatchError),
     #[error("plot: {0}")]
-    Plot(#[from] crate::io::plot::PlotError),
+    Plot(#[from] crate::figures::plot::PlotError),
     #[error("csv: {0}")]
     Csv(#[from] csv::Error),
 }
@@ -197,7 +197,7 @@ fn score_run(
             })
             .collect()
     };
-    let weights = crate::io::manifest::Manifest::read(dir).ok().flatten().and_then(|m| m.weights);
+    let weights = crate::output::manifest::Manifest::read(dir).ok().flatten().and_then(|m| m.weights);
     let mut rows = vec![row(nodes, noise_m, &variant.name, recording, &score(false))];
     if variant.recovered {
         rows.push(row(nodes, noise_m, &recovered_name(&variant.name), recording, &score(true)));

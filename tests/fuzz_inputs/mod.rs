@@ -3,7 +3,7 @@
 use std::path::Path;
 use std::sync::OnceLock;
 
-use cosserat::io::clip_files::RECORDING_HEADER;
+use cosserat::engine::input::clip_files::RECORDING_HEADER;
 use cosserat::io::npy::npy_bytes;
 use proptest::prelude::*;
 use proptest::sample::Index;

@@ -1,0 +1,167 @@
+//! The memory a run will need, estimated from the case before anything is allocated, and the
+//! refusal of a run above a limit (`cosserat … --max-memory-gib`). The estimate counts the
+//! arrays the solvers allocate: per forward unknown the band LU (`linalg::band`, `2 kl + ku + 1`
+//! rows, `kl = ku = 2 b − 1` for blocks of `b` unknowns per node), per element the pattern's
+//! values, scaled copy and slots (`linalg::pattern`), a few dozen work vectors; a clip's frames
+//! and per-frame summary (`engine::rust::clip::ClipRun`); the dense matrices of the modal model
+//! (`solve::modes`, about twelve `n × n`). Checked against the peak resident size of real runs in
+//! `docs/results.md`: it errs high, never low by more than the process's fixed few MB.
+use crate::case::{Analysis, Case, ClipKind};
+
+/// Bytes in a GiB.
+pub const GIB: f64 = 1024.0 * 1024.0 * 1024.0;
+
+/// What part of the program will run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Footprint {
+    /// `run`, `sweep` points, `compare`: the case's solver
+    Run,
+    /// `modes`: the dense modal model
+    Modes,
+}
+
+/// A run refused before it started.
+#[derive(Debug, thiserror::Error)]
+#[error(
+    "{case}: {what} would need about {:.3e} GiB of memory (estimated from {basis}), above {}",
+    .bytes / GIB,
+    limit_text(*.limit, *.address_space, key)
+)]
+pub struct BudgetError {
+    /// the case file (or the case's name)
+    pub case: String,
+    pub what: &'static str,
+    pub bytes: f64,
+    pub limit: f64,
+    pub basis: String,
+    pub key: &'static str,
+    /// the limit is the process's address-space limit (`ulimit -v`), below the one asked for
+    pub address_space: bool,
+}
+
+/// The limit of a [`BudgetError`] and how to raise it.
+fn limit_text(limit: f64, address_space: bool, key: &str) -> String {
+    if address_space {
+        format!(
+            "the process's address-space limit of {:.1} MiB (ulimit -v); reduce {key} or raise that limit",
+            limit / (1024.0 * 1024.0)
+        )
+    } else {
+        format!("the limit of {:.1} GiB; reduce {key} or raise the limit with --max-memory-gib", limit / GIB)
+    }
+}
+
+/// The soft limit of the process's address space (`ulimit -v`, `RLIMIT_AS`) [bytes], if it has
+/// one (from `/proc/self/limits`).
+pub fn address_space_limit() -> Option<f64> {
+    let text = std::fs::read_to_string("/proc/self/limits").ok()?;
+    let line = text.lines().find(|l| l.starts_with("Max address space"))?;
+    line.trim_start_matches("Max address space").split_whitespace().next()?.parse::<f64>().ok()
+}
+
+/// Fixed cost of a process [bytes] (binary, allocator, thread stacks).
+const FIXED_BYTES: f64 = 32.0 * 1024.0 * 1024.0;
+
+/// Bytes per element of a banded solve with `b` unknowns per node: band LU over `b` unknowns
+/// (`ld = 3 kl + 1`... with pivots), pattern values + equilibrated copy + slots of the two
+/// nodes' `(2b)²` entries, and about 40 work vectors of `b` entries.
+fn banded_bytes_per_element(b: f64) -> f64 {
+    let kl = 2.0 * b - 1.0;
+    let band = (3.0 * kl + 1.0) * b * 8.0 + b * 8.0;
+    let pattern = (2.0 * b).powi(2) * (8.0 + 8.0 + 8.0);
+    let vectors = 40.0 * b * 8.0;
+    band + pattern + vectors
+}
+
+/// Node-frames of a clip case, from its settings or the size of its file, and what they were
+/// estimated from.
+fn clip_node_frames(case: &Case) -> Option<(f64, String)> {
+    let c = case.clip()?;
+    let nodes = case.mesh.nodes() as f64;
+    let frames = match (&c.kind, c.frames) {
+        (_, Some((a, b))) => Some((b.saturating_sub(a) as f64, format!("clip.frames = [{a}, {b}]"))),
+        (ClipKind::Roll3d(s), None) => Some((s.frames as f64, format!("clip.clip_frames = {}", s.frames))),
+        _ => None,
+    };
+    match frames {
+        Some((f, key)) => Some((f * nodes, format!("{key} × {nodes} nodes"))),
+        None => {
+            // a recording or kymogram: every number takes at least 8 bytes in the file; a
+            // node-frame of a recording 3 numbers, a kymogram's frame of `nodes` nodes one
+            // angle per joint
+            let size = std::fs::metadata(&c.file).map(|m| m.len() as f64).unwrap_or(0.0);
+            let node_frames = match c.kind {
+                ClipKind::Kymogram => size / 8.0 * nodes,
+                _ => size / 24.0,
+            };
+            Some((node_frames, format!("{} ({:.0} MB)", c.file.display(), size / 1e6)))
+        }
+    }
+}
+
+/// Bytes per time step of a dynamic run's tip history (`solve::dynamics::TipRecord` and its
+/// row in `tip_history.csv`).
+const TIP_RECORD_BYTES: f64 = 64.0;
+
+/// Estimated peak memory [bytes] of `what` on `case`, with what it was estimated from and the
+/// keys that scale it.
+pub fn estimate(case: &Case, what: Footprint) -> (f64, String, &'static str) {
+    let elements = case.mesh.elements;
+    let e = elements as f64;
+    let n_forward = 6.0 * (e + 1.0);
+    let basis = format!("rod.elements = {elements}");
+    match what {
+        Footprint::Modes => (
+            FIXED_BYTES + 12.0 * n_forward * n_forward * 8.0,
+            format!("{basis}: a dense modal model of {n_forward} unknowns"),
+            "rod.elements",
+        ),
+        Footprint::Run => match &case.analysis {
+            Analysis::Static(_) => (FIXED_BYTES + e * banded_bytes_per_element(6.0), basis, "rod.elements"),
+            Analysis::Dynamic(p) => (
+                FIXED_BYTES + e * banded_bytes_per_element(6.0) + (p.steps as f64 + 1.0) * TIP_RECORD_BYTES,
+                format!("{basis}, time.steps = {}", p.steps),
+                "rod.elements or time.steps",
+            ),
+            Analysis::Inverse(_) => {
+                // the KKT system (12 unknowns per node), the forward data solve beside it
+                let mut bytes = FIXED_BYTES + e * (banded_bytes_per_element(12.0) + banded_bytes_per_element(6.0));
+                let mut basis = basis;
+                if let Some((node_frames, what)) = clip_node_frames(case) {
+                    // positions (3) + κ2, data κ, ω (3), truth (2) per node-frame, twice over
+                    // while it is read
+                    bytes += node_frames * 12.0 * 8.0;
+                    basis = format!("{basis}, {what}");
+                }
+                (bytes, basis, "rod.elements or the clip's frames")
+            }
+        },
+    }
+}
+
+/// Refuse `what` on `case` if its estimate exceeds `limit_bytes`, or the process's
+/// address-space limit where that is lower (an allocation beyond it would fail mid-run).
+pub fn check(case: &Case, what: Footprint, limit_bytes: f64) -> Result<(), BudgetError> {
+    let (bytes, basis, key) = estimate(case, what);
+    let (limit_bytes, address_space) = match address_space_limit() {
+        Some(a) if a < limit_bytes => (a, true),
+        _ => (limit_bytes, false),
+    };
+    if bytes > limit_bytes {
+        let what = match what {
+            Footprint::Run => "the run",
+            Footprint::Modes => "the modal model",
+        };
+        let case = case.origin.source.as_ref().map(|p| p.display().to_string()).unwrap_or_else(|| case.name.clone());
+        return Err(BudgetError { case, what, bytes, limit: limit_bytes, basis, key, address_space });
+    }
+    Ok(())
+}
+
+/// The default limit: half of the machine's memory (`/proc/meminfo`), 4 GiB where unknown.
+pub fn default_limit_bytes() -> f64 {
+    let total_kib = std::fs::read_to_string("/proc/meminfo").ok().and_then(|s| {
+        s.lines().find(|l| l.starts_with("MemTotal:")).and_then(|l| l.split_whitespace().nth(1)?.parse::<f64>().ok())
+    });
+    total_kib.map(|k| k * 1024.0 / 2.0).unwrap_or(4.0 * GIB)
+}

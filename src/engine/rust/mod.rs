@@ -1,0 +1,272 @@
+//! Running a case in the Rust engine on data in memory: a forward case, the forward data of a
+//! synthetic inverse case, one inverse frame ([`run_inverse`]) or a whole clip
+//! ([`clip::run_clip`]), each producing the engine-agnostic [`RunResult`] of [`result`].
+//! The files a case runs on are `super::input`'s, the FreeFEM engine `super::freefem`, the output
+//! folder `crate::output`'s.
+pub mod budget;
+pub mod clip;
+pub mod clip_frame;
+pub mod clip_metrics;
+pub mod frames;
+pub mod metrics;
+pub mod result;
+pub mod weights;
+
+use std::time::Instant;
+
+use nalgebra::{DVector, Vector3};
+
+pub use result::{Engine, InverseOutput, NodalState, RunResult, SolverStats};
+
+use crate::case::{Analysis, Case, DataSource};
+use crate::clip::ClipError;
+use crate::model::mesh::Field;
+use crate::solve::inverse::{Frame, FrameSolver, InverseRecord, Start};
+use crate::solve::sequence::{first_chart, SequenceError};
+use crate::solve::{dynamics, statics, SolveError};
+use metrics::INNER_SKIP_ELEMENTS;
+
+/// Errors of running a case.
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    #[error("rust engine")]
+    Solve(#[from] SolveError),
+    #[error("clip")]
+    Clip(#[from] ClipError),
+    #[error("clip")]
+    Sequence(#[from] SequenceError),
+    #[error("case `{case}` is not {what}")]
+    Kind { case: String, what: &'static str },
+    #[error(
+        "case `{case}`: the single-frame inverse path solves a clip's first frame alone, in the paper's angle chart (eq. 1) from the straight reference state, but this clip's first frame is solved in the rebased chart with singular axis ({:.3}, {:.3}, {:.3}) (clip.rotation = \"rebased\" with clip.gauge or clip.orientation away from e2). `cosserat run` and `cosserat compare` solve the clip frame by frame in its charts; for the single-frame path set clip.rotation = \"global_euler\" or a gauge along e2", axis[0], axis[1], axis[2]
+    )]
+    Chart { case: String, axis: [f64; 3] },
+    #[error("writing the clip")]
+    Sink(#[source] Box<dyn std::error::Error + Send + Sync>),
+    #[error("resuming the clip: {0}")]
+    Resume(clip::ResumeError),
+    #[error("the clip's frame generator stopped after {received} of {total} frames")]
+    Generator { received: usize, total: usize },
+    /// A forward solve diverged: the error, with the largest load of the case named (a load
+    /// far beyond the rod's stiffness is the usual cause).
+    #[error("rust engine: the solve could not follow the loads, the largest of which is {key} = \"{expr}\" = {value:e} (check its magnitude and units, or raise solver.continuation_steps of a static case)")]
+    Diverged { source: SolveError, key: String, expr: String, value: f64 },
+    /// The solver stopped without meeting its rule; `partial` holds the last iterate and the
+    /// history up to there (sweeps keep it so that non-converging values still show).
+    #[error("rust engine stopped after {} iterations without meeting its stopping rule", .partial.stats.iterations)]
+    Incomplete {
+        #[source]
+        source: SolveError,
+        partial: Box<RunResult>,
+    },
+}
+
+impl RunError {
+    /// Did the run stop because a stop was requested (`crate::interrupt`)?
+    pub fn is_interrupted(&self) -> bool {
+        match self {
+            RunError::Solve(e) | RunError::Incomplete { source: e, .. } | RunError::Diverged { source: e, .. } => {
+                matches!(e, SolveError::Interrupted { .. })
+            }
+            RunError::Sequence(SequenceError::Solve(e)) => matches!(e, SolveError::Interrupted { .. }),
+            _ => false,
+        }
+    }
+
+    fn kind(case: &Case, what: &'static str) -> Self {
+        RunError::Kind { case: case.name.clone(), what }
+    }
+}
+
+/// Run a forward (static or dynamic) case in the Rust engine; `progress(done, total)` per
+/// iteration or time step. A diverged solve names the case's largest load.
+pub fn run_forward(case: &Case, progress: impl FnMut(usize, usize)) -> Result<RunResult, RunError> {
+    run_forward_solve(case, progress).map_err(|e| match e {
+        RunError::Solve(source @ (SolveError::Diverged { .. } | SolveError::Linear(_))) => {
+            let s: Vec<f64> = (0..case.mesh.nodes()).map(|i| case.mesh.node_s(i)).collect();
+            let end = match &case.analysis {
+                Analysis::Dynamic(p) => p.end_time_s,
+                _ => 0.0,
+            };
+            let big = [0.0, end]
+                .iter()
+                .filter_map(|&t| case.loads.largest(&s, t))
+                .max_by(|a, b| a.2.abs().total_cmp(&b.2.abs()));
+            match big {
+                Some((key, expr, value)) => RunError::Diverged { source, key, expr, value },
+                None => RunError::Solve(source),
+            }
+        }
+        e => e,
+    })
+}
+
+fn run_forward_solve(case: &Case, mut progress: impl FnMut(usize, usize)) -> Result<RunResult, RunError> {
+    let problem = case.problem();
+    let start = Instant::now();
+    match &case.analysis {
+        Analysis::Static(params) => {
+            let sol = statics::solve(&problem, params, |r| progress(r.iteration, params.max_iterations))?;
+            let result = RunResult {
+                engine: Engine::Rust,
+                nodes: NodalState::from_vector(&case.mesh, &sol.u),
+                history: sol.history.clone(),
+                tip: Vec::new(),
+                stats: SolverStats {
+                    iterations: sol.iterations,
+                    last_change: Some(sol.last_change),
+                    residual: Some(sol.residual),
+                    max_newton_iterations: None,
+                    certificate: Some(sol.certificate.value),
+                    wall_time_s: start.elapsed().as_secs_f64(),
+                },
+                inverse: None,
+            };
+            match sol.converged() {
+                Ok(_) => Ok(result),
+                Err(source) => Err(RunError::Incomplete { source, partial: Box::new(result) }),
+            }
+        }
+        Analysis::Dynamic(params) => {
+            let sol = dynamics::solve(&problem, params, &mut progress)?;
+            Ok(RunResult {
+                engine: Engine::Rust,
+                nodes: NodalState::from_vector(&case.mesh, &sol.u),
+                history: Vec::new(),
+                tip: sol.tip,
+                stats: SolverStats {
+                    iterations: sol.total_newton_iterations,
+                    last_change: None,
+                    residual: None,
+                    max_newton_iterations: Some(sol.max_newton_iterations),
+                    certificate: Some(sol.max_certificate),
+                    wall_time_s: start.elapsed().as_secs_f64(),
+                },
+                inverse: None,
+            })
+        }
+        Analysis::Inverse(_) => Err(RunError::kind(case, "a forward case")),
+    }
+}
+
+/// The data of a synthetic inverse case: the Rust forward engine on [`Case::data_case`] (I7).
+pub fn forward_data(case: &Case) -> Result<NodalState, RunError> {
+    let data_case = case.data_case().ok_or_else(|| RunError::kind(case, "an inverse case with [data]"))?;
+    match run_forward(&data_case, |_, _| {}) {
+        Ok(r) => Ok(r.nodes),
+        Err(RunError::Incomplete { source, .. }) => Err(source.into()),
+        Err(e) => Err(e),
+    }
+}
+
+/// Does the data source of an inverse case carry the true angles (synthetic forward data)?
+pub fn angles_known(case: &Case) -> bool {
+    matches!(case.inverse().map(|i| &i.data), Some(DataSource::Forward(_)))
+}
+
+/// The single-frame path (`run_inverse`: `compare` and `sweep` on a clip case) solves a clip's
+/// first frame in the paper's chart from the straight reference state, as the FreeFEM engine
+/// does. A clip whose first frame the clip driver solves in another chart (`clip.rotation =
+/// "rebased"` with `clip.gauge` or `clip.orientation` away from e2) is refused: from the straight
+/// state in a rotated chart the scheme reaches a spurious root, and in the paper's chart the
+/// settings would be ignored.
+pub fn check_single_frame(case: &Case) -> Result<(), RunError> {
+    match case.sequence_params().map(|sp| first_chart(&sp)) {
+        Some(chart) if !chart.is_identity() => {
+            Err(RunError::Chart { case: case.name.clone(), axis: chart.axis().into() })
+        }
+        _ => Ok(()),
+    }
+}
+
+/// Solve the inverse case `case` as one first frame (Remark 6) in the Rust engine on the data
+/// `data` (its positions; for synthetic data also the true angles, for the curvature errors),
+/// from the straight reference state in the paper's chart ([`check_single_frame`]).
+pub fn run_inverse(
+    case: &Case,
+    data: &NodalState,
+    mut progress: impl FnMut(usize, usize),
+) -> Result<RunResult, RunError> {
+    let settings = case.inverse().ok_or_else(|| RunError::kind(case, "an inverse case"))?;
+    check_single_frame(case)?;
+    let params = settings.params;
+    let problem = case.problem();
+    let start = Instant::now();
+    let known = angles_known(case);
+    let truth: Vec<Vector3<f64>> = data.element_curvature().into_iter().map(|(_, k)| k).collect();
+    let mut kappa_err = Vec::new();
+    let observer = |r: &InverseRecord, u: &DVector<f64>, _: &DVector<f64>| {
+        if crate::interrupt::requested() {
+            std::panic::resume_unwind(Box::new(StopRequested { iteration: r.iteration }));
+        }
+        if known {
+            let k: Vec<Vector3<f64>> =
+                NodalState::from_vector(&case.mesh, u).element_curvature().into_iter().map(|(_, k)| k).collect();
+            kappa_err.push([
+                metrics::relative_error(&k, &truth, 0),
+                metrics::relative_error(&k, &truth, INNER_SKIP_ELEMENTS),
+            ]);
+        }
+        progress(r.iteration, params.max_iterations)
+    };
+    let frame = Frame { index: 0, x_g: &data.x, previous: None, weight: None };
+    let solve = || FrameSolver::new(&problem, params).solve(&frame, &problem.reference_state(), Start::Guess, observer);
+    let sol = match std::panic::catch_unwind(std::panic::AssertUnwindSafe(solve)) {
+        Ok(solved) => solved?,
+        Err(payload) => match payload.downcast::<StopRequested>() {
+            Ok(stop) => {
+                let total = params.max_iterations;
+                return Err(SolveError::Interrupted { what: "iterations", done: stop.iteration, total }.into());
+            }
+            Err(panic) => std::panic::resume_unwind(panic),
+        },
+    };
+    let dofs = problem.dofs();
+    let result = RunResult {
+        engine: Engine::Rust,
+        nodes: NodalState::from_vector(&case.mesh, &sol.u),
+        history: Vec::new(),
+        tip: Vec::new(),
+        stats: SolverStats {
+            iterations: sol.history.len(),
+            last_change: sol.history.last().map(|h| h.rel_change),
+            residual: None,
+            max_newton_iterations: None,
+            certificate: Some(sol.certificate.value),
+            wall_time_s: start.elapsed().as_secs_f64(),
+        },
+        inverse: Some(InverseOutput {
+            data: data.clone(),
+            angles_known: known,
+            xhat: dofs.field(&sol.adjoint, Field::X),
+            ahat: dofs.field(&sol.adjoint, Field::Alpha),
+            history: sol.history.clone(),
+            kappa_err,
+            lambda_f: params.weights.lambda_f,
+            lambda_l: params.weights.lambda_l,
+        }),
+    };
+    match sol.converged(0) {
+        Ok(_) => Ok(result),
+        Err(source) => Err(RunError::Incomplete { source, partial: Box::new(result) }),
+    }
+}
+
+/// The unwind that stops an inverse solve at its next iteration once a stop is requested
+/// (`crate::interrupt`): the frame solver (`solve::inverse`) checks for no stop itself and its
+/// observer can only watch, so the observer unwinds out of it with this payload (no panic
+/// message: `resume_unwind` skips the panic hook) and [`run_inverse`] turns it into
+/// `SolveError::Interrupted`. The solver's state is dropped; nothing of it is kept.
+struct StopRequested {
+    iteration: usize,
+}
+
+/// Run `case` in the Rust engine from memory: a forward case, or a synthetic inverse case on
+/// its forward data generated here (identical to what `data.csv` holds: the file round-trips
+/// `f64` exactly). Clips are read from files: `crate::engine`.
+pub fn run_rust(case: &Case, progress: impl FnMut(usize, usize)) -> Result<RunResult, RunError> {
+    match &case.analysis {
+        Analysis::Inverse(_) => run_inverse(case, &forward_data(case)?, progress),
+        _ => run_forward(case, progress),
+    }
+}

@@ -1,0 +1,242 @@
+//! Heatmaps (kymographs) and the colour bar every colour-coded figure carries: the quantity and
+//! its unit beside a bar of the colour scale with round ticks ([`draw_colour_bar`], also used by
+//! the posture figures of [`super::posture`]).
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
+use std::ops::Range;
+
+use super::plot::{
+    axis_tick, draw_err, fit_font, font, nice_ticks, render, text_style, title_strip, PlotError, CHAR_WIDTH, DESC_PX,
+    LEGEND_PX, TICK_PX, TITLE_PX, TITLE_STRIP,
+};
+
+/// Width of the strip right of a heatmap: head/tail labels, colour bar, its ticks and label [px].
+pub(crate) const COLOUR_BAR_STRIP: u32 = 170;
+
+/// How values map to colours on a heatmap.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ColourScale {
+    /// Symmetric about 0: blue < 0 < red, clipped at ± the limit.
+    #[default]
+    Diverging,
+    /// From 0 (white) to the limit (dark red), for values ≥ 0.
+    Sequential,
+}
+
+impl ColourScale {
+    /// The colour of `v` on this scale clipped at `limit`.
+    fn colour(self, v: f64, limit: f64) -> RGBColor {
+        let t = if limit > 0.0 && v.is_finite() { v / limit } else { 0.0 };
+        match self {
+            ColourScale::Diverging => diverging(t.clamp(-1.0, 1.0)),
+            ColourScale::Sequential => diverging(t.clamp(0.0, 1.0)),
+        }
+    }
+    /// The range the colour bar shows.
+    fn range(self, limit: f64) -> (f64, f64) {
+        match self {
+            ColourScale::Diverging => (-limit, limit),
+            ColourScale::Sequential => (0.0, limit),
+        }
+    }
+}
+
+/// Blue (−1) through white (0) to dark red (+1); on [0, 1] the sequential scale.
+fn diverging(t: f64) -> RGBColor {
+    let (r, g, b) = if t >= 0.0 { (1.0 - 0.3 * t, 1.0 - t, 1.0 - t) } else { (1.0 + t, 1.0 + 0.7 * t, 1.0 - 0.3 * t) };
+    RGBColor((r * 255.0) as u8, (g * 255.0) as u8, (b * 255.0) as u8)
+}
+
+/// A value field over a regular grid drawn as coloured cells (a kymograph): `values[i][j]` at
+/// `(x[i], y[j])`, on `scale` clipped at `limit`, with a colour bar labelled `colour_label`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Heatmap {
+    pub title: String,
+    pub x_label: String,
+    pub y_label: String,
+    pub x: Vec<f64>,
+    pub y: Vec<f64>,
+    pub values: Vec<Vec<f64>>,
+    /// The colour scale ends at ± this (a diverging scale) or at this (a sequential one).
+    pub limit: f64,
+    /// The colour bar's label: the quantity and its unit, e.g. `"κ2 [1/m]"`.
+    pub colour_label: String,
+    pub scale: ColourScale,
+    /// Labels of the bottom and top ends of the y axis (e.g. head and tail).
+    pub y_ends: Option<(String, String)>,
+}
+
+impl Heatmap {
+    /// A kymograph: time `t` [s] along x, arc length `s` [mm] along y from the head (s = 0) to
+    /// the tail; diverging colours about 0.
+    pub fn kymograph(
+        title: String,
+        times_s: Vec<f64>,
+        s_mm: Vec<f64>,
+        values: Vec<Vec<f64>>,
+        limit: f64,
+        colour_label: String,
+    ) -> Self {
+        Heatmap {
+            title,
+            x_label: "t [s]".into(),
+            y_label: "arc length s [mm]".into(),
+            x: times_s,
+            y: s_mm,
+            values,
+            limit,
+            colour_label,
+            scale: ColourScale::Diverging,
+            y_ends: Some(("head".into(), "tail".into())),
+        }
+    }
+}
+
+/// A vertical colour bar in `area` (coordinates relative to it) at `x`, spanning the pixel
+/// rows `y` (top to bottom: `hi` to `lo`), with round ticks and `label` (the quantity and its
+/// unit) written upwards beside them. `colour(t)` gives the colour of `t` in [0, 1].
+pub(crate) fn draw_colour_bar<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    x: i32,
+    y: Range<i32>,
+    colour: &dyn Fn(f64) -> RGBColor,
+    (lo, hi): (f64, f64),
+    label: &str,
+) -> Result<(), PlotError> {
+    let (bar_w, h) = (22, (y.end - y.start).max(1));
+    let steps = 64;
+    for k in 0..steps {
+        let (ya, yb) = (y.end - k * h / steps, y.end - (k + 1) * h / steps);
+        let c = colour((k as f64 + 0.5) / steps as f64);
+        area.draw(&Rectangle::new([(x, ya), (x + bar_w, yb)], c.filled())).map_err(|e| draw_err(label, e))?;
+    }
+    area.draw(&Rectangle::new([(x, y.start), (x + bar_w, y.end)], BLACK.stroke_width(1)))
+        .map_err(|e| draw_err(label, e))?;
+    let span = hi - lo;
+    let mut widest = 0;
+    for v in nice_ticks(lo, hi, 5) {
+        let py = if span > 0.0 { y.end - ((v - lo) / span * h as f64).round() as i32 } else { (y.start + y.end) / 2 };
+        area.draw(&PathElement::new(vec![(x + bar_w, py), (x + bar_w + 5, py)], BLACK.stroke_width(1)))
+            .map_err(|e| draw_err(label, e))?;
+        let s = axis_tick(v, span);
+        widest = widest.max(s.chars().count());
+        area.draw_text(&s, &text_style(TICK_PX), (x + bar_w + 8, py)).map_err(|e| draw_err(label, e))?;
+    }
+    let lx = x + bar_w + 14 + (widest as f64 * CHAR_WIDTH * TICK_PX as f64) as i32 + DESC_PX as i32 / 2;
+    let style = TextStyle::from(font(fit_font(label, h as u32, DESC_PX)).transform(FontTransform::Rotate270))
+        .pos(Pos::new(HPos::Center, VPos::Center));
+    area.draw_text(label, &style, (lx, (y.start + y.end) / 2)).map_err(|e| draw_err(label, e))
+}
+
+/// Checks the grid of every map.
+fn validate_maps(maps: &[Heatmap]) -> Result<(), PlotError> {
+    if maps.is_empty() {
+        return Err(PlotError::InvalidGrid { panels: 0, cols: 0 });
+    }
+    for m in maps {
+        if m.x.len() < 2
+            || m.y.len() < 2
+            || m.values.len() != m.x.len()
+            || m.values.iter().any(|r| r.len() != m.y.len())
+        {
+            return Err(PlotError::LengthMismatch {
+                title: m.title.clone(),
+                series: "values".into(),
+                x_len: m.x.len(),
+                y_len: m.y.len(),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// One heatmap in `area`: title strip, cells, the y ends' labels and the colour bar.
+fn draw_heatmap<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, m: &Heatmap) -> Result<(), PlotError> {
+    let t = m.title.as_str();
+    let (w, _) = area.dim_in_pixel();
+    let body = title_strip(area, t, TITLE_STRIP, TITLE_PX)?;
+    let (chart_area, _) = body.split_horizontally(w - COLOUR_BAR_STRIP);
+    let (x0, x1) = (m.x[0], m.x[m.x.len() - 1]);
+    let (y0, y1) = (m.y[0], m.y[m.y.len() - 1]);
+    let mut chart = ChartBuilder::on(&chart_area)
+        .margin(10)
+        .x_label_area_size(58)
+        .y_label_area_size(80)
+        .build_cartesian_2d(x0..x1, y0..y1)
+        .map_err(|e| draw_err(t, e))?;
+    let (sx, sy) = (x1 - x0, y1 - y0);
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .x_desc(m.x_label.as_str())
+        .y_desc(m.y_label.as_str())
+        .label_style(font(TICK_PX))
+        .axis_desc_style(font(DESC_PX))
+        .x_label_formatter(&|v| axis_tick(*v, sx))
+        .y_label_formatter(&|v| axis_tick(*v, sy))
+        .draw()
+        .map_err(|e| draw_err(t, e))?;
+    let half = |v: &[f64], i: usize| -> (f64, f64) {
+        let lo = if i == 0 { v[0] } else { 0.5 * (v[i - 1] + v[i]) };
+        let hi = if i + 1 == v.len() { v[i] } else { 0.5 * (v[i] + v[i + 1]) };
+        (lo, hi)
+    };
+    let cells = (0..m.x.len()).flat_map(|i| (0..m.y.len()).map(move |j| (i, j))).map(|(i, j)| {
+        let (xa, xb) = half(&m.x, i);
+        let (ya, yb) = half(&m.y, j);
+        Rectangle::new([(xa, ya), (xb, yb)], m.scale.colour(m.values[i][j], m.limit).filled())
+    });
+    chart.draw_series(cells).map_err(|e| draw_err(t, e))?;
+    // the plotting area in the pixels of `area`
+    let (px, py) = chart.plotting_area().get_pixel_range();
+    let base = area.get_base_pixel();
+    let (right, rows) = (px.end - base.0, (py.start - base.1)..(py.end - base.1));
+    if let Some((bottom, top)) = &m.y_ends {
+        area.draw_text(top, &text_style(LEGEND_PX).pos(Pos::new(HPos::Left, VPos::Top)), (right + 6, rows.start))
+            .map_err(|e| draw_err(t, e))?;
+        area.draw_text(bottom, &text_style(LEGEND_PX).pos(Pos::new(HPos::Left, VPos::Bottom)), (right + 6, rows.end))
+            .map_err(|e| draw_err(t, e))?;
+    }
+    let (scale, limit) = (m.scale, m.limit);
+    let (lo, hi) = scale.range(limit);
+    let colour = move |u: f64| scale.colour(lo + u * (hi - lo), limit);
+    draw_colour_bar(area, right + 50, rows, &colour, (lo, hi), &m.colour_label)
+}
+
+/// Size of one heatmap [px]: wide, for a long time axis.
+pub const HEATMAP_SIZE: (u32, u32) = (1200, 440);
+
+/// Heatmaps from top to bottom (one column, as the paper's kymographs) in one SVG, each with its
+/// colour bar.
+pub fn render_heatmaps_svg(maps: &[Heatmap]) -> Result<String, PlotError> {
+    validate_maps(maps)?;
+    let size = (HEATMAP_SIZE.0, HEATMAP_SIZE.1 * maps.len() as u32);
+    let title = maps[0].title.clone();
+    render(size, &title, |root| {
+        for (m, area) in maps.iter().zip(root.split_evenly((maps.len(), 1))) {
+            draw_heatmap(&area, m)?;
+        }
+        Ok(())
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::figures::plot::smallest_text;
+
+    #[test]
+    fn heatmap_has_a_colour_bar_with_its_unit_and_the_ends_labelled() {
+        let x = vec![0.0, 0.04, 0.08];
+        let y = vec![0.0, 0.5, 1.0];
+        let values = vec![vec![-1.0, 0.0, 1.0]; 3];
+        let m = Heatmap::kymograph("k".into(), x, y, values, 1.0, "κ2 [1/mm]".into());
+        let svg = render_heatmaps_svg(&[m]).unwrap();
+        for text in ["κ2 [1/mm]", "t [s]", "\nhead\n", "\ntail\n", "\n-1\n", "\n0\n", "\n1\n"] {
+            assert!(svg.contains(text), "missing {text}");
+        }
+        assert!(smallest_text(&svg) >= 12.0);
+    }
+}

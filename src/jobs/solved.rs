@@ -1,0 +1,276 @@
+//! One run of a case into a folder, the core shared by `cosserat run` ([`super::job`]), the
+//! points of a sweep or an audit ([`super::sweep`]) and a batch of recordings: a forward or
+//! single-frame inverse run writes its files (the last iterate's too, when it stops at its
+//! iteration limit), a clip streams its frames and then its figures over the frames solved.
+//! The caller owns the folder and its `run.json` ([`crate::output::run_folder`]).
+use std::path::Path;
+
+use crate::case::Case;
+use crate::engine::input::data::write_data;
+use crate::engine::rust::clip::{ClipFrame, ClipRun};
+use crate::engine::rust::clip_metrics::clip_metrics;
+use crate::engine::rust::metrics::{all_metrics, Metrics};
+use crate::engine::rust::{Engine, RunError, RunResult};
+use crate::engine::{load_data, run_case, run_inverse_on, EngineError};
+use crate::output::clip_output::remove_raw;
+use crate::output::clip_run::{run_clip_to, write_clip_figures, ClipOptions};
+use crate::output::journal::remove_journal;
+use crate::output::run_files::write_run;
+use crate::output::run_folder::{CertificateSummary, Status};
+use crate::solve::sequence::FrameReport;
+use crate::solve::SolveError;
+
+/// How one run ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RunStatus {
+    Ok,
+    /// iteration limit reached; the metrics are those of the last iterate
+    NotConverged,
+    /// the iteration stopped moving but its residual certificate is above the tolerance
+    /// (`solve::Stop::Stalled`); the metrics are those of the last iterate
+    Stalled,
+    /// a clip solved whole, with frames over the fit-quality gate (`solve::fit`): every frame
+    /// is certified, but some do not follow their data
+    Warnings,
+    Failed,
+    /// stopped by a signal (or not started because of one)
+    Interrupted,
+}
+
+impl RunStatus {
+    /// A result whole: `ok`, or a clip complete with warnings.
+    pub fn is_complete(&self) -> bool {
+        matches!(self, RunStatus::Ok | RunStatus::Warnings)
+    }
+
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            RunStatus::Ok => "ok",
+            RunStatus::NotConverged => "not_converged",
+            RunStatus::Stalled => "stalled",
+            RunStatus::Warnings => "complete_with_warnings",
+            RunStatus::Failed => "failed",
+            RunStatus::Interrupted => "interrupted",
+        }
+    }
+
+    /// The status of the run's folder (`run.json`).
+    pub fn folder_status(&self) -> Status {
+        match self {
+            RunStatus::Ok => Status::Complete,
+            RunStatus::NotConverged | RunStatus::Failed => Status::Failed,
+            RunStatus::Stalled => Status::Stalled,
+            RunStatus::Warnings => Status::CompleteWithWarnings,
+            RunStatus::Interrupted => Status::Interrupted,
+        }
+    }
+}
+
+/// What one run left in its folder.
+pub struct Solved {
+    pub status: RunStatus,
+    /// why it failed or stopped (the error and its causes, prefixed by the case)
+    pub error: Option<String>,
+    /// the metrics of a single run (also of the last iterate of one that did not converge) or
+    /// of a complete clip (`engine::rust::clip_metrics`)
+    pub metrics: Option<Metrics>,
+    /// a single run's result
+    pub single: Option<RunResult>,
+    /// a clip's summary over the frames it holds
+    pub clip: Option<ClipRun>,
+    /// clips: frames in the folder and frames of the clip
+    pub frames: Option<(usize, usize)>,
+    /// it stopped because the disk (or quota) was full (`crate::io::disk`)
+    pub disk_full: bool,
+}
+
+impl Solved {
+    /// The residual certificate of the result for `run.json` (`docs/certificate.md`): the
+    /// `certificate` metric (a clip's: the largest of its frames) against the case's tolerance.
+    pub fn certificate(&self, case: &Case) -> Option<CertificateSummary> {
+        let value = match (&self.metrics, &self.single, &self.clip) {
+            (Some(m), _, _) if m.contains_key("certificate") => m["certificate"],
+            (_, Some(r), _) => r.stats.certificate?,
+            (_, _, Some(c)) if !c.reports.is_empty() => c.reports.iter().map(|r| r.certificate).fold(0.0, f64::max),
+            _ => return None,
+        };
+        let flagged_frames = self.clip.as_ref().map(|c| c.reports.iter().filter(|r| r.fit.flagged).count());
+        Some(CertificateSummary { value, tolerance: case.certificate_tolerance(), flagged_frames })
+    }
+
+    /// A run that produced nothing, with its error.
+    pub fn failed(error: String) -> Self {
+        Solved {
+            status: RunStatus::Failed,
+            error: Some(error),
+            metrics: None,
+            single: None,
+            clip: None,
+            frames: None,
+            disk_full: false,
+        }
+    }
+
+    /// A run that produced nothing, with its error `e` described as `error`.
+    fn failed_by(error: String, e: &(dyn std::error::Error + 'static)) -> Self {
+        Solved { disk_full: crate::io::disk::is_full(e), ..Solved::failed(error) }
+    }
+
+    /// A run stopped (or not started) by a signal.
+    pub fn interrupted() -> Self {
+        Solved { status: RunStatus::Interrupted, ..Solved::failed("interrupted by a signal".into()) }
+    }
+}
+
+/// Run `case` in `engine` into the folder `dir` (which the caller has claimed). A clip runs in
+/// the Rust engine only, with `clip` (journal, resume); its frames are shown to `observer`.
+/// `progress(done, total)` follows iterations, time steps or frames.
+pub fn solve_into(
+    case: &Case,
+    engine: Engine,
+    dir: &Path,
+    clip: ClipOptions,
+    observer: impl FnMut(&ClipFrame) + Send,
+    progress: impl FnMut(usize, usize),
+) -> Solved {
+    if crate::interrupt::requested() {
+        return Solved::interrupted();
+    }
+    if case.clip().is_some() {
+        solve_clip(case, engine, dir, clip, observer, progress)
+    } else {
+        solve_single(case, engine, dir, progress)
+    }
+}
+
+fn solve_single(case: &Case, engine: Engine, dir: &Path, progress: impl FnMut(usize, usize)) -> Solved {
+    let work = dir.join("freefem_work");
+    let result = if case.inverse().is_some() {
+        let path = dir.join("data.csv");
+        match load_data(case).and_then(|d| Ok(write_data(&path, &d)?)) {
+            Ok(()) => run_inverse_on(case, engine, &path, &work, progress),
+            Err(e) => {
+                let status = if interrupted(&e) { RunStatus::Interrupted } else { RunStatus::Failed };
+                let error = format!("{}: generating the data: {}", case_label(case), chain(&e));
+                return Solved { status, ..Solved::failed_by(error, &e) };
+            }
+        }
+    } else {
+        run_case(case, engine, &work, progress)
+    };
+    let (status, r, error) = match result {
+        Ok(r) => (RunStatus::Ok, r, None),
+        Err(EngineError::Run(RunError::Incomplete { source, partial })) => (
+            if matches!(source, SolveError::Stalled(_)) { RunStatus::Stalled } else { RunStatus::NotConverged },
+            *partial,
+            Some(format!("{}: {source}; the files here hold the last iterate", case_label(case))),
+        ),
+        Err(e) => {
+            let status = if interrupted(&e) { RunStatus::Interrupted } else { RunStatus::Failed };
+            return Solved { status, ..Solved::failed_by(format!("{}: {}", case_label(case), chain(&e)), &e) };
+        }
+    };
+    let m = match all_metrics(case, &r) {
+        Ok(m) => m,
+        Err(e) => return Solved::failed(format!("{}: {}", case_label(case), chain(&e))),
+    };
+    match write_run(case, &r, &m, dir) {
+        Ok(_) => {
+            Solved { status, error, metrics: Some(m), single: Some(r), clip: None, frames: None, disk_full: false }
+        }
+        Err(e) => Solved::failed_by(format!("{}: {}", case_label(case), chain(&e)), &e),
+    }
+}
+
+/// Did the engine stop because a stop was requested (`crate::interrupt`)?
+fn interrupted(e: &EngineError) -> bool {
+    match e {
+        EngineError::Run(r) => r.is_interrupted(),
+        EngineError::FreeFem(f) => f.is_interrupted(),
+        _ => false,
+    }
+}
+
+fn solve_clip(
+    case: &Case,
+    engine: Engine,
+    dir: &Path,
+    opts: ClipOptions,
+    observer: impl FnMut(&ClipFrame) + Send,
+    progress: impl FnMut(usize, usize),
+) -> Solved {
+    let fail =
+        |e: &(dyn std::error::Error + 'static)| Solved::failed_by(format!("{}: {}", case_label(case), chain(e)), e);
+    if engine != Engine::Rust {
+        return Solved::failed(format!(
+            "{}: `run` solves clips in the Rust engine (`--engine rust`); to run a clip in FreeFEM against it, use `cosserat compare CASE --frames N` (or `--frames all`)",
+            case_label(case)
+        ));
+    }
+    let out = match run_clip_to(case, dir, opts, observer, progress) {
+        Ok(out) => out,
+        Err(e) => return fail(&e),
+    };
+    let (done, total) = (out.run.reports.len(), out.total);
+    let flagged: Vec<&FrameReport> = out.run.reports.iter().filter(|r| r.fit.flagged).collect();
+    let mut disk_full = out.stopped.as_ref().is_some_and(|e| crate::io::disk::is_full(e));
+    let (mut status, mut error) = match &out.stopped {
+        None if !flagged.is_empty() => (RunStatus::Warnings, Some(flag_message(case, &flagged, done))),
+        None => (RunStatus::Ok, None),
+        Some(e) if e.is_interrupted() => (RunStatus::Interrupted, Some(format!("{}: {}", case_label(case), chain(e)))),
+        Some(e) => (
+            RunStatus::Failed,
+            Some(format!("{}: {}; the converged frames before it are in this folder", case_label(case), chain(e))),
+        ),
+    };
+    // A clip whose figures cannot be written keeps its frames (and says so).
+    let figures = if done > 0 { write_clip_figures(case, &out.run, dir) } else { Ok(()) };
+    if let Err(e) = figures {
+        disk_full |= crate::io::disk::is_full(&e);
+        error = Some(match error {
+            Some(m) => format!("{m}; then {}", chain(&e)),
+            None => format!("{}: {}", case_label(case), chain(&e)),
+        });
+        status = RunStatus::Failed;
+    }
+    if status.is_complete() && opts.journal {
+        if let Err(e) = remove_journal(dir).and_then(|_| remove_raw(dir)) {
+            return Solved::failed_by(chain(&e), &e);
+        }
+    }
+    let metrics = status.is_complete().then(|| clip_metrics(case, &out.run));
+    Solved { status, error, metrics, single: None, clip: Some(out.run), frames: Some((done, total)), disk_full }
+}
+
+/// The message of a clip whose frames `flagged` (of `done`) are over the fit-quality gate.
+fn flag_message(case: &Case, flagged: &[&FrameReport], done: usize) -> String {
+    let first = flagged[0];
+    let (h, length) = (case.mesh.h(), case.mesh.length_m);
+    let gate = case.clip().map(|c| c.gate).unwrap_or_default();
+    format!(
+        "{}: {} of {done} frames are over the fit-quality gate (`flagged` in frames.csv; docs/certificate.md C5): each is certified, but does not follow its data. The first is frame {}: {}",
+        case_label(case),
+        flagged.len(),
+        first.frame,
+        first.fit.reason(&gate, length, h)
+    )
+}
+
+/// The case's name and file, for messages.
+pub fn case_label(case: &Case) -> String {
+    match &case.origin.source {
+        Some(p) => format!("case {} ({})", case.name, p.display()),
+        None => format!("case {}", case.name),
+    }
+}
+
+/// An error and its causes, `: `-separated.
+pub fn chain(e: &dyn std::error::Error) -> String {
+    let mut s = e.to_string();
+    let mut src = e.source();
+    while let Some(c) = src {
+        s += &format!(": {c}");
+        src = c.source();
+    }
+    s
+}

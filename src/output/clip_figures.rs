@@ -1,0 +1,263 @@
+//! The summary figures of a clip run, written at the end over the frames solved: `plot.svg`,
+//! `kymograph.svg`, `omega.svg`, `truth.svg` and `truth_errors.svg`.
+use std::path::Path;
+
+use crate::case::Case;
+use crate::engine::rust::clip::ClipRun;
+use crate::figures::heatmap::{render_heatmaps_svg, ColourScale, Heatmap};
+use crate::figures::plot::{render_panels_svg, LinePlot, Series};
+use crate::io::files::{write_plot, OutputError};
+use crate::solve::sequence::FrameReport;
+
+/// The times of a clip run's frames [s] (frame number × Δt) as the x axis of its per-frame
+/// figures and kymographs.
+struct FrameAxis(Vec<f64>);
+
+impl FrameAxis {
+    fn new(case: &Case, reports: &[FrameReport]) -> Self {
+        let dt = frame_interval_s(case);
+        FrameAxis(reports.iter().map(|r| r.frame as f64 * dt).collect())
+    }
+    fn series(&self, label: &str, y: Vec<f64>) -> Series {
+        Series::new(label, self.0.clone(), y)
+    }
+    fn plot(title: String, y_label: &str, series: Vec<Series>, log_y: bool) -> LinePlot {
+        LinePlot { title, x_label: "t [s]".into(), y_label: y_label.into(), series, log_y, ..Default::default() }
+    }
+    /// The times of the frames `frames` (indices into the reports).
+    fn at(&self, frames: &[usize]) -> Vec<f64> {
+        frames.iter().map(|&i| self.0[i]).collect()
+    }
+}
+
+/// The clip's frame interval Δt [s].
+fn frame_interval_s(case: &Case) -> f64 {
+    case.inverse().map_or(1.0, |i| i.params.frame_interval_s)
+}
+
+/// A kymograph of a clip run: `values` (already in the unit of `colour_label`) over the frames'
+/// times and `s_mm`, clipped at ±`limit`.
+fn kymograph(
+    title: String,
+    t: Vec<f64>,
+    s_mm: Vec<f64>,
+    values: Vec<Vec<f64>>,
+    limit: f64,
+    colour_label: &str,
+) -> Heatmap {
+    Heatmap::kymograph(title, t, s_mm, values, limit, colour_label.into())
+}
+
+/// Recovered vs true for a synthetic clip (`truth.svg`): bending κ1² + κ2² kymographs (true,
+/// recovered) and per frame the errors, the roll offset against the true roll, and κ3.
+pub fn write_truth_plot(case: &Case, run: &ClipRun, path: &Path) -> Result<(), OutputError> {
+    let Some(t) = &run.truth else { return Ok(()) };
+    let nf = t.comparisons.len();
+    if nf < 2 {
+        return Ok(());
+    }
+    let axis = FrameAxis::new(case, &run.reports);
+    let (s, plot) = (|l: &str, y| axis.series(l, y), FrameAxis::plot);
+    let c = &t.comparisons;
+    let panels = vec![
+        plot(
+            format!("{}: errors against the ground truth", case.name),
+            "relative error / rad",
+            vec![
+                s("|x - x_true|/|x_true|", c.iter().map(|v| v.position_rel_l2).collect()),
+                s("bending k1^2+k2^2, rel. L2", c.iter().map(|v| v.bending_rel_l2).collect()),
+                s("max angle(d3, true d3) [rad]", c.iter().map(|v| v.max_tangent_angle_rad).collect()),
+            ],
+            true,
+        ),
+        plot(
+            "roll of the frame about d3".into(),
+            "angle [rad]",
+            vec![
+                s("true roll psi of the bending plane", t.roll_rad.clone()),
+                s("recovered d1 vs true d1 (offset)", c.iter().map(|v| v.roll_offset_rad).collect()),
+            ],
+            false,
+        ),
+        plot(
+            "twist κ3".into(),
+            "κ3 [1/mm]",
+            vec![
+                s("true", t.twist_per_m.iter().map(|v| v * 1e-3).collect()),
+                s("recovered (mean over inner nodes)", c.iter().map(|v| v.twist_mean_per_m * 1e-3).collect()),
+                s("rms error", c.iter().map(|v| v.twist_rms_error_per_m * 1e-3).collect()),
+            ],
+            false,
+        ),
+        plot(
+            "angle chart: min |cos beta| over the nodes".into(),
+            "|cos beta|",
+            vec![s("rebased chart", run.reports.iter().map(|r| r.min_cos_beta).collect())],
+            false,
+        ),
+    ];
+    let lines = path.with_file_name("truth_errors.svg");
+    write_plot(&lines, render_panels_svg(&panels, 2))?;
+    let fs = nf.div_ceil(150);
+    let frames: Vec<usize> = (0..nf).step_by(fs).collect();
+    let x = axis.at(&frames);
+    let m = t.bending_true[0].len();
+    let cols: Vec<usize> = (0..m).step_by(m.div_ceil(64)).collect();
+    let y: Vec<f64> = cols.iter().map(|&j| j as f64 * case.mesh.h() * 1e3).collect();
+    // bending √(κ1² + κ2²) [1/mm]
+    let grid = |field: &Vec<Vec<f64>>| -> Vec<Vec<f64>> {
+        frames.iter().map(|&i| cols.iter().map(|&j| field[i][j].sqrt() * 1e-3).collect()).collect()
+    };
+    let limit = percentile_99(t.bending_true.iter().flatten().map(|v| v.sqrt() * 1e-3).collect());
+    let map = |title: &str, values: Vec<Vec<f64>>| Heatmap {
+        scale: ColourScale::Sequential,
+        ..kymograph(title.into(), x.clone(), y.clone(), values, limit, "√(κ1² + κ2²) [1/mm]")
+    };
+    write_plot(
+        path,
+        render_heatmaps_svg(&[
+            map(&format!("{}: true bending", case.name), grid(&t.bending_true)),
+            map("recovered bending", grid(&t.bending_recovered)),
+        ]),
+    )
+}
+
+/// Per-frame summary of a clip run: iterations, fit, chart guard and roughness against frame.
+pub fn write_clip_plot(
+    case: &Case,
+    reports: &[FrameReport],
+    roughness: &[(f64, f64)],
+    path: &Path,
+) -> Result<(), OutputError> {
+    if reports.is_empty() {
+        return Ok(());
+    }
+    let axis = FrameAxis::new(case, reports);
+    let (s, plot) = (|l: &str, y| axis.series(l, y), FrameAxis::plot);
+    let panels = vec![
+        plot(
+            format!("{}: iterations per frame", case.name),
+            "iterations",
+            vec![s("iterations", reports.iter().map(|r| r.iterations as f64).collect())],
+            false,
+        ),
+        plot(
+            "fit per frame".into(),
+            "misfit (units in the legend)",
+            vec![
+                s("position misfit [body lengths]", reports.iter().map(|r| r.fit.position).collect()),
+                s("|x' - d3| [m^1/2]", reports.iter().map(|r| r.tangent_misfit).collect()),
+                s("last relative change", reports.iter().map(|r| r.last_change).collect()),
+            ],
+            true,
+        ),
+        plot(
+            "angle chart: min |cos beta| over the nodes".into(),
+            "|cos beta|",
+            vec![s("min |cos beta|", reports.iter().map(|r| r.min_cos_beta).collect())],
+            false,
+        ),
+        plot(
+            "objective (41)".into(),
+            "J (41)",
+            vec![
+                s("tracking", reports.iter().map(|r| r.objective.tracking).collect()),
+                s("total", reports.iter().map(|r| r.objective.total()).collect()),
+            ],
+            true,
+        ),
+        plot(
+            "roughness of the curvature (sign alternation of its differences)".into(),
+            "fraction of elements [–]",
+            vec![
+                s("recovered κ2", roughness.iter().map(|r| r.0).collect()),
+                s("data", roughness.iter().map(|r| r.1).collect()),
+            ],
+            false,
+        ),
+    ];
+    write_plot(path, render_panels_svg(&panels, 2))
+}
+
+/// Kymographs of a planar clip (Fig. 17 style): the data's curvature and the recovered κ2
+/// [1/mm] over time [s] (x) and arc length (y, head at 0), on one colour scale (±the 99th
+/// percentile of |data|, the colour bar beside each). At most ~150 frames and 64 positions are
+/// drawn (strided) to keep the SVG small.
+pub fn write_clip_kymographs(case: &Case, run: &ClipRun, path: &Path) -> Result<(), OutputError> {
+    let nf = run.kappa2.len();
+    if nf < 2 {
+        return Ok(());
+    }
+    let fs = nf.div_ceil(150);
+    let frames: Vec<usize> = (0..nf).step_by(fs).collect();
+    let x = FrameAxis::new(case, &run.reports).at(&frames);
+    let h = case.mesh.h();
+    let grid = |field: &Vec<Vec<f64>>, s_of: &dyn Fn(usize) -> f64| {
+        let m = field[0].len();
+        let ss = m.div_ceil(64);
+        let cols: Vec<usize> = (0..m).step_by(ss).collect();
+        let y: Vec<f64> = cols.iter().map(|&j| s_of(j) * 1e3).collect();
+        let values: Vec<Vec<f64>> =
+            frames.iter().map(|&i| cols.iter().map(|&j| field[i][j] * 1e-3).collect()).collect();
+        (y, values)
+    };
+    let limit = abs_percentile_99(run.data_kappa.iter().flatten().map(|k| k * 1e-3));
+    let (yd, vd) = grid(&run.data_kappa, &|j| (j + 1) as f64 * h);
+    let (yr, vr) = grid(&run.kappa2, &|j| (j as f64 + 0.5) * h);
+    write_plot(
+        path,
+        render_heatmaps_svg(&[
+            kymograph(format!("{}: data curvature", case.name), x.clone(), yd, vd, limit, "κ data [1/mm]"),
+            kymograph("recovered κ2".into(), x.clone(), yr, vr, limit, "κ2 [1/mm]"),
+        ]),
+    )
+}
+
+/// The 99th percentile of |v| over the finite values (1 if there are none): the colour limit
+/// of a kymograph.
+pub(crate) fn abs_percentile_99(values: impl Iterator<Item = f64>) -> f64 {
+    percentile_99(values.map(f64::abs).filter(|v| v.is_finite()).collect())
+}
+
+/// The value at rank `⌊0.99 n⌋` of `all` in ascending order (`f64::total_cmp`; 1 for none), by
+/// selection rather than a full sort: the same value.
+fn percentile_99(mut all: Vec<f64>) -> f64 {
+    let k = (all.len() as f64 * 0.99) as usize;
+    if k >= all.len() {
+        return 1.0;
+    }
+    *all.select_nth_unstable_by(k, f64::total_cmp).1
+}
+
+/// Kymographs of the angular velocity (Fig. 24 style, `omega.svg`): ω1, ω2, ω3 [rad/s] in the
+/// local frame (eq. 27, [`ClipRun::omega`]) over time [s] (x) and the nodes' arc length (y),
+/// each on its own colour scale (±the 99th percentile of its |ω| over the frames after the
+/// first, which has none; the colour bar beside it). Strided as [`write_clip_kymographs`];
+/// nothing is written for fewer than two frames.
+pub fn write_omega_kymographs(case: &Case, run: &ClipRun, path: &Path) -> Result<(), OutputError> {
+    let nf = run.omega.len().min(run.reports.len());
+    if nf < 2 {
+        return Ok(());
+    }
+    let frames: Vec<usize> = (0..nf).step_by(nf.div_ceil(150)).collect();
+    let x = FrameAxis::new(case, &run.reports).at(&frames);
+    let m = run.omega[0].len();
+    let cols: Vec<usize> = (0..m).step_by(m.div_ceil(64).max(1)).collect();
+    let y: Vec<f64> = cols.iter().map(|&j| case.mesh.node_s(j) * 1e3).collect();
+    let maps: Vec<Heatmap> = (0..3)
+        .map(|k| {
+            let limit = abs_percentile_99(run.omega[1..nf].iter().flatten().map(|w| w[k]));
+            let name = if k == 0 { format!("{}: ", case.name) } else { String::new() };
+            let zero = if limit > 0.0 { "" } else { ": 0 everywhere" };
+            kymograph(
+                format!("{name}ω{} (local frame){zero}", k + 1),
+                x.clone(),
+                y.clone(),
+                frames.iter().map(|&i| cols.iter().map(|&j| run.omega[i][j][k]).collect()).collect(),
+                limit,
+                &format!("ω{} [rad/s]", k + 1),
+            )
+        })
+        .collect();
+    write_plot(path, render_heatmaps_svg(&maps))
+}
