@@ -256,6 +256,27 @@ fn compare_refuses_frames_on_a_case_without_a_clip() {
         .stderr(predicate::str::contains("`--frames` applies to clips only"));
 }
 
+/// `run --engine freefem` on a clip is refused before anything is prepared: the message names
+/// `compare`, which runs FreeFEM's clip script, and no output folder (not even a failed one) is
+/// left behind.
+#[test]
+fn run_refuses_a_clip_in_freefem_before_it_makes_a_folder() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = dir.path().join("clip");
+    cosserat()
+        .args(["run", "--engine", "freefem", "cases/worm_delta_turn_ld1.toml", "--out"])
+        .arg(&out)
+        .assert()
+        .failure()
+        .stderr(
+            predicate::str::contains("cosserat compare CASE --frames N")
+                .and(predicate::str::contains("running FreeFEM").not()),
+        );
+    assert!(!out.exists(), "a refused run left {}", out.display());
+    let left: Vec<_> = std::fs::read_dir(dir.path()).expect("dir").collect();
+    assert!(left.is_empty(), "a refused run left {left:?}");
+}
+
 /// Without a terminal (stderr to a pipe: a log file, nohup, a Slurm task) a long command prints
 /// a progress line every interval (10 s; 0.1 s here) with done/total, rate and time left, and a
 /// final line; `--quiet` prints none.

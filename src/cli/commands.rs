@@ -3,7 +3,7 @@
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use anyhow::{Context, Result};
+use anyhow::{bail, Context, Result};
 
 use super::args::Limits;
 use super::progress::{FreefemProgress, Progress};
@@ -36,6 +36,9 @@ pub fn cmd_run(
     (quiet, strict): (bool, bool),
 ) -> Result<ExitCode> {
     let case = load(path)?;
+    if let Some(why) = cosserat::jobs::solved::unsupported(&case, engine) {
+        bail!(why);
+    }
     check_memory(&case, Footprint::Run, limits)?;
     let dir = out.unwrap_or_else(|| PathBuf::from("out").join(&case.name).join(engine.to_string()));
     // FreeFEM's frames (a clip) or time steps (a dynamic case) as the script writes them; its other

@@ -201,11 +201,8 @@ fn solve_clip(
 ) -> Solved {
     let fail =
         |e: &(dyn std::error::Error + 'static)| Solved::failed_by(format!("{}: {}", case_label(case), chain(e)), e);
-    if engine != Engine::Rust {
-        return Solved::failed(format!(
-            "{}: `run` solves clips in the Rust engine (`--engine rust`); to run a clip in FreeFEM against it, use `cosserat compare CASE --frames N` (or `--frames all`)",
-            case_label(case)
-        ));
+    if let Some(why) = unsupported(case, engine) {
+        return Solved::failed(why);
     }
     let out = match run_clip_to(case, dir, opts, observer, progress) {
         Ok(out) => out,
@@ -257,6 +254,18 @@ fn flag_message(case: &Case, flagged: &[&FrameReport], done: usize) -> String {
 }
 
 /// The case's name and file, for messages.
+/// Why `engine` cannot solve `case` into a folder, if it cannot: a clip in FreeFEM (`run` solves
+/// clips in the Rust engine; `compare` runs FreeFEM's clip script frame by frame against it). A
+/// command checks this before it prepares any folder.
+pub fn unsupported(case: &Case, engine: Engine) -> Option<String> {
+    (engine != Engine::Rust && case.clip().is_some()).then(|| {
+        format!(
+            "{}: `run` solves clips in the Rust engine (`--engine rust`); to run a clip in FreeFEM against it, use `cosserat compare CASE --frames N` (or `--frames all`)",
+            case_label(case)
+        )
+    })
+}
+
 pub fn case_label(case: &Case) -> String {
     match &case.origin.source {
         Some(p) => format!("case {} ({})", case.name, p.display()),
