@@ -462,7 +462,6 @@ const LARGE_STRUCTS_LEFT: &[&str] = &[
     "src/case/raw.rs:RawCase",
     "src/case/raw.rs:RawClip",
     "src/jobs/batch.rs:BatchRow",
-    "src/solve/inverse/mod.rs:FrameSolver",
     "src/solve/sequence.rs:FrameReport",
     "src/study/mod.rs:StudyRow",
 ];
