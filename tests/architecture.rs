@@ -456,16 +456,17 @@ fn no_function_is_longer_than_80_lines_outside_tests() {
 const MAX_STRUCT_FIELDS: usize = 10;
 
 /// Structs still over [`MAX_STRUCT_FIELDS`] (`file:name`): the list may only shrink (a listed
-/// struct that became small must leave it). Most mirror a file format field by field: the
-/// case file's tables (`raw`), command-line options, and the columns of a CSV row.
+/// struct that became small must leave it). Each mirrors a file format field by field, where
+/// grouping its fields into typed parts would change the format or how it is read (the comment
+/// of each says how).
 const LARGE_STRUCTS_LEFT: &[&str] = &[
-    "src/audit/spec.rs:Claim",
+    // the case file's top-level tables as written: `deny_unknown_fields`, which `flatten` breaks
     "src/case/raw.rs:RawCase",
+    // the case file's `[clip]` table as written: `deny_unknown_fields`, which `flatten` breaks
     "src/case/raw.rs:RawClip",
-    "src/cli/mod.rs:BatchArgs",
+    // a recording's row of summary.csv (SUMMARY_COLUMNS, a field per column) and batch_row.json
     "src/jobs/batch.rs:BatchRow",
-    "src/solve/inverse/mod.rs:FrameSolver",
-    "src/solve/sequence.rs:FrameReport",
+    // a row of noise_study.csv written by the csv crate's `serialize`, which refuses `flatten`
     "src/study/mod.rs:StudyRow",
 ];
 

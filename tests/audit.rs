@@ -304,7 +304,7 @@ fn check_causes_have_no_measured_numbers(report: &cosserat::audit::AuditReport, 
     let allowed: Vec<f64> = numbers(inputs).iter().filter_map(|(_, n)| n.parse::<f64>().ok()).collect();
     let mut problems = Vec::new();
     for c in &report.claims {
-        for text in c.claim.cause.iter() {
+        for text in c.claim.caveats.cause.iter() {
             for (_, n) in numbers(text) {
                 let v: f64 = n.parse().unwrap_or(f64::NAN);
                 let ok = allowed.iter().any(|x| (x.abs() - v.abs()).abs() <= 1e-9 * v.abs().max(1e-300))

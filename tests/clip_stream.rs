@@ -48,11 +48,17 @@ fn solve(case: &Case, frames: ClipFrames<'_>) -> (ClipOutcome, Vec<ClipFrame>) {
 /// Every number of a frame that derives from its solve, as bits.
 fn bits(f: &ClipFrame) -> Vec<u64> {
     let r = &f.report;
-    let mut v: Vec<u64> = [r.last_change, r.x_err_rel, r.tangent_misfit, r.objective.tracking, r.min_cos_beta]
-        .iter()
-        .map(|x| x.to_bits())
-        .collect();
-    v.push(r.iterations as u64);
+    let mut v: Vec<u64> = [
+        r.convergence.last_change,
+        r.misfit.x_err_rel,
+        r.misfit.tangent_misfit,
+        r.misfit.objective.tracking,
+        r.conditioning.min_cos_beta,
+    ]
+    .iter()
+    .map(|x| x.to_bits())
+    .collect();
+    v.push(r.convergence.iterations as u64);
     v.extend(f.record.state.iter().chain(f.record.adjoint.iter()).map(|x| x.to_bits()));
     v.extend(f.planar.kappa2.iter().map(|x| x.to_bits()));
     v.extend(f.truth.iter().flat_map(|t| t.bending_recovered.iter().map(|x| x.to_bits())));

@@ -56,7 +56,7 @@ fn run(name: &str, clip_lines: &str, frames: Option<usize>) -> Result<Recovered,
         d: vec![],
         kappa: vec![],
         axes: vec![],
-        iterations: r.reports.iter().map(|f| f.iterations).collect(),
+        iterations: r.reports.iter().map(|f| f.convergence.iterations).collect(),
     };
     for f in 0..nf {
         let rows = &fields[f * nodes..(f + 1) * nodes];

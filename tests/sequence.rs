@@ -94,20 +94,20 @@ fn quasi_static_clip_is_recovered_frame_by_frame() {
         eprintln!(
             "frame {}: {} iterations, change {:.2e}, |x-xg|/|xg| {:.2e}, min |cos β| {:.3} (node {}), max |j-1| {:.2e}",
             r.frame,
-            r.iterations,
-            r.last_change,
-            r.x_err_rel,
-            r.min_cos_beta,
-            r.min_cos_beta_node,
-            r.max_stretch_deviation
+            r.convergence.iterations,
+            r.convergence.last_change,
+            r.misfit.x_err_rel,
+            r.conditioning.min_cos_beta,
+            r.conditioning.min_cos_beta_node,
+            r.conditioning.max_stretch_deviation
         );
-        assert!(r.x_err_rel < 1e-4, "frame {}: {}", r.frame, r.x_err_rel);
-        assert!(r.max_stretch_deviation < 1e-2);
+        assert!(r.misfit.x_err_rel < 1e-4, "frame {}: {}", r.frame, r.misfit.x_err_rel);
+        assert!(r.conditioning.max_stretch_deviation < 1e-2);
     }
     assert!(
-        reports[1..].iter().all(|r| r.iterations < reports[0].iterations),
+        reports[1..].iter().all(|r| r.convergence.iterations < reports[0].convergence.iterations),
         "warm start did not help: {:?}",
-        reports.iter().map(|r| r.iterations).collect::<Vec<_>>()
+        reports.iter().map(|r| r.convergence.iterations).collect::<Vec<_>>()
     );
 }
 
@@ -171,10 +171,10 @@ fn chart_guard_names_frame_and_node() {
                 .expect("rebased chart");
         eprintln!(
             "rebased, gauge {gauge:?}: {} iterations, x error {:.2e}, min |cos β| {}",
-            reports[0].iterations, reports[0].x_err_rel, reports[0].min_cos_beta
+            reports[0].convergence.iterations, reports[0].misfit.x_err_rel, reports[0].conditioning.min_cos_beta
         );
-        assert!(reports[0].min_cos_beta > 1.0 - 1e-12, "{}", reports[0].min_cos_beta);
-        assert!(reports[0].x_err_rel < 1e-3);
+        assert!(reports[0].conditioning.min_cos_beta > 1.0 - 1e-12, "{}", reports[0].conditioning.min_cos_beta);
+        assert!(reports[0].misfit.x_err_rel < 1e-3);
     }
 }
 

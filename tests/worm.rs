@@ -38,13 +38,13 @@ fn every_frame_of_both_clips_converges_and_stays_smooth() {
         let case = case_file(name);
         let r = run(&case);
         let n = r.reports.len();
-        let its: Vec<usize> = r.reports.iter().map(|f| f.iterations).collect();
+        let its: Vec<usize> = r.reports.iter().map(|f| f.convergence.iterations).collect();
         let worst_rough = r.roughness.iter().map(|(k, d)| k - d).fold(f64::NEG_INFINITY, f64::max);
         let mean_rough = r.roughness.iter().map(|(k, _)| k).sum::<f64>() / n as f64;
         let mean_data = r.roughness.iter().map(|(_, d)| d).sum::<f64>() / n as f64;
-        let worst_x = r.reports.iter().map(|f| f.x_err_rel).fold(0.0, f64::max);
-        let jmax = r.reports.iter().map(|f| f.max_stretch_deviation).fold(0.0, f64::max);
-        let cmin = r.reports.iter().map(|f| f.min_cos_beta).fold(1.0, f64::min);
+        let worst_x = r.reports.iter().map(|f| f.misfit.x_err_rel).fold(0.0, f64::max);
+        let jmax = r.reports.iter().map(|f| f.conditioning.max_stretch_deviation).fold(0.0, f64::max);
+        let cmin = r.reports.iter().map(|f| f.conditioning.min_cos_beta).fold(1.0, f64::min);
         eprintln!(
             "{name}: {n} frames in {:.1} s; iterations min {} mean {:.1} max {}; max |x-xg|/|xg| {worst_x:.2e}; max |j-1| {jmax:.2e}; min |cos β| {cmin:.3}; roughness mean {mean_rough:.3} (data {mean_data:.3}), worst excess {worst_rough:.3}",
             r.wall_time_s,
@@ -106,8 +106,8 @@ fn newton_and_fixed_point_agree_on_the_first_frames() {
         let vb: Vec<f64> = lb.split(',').map(|v| v.parse().expect("num")).collect();
         worst = worst.max((va[8] - vb[8]).abs()); // gamma [rad], the bending angle in the x–z plane
     }
-    let itn: usize = rn.reports.iter().map(|r| r.iterations).sum();
-    let itf: usize = rf.reports.iter().map(|r| r.iterations).sum();
+    let itn: usize = rn.reports.iter().map(|r| r.convergence.iterations).sum();
+    let itf: usize = rf.reports.iter().map(|r| r.convergence.iterations).sum();
     eprintln!(
         "first 8 frames: Newton {itn} iterations ({:.2} s), fixed point {itf} ({:.2} s); max |Δγ| {worst:.2e} rad",
         rn.wall_time_s, rf.wall_time_s

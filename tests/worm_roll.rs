@@ -45,9 +45,9 @@ fn the_3d_clip_is_reconstructed_against_its_ground_truth() {
         t.comparisons.iter().map(f).fold(0.0, f64::max)
     };
     let (ex, eb, ed) = (max(&|c| c.position_rel_l2), max(&|c| c.bending_rel_l2), max(&|c| c.max_tangent_angle_rad));
-    let cmin = r.reports.iter().map(|f| f.min_cos_beta).fold(1.0, f64::min);
+    let cmin = r.reports.iter().map(|f| f.conditioning.min_cos_beta).fold(1.0, f64::min);
     let restarts = r.reports.iter().filter(|f| f.restarted).count();
-    let its = r.reports.iter().map(|f| f.iterations).sum::<usize>() as f64 / 1160.0;
+    let its = r.reports.iter().map(|f| f.convergence.iterations).sum::<usize>() as f64 / 1160.0;
     let roll_end = t.comparisons.last().expect("frames").roll_offset_rad;
     let twist = max(&|c| c.twist_rms_error_per_m);
     eprintln!(
@@ -125,8 +125,8 @@ fn a_rotated_3d_clip_gives_the_rotated_answer() {
     }
     eprintln!(
         "3D clip, orientation {v:?}: x {dx:.1e}, d {dd:.1e}, κ {dk:.1e}; iterations {:?} vs {:?}",
-        a.reports.iter().map(|r| r.iterations).sum::<usize>(),
-        b.reports.iter().map(|r| r.iterations).sum::<usize>()
+        a.reports.iter().map(|r| r.convergence.iterations).sum::<usize>(),
+        b.reports.iter().map(|r| r.convergence.iterations).sum::<usize>()
     );
     assert!(dx < 1e-7 && dd < 1e-7 && dk < 1e-7, "{dx:e} {dd:e} {dk:e}");
 }

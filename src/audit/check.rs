@@ -537,26 +537,26 @@ pub fn judge(spec: &Spec, claim: &Claim, runs: &[RunResults]) -> ClaimResult {
         return result(None, why);
     }
     let (o, mut ours) = evaluate(&claim.check, runs);
-    if let Some(s) = &claim.substitute {
+    if let Some(s) = &claim.caveats.substitute {
         ours = format!("{ours} [on {s}]");
     }
     let deviations = scheme_deviations(spec, &claim.check);
     if !deviations.is_empty() {
         ours = format!("{ours} [scheme not the paper's: {}]", deviations.join(", "));
     }
-    if let Some(p) = &claim.partial {
+    if let Some(p) = &claim.caveats.partial {
         ours = format!("{ours} [partial check: {p}]");
     }
     // A claim on data we do not have is "not computable here" when its check holds on the
     // substitute; when it does not hold there either, the substitute's outcome decides.
-    let verdict = match (o, claim.not_computable.is_some()) {
+    let verdict = match (o, claim.caveats.not_computable.is_some()) {
         (Outcome::Holds, true) => Verdict::NotComputable,
         (Outcome::Holds, false) => Verdict::Reproduced,
-        (Outcome::Partly, _) => claim.if_partly,
-        (Outcome::Fails, _) => claim.if_fails,
+        (Outcome::Partly, _) => claim.fallback.if_partly,
+        (Outcome::Fails, _) => claim.fallback.if_fails,
     };
     // a check weaker than the paper's words cannot reproduce it
-    let verdict = match (verdict, &claim.partial) {
+    let verdict = match (verdict, &claim.caveats.partial) {
         (Verdict::Reproduced | Verdict::NotComputable, Some(_)) => Verdict::Differs,
         (v, _) => v,
     };

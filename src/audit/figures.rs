@@ -454,14 +454,14 @@ fn objectives(spec: &Spec, title: &str, names: &[String], runs: &[RunResults]) -
     /// a panel's title, its y axis and its value of a frame's report (and √L [m^½])
     type Panel = (&'static str, &'static str, fn(&crate::solve::sequence::FrameReport, f64) -> f64);
     let panels_def: [Panel; 8] = [
-        ("tracking error", "|x − x_g| / |x_g| [–]", |r, _| r.x_err_rel),
-        ("shear–stretch misfit", "‖∂s x − d3‖ / √L [–]", |r, sqrt_l| r.tangent_misfit / sqrt_l),
-        ("force term of (41)", "λf/2 ∫|f|² ds", |r, _| r.objective.force),
-        ("torque term of (41)", "λl/2 ∫|l|² ds", |r, _| r.objective.torque),
-        ("λd term of (41)", "λd/2 ∫|∂s x − d3|² ds", |r, _| r.objective.shear),
-        ("bending term of (41)", "½ ∫ κᵀ Λκ κ ds", |r, _| r.objective.bending),
-        ("angular velocity term of (41)", "½ ∫ ωᵀ Λω ω ds", |r, _| r.objective.angular),
-        ("total objective (41)", "J", |r, _| r.objective.total()),
+        ("tracking error", "|x − x_g| / |x_g| [–]", |r, _| r.misfit.x_err_rel),
+        ("shear–stretch misfit", "‖∂s x − d3‖ / √L [–]", |r, sqrt_l| r.misfit.tangent_misfit / sqrt_l),
+        ("force term of (41)", "λf/2 ∫|f|² ds", |r, _| r.misfit.objective.force),
+        ("torque term of (41)", "λl/2 ∫|l|² ds", |r, _| r.misfit.objective.torque),
+        ("λd term of (41)", "λd/2 ∫|∂s x − d3|² ds", |r, _| r.misfit.objective.shear),
+        ("bending term of (41)", "½ ∫ κᵀ Λκ κ ds", |r, _| r.misfit.objective.bending),
+        ("angular velocity term of (41)", "½ ∫ ωᵀ Λω ω ds", |r, _| r.misfit.objective.angular),
+        ("total objective (41)", "J", |r, _| r.misfit.objective.total()),
     ];
     let pts = points_of(spec, runs, names);
     let mut panels = Vec::new();

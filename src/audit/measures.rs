@@ -84,7 +84,7 @@ impl ClipRecorder {
         self.series
             .omega_max
             .push(frame.omega.as_ref().map_or(0.0, |w| w.iter().map(|v| v.norm()).fold(0.0, f64::max)));
-        self.series.x_err_rel.push(frame.report.x_err_rel);
+        self.series.x_err_rel.push(frame.report.misfit.x_err_rel);
         if self.keep.contains(&frame.report.frame) {
             self.series.kept.push(frame.clone());
         }

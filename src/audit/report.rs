@@ -14,9 +14,9 @@ fn cells(c: &ClaimResult) -> [String; 10] {
     [
         c.spec.clone(),
         c.claim.id.clone(),
-        c.claim.location.clone(),
-        c.claim.statement.clone(),
-        c.claim.paper.clone(),
+        c.claim.cited.location.clone(),
+        c.claim.cited.statement.clone(),
+        c.claim.cited.paper.clone(),
         c.ours.clone(),
         verdict_text(c).into(),
         c.claim.expect.as_str().into(),
@@ -34,7 +34,7 @@ fn verdict_text(c: &ClaimResult) -> &'static str {
 pub const NOT_JUDGED: &str = "not judged";
 
 fn cause(c: &ClaimResult) -> String {
-    match (&c.claim.not_computable, &c.claim.cause) {
+    match (&c.claim.caveats.not_computable, &c.claim.caveats.cause) {
         (Some(n), Some(k)) => format!("{n}. {k}"),
         (Some(n), None) => n.clone(),
         (None, Some(k)) => k.clone(),
@@ -212,9 +212,9 @@ fn row(o: &mut String, c: &ClaimResult) {
         o,
         "| {} | {} | “{}” (read as: {}) | {} | {} | {} |",
         c.claim.id,
-        md(&c.claim.location),
-        md(&c.claim.statement),
-        md(&c.claim.paper),
+        md(&c.claim.cited.location),
+        md(&c.claim.cited.statement),
+        md(&c.claim.cited.paper),
         md(&c.ours),
         verdict,
         fig

@@ -315,20 +315,46 @@ pub struct RunSpec {
 #[derive(Clone, Debug)]
 pub struct Claim {
     pub id: String,
+    /// where the paper makes the claim, its words and its number
+    pub cited: Citation,
+    pub check: Check,
+    /// the verdict this project established (asserted by the quick audit in `cargo test`)
+    pub expect: Verdict,
+    /// the verdicts when the check does not hold on every point
+    pub fallback: FallbackVerdicts,
+    /// why the verdict may be other than "reproduced", and what the check runs on instead
+    pub caveats: Caveats,
+    /// a figure file of the spec illustrating the claim
+    pub figure: Option<String>,
+    /// a check of ours, not a claim of the paper: reported in its own table, counted apart
+    pub ours: bool,
+}
+
+/// What the paper says: the claim as cited in the report's `where`, `statement` and `paper`
+/// columns.
+#[derive(Clone, Debug)]
+pub struct Citation {
     /// section, equation, figure
     pub location: String,
     /// the paper's words (a short quote)
     pub statement: String,
     /// the paper's number or range
     pub paper: String,
-    pub check: Check,
-    /// the verdict this project established (asserted by the quick audit in `cargo test`)
-    pub expect: Verdict,
+}
+
+/// A claim's verdicts when its check does not hold on every point of the paper's range.
+#[derive(Clone, Copy, Debug)]
+pub struct FallbackVerdicts {
     /// the verdict when the check fails outright (default: differs)
     pub if_fails: Verdict,
     /// the verdict when the check holds on some points of the paper's range only (default:
     /// differs; "refuted" is refused when a spec is read: the audit runs the Rust engine only)
     pub if_partly: Verdict,
+}
+
+/// The reservations of a claim's verdict, each reported with it.
+#[derive(Clone, Debug)]
+pub struct Caveats {
     /// why our number differs (reported with any verdict but reproduced)
     pub cause: Option<String>,
     /// what of the paper is not available here (its data, its code): the check runs on the
@@ -336,12 +362,8 @@ pub struct Claim {
     pub not_computable: Option<String>,
     /// the data the check runs on when it is not the paper's
     pub substitute: Option<String>,
-    /// a figure file of the spec illustrating the claim
-    pub figure: Option<String>,
     /// the check is weaker than the paper's words: why. Such a claim is at best "differs".
     pub partial: Option<String>,
-    /// a check of ours, not a claim of the paper: reported in its own table, counted apart
-    pub ours: bool,
 }
 
 /// A validated audit spec.
@@ -495,18 +517,20 @@ fn read_claim(path: &Path, c: RawClaim, earlier: &[Claim], runs: &[RunSpec]) -> 
     }
     Ok(Claim {
         id: c.id,
-        location: c.location,
-        statement: c.statement,
-        paper: c.paper,
+        cited: Citation { location: c.location, statement: c.statement, paper: c.paper },
         check: c.check,
         expect: c.expect,
-        if_fails: c.if_fails.unwrap_or(Verdict::Differs),
-        if_partly: c.if_partly.unwrap_or(Verdict::Differs),
-        cause: c.cause,
-        not_computable: c.not_computable,
-        substitute: c.substitute,
+        fallback: FallbackVerdicts {
+            if_fails: c.if_fails.unwrap_or(Verdict::Differs),
+            if_partly: c.if_partly.unwrap_or(Verdict::Differs),
+        },
+        caveats: Caveats {
+            cause: c.cause,
+            not_computable: c.not_computable,
+            substitute: c.substitute,
+            partial: c.partial,
+        },
         figure: c.figure,
-        partial: c.partial,
         ours: c.ours,
     })
 }

@@ -37,10 +37,25 @@ pub struct BatchArgs {
     /// Recordings run at once [default: number of cores]
     #[arg(long)]
     jobs: Option<usize>,
+    /// `--slurm` and the options of the Slurm job array
+    #[command(flatten)]
+    slurm: SlurmArgs,
+    /// How each recording's per-node fields are written (as `cosserat run --output-format`)
+    #[arg(long, value_enum, default_value_t = OutputFormat::Csv)]
+    output_format: OutputFormat,
+    /// Do not show progress (a bar on a terminal, else a line every 10 s)
+    #[arg(long)]
+    quiet: bool,
+}
+
+/// `cosserat batch --slurm`: whether to submit a job array, and its options (each but `--slurm`
+/// requires `--slurm`).
+#[derive(clap::Args, Debug)]
+pub struct SlurmArgs {
     /// Submit a Slurm job array (sbatch) instead of running here; `cosserat gather OUT` then
     /// writes summary.csv. OUT must be on a filesystem that every node sees
-    #[arg(long)]
-    slurm: bool,
+    #[arg(id = "slurm", long = "slurm")]
+    submit: bool,
     /// Recordings per Slurm array task
     #[arg(long, default_value_t = 1, requires = "slurm", value_parser = clap::value_parser!(u64).range(1..))]
     per_task: u64,
@@ -72,12 +87,6 @@ pub struct BatchArgs {
     /// submitting it; `sbatch OUT/batch.sbatch` submits it
     #[arg(long, requires = "slurm", conflicts_with = "wait")]
     dry_run: bool,
-    /// How each recording's per-node fields are written (as `cosserat run --output-format`)
-    #[arg(long, value_enum, default_value_t = OutputFormat::Csv)]
-    output_format: OutputFormat,
-    /// Do not show progress (a bar on a terminal, else a line every 10 s)
-    #[arg(long)]
-    quiet: bool,
 }
 
 /// `cosserat batch-task` (run by a Slurm array task).
@@ -139,7 +148,7 @@ fn interrupted_summary(out: &Path, rows: &[BatchRow]) -> String {
 
 pub fn cmd_batch(a: BatchArgs) -> Result<ExitCode> {
     let recordings = list_recordings(&a.recordings)?;
-    let per_task = if a.slurm { a.per_task as usize } else { 1 };
+    let per_task = if a.slurm.submit { a.slurm.per_task as usize } else { 1 };
     let mut plan = Plan::new(&a.case, &recordings, per_task);
     plan.format = a.output_format;
     // the case is read (and refused if it is not a clip case) before anything is written
@@ -147,8 +156,8 @@ pub fn cmd_batch(a: BatchArgs) -> Result<ExitCode> {
     let _lock = lock_batch(&a.out)?;
     plan.begin(&a.out)?;
     let out = std::fs::canonicalize(&a.out).with_context(|| format!("output folder {}", a.out.display()))?;
-    if a.slurm {
-        return submit_batch(&a, &plan, &out, &case.name);
+    if a.slurm.submit {
+        return submit_batch(&a.slurm, a.quiet, &plan, &out, &case.name);
     }
     let pb = Progress::new(&format!("{} batch", case.name), "recordings", plan.recordings.len(), a.quiet);
     let ran = run_batch(&plan, &out, a.jobs.unwrap_or(0), || pb.inc())?;
@@ -177,8 +186,8 @@ fn lock_batch(out: &Path) -> Result<cosserat::output::folder_lock::FolderLock> {
 
 /// `batch --slurm`: the job script of the array tasks that have a recording to run (a
 /// resubmission runs only the unfinished recordings), submitted unless `--dry-run`; with
-/// `--wait`, waited for and gathered.
-fn submit_batch(a: &BatchArgs, plan: &Plan, out: &Path, name: &str) -> Result<ExitCode> {
+/// `--wait`, waited for (progress unless `quiet`) and gathered.
+fn submit_batch(a: &SlurmArgs, quiet: bool, plan: &Plan, out: &Path, name: &str) -> Result<ExitCode> {
     let exe = std::env::current_exe().context("cannot find the cosserat executable for the job script")?;
     let complete = batch::complete_recordings(plan, out)?;
     let skipped = complete.iter().filter(|c| **c).count();
@@ -224,7 +233,7 @@ fn submit_batch(a: &BatchArgs, plan: &Plan, out: &Path, name: &str) -> Result<Ex
         eprintln!("when it has finished: cosserat gather {}", out.display());
         return Ok(ExitCode::SUCCESS);
     }
-    let pb = Progress::new(&format!("{name} job {id}"), "array tasks", tasks.len(), a.quiet);
+    let pb = Progress::new(&format!("{name} job {id}"), "array tasks", tasks.len(), quiet);
     slurm::wait(&id, Duration::from_millis(500), |queued| pb.set(tasks.len() - queued.min(tasks.len()), 0))?;
     pb.finish();
     let rows = gather(out)?;

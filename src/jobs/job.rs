@@ -79,10 +79,10 @@ impl JobEnd {
             );
         }
         let n = run.reports.len();
-        let its: Vec<usize> = run.reports.iter().map(|r| r.iterations).collect();
+        let its: Vec<usize> = run.reports.iter().map(|r| r.convergence.iterations).collect();
         // in body lengths (solve::fit): ‖x − x_g‖/‖x_g‖ would depend on where the clip sits
         let worst = run.reports.iter().map(|r| r.fit.position).fold(0.0, f64::max);
-        let jmax = run.reports.iter().map(|r| r.max_stretch_deviation).fold(0.0, f64::max);
+        let jmax = run.reports.iter().map(|r| r.conditioning.max_stretch_deviation).fold(0.0, f64::max);
         out += &format!(
             "{name} [rust]: {n} frames in {:.2} s ({:.1} frames/s; solving {:.2} s); iterations per frame min {} / mean {:.1} / max {}; max position misfit {worst:.3e} body lengths; max |j - 1| {jmax:.3e}; wrote {}\n",
             run.wall_time_s,

@@ -92,7 +92,7 @@ pub fn write_truth_plot(case: &Case, run: &ClipRun, path: &Path) -> Result<(), O
         plot(
             "angle chart: min |cos beta| over the nodes".into(),
             "|cos beta|",
-            vec![s("rebased chart", run.reports.iter().map(|r| r.min_cos_beta).collect())],
+            vec![s("rebased chart", run.reports.iter().map(|r| r.conditioning.min_cos_beta).collect())],
             false,
         ),
     ];
@@ -138,7 +138,7 @@ pub fn write_clip_plot(
         plot(
             format!("{}: iterations per frame", case.name),
             "iterations",
-            vec![s("iterations", reports.iter().map(|r| r.iterations as f64).collect())],
+            vec![s("iterations", reports.iter().map(|r| r.convergence.iterations as f64).collect())],
             false,
         ),
         plot(
@@ -146,23 +146,23 @@ pub fn write_clip_plot(
             "misfit (units in the legend)",
             vec![
                 s("position misfit [body lengths]", reports.iter().map(|r| r.fit.position).collect()),
-                s("|x' - d3| [m^1/2]", reports.iter().map(|r| r.tangent_misfit).collect()),
-                s("last relative change", reports.iter().map(|r| r.last_change).collect()),
+                s("|x' - d3| [m^1/2]", reports.iter().map(|r| r.misfit.tangent_misfit).collect()),
+                s("last relative change", reports.iter().map(|r| r.convergence.last_change).collect()),
             ],
             true,
         ),
         plot(
             "angle chart: min |cos beta| over the nodes".into(),
             "|cos beta|",
-            vec![s("min |cos beta|", reports.iter().map(|r| r.min_cos_beta).collect())],
+            vec![s("min |cos beta|", reports.iter().map(|r| r.conditioning.min_cos_beta).collect())],
             false,
         ),
         plot(
             "objective (41)".into(),
             "J (41)",
             vec![
-                s("tracking", reports.iter().map(|r| r.objective.tracking).collect()),
-                s("total", reports.iter().map(|r| r.objective.total()).collect()),
+                s("tracking", reports.iter().map(|r| r.misfit.objective.tracking).collect()),
+                s("total", reports.iter().map(|r| r.misfit.objective.total()).collect()),
             ],
             true,
         ),

@@ -450,12 +450,19 @@ fn push_csv(s: &mut String, values: &[f64]) {
 
 /// The row of `frames.csv` of a frame: its report, time [s], roughness and largest |ω| [rad/s].
 fn report_row(r: &FrameReport, time_s: f64, roughness: (f64, f64), omega: &[Vector3<f64>]) -> Vec<f64> {
-    let mut row = vec![r.frame as f64, time_s, r.iterations as f64, r.last_change, r.x_err_rel, r.tangent_misfit];
-    row.extend(r.objective.values());
+    let mut row = vec![
+        r.frame as f64,
+        time_s,
+        r.convergence.iterations as f64,
+        r.convergence.last_change,
+        r.misfit.x_err_rel,
+        r.misfit.tangent_misfit,
+    ];
+    row.extend(r.misfit.objective.values());
     row.extend([
-        r.min_cos_beta,
-        r.min_cos_beta_node as f64,
-        r.max_stretch_deviation,
+        r.conditioning.min_cos_beta,
+        r.conditioning.min_cos_beta_node as f64,
+        r.conditioning.max_stretch_deviation,
         roughness.0,
         roughness.1,
         f64::from(u8::from(r.restarted)),

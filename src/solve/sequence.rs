@@ -15,8 +15,10 @@ use std::f64::consts::PI;
 use nalgebra::{DVector, Matrix3, Vector3};
 
 mod carry;
+mod report;
 pub use carry::vector_to_space;
 use carry::{carry_converted, carry_state, to_space};
+pub use report::{DataMisfit, FrameConditioning, FrameConvergence, FrameReport};
 
 use crate::model::chart::{frame_axis, Chart};
 use crate::model::mesh::{DofMap, Field};
@@ -24,9 +26,7 @@ use crate::model::rotation::{angles_from_rotation, skew, Angles};
 
 use super::fit::{noise_level, position_misfit, FitGate, FrameFit};
 use super::inverse::tracking::{tracking_weights, MIN_TRACKED};
-use super::inverse::{
-    Frame, FrameSolver, InverseParams, InverseRecord, InverseSolution, ObjectiveTerms, Records, Start,
-};
+use super::inverse::{Frame, FrameSolver, InverseParams, InverseRecord, InverseSolution, Records, Start};
 use super::{Problem, SolveError};
 
 /// Settings of a clip solve.
@@ -102,36 +102,6 @@ pub enum FrameStart {
     PreviousFrame,
     /// [`data_frame_guess`] of the frame itself (D13)
     DataGuess,
-}
-
-/// Per-frame report.
-#[derive(Clone, Copy, Debug, serde::Serialize, serde::Deserialize)]
-pub struct FrameReport {
-    pub frame: usize,
-    pub iterations: usize,
-    /// relative change of (x, α) of the last iteration (D5)
-    pub last_change: f64,
-    pub x_err_rel: f64,
-    /// ‖∂s x − d3‖ [m^½]
-    pub tangent_misfit: f64,
-    pub objective: ObjectiveTerms,
-    /// smallest |cos β| over the nodes, and where
-    pub min_cos_beta: f64,
-    pub min_cos_beta_node: usize,
-    /// max over elements of |j − 1|, j = |Δx_g|/h the data's stretch (Remark 9)
-    pub max_stretch_deviation: f64,
-    /// the frame failed from the previous frame's solution and was solved from the data guess
-    pub restarted: bool,
-    /// singular axis `n = Bᵀ e2` of the frame's chart (e2 for the global chart)
-    pub chart_axis: Vector3<f64>,
-    pub wall_time_s: f64,
-    /// the residual certificate of the frame's solution (`inverse::kkt::certificate`)
-    pub certificate: f64,
-    /// how well the frame follows its data, and whether it is over the gate (`solve::fit`)
-    pub fit: FrameFit,
-    /// nodes of the frame that were tracked (`clip::missing`; all of them without missing data)
-    #[serde(default)]
-    pub nodes_tracked: usize,
 }
 
 /// Errors of a clip solve: the frame's own error, or the chart guard.
@@ -460,14 +430,13 @@ pub fn solve_sequence_from<'a>(
         let last = sol.history.last().copied().ok_or(SequenceError::NoIteration { frame: k })?;
         let rep = FrameReport {
             frame: k,
-            iterations: last.iteration,
-            last_change: last.rel_change,
-            x_err_rel: last.x_err_rel,
-            tangent_misfit: last.tangent_misfit,
-            objective: last.objective,
-            min_cos_beta: cos_beta,
-            min_cos_beta_node: node,
-            max_stretch_deviation: max_stretch_deviation(x_space, h, tracked),
+            convergence: FrameConvergence::at(&last),
+            misfit: DataMisfit::at(&last),
+            conditioning: FrameConditioning {
+                min_cos_beta: cos_beta,
+                min_cos_beta_node: node,
+                max_stretch_deviation: max_stretch_deviation(x_space, h, tracked),
+            },
             restarted,
             chart_axis: chart.axis(),
             wall_time_s: start.elapsed().as_secs_f64(),

@@ -45,30 +45,33 @@ pub fn clip_metrics(case: &Case, run: &ClipRun) -> Metrics {
     let mut m = Metrics::new();
     let n = r.len();
     m.insert("frames".into(), n as f64);
-    let its: Vec<f64> = r.iter().map(|f| f.iterations as f64).collect();
+    let its: Vec<f64> = r.iter().map(|f| f.convergence.iterations as f64).collect();
     m.insert("iterations".into(), its.iter().sum());
     m.insert("iterations_mean".into(), its.iter().sum::<f64>() / n.max(1) as f64);
     m.insert("iterations_max".into(), max(its.iter().copied()));
     m.insert("restarts".into(), r.iter().filter(|f| f.restarted).count() as f64);
-    m.insert("x_err_rel_max".into(), max(r.iter().map(|f| f.x_err_rel)));
-    m.insert("x_err_rel_median".into(), median(r.iter().map(|f| f.x_err_rel).collect()));
+    m.insert("x_err_rel_max".into(), max(r.iter().map(|f| f.misfit.x_err_rel)));
+    m.insert("x_err_rel_median".into(), median(r.iter().map(|f| f.misfit.x_err_rel).collect()));
     let d3_norm = case.mesh.length_m.sqrt();
-    m.insert("tangent_misfit_rel_max".into(), max(r.iter().map(|f| f.tangent_misfit / d3_norm)));
-    m.insert("max_abs_j_minus_1".into(), max(r.iter().map(|f| f.max_stretch_deviation)));
+    m.insert("tangent_misfit_rel_max".into(), max(r.iter().map(|f| f.misfit.tangent_misfit / d3_norm)));
+    m.insert("max_abs_j_minus_1".into(), max(r.iter().map(|f| f.conditioning.max_stretch_deviation)));
     m.insert("certificate".into(), max(r.iter().map(|f| f.certificate)));
     m.insert("flagged_frames".into(), r.iter().filter(|f| f.fit.flagged).count() as f64);
     m.insert("fit_position_rel_length_max".into(), max(r.iter().map(|f| f.fit.position)));
     m.insert("fit_tangent_rms_max".into(), max(r.iter().map(|f| f.fit.tangent)));
     m.insert("data_noise_m_median".into(), median(r.iter().map(|f| f.fit.noise_m).collect()));
-    m.insert("min_abs_cos_beta".into(), r.iter().map(|f| f.min_cos_beta).fold(f64::INFINITY, f64::min));
+    m.insert("min_abs_cos_beta".into(), r.iter().map(|f| f.conditioning.min_cos_beta).fold(f64::INFINITY, f64::min));
     let terms = |f: &FrameReport| {
-        let o = &f.objective;
+        let o = &f.misfit.objective;
         [o.tracking, o.force, o.torque, o.shear, o.bending, o.angular, o.total()]
     };
     for (k, name) in crate::solve::inverse::ObjectiveTerms::NAMES.iter().enumerate() {
         m.insert(format!("{name}_median"), median(r.iter().map(|f| terms(f)[k]).collect()));
     }
-    m.insert("shear_share_median".into(), median(r.iter().map(|f| f.objective.shear / f.objective.total()).collect()));
+    m.insert(
+        "shear_share_median".into(),
+        median(r.iter().map(|f| f.misfit.objective.shear / f.misfit.objective.total()).collect()),
+    );
     let mean = |v: &mut dyn Iterator<Item = f64>| {
         let (s, c) = v.fold((0.0, 0usize), |(s, c), x| (s + x, c + 1));
         s / c.max(1) as f64

@@ -108,7 +108,7 @@ pub fn solve_frames<'a>(case: &Case, data: impl Into<ClipData<'a>>) -> Result<So
                 dofs.field(&sol.adjoint, Field::X),
                 dofs.field(&sol.adjoint, Field::Alpha),
                 last,
-                rep.iterations,
+                rep.convergence.iterations,
                 rep.wall_time_s,
             );
             out.push(SolvedFrame { frame: rep.frame, restarted: rep.restarted, result });

@@ -350,17 +350,33 @@ pub struct FrameSolver<'p> {
     pub(crate) dofs: DofMap,
     pub(crate) pattern: Pattern,
     pub(crate) solver: LinearSolver,
-    /// Dirichlet unknowns of I5 and their values (KKT numbering)
-    pub(crate) fixed: Vec<(usize, f64)>,
-    pub(crate) rows: Vec<usize>,
-    /// system values (pattern order)
-    pub(crate) values: Vec<f64>,
-    /// Newton: the residual merit's row weights (Ruiz row factors of the first Jacobian)
-    pub(crate) merit_weights: Vec<f64>,
+    /// the Dirichlet conditions of I5 of the frame being solved
+    pub(crate) dirichlet: Dirichlet,
+    /// the value arrays refilled per frame
+    pub(crate) work: Workspace,
     /// zero angles: the `α_{n−1}` of a first frame (its Λω term is off)
     pub(crate) no_previous: Vec<Angles>,
     /// which Newton iterations keep a record
     pub(crate) records: Records,
+}
+
+/// The Dirichlet conditions of I5 of a frame, refilled per frame: the positions depend only
+/// on whether the frame is the first, the values on its data.
+#[derive(Default)]
+pub(crate) struct Dirichlet {
+    /// the fixed unknowns (KKT numbering) and their values: `x = x_g` [m] and `x̂ = α̂ = 0` at
+    /// both ends, and on the first frame `α(0) = α0` [rad] ([`kkt::dirichlet_into`])
+    pub(crate) fixed: Vec<(usize, f64)>,
+    /// the fixed unknowns alone: the rows of the system set to identity rows
+    pub(crate) rows: Vec<usize>,
+}
+
+/// The value arrays of a [`FrameSolver`], kept between frames so that no frame allocates them.
+pub(crate) struct Workspace {
+    /// system (Jacobian) values, in the pattern's order
+    pub(crate) values: Vec<f64>,
+    /// Newton: the residual merit's row weights (Ruiz row factors of the first Jacobian)
+    pub(crate) merit_weights: Vec<f64>,
     /// scratch matrix values of the certificate's system (`kkt::certificate`)
     pub(crate) cert_values: Vec<f64>,
 }
@@ -378,13 +394,10 @@ impl<'p> FrameSolver<'p> {
             dofs,
             pattern,
             solver,
-            fixed: Vec::new(),
-            rows: Vec::new(),
-            values,
-            merit_weights: Vec::new(),
+            dirichlet: Dirichlet::default(),
+            work: Workspace { values, merit_weights: Vec::new(), cert_values: Vec::new() },
             no_previous: vec![Vector3::zeros(); problem.mesh.nodes()],
             records: Records::Every,
-            cert_values: Vec::new(),
         }
     }
 
@@ -466,16 +479,16 @@ impl<'p> FrameSolver<'p> {
 
     /// [`FrameSolver::certify`] of a KKT vector.
     pub(crate) fn certify_kkt(&mut self, frame: &Frame, big: &DVector<f64>) -> Certificate {
-        self.cert_values.resize(self.pattern.nnz(), 0.0);
+        self.work.cert_values.resize(self.pattern.nnz(), 0.0);
         let previous = frame.previous.unwrap_or(&self.no_previous);
-        kkt::certificate(self.problem, &self.params, frame, previous, big, &self.pattern, &mut self.cert_values)
+        kkt::certificate(self.problem, &self.params, frame, previous, big, &self.pattern, &mut self.work.cert_values)
     }
 
     /// Dirichlet rows and values of I5 for the frame.
     fn set_dirichlet(&mut self, frame: &Frame) {
-        kkt::dirichlet_into(&self.dofs, self.params.alpha0_rad, frame, &mut self.fixed);
-        self.rows.clear();
-        self.rows.extend(self.fixed.iter().map(|f| f.0));
+        kkt::dirichlet_into(&self.dofs, self.params.alpha0_rad, frame, &mut self.dirichlet.fixed);
+        self.dirichlet.rows.clear();
+        self.dirichlet.rows.extend(self.dirichlet.fixed.iter().map(|f| f.0));
     }
 
     /// Solve `K(u) U = r(u)` of I4 with the boundary conditions of I5 (equilibrated, I6); `U`
@@ -494,19 +507,19 @@ impl<'p> FrameSolver<'p> {
             params,
             frame.is_first(),
             &self.pattern,
-            &mut self.values,
+            &mut self.work.values,
             u,
             frame.tracking(),
             previous,
         );
-        for &(d, v) in &self.fixed {
+        for &(d, v) in &self.dirichlet.fixed {
             rhs[d] = v;
         }
-        self.pattern.set_identity_rows(&mut self.values, &self.rows);
+        self.pattern.set_identity_rows(&mut self.work.values, &self.dirichlet.rows);
         Ok(if rescale {
-            self.solver.solve_rescaled(&self.values, &rhs)?
+            self.solver.solve_rescaled(&self.work.values, &rhs)?
         } else {
-            self.solver.solve_equilibrated(&self.values, &rhs)?
+            self.solver.solve_equilibrated(&self.work.values, &rhs)?
         })
     }
 }

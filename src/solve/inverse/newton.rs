@@ -248,11 +248,11 @@ fn solve_from(
     // Consistent start: one linear solve of the fixed point at u0.
     let big = s.solve_linearised(params, frame, u0, rescale)?;
     let fwd = s.problem.dofs();
-    s.cert_values.resize(s.pattern.nnz(), 0.0);
+    s.work.cert_values.resize(s.pattern.nnz(), 0.0);
     let lean = s.records == Records::Last;
     // the Ruiz row factors of the start's matrix weigh the merit of the whole frame (I6)
-    s.merit_weights.clear();
-    s.merit_weights.extend_from_slice(s.solver.row_factors());
+    s.work.merit_weights.clear();
+    s.work.merit_weights.extend_from_slice(s.solver.row_factors());
     let mut it = Iterate {
         u: s.dofs.kkt_state(&big),
         big,
@@ -336,7 +336,7 @@ struct Newton<'a, 'p, 'f> {
 impl Newton<'_, '_, '_> {
     /// The merit: the residual's norm weighted by the start's Ruiz row factors (I6).
     fn merit(&self, r: &DVector<f64>) -> f64 {
-        r.iter().zip(self.s.merit_weights.iter()).map(|(a, b)| (a * b).powi(2)).sum::<f64>().sqrt()
+        r.iter().zip(self.s.work.merit_weights.iter()).map(|(a, b)| (a * b).powi(2)).sum::<f64>().sqrt()
     }
 
     /// The residual at `big` ([`assemble_residual`]), with the Jacobian into the solver's
@@ -344,15 +344,15 @@ impl Newton<'_, '_, '_> {
     fn residual(&mut self, big: &DVector<f64>, jacobian: bool) -> DVector<f64> {
         let s = &mut *self.s;
         let previous = self.frame.previous.unwrap_or(s.no_previous.as_slice());
-        let jacobian = jacobian.then_some((&s.pattern, s.values.as_mut_slice(), s.rows.as_slice()));
-        assemble_residual(s.problem, self.params, self.frame, previous, big, &s.fixed, jacobian)
+        let jacobian = jacobian.then_some((&s.pattern, s.work.values.as_mut_slice(), s.dirichlet.rows.as_slice()));
+        assemble_residual(s.problem, self.params, self.frame, previous, big, &s.dirichlet.fixed, jacobian)
     }
 
     /// The residual certificate of `big` (`kkt::certificate`).
     fn certify(&mut self, big: &DVector<f64>) -> Certificate {
         let s = &mut *self.s;
         let previous = self.frame.previous.unwrap_or(s.no_previous.as_slice());
-        super::kkt::certificate(s.problem, self.params, self.frame, previous, big, &s.pattern, &mut s.cert_values)
+        super::kkt::certificate(s.problem, self.params, self.frame, previous, big, &s.pattern, &mut s.work.cert_values)
     }
 
     /// The record of iteration `k` (`measures::record`).
@@ -395,7 +395,7 @@ impl Newton<'_, '_, '_> {
         let delta = if chord {
             self.s.solver.solve_factored(&(-&r))?
         } else {
-            self.s.solver.solve_rescaled(&self.s.values, &(-&r))?
+            self.s.solver.solve_rescaled(&self.s.work.values, &(-&r))?
         };
         let phi = self.merit(&r);
         if k == 1 {
