@@ -69,10 +69,6 @@ fn every_case_agrees_between_rust_and_freefem() {
     eprintln!("{compared} cases compared");
 }
 
-/// The whole delta-turn clip (300 frames, Newton per frame) in both engines, every compared row
-/// (per-frame differences, worst frame) within the tolerance `compare` derives for it
-/// (`cosserat compare cases/worm_delta_turn_ld1.toml --frames all`; FreeFEM ~0.33 s per frame,
-/// docs/results.md "The FreeFEM engine").
 /// The time stepping runs the same Newton with chord steps in both engines (docs/decisions.md D11:
 /// the last factorisation reused while the increments contract by 0.01): every one of the 200
 /// short-horizon steps of the dynamic cantilever takes the same number of iterations in FreeFEM as
@@ -108,6 +104,10 @@ fn dynamic_steps_take_the_same_iterations_in_both_engines() {
     assert!(total > 3 * 200, "the chord steps ({total} iterations over 200 steps) are more than Newton's 3 per step");
 }
 
+/// The whole delta-turn clip (300 frames, Newton per frame) in both engines, every compared row
+/// (per-frame differences, worst frame) within the tolerance `compare` derives for it
+/// (`cosserat compare cases/worm_delta_turn_ld1.toml --frames all`; FreeFEM ~0.23 s per frame,
+/// docs/results.md "The FreeFEM engine").
 #[test]
 fn whole_delta_turn_clip_agrees_between_rust_and_freefem() {
     if !common::freefem_required() {
