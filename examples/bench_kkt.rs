@@ -48,11 +48,11 @@ fn main() -> Result<()> {
 
     // Frame 0, then frame 1 up to the warm start: a realistic Newton start.
     let mut solver0 = FrameSolver::new(&problem, base);
-    let f0_frame = Frame { index: 0, x_g: &clip.frames[0], previous: None, weight: None };
+    let f0_frame = Frame { index: 0, x_g: &clip.frames[0], previous: None, weight: None, fix_roll: false };
     let f0 = solver0.solve(&f0_frame, &data_frame_guess(&clip.frames[0]), Start::Guess, |_, _, _| {})?.converged(0)?;
     let prev = fwd.field(&f0.u, Field::Alpha);
     let x_g = &clip.frames[1];
-    let frame = Frame { index: 1, x_g, previous: Some(&prev), weight: None };
+    let frame = Frame { index: 1, x_g, previous: Some(&prev), weight: None, fix_roll: false };
     let warm_params = InverseParams { method: InverseMethod::FixedPoint, tolerance: warm, ..base };
     let start =
         FrameSolver::new(&problem, warm_params).solve(&frame, &data_frame_guess(x_g), Start::Guess, |_, _, _| {})?;

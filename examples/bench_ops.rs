@@ -43,7 +43,7 @@ fn main() -> Result<()> {
     let mut values = vec![0.0; pattern.nnz()];
     let x_g = &frames[29];
     let prev = vec![Vector3::zeros(); problem.mesh.nodes()];
-    let frame = Frame { index: 29, x_g, previous: Some(&prev), weight: None };
+    let frame = Frame { index: 29, x_g, previous: Some(&prev), weight: None, fix_roll: false };
     let fixed = kkt::dirichlet(&dofs, 0.0, &frame);
     let rows: Vec<usize> = fixed.iter().map(|f| f.0).collect();
     let time = |name: &str, f: &mut dyn FnMut()| {

@@ -39,7 +39,7 @@ fn main() {
     params.method = InverseMethod::FixedPoint;
     params.tolerance = fptol;
     params.max_iterations = 20000;
-    let frame = Frame { index: 0, x_g: &data.x, previous: None, weight: None };
+    let frame = Frame { index: 0, x_g: &data.x, previous: None, weight: None, fix_roll: false };
     let kd = case.mesh.kkt_dofs();
     let fixed = dirichlet(&kd, 0.0, &frame);
     let prev = vec![Vector3::zeros(); kd.nodes()];

@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# The full comparison: every case of cases/ through both engines, whole runs (the dynamic
+# The full comparison: every case of cases/ and cases/benchmarks/ (with its published values)
+# through both engines, whole runs (the dynamic
 # cantilever's 1000 steps take ~5 minutes in FreeFEM; each inverse fixed point ~1 minute), the
 # first 10 frames of each clip, then one whole clip in both engines (CLIP, default
 # worm_delta_turn_ld1) with the time of each engine, then a batch of generated cases
@@ -9,10 +10,12 @@ set -uo pipefail
 cd "$(dirname "$0")/.."
 cargo build --release -q || exit 1
 bin=target/release/cosserat
+# the recordings of cases/worm_2d_recording.toml, as scripts/setup.sh writes them
+[ -f data/tracker/worm_000.csv ] || $bin synth --tracker --out data/tracker --force
 clip=${CLIP:-worm_delta_turn_ld1}
 status=0
 mkdir -p out/full
-for c in cases/*.toml; do
+for c in cases/*.toml cases/benchmarks/*.toml; do
   name=$(basename "$c" .toml)
   echo "== $name"
   $bin compare "$c" --out "out/full/$name" | tee "out/full/$name.txt" || status=1

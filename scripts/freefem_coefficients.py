@@ -54,6 +54,9 @@ rot_composites = ["QIA" + i + j for i in "123" for j in "123"]
 vel_composites = ["OMV" + i for i in "123"] + ["WV" + k + i for k in "ABG" for i in "123"]
 vel_composites += ["HD" + k + i for k in "ABG" for i in "123"]
 intermediates |= {c for c in vel_composites if not c.startswith("HD")}
+# the reference strains' terms of the frozen right-hand side (D20: Q^T K eps0, x' x Q^T K eps0, Q^T J kappa0), evaluated
+# with the state quantities only when coefRef = 1 (a forward case with a reference other than the straight rod)
+ref_composites = [n + i for n in ("RN", "XRN", "RM") for i in "123"]
 derivs = ["cD" + k for k in "123abg"]
 out = []
 w = out.append
@@ -72,6 +75,9 @@ w("// ulps. The forms read the fields' values only (an attempt that also read dx
 w("// The values at the points are computed in Vq, a container with one dof per point (prefix cq): the angles")
 w("// interpolated linearly between the vertices, the rotation formulas by vector operations in FreeFEM's order of")
 w("// evaluation (the same bits as the expression), the state quantities by their formulas at P = cq.")
+w("// The strains are measured from the reference configuration (D20): EPS and KAP subtract the reference strains at")
+w("// the points, the containers cqrE1..3, cqrK1..3 (RS(E1) ... in kinematics.idp's formulas), zero unless the including")
+w("// script sets them (forward.edp with a curved reference; it then sets coefRef = 1, which also evaluates RN, XRN, RM).")
 w("// The including script defines meshL Th and int nel first.")
 w("")
 w("fespace Ch(Th, P2dc);                        // coefficient fields: 3 dofs per element")
@@ -148,7 +154,10 @@ w("  for (int c = 0; c < 6; c++) coefD[c] = coefDeriv(nc, c);")
 w("  return 0;")
 w("}")
 w("")
+w("Vq cqrE1, cqrE2, cqrE3, cqrK1, cqrK2, cqrK3;   // the reference strains eps0, kappa0 at the points (D20; zero: straight)")
+w("int coefRef = 0;                             // 1: evaluate the reference strains' right-hand side quantities too")
 allf = names + derivs + ["c" + c for c in rot_composites + composites + tangent_composites + vel_composites]
+allf += ["c" + c for c in ref_composites]
 w("Vq " + ", ".join("cq" + n for n in allf) + ";   // the container's values (prefix cq)")
 decl = ", ".join("P#" + n for n in allf)
 w(f"macro COEFDECL(P) Ch {decl}; real[int] P#CoefLast(9*coefNq), P#CoefLastQ(3*coefNq), P#CoefLastV(6*coefNq); "
@@ -189,13 +198,15 @@ def entry_ref(e):
 def parse_composite(text):
     """The formula of a state quantity (kinematics.idp's NAME#F(P) at P = cq) as a tree: ("sum", [(sign, product)]),
     a product a list of factors ("arr", array) / ("num", literal) / ("var", scalar) / ("sum", ...), left to right."""
-    toks = re.findall(r"C(QA|QB|QG|AA|AB|AG|Q|A)(\d\d)\(P\)|dQp\((\d\d),P,P\)|Qp\((\d\d),P\)|Ap\((\d\d),P\)|"
+    toks = re.findall(r"RS\((\w+)\)|C(QA|QB|QG|AA|AB|AG|Q|A)(\d\d)\(P\)|dQp\((\d\d),P,P\)|Qp\((\d\d),P\)|Ap\((\d\d),P\)|"
                       r"DP\(P,(\w)\)|VV\(P,(\w)\)|([A-Z]+\d+)\(P\)|"
                       r"([A-Za-z_]\w*)|(\d+\.?\d*(?:e-?\d+)?)|([-+*()])|(\S)", text)
     items = []
-    for fam, fij, dq, q, a, d, vv, comp, ident, num, op, bad in toks:
+    for ref, fam, fij, dq, q, a, d, vv, comp, ident, num, op, bad in toks:
         assert not bad, (text, bad)
-        if fam:
+        if ref:
+            items.append(("ref", f"cqr{ref}[]"))
+        elif fam:
             items.append(entry_ref(fam + fij))
         elif dq:
             ab = [(("+", [entry_ref("Q" + x + dq), ("arr", f"cq{v}[]")])) for x, v in (("A", "a"), ("B", "b"), ("G", "g"))]
@@ -262,6 +273,13 @@ def emit_sum(tree, dst, temps, out):
     if not terms:
         out.append(f"{dst} = 0.;")
         return
+    # a reference strain subtracted (EPS, KAP: "- RS(E1)"): only where there is one (coefRef), since it is zero
+    # otherwise and subtracting a zero leaves the bits as they were
+    refs = [(sign, prod) for sign, prod in terms if len(prod) == 1 and prod[0][0] == "ref"]
+    terms = [t for t in terms if t not in refs]
+    ref_statements = [f"if (coefRef) {{ {dst} {sign}= {prod[0][1]}; }}" for sign, prod in refs]
+    # inside a product a reference strain is an array like any other
+    terms = [(sign, [("arr", f[1]) if f[0] == "ref" else f for f in prod]) for sign, prod in terms]
     for k, (sign, prod) in enumerate(terms):
         tgt = dst if k == 0 else temps[0]
         rest = temps if k == 0 else temps[1:]
@@ -289,6 +307,7 @@ def emit_sum(tree, dst, temps, out):
             out.append(f"{dst} *= -1.;")
         elif k > 0:
             out.append(f"{dst} {sign}= {tgt};")
+    out += ref_statements
 
 
 def composite_statements(c):
@@ -326,7 +345,8 @@ def base_statements():
     upd = rotation_statements()
     for d in derivs:
         upd.append(f"P#{d}[] = coefMap*cq{d}[];")
-    return upd + quantity_statements(composites)
+    upd += quantity_statements(composites)
+    return upd + ["if (coefRef) {"] + quantity_statements(ref_composites) + ["}"]
 
 
 def key_statements(with_state, with_velocity):
@@ -396,7 +416,7 @@ update_macro("MOMUPDATE", "CoefLastV", False, with_velocity=True)
 w("")
 w("// the coefficient entries and state quantities read by kinematics.idp (a field of P, or a constant)")
 w("macro DP(P,k) P#cD#k //                      // d_s of the state's unknown k = 1, 2, 3, a, b, g")
-for c in rot_composites + composites + tangent_composites + vel_composites:
+for c in rot_composites + composites + tangent_composites + vel_composites + ref_composites:
     w(f"macro {c}(P) P#c{c} //")
 for e in entries:
     if e in const:

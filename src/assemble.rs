@@ -27,6 +27,11 @@ impl<'a> Tangent<'a> {
         Tangent { pattern, values, scale, overwrite: false }
     }
 
+    /// The same target for another pass (which adds into the values the first pass left).
+    pub fn reborrow(&mut self) -> Tangent<'_> {
+        Tangent { pattern: self.pattern, values: &mut *self.values, scale: self.scale, overwrite: self.overwrite }
+    }
+
     /// A pass that replaces the values (the same numbers as zeroing them and adding,
     /// [`Pattern::scatter_first`]), without a sweep that zeroes them first.
     pub fn overwriting(pattern: &'a Pattern, values: &'a mut [f64], scale: f64) -> Self {

@@ -14,7 +14,7 @@ fn batch_runs_every_recording_fails_the_bad_one_alone_and_resumes() {
     let tmp = tempfile::tempdir().expect("tempdir");
     let (recs, out) = (tmp.path().join("recordings"), tmp.path().join("out"));
     corpus(&recs);
-    let run = || batch_command(&recs, &out, &["--jobs", "2"]).output().expect("batch");
+    let run = || batch_command(&recs, &out, &["--jobs", "2", "--output-format", "csv"]).output().expect("batch");
     let first = run();
     let stderr = String::from_utf8_lossy(&first.stderr);
     assert_eq!(first.status.code(), Some(1), "one bad recording: exit status 1; stderr {stderr}");
@@ -73,9 +73,10 @@ fn batch_runs_every_recording_fails_the_bad_one_alone_and_resumes() {
     assert_eq!(second.status.code(), Some(1));
     assert!(stdout.contains(&format!("{GOOD} already complete, skipped")), "{stdout}");
     assert_eq!(summary_without_time(&out), rows, "a resumed batch writes the same summary");
-    // The compact format is another output: the complete CSV runs are not taken for it, every
-    // recording runs again into `fields.npz`, and the summary is the same numbers.
-    let compact = batch_command(&recs, &out, &["--jobs", "2", "--output-format", "compact"]).output().expect("batch");
+    // The compact format, a batch's default, is another output: the complete CSV runs are not
+    // taken for it, every recording runs again into `fields.npz`, and the summary is the same
+    // numbers.
+    let compact = batch_command(&recs, &out, &["--jobs", "2"]).output().expect("batch");
     let stdout = String::from_utf8_lossy(&compact.stdout);
     assert_eq!(compact.status.code(), Some(1));
     assert!(stdout.contains("(0 already complete, skipped)"), "{stdout}");

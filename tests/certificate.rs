@@ -23,7 +23,7 @@ fn kkt_certificate(
     let kd = case.mesh.kkt_dofs();
     let pattern = kd.pattern();
     let mut values = vec![0.0; pattern.nnz()];
-    let frame = Frame { index: 0, x_g, previous: None, weight: None };
+    let frame = Frame { index: 0, x_g, previous: None, weight: None, fix_roll: false };
     let prev = vec![Vector3::zeros(); case.mesh.nodes()];
     let params = case.inverse().expect("inverse").params;
     certificate(&p, &params, &frame, &prev, &kd.kkt_join(u, a), &pattern, &mut values)
@@ -59,7 +59,7 @@ fn certificate_detects_a_perturbation_and_ignores_a_translation() {
     let (_, x_g) = forward_data(&case, 10);
     let p = case.problem();
     let params = case.inverse().unwrap().params;
-    let frame = Frame { index: 0, x_g: &x_g, previous: None, weight: None };
+    let frame = Frame { index: 0, x_g: &x_g, previous: None, weight: None, fix_roll: false };
     let sol = FrameSolver::new(&p, params).solve(&frame, &p.reference_state(), Start::Guess, |_, _, _| {}).unwrap();
     assert_eq!(sol.stop, Stop::Converged);
     let root = kkt_certificate(&case, &x_g, &sol.u, &sol.adjoint).value;

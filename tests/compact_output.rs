@@ -113,13 +113,17 @@ fn the_compact_file_holds_every_field_of_the_default_output_exactly() {
     for f in 0..FRAMES {
         let text = std::fs::read_to_string(csv.join(format!("vtk/frame_{f:05}.vtp"))).expect("vtp");
         let arrays = vtp_arrays(&text);
-        let kappa: Vec<(f64, Vector3<f64>)> = (0..NODES - 1)
-            .map(|m| {
-                let k = |i: usize| value(&c, CURVATURE_COLUMNS[i], f, m);
-                (k(0), Vector3::new(k(1), k(2), k(3)))
-            })
-            .collect();
-        let kn = nodal_curvature(&kappa);
+        // per element: κ from columns 1–3, n from 4–6, m from 7–9 (CURVATURE_COLUMNS), each
+        // written per node as the mean of the adjacent elements
+        let element = |first: usize| -> Vec<(f64, Vector3<f64>)> {
+            (0..NODES - 1)
+                .map(|m| {
+                    let k = |i: usize| value(&c, CURVATURE_COLUMNS[i], f, m);
+                    (k(0), Vector3::new(k(first), k(first + 1), k(first + 2)))
+                })
+                .collect()
+        };
+        let kn = nodal_curvature(&element(1));
         for (array, cols) in vectors {
             let expected: Vec<String> = (0..NODES)
                 .flat_map(|n| cols.iter().map(move |col| (n, col)))
@@ -127,10 +131,13 @@ fn the_compact_file_holds_every_field_of_the_default_output_exactly() {
                 .collect();
             assert_eq!(arrays[array], expected, "frame {f} {array}");
         }
-        let expected: Vec<String> =
-            kn.iter().flat_map(|k| k.iter().map(|v| format!("{v:.9e}")).collect::<Vec<_>>()).collect();
-        assert_eq!(arrays["kappa_per_m"], expected, "frame {f} kappa_per_m");
-        assert_eq!(arrays.len(), vectors.len() + 3, "frame {f}: arrays {:?}", arrays.keys());
+        let printed = |v: &[Vector3<f64>]| -> Vec<String> {
+            v.iter().flat_map(|k| k.iter().map(|v| format!("{v:.9e}")).collect::<Vec<_>>()).collect()
+        };
+        assert_eq!(arrays["kappa_per_m"], printed(&kn), "frame {f} kappa_per_m");
+        assert_eq!(arrays["n_n"], printed(&nodal_curvature(&element(4))), "frame {f} n_n");
+        assert_eq!(arrays["m_nm"], printed(&nodal_curvature(&element(7))), "frame {f} m_nm");
+        assert_eq!(arrays.len(), vectors.len() + 5, "frame {f}: arrays {:?}", arrays.keys());
     }
 }
 

@@ -39,9 +39,7 @@ fn every_case_agrees_between_rust_and_freefem() {
     let mut compared = 0;
     for f in files {
         let case = Case::from_file(&f).unwrap_or_else(|e| panic!("{e}"));
-        if common::is_clip(&case) && !common::worm_data_present(&case.name) {
-            continue;
-        }
+        let Some(case) = common::with_clip_data(case) else { continue };
         let dir = tempfile::tempdir().expect("tempdir");
         let opts = CompareOptions { horizon: Horizon::Short, frames: None };
         match compare_case(&case, dir.path(), &opts) {

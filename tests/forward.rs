@@ -26,6 +26,7 @@ fn static_tip(case: &Case, method: Method, tol: f64) -> (f64, f64, usize) {
             max_iterations: 500,
             continuation_steps: 1,
             certificate_tolerance: DEFAULT_CERTIFICATE_TOLERANCE,
+            path: None,
         },
         |_| {},
     )
@@ -251,6 +252,7 @@ fn follower_load_eq64_large_bend() {
             max_iterations: 2000,
             continuation_steps: 1,
             certificate_tolerance: DEFAULT_CERTIFICATE_TOLERANCE,
+            path: None,
         },
         |_| {},
     )
@@ -264,6 +266,7 @@ fn follower_load_eq64_large_bend() {
             max_iterations: 30,
             continuation_steps: 5,
             certificate_tolerance: DEFAULT_CERTIFICATE_TOLERANCE,
+            path: None,
         },
         |_| {},
     )
@@ -298,6 +301,7 @@ fn follower_load_eq65_needs_newton() {
             max_iterations: 30,
             continuation_steps: 10,
             certificate_tolerance: DEFAULT_CERTIFICATE_TOLERANCE,
+            path: None,
         },
         |_| {},
     )
@@ -320,6 +324,7 @@ fn follower_load_eq65_needs_newton() {
             max_iterations: 500,
             continuation_steps: 1,
             certificate_tolerance: DEFAULT_CERTIFICATE_TOLERANCE,
+            path: None,
         },
         |_| {},
     )

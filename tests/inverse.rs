@@ -148,8 +148,11 @@ fn adjoint_gradient_matches_finite_differences() {
     // The KKT solution is a stationary point of the reduced objective.
     let mut kb = k.clone();
     let mut rb = rhs.clone();
-    for (d, v) in dirichlet(&kd, params.alpha0_rad, &Frame { index: 1, x_g: &xg, previous: Some(&prev), weight: None })
-    {
+    for (d, v) in dirichlet(
+        &kd,
+        params.alpha0_rad,
+        &Frame { index: 1, x_g: &xg, previous: Some(&prev), weight: None, fix_roll: false },
+    ) {
         kb.row_mut(d).fill(0.0);
         kb[(d, d)] = 1.0;
         rb[d] = v;

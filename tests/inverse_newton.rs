@@ -93,7 +93,7 @@ fn jacobian_check(lambda_g: f64) -> (f64, f64) {
     let (fwd, xg) = common::forward_data(&case, 5);
     let (fd_map, kd) = (case.mesh.dofs(), case.mesh.kkt_dofs());
     let prev: Vec<Vector3<f64>> = fd_map.field(&fwd, Field::Alpha).iter().map(|a| a * 0.9).collect();
-    let frame = Frame { index: 1, x_g: &xg, previous: Some(&prev), weight: None };
+    let frame = Frame { index: 1, x_g: &xg, previous: Some(&prev), weight: None, fix_roll: false };
     let params = with_weights(&common::all_terms_params(), |w| w.lambda_g = lambda_g);
     let big = DVector::from_fn(kd.len(), |i, _| {
         let (n, c) = (i / kd.block(), i % 3);
@@ -286,7 +286,7 @@ fn newton_on_eq64_paper_parameters_fails_with_a_clear_error() {
         max_iterations: 15,
         ..params
     };
-    let frame = Frame { index: 7, x_g: &xg, previous: None, weight: None };
+    let frame = Frame { index: 7, x_g: &xg, previous: None, weight: None, fix_roll: false };
     let err = cosserat::solve::inverse::FrameSolver::new(&p, newton)
         .solve(&frame, &start.u, Start::Near, |r, _, _| hist.push(*r))
         .and_then(|s| s.converged(7))
@@ -309,7 +309,7 @@ fn banded_solver_on_real_kkt_matrices() {
     let (fwd, xg) = common::forward_data(&case, 5);
     let (fd_map, kd) = (case.mesh.dofs(), case.mesh.kkt_dofs());
     let prev: Vec<Vector3<f64>> = fd_map.field(&fwd, Field::Alpha).iter().map(|a| a * 0.9).collect();
-    let frame = Frame { index: 1, x_g: &xg, previous: Some(&prev), weight: None };
+    let frame = Frame { index: 1, x_g: &xg, previous: Some(&prev), weight: None, fix_roll: false };
     let params = common::all_terms_params();
     let state = DVector::from_fn(fd_map.len(), |i, _| fwd[i] + 1e-3 * (i as f64 * 0.7).sin());
     let adjoint = DVector::from_fn(fd_map.len(), |i, _| 1e-5 * (i as f64 * 0.3).sin());

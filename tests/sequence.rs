@@ -47,6 +47,7 @@ fn forward(p: &Problem, steps: usize) -> DVector<f64> {
         max_iterations: 40,
         continuation_steps: steps,
         certificate_tolerance: DEFAULT_CERTIFICATE_TOLERANCE,
+        path: None,
     };
     statics::solve(p, &params, |_| {}).and_then(|s| s.converged()).expect("forward").u
 }
@@ -75,6 +76,7 @@ fn quasi_static_clip_is_recovered_frame_by_frame() {
         gauge: Vector3::y(),
         records: Records::Every,
         gate: FitGate::default(),
+        plane: None,
     };
     let mut streamed = 0;
     let reports = solve_sequence(
@@ -143,6 +145,7 @@ fn chart_guard_names_frame_and_node() {
         gauge: Vector3::y(),
         records: Records::Every,
         gate: FitGate::default(),
+        plane: None,
     };
     let err = solve_sequence(
         &p,
@@ -266,6 +269,7 @@ fn rebased_and_global_charts_differ_at_second_order_on_a_3d_clip() {
                 gauge: Vector3::y(),
                 records: Records::Every,
                 gate: FitGate::default(),
+                plane: None,
             };
             let mut out = Vec::new();
             solve_sequence(

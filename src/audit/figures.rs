@@ -530,7 +530,8 @@ fn postures(title: &str, p: &PointResult, frames: &[usize], all: &RunResults) ->
         .into_iter()
         .map(|k| {
             let d = k.nodes.directors();
-            let colour = crate::engine::rust::clip::nodal_curvature(&k.kappa).iter().map(|v| v.norm() * 1e-3).collect();
+            let colour =
+                crate::engine::rust::clip::nodal_curvature(&k.elements.kappa).iter().map(|v| v.norm() * 1e-3).collect();
             PosturePanel {
                 label: format!("frame {} (t = {} s)", k.report.frame, crate::figures::plot::format_tick(k.time_s)),
                 x: k.nodes.x.clone(),
@@ -569,7 +570,7 @@ fn profiles(all: &RunResults, frames: &[usize]) -> Option<LinePlot> {
                     })
                     .unzip()
             }
-            "lambda_kappa3" => k.kappa.iter().map(|(s, v)| (s * 1e3, v[2] * 1e-3)).unzip(),
+            "lambda_kappa3" => k.elements.kappa.iter().map(|(s, v)| (s * 1e3, v[2] * 1e-3)).unzip(),
             _ => return None,
         };
         series.push(Series::new(label(p), x, y).nth_of_many(series.len()));

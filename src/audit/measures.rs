@@ -77,10 +77,10 @@ impl ClipRecorder {
     }
     pub fn record(&mut self, frame: &ClipFrame) {
         if self.series.s_mid.is_empty() {
-            self.series.s_mid = frame.kappa.iter().map(|(s, _)| *s).collect();
+            self.series.s_mid = frame.elements.kappa.iter().map(|(s, _)| *s).collect();
         }
         self.series.frames.push(frame.report.frame);
-        self.series.kappa.push(frame.kappa.iter().map(|(_, k)| *k).collect());
+        self.series.kappa.push(frame.elements.kappa.iter().map(|(_, k)| *k).collect());
         self.series
             .omega_max
             .push(frame.omega.as_ref().map_or(0.0, |w| w.iter().map(|v| v.norm()).fold(0.0, f64::max)));

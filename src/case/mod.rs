@@ -13,6 +13,7 @@ use std::path::{Path, PathBuf};
 use nalgebra::{Matrix3, Vector3};
 
 mod file;
+pub mod published;
 mod raw;
 pub mod sweep;
 mod toml_error;
@@ -21,8 +22,9 @@ mod validate;
 use crate::clip::length::BodyLength;
 use crate::clip::synthetic::{RollClipParams, TimeMapping};
 use crate::clip::{ClipPlane, KymogramParams};
+use crate::model::geometry::Rod;
 use crate::model::loads::Loads;
-use crate::model::material::{CrossSection, Material, RodProperties};
+use crate::model::material::{CrossSection, Material, RodProperties, Stiffnesses};
 use crate::model::mesh::{Mesh, QuadratureScheme};
 use crate::solve::dynamics::DynamicParams;
 use crate::solve::fit::FitGate;
@@ -30,6 +32,7 @@ use crate::solve::inverse::{InverseParams, Records};
 use crate::solve::sequence::{FrameStart, RotationTreatment, SequenceParams};
 use crate::solve::statics::StaticParams;
 use crate::solve::Problem;
+use published::Published;
 use validate::Validator;
 pub use validate::MAX_ELEMENTS;
 
@@ -149,6 +152,21 @@ pub struct ClipSource {
     pub gate: FitGate,
     /// what marks an untracked node of a recording (`clip.missing`, `clip::missing`)
     pub missing: crate::clip::missing::MissingData,
+    /// how a recording's file is read (its unit, its worm, its plane)
+    pub recording: RecordingKeys,
+}
+
+/// The keys of a recording's file (`engine::input::recording`).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct RecordingKeys {
+    /// `clip.unit` and `clip.scale_m_per_px`
+    pub units: crate::clip::recording::UnitSpec,
+    /// `clip.worm_id`: the worm of a WCON file with several
+    pub worm_id: Option<String>,
+    /// `clip.data_plane`: the unit normal of a planar recording's plane in space coordinates
+    /// (after `clip.orientation`); set when a planar recording is read
+    /// (`engine::input::clip_files::resolve_recording`)
+    pub data_plane: Option<Vector3<f64>>,
 }
 
 /// Where a clip's frames are placed in space, and the gauge vector placed with them.
@@ -247,7 +265,7 @@ pub struct Case {
     pub mesh: Mesh,
     /// how the rod was given: its length's source and its material
     pub rod: RodGiven,
-    pub section: CrossSection,
+    pub section: Section,
     pub props: RodProperties,
     pub quadrature: QuadratureScheme,
     pub loads: Loads,
@@ -263,6 +281,8 @@ pub struct CaseChecks {
     pub compare: CompareSpec,
     /// independent theory (`[reference]`), if any
     pub reference: Option<Reference>,
+    /// published values (`[[reference.values]]`) and the test's shorter variant
+    pub published: Published,
 }
 
 /// Where a [`Case`] comes from.
@@ -282,10 +302,25 @@ pub struct CaseOrigin {
 pub struct RodGiven {
     /// where `mesh.length_m` comes from
     pub length: RodLength,
-    pub material: Material,
-    /// whether the case file gave `material.density_kg_m3` (static and inverse analyses run
-    /// with 1 kg/m³ when it does not: their equations never use it)
+    /// the material of a circle or rectangle section; `None` for a section given by its
+    /// stiffnesses (D24)
+    pub material: Option<Material>,
+    /// whether the case file gave the density (`material.density_kg_m3`, or the inertias of a
+    /// stiffness section): static and inverse analyses run with 1 kg/m³ when it does not,
+    /// their equations never use it
     pub(crate) density_given: bool,
+    /// the reference configuration, chart and ends of a forward case beyond the paper's rod
+    /// (D20–D22); `None`: straight along e3 from the origin, clamped at s = 0, free at s = L
+    pub general: Option<Rod>,
+}
+
+/// The cross section of a [`Case`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Section {
+    /// a circle or rectangle of the case's material
+    Shape(CrossSection),
+    /// the stiffnesses and inertias themselves (D24)
+    Stiffness(Stiffnesses),
 }
 
 impl Case {
@@ -314,6 +349,7 @@ impl Case {
         };
         let raw: raw::RawCase = toml::from_str(text).map_err(syntax)?;
         let mut case = Validator::new(path).case(raw, name)?;
+        case.short_variant_keys(path)?;
         case.origin.raw = Some((toml::from_str(text).map_err(syntax)?, path.to_path_buf()));
         Ok(case)
     }
@@ -321,7 +357,7 @@ impl Case {
     /// The discrete forward problem of the case (`[rod]`, `[material]`, `[cross_section]`,
     /// `[loads]`, `solver.quadrature`).
     pub fn problem(&self) -> Problem<'_> {
-        Problem::new(self.mesh, self.props, self.quadrature, &self.loads)
+        Problem::new(self.mesh, self.props, self.quadrature, &self.loads).on_rod(self.rod.general.as_ref())
     }
 
     /// The same dynamic case cut to its first `steps` time steps (same Δt): the short but real
@@ -423,6 +459,7 @@ impl Case {
             gauge: clip.placement.gauge,
             records: Records::Every,
             gate: clip.gate,
+            plane: clip.recording.data_plane,
         })
     }
 }

@@ -20,12 +20,18 @@ pub(super) struct RawCase {
     #[serde(default)]
     pub(super) constants: BTreeMap<String, Scalar>,
     pub(super) rod: RawRod,
-    pub(super) material: RawMaterial,
+    /// absent with `cross_section.shape = "stiffness"` (D24)
+    pub(super) material: Option<RawMaterial>,
     pub(super) cross_section: RawSection,
     #[serde(default)]
     pub(super) loads: RawLoads,
     pub(super) solver: RawSolver,
     pub(super) time: Option<RawTime>,
+    /// path following (`solver.continuation = "arc_length"`, D25)
+    pub(super) arc_length: Option<RawArcLength>,
+    /// the ends of the rod (D22); default clamped at s = 0, free at s = L
+    #[serde(default)]
+    pub(super) ends: RawEnds,
     #[serde(default)]
     pub(super) compare: RawCompare,
     pub(super) reference: Option<RawReference>,
@@ -85,6 +91,21 @@ pub(super) struct RawClip {
     /// what marks a node that was not tracked in a recording (`clip::missing`); absent: a NaN
     /// is an error
     pub(super) missing: Option<RawMissing>,
+    /// recordings: the unit of the positions, "m", "mm", "um" or "px" (a CSV header's suffix
+    /// says it too)
+    pub(super) unit: Option<String>,
+    /// recordings in pixels: metres per pixel
+    pub(super) scale_m_per_px: Option<Scalar>,
+    /// WCON recordings with several worms: the `id` of the one to reconstruct
+    pub(super) worm_id: Option<String>,
+    /// the tracking noise per coordinate [m], stated instead of estimated from the recording
+    pub(super) noise_m: Option<Scalar>,
+    /// the largest curvature a frame may have before it is re-solved from its data or flagged
+    /// [1/m]; default the inverse of the cross-section's radius
+    pub(super) max_curvature_per_m: Option<Scalar>,
+    /// the unit normal of the plane a planar recording lies in (set when a 2D recording, or one
+    /// with a constant coordinate, is read)
+    pub(super) data_plane: Option<[f64; 3]>,
 }
 
 #[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
@@ -151,11 +172,37 @@ pub(super) struct RawInverse {
     pub(super) weights: super::WeightsRule,
 }
 
+/// `[reference]`: an analytic theory (`kind`), published values (`[[reference.values]]`), or both.
 #[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields, tag = "kind", rename_all = "snake_case")]
-pub(super) enum RawReference {
+#[serde(deny_unknown_fields)]
+pub(super) struct RawReference {
+    pub(super) kind: Option<RawReferenceKind>,
+    /// `tip_loaded_cantilever`: the magnitude of the dead end force [N]
+    pub(super) force_n: Option<Scalar>,
+    #[serde(default)]
+    pub(super) values: Vec<RawPublished>,
+    /// the shorter variant `cargo test` runs: keys of `cosserat sweep --set` and their values
+    #[serde(default)]
+    pub(super) short: BTreeMap<String, super::published::Setting>,
+}
+
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub(super) enum RawReferenceKind {
     /// Planar cantilever clamped at s = 0 under a dead end force of magnitude `force_n` along −e2.
-    TipLoadedCantilever { force_n: Scalar },
+    TipLoadedCantilever,
+}
+
+/// One `[[reference.values]]` row.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawPublished {
+    pub(super) quantity: String,
+    pub(super) value: Scalar,
+    pub(super) tolerance_abs: Option<Scalar>,
+    pub(super) tolerance_rel: Option<Scalar>,
+    pub(super) source: Option<String>,
+    pub(super) note: Option<String>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -163,6 +210,53 @@ pub(super) enum RawReference {
 pub(super) struct RawRod {
     pub(super) length_m: Scalar,
     pub(super) elements: usize,
+    /// position of s = 0 [m] (D20)
+    pub(super) start_position_m: Option<[Scalar; 3]>,
+    /// d3 at s = 0, space components (D20)
+    pub(super) start_d3: Option<[Scalar; 3]>,
+    /// d1 at s = 0, space components (D20)
+    pub(super) start_d1: Option<[Scalar; 3]>,
+    /// intrinsic curvature and twist κ̄(s) [1/m], body frame, expressions of s (D20)
+    pub(super) intrinsic_curvature_per_m: Option<[Scalar; 3]>,
+    /// the singular axis of the angle chart (D21)
+    pub(super) chart_axis: Option<[Scalar; 3]>,
+    /// with `length_m = "from_data"`: the body length [m] that `[cross_section]` describes;
+    /// each recording's section is scaled by its measured length over this
+    pub(super) section_length_m: Option<Scalar>,
+}
+
+#[derive(Debug, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawEnds {
+    pub(super) start: Option<RawEnd>,
+    pub(super) end: Option<RawEnd>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawEnd {
+    pub(super) kind: RawEndKind,
+    /// pinned ends: "free" (default) or "held" (the roll α about d3)
+    pub(super) twist: Option<RawTwist>,
+    /// a moving end's displacement [m], space components
+    pub(super) displacement_m: Option<[Scalar; 3]>,
+    /// a moving clamp's rotation vector [rad], space components
+    pub(super) rotation_rad: Option<[Scalar; 3]>,
+}
+
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub(super) enum RawEndKind {
+    Clamped,
+    Pinned,
+    Free,
+}
+
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub(super) enum RawTwist {
+    Free,
+    Held,
 }
 
 #[derive(Debug, Deserialize)]
@@ -177,8 +271,26 @@ pub(super) struct RawMaterial {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields, tag = "shape", rename_all = "snake_case")]
 pub(super) enum RawSection {
-    Circle { radius_m: Scalar },
-    Rectangle { width_m: Scalar, height_m: Scalar },
+    Circle {
+        radius_m: Scalar,
+    },
+    Rectangle {
+        width_m: Scalar,
+        height_m: Scalar,
+    },
+    /// the stiffnesses and inertias themselves (D24)
+    Stiffness {
+        ea_n: Scalar,
+        ga1_n: Scalar,
+        ga2_n: Scalar,
+        ei1_nm2: Scalar,
+        ei2_nm2: Scalar,
+        gj_nm2: Scalar,
+        rho_a_kg_per_m: Option<Scalar>,
+        rho_i1_kg_m: Option<Scalar>,
+        rho_i2_kg_m: Option<Scalar>,
+        rho_j_kg_m: Option<Scalar>,
+    },
 }
 
 #[derive(Debug, Deserialize, Default)]
@@ -190,6 +302,19 @@ pub(super) struct RawLoads {
     pub(super) torque_nm_per_m: Option<[Scalar; 3]>,
     pub(super) end_force_n: Option<[Scalar; 3]>,
     pub(super) end_torque_nm: Option<[Scalar; 3]>,
+    /// point loads at any s (`[[loads.point]]`, D23)
+    #[serde(default)]
+    pub(super) point: Vec<RawPointLoad>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawPointLoad {
+    pub(super) s_m: Scalar,
+    pub(super) force_n: Option<[Scalar; 3]>,
+    pub(super) torque_nm: Option<[Scalar; 3]>,
+    /// "global" (dead, default) or "local" (follower)
+    pub(super) frame: Option<RawFrame>,
 }
 
 #[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default)]
@@ -243,6 +368,8 @@ pub(super) struct RawSolver {
     pub(super) continuation_steps: usize,
     /// inverse Newton: the fixed point runs until this relative change before Newton starts
     pub(super) warm_start_tolerance: Option<f64>,
+    /// static: "load_steps" (default) or "arc_length" (D25)
+    pub(super) continuation: Option<RawContinuation>,
     /// the residual certificate a converged result must meet (docs/certificate.md)
     pub(super) certificate_tolerance: Option<f64>,
 }
@@ -254,6 +381,24 @@ pub(super) fn default_method() -> RawMethod {
 }
 pub(super) fn default_quadrature() -> RawQuadrature {
     RawQuadrature::Selective
+}
+
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub(super) enum RawContinuation {
+    LoadSteps,
+    ArcLength,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawArcLength {
+    pub(super) steps: usize,
+    pub(super) initial_increment: f64,
+    pub(super) max_load_factor: Option<Scalar>,
+    pub(super) min_increment: Option<f64>,
+    pub(super) max_increment: Option<f64>,
+    pub(super) target_iterations: Option<usize>,
 }
 
 #[derive(Debug, Deserialize)]

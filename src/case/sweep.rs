@@ -3,6 +3,7 @@
 //! `lambda_d` → `inverse.lambda_d`, `elements` → `rod.elements`) and the whole case is
 //! validated again, so a swept value meets exactly the rules, and reaches the solvers by
 //! exactly the path, of a value written in the file.
+use super::published::Setting;
 use super::raw::RawCase;
 use super::validate::Validator;
 use super::{Analysis, Case, CaseError, RodLength};
@@ -234,6 +235,45 @@ impl Case {
             }
             Ok(())
         })
+    }
+
+    /// The shorter variant of a benchmark that `cargo test` runs (`[reference.short]`, keys of
+    /// [`known_keys`]), validated as a whole; `None` when the case has none.
+    pub fn short_variant(&self) -> Result<Option<Case>, SweepError> {
+        let short = &self.checks.published.short;
+        if short.is_empty() {
+            return Ok(None);
+        }
+        let values: Vec<(&str, SweepValue)> = short
+            .iter()
+            .map(|(k, v)| {
+                let v = match v {
+                    Setting::Number(x) => SweepValue::Number(*x),
+                    Setting::Word(w) => SweepValue::Word(w.clone()),
+                };
+                (k.as_str(), v)
+            })
+            .collect();
+        let mut c = self.with_values(&values)?;
+        c.name = format!("{} (short)", self.name);
+        Ok(Some(c))
+    }
+
+    /// `[reference.short]` names keys of [`known_keys`] for this case's analysis (checked when
+    /// the file is read; the values when the variant is made, [`Case::short_variant`]).
+    pub(super) fn short_variant_keys(&self, path: &std::path::Path) -> Result<(), CaseError> {
+        let known = known_keys(self);
+        match self.checks.published.short.iter().find(|(k, _)| !known.contains(&k.as_str())) {
+            Some((k, _)) => Err(CaseError::Invalid {
+                path: path.to_path_buf(),
+                key: format!("reference.short.{k}"),
+                reason: format!(
+                    "not a setting of this case's shorter variant (the keys of `cosserat sweep --set`: {})",
+                    known.join(", ")
+                ),
+            }),
+            None => Ok(()),
+        }
     }
 
     /// Apply `edit` to a copy of the case file's tables and validate the result (errors name

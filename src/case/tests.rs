@@ -37,7 +37,7 @@ fn good_case_parses() {
     let c = parse(GOOD).unwrap();
     assert_eq!(c.mesh.elements, 10);
     assert!((c.mesh.length_m - 1e-3).abs() < 1e-18);
-    assert!((c.rod.material.shear_correction - 4.0 / 3.0).abs() < 1e-15);
+    assert!((c.rod.material.expect("a material").shear_correction - 4.0 / 3.0).abs() < 1e-15);
     assert!(
         matches!(c.analysis, Analysis::Static(StaticParams { method: Method::FixedPoint { relaxation }, .. }) if relaxation == 0.5)
     );

@@ -11,10 +11,10 @@ use nalgebra::Vector3;
 use super::raw::*;
 use super::{
     Analysis, Case, CaseChecks, CaseError, CaseOrigin, CompareOverrides, CompareSpec, DataSource, InverseSettings,
-    Reference, RodGiven, RodLength, WeightsRule, DEFAULT_COMPARE_FRAMES,
+    Reference, RodGiven, RodLength, Section, WeightsRule, DEFAULT_COMPARE_FRAMES,
 };
 use crate::expr::{Expr, ExprError, Node};
-use crate::model::material::{CrossSection, Material, RodProperties};
+use crate::model::material::RodProperties;
 use crate::model::mesh::{Mesh, QuadratureScheme};
 use crate::solve::certificate::{CERTIFICATE_FLOOR, DEFAULT_CERTIFICATE_TOLERANCE};
 use crate::solve::dynamics::DynamicParams;
@@ -22,7 +22,9 @@ use crate::solve::inverse::{default_stabilisation, InverseMethod, InverseParams,
 use crate::solve::statics::{Method, StaticParams};
 
 mod clip;
+mod general;
 mod loads;
+mod published;
 mod rod;
 
 /// Most elements of a mesh: 10⁶. The cases use 10–400 (the Timoshenko convergence study of
@@ -37,11 +39,13 @@ pub(super) struct Validator<'a> {
     constants: BTreeMap<String, f64>,
     /// the names of `[constants]` (known before they are evaluated, for messages)
     constant_names: BTreeSet<String>,
+    /// `time.end_s` of a dynamic case, once known (the times at which expressions of t are checked)
+    end_time_s: Option<f64>,
 }
 
 impl<'a> Validator<'a> {
     pub(super) fn new(path: &'a Path) -> Self {
-        Validator { path, constants: BTreeMap::new(), constant_names: BTreeSet::new() }
+        Validator { path, constants: BTreeMap::new(), constant_names: BTreeSet::new(), end_time_s: None }
     }
 
     fn err(&self, key: &str, reason: impl Into<String>) -> CaseError {
@@ -115,13 +119,15 @@ impl<'a> Validator<'a> {
         self.constants(std::mem::take(&mut raw.constants))?;
         let (mesh, rod_length) = self.mesh(&raw.rod)?;
         let kind = raw.solver.analysis;
-        let material = self.material(&raw.material, kind)?;
-        let section = self.section(&raw.cross_section)?;
+        self.end_time_s = raw.time.as_ref().and_then(|t| self.scalar("time.end_s", &t.end_s).ok());
+        let (section, material, props, density_given) = self.section_and_material(&raw, kind, &mesh, rod_length)?;
         if rod_length == RodLength::Given {
             // a length from the data is checked when it is known (the case is validated again)
             self.slenderness(&mesh, &section)?;
         }
         let (loads, load_texts) = self.loads(&raw.loads, kind)?;
+        let loads = loads.with_point_loads(self.point_loads(&raw.loads.point, &mesh, kind)?);
+        let general = self.general_rod(&raw, &mesh)?;
         self.tables_of_other_analyses(&raw, kind)?;
         let quadrature = match raw.solver.quadrature {
             RawQuadrature::Selective => QuadratureScheme::Selective,
@@ -137,16 +143,17 @@ impl<'a> Validator<'a> {
             ));
         }
         let analysis = match kind {
-            RawAnalysis::Static => Analysis::Static(self.static_solve("solver", &raw.solver)?),
-            RawAnalysis::Dynamic => Analysis::Dynamic(self.dynamic(&raw.solver, raw.time.as_ref())?),
-            RawAnalysis::Inverse => {
-                Analysis::Inverse(self.inverse(&raw, &mesh, &RodProperties::new(&material, &section))?)
+            RawAnalysis::Static => {
+                Analysis::Static(StaticParams { path: self.path(&raw)?, ..self.static_solve("solver", &raw.solver)? })
             }
+            RawAnalysis::Dynamic => Analysis::Dynamic(self.dynamic(&raw.solver, raw.time.as_ref())?),
+            RawAnalysis::Inverse => Analysis::Inverse(self.inverse(&raw, (&mesh, &section), &props)?),
         };
         self.loads_are_finite(&loads, &load_texts, &mesh, quadrature, &analysis)?;
         self.length_from_data(rod_length, &analysis)?;
         let compare = self.compare(&raw.compare)?;
         let reference = self.reference(raw.reference.as_ref(), kind, &loads)?;
+        let published = self.published(raw.reference.as_ref(), &mesh, &analysis)?;
         Ok(Case {
             name: name.to_string(),
             origin: CaseOrigin {
@@ -157,13 +164,13 @@ impl<'a> Validator<'a> {
                 raw: None,
             },
             mesh,
-            props: RodProperties::new(&material, &section),
-            rod: RodGiven { length: rod_length, material, density_given: raw.material.density_kg_m3.is_some() },
+            props,
+            rod: RodGiven { length: rod_length, material, density_given, general },
             section,
             quadrature,
             loads,
             analysis,
-            checks: CaseChecks { compare, reference },
+            checks: CaseChecks { compare, reference, published },
         })
     }
 
@@ -227,36 +234,6 @@ impl<'a> Validator<'a> {
         Ok(())
     }
 
-    /// `[material]`; the density is required by a dynamic analysis only.
-    fn material(&self, m: &RawMaterial, kind: RawAnalysis) -> Result<Material, CaseError> {
-        let density = match (&m.density_kg_m3, kind) {
-            (Some(d), _) => self.positive("material.density_kg_m3", d)?,
-            (None, RawAnalysis::Static | RawAnalysis::Inverse) => 1.0,
-            (None, RawAnalysis::Dynamic) => {
-                return Err(self.err("material.density_kg_m3", "required for a dynamic analysis"))
-            }
-        };
-        Ok(Material {
-            young_modulus_pa: self.positive("material.young_modulus_pa", &m.young_modulus_pa)?,
-            shear_modulus_pa: self.positive("material.shear_modulus_pa", &m.shear_modulus_pa)?,
-            density_kg_m3: density,
-            shear_correction: self.positive("material.shear_correction", &m.shear_correction)?,
-        })
-    }
-
-    /// `[cross_section]`.
-    fn section(&self, s: &RawSection) -> Result<CrossSection, CaseError> {
-        Ok(match s {
-            RawSection::Circle { radius_m } => {
-                CrossSection::Circle { radius_m: self.positive("cross_section.radius_m", radius_m)? }
-            }
-            RawSection::Rectangle { width_m, height_m } => CrossSection::Rectangle {
-                width_m: self.positive("cross_section.width_m", width_m)?,
-                height_m: self.positive("cross_section.height_m", height_m)?,
-            },
-        })
-    }
-
     /// Tables and `[solver]` keys that belong to another analysis are refused.
     fn tables_of_other_analyses(&self, raw: &RawCase, kind: RawAnalysis) -> Result<(), CaseError> {
         let s = &raw.solver;
@@ -312,6 +289,7 @@ impl<'a> Validator<'a> {
             continuation_steps: self.count(&format!("{table}.continuation_steps"), s.continuation_steps)?,
             certificate_tolerance: self
                 .certificate_tolerance(&format!("{table}.certificate_tolerance"), s.certificate_tolerance)?,
+            path: None,
         })
     }
 
@@ -359,10 +337,10 @@ impl<'a> Validator<'a> {
     }
 
     /// Where an inverse analysis's data come from: `[data]` (a forward solve) or `[clip]`.
-    fn data_source(&self, raw: &RawCase, mesh: &Mesh) -> Result<DataSource, CaseError> {
+    fn data_source(&self, raw: &RawCase, mesh: &Mesh, section: &Section) -> Result<DataSource, CaseError> {
         Ok(match (&raw.data, &raw.clip) {
             (Some(d), None) => DataSource::Forward(self.data(d)?),
-            (None, Some(cl)) => DataSource::Clip(Box::new(self.clip(cl, mesh)?)),
+            (None, Some(cl)) => DataSource::Clip(Box::new(self.clip(cl, mesh, section)?)),
             (Some(_), Some(_)) => {
                 return Err(self.err("clip", "give either [data] (synthetic) or [clip] (recorded), not both"))
             }
@@ -374,7 +352,12 @@ impl<'a> Validator<'a> {
     }
 
     /// `[solver]`, `[inverse]` and `[data]` or `[clip]` of an inverse analysis.
-    fn inverse(&self, raw: &RawCase, mesh: &Mesh, props: &RodProperties) -> Result<InverseSettings, CaseError> {
+    fn inverse(
+        &self,
+        raw: &RawCase,
+        (mesh, section): (&Mesh, &Section),
+        props: &RodProperties,
+    ) -> Result<InverseSettings, CaseError> {
         let s = &raw.solver;
         // Both methods need the relaxation: Newton starts from the fixed point (I8).
         let relaxation = self.relaxation("solver", s.relaxation)?;
@@ -382,7 +365,7 @@ impl<'a> Validator<'a> {
         if s.continuation_steps != 1 {
             return Err(self.err("solver.continuation_steps", "not used by an inverse analysis"));
         }
-        let data = self.data_source(raw, mesh)?;
+        let data = self.data_source(raw, mesh, section)?;
         let inv = raw.inverse.as_ref().ok_or_else(|| {
             self.err("inverse", "required when solver.analysis = \"inverse\" (the weights of eq. 41)")
         })?;
@@ -469,6 +452,7 @@ impl<'a> Validator<'a> {
             max_iterations: d.max_iterations,
             continuation_steps: d.continuation_steps,
             certificate_tolerance: self.certificate_tolerance("data.certificate_tolerance", d.certificate_tolerance)?,
+            path: None,
         })
     }
 
@@ -519,12 +503,15 @@ impl<'a> Validator<'a> {
         kind: RawAnalysis,
         loads: &crate::model::loads::Loads,
     ) -> Result<Option<Reference>, CaseError> {
-        match r {
-            None => Ok(None),
-            Some(RawReference::TipLoadedCantilever { force_n }) => {
+        match r.map(|r| (r.kind, r.force_n.as_ref())) {
+            None | Some((None, None)) => Ok(None),
+            Some((None, Some(_))) => Err(self.err("reference.force_n", "only with kind = \"tip_loaded_cantilever\"")),
+            Some((Some(RawReferenceKind::TipLoadedCantilever), force_n)) => {
                 if kind != RawAnalysis::Static {
                     return Err(self.err("reference.kind", "\"tip_loaded_cantilever\" needs a static analysis"));
                 }
+                let force_n = force_n
+                    .ok_or_else(|| self.err("reference.force_n", "required by kind = \"tip_loaded_cantilever\""))?;
                 let force_n = self.positive("reference.force_n", force_n)?;
                 // the theories (elastica, Reissner) are of the case's own tip force
                 // scaled, so that a 5e300 N force does not overflow to an infinite norm

@@ -17,6 +17,14 @@ pub struct Cli {
 #[derive(Subcommand, Debug)]
 pub enum Command {
     /// Run a case and write fields (CSV), metrics.json and plot.svg.
+    ///
+    /// A case with published values ([[reference.values]]) also writes reference.csv (published,
+    /// computed, error, tolerance, pass, source per value), adds them to metrics.json and prints
+    /// one line per value on stderr.
+    ///
+    /// Exit status: 0 the run is complete; 1 it failed, did not converge or stalled (the folder's
+    /// run.json says which), or, with --strict, a published value missed its tolerance or a
+    /// clip has frames over the fit-quality gate; 130 stopped by a signal.
     Run {
         /// Case file (TOML), e.g. cases/timoshenko_10pct.toml
         case: PathBuf,
@@ -43,8 +51,9 @@ pub enum Command {
         /// Do not show progress (a bar on a terminal, else a line every 10 s)
         #[arg(long)]
         quiet: bool,
-        /// Clips: exit with status 1 when frames are over the fit-quality gate (run.json then
-        /// says complete_with_warnings either way)
+        /// Exit with status 1 when a published value ([[reference.values]]) misses its
+        /// tolerance, or a clip has frames over the fit-quality gate (run.json says complete,
+        /// or complete_with_warnings, either way)
         #[arg(long)]
         strict: bool,
     },
@@ -56,7 +65,10 @@ pub enum Command {
     /// case again with its input perturbed by 1e-13 (relative), and a row passes when the
     /// engines differ by less than 10 x (that change + the solver tolerance) + 1e-12. Values in
     /// the case's [compare] table override them (with a `reason`). Writes compare.csv, the
-    /// engines' outputs (single runs) and FreeFEM's work folder to --out.
+    /// engines' outputs (single runs) and FreeFEM's work folder to --out. A case with published
+    /// values ([[reference.values]]) has them checked in both engines: a second table, and
+    /// reference.csv with both engines' values, errors and verdicts; a value missed in either
+    /// engine is exit status 1 too.
     Compare {
         /// Case file (TOML)
         case: PathBuf,

@@ -71,6 +71,9 @@ pub fn cmd_compare(
 ) -> Result<ExitCode> {
     use cosserat::jobs::compare::default_dir;
     let case = load(path)?;
+    if let Some(why) = cosserat::engine::rust::published::unavailable(&case) {
+        bail!(why);
+    }
     check_memory(&case, Footprint::Run, limits)?;
     let target = out.unwrap_or_else(|| default_dir(&case));
     let mut manifest = run_manifest(&case, Engine::Rust)?;
@@ -124,7 +127,31 @@ fn compare_into(case: &Case, dir: &Path, target: &Path, short: bool, frames: Opt
     if failed > 0 {
         eprintln!("{}: {failed} of {} rows FAILED", case.name, report.rows.len());
     }
-    Ok(if failed == 0 { ExitCode::SUCCESS } else { ExitCode::from(1) })
+    let missed = compare_published(case, &report, opts.horizon, dir, target)?;
+    Ok(if failed == 0 && missed == 0 { ExitCode::SUCCESS } else { ExitCode::from(1) })
+}
+
+/// The published values of `case` in both engines of `report`: their table, `reference.csv`
+/// in `dir`; returns how many missed in either engine.
+fn compare_published(
+    case: &Case,
+    report: &cosserat::jobs::compare::CompareReport,
+    horizon: cosserat::jobs::compare::Horizon,
+    dir: &Path,
+    target: &Path,
+) -> Result<usize> {
+    use cosserat::jobs::compare_published::PublishedComparison;
+    let Some(p) = PublishedComparison::of(case, report, horizon).with_context(|| case_label(case))? else {
+        return Ok(0);
+    };
+    cosserat::io::files::write_atomic(&dir.join("reference.csv"), p.csv().as_bytes())?;
+    print!("{}", p.table());
+    println!("wrote {}", target.join("reference.csv").display());
+    let missed = p.missed();
+    if missed > 0 {
+        eprintln!("{}: {missed} of {} published values MISSED in rust or freefem", case.name, p.rust.len());
+    }
+    Ok(missed)
 }
 
 #[allow(clippy::too_many_arguments)]

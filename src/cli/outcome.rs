@@ -98,8 +98,8 @@ pub fn disk_full_text(e: &(dyn std::error::Error + 'static), target: &Path, what
     )
 }
 
-/// How `cosserat run` ends, by the status of its folder: the summary on stdout, a warning
-/// (`--strict`: exit 1), the interrupt's exit status 130 with what was kept, or the error with
+/// How `cosserat run` ends, by the status of its folder: the summary on stdout, its published
+/// values on stderr, a warning or a missed published value (`--strict`: exit 1), the interrupt's exit status 130 with what was kept, or the error with
 /// what the folder holds.
 pub fn run_end(
     end: cosserat::jobs::job::JobEnd,
@@ -109,7 +109,12 @@ pub fn run_end(
     strict: bool,
 ) -> anyhow::Result<std::process::ExitCode> {
     match end.status {
-        Status::Complete => print!("{}", end.summary(&case.name, engine)),
+        Status::Complete => {
+            print!("{}", end.summary(&case.name, engine));
+            if published_values(&end, (case, engine), strict) > 0 && strict {
+                return Ok(std::process::ExitCode::from(1));
+            }
+        }
         Status::CompleteWithWarnings => {
             print!("{}", end.summary(&case.name, engine));
             eprintln!("warning: {}", end.message.unwrap_or_default());
@@ -149,4 +154,33 @@ pub fn run_end(
         }
     }
     Ok(std::process::ExitCode::SUCCESS)
+}
+
+/// The published values (`[[reference.values]]`) of a complete single run on stderr, one line
+/// each, and a line with the number missed; returns that number.
+fn published_values(end: &cosserat::jobs::job::JobEnd, (case, engine): (&Case, Engine), strict: bool) -> usize {
+    use cosserat::engine::rust::{metrics::all_metrics, published::evaluate};
+    let Some(r) = &end.single else { return 0 };
+    let rows = match all_metrics(case, r) {
+        Ok(m) => evaluate(case, r, &m),
+        Err(_) => return 0,
+    };
+    for row in &rows {
+        eprintln!("{} [{engine}] published {}", case.name, row.summary());
+    }
+    for s in cosserat::engine::rust::published::sources(&rows) {
+        eprintln!("  source: {s}");
+    }
+    let missed = rows.iter().filter(|r| !r.pass).count();
+    if missed > 0 {
+        eprintln!(
+            "{}{}: {missed} of {} published values missed (reference.csv in {}){}",
+            if strict { "error: " } else { "warning: " },
+            case.name,
+            rows.len(),
+            end.dir.display(),
+            if strict { "" } else { "; `--strict` makes this exit status 1" }
+        );
+    }
+    missed
 }

@@ -204,6 +204,7 @@ impl FreefemProgress {
             let unit = match c.unit {
                 Unit::Frames => "frames",
                 Unit::Steps => "time steps",
+                Unit::PathSteps => "path steps",
             };
             let mut p = into.lock().unwrap_or_else(|e| e.into_inner());
             p.get_or_insert_with(|| Progress::new(&label, unit, c.total, false)).set(c.done, c.total);

@@ -67,7 +67,7 @@
 use nalgebra::Vector3;
 
 use super::polyline_length;
-use crate::solve::fit::noise_level;
+use crate::solve::fit::{noise_level, noise_level_in};
 
 /// `√(2/π)`.
 const SQRT_2_OVER_PI: f64 = 0.797_884_560_802_865_4;
@@ -198,8 +198,25 @@ impl FrameLength {
         FrameLength::with_noise(x, noise_level(x))
     }
 
+    /// The lengths of the frame `x` of a recording whose noise lies in the plane normal to
+    /// `plane` (a planar recording, `crate::clip::recording`), or in all three coordinates
+    /// (`None`). Planar noise has two components: a chord gains half the length a 3D chord
+    /// does, and a turning angle carries one component of noise across each chord, not two.
+    pub fn of_in(x: &[Vector3<f64>], plane: Option<&Vector3<f64>>) -> FrameLength {
+        match plane {
+            None => FrameLength::of(x),
+            Some(n) => FrameLength::measured(x, noise_level_in(x, Some(n)), true),
+        }
+    }
+
     /// The lengths of the frame `x` with the noise level `noise_m` [m] per coordinate.
     pub fn with_noise(x: &[Vector3<f64>], noise_m: f64) -> FrameLength {
+        FrameLength::measured(x, noise_m, false)
+    }
+
+    /// The lengths of the frame `x` with the noise level `noise_m` [m] per coordinate, in two
+    /// coordinates (`planar`) or three.
+    fn measured(x: &[Vector3<f64>], noise_m: f64, planar: bool) -> FrameLength {
         let polyline_m = polyline_length(x);
         let n = x.len().saturating_sub(1);
         let s = std::f64::consts::SQRT_2 * noise_m.max(0.0);
@@ -213,7 +230,7 @@ impl FrameLength {
             .map(|o| {
                 let m = (n - o) / k;
                 let nodes: Vec<Vector3<f64>> = (0..=m).map(|j| x[o + j * k]).collect();
-                curvature_corrected(&nodes, noise_m) * n as f64 / (m * k) as f64
+                curvature_corrected(&nodes, noise_m, planar) * n as f64 / (m * k) as f64
             })
             .collect();
         let corrected_m = estimates.iter().sum::<f64>() / estimates.len().max(1) as f64;
@@ -266,11 +283,18 @@ fn chord_step(x: &[Vector3<f64>], s: f64) -> usize {
 }
 
 /// Steps 2 and 3 of the module doc on the chords of `nodes` (the nodes kept) with noise
-/// `noise_m` [m] per coordinate: `Σ_j ℓ_j (θ̄_j/2)/sin(θ̄_j/2)` [m].
-fn curvature_corrected(nodes: &[Vector3<f64>], noise_m: f64) -> f64 {
+/// `noise_m` [m] per coordinate, in three coordinates or two (`planar`,
+/// [`FrameLength::of_in`]):
+/// `Σ_j ℓ_j (θ̄_j/2)/sin(θ̄_j/2)` [m].
+fn curvature_corrected(nodes: &[Vector3<f64>], noise_m: f64, planar: bool) -> f64 {
     let s = std::f64::consts::SQRT_2 * noise_m;
     let chords: Vec<Vector3<f64>> = nodes.windows(2).map(|w| w[1] - w[0]).collect();
-    let l: Vec<f64> = chords.iter().map(|c| denoised_chord(c.norm(), s)).collect();
+    let l: Vec<f64> = chords
+        .iter()
+        .map(|c| if planar { denoised_planar_chord(c.norm(), s) } else { denoised_chord(c.norm(), s) })
+        .collect();
+    // components of a node's noise across a chord: two in space, one in the plane
+    let across = if planar { 1.0 } else { 2.0 };
     // θ̃² at the vertex between chords j − 1 and j, eq. (3)
     let theta2: Vec<f64> = (1..chords.len())
         .map(|j| {
@@ -281,7 +305,7 @@ fn curvature_corrected(nodes: &[Vector3<f64>], noise_m: f64) -> f64 {
             }
             let theta = u.cross(&v).norm().atan2(u.dot(&v));
             let (a, b) = (1.0 / l[j], 1.0 / l[j - 1]);
-            (theta * theta - 2.0 * noise_m * noise_m * (a * a + (a + b) * (a + b) + b * b)).max(0.0)
+            (theta * theta - across * noise_m * noise_m * (a * a + (a + b) * (a + b) + b * b)).max(0.0)
         })
         .collect();
     let end = |j: usize| -> Option<f64> { j.checked_sub(1).and_then(|i| theta2.get(i)).copied() };
@@ -294,6 +318,28 @@ fn curvature_corrected(nodes: &[Vector3<f64>], noise_m: f64) -> f64 {
             lj * arc_over_chord(t2.sqrt())
         })
         .sum()
+}
+
+/// `ℓ = s m₂⁻¹(c/s)` [m]: eq. (2) of the module doc for a planar recording
+/// ([`FrameLength::of_in`]), whose
+/// chord noise has two components of `s²` each; `|c|/s` is then a Rice variable, whose mean
+/// is `m₂(λ) = λ + 1/(2λ) + O(λ⁻³)` (each chord gains `s²/(2|d|) = σ²/h`, half the 3D
+/// excess). Inverted in closed form, `λ = (q + √(q² − 2))/2`; a chord no longer than the mean of
+/// noise alone (`√(π/2) s`, the Rayleigh mean) is 0, and between that and `√2 s`, where the
+/// expansion has no root, `λ = q/√2` (chords there are shorter than `Λ s`/5, which step 1 keeps
+/// rare: the expansion's error at `Λ` is 3e-4 of a chord).
+pub fn denoised_planar_chord(c: f64, s: f64) -> f64 {
+    if !(s > 0.0 && s.is_finite() && c.is_finite()) {
+        return c;
+    }
+    let q = c / s;
+    if q <= (std::f64::consts::PI / 2.0).sqrt() {
+        return 0.0;
+    }
+    if q < std::f64::consts::SQRT_2 {
+        return s * q / std::f64::consts::SQRT_2;
+    }
+    s * 0.5 * (q + (q * q - 2.0).sqrt())
 }
 
 /// A body length estimated from the frames of a recording (module doc).
@@ -316,7 +362,13 @@ impl BodyLength {
     /// The estimate from `frames` (each a centreline, [m]); `None` without a frame of positive
     /// finite corrected length.
     pub fn estimate(frames: &[Vec<Vector3<f64>>]) -> Option<BodyLength> {
-        let lengths: Vec<FrameLength> = frames.iter().map(|f| FrameLength::of(f)).collect();
+        BodyLength::estimate_in(frames, None)
+    }
+
+    /// [`BodyLength::estimate`] of a recording whose noise lies in the plane normal to `plane`
+    /// ([`FrameLength::of_in`]).
+    pub fn estimate_in(frames: &[Vec<Vector3<f64>>], plane: Option<&Vector3<f64>>) -> Option<BodyLength> {
+        let lengths: Vec<FrameLength> = frames.iter().map(|f| FrameLength::of_in(f, plane)).collect();
         let mut l: Vec<f64> = lengths.iter().map(|f| f.corrected_m).filter(|v| v.is_finite()).collect();
         let length_m = median(&mut l)?;
         if length_m.is_nan() || length_m <= 0.0 {

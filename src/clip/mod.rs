@@ -43,6 +43,7 @@ use nalgebra::{Matrix3, Vector2, Vector3};
 pub mod length;
 pub use crate::solve::smoothing;
 pub mod missing;
+pub mod recording;
 mod spline;
 pub mod synthetic;
 
@@ -147,9 +148,18 @@ pub struct Clip {
     /// every node of every frame. The untracked positions in `frames` are filled
     /// ([`missing::fill_missing`]).
     pub tracked: Option<Vec<Vec<bool>>>,
+    /// what a recording says about itself: its first frame's number, its unit, its plane
+    /// ([`recording`]); the default for kymograms and synthetic clips
+    pub recording: recording::RecordingInfo,
 }
 
 impl Clip {
+    /// A clip of `frames` [m] at `dt_s` [s] from `source`, of reference length `length_m` [m],
+    /// every node tracked and nothing known of a recording (a kymogram, a synthetic clip).
+    pub fn new(frames: Vec<Vec<Vector3<f64>>>, dt_s: f64, source: String, length_m: f64) -> Clip {
+        Clip { frames, dt_s, source, length_m, tracked: None, recording: Default::default() }
+    }
+
     /// Nodes per frame.
     pub fn node_count(&self) -> usize {
         self.frames.first().map_or(0, Vec::len)
@@ -201,6 +211,9 @@ impl Clip {
     pub fn rotate(&mut self, r: &Matrix3<f64>) {
         for frame in &mut self.frames {
             rotate_frame(frame, r);
+        }
+        if let Some(n) = &mut self.recording.plane_normal {
+            *n = r * *n;
         }
     }
 
@@ -295,7 +308,7 @@ pub fn clip_from_angles(rows: &[Vec<f64>], params: &KymogramParams, source: Stri
     assert!(params.nodes >= 2, "at least two nodes");
     let joints: Vec<Vec<Vector2<f64>>> = rows.iter().map(|a| kymogram_joints(a, params.length_m)).collect();
     let Some(first) = joints.first() else {
-        return Clip { frames: Vec::new(), dt_s: params.dt_s, source, length_m: params.length_m, tracked: None };
+        return Clip::new(Vec::new(), params.dt_s, source, params.length_m);
     };
     let (head, chord) = (first[0], first[first.len() - 1] - first[0]);
     let (c, s) = (chord.x / chord.norm(), chord.y / chord.norm());
@@ -323,7 +336,7 @@ pub fn clip_from_angles(rows: &[Vec<f64>], params: &KymogramParams, source: Stri
             }
         })
         .collect();
-    Clip { frames, dt_s: params.dt_s, source, length_m: params.length_m, tracked: None }
+    Clip::new(frames, params.dt_s, source, params.length_m)
 }
 
 #[cfg(test)]
@@ -464,8 +477,7 @@ pub(crate) mod tests {
     fn stretch_and_tangent_diagnostics() {
         let straight: Vec<Vector3<f64>> = (0..5).map(|i| Vector3::new(0.0, 0.0, i as f64 * 0.25e-3)).collect();
         let bent: Vec<Vector3<f64>> = (0..5).map(|i| Vector3::new(0.0, i as f64 * 0.26e-3, 0.0)).collect();
-        let clip =
-            Clip { frames: vec![straight, bent], dt_s: 0.1, source: "test".into(), length_m: 1e-3, tracked: None };
+        let clip = Clip::new(vec![straight, bent], 0.1, "test".into(), 1e-3);
         assert!((clip.stretch(0) - 1.0).abs() < 1e-15);
         let (frame, dev) = clip.max_stretch_deviation();
         assert_eq!(frame, 1);

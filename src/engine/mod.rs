@@ -15,7 +15,9 @@ use nalgebra::Vector3;
 use self::freefem::FreeFemError;
 use self::input::clip_files::{load_clip, roll_stream, ClipFileError, RollStream};
 use self::input::data::{read_data, write_data};
-use self::rust::clip::{run_clip, ClipFrames, ClipOutcome, FrameRecord, FrameSink, StreamedFrame};
+use self::rust::clip::{
+    run_clip_resumed, ClipFrames, ClipOutcome, FrameSink, ResumeRecords, StreamedFrame, STREAM_AHEAD,
+};
 use self::rust::weights::{choose_weights, Auto};
 use self::rust::{Engine, NodalState, RunError, RunResult};
 use crate::case::{Case, DataSource, WeightsRule};
@@ -78,6 +80,7 @@ pub fn load_data(case: &Case) -> Result<NodalState, EngineError> {
                 x,
                 alpha: vec![Vector3::zeros(); n],
                 chart: Chart::default(),
+                reference_x: None,
             })
         }
     }
@@ -158,24 +161,26 @@ impl ClipInput {
 pub fn run_clip_into<S: FrameSink>(
     case: &Case,
     input: ClipInput,
-    records: &[FrameRecord],
+    records: ResumeRecords<'_>,
     sink: S,
     progress: impl FnMut(usize, usize),
 ) -> Result<ClipOutcome, EngineError> {
     match input {
         ClipInput::Streamed(stream) => std::thread::scope(|scope| {
-            let (tx, rx) = std::sync::mpsc::channel();
+            // at most STREAM_AHEAD frames wait to be solved: the generator is faster than the
+            // solve, and a clip of any length is held a window at a time
+            let (tx, rx) = std::sync::mpsc::sync_channel(STREAM_AHEAD);
             let (header, total) = (stream.header(), stream.len());
             let stream = &stream;
             // stops at the first frame the solve no longer takes (it ended early)
             scope.spawn(move || (0..total).try_for_each(|i| tx.send(stream_frame(stream, i))));
             let frames = ClipFrames::Streamed { header, total, truth: true, frames: rx };
-            Ok(run_clip(case, frames, records, sink, progress)?)
+            Ok(run_clip_resumed(case, frames, records, sink, progress)?)
         }),
         ClipInput::Loaded { clip, truth, chosen } => {
             let case = chosen.as_ref().map_or(case, |a| &a.case);
             let start = chosen.as_ref().and_then(|a| a.start.as_ref());
-            let mut out = run_clip(
+            let mut out = run_clip_resumed(
                 case,
                 ClipFrames::Loaded { clip: &clip, truth: truth.as_ref(), start },
                 records,

@@ -130,6 +130,107 @@ pub(crate) fn draw_colour_bar<DB: DrawingBackend>(
     area.draw_text(label, &style, (lx, (y.start + y.end) / 2)).map_err(|e| draw_err(label, e))
 }
 
+/// Columns of the heatmaps of one figure marked for what happened in the frames they stand
+/// for: `hatched` columns are drawn over with diagonal lines, `barred` ones get a black bar
+/// above the plotting area; a legend row under each title names both (drawn only if any
+/// column is marked).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ColumnMarks {
+    /// indices into the maps' `x` of the hatched columns
+    pub hatched: Vec<usize>,
+    pub hatched_label: String,
+    /// indices into the maps' `x` of the barred columns
+    pub barred: Vec<usize>,
+    pub barred_label: String,
+}
+
+impl ColumnMarks {
+    fn is_empty(&self) -> bool {
+        self.hatched.is_empty() && self.barred.is_empty()
+    }
+}
+
+/// Height of the legend row of [`ColumnMarks`] [px].
+const MARKS_ROW: u32 = 24;
+/// Spacing of the hatching of a marked column [px].
+const HATCH_PX: i32 = 6;
+/// The colour of the marks.
+const MARK_COLOUR: RGBColor = RGBColor(40, 40, 40);
+
+/// Diagonal lines (`x + y = c`, `c` on a grid of [`HATCH_PX`], so that adjacent columns join)
+/// over the pixel rectangle `[x0, x1] × [y0, y1]` of `area`.
+fn hatch<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    (x0, x1): (i32, i32),
+    (y0, y1): (i32, i32),
+) -> Result<(), PlotError> {
+    let first = (x0 + y0).div_euclid(HATCH_PX) * HATCH_PX;
+    for c in (first..=x1 + y1).step_by(HATCH_PX as usize) {
+        let (lo, hi) = ((c - y1).max(x0), (c - y0).min(x1));
+        if lo < hi {
+            area.draw(&PathElement::new(vec![(lo, c - lo), (hi, c - hi)], MARK_COLOUR.stroke_width(1)))
+                .map_err(|e| draw_err("marks", e))?;
+        }
+    }
+    Ok(())
+}
+
+/// The legend of `marks` in `row`, from `left` [px]: a sample of each mark and its label.
+fn draw_marks_legend<DB: DrawingBackend>(
+    row: &DrawingArea<DB, Shift>,
+    marks: &ColumnMarks,
+    left: i32,
+) -> Result<(), PlotError> {
+    let mid = MARKS_ROW as i32 / 2;
+    let style = text_style(LEGEND_PX).pos(Pos::new(HPos::Left, VPos::Center));
+    let mut x = left;
+    for (hatched, label) in [(true, &marks.hatched_label), (false, &marks.barred_label)] {
+        if (hatched && marks.hatched.is_empty()) || (!hatched && marks.barred.is_empty()) {
+            continue;
+        }
+        if hatched {
+            row.draw(&Rectangle::new([(x, mid - 7), (x + 14, mid + 7)], MARK_COLOUR.stroke_width(1)))
+                .map_err(|e| draw_err(label, e))?;
+            hatch(row, (x, x + 14), (mid - 7, mid + 7))?;
+        } else {
+            row.draw(&Rectangle::new([(x, mid - 3), (x + 14, mid + 3)], MARK_COLOUR.filled()))
+                .map_err(|e| draw_err(label, e))?;
+        }
+        row.draw_text(label, &style, (x + 20, mid)).map_err(|e| draw_err(label, e))?;
+        x += 20 + (label.chars().count() as f64 * CHAR_WIDTH * LEGEND_PX as f64) as i32 + 28;
+    }
+    Ok(())
+}
+
+/// The marks of `marks` on the heatmap `m` drawn in `area`; `px` maps a point of the map to
+/// the pixels of `area`.
+fn draw_marks<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    px: &dyn Fn(f64, f64) -> (i32, i32),
+    m: &Heatmap,
+    marks: &ColumnMarks,
+) -> Result<(), PlotError> {
+    let (y0, y1) = (m.y[0], m.y[m.y.len() - 1]);
+    let column = |i: usize| {
+        let lo = if i == 0 { m.x[0] } else { 0.5 * (m.x[i - 1] + m.x[i]) };
+        let hi = if i + 1 == m.x.len() { m.x[i] } else { 0.5 * (m.x[i] + m.x[i + 1]) };
+        let ((a, top), (b, bottom)) = (px(lo, y1), px(hi, y0));
+        // at least 2 px wide, so that a lone marked column stays visible
+        ((a.min(b), a.max(b).max(a.min(b) + 2)), (top.min(bottom), top.max(bottom)))
+    };
+    for &i in marks.hatched.iter().filter(|&&i| i < m.x.len()) {
+        let (xs, ys) = column(i);
+        hatch(area, xs, ys)?;
+    }
+    for &i in marks.barred.iter().filter(|&&i| i < m.x.len()) {
+        let ((a, b), (top, _)) = column(i);
+        let (a, b) = (a.min(b - 4), b);
+        area.draw(&Rectangle::new([(a, top - 9), (b, top - 1)], MARK_COLOUR.filled()))
+            .map_err(|e| draw_err("marks", e))?;
+    }
+    Ok(())
+}
+
 /// Checks the grid of every map.
 fn validate_maps(maps: &[Heatmap]) -> Result<(), PlotError> {
     if maps.is_empty() {
@@ -152,11 +253,23 @@ fn validate_maps(maps: &[Heatmap]) -> Result<(), PlotError> {
     Ok(())
 }
 
-/// One heatmap in `area`: title strip, cells, the y ends' labels and the colour bar.
-fn draw_heatmap<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, m: &Heatmap) -> Result<(), PlotError> {
+/// One heatmap in `area`: title strip (and the legend row of `marks`), cells, the marks, the y
+/// ends' labels and the colour bar.
+fn draw_heatmap<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    m: &Heatmap,
+    marks: &ColumnMarks,
+) -> Result<(), PlotError> {
     let t = m.title.as_str();
     let (w, _) = area.dim_in_pixel();
     let body = title_strip(area, t, TITLE_STRIP, TITLE_PX)?;
+    let body = if marks.is_empty() {
+        body
+    } else {
+        let (row, body) = body.split_vertically(MARKS_ROW);
+        draw_marks_legend(&row, marks, 90)?;
+        body
+    };
     let (chart_area, _) = body.split_horizontally(w - COLOUR_BAR_STRIP);
     let (x0, x1) = (m.x[0], m.x[m.x.len() - 1]);
     let (y0, y1) = (m.y[0], m.y[m.y.len() - 1]);
@@ -189,9 +302,14 @@ fn draw_heatmap<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, m: &Heatmap) 
         Rectangle::new([(xa, ya), (xb, yb)], m.scale.colour(m.values[i][j], m.limit).filled())
     });
     chart.draw_series(cells).map_err(|e| draw_err(t, e))?;
+    let base = area.get_base_pixel();
+    let to_area = |x: f64, y: f64| {
+        let (a, b) = chart.backend_coord(&(x, y));
+        (a - base.0, b - base.1)
+    };
+    draw_marks(area, &to_area, m, marks)?;
     // the plotting area in the pixels of `area`
     let (px, py) = chart.plotting_area().get_pixel_range();
-    let base = area.get_base_pixel();
     let (right, rows) = (px.end - base.0, (py.start - base.1)..(py.end - base.1));
     if let Some((bottom, top)) = &m.y_ends {
         area.draw_text(top, &text_style(LEGEND_PX).pos(Pos::new(HPos::Left, VPos::Top)), (right + 6, rows.start))
@@ -211,12 +329,18 @@ pub const HEATMAP_SIZE: (u32, u32) = (1200, 440);
 /// Heatmaps from top to bottom (one column, as the paper's kymographs) in one SVG, each with its
 /// colour bar.
 pub fn render_heatmaps_svg(maps: &[Heatmap]) -> Result<String, PlotError> {
+    render_marked_heatmaps_svg(maps, &ColumnMarks::default())
+}
+
+/// [`render_heatmaps_svg`] with the columns of `marks` marked on every map (maps of one time
+/// axis), and its legend under each title.
+pub fn render_marked_heatmaps_svg(maps: &[Heatmap], marks: &ColumnMarks) -> Result<String, PlotError> {
     validate_maps(maps)?;
     let size = (HEATMAP_SIZE.0, HEATMAP_SIZE.1 * maps.len() as u32);
     let title = maps[0].title.clone();
     render(size, &title, |root| {
         for (m, area) in maps.iter().zip(root.split_evenly((maps.len(), 1))) {
-            draw_heatmap(&area, m)?;
+            draw_heatmap(&area, m, marks)?;
         }
         Ok(())
     })
@@ -238,5 +362,32 @@ mod tests {
             assert!(svg.contains(text), "missing {text}");
         }
         assert!(smallest_text(&svg) >= 12.0);
+    }
+
+    /// Marked columns are hatched or barred on every map, with a legend under each title;
+    /// without marks there is neither.
+    #[test]
+    fn marked_columns_are_hatched_or_barred_with_a_legend() {
+        let x: Vec<f64> = (0..20).map(|i| i as f64 * 0.04).collect();
+        let y = vec![0.0, 0.5, 1.0];
+        let m = Heatmap::kymograph("k".into(), x.clone(), y, vec![vec![0.5; 3]; 20], 1.0, "κ [1/mm]".into());
+        let plain = render_heatmaps_svg(&[m.clone(), m.clone()]).unwrap();
+        let marks = ColumnMarks {
+            hatched: vec![3, 4],
+            hatched_label: "lost frames".into(),
+            barred: vec![10],
+            barred_label: "flagged frames".into(),
+        };
+        let marked = render_marked_heatmaps_svg(&[m.clone(), m], &marks).unwrap();
+        let lines = |svg: &str| svg.matches("stroke=\"#282828\"").count();
+        let bars = |svg: &str| svg.matches("fill=\"#282828\"").count();
+        assert_eq!((lines(&plain), bars(&plain)), (0, 0));
+        assert!(!plain.contains("lost frames"));
+        assert_eq!(marked.matches("lost frames").count(), 2);
+        assert_eq!(marked.matches("flagged frames").count(), 2);
+        // two columns of ~45 px × ~300 px: dozens of hatch lines per map; one bar per map and
+        // one in each legend
+        assert!(lines(&marked) > 2 * 20, "{}", lines(&marked));
+        assert_eq!(bars(&marked), 4);
     }
 }

@@ -10,13 +10,11 @@
 //! `curvature.f64`, which the resume journal cuts back like CSVs; `fields.npz` is written
 //! (atomically) when the clip ends, and the raw files go with the journal.
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
-use rayon::prelude::*;
-
-use super::files::{read_capped, write_atomic, InputError, OutputError};
+use super::files::{read_capped, InputError};
 pub use super::files::{CompactError, ZipError};
-use super::npy::{npy_header, npy_payload};
+use super::npy::npy_payload;
 
 /// The compact file in a clip's output folder.
 pub const COMPACT_FILE: &str = "fields.npz";
@@ -24,8 +22,28 @@ pub const COMPACT_FILE: &str = "fields.npz";
 /// `frame,node`; per element, those of `curvature.csv` after `frame`.
 pub const RAW_FIELDS: &str = "fields.f64";
 pub const RAW_CURVATURE: &str = "curvature.f64";
-/// Columns of `curvature.csv` after `frame`.
-pub const CURVATURE_COLUMNS: [&str; 4] = ["s_mid_m", "kappa1_per_m", "kappa2_per_m", "kappa3_per_m"];
+/// Columns of `curvature.csv` after `frame`, one row per element: its midpoint, the curvature
+/// κ = A ∂sα [1/m] (eq. 28), and its stress resultants (`model::resultants::resultants`): the
+/// internal force n [N] and moment m [N m] in global components (eqs. 13, 15), then in the
+/// directors' (`n1` along d1 … `m3` the twisting moment about d3).
+pub const CURVATURE_COLUMNS: [&str; 16] = [
+    "s_mid_m",
+    "kappa1_per_m",
+    "kappa2_per_m",
+    "kappa3_per_m",
+    "n_x_n",
+    "n_y_n",
+    "n_z_n",
+    "m_x_nm",
+    "m_y_nm",
+    "m_z_nm",
+    "n1_n",
+    "n2_n",
+    "n3_n",
+    "m1_nm",
+    "m2_nm",
+    "m3_nm",
+];
 /// Largest `fields.npz` read [bytes]: 4 GiB (what a zip without its 64-bit extension holds).
 pub const COMPACT_FILE_CAP_BYTES: u64 = 1 << 32;
 
@@ -70,24 +88,8 @@ pub fn decode_column(bytes: &[u8], per: usize) -> Vec<f64> {
     words.into_iter().map(f64::from_bits).collect()
 }
 
-/// One `.npy` member of the archive: its name and the bytes of the `.npy` file, in parts
-/// (header, byte planes) that are deflated one by one.
-struct Member {
-    name: String,
-    parts: Vec<Vec<u8>>,
-}
-
-/// The encoded column `name` of `frames` × `per` values as a `|u1` array of shape
-/// `(8, frames, per)`, one part per byte plane.
-fn column_member(name: &str, values: &[f64], frames: usize, per: usize) -> Member {
-    let mut parts = vec![npy_header("|u1", &[8, frames, per])];
-    let planes = encode_column(values, frames);
-    parts.extend(planes.chunks(values.len().max(1)).map(<[u8]>::to_vec));
-    Member { name: format!("{name}.npy"), parts }
-}
-
 /// Shannon entropy of the bytes of `b` [bits per byte].
-fn entropy(b: &[u8]) -> f64 {
+pub(crate) fn entropy(b: &[u8]) -> f64 {
     let mut count = [0usize; 256];
     for &x in b {
         count[x as usize] += 1;
@@ -99,7 +101,7 @@ fn entropy(b: &[u8]) -> f64 {
 /// `data` as deflate blocks ending on a byte boundary and not final (a sync flush), so that
 /// such segments, each compressed on its own, concatenate to one deflate stream. Noise (the low
 /// mantissa bytes, more than 7.9 bits per byte) is stored; the rest is deflated at level 3.
-fn deflate_segment(data: &[u8]) -> Result<Vec<u8>, ZipError> {
+pub(super) fn deflate_segment(data: &[u8]) -> Result<Vec<u8>, ZipError> {
     if entropy(data) > 7.9 {
         // stored blocks: a header byte (not final, type 00), LEN and its complement, the bytes
         let mut out = Vec::with_capacity(data.len() + 5 * (data.len() / 65535 + 1));
@@ -125,97 +127,6 @@ fn deflate_segment(data: &[u8]) -> Result<Vec<u8>, ZipError> {
     }
 }
 
-/// Bytes of a zip archive of `members`, each deflated (in parallel), without the 64-bit
-/// extension; `Err` when a member or the archive exceeds its 4 GiB.
-fn zip_bytes(members: &[Member]) -> Result<Vec<u8>, ZipError> {
-    let packed: Vec<(u32, usize, Vec<u8>)> = members
-        .par_iter()
-        .map(|m| {
-            let mut crc = crc32fast::Hasher::new();
-            let mut data = Vec::new();
-            for part in &m.parts {
-                crc.update(part);
-                data.extend(deflate_segment(part)?);
-            }
-            data.extend([0x03, 0x00]); // an empty final block
-            Ok((crc.finalize(), m.parts.iter().map(Vec::len).sum(), data))
-        })
-        .collect::<Result<_, ZipError>>()?;
-    let u32_of = |n: usize, what: &str| u32::try_from(n).map_err(|_| ZipError::TooLarge { what: what.to_string() });
-    let (mut out, mut central) = (Vec::new(), Vec::new());
-    for (m, (crc, plain, data)) in members.iter().zip(&packed) {
-        let offset = u32_of(out.len(), "the archive")?;
-        let (csize, usize_) = (u32_of(data.len(), &m.name)?, u32_of(*plain, &m.name)?);
-        // version 2.0, no flags, deflate, 1980-01-01 00:00
-        let common = |out: &mut Vec<u8>| {
-            for v in [20u16, 0, 8, 0, 0x21] {
-                out.extend(v.to_le_bytes());
-            }
-            for v in [*crc, csize, usize_] {
-                out.extend(v.to_le_bytes());
-            }
-            out.extend((m.name.len() as u16).to_le_bytes());
-            out.extend(0u16.to_le_bytes());
-        };
-        out.extend(0x0403_4b50u32.to_le_bytes());
-        common(&mut out);
-        out.extend(m.name.as_bytes());
-        out.extend(data);
-        central.extend(0x0201_4b50u32.to_le_bytes());
-        central.extend(20u16.to_le_bytes());
-        common(&mut central);
-        central.extend([0u8; 10]); // comment length, disk, internal and external attributes
-        central.extend(offset.to_le_bytes());
-        central.extend(m.name.as_bytes());
-    }
-    let (cd_offset, cd_size) = (u32_of(out.len(), "the archive")?, u32_of(central.len(), "the directory")?);
-    out.extend(central);
-    out.extend(0x0605_4b50u32.to_le_bytes());
-    out.extend([0u8; 4]);
-    let count = u16::try_from(members.len()).map_err(|_| ZipError::TooManyMembers { count: members.len() })?;
-    out.extend(count.to_le_bytes());
-    out.extend(count.to_le_bytes());
-    out.extend(cd_size.to_le_bytes());
-    out.extend(cd_offset.to_le_bytes());
-    out.extend(0u16.to_le_bytes());
-    Ok(out)
-}
-
-/// Write `dir/fields.npz` from the raw rows in `dir` (`RAW_FIELDS`, `RAW_CURVATURE`) of the
-/// frames `frames`, `field_columns` values per node and `CURVATURE_COLUMNS` per element.
-pub fn write_compact(dir: &Path, frames: &[i64], field_columns: &[&str]) -> Result<PathBuf, OutputError> {
-    let path = dir.join(COMPACT_FILE);
-    let invalid = |reason: String| OutputError::Invalid { path: path.clone(), reason };
-    let zip_error = |reason: ZipError| OutputError::Zip { path: path.clone(), reason };
-    let read = |name: &str| -> Result<Vec<f64>, OutputError> {
-        let p = dir.join(name);
-        let bytes = std::fs::read(&p).map_err(|source| OutputError::Io { path: p, source })?;
-        Ok(bytes.chunks_exact(8).map(|c| f64::from_le_bytes(c.try_into().unwrap_or([0; 8]))).collect())
-    };
-    let nf = frames.len();
-    let mut members = Vec::new();
-    let mut npy = npy_header("<i8", &[nf]);
-    npy.extend(frames.iter().flat_map(|f| f.to_le_bytes()));
-    members.push(Member { name: "frame.npy".into(), parts: vec![npy] });
-    for (raw, columns) in [(RAW_FIELDS, field_columns), (RAW_CURVATURE, &CURVATURE_COLUMNS[..])] {
-        let values = read(raw)?;
-        let (nc, rows) = (columns.len(), values.len() / columns.len().max(1));
-        if nf == 0 || rows % nf != 0 || values.len() % nc != 0 {
-            return Err(invalid(format!("{raw} holds {} values, not {nf} frames of {nc} columns", values.len())));
-        }
-        let per = rows / nf;
-        let mut cols: Vec<Vec<f64>> = vec![Vec::with_capacity(rows); nc];
-        for (i, v) in values.into_iter().enumerate() {
-            cols[i % nc].push(v);
-        }
-        let cols: Vec<Member> =
-            cols.par_iter().zip(columns.par_iter()).map(|(col, name)| column_member(name, col, nf, per)).collect();
-        members.extend(cols);
-    }
-    write_atomic(&path, &zip_bytes(&members).map_err(zip_error)?)?;
-    Ok(path)
-}
-
 /// A `fields.npz` read back: the frame numbers and every column over frames × nodes (fields)
 /// or frames × elements (curvature), row-major.
 #[derive(Clone, Debug, Default)]
@@ -225,7 +136,7 @@ pub struct CompactClip {
     pub columns: BTreeMap<String, (usize, Vec<f64>)>,
 }
 
-/// Read a `fields.npz` written by [`write_compact`].
+/// Read a `fields.npz` written by [`super::compact_write::write_compact`].
 pub fn read_compact(path: &Path) -> Result<CompactClip, InputError> {
     let bytes = read_capped(path, COMPACT_FILE_CAP_BYTES, "compact clip file")?;
     parse_compact(&bytes).map_err(|reason| InputError::Compact { path: path.to_path_buf(), reason: Box::new(reason) })
@@ -239,6 +150,27 @@ fn u32_at(b: &[u8], at: usize) -> Result<usize, CompactError> {
     b.get(at..at + 4).map(|s| u32::from_le_bytes([s[0], s[1], s[2], s[3]]) as usize).ok_or(CompactError::Truncated)
 }
 
+fn u64_at(b: &[u8], at: usize) -> Result<usize, CompactError> {
+    let v =
+        b.get(at..at + 8).map(|s| u64::from_le_bytes(s.try_into().unwrap_or([0; 8]))).ok_or(CompactError::Truncated)?;
+    usize::try_from(v).map_err(|_| CompactError::Truncated)
+}
+
+/// The local header offset of a central directory entry's Zip64 extra field (id 0x0001,
+/// holding only the offset: the sizes of our members fit 32 bits), among its `len` bytes of
+/// extra fields at `at`.
+fn zip64_offset(b: &[u8], mut at: usize, len: usize) -> Result<usize, CompactError> {
+    let end = at + len;
+    while at + 4 <= end {
+        let (id, size) = (u16_at(b, at)?, u16_at(b, at + 2)?);
+        if id == 1 && size >= 8 {
+            return u64_at(b, at + 4);
+        }
+        at += 4 + size;
+    }
+    Err(CompactError::CorruptDirectory)
+}
+
 /// The members of a zip archive (stored or deflated), by name.
 fn unzip(b: &[u8]) -> Result<BTreeMap<String, Vec<u8>>, CompactError> {
     let eocd = (0..b.len().saturating_sub(21))
@@ -247,6 +179,12 @@ fn unzip(b: &[u8]) -> Result<BTreeMap<String, Vec<u8>>, CompactError> {
         .find(|&i| b[i..].starts_with(&0x0605_4b50u32.to_le_bytes()))
         .ok_or(CompactError::NotZip)?;
     let (count, mut at) = (u16_at(b, eocd + 10)?, u32_at(b, eocd + 16)?);
+    if at == u32::MAX as usize {
+        // Zip64: the locator before the end record gives the Zip64 end record, and that the
+        // directory's offset
+        let record = u64_at(b, eocd.checked_sub(12).ok_or(CompactError::Truncated)?)?;
+        at = u64_at(b, record + 48)?;
+    }
     let mut out = BTreeMap::new();
     for _ in 0..count {
         if u32_at(b, at)? != 0x0201_4b50 {
@@ -258,6 +196,7 @@ fn unzip(b: &[u8]) -> Result<BTreeMap<String, Vec<u8>>, CompactError> {
             (u16_at(b, at + 28)?, u16_at(b, at + 30)?, u16_at(b, at + 32)?, u32_at(b, at + 42)?);
         let name = b.get(at + 46..at + 46 + nlen).ok_or(CompactError::Truncated)?;
         let name = String::from_utf8_lossy(name).into_owned();
+        let local = if local == u32::MAX as usize { zip64_offset(b, at + 46 + nlen, xlen)? } else { local };
         at += 46 + nlen + xlen + clen;
         let start = local + 30 + u16_at(b, local + 26)? + u16_at(b, local + 28)?;
         let data = b.get(start..start + csize).ok_or_else(|| CompactError::MemberTruncated { name: name.clone() })?;
@@ -311,51 +250,5 @@ mod tests {
             (0..60).map(|i| (i as f64 * 0.37).sin() * 1e-3 + if i == 7 { f64::NAN } else { 0.0 }).collect();
         let back = decode_column(&encode_column(&v, 5), 12);
         assert!(v.iter().zip(&back).all(|(a, b)| a.to_bits() == b.to_bits()));
-    }
-
-    #[test]
-    fn noise_is_stored_and_reads_back() {
-        let dir = tempfile::tempdir().unwrap();
-        let mut state = 7u64;
-        let noise: Vec<f64> = (0..3 * 70_000)
-            .map(|_| {
-                // splitmix64
-                state = state.wrapping_add(0x9e37_79b9_7f4a_7c15);
-                let z = (state ^ (state >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-                let z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-                f64::from_bits((z ^ (z >> 31)) >> 2)
-            })
-            .collect();
-        let bytes: Vec<u8> = noise.iter().flat_map(|x| x.to_le_bytes()).collect();
-        std::fs::write(dir.path().join(RAW_FIELDS), bytes).unwrap();
-        std::fs::write(dir.path().join(RAW_CURVATURE), 0.5f64.to_le_bytes().repeat(4 * 2)).unwrap();
-        assert!(entropy(&encode_column(&noise, 2)[..noise.len()]) > 7.9);
-        let p = write_compact(dir.path(), &[0, 1], &["a", "b", "c"]).unwrap();
-        let c = read_compact(&p).unwrap();
-        for (k, name) in ["a", "b", "c"].iter().enumerate() {
-            let expected: Vec<u64> = noise.iter().skip(k).step_by(3).map(|v| v.to_bits()).collect();
-            assert_eq!(c.columns[*name].1.iter().map(|v| v.to_bits()).collect::<Vec<_>>(), expected, "{name}");
-        }
-    }
-
-    #[test]
-    fn archive_round_trips_and_refuses_garbage() {
-        let dir = tempfile::tempdir().unwrap();
-        let raw = |name: &str, v: &[f64]| {
-            std::fs::write(dir.path().join(name), v.iter().flat_map(|x| x.to_le_bytes()).collect::<Vec<_>>()).unwrap()
-        };
-        let fields: Vec<f64> = (0..2 * 3 * 2).map(|i| i as f64 * 0.1).collect();
-        let curv: Vec<f64> = (0..2 * 2 * 4).map(|i| -(i as f64)).collect();
-        raw(RAW_FIELDS, &fields);
-        raw(RAW_CURVATURE, &curv);
-        let p = write_compact(dir.path(), &[4, 5], &["a", "b"]).unwrap();
-        let c = read_compact(&p).unwrap();
-        assert_eq!(c.frame, vec![4, 5]);
-        assert_eq!(c.columns["a"], (3, fields.iter().step_by(2).copied().collect::<Vec<_>>()));
-        assert_eq!(c.columns["kappa3_per_m"], (2, curv.iter().skip(3).step_by(4).copied().collect::<Vec<_>>()));
-        std::fs::write(&p, b"PK not really").unwrap();
-        assert!(read_compact(&p).is_err());
-        raw(RAW_FIELDS, &fields[..5]);
-        assert!(write_compact(dir.path(), &[4, 5], &["a", "b"]).is_err());
     }
 }

@@ -84,11 +84,15 @@ pub enum InputError {
     NonFinitePosition { path: PathBuf, frame: usize, node: usize, axis: char, value: f64 },
     #[error("{path}, frame {frame}: {nodes} nodes, but frame 0 has {expected}")]
     NodeCount { path: PathBuf, frame: usize, nodes: usize, expected: usize },
-    #[error("{path}, frame {frame}, node {node}: no row (frames and nodes must be contiguous from 0)")]
+    #[error(
+        "{path}, frame {frame}, node {node}: no row (nodes are numbered contiguously from 0 or 1; if the tracker \
+         leaves untracked nodes out, set clip.missing = \"nan\" in the case)"
+    )]
     MissingRow { path: PathBuf, frame: usize, node: usize },
     #[error(
-        "{path}, row {row}: frame {next} comes where frame {frame} was expected: frame {frame} has no rows (frames \
-         must be contiguous from 0; is the frame column a timestamp, or a -1 written unsigned?)"
+        "{path}, row {row}: frame {next} comes where frame {frame} was expected: frame {frame} has no rows (a \
+         dropped frame? with clip.missing = \"nan\" it is a lost frame, bridged from its neighbours; or is the \
+         frame column a timestamp, or a -1 written unsigned?)"
     )]
     FrameGap { path: PathBuf, frame: usize, next: usize, row: usize },
     #[error("{path}, row {row}: frame {frame}, node {node} already given in row {first_row}")]

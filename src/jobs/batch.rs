@@ -403,7 +403,6 @@ pub fn run_recording(case: &Case, case_file: &InputFile, entry: &PlanEntry, out:
         Ok(c) => c,
         Err(e) => return failed(chain(&e)),
     };
-    let manifest = Manifest { body_length: case.body_length(), ..manifest };
     let mut folder = match RunFolder::begin(&dir, manifest, Mode::Fresh { force: false }) {
         Ok(f) => f,
         Err(e) => return failed(chain(&e)),
@@ -438,6 +437,7 @@ pub fn run_recording(case: &Case, case_file: &InputFile, entry: &PlanEntry, out:
     folder.manifest.frames.frames_done = solved.frames.map(|f| f.0);
     folder.manifest.frames.frames_total = solved.frames.map(|f| f.1);
     folder.manifest.certificate = solved.certificate(&case);
+    folder.manifest.recording = solved.recording_notes(&case);
     let written = serde_json::to_vec_pretty(&row)
         .map_err(|e| OutputError::Invalid { path: folder.dir().join(ROW), reason: e.to_string() })
         .and_then(|bytes| write_atomic(&folder.dir().join(ROW), &bytes));

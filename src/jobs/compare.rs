@@ -35,10 +35,7 @@ use crate::engine::{load_data, EngineError};
 use crate::io::files::{write_atomic, OutputError};
 use crate::output::run_files::write_run;
 use crate::solve::certificate::CERTIFICATE_FLOOR;
-use crate::solve::inverse::InverseMethod;
-use crate::solve::sequence::ClipData;
-use crate::solve::statics::Method;
-use crate::solve::{SolveError, PLATEAU_ITERATIONS};
+use crate::solve::{inverse::InverseMethod, sequence::ClipData, statics::Method, SolveError, PLATEAU_ITERATIONS};
 
 /// Relative size of the input perturbation that measures a case's conditioning: 450 ulps, far
 /// above the engines' own round-off and far below any physical change.
@@ -336,6 +333,7 @@ fn compare_single(case: &Case, dir: &Path, opts: &CompareOptions) -> Result<Comp
         let ff = freefem::run(&case, &work).map_err(EngineError::from)?;
         let what = match &case.analysis {
             Analysis::Dynamic(p) => format!("dynamic, {} time steps", p.steps),
+            Analysis::Static(p) if p.path.is_some() => "static arc-length path (D25), to the tolerance".to_string(),
             _ => "static, to the solver's tolerance".to_string(),
         };
         (rust, p, ff, what)
@@ -424,8 +422,8 @@ struct ClipRuns {
     freefem: FreeFemFrames,
 }
 
-/// Solve `clip` in Rust, in Rust on perturbed positions, and in FreeFEM (in
-/// `dir/freefem_work`; a fixed point at Rust's iteration count and restarts per frame).
+/// Solve `clip` in Rust, in Rust on perturbed positions, and in FreeFEM (in `dir/freefem_work`; a
+/// fixed point at Rust's iteration count; restarted where Rust restarted, a branch too).
 fn solve_clip_both(case: &Case, clip: ClipData<'_>, dir: &Path) -> Result<ClipRuns, CompareError> {
     let (frames, tracked) = (clip.positions, clip.tracked);
     let rust = solve_frames(case, ClipData { positions: frames, tracked })?;
@@ -433,8 +431,8 @@ fn solve_clip_both(case: &Case, clip: ClipData<'_>, dir: &Path) -> Result<ClipRu
         frames.iter().enumerate().map(|(f, x)| perturb_positions(x, 1000 + f as u64)).collect();
     let perturbed =
         solve_frames(case, ClipData { positions: &pert, tracked }).map_err(|e| CompareError::Perturbed(e.into()))?;
-    let exact: Option<Vec<(usize, bool)>> = is_fixed_point_inverse(case)
-        .then(|| rust.frames.iter().map(|f| (f.result.stats.iterations, f.restarted)).collect());
+    let n = |f: &SolvedFrame| if is_fixed_point_inverse(case) { f.result.stats.iterations } else { 0 };
+    let exact: Option<Vec<(usize, bool)>> = Some(rust.frames.iter().map(|f| (n(f), f.restarted)).collect());
     let work = dir.join("freefem_work");
     let freefem =
         run_clip(case, ClipData { positions: frames, tracked }, exact.as_deref(), &work).map_err(EngineError::from)?;

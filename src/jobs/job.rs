@@ -124,7 +124,7 @@ pub fn run_manifest(case: &Case, engine: Engine) -> Result<Manifest, FolderError
         m.frames.frames_done = Some(0);
     }
     m.input.engine = Some(engine.to_string());
-    m.body_length = case.body_length();
+    m.recording.body_length = case.body_length();
     Ok(m)
 }
 
@@ -179,9 +179,17 @@ pub fn run_into(
         notes: std::mem::take(&mut folder.notes),
         disk_full: None,
     };
+    if case.clip().is_some_and(|c| c.recording.data_plane.is_some()) {
+        end.notes.push(format!(
+            "{}: a planar recording: its twist is {} (run.json: planar)",
+            case.name,
+            crate::output::manifest::PLANAR_TWIST
+        ));
+    }
     let clip = ClipOptions { journal: true, resume: mode == Mode::Resume, format };
     let solved = solve_into(case, engine, &dir, clip, |_| {}, progress);
     folder.manifest.certificate = solved.certificate(case);
+    folder.manifest.recording = solved.recording_notes(case);
     end.status = solved.status.folder_status();
     end.message = solved.error;
     end.single = solved.single;

@@ -6,6 +6,7 @@
 use std::path::Path;
 
 use crate::case::Case;
+use crate::clip::missing::MIN_TRACKED;
 use crate::engine::input::data::write_data;
 use crate::engine::rust::clip::{ClipFrame, ClipRun};
 use crate::engine::rust::clip_metrics::clip_metrics;
@@ -15,6 +16,7 @@ use crate::engine::{load_data, run_case, run_inverse_on, EngineError};
 use crate::output::clip_output::remove_raw;
 use crate::output::clip_run::{run_clip_to, write_clip_figures, ClipOptions};
 use crate::output::journal::remove_journal;
+use crate::output::manifest::{FrameDataNote, PlanarNote, RecordingNotes};
 use crate::output::run_files::write_run;
 use crate::output::run_folder::{CertificateSummary, Status};
 use crate::solve::sequence::FrameReport;
@@ -98,6 +100,24 @@ impl Solved {
         Some(CertificateSummary { value, tolerance: case.certificate_tolerance(), flagged_frames })
     }
 
+    /// What the case's recording said of itself and of the frames solved, for `run.json`.
+    pub fn recording_notes(&self, case: &Case) -> RecordingNotes {
+        let frame_data = self.clip.as_ref().filter(|c| !c.reports.is_empty()).map(|c| {
+            let nodes = case.mesh.nodes();
+            let reports = &c.reports;
+            FrameDataNote {
+                lost: reports.iter().filter(|r| r.nodes_tracked < MIN_TRACKED).map(|r| r.frame).collect(),
+                filled: reports.iter().filter(|r| (MIN_TRACKED..nodes).contains(&r.nodes_tracked)).count(),
+                resolved: reports.iter().filter(|r| r.fit.resolved).map(|r| r.frame).collect(),
+            }
+        });
+        RecordingNotes {
+            body_length: case.body_length(),
+            planar: case.clip().and_then(|c| c.recording.data_plane).map(|n| PlanarNote::new(&n)),
+            frame_data,
+        }
+    }
+
     /// A run that produced nothing, with its error.
     pub fn failed(error: String) -> Self {
         Solved {
@@ -144,6 +164,9 @@ pub fn solve_into(
 }
 
 fn solve_single(case: &Case, engine: Engine, dir: &Path, progress: impl FnMut(usize, usize)) -> Solved {
+    if let Some(why) = unsupported(case, engine) {
+        return Solved::failed(why);
+    }
     let work = dir.join("freefem_work");
     let result = if case.inverse().is_some() {
         let path = dir.join("data.csv");
@@ -254,10 +277,14 @@ fn flag_message(case: &Case, flagged: &[&FrameReport], done: usize) -> String {
 }
 
 /// The case's name and file, for messages.
-/// Why `engine` cannot solve `case` into a folder, if it cannot: a clip in FreeFEM (`run` solves
+/// Why `engine` cannot solve `case` into a folder, if it cannot: a published value the run
+/// cannot compute (`engine::rust::published::unavailable`), a clip in FreeFEM (`run` solves
 /// clips in the Rust engine; `compare` runs FreeFEM's clip script frame by frame against it). A
 /// command checks this before it prepares any folder.
 pub fn unsupported(case: &Case, engine: Engine) -> Option<String> {
+    if let Some(why) = crate::engine::rust::published::unavailable(case) {
+        return Some(why);
+    }
     (engine != Engine::Rust && case.clip().is_some()).then(|| {
         format!(
             "{}: `run` solves clips in the Rust engine (`--engine rust`); to run a clip in FreeFEM against it, use `cosserat compare CASE --frames N` (or `--frames all`)",

@@ -132,7 +132,7 @@ pub fn point_manifest(command: &str, case: &Case, point: &Point) -> Manifest {
     m.input.inputs = super::job::case_inputs(case).unwrap_or_default();
     m.input.settings = point.iter().cloned().collect();
     m.input.engine = Some("rust".into());
-    m.body_length = case.body_length();
+    m.recording.body_length = case.body_length();
     m
 }
 

@@ -141,6 +141,30 @@ impl Pattern {
         }
     }
 
+    /// The position in `values` of the entry `(row, col)`, if the pattern holds it.
+    pub fn position(&self, row: usize, col: usize) -> Option<usize> {
+        let (lo, hi) = (self.col_ptr[col], self.col_ptr[col + 1]);
+        let first = self.row_idx[lo];
+        (row >= first && row - first < hi - lo).then(|| lo + row - first)
+    }
+
+    /// Replace the three rows `rows` of one node by their combinations
+    /// `row'_k = Σ_j t[k][j] row_j`, over every column of the node's band.
+    pub fn combine_rows(&self, values: &mut [f64], rows: [usize; 3], t: &[[f64; 3]; 3]) {
+        let nodes = self.ndofs / self.block;
+        let node = rows[0] / self.block;
+        let lo = node.saturating_sub(1) * self.block;
+        let hi = (node + 2).min(nodes) * self.block;
+        for j in lo..hi {
+            let first = self.row_idx[self.col_ptr[j]];
+            let at = rows.map(|r| self.col_ptr[j] + r - first);
+            let old = at.map(|k| values[k]);
+            for (k, pos) in at.iter().enumerate() {
+                values[*pos] = t[k][0] * old[0] + t[k][1] * old[1] + t[k][2] * old[2];
+            }
+        }
+    }
+
     /// Dense copy (for eigenvalue problems of modest size).
     pub fn to_dense(&self, values: &[f64]) -> nalgebra::DMatrix<f64> {
         let mut m = nalgebra::DMatrix::zeros(self.ndofs, self.ndofs);

@@ -144,6 +144,12 @@ impl LinearSolver {
         self.solve_factored(b)
     }
 
+    /// The sign of the determinant of the matrix of the last solve (its scalings, when
+    /// equilibrated, are positive).
+    pub fn determinant_sign(&self) -> i8 {
+        self.lu.determinant_sign()
+    }
+
     /// Solve `M x = b` with the factors of the last solve (no copy, no factorisation: the
     /// matrix of that solve, e.g. a chord step's frozen Jacobian), scaled as that solve was
     /// (`x = D_c (D_r M D_c)⁻¹ D_r b` after an equilibrated or rescaled solve).

@@ -3,14 +3,17 @@
 //! Local unknowns are ordered `[x_a, α_a, x_b, α_b]` (12 values). Shape functions on the
 //! element `[s0, s0 + h]`: `N = (1 − ξ, ξ)`, `∂s N = (−1/h, 1/h)`.
 //!
-//! Integrands (see `docs/decisions.md`, D3–D6):
+//! Integrands (see `docs/decisions.md`, D3–D6, D20):
 //!
 //! ```text
-//!   stretch–shear:  ∂sδx · n − δα · (∂s x × n),   n = Qᵀ K (Q ∂s x − e3)        eqs. (13), (40)
-//!   bending:        ∂sδα · m,                      m = Qᵀ J A ∂s α               eqs. (15), (28), (40)
+//!   stretch–shear:  ∂sδx · n − δα · (∂s x × n),   n = Qᵀ K (Q ∂s x − e3 − ε̄)    eqs. (13), (40)
+//!   bending:        ∂sδα · m,                      m = Qᵀ J (A ∂s α − κ̄)         eqs. (15), (28), (40)
 //!   momentum:       δx · ρA ẋ + δα · Qᵀ I A α̇                                  eqs. (7), (27), (40)
 //!   loads:          δx · f + δα · l                                             eq. (40)
 //! ```
+//!
+//! `ε̄`, `κ̄` are the strains of the discrete reference configuration at the quadrature point
+//! ([`ElementRest`], D20): zero for the paper's straight rod.
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 
 use super::material::RodProperties;
@@ -22,10 +25,42 @@ pub type LocalVec = SVector<f64, 12>;
 /// Local element matrix (12 × 12).
 pub type LocalMat = SMatrix<f64, 12, 12>;
 
+/// The strains of the discrete reference configuration of one element at the three quadrature
+/// points of any rule (slots of `mesh::POINT_SLOTS`), D20: `ε̄ = Q(α0_h) ∂s x0_h − e3` and
+/// `κ̄ = A(α0_h) ∂s α0_h`. The constitutive laws measure strains from them, so the reference is
+/// stress free. Zero for the straight rod along e3 ([`ElementRest::ZERO`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ElementRest {
+    /// `ε̄` at each slot [-]
+    pub stretch_shear: [Vector3<f64>; 3],
+    /// `κ̄` at each slot [1/m]
+    pub curvature: [Vector3<f64>; 3],
+}
+
+impl ElementRest {
+    /// The straight reference along e3: no reference strain.
+    pub const ZERO: ElementRest =
+        ElementRest { stretch_shear: [Vector3::new(0.0, 0.0, 0.0); 3], curvature: [Vector3::new(0.0, 0.0, 0.0); 3] };
+
+    /// The reference strains of the element whose reference nodal values are `u0` (forward
+    /// element layout, chart coordinates) and size `h` [m]: the same interpolation as the
+    /// kernels', so that `u0` is exactly stress free.
+    pub fn of(u0: &LocalVec, h: f64) -> Self {
+        let mut rest = ElementRest::ZERO;
+        for (k, xi) in super::mesh::POINT_SLOTS.iter().enumerate() {
+            let p = interpolate(u0, h, *xi);
+            let f = PointFrame::new(&p.alpha, false);
+            rest.stretch_shear[k] = f.q * p.dx - Vector3::z();
+            rest.curvature[k] = f.a * p.dalpha;
+        }
+        rest
+    }
+}
+
 /// Layout of an element vector (two nodes of the forward layout).
 const LOCAL: DofMap = DofMap::forward(2);
-const X: [usize; 2] = [LOCAL.local(0, Field::X, 0), LOCAL.local(1, Field::X, 0)];
-const ALPHA: [usize; 2] = [LOCAL.local(0, Field::Alpha, 0), LOCAL.local(1, Field::Alpha, 0)];
+pub(crate) const X: [usize; 2] = [LOCAL.local(0, Field::X, 0), LOCAL.local(1, Field::X, 0)];
+pub(crate) const ALPHA: [usize; 2] = [LOCAL.local(0, Field::Alpha, 0), LOCAL.local(1, Field::Alpha, 0)];
 
 /// Fields interpolated at one point of an element.
 #[derive(Clone, Copy, Debug)]
@@ -81,16 +116,17 @@ pub fn internal_force(
     scheme: QuadratureScheme,
     h: f64,
     u: &LocalVec,
+    rest: &ElementRest,
     mut tangent: Option<&mut LocalMat>,
 ) -> LocalVec {
     let K = Matrix3::from_diagonal(&props.shear_stretch_n);
     let J = Matrix3::from_diagonal(&props.bend_twist_nm2);
     let mut r = LocalVec::zeros();
     let with_tangent = tangent.is_some();
-    for_each_point(&scheme.stretch_shear(), h, u, |p, wh| {
+    for_each_point(&scheme.stretch_shear(), h, u, |p, wh, slot| {
         let f = PointFrame::new(&p.alpha, with_tangent);
         let Q = f.q;
-        let e = Q * p.dx - Vector3::z();
+        let e = Q * p.dx - Vector3::z() - rest.stretch_shear[slot];
         let n = Q.transpose() * (K * e);
         let c = p.dx.cross(&n);
         for a in 0..2 {
@@ -114,17 +150,18 @@ pub fn internal_force(
             }
         }
     });
-    for_each_point(&scheme.bending(), h, u, |p, wh| {
+    for_each_point(&scheme.bending(), h, u, |p, wh, slot| {
         let f = PointFrame::new(&p.alpha, with_tangent);
         let (Q, A) = (f.q, f.a);
-        let m = Q.transpose() * (J * (A * p.dalpha));
+        let kappa = A * p.dalpha - rest.curvature[slot];
+        let m = Q.transpose() * (J * kappa);
         for a in 0..2 {
             add_vec(&mut r, ALPHA[a], &(m * (wh * p.dn[a])));
         }
         if let Some(t) = tangent.as_deref_mut() {
             let (dQ, dA) = (f.dq, f.da);
             let dm_dda = Q.transpose() * J * A;
-            let ja = J * (A * p.dalpha);
+            let ja = J * kappa;
             let dm_da = columns([0, 1, 2].map(|j| dQ[j].transpose() * ja + Q.transpose() * (J * (dA[j] * p.dalpha))));
             for a in 0..2 {
                 for b in 0..2 {
@@ -141,17 +178,32 @@ pub fn internal_force(
 /// returns `(L, b)` with `L(u_k) û = b(u_k)` (loads excluded from `b`), where `Q_k, A_k, B_k,
 /// q3_k` come from the iterate `u_k`. At a fixed point `L u − b = G(u)`.
 #[allow(non_snake_case)] // paper symbols K, J, Q, A, S, C, Bk, H, I
-pub fn frozen_operator(props: &RodProperties, scheme: QuadratureScheme, h: f64, uk: &LocalVec) -> (LocalMat, LocalVec) {
+pub fn frozen_operator(
+    props: &RodProperties,
+    scheme: QuadratureScheme,
+    h: f64,
+    uk: &LocalVec,
+    rest: &ElementRest,
+) -> (LocalMat, LocalVec) {
     let K = Matrix3::from_diagonal(&props.shear_stretch_n);
     let J = Matrix3::from_diagonal(&props.bend_twist_nm2);
     let k33 = props.shear_stretch_n[2];
     let mut l = LocalMat::zeros();
     let mut b = LocalVec::zeros();
-    for_each_point(&scheme.stretch_shear(), h, uk, |p, wh| {
+    for_each_point(&scheme.stretch_shear(), h, uk, |p, wh, slot| {
         let Q = rotation(&p.alpha);
         let S = Q.transpose() * K * Q;
         let q3: Vector3<f64> = Q.row(2).transpose();
         let Bk = skew(&p.dx);
+        // Qᵀ K (e3 + ε̄) = K33 q3 + Qᵀ K ε̄ (D5, D20): the second term only where ε̄ ≠ 0
+        let eps_bar = rest.stretch_shear[slot];
+        if eps_bar != Vector3::zeros() {
+            let qke = Q.transpose() * (K * eps_bar);
+            for a in 0..2 {
+                add_vec(&mut b, X[a], &(qke * (wh * p.dn[a])));
+                add_vec(&mut b, ALPHA[a], &(Bk * qke * (-wh * p.n[a])));
+            }
+        }
         for a in 0..2 {
             add_vec(&mut b, X[a], &(q3 * (wh * p.dn[a] * k33)));
             add_vec(&mut b, ALPHA[a], &(Bk * q3 * (-wh * p.n[a] * k33)));
@@ -161,10 +213,18 @@ pub fn frozen_operator(props: &RodProperties, scheme: QuadratureScheme, h: f64, 
             }
         }
     });
-    for_each_point(&scheme.bending(), h, uk, |p, wh| {
+    for_each_point(&scheme.bending(), h, uk, |p, wh, slot| {
         let f = PointFrame::new(&p.alpha, false);
         let (Q, A) = (f.q, f.a);
         let C = Q.transpose() * J * A;
+        // the reference curvature on the right-hand side: ∂sδα · Qᵀ J κ̄ (D20)
+        let kappa_bar = rest.curvature[slot];
+        if kappa_bar != Vector3::zeros() {
+            let mk = Q.transpose() * (J * kappa_bar);
+            for a in 0..2 {
+                add_vec(&mut b, ALPHA[a], &(mk * (wh * p.dn[a])));
+            }
+        }
         for a in 0..2 {
             for c in 0..2 {
                 add_mat(&mut l, ALPHA[a], ALPHA[c], &(C * (wh * p.dn[a] * p.dn[c])));
@@ -260,7 +320,7 @@ pub fn follower_load(
     mut tangent: Option<&mut LocalMat>,
 ) -> LocalVec {
     let mut r = LocalVec::zeros();
-    for_each_point(&scheme.loads(), h, u, |p, wh| {
+    for_each_point(&scheme.loads(), h, u, |p, wh, _| {
         let xi = p.n[1];
         let (fl, ll) = field(s0 + xi * h);
         let Qt = rotation(&p.alpha).transpose();
@@ -283,6 +343,50 @@ pub fn follower_load(
     r
 }
 
+/// A dead point load at `ξ` of an element (D23): `N_a(ξ) F` on the positions and `N_a(ξ) M` on
+/// the angles of node a (a node with `N_a = 0` gets nothing: a load at a node stays there).
+pub fn point_shape(xi: f64, force: &Vector3<f64>, torque: &Vector3<f64>) -> LocalVec {
+    let mut r = LocalVec::zeros();
+    for (a, n) in [1.0 - xi, xi].into_iter().enumerate() {
+        if n != 0.0 {
+            add_vec(&mut r, X[a], &(force * n));
+            add_vec(&mut r, ALPHA[a], &(torque * n));
+        }
+    }
+    r
+}
+
+/// A follower point load at `ξ` of an element (D23, eq. 4): components along d1, d2, d3, so
+/// `N_a Qᵀ(α_h(ξ)) F`, `N_a Qᵀ(α_h(ξ)) M`; its derivative with respect to the element's
+/// unknowns, `N_a N_b ∂Qᵀ/∂α_k F`, added into `tangent` if given.
+#[allow(non_snake_case)] // paper symbol Q
+pub fn follower_point_load(
+    xi: f64,
+    u: &LocalVec,
+    force: &Vector3<f64>,
+    torque: &Vector3<f64>,
+    tangent: Option<&mut LocalMat>,
+) -> LocalVec {
+    let p = interpolate(u, 1.0, xi);
+    let Qt = rotation(&p.alpha).transpose();
+    let r = point_shape(xi, &(Qt * force), &(Qt * torque));
+    if let Some(t) = tangent {
+        let dQ = rotation_derivatives(&p.alpha);
+        let df = columns([0, 1, 2].map(|j| dQ[j].transpose() * force));
+        let dl = columns([0, 1, 2].map(|j| dQ[j].transpose() * torque));
+        for a in 0..2 {
+            for b in 0..2 {
+                let nn = p.n[a] * p.n[b];
+                if nn != 0.0 {
+                    add_mat(t, X[a], ALPHA[b], &(df * nn));
+                    add_mat(t, ALPHA[a], ALPHA[b], &(dl * nn));
+                }
+            }
+        }
+    }
+    r
+}
+
 /// Curvature `κˡ = A(α_m) ∂sα` [1/m] (eq. 28) at the midpoint of every element of a nodal
 /// field of angles `alpha` at the arc lengths `s` [m], with the midpoint arc length [m]:
 /// `α_m = (α_e + α_{e+1})/2`, `∂sα = (α_{e+1} − α_e)/(s_{e+1} − s_e)`. The one curvature of
@@ -297,19 +401,20 @@ pub fn midpoint_curvatures(s: &[f64], alpha: &[Vector3<f64>]) -> Vec<(f64, Vecto
         .collect()
 }
 
-fn for_each_point(rule: &Rule, h: f64, u: &LocalVec, mut f: impl FnMut(&PointState, f64)) {
-    for (xi, w) in rule.points.iter().zip(rule.weights) {
+/// `f(point, w h, slot)` at every point of `rule` (slot: `mesh::POINT_SLOTS`).
+pub(crate) fn for_each_point(rule: &Rule, h: f64, u: &LocalVec, mut f: impl FnMut(&PointState, f64, usize)) {
+    for ((xi, w), slot) in rule.points.iter().zip(rule.weights).zip(rule.slots) {
         let p = interpolate(u, h, *xi);
-        f(&p, w * h);
+        f(&p, w * h, *slot);
     }
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::model::material::{CrossSection, Material, RodProperties};
 
-    fn props() -> RodProperties {
+    pub(crate) fn props() -> RodProperties {
         let mat = Material {
             young_modulus_pa: 7.1e10,
             shear_modulus_pa: 2.69e10,
@@ -319,7 +424,7 @@ mod tests {
         RodProperties::new(&mat, &CrossSection::Rectangle { width_m: 0.06, height_m: 0.04 })
     }
 
-    fn state() -> LocalVec {
+    pub(crate) fn state() -> LocalVec {
         let h = 0.1;
         LocalVec::from_column_slice(&[0.01, -0.02, 0.0, 0.3, -0.5, 0.2, 0.03, 0.01, h * 1.01, 0.45, -0.35, 0.4])
     }
@@ -344,8 +449,8 @@ mod tests {
         for scheme in [QuadratureScheme::Selective, QuadratureScheme::Full, QuadratureScheme::Reduced] {
             let u = state();
             let mut t = LocalMat::zeros();
-            internal_force(&p, scheme, 0.1, &u, Some(&mut t));
-            fd_check(&|v| internal_force(&p, scheme, 0.1, v, None), &t, &u);
+            internal_force(&p, scheme, 0.1, &u, &ElementRest::ZERO, Some(&mut t));
+            fd_check(&|v| internal_force(&p, scheme, 0.1, v, &ElementRest::ZERO, None), &t, &u);
         }
     }
 
@@ -379,13 +484,58 @@ mod tests {
     }
 
     #[test]
+    fn follower_point_load_tangent_matches_fd_and_a_node_keeps_its_load() {
+        let u = state();
+        let (f, m) = (Vector3::new(0.3, -1.0, 0.2), Vector3::new(0.01, 0.02, -0.03));
+        for xi in [0.0, 0.37, 1.0] {
+            let mut t = LocalMat::zeros();
+            follower_point_load(xi, &u, &f, &m, Some(&mut t));
+            fd_check(&|v| follower_point_load(xi, v, &f, &m, None), &t, &u);
+        }
+        // at ξ = 1 everything is on node b, bit for bit the end load of the paper's D3
+        let r = point_shape(1.0, &f, &m);
+        assert_eq!(r.rows(0, 6).amax(), 0.0);
+        assert_eq!(r.fixed_rows::<3>(6).into_owned(), f);
+        // the virtual work of a point load is δx(ξ)·F: linear in ξ between the nodes
+        let r = point_shape(0.25, &f, &m);
+        assert!((r.fixed_rows::<3>(0) - f * 0.75).amax() < 1e-16 && (r.fixed_rows::<3>(9) - m * 0.25).amax() < 1e-16);
+    }
+
+    #[test]
     fn frozen_operator_is_consistent_with_the_residual() {
         // L(u) u − b(u) = G(u): the fixed point of §4 solves the discrete equations of D3.
         let p = props();
         for scheme in [QuadratureScheme::Selective, QuadratureScheme::Full] {
             let u = state();
-            let (l, b) = frozen_operator(&p, scheme, 0.1, &u);
-            let g = internal_force(&p, scheme, 0.1, &u, None);
+            let (l, b) = frozen_operator(&p, scheme, 0.1, &u, &ElementRest::ZERO);
+            let g = internal_force(&p, scheme, 0.1, &u, &ElementRest::ZERO, None);
+            assert!((l * u - b - g).amax() < 1e-9 * g.amax());
+        }
+    }
+
+    /// A reference element of any shape (D20): a curved, twisted, sheared pair of nodes.
+    fn rest_element() -> (LocalVec, ElementRest) {
+        let h = 0.1;
+        let u0 = LocalVec::from_column_slice(&[0.2, -0.1, 0.3, 0.3, -0.4, 0.5, 0.21, -0.07, 0.39, 0.36, -0.45, 0.62]);
+        (u0, ElementRest::of(&u0, h))
+    }
+
+    #[test]
+    fn the_reference_is_stress_free_and_the_kernels_stay_consistent() {
+        let p = props();
+        let (u0, rest) = rest_element();
+        assert!(rest.curvature[0].amax() > 0.1 && rest.stretch_shear[1].amax() > 0.1, "a curved, sheared reference");
+        for scheme in [QuadratureScheme::Selective, QuadratureScheme::Full, QuadratureScheme::Reduced] {
+            // G(u0) = 0 against the size of one strain's force, K ε̄ / h ~ 1e9
+            let g = internal_force(&p, scheme, 0.1, &u0, &rest, None);
+            assert!(g.amax() < 1e-15 * p.shear_stretch_n.amax(), "{scheme:?}: {g}");
+            // the tangent at another state, and the frozen operator's identity L u − b = G
+            let u = state();
+            let mut t = LocalMat::zeros();
+            internal_force(&p, scheme, 0.1, &u, &rest, Some(&mut t));
+            fd_check(&|v| internal_force(&p, scheme, 0.1, v, &rest, None), &t, &u);
+            let (l, b) = frozen_operator(&p, scheme, 0.1, &u, &rest);
+            let g = internal_force(&p, scheme, 0.1, &u, &rest, None);
             assert!((l * u - b - g).amax() < 1e-9 * g.amax());
         }
     }
@@ -396,7 +546,7 @@ mod tests {
         let p = props();
         let h = 0.1;
         let u = LocalVec::from_column_slice(&[1.0, 2.0, 3.0, 0.0, 0.0, 0.0, 1.0, 2.0, 3.0 + h, 0.0, 0.0, 0.0]);
-        let g = internal_force(&p, QuadratureScheme::Selective, h, &u, None);
+        let g = internal_force(&p, QuadratureScheme::Selective, h, &u, &ElementRest::ZERO, None);
         assert!(g.amax() < 1e-6, "{g}");
         // Rigid rotation: x' = d3(α) with constant α → also stress free.
         let a = Vector3::new(0.3, 0.4, -0.2);
@@ -407,7 +557,7 @@ mod tests {
             u[3 + k] = a[k];
             u[9 + k] = a[k];
         }
-        let g = internal_force(&p, QuadratureScheme::Full, h, &u, None);
+        let g = internal_force(&p, QuadratureScheme::Full, h, &u, &ElementRest::ZERO, None);
         assert!(g.amax() < 1e-6, "{g}");
     }
 }

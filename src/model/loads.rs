@@ -1,6 +1,6 @@
 //! External loads of eq. (40): distributed force `f(s,t)` [N/m] and torque `l(s,t)` [N m/m]
-//! (global frame), and dead end loads at `s = L`: force [N] and torque [N m]. Components are
-//! expressions compiled once; evaluation does no string lookups.
+//! (global frame), dead end loads at `s = L`: force [N] and torque [N m], and point loads at any
+//! `s` (D23). Components are expressions compiled once; evaluation does no string lookups.
 use std::collections::BTreeMap;
 
 use nalgebra::Vector3;
@@ -19,6 +19,60 @@ pub enum LoadFrame {
     Local,
 }
 
+/// Three components, each an expression of the reference arc length `s` [m], the time `t` [s]
+/// and the case's constants, compiled once (a point load's force, an end's motion, the
+/// intrinsic curvature of D20).
+#[derive(Clone, Debug)]
+pub struct VectorExpr {
+    /// the source expressions, kept for the FreeFEM include file
+    pub exprs: [Expr; 3],
+    compiled: [Compiled; 3],
+    /// slot values: s, t, constants...
+    slots: Vec<f64>,
+}
+
+impl VectorExpr {
+    /// Compile the three components against `s`, `t` and the constants.
+    pub fn new(exprs: [Expr; 3], constants: &BTreeMap<String, f64>) -> Result<Self, ExprError> {
+        let names: Vec<&str> = FIXED.iter().copied().chain(constants.keys().map(|k| k.as_str())).collect();
+        let compiled = [exprs[0].compile(&names)?, exprs[1].compile(&names)?, exprs[2].compile(&names)?];
+        let slots = [0.0, 0.0].into_iter().chain(constants.values().copied()).collect();
+        Ok(VectorExpr { exprs, compiled, slots })
+    }
+
+    /// The zero vector (three literal zeros).
+    pub fn zero() -> Self {
+        let z = || Expr::parse("0").expect("the literal 0 parses");
+        VectorExpr::new([z(), z(), z()], &BTreeMap::new()).expect("the literal 0 compiles")
+    }
+
+    /// The value at `(s, t)`.
+    pub fn at(&self, s: f64, t: f64) -> Vector3<f64> {
+        let mut slots = self.slots.clone();
+        slots[0] = s;
+        slots[1] = t;
+        Vector3::new(self.compiled[0].eval(&slots), self.compiled[1].eval(&slots), self.compiled[2].eval(&slots))
+    }
+
+    /// True when every component is the literal zero.
+    pub fn is_zero(&self) -> bool {
+        self.compiled.iter().all(|c| c.as_constant() == Some(0.0))
+    }
+}
+
+/// A force [N] and a torque [N m] at one arc length `s_m` [m] (D23): dead (global components)
+/// or following the section (components along d1, d2, d3, `Qᵀ(α_h(s_m))` applied).
+#[derive(Clone, Debug)]
+pub struct PointLoad {
+    /// where the load acts [m], in `[0, L]`
+    pub s_m: f64,
+    pub frame: LoadFrame,
+    /// force [N], expressions of `t` and the constants
+    pub force: VectorExpr,
+    /// torque [N m]
+    pub torque: VectorExpr,
+}
+
 /// Parsed and compiled load expressions of a case.
 #[derive(Clone, Debug)]
 pub struct Loads {
@@ -29,6 +83,8 @@ pub struct Loads {
     compiled: Vec<Compiled>,
     /// slot values: s, t, constants...
     slots: Vec<f64>,
+    /// point loads at any s (`[[loads.point]]`, D23), besides the end loads
+    pub point: Vec<PointLoad>,
 }
 
 impl Loads {
@@ -49,7 +105,13 @@ impl Loads {
             }
         }
         let slots = [0.0, 0.0].into_iter().chain(constants.values().copied()).collect();
-        Ok(Loads { frame, exprs, compiled, slots })
+        Ok(Loads { frame, exprs, compiled, slots, point: Vec::new() })
+    }
+
+    /// The same loads with point loads (D23).
+    pub fn with_point_loads(mut self, point: Vec<PointLoad>) -> Self {
+        self.point = point;
+        self
     }
 
     fn eval3(&self, group: usize, s: f64, t: f64) -> Vector3<f64> {

@@ -52,6 +52,30 @@ impl CrossSection {
     }
 }
 
+/// A section given by its stiffnesses and inertias, as the rod literature states them (D24).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Stiffnesses {
+    /// axial stiffness EA [N]
+    pub ea_n: f64,
+    /// shear stiffnesses GA1, GA2 along d1, d2 [N], shear correction included
+    pub ga_n: [f64; 2],
+    /// bending stiffnesses EI1, EI2 about d1, d2 [N m²]
+    pub ei_nm2: [f64; 2],
+    /// torsional stiffness GJ [N m²]
+    pub gj_nm2: f64,
+    /// mass per length ρA [kg/m], if given
+    pub rho_a_kg_per_m: Option<f64>,
+    /// rotary inertias ρI1, ρI2, ρJ [kg m], if given
+    pub rho_i_kg_m: Option<[f64; 3]>,
+}
+
+impl Stiffnesses {
+    /// The radius of gyration `√(min(EI1, EI2)/EA)` [m] of the slenderness check.
+    pub fn radius_of_gyration_m(&self) -> f64 {
+        (self.ei_nm2[0].min(self.ei_nm2[1]) / self.ea_n).sqrt()
+    }
+}
+
 /// The constant coefficient diagonals of the rod model on the reference configuration (j = 1).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RodProperties {
@@ -66,6 +90,18 @@ pub struct RodProperties {
 }
 
 impl RodProperties {
+    /// The diagonals of a section given by its stiffnesses (D24): `K0 = diag(GA1, GA2, EA)`,
+    /// `J0 = diag(EI1, EI2, GJ)`, `I0 = diag(ρI1, ρI2, ρJ)`; a missing ρA is 1 kg/m and missing
+    /// inertias 1 kg m (a static analysis never uses them; dynamics and modes require them).
+    pub fn from_stiffnesses(s: &Stiffnesses) -> Self {
+        RodProperties {
+            shear_stretch_n: Vector3::new(s.ga_n[0], s.ga_n[1], s.ea_n),
+            bend_twist_nm2: Vector3::new(s.ei_nm2[0], s.ei_nm2[1], s.gj_nm2),
+            rotary_inertia_kg_m: Vector3::from(s.rho_i_kg_m.unwrap_or([1.0; 3])),
+            mass_per_length_kg_m: s.rho_a_kg_per_m.unwrap_or(1.0),
+        }
+    }
+
     /// Explicit conversion from material and cross-section (no faked parameters).
     pub fn new(material: &Material, section: &CrossSection) -> Self {
         let area = section.area_m2();

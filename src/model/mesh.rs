@@ -5,6 +5,9 @@ use nalgebra::{DVector, SVector, Vector3};
 
 use crate::linalg::Pattern;
 
+/// A point within this fraction of an element from a node is at the node (`Mesh::locate`).
+pub const NODE_SNAP: f64 = 1e-12;
+
 /// A uniform mesh of `elements` segments on `[0, length_m]`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Mesh {
@@ -28,6 +31,21 @@ impl Mesh {
     /// Reference arc length of node `i` [m].
     pub fn node_s(&self, i: usize) -> f64 {
         self.length_m * i as f64 / self.elements as f64
+    }
+    /// The element holding the arc length `s` [m] and the point's coordinate `ξ ∈ [0, 1]` in it,
+    /// snapped to a node within 1e-12 (D23); `s` is clamped to `[0, L]`.
+    pub fn locate(&self, s: f64) -> (usize, f64) {
+        let at = (s / self.h()).clamp(0.0, self.elements as f64);
+        let e = (at.floor() as usize).min(self.elements - 1);
+        let xi = at - e as f64;
+        let xi = if xi.abs() < NODE_SNAP {
+            0.0
+        } else if (xi - 1.0).abs() < NODE_SNAP {
+            1.0
+        } else {
+            xi
+        };
+        (e, xi)
     }
     /// Layout of the forward unknowns `(x, α)` on this mesh.
     pub fn dofs(&self) -> DofMap {
@@ -232,12 +250,19 @@ impl QuadratureScheme {
     }
 }
 
-/// A Gauss rule on the unit interval: points ξ ∈ (0,1) and weights summing to 1.
+/// A Gauss rule on the unit interval: points ξ ∈ (0,1) and weights summing to 1, and the slot of
+/// each point among the three points any rule uses (`ξ = G2A, ½, G2B` → slots 0, 1, 2), where
+/// per-point data of an element (the reference strains of D20, `element::ElementRest`) is kept.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Rule {
     pub points: &'static [f64],
     pub weights: &'static [f64],
+    pub slots: &'static [usize],
 }
+
+/// The points of every rule on the unit interval, by slot (FreeFEM's `coefficients.idp` keeps its
+/// fields at the same three points).
+pub const POINT_SLOTS: [f64; 3] = [G2A, 0.5, G2B];
 
 impl Rule {
     /// `(ξ, w)` of every point.
@@ -250,9 +275,9 @@ const G2A: f64 = 0.211_324_865_405_187_1; // (1 − 1/√3)/2
 const G2B: f64 = 0.788_675_134_594_812_9; // (1 + 1/√3)/2
 
 /// 1-point Gauss (midpoint), FreeFEM `qf1pE`.
-pub const GAUSS1: Rule = Rule { points: &[0.5], weights: &[1.0] };
+pub const GAUSS1: Rule = Rule { points: &[0.5], weights: &[1.0], slots: &[1] };
 /// 2-point Gauss, FreeFEM `qf2pE`.
-pub const GAUSS2: Rule = Rule { points: &[G2A, G2B], weights: &[0.5, 0.5] };
+pub const GAUSS2: Rule = Rule { points: &[G2A, G2B], weights: &[0.5, 0.5], slots: &[0, 2] };
 
 impl QuadratureScheme {
     /// Rule for the stretch–shear integrand `∂sδx·n − δα·(∂s x × n)`.

@@ -3,7 +3,10 @@
 //! and the pure P1 element kernels. Nothing here knows a solver, a case file or a file format.
 pub mod chart;
 pub mod element;
+pub mod ends;
+pub mod geometry;
 pub mod loads;
 pub mod material;
 pub mod mesh;
+pub mod resultants;
 pub mod rotation;

@@ -3,14 +3,16 @@
 use std::path::Path;
 
 use crate::case::Case;
-use crate::engine::rust::clip::ClipRun;
-use crate::figures::heatmap::{render_heatmaps_svg, ColourScale, Heatmap};
+use crate::engine::rust::clip::{ClipRun, KymographColumn};
+use crate::figures::decimate::{min_max, MAX_LINE_POINTS};
+use crate::figures::heatmap::{render_marked_heatmaps_svg, ColourScale, ColumnMarks, Heatmap};
 use crate::figures::plot::{render_panels_svg, LinePlot, Series};
 use crate::io::files::{write_plot, OutputError};
 use crate::solve::sequence::FrameReport;
 
 /// The times of a clip run's frames [s] (frame number × Δt) as the x axis of its per-frame
-/// figures and kymographs.
+/// figures and kymographs; each curve drawn with at most [`MAX_LINE_POINTS`] points
+/// ([`min_max`]: an hour of frames is drawn as its envelope).
 struct FrameAxis(Vec<f64>);
 
 impl FrameAxis {
@@ -19,15 +21,42 @@ impl FrameAxis {
         FrameAxis(reports.iter().map(|r| r.frame as f64 * dt).collect())
     }
     fn series(&self, label: &str, y: Vec<f64>) -> Series {
-        Series::new(label, self.0.clone(), y)
+        let (x, y) = min_max(&self.0, &y, MAX_LINE_POINTS);
+        Series::new(label, x, y)
     }
     fn plot(title: String, y_label: &str, series: Vec<Series>, log_y: bool) -> LinePlot {
         LinePlot { title, x_label: "t [s]".into(), y_label: y_label.into(), series, log_y, ..Default::default() }
     }
-    /// The times of the frames `frames` (indices into the reports).
-    fn at(&self, frames: &[usize]) -> Vec<f64> {
-        frames.iter().map(|&i| self.0[i]).collect()
+}
+
+/// The columns of a clip run's kymographs: their times [s] and the marks of the frames they
+/// stand for (`Kymograph::span`) that were lost (no node tracked: `frames.csv`'s
+/// `nodes_tracked` = 0, the frame's data filled from its neighbours, D19) or flagged (over the
+/// fit-quality gate: `flagged` = 1).
+fn kymograph_columns(case: &Case, run: &ClipRun) -> (Vec<f64>, ColumnMarks) {
+    let k = &run.kymograph;
+    let axis = FrameAxis::new(case, &run.reports);
+    let times = k.columns.iter().map(|c| axis.0[c.index]).collect();
+    let nf = run.reports.len();
+    let mut marks = ColumnMarks::default();
+    let (mut lost, mut flagged) = (0, 0);
+    for c in 0..k.columns.len() {
+        let span = &run.reports[k.span(c, nf)];
+        let l = span.iter().filter(|r| r.nodes_tracked == 0).count();
+        let f = span.iter().filter(|r| r.fit.flagged).count();
+        (lost, flagged) = (lost + l, flagged + f);
+        if l > 0 {
+            marks.hatched.push(c);
+        }
+        if f > 0 {
+            marks.barred.push(c);
+        }
     }
+    let per = if k.stride > 1 { format!(" (a column: {} frames)", k.stride) } else { String::new() };
+    let frames = |n: usize| if n == 1 { "1 frame".to_string() } else { format!("{n} frames") };
+    marks.hatched_label = format!("lost: {} without a tracked node, filled{per}", frames(lost));
+    marks.barred_label = format!("flagged: {} over the fit-quality gate{per}", frames(flagged));
+    (times, marks)
 }
 
 /// The clip's frame interval Δt [s].
@@ -98,27 +127,30 @@ pub fn write_truth_plot(case: &Case, run: &ClipRun, path: &Path) -> Result<(), O
     ];
     let lines = path.with_file_name("truth_errors.svg");
     write_plot(&lines, render_panels_svg(&panels, 2))?;
-    let fs = nf.div_ceil(150);
-    let frames: Vec<usize> = (0..nf).step_by(fs).collect();
-    let x = axis.at(&frames);
-    let m = t.bending_true[0].len();
+    let k = &run.kymograph;
+    let bending: Vec<&[Vec<f64>; 2]> = k.columns.iter().filter_map(|c| c.bending.as_ref()).collect();
+    if bending.len() < 2 || bending.len() != k.columns.len() {
+        return Ok(());
+    }
+    let (x, marks) = kymograph_columns(case, run);
+    let m = bending[0][0].len();
     let cols: Vec<usize> = (0..m).step_by(m.div_ceil(64)).collect();
     let y: Vec<f64> = cols.iter().map(|&j| j as f64 * case.mesh.h() * 1e3).collect();
     // bending √(κ1² + κ2²) [1/mm]
-    let grid = |field: &Vec<Vec<f64>>| -> Vec<Vec<f64>> {
-        frames.iter().map(|&i| cols.iter().map(|&j| field[i][j].sqrt() * 1e-3).collect()).collect()
+    let grid = |which: usize| -> Vec<Vec<f64>> {
+        bending.iter().map(|b| cols.iter().map(|&j| b[which][j].sqrt() * 1e-3).collect()).collect()
     };
-    let limit = percentile_99(t.bending_true.iter().flatten().map(|v| v.sqrt() * 1e-3).collect());
+    let limit = percentile_99(bending.iter().flat_map(|b| b[0].iter()).map(|v| v.sqrt() * 1e-3).collect());
     let map = |title: &str, values: Vec<Vec<f64>>| Heatmap {
         scale: ColourScale::Sequential,
         ..kymograph(title.into(), x.clone(), y.clone(), values, limit, "√(κ1² + κ2²) [1/mm]")
     };
     write_plot(
         path,
-        render_heatmaps_svg(&[
-            map(&format!("{}: true bending", case.name), grid(&t.bending_true)),
-            map("recovered bending", grid(&t.bending_recovered)),
-        ]),
+        render_marked_heatmaps_svg(
+            &[map(&format!("{}: true bending", case.name), grid(0)), map("recovered bending", grid(1))],
+            &marks,
+        ),
     )
 }
 
@@ -181,36 +213,46 @@ pub fn write_clip_plot(
 
 /// Kymographs of a planar clip (Fig. 17 style): the data's curvature and the recovered κ2
 /// [1/mm] over time [s] (x) and arc length (y, head at 0), on one colour scale (±the 99th
-/// percentile of |data|, the colour bar beside each). At most ~150 frames and 64 positions are
-/// drawn (strided) to keep the SVG small.
+/// percentile of |data| over the frames drawn, the colour bar beside each), lost and flagged
+/// frames marked ([`kymograph_columns`]). At most `KYMOGRAPH_COLUMNS` frames
+/// (`ClipRun::kymograph`) and 64 positions are drawn (strided) to keep the SVG small.
 pub fn write_clip_kymographs(case: &Case, run: &ClipRun, path: &Path) -> Result<(), OutputError> {
-    let nf = run.kappa2.len();
-    if nf < 2 {
+    let k = &run.kymograph;
+    if k.columns.len() < 2 {
         return Ok(());
     }
-    let fs = nf.div_ceil(150);
-    let frames: Vec<usize> = (0..nf).step_by(fs).collect();
-    let x = FrameAxis::new(case, &run.reports).at(&frames);
+    let (x, marks) = kymograph_columns(case, run);
     let h = case.mesh.h();
-    let grid = |field: &Vec<Vec<f64>>, s_of: &dyn Fn(usize) -> f64| {
-        let m = field[0].len();
-        let ss = m.div_ceil(64);
-        let cols: Vec<usize> = (0..m).step_by(ss).collect();
+    let grid = |field: &dyn Fn(&KymographColumn) -> &[f64], s_of: &dyn Fn(usize) -> f64| {
+        let m = field(&k.columns[0]).len();
+        let cols: Vec<usize> = (0..m).step_by(m.div_ceil(64)).collect();
         let y: Vec<f64> = cols.iter().map(|&j| s_of(j) * 1e3).collect();
         let values: Vec<Vec<f64>> =
-            frames.iter().map(|&i| cols.iter().map(|&j| field[i][j] * 1e-3).collect()).collect();
+            k.columns.iter().map(|c| cols.iter().map(|&j| field(c)[j] * 1e-3).collect()).collect();
         (y, values)
     };
-    let limit = abs_percentile_99(run.data_kappa.iter().flatten().map(|k| k * 1e-3));
-    let (yd, vd) = grid(&run.data_kappa, &|j| (j + 1) as f64 * h);
-    let (yr, vr) = grid(&run.kappa2, &|j| (j as f64 + 0.5) * h);
+    let limit = abs_percentile_99(k.columns.iter().flat_map(|c| c.data_kappa.iter()).map(|v| v * 1e-3));
+    let (yd, vd) = grid(&|c| &c.data_kappa, &|j| (j + 1) as f64 * h);
+    let (yr, vr) = grid(&|c| &c.kappa2, &|j| (j as f64 + 0.5) * h);
     write_plot(
         path,
-        render_heatmaps_svg(&[
-            kymograph(format!("{}: data curvature", case.name), x.clone(), yd, vd, limit, "κ data [1/mm]"),
-            kymograph("recovered κ2".into(), x.clone(), yr, vr, limit, "κ2 [1/mm]"),
-        ]),
+        render_marked_heatmaps_svg(
+            &[
+                kymograph(format!("{}: data curvature", case.name), x.clone(), yd, vd, limit, "κ data [1/mm]"),
+                kymograph(format!("recovered κ2{}", planar_caption(case)), x, yr, vr, limit, "κ2 [1/mm]"),
+            ],
+            &marks,
+        ),
     )
+}
+
+/// The caption of a planar recording's recovered curvature and angular velocity: its twist and
+/// roll are the gauge's, not measured (`clip::recording`, run.json's `planar`).
+fn planar_caption(case: &Case) -> &'static str {
+    match case.clip().and_then(|c| c.recording.data_plane) {
+        Some(_) => " (planar data: twist κ3 and roll not observable, set by the gauge)",
+        None => "",
+    }
 }
 
 /// The 99th percentile of |v| over the finite values (1 if there are none): the colour limit
@@ -230,34 +272,34 @@ fn percentile_99(mut all: Vec<f64>) -> f64 {
 }
 
 /// Kymographs of the angular velocity (Fig. 24 style, `omega.svg`): ω1, ω2, ω3 [rad/s] in the
-/// local frame (eq. 27, [`ClipRun::omega`]) over time [s] (x) and the nodes' arc length (y),
-/// each on its own colour scale (±the 99th percentile of its |ω| over the frames after the
-/// first, which has none; the colour bar beside it). Strided as [`write_clip_kymographs`];
-/// nothing is written for fewer than two frames.
+/// local frame (eq. 27, `ClipFrame::omega`) over time [s] (x) and the nodes' arc length (y),
+/// each on its own colour scale (±the 99th percentile of its |ω| over the frames drawn after the
+/// first, which has none; the colour bar beside it), lost and flagged frames marked. Sampled
+/// as [`write_clip_kymographs`]; nothing is written for fewer than two frames drawn.
 pub fn write_omega_kymographs(case: &Case, run: &ClipRun, path: &Path) -> Result<(), OutputError> {
-    let nf = run.omega.len().min(run.reports.len());
-    if nf < 2 {
+    let k = &run.kymograph;
+    if k.columns.len() < 2 {
         return Ok(());
     }
-    let frames: Vec<usize> = (0..nf).step_by(nf.div_ceil(150)).collect();
-    let x = FrameAxis::new(case, &run.reports).at(&frames);
-    let m = run.omega[0].len();
+    let (x, marks) = kymograph_columns(case, run);
+    let m = k.columns[0].omega.len();
     let cols: Vec<usize> = (0..m).step_by(m.div_ceil(64).max(1)).collect();
     let y: Vec<f64> = cols.iter().map(|&j| case.mesh.node_s(j) * 1e3).collect();
     let maps: Vec<Heatmap> = (0..3)
-        .map(|k| {
-            let limit = abs_percentile_99(run.omega[1..nf].iter().flatten().map(|w| w[k]));
-            let name = if k == 0 { format!("{}: ", case.name) } else { String::new() };
+        .map(|i| {
+            let after_first = k.columns.iter().filter(|c| c.index > 0);
+            let limit = abs_percentile_99(after_first.flat_map(|c| c.omega.iter()).map(|w| w[i]));
+            let name = if i == 0 { format!("{}: ", case.name) } else { String::new() };
             let zero = if limit > 0.0 { "" } else { ": 0 everywhere" };
             kymograph(
-                format!("{name}ω{} (local frame){zero}", k + 1),
+                format!("{name}ω{} (local frame){zero}", i + 1),
                 x.clone(),
                 y.clone(),
-                frames.iter().map(|&i| cols.iter().map(|&j| run.omega[i][j][k]).collect()).collect(),
+                k.columns.iter().map(|c| cols.iter().map(|&j| c.omega[j][i]).collect()).collect(),
                 limit,
-                &format!("ω{} [rad/s]", k + 1),
+                &format!("ω{} [rad/s]", i + 1),
             )
         })
         .collect();
-    write_plot(path, render_heatmaps_svg(&maps))
+    write_plot(path, render_marked_heatmaps_svg(&maps, &marks))
 }

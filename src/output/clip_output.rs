@@ -9,11 +9,14 @@ use nalgebra::Vector3;
 
 pub(crate) use super::clip_figures::abs_percentile_99;
 pub use super::clip_figures::{write_clip_kymographs, write_clip_plot, write_omega_kymographs, write_truth_plot};
-use super::journal::{Entry, Journal, Offsets, JOURNAL};
+use super::journal::{Entry, Journal, JournalScan, Offsets, JOURNAL};
+use super::run_files::element_row;
 use crate::engine::rust::clip::{nodal_curvature, ClipFrame, Controls, FrameSink};
-use crate::io::compact::{write_compact, OutputFormat, CURVATURE_COLUMNS, RAW_CURVATURE, RAW_FIELDS};
+use crate::io::compact::{OutputFormat, CURVATURE_COLUMNS, RAW_CURVATURE, RAW_FIELDS};
+use crate::io::compact_write::write_compact;
 use crate::io::files::OutputError;
 use crate::io::vtk::{write_pvd, write_vtp, PolylineFields};
+use crate::model::resultants::Resultants;
 use crate::solve::sequence::FrameReport;
 
 /// Streams a clip solve to disk, one frame at a time (`frames.csv`, `fields.csv`,
@@ -26,7 +29,8 @@ pub struct ClipWriter {
     curvature: std::io::BufWriter<std::fs::File>,
     /// `truth.csv` of a synthetic clip
     truth: Option<std::io::BufWriter<std::fs::File>>,
-    pvd: Vec<(f64, String)>,
+    /// per frame written: its time [s] and number (its `clip.pvd` entry)
+    pvd: Vec<(f64, usize)>,
     /// the resume journal, if kept
     journal: Option<Journal>,
     /// compact: the per-node rows go raw to `fields.f64` / `curvature.f64` (no VTK), and
@@ -48,8 +52,12 @@ fn row_files(format: OutputFormat) -> [&'static str; 2] {
 /// `max_abs_omega_rad_per_s` is the largest |ωˡ| over the nodes [rad/s] (eq. 27, 0 on the
 /// first frame; `engine::rust::clip::ClipFrame::omega`). `nodes_tracked`: the nodes of the frame that were
 /// tracked (`clip.missing`; all of them without missing data); `x_err_rel` and the `fit_*`
-/// columns measure the fit over those nodes.
-pub const CLIP_FRAME_COLUMNS: [&str; 29] = [
+/// columns measure the fit over those nodes. `lost`: fewer than 2 nodes tracked, the frame
+/// bridged in time from its neighbours; `filled`: some of its nodes filled; `resolved`: solved
+/// again from its data guess because its solution from the previous frame was over the gate
+/// (`solve::sequence`); `kappa_max_per_m`: the largest |κ| over the element midpoints [1/m],
+/// held against `clip.max_curvature_per_m` by the gate.
+pub const CLIP_FRAME_COLUMNS: [&str; 33] = [
     "frame",
     "time_s",
     "iterations",
@@ -79,6 +87,10 @@ pub const CLIP_FRAME_COLUMNS: [&str; 29] = [
     "fit_tangent_rms",
     "flagged",
     "nodes_tracked",
+    "lost",
+    "filled",
+    "resolved",
+    "kappa_max_per_m",
 ];
 
 /// Columns of `fields.csv`, one row per frame and node: position [m], the angles [rad] in the
@@ -149,18 +161,12 @@ impl ClipWriter {
         })
     }
 
-    /// Reopen the streamed files of an earlier run in `dir` after the frames of `entries` (its
-    /// journal's complete lines, `journal_bytes` long): every CSV cut back to its length after
-    /// the last of them, the VTK files of later frames removed, the journal continued. `format`
-    /// must be the earlier run's.
-    pub fn resume(
-        dir: &Path,
-        truth: bool,
-        entries: &[Entry],
-        journal_bytes: u64,
-        format: OutputFormat,
-    ) -> Result<Self, OutputError> {
-        let Some(last) = entries.last() else { return Self::create(dir, truth, true, format) };
+    /// Reopen the streamed files of an earlier run in `dir` after the frames of `scan` (its
+    /// journal's complete lines): every CSV cut back to its length after the last of them, the
+    /// VTK files of later frames removed, the journal continued. `format` must be the earlier
+    /// run's.
+    pub fn resume(dir: &Path, truth: bool, scan: &JournalScan, format: OutputFormat) -> Result<Self, OutputError> {
+        let Some(o) = scan.last else { return Self::create(dir, truth, true, format) };
         let [fields, curvature] = row_files(format);
         if !dir.join(fields).is_file() {
             return Err(OutputError::Invalid {
@@ -176,7 +182,6 @@ impl ClipWriter {
             f.set_len(len).map_err(err(p))?;
             Ok(std::io::BufWriter::new(f))
         };
-        let o = last.offsets;
         let truth = match (truth, o.truth) {
             (true, Some(len)) => Some(reopen("truth.csv", len)?),
             (false, None) => None,
@@ -188,7 +193,7 @@ impl ClipWriter {
             }
         };
         let kept: std::collections::BTreeSet<String> =
-            entries.iter().map(|e| format!("frame_{:05}.vtp", e.record.report.frame)).collect();
+            scan.frames.iter().map(|(frame, _)| format!("frame_{frame:05}.vtp")).collect();
         let vtk = dir.join("vtk");
         let compact = format == OutputFormat::Compact;
         for entry in if compact { Vec::new() } else { std::fs::read_dir(&vtk).map_err(err(vtk.clone()))?.collect() } {
@@ -203,9 +208,9 @@ impl ClipWriter {
             fields: reopen(fields, o.fields)?,
             curvature: reopen(curvature, o.curvature)?,
             truth,
-            pvd: entries.iter().map(|e| (e.time_s, format!("vtk/frame_{:05}.vtp", e.record.report.frame))).collect(),
-            journal: Some(Journal::reopen(dir, journal_bytes)?),
-            compact: compact.then(|| entries.iter().map(|e| e.record.report.frame as i64).collect()),
+            pvd: scan.frames.iter().map(|&(frame, time_s)| (time_s, frame)).collect(),
+            journal: Some(Journal::reopen(dir, scan.bytes)?),
+            compact: compact.then(|| scan.frames.iter().map(|&(frame, _)| frame as i64).collect()),
         })
     }
 
@@ -240,7 +245,7 @@ impl ClipWriter {
     /// Append one converged frame: its report row, nodal fields, element curvature, truth row
     /// and VTK file.
     pub fn write_frame(&mut self, frame: &ClipFrame) -> Result<(), OutputError> {
-        let ClipFrame { report, time_s, nodes, controls, data, omega, kappa, planar, .. } = frame;
+        let ClipFrame { report, time_s, nodes, controls, data, omega, elements, planar, .. } = frame;
         let Controls { force, torque } = controls;
         let omega = omega.clone().unwrap_or_else(|| vec![Vector3::zeros(); nodes.s.len()]);
         let (time_s, roughness) = (*time_s, planar.roughness);
@@ -250,7 +255,7 @@ impl ClipWriter {
             move |source| OutputError::Io { path: p.clone(), source }
         };
         let r = report;
-        let row = report_row(r, time_s, roughness, &omega);
+        let row = report_row(r, time_s, roughness, &omega, nodes.s.len());
         writeln!(self.frames, "{}", frames_row(&row)).and_then(|_| self.frames.flush()).map_err(err("frames.csv"))?;
         let d = nodes.directors();
         let [fields, curvature] = row_files(self.format());
@@ -274,8 +279,8 @@ impl ClipWriter {
         }
         self.fields.write_all(&block).and_then(|_| self.fields.flush()).map_err(err(fields))?;
         block.clear();
-        for (s, k) in kappa {
-            push_row(&mut block, compact, &[r.frame], &[*s, k[0], k[1], k[2]]);
+        for row in elements.kappa.iter().zip(&elements.resultants).map(element_row) {
+            push_row(&mut block, compact, &[r.frame], &row);
         }
         self.curvature.write_all(&block).and_then(|_| self.curvature.flush()).map_err(err(curvature))?;
         if let Some(frames) = &mut self.compact {
@@ -316,7 +321,12 @@ impl ClipWriter {
     ) -> Result<(), OutputError> {
         let (d1, d2, d3): (Vec<_>, Vec<_>, Vec<_>) =
             (d.iter().map(|x| x[0]).collect(), d.iter().map(|x| x[1]).collect(), d.iter().map(|x| x[2]).collect());
-        let kn = nodal_curvature(&frame.kappa);
+        let kn = nodal_curvature(&frame.elements.kappa);
+        let resultants = &frame.elements.resultants;
+        let nodal = |f: &dyn Fn(&Resultants) -> Vector3<f64>| {
+            nodal_curvature(&resultants.iter().map(|r| (0.0, f(r))).collect::<Vec<_>>())
+        };
+        let (n, m) = (nodal(&|r| r.n), nodal(&|r| r.m));
         let name = format!("frame_{:05}.vtp", frame.report.frame);
         write_vtp(
             &self.dir.join("vtk").join(&name),
@@ -329,20 +339,24 @@ impl ClipWriter {
                     ("f_n_per_m", &frame.controls.force),
                     ("l_nm_per_m", &frame.controls.torque),
                     ("kappa_per_m", &kn),
+                    ("n_n", &n),
+                    ("m_nm", &m),
                     ("data_position_m", &frame.data),
                     ("omega_rad_per_s", omega),
                 ],
                 scalars: vec![],
             },
         )?;
-        self.pvd.push((frame.time_s, format!("vtk/{name}")));
+        self.pvd.push((frame.time_s, frame.report.frame));
         Ok(())
     }
 
     /// Write the ParaView collection of the frames written so far.
     pub fn write_pvd(&mut self) -> Result<PathBuf, OutputError> {
         let p = self.dir.join("clip.pvd");
-        write_pvd(&p, &self.pvd)?;
+        let entries: Vec<(f64, String)> =
+            self.pvd.iter().map(|&(t, frame)| (t, format!("vtk/frame_{frame:05}.vtp"))).collect();
+        write_pvd(&p, &entries)?;
         Ok(p)
     }
 }
@@ -411,8 +425,17 @@ pub const TRUTH_COLUMNS: [&str; 10] = [
 ];
 
 /// The integer columns of `frames.csv` (the frame, its iterations, a node index, a flag).
-pub const CLIP_FRAME_INTEGER_COLUMNS: [&str; 6] =
-    ["frame", "iterations", "min_abs_cos_beta_node", "restarted", "flagged", "nodes_tracked"];
+pub const CLIP_FRAME_INTEGER_COLUMNS: [&str; 9] = [
+    "frame",
+    "iterations",
+    "min_abs_cos_beta_node",
+    "restarted",
+    "flagged",
+    "nodes_tracked",
+    "lost",
+    "filled",
+    "resolved",
+];
 
 /// One row of `frames.csv` ([`CLIP_FRAME_COLUMNS`]): the [`CLIP_FRAME_INTEGER_COLUMNS`] as
 /// integers, the others `{:.10e}`.
@@ -449,7 +472,7 @@ fn push_csv(s: &mut String, values: &[f64]) {
 }
 
 /// The row of `frames.csv` of a frame: its report, time [s], roughness and largest |ω| [rad/s].
-fn report_row(r: &FrameReport, time_s: f64, roughness: (f64, f64), omega: &[Vector3<f64>]) -> Vec<f64> {
+fn report_row(r: &FrameReport, time_s: f64, roughness: (f64, f64), omega: &[Vector3<f64>], nodes: usize) -> Vec<f64> {
     let mut row = vec![
         r.frame as f64,
         time_s,
@@ -472,5 +495,9 @@ fn report_row(r: &FrameReport, time_s: f64, roughness: (f64, f64), omega: &[Vect
     row.push(r.certificate);
     row.extend([r.fit.noise_m, r.fit.position, r.fit.tangent, f64::from(u8::from(r.fit.flagged))]);
     row.push(r.nodes_tracked as f64);
+    let lost = r.nodes_tracked < crate::clip::missing::MIN_TRACKED;
+    let filled = !lost && r.nodes_tracked < nodes;
+    row.extend([lost, filled, r.fit.resolved].map(|b| f64::from(u8::from(b))));
+    row.push(r.fit.curvature_max_per_m);
     row
 }

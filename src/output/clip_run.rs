@@ -6,7 +6,7 @@ use std::path::Path;
 use super::clip_output::{
     write_clip_kymographs, write_clip_plot, write_omega_kymographs, write_truth_plot, ClipWriter,
 };
-use super::journal::read_journal;
+use super::journal::{journal_records, scan_journal, JournalScan};
 use crate::case::Case;
 use crate::engine::rust::clip::{ClipFrame, ClipOutcome, ClipRun, FrameSink};
 use crate::engine::{run_clip_into, ClipInput, EngineError};
@@ -59,18 +59,23 @@ pub fn run_clip_to(
 ) -> Result<ClipOutcome, EngineError> {
     let input = ClipInput::of(case)?;
     let has_truth = input.has_truth();
-    let (records, sink): (Vec<_>, _) = if opts.resume {
+    let (scan, sink) = if opts.resume {
         // a run killed before its first frame has no journal yet: it resumes from the start
-        let (entries, bytes) = match read_journal(dir) {
-            Err(JournalError::Missing { .. }) => (Vec::new(), 0),
+        let scan = match scan_journal(dir) {
+            Err(JournalError::Missing { .. }) => JournalScan::default(),
             read => read?,
         };
-        let sink = ClipWriter::resume(dir, has_truth, &entries, bytes, opts.format)?;
-        (entries.into_iter().map(|e| e.record).collect(), sink)
+        let sink = ClipWriter::resume(dir, has_truth, &scan, opts.format)?;
+        (scan, sink)
     } else {
-        (Vec::new(), ClipWriter::create(dir, has_truth, opts.journal, opts.format)?)
+        (JournalScan::default(), ClipWriter::create(dir, has_truth, opts.journal, opts.format)?)
     };
-    run_clip_into(case, input, &records, Observed { sink, observer }, progress)
+    // the records of the resumed frames, read again one at a time while they are summarised
+    let mut records: Box<dyn Iterator<Item = _>> = match scan.frames.len() {
+        0 => Box::new(std::iter::empty()),
+        n => Box::new(journal_records(dir, n)?),
+    };
+    run_clip_into(case, input, &mut records, Observed { sink, observer }, progress)
 }
 
 /// A [`FrameSink`] that writes each frame and then shows it to an observer.

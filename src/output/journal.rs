@@ -68,32 +68,88 @@ impl Journal {
     }
 }
 
-/// The complete lines of the journal of `dir`, in order, and their length [bytes]; reading
-/// stops at the first line that is not a complete entry (a kill while it was written).
-pub fn read_journal(dir: &Path) -> Result<(Vec<Entry>, u64), JournalError> {
+/// The journal of `dir` opened for reading.
+fn open(dir: &Path) -> Result<(std::io::BufReader<std::fs::File>, PathBuf), JournalError> {
     let path = dir.join(JOURNAL);
-    let file = match std::fs::File::open(&path) {
-        Ok(f) => f,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Err(JournalError::Missing { path }),
-        Err(source) => return Err(JournalError::Io { path, source }),
-    };
-    let mut reader = std::io::BufReader::new(file);
-    let (mut entries, mut bytes) = (Vec::new(), 0u64);
-    let mut line = Vec::new();
-    loop {
-        line.clear();
-        let n =
-            reader.read_until(b'\n', &mut line).map_err(|source| JournalError::Io { path: path.clone(), source })?;
-        if n == 0 || line.last() != Some(&b'\n') {
-            break;
-        }
-        match serde_json::from_slice::<Entry>(&line) {
-            Ok(e) => entries.push(e),
-            Err(_) => break,
-        }
-        bytes += n as u64;
+    match std::fs::File::open(&path) {
+        Ok(f) => Ok((std::io::BufReader::new(f), path)),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Err(JournalError::Missing { path }),
+        Err(source) => Err(JournalError::Io { path, source }),
     }
-    Ok((entries, bytes))
+}
+
+/// The next complete line of a journal and its length [bytes]; `None` at its end or at the
+/// first line that is not a complete entry (a kill while it was written). `line`: a buffer.
+fn next_entry(
+    reader: &mut std::io::BufReader<std::fs::File>,
+    path: &Path,
+    line: &mut Vec<u8>,
+) -> Result<Option<(Entry, u64)>, JournalError> {
+    line.clear();
+    let n = reader.read_until(b'\n', line).map_err(|source| JournalError::Io { path: path.to_path_buf(), source })?;
+    if n == 0 || line.last() != Some(&b'\n') {
+        return Ok(None);
+    }
+    Ok(serde_json::from_slice::<Entry>(line).ok().map(|e| (e, n as u64)))
+}
+
+/// What the complete lines of a journal say, without their records (a record holds a frame's
+/// whole state: an hour of frames would not fit in memory).
+#[derive(Clone, Debug, Default)]
+pub struct JournalScan {
+    /// per complete line: the frame's number and time [s]
+    pub frames: Vec<(usize, f64)>,
+    /// the streamed files' lengths after the last complete line
+    pub last: Option<Offsets>,
+    /// the length of the complete lines [bytes]
+    pub bytes: u64,
+}
+
+/// Read the journal of `dir` line by line up to its first incomplete line ([`JournalScan`]).
+pub fn scan_journal(dir: &Path) -> Result<JournalScan, JournalError> {
+    let (mut reader, path) = open(dir)?;
+    let (mut scan, mut line) = (JournalScan::default(), Vec::new());
+    while let Some((e, n)) = next_entry(&mut reader, &path, &mut line)? {
+        scan.frames.push((e.record.report.frame, e.time_s));
+        scan.last = Some(e.offsets);
+        scan.bytes += n;
+    }
+    Ok(scan)
+}
+
+/// The records of the first `count` lines of a journal, read one at a time
+/// ([`journal_records`]).
+pub struct JournalRecords {
+    reader: std::io::BufReader<std::fs::File>,
+    path: PathBuf,
+    line: Vec<u8>,
+    left: usize,
+}
+
+impl Iterator for JournalRecords {
+    type Item = Result<FrameRecord, JournalError>;
+    fn next(&mut self) -> Option<Self::Item> {
+        if self.left == 0 {
+            return None;
+        }
+        self.left -= 1;
+        match next_entry(&mut self.reader, &self.path, &mut self.line) {
+            Ok(Some((e, _))) => Some(Ok(e.record)),
+            // the scan saw this line whole: the file changed under the run
+            Ok(None) => Some(Err(JournalError::Io {
+                path: self.path.clone(),
+                source: std::io::Error::new(std::io::ErrorKind::UnexpectedEof, "the journal ended early"),
+            })),
+            Err(e) => Some(Err(e)),
+        }
+    }
+}
+
+/// The records of the first `count` complete lines of the journal of `dir` (its
+/// [`JournalScan`]'s), in order, one at a time.
+pub fn journal_records(dir: &Path, count: usize) -> Result<JournalRecords, JournalError> {
+    let (reader, path) = open(dir)?;
+    Ok(JournalRecords { reader, path, line: Vec::new(), left: count })
 }
 
 /// Remove the journal of `dir` (a complete run), if any.

@@ -88,14 +88,61 @@ pub struct Manifest {
     /// clips with `[inverse] weights = "auto"`: the noise level and the weights chosen
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub weights: Option<crate::engine::rust::weights::ChosenWeights>,
-    /// `rod.length_m = "from_data"`: the body length estimated from the recording, with the
-    /// spread and range of its frames (`clip::length`)
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub body_length: Option<BodyLength>,
+    /// what the recording said of itself and of its frames: its body length, its plane, its
+    /// lost, filled and re-solved frames
+    #[serde(flatten)]
+    pub recording: RecordingNotes,
     #[serde(flatten)]
     pub process: Process,
     /// every file of the folder (relative paths, `/`-separated), `run.json` excepted
     pub files: Vec<String>,
+}
+
+/// What a clip's recording said of itself, in `run.json` (each key only where it applies).
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct RecordingNotes {
+    /// `rod.length_m = "from_data"`: the body length estimated from the recording, with the
+    /// spread and range of its frames (`clip::length`)
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub body_length: Option<BodyLength>,
+    /// a planar recording (`clip::recording`): its plane, and what its data cannot tell
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub planar: Option<PlanarNote>,
+    /// clips: the frames whose data were lost or filled, and those re-solved from their data
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub frame_data: Option<FrameDataNote>,
+}
+
+/// What a planar recording cannot tell (`clip::recording`).
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct PlanarNote {
+    /// the unit normal of the data's plane, in space coordinates
+    pub plane_normal: [f64; 3],
+    /// in words: the twist and the roll are not observable
+    pub twist: String,
+}
+
+/// The words of [`PlanarNote::twist`], also on stderr and in the figures' titles.
+pub const PLANAR_TWIST: &str = "not observable: the data lie in one plane (one camera), so the rotation of the cross-section about the centreline is fixed by the gauge alpha(0) = 0 on every frame and kappa3 = 0 is the gauge's, not a measurement of no twist; the bending is kappa2, d2 normal to the plane";
+
+impl PlanarNote {
+    pub fn new(n: &nalgebra::Vector3<f64>) -> Self {
+        PlanarNote { plane_normal: [n.x, n.y, n.z], twist: PLANAR_TWIST.into() }
+    }
+}
+
+/// A clip's frames by their data (`frames.csv` has the same per frame: `nodes_tracked`,
+/// `lost`, `filled`, `resolved`, `flagged`).
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct FrameDataNote {
+    /// frames with fewer than 2 tracked nodes: bridged in time from their neighbours
+    /// (`clip::missing`), their numbers
+    pub lost: Vec<usize>,
+    /// frames with some, not all, of their nodes filled
+    pub filled: usize,
+    /// frames solved again from their data guess because their solution from the previous
+    /// frame was over the fit-quality gate (`solve::sequence`), their numbers
+    pub resolved: Vec<usize>,
 }
 
 /// What wrote a run folder.
@@ -217,7 +264,7 @@ impl Manifest {
             message: None,
             certificate: None,
             weights: None,
-            body_length: None,
+            recording: RecordingNotes::default(),
             process: Process { pid: std::process::id(), started_unix_s: now_unix_s(), finished_unix_s: None },
             files: Vec::new(),
         }

@@ -1,5 +1,5 @@
 //! The output-folder contract: a run's files ([`run_files`]: nodes, curvature, metrics, the
-//! plot), a clip's files streamed frame by frame ([`clip_output`], its figures
+//! plot, the published values of [`reference_file`]), a clip's files streamed frame by frame ([`clip_output`], its figures
 //! [`clip_figures`], the resume [`journal`]) and a clip case run into its folder
 //! ([`clip_run`]); the folder itself ([`run_folder`]: its lock [`folder_lock`], what runs leave
 //! beside it, `staging`) and its record `run.json` ([`manifest`]).
@@ -9,6 +9,8 @@ pub mod clip_run;
 pub mod folder_lock;
 pub mod journal;
 pub mod manifest;
+pub mod path_files;
+pub mod reference_file;
 pub mod run_files;
 pub mod run_folder;
 mod staging;

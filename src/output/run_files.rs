@@ -6,7 +6,9 @@ use crate::case::Case;
 use crate::engine::rust::metrics::Metrics;
 use crate::engine::rust::{InverseOutput, RunResult};
 use crate::figures::plot::{render_panels_svg, LinePlot, Mark, Series};
+use crate::io::compact::CURVATURE_COLUMNS;
 use crate::io::files::{csv_text, csv_text_int, write_atomic, write_plot, OutputError};
+use crate::model::resultants::Resultants;
 use crate::solve::inverse::ObjectiveTerms;
 
 /// Write every output of a run into `dir`; returns the written paths.
@@ -29,14 +31,9 @@ pub fn write_run(case: &Case, r: &RunResult, metrics: &Metrics, dir: &Path) -> R
             .into_bytes(),
     )?;
     let kappa = r.nodes.element_curvature();
-    put(
-        "curvature.csv",
-        csv_text(
-            &["s_mid_m", "kappa1_per_m", "kappa2_per_m", "kappa3_per_m"],
-            kappa.iter().map(|(s, k)| vec![*s, k[0], k[1], k[2]]),
-        )
-        .into_bytes(),
-    )?;
+    let rest = case.rod.general.as_ref().map(|g| g.rest.strains.as_slice());
+    let loads = r.nodes.resultants(&case.props, case.quadrature, rest);
+    put("curvature.csv", csv_text(&CURVATURE_COLUMNS, kappa.iter().zip(&loads).map(element_row)).into_bytes())?;
     if !r.history.is_empty() {
         put(
             "history.csv",
@@ -81,12 +78,41 @@ pub fn write_run(case: &Case, r: &RunResult, metrics: &Metrics, dir: &Path) -> R
     if let Some(inv) = &r.inverse {
         write_inverse(r, inv, &mut put)?;
     }
-    let json = serde_json::to_string_pretty(metrics).unwrap_or_else(|_| "{}".into());
-    put("metrics.json", json.into_bytes())?;
+    if let Some(p) = &r.path {
+        put("path.csv", super::path_files::path_csv(p).into_bytes())?;
+        put("critical_points.csv", super::path_files::critical_csv(p).into_bytes())?;
+    }
+    write_metrics(case, r, metrics, &mut put)?;
     let plot_path = dir.join("plot.svg");
     write_plot(&plot_path, render_panels_svg(&headline_panels(case, r), 2))?;
     written.push(plot_path);
     Ok(written)
+}
+
+/// `metrics.json` and, for a case with published values, `reference.csv`.
+fn write_metrics(
+    case: &Case,
+    r: &RunResult,
+    metrics: &Metrics,
+    put: &mut impl FnMut(&str, Vec<u8>) -> Result<(), OutputError>,
+) -> Result<(), OutputError> {
+    let json = serde_json::to_string_pretty(metrics).unwrap_or_else(|_| "{}".into());
+    put("metrics.json", json.into_bytes())?;
+    let published = crate::engine::rust::published::evaluate(case, r, metrics);
+    if !published.is_empty() {
+        put("reference.csv", super::reference_file::run_csv(&published).into_bytes())?;
+    }
+    Ok(())
+}
+
+/// One row of `curvature.csv` ([`CURVATURE_COLUMNS`]): an element's midpoint [m], curvature
+/// [1/m] and stress resultants [N, N m].
+pub fn element_row(((s, k), r): (&(f64, nalgebra::Vector3<f64>), &Resultants)) -> Vec<f64> {
+    let mut row = vec![*s, k[0], k[1], k[2]];
+    for v in [r.n, r.m, r.n_local, r.m_local] {
+        row.extend(v.iter());
+    }
+    row
 }
 
 /// The inverse-specific files: recovered frame and controls along the rod, curvature against
@@ -177,6 +203,9 @@ pub fn headline_panels(case: &Case, r: &RunResult) -> Vec<LinePlot> {
     };
     if let Some(inv) = &r.inverse {
         return inverse_panels(case, r, inv);
+    }
+    if let Some(p) = &r.path {
+        return vec![super::path_files::path_panel(case, p)];
     }
     if !r.tip.is_empty() {
         let t: Vec<f64> = r.tip.iter().map(|p| p.time_s).collect();

@@ -51,7 +51,7 @@ pub(super) fn leftovers(parent: &Path, name: &str) -> Result<(Vec<Leftover>, Vec
 
 /// Converged frames in the resume journal of `dir` (0 without one).
 pub(super) fn journal_frames(dir: &Path) -> usize {
-    super::journal::read_journal(dir).map(|(entries, _)| entries.len()).unwrap_or(0)
+    super::journal::scan_journal(dir).map(|scan| scan.frames.len()).unwrap_or(0)
 }
 
 /// Where a resumed run continues from.

@@ -12,10 +12,12 @@
 use nalgebra::{DVector, Vector3};
 
 use super::certificate::{system_terms, Certificate};
+use super::problem::{FrameAt, Held, HeldRows};
 use super::statics::frozen_system;
 use super::{divergence, Problem, SolveError, Step, CHORD_CONTRACTION};
 use crate::assemble::Tangent;
 use crate::linalg::{LinearSolver, Pattern};
+use crate::model::ends::MotionAt;
 use crate::model::loads::LoadFrame;
 use crate::model::mesh::Field;
 
@@ -84,7 +86,6 @@ pub fn solve(
         solver: LinearSolver::new(&pattern),
         values: vec![0.0; pattern.nnz()],
         pattern,
-        fixed: problem.clamped_dofs(),
         dt,
         factored: false,
         refactor: true,
@@ -94,18 +95,23 @@ pub fn solve(
             return Err(SolveError::Interrupted { what: "time steps", done: n - 1, total: params.steps });
         }
         let t = n as f64 * dt;
-        let u = &prev.u + &prev.v * dt;
+        let held = problem.held(MotionAt::Dynamic { t_prev: t - dt, t }, Some(&prev.u));
+        let mut u = &prev.u + &prev.v * dt;
+        if problem.ends().moving() {
+            // a moving end's held unknowns start at their targets; fixed ones keep the
+            // predictor's (their Newton rows are identities with zero residual)
+            held.impose(&mut u);
+        }
         let f_step = if state_free_loads { Some(problem.loads_at(&u, t, None)) } else { None };
-        let (u, it, increment) = stepper.newton(n, t, u, &prev, f_step.as_ref())?;
+        let at = StepAt { n, t, held: &held, f_step: f_step.as_ref() };
+        let (u, it, increment) = stepper.newton(at, u, &prev)?;
         total += it;
         max_it = max_it.max(it);
         let v = (&u - &prev.u) * (2.0 / dt) - &prev.v;
         let p_n = problem.momentum(&u, &v, None);
-        let f_n = match f_step {
-            Some(f) => f,
-            None => problem.loads_at(&u, t, None),
-        };
-        let terms = StepTerms { u: &u, u_prev: &prev.u, p: &p_n, p_prev: &prev.p, f: &f_n, f_prev: &prev.f, dt };
+        let f_n = f_step.unwrap_or_else(|| problem.loads_at(&u, t, None));
+        let terms =
+            StepTerms { u: &u, u_prev: &prev.u, p: &p_n, p_prev: &prev.p, f: &f_n, f_prev: &prev.f, dt, held: &held };
         let certificate = step_certificate(problem, terms, &stepper.pattern, &mut cert_values);
         if !certificate.within(params.certificate_tolerance) {
             return Err(SolveError::StepNotCertified {
@@ -152,7 +158,6 @@ struct Stepper<'a, 'p> {
     pattern: Pattern,
     solver: LinearSolver,
     values: Vec<f64>,
-    fixed: Vec<usize>,
     /// time step Δt [s]
     dt: f64,
     /// a factorisation exists, and the next iteration should make a new one
@@ -166,13 +171,12 @@ impl Stepper<'_, '_> {
     /// increment.
     fn newton(
         &mut self,
-        n: usize,
-        t: f64,
+        at: StepAt,
         mut u: DVector<f64>,
         prev: &StepState,
-        f_step: Option<&DVector<f64>>,
     ) -> Result<(DVector<f64>, usize, f64), SolveError> {
         let (problem, dt) = (self.problem, self.dt);
+        let StepAt { n, t, held, f_step } = at;
         let mut increment = f64::NAN;
         let mut previous = f64::INFINITY;
         for it in 1..=self.params.newton_max_iterations {
@@ -198,11 +202,16 @@ impl Stepper<'_, '_> {
                 }
             };
             let mut r = (p - &prev.p) / dt + g - (f_n + &prev.f) * 0.5;
-            for &d in &self.fixed {
-                r[d] = 0.0;
-            }
+            let values = if newton { Some(&mut self.values[..]) } else { None };
+            problem.apply_held(
+                &self.pattern,
+                values,
+                &mut r,
+                held,
+                HeldRows::Zero,
+                FrameAt { state: &u_mid, rate: 0.5 },
+            );
             let du = if newton {
-                self.pattern.set_identity_rows(&mut self.values, &self.fixed);
                 let du = self.solver.solve(&self.values, &(-r))?;
                 (self.factored, self.refactor) = (true, false);
                 du
@@ -230,6 +239,15 @@ impl Stepper<'_, '_> {
     }
 }
 
+/// Where a time step's Newton starts from: step `n` at `t` [s], its held unknowns and, if they do
+/// not depend on the state, its loads `F(t_n)`.
+struct StepAt<'a> {
+    n: usize,
+    t: f64,
+    held: &'a Held,
+    f_step: Option<&'a DVector<f64>>,
+}
+
 /// The assembly target of one term of the Jacobian, if one is assembled.
 fn tangent<'a>(on: bool, pattern: &'a Pattern, values: &'a mut [f64], scale: f64) -> Option<Tangent<'a>> {
     on.then(|| Tangent::new(pattern, values, scale))
@@ -245,6 +263,8 @@ pub struct StepTerms<'a> {
     pub f: &'a DVector<f64>,
     pub f_prev: &'a DVector<f64>,
     pub dt: f64,
+    /// the held unknowns of the step and their values (D22)
+    pub held: &'a Held,
 }
 
 /// The residual certificate of a time step (`docs/certificate.md`): the block backward error of
@@ -262,20 +282,29 @@ pub fn step_certificate(problem: &Problem, s: StepTerms, pattern: &Pattern, valu
     let mid = (s.u + s.u_prev) * 0.5;
     // the frozen system at m without loads: b(m) (Dirichlet rows: the clamp's values)
     let unloaded = Problem { load_factor: 0.0, ..*problem };
-    let b = frozen_system(&unloaded, &mid, pattern, values);
+    let b = frozen_system(&unloaded, &mid, pattern, values, s.held);
     let (mut res, mut scale) = system_terms(pattern, values, &mid, &b);
-    let fixed = problem.clamped_dofs();
+    let fixed = &s.held.dofs;
     for i in 0..res.len() {
-        if fixed.contains(&i) {
+        if fixed.binary_search(&i).is_ok() {
             continue;
         }
         res[i] += (s.p[i] - s.p_prev[i]) / s.dt - 0.5 * (s.f[i] + s.f_prev[i]);
         scale[i] += (s.p[i].abs() + s.p_prev[i].abs()) / s.dt + 0.5 * (s.f[i].abs() + s.f_prev[i].abs());
     }
-    let reference = problem.reference_state();
-    for &d in &fixed {
-        res[d] = s.u[d] - reference[d];
-        scale[d] = s.u[d].abs() + reference[d].abs();
+    // a twist-held node's moment rows as the solver combines them (D22): the residual with the
+    // frame at the midpoint, the term sizes with its magnitudes
+    for &node in &s.held.twist_nodes {
+        let i0 = dofs.index(node, crate::model::mesh::Field::Alpha, 0);
+        let t = super::problem::twist_rows(&dofs.get(&mid, node, crate::model::mesh::Field::Alpha)).t;
+        let (r, sc) = (res.fixed_rows::<3>(i0).into_owned(), scale.fixed_rows::<3>(i0).into_owned());
+        let perm = nalgebra::Matrix3::from_fn(|i, j| t[i][j]);
+        res.fixed_rows_mut::<3>(i0).copy_from(&(perm * r));
+        scale.fixed_rows_mut::<3>(i0).copy_from(&(perm.abs() * sc));
+    }
+    for (&d, &v) in s.held.dofs.iter().zip(&s.held.values) {
+        res[d] = s.u[d] - v;
+        scale[d] = s.u[d].abs() + v.abs();
     }
     Certificate::from_residual(&dofs, &res, &scale)
 }

@@ -4,7 +4,9 @@
 //! [`sequence`] (a clip of frames). Each solver has a params struct, returns a solution with
 //! its info (iterations, history, [`Stop`]) and fails with a [`SolveError`] that carries the
 //! numbers. All of them assemble through the one element loop of [`crate::assemble`].
+pub mod arclength;
 pub mod certificate;
+pub mod continuation;
 pub mod dynamics;
 pub mod fit;
 pub mod inverse;

@@ -14,8 +14,10 @@ use std::f64::consts::PI;
 
 use nalgebra::{DVector, Matrix3, Vector3};
 
+mod accept;
 mod carry;
 mod report;
+use accept::{accepted, frame_fit};
 pub use carry::vector_to_space;
 use carry::{carry_converted, carry_state, to_space};
 pub use report::{DataMisfit, FrameConditioning, FrameConvergence, FrameReport};
@@ -24,8 +26,8 @@ use crate::model::chart::{frame_axis, Chart};
 use crate::model::mesh::{DofMap, Field};
 use crate::model::rotation::{angles_from_rotation, skew, Angles};
 
-use super::fit::{noise_level, position_misfit, FitGate, FrameFit};
-use super::inverse::tracking::{tracking_weights, MIN_TRACKED};
+use super::fit::FitGate;
+use super::inverse::tracking::tracking_weights;
 use super::inverse::{Frame, FrameSolver, InverseParams, InverseRecord, InverseSolution, Records, Start};
 use super::{Problem, SolveError};
 
@@ -50,6 +52,11 @@ pub struct SequenceParams {
     pub records: Records,
     /// the fit-quality gate that flags frames (`solve::fit`)
     pub gate: FitGate,
+    /// the unit normal of the plane a planar recording lies in (`clip::recording`), in space
+    /// coordinates; `None`: 3D data. Planar data do not hold the roll of the frame about the
+    /// centreline, so every frame, not only the first, has the gauge `α(0) = α0` (R7), and the
+    /// noise is estimated in the plane ([`super::fit::noise_level_in`])
+    pub plane: Option<Vector3<f64>>,
 }
 
 /// The frames of a clip as the solve takes them: positions per node (untracked ones filled,
@@ -183,36 +190,6 @@ pub fn max_stretch_deviation(x_g: &[Vector3<f64>], h: f64, tracked: Option<&[boo
         .filter(|&e| both(e))
         .map(|e| ((x_g[e + 1] - x_g[e]).norm() / h - 1.0).abs())
         .fold(0.0, f64::max)
-}
-
-/// The fit measures of a frame's solution `sol` on its data `x_g` (chart coordinates both) over
-/// its `tracked` nodes (`None`: all) and the gate's verdict (`solve::fit`); `tangent_misfit`:
-/// `‖∂s x − d3‖` [m^½] of its last record.
-fn frame_fit(
-    gate: &FitGate,
-    problem: &Problem,
-    dofs: &DofMap,
-    sol: &InverseSolution,
-    x_g: &[Vector3<f64>],
-    tracked: Option<&[bool]>,
-    tangent_misfit: f64,
-) -> FrameFit {
-    let length = problem.mesh.length_m;
-    // the noise of the tracked positions only (the filled ones are smooth by construction)
-    let recorded: Vec<Vector3<f64>> = match tracked {
-        Some(t) => x_g.iter().zip(t).map(|(x, &t)| if t { *x } else { Vector3::repeat(f64::NAN) }).collect(),
-        None => Vec::new(),
-    };
-    let mut fit = FrameFit {
-        noise_m: noise_level(if tracked.is_some() { &recorded } else { x_g }),
-        position: position_misfit(&dofs.field(&sol.u, Field::X), x_g, tracked, length),
-        tangent: tangent_misfit / length.sqrt(),
-        flagged: false,
-    };
-    // a bridged frame (too few tracked nodes, `clip::missing`) has no data to fall short of
-    let bridged = tracked.is_some_and(|t| t.iter().filter(|t| **t).count() < MIN_TRACKED);
-    fit.flagged = !bridged && gate.check(&fit, length, problem.mesh.h());
-    fit
 }
 
 /// The advice of a chart-guard stop: where the fit had degraded before it, the degradation;
@@ -396,10 +373,7 @@ pub fn solve_sequence_from<'a>(
     let mut reports: Vec<FrameReport> = Vec::with_capacity(frames.len());
     // the previous frame: its chart and its state in that chart; the frame before that, for
     // the linear predictor of a warm start
-    let (first, mut prev, mut prev2) = match resume {
-        Some(r) => (r.next, Some(r.prev), r.prev2),
-        None => (0, None, None),
-    };
+    let (first, mut prev, mut prev2) = resume.map_or((0, None, None), |r| (r.next, Some(r.prev), r.prev2));
     // pattern, LU storage and scratch once per clip, reused by every frame
     let mut solver = FrameSolver::new(problem, sp.inverse).with_records(sp.records);
     for (i, x_space) in frames.iter().enumerate().skip(first) {
@@ -412,7 +386,8 @@ pub fn solve_sequence_from<'a>(
             prepare(sp, problem, x_space, prev.as_ref(), prev2.as_ref(), start0);
         let guess = || data_frame_guess(&frame_geometry(&x_g, problem.mesh.length_m));
         let (weight, tracked) = (data.weights(i), data.tracked(i));
-        let frame = Frame { index: k, x_g: &x_g, previous: alpha_prev.as_deref(), weight: weight.as_deref() };
+        let (previous, fix_roll) = (alpha_prev.as_deref(), sp.plane.is_some());
+        let frame = Frame { index: k, x_g: &x_g, previous, weight: weight.as_deref(), fix_roll };
         // From the previous frame's solution (already close) Newton runs directly; from a guess
         // it needs the fixed point's warm start (I8).
         let lambda_g = sp.inverse.weights.lambda_g;
@@ -424,7 +399,10 @@ pub fn solve_sequence_from<'a>(
         let from_previous = i > 0 && sp.start == FrameStart::PreviousFrame;
         let near = from_previous || (carried.is_none() && matches!(start0, FirstStart::Near(_)));
         let smooth = || smoothed_guess(&x_g, problem.mesh.length_m);
-        let (sol, restarted) = with_restarts(&mut solve, &first_start, near, &guess, &smooth, lambda_g)?;
+        let first = with_restarts(&mut solve, &first_start, near, &guess, &smooth, lambda_g)?;
+        let check = |sol: &InverseSolution| frame_fit(sp, problem, sol, (&x_g[..], tracked), &chart);
+        let (sol, restarted, fit) =
+            accepted(first, from_previous, &check, || solve(&guess(), Start::Guess, lambda_g).ok());
         let (cos_beta, node) = min_cos_beta(&dofs, &sol.u);
         chart_guard(sp, &reports, k, &chart, (cos_beta, node))?;
         let last = sol.history.last().copied().ok_or(SequenceError::NoIteration { frame: k })?;
@@ -441,7 +419,7 @@ pub fn solve_sequence_from<'a>(
             chart_axis: chart.axis(),
             wall_time_s: start.elapsed().as_secs_f64(),
             certificate: sol.certificate.value,
-            fit: frame_fit(&sp.gate, problem, &dofs, &sol, &x_g, tracked, last.tangent_misfit),
+            fit,
             nodes_tracked: tracked.map_or(x_g.len(), |t| t.iter().filter(|t| **t).count()),
         };
         let in_space = if chart.is_identity() { None } else { Some(to_space(&dofs, &chart, &sol)) };

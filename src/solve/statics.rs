@@ -18,6 +18,7 @@
 use nalgebra::DVector;
 
 use super::certificate::{of_system, Certificate, DEFAULT_CERTIFICATE_TOLERANCE};
+use super::problem::{FrameAt, Held, HeldRows};
 use super::{divergence, Problem, SolveError, Stall, Step, Stop, PLATEAU_ITERATIONS};
 use crate::assemble::{assemble, Tangent};
 use crate::linalg::{LinearSolver, Pattern};
@@ -34,6 +35,9 @@ pub struct StaticParams {
     pub continuation_steps: usize,
     /// the result is converged only with its certificate ([`certificate`]) at most this
     pub certificate_tolerance: f64,
+    /// path following through limit points instead of load steps (`solver.continuation =
+    /// "arc_length"`, D25)
+    pub path: Option<super::continuation::ArcLengthParams>,
 }
 
 impl StaticParams {
@@ -45,6 +49,7 @@ impl StaticParams {
             max_iterations,
             continuation_steps,
             certificate_tolerance: DEFAULT_CERTIFICATE_TOLERANCE,
+            path: None,
         }
     }
 }
@@ -182,8 +187,7 @@ fn solve_step(
     progress: &mut impl FnMut(&IterationRecord),
 ) -> Result<(DVector<f64>, f64, Stop), SolveError> {
     let dofs = problem.dofs();
-    let fixed = problem.clamped_dofs();
-    let reference = problem.reference_state();
+    let held = problem.held_static();
     let mut values = vec![0.0; pattern.nnz()];
     let mut cert_values = vec![0.0; pattern.nnz()];
     let mut last = f64::NAN;
@@ -203,7 +207,7 @@ fn solve_step(
         }
         let change = match params.method {
             Method::FixedPoint { relaxation } => {
-                let b = frozen_system(problem, &u, pattern, &mut values);
+                let b = frozen_system(problem, &u, pattern, &mut values, &held);
                 let u_hat = solver.solve(&values, &b)?;
                 let u_new = &u_hat * relaxation + &u * (1.0 - relaxation);
                 let change = relative_change(&dofs, &u_new, &u);
@@ -214,10 +218,7 @@ fn solve_step(
                 values.iter_mut().for_each(|v| *v = 0.0);
                 let g = problem.internal_force(&u, Some(Tangent::new(pattern, &mut values, 1.0)));
                 let mut r = g - problem.loads_at(&u, 0.0, Some(Tangent::new(pattern, &mut values, -1.0)));
-                for &d in &fixed {
-                    r[d] = u[d] - reference[d];
-                }
-                pattern.set_identity_rows(&mut values, &fixed);
+                problem.apply_held(pattern, Some(&mut values), &mut r, &held, HeldRows::Residual(&u), FrameAt::of(&u));
                 let du = solver.solve(&values, &(-r))?;
                 u += &du;
                 problem.increment_measure(&du)
@@ -226,7 +227,7 @@ fn solve_step(
         if let Some((quantity, value)) = divergence(problem, &u, change) {
             return Err(SolveError::Diverged { step: Some(Step::Continuation(step)), iteration: k, quantity, value });
         }
-        let b = frozen_system(problem, &u, pattern, &mut cert_values);
+        let b = frozen_system(problem, &u, pattern, &mut cert_values, &held);
         let certificate = of_system(&dofs, pattern, &cert_values, &u, &b).value;
         let rec = IterationRecord { step, iteration: k, change, certificate };
         progress(&rec);
@@ -241,26 +242,27 @@ fn solve_step(
 }
 
 /// The frozen-coefficient system of the fixed point (D5) at `u` into `values` (replaced), with
-/// the clamp's identity rows: returns its right-hand side `b(u) + F(u)` (the clamp's values in
-/// the clamped rows). `L(u) u − b(u) − F(u)` is D3's residual `G(u) − F(u)`.
-pub fn frozen_system(problem: &Problem, u: &DVector<f64>, pattern: &Pattern, values: &mut [f64]) -> DVector<f64> {
+/// the identity rows of the `held` unknowns (D22): returns its right-hand side `b(u) + F(u)`
+/// (the held values in the held rows). `L(u) u − b(u) − F(u)` is D3's residual `G(u) − F(u)`.
+pub fn frozen_system(
+    problem: &Problem,
+    u: &DVector<f64>,
+    pattern: &Pattern,
+    values: &mut [f64],
+    held: &Held,
+) -> DVector<f64> {
     let dofs = problem.dofs();
     let h = problem.mesh.h();
     // (a problem without loads, the dynamic step's certificate: no pass over the loads)
     let mut b = if problem.load_factor == 0.0 { dofs.zeros() } else { problem.loads_at(u, 0.0, None) };
     assemble(&dofs, &mut b, Some(Tangent::overwriting(pattern, values, 1.0)), |e, t| {
-        let (l, bl) = frozen_operator(&problem.props, problem.scheme, h, &dofs.gather(u, e));
+        let (l, bl) = frozen_operator(&problem.props, problem.scheme, h, &dofs.gather(u, e), problem.rest(e));
         if let Some(t) = t {
             *t = l;
         }
         bl
     });
-    let reference = problem.reference_state();
-    let fixed = problem.clamped_dofs();
-    for &d in &fixed {
-        b[d] = reference[d];
-    }
-    pattern.set_identity_rows(values, &fixed);
+    problem.apply_held(pattern, Some(values), &mut b, held, HeldRows::Values, FrameAt::of(u));
     b
 }
 
@@ -272,7 +274,7 @@ pub fn certificate(problem: &Problem, u: &DVector<f64>) -> Certificate {
     let dofs = problem.dofs();
     let pattern = dofs.pattern();
     let mut values = vec![0.0; pattern.nnz()];
-    let b = frozen_system(problem, u, &pattern, &mut values);
+    let b = frozen_system(problem, u, &pattern, &mut values, &problem.held_static());
     of_system(&dofs, &pattern, &values, u, &b)
 }
 

@@ -19,6 +19,7 @@ pub use spec::{Mesh, StudySpec, Variant};
 
 use crate::engine::input::clip_files::read_recording;
 use crate::engine::input::corpus::{recording_path, write_corpus, CorpusParams};
+use crate::engine::input::tracker::{write_tracker_corpus, Losses, TrackerParams};
 use crate::engine::input::truth_file::{read_truth, truth_sidecar};
 use crate::io::{write_atomic, InputError, OutputError};
 use crate::jobs::batch::{run_batch, Plan};
@@ -81,7 +82,8 @@ pub fn run_study(spec: &StudySpec, out: &Path, quick: bool, tick: impl Fn(&str))
     let mut rows = Vec::new();
     for mesh in &spec.meshes {
         for &noise_m in &plan.noise_m {
-            let tag = format!("n{}_s{}", mesh.nodes, crate::case::sweep::fmt_value(noise_m));
+            let kind = if mesh.planar { "_planar" } else { "" };
+            let tag = format!("n{}{kind}_s{}", mesh.nodes, crate::case::sweep::fmt_value(noise_m));
             let corpus = out.join("corpora").join(&tag);
             let params = CorpusParams {
                 count: plan.recordings,
@@ -91,8 +93,24 @@ pub fn run_study(spec: &StudySpec, out: &Path, quick: bool, tick: impl Fn(&str))
                 seed: spec.seed,
                 ..CorpusParams::default()
             };
-            let entries = write_corpus(&corpus, &spec.kymogram, &params)?;
-            let recordings: Vec<PathBuf> = entries.iter().map(|e| recording_path(&corpus, &e.name)).collect();
+            let recordings: Vec<PathBuf> = if mesh.planar {
+                let tracker = TrackerParams {
+                    count: params.count,
+                    frames: params.frames,
+                    nodes: params.nodes,
+                    lengths_m: vec![params.length_m],
+                    dt_s: params.dt_s,
+                    noise_m,
+                    seed: spec.seed,
+                    losses: Losses::NONE,
+                    first_frame: 0,
+                };
+                let entries = write_tracker_corpus(&corpus, std::slice::from_ref(&spec.kymogram), &tracker)?;
+                entries.iter().map(|e| corpus.join(format!("{}.csv", e.name))).collect()
+            } else {
+                let entries = write_corpus(&corpus, &spec.kymogram, &params)?;
+                entries.iter().map(|e| recording_path(&corpus, &e.name)).collect()
+            };
             rows.extend(spline_rows(mesh.nodes, noise_m, params.length_m, &recordings, spec.skip_elements)?);
             for variant in &spec.variants {
                 let case = spec.variant_case(mesh, variant, &out.join("cases"))?;

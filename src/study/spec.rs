@@ -24,6 +24,10 @@ pub struct Mesh {
     pub nodes: usize,
     /// the batch case (relative to the spec's folder)
     pub case: PathBuf,
+    /// the recordings as a single-camera tracker writes them (`engine::input::tracker`: 2D, in
+    /// µm, noise in x and y only; no frame or point lost) instead of 3D `roll_3d` clips
+    #[serde(default)]
+    pub planar: bool,
 }
 
 /// A way of reconstructing: keys of the case set to values (`"inverse.weights" = "auto"`).

@@ -653,6 +653,18 @@ case("contra_compare_without_reason", "base_static", ["\n[compare]\ndisplacement
 case("contra_reference_force_mismatch", "base_static", [('force_n = "F"', 'force_n = "2*F"')],
      ["reference.force_n|force_n", "end_force_n"],
      "the reference's force (2F) is not the tip load (F): the theory errors in metrics.json are against another load")
+PUBLISHED = ('\n[[reference.values]]\nquantity = "tip.y_m"\nvalue = "-0.05*L0"\ntolerance_abs = "1e-3*L0"\n'
+             'source = "A. Author (2000), J. Rods 1, Table 1"\n')
+case("published_unknown_quantity", "base_static", [PUBLISHED.replace("tip.y_m", "tip.deflection_m")],
+     ["reference.values[0].quantity", "deflection_m", "tip.displacement_y_m"],
+     "a published value of a quantity that is not in the vocabulary")
+case("published_without_source", "base_static", [PUBLISHED.replace('source = "A. Author (2000), J. Rods 1, Table 1"\n', "")],
+     ["reference.values[0].source", "source"], "a published value without its source")
+case("published_two_tolerances", "base_static",
+     [PUBLISHED.replace('tolerance_abs = "1e-3*L0"', 'tolerance_abs = "1e-3*L0"\ntolerance_rel = 0.01')],
+     ["reference.values[0]", "tolerance_abs", "tolerance_rel"], "a published value with two tolerances")
+case("published_metric_not_written", "base_static", [PUBLISHED.replace("tip.y_m", "metric.tip_max_abs_y_m")],
+     ["reference.values[0]", "tip_max_abs_y_m"], "a published metric that a static run does not write")
 case("contra_kymogram_on_static", "base_static",
      ['\n[clip]\nkind = "kymogram"\nfile = "../recordings/kymogram_good.npy"\nframe_interval_s = 0.04\nmin_cos_beta = 1e-3\n'],
      ["clip", "inverse"], "a [clip] table on a static analysis")

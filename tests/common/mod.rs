@@ -69,6 +69,29 @@ pub fn worm_data_present(test: &str) -> bool {
     ok
 }
 
+/// `case` as `cosserat run` and `compare` read it (a recording's length, plane and frame
+/// numbers from its data: `resolve_recording`), if its data are here. A case without a clip
+/// needs none; a clip needs the elegansbot kymograms (`scripts/fetch_worm_data.sh`; `None` and a
+/// notice when absent), and a case on the tracker recordings of `data/tracker/`
+/// (`cases/worm_2d_recording.toml`) those too, from which they are written when absent with
+/// the recordings `scripts/setup.sh` writes (`cosserat synth --tracker --out data/tracker`:
+/// the same parameters, the same bytes).
+pub fn with_clip_data(case: Case) -> Option<Case> {
+    let Some(src) = case.clip() else { return Some(case) };
+    if !worm_data_present(&case.name) {
+        return None;
+    }
+    if !src.file.is_file() && src.file.components().any(|c| c.as_os_str() == "tracker") {
+        use cosserat::engine::input::tracker::{write_tracker_corpus, TrackerParams};
+        let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+        let kymograms = ["omega", "delta"].map(|t| root.join(format!("data/elegansbot/kymogram_{t}-turn.npy")));
+        write_tracker_corpus(&root.join("data/tracker"), &kymograms, &TrackerParams::default())
+            .unwrap_or_else(|e| panic!("the tracker recordings of {}: {e}", case.name));
+    }
+    let resolved = cosserat::engine::input::clip_files::resolve_recording(&case);
+    Some(resolved.unwrap_or_else(|e| panic!("{}: {}", case.name, error_chain(&e))))
+}
+
 /// Is this case a recorded clip (`[clip]`)?
 pub fn is_clip(case: &Case) -> bool {
     case.clip().is_some()
@@ -87,6 +110,7 @@ pub fn forward_data(case: &Case, steps: usize) -> (nalgebra::DVector<f64>, Vec<n
             max_iterations: 40,
             continuation_steps: steps,
             certificate_tolerance: DEFAULT_CERTIFICATE_TOLERANCE,
+            path: None,
         },
         |_| {},
     )
@@ -174,7 +198,7 @@ pub fn solve_frame_any(
     start: Start,
     mut on: impl FnMut(&InverseRecord),
 ) -> Result<InverseSolution, SolveError> {
-    let frame = Frame { index: 0, x_g, previous, weight: None };
+    let frame = Frame { index: 0, x_g, previous, weight: None, fix_roll: false };
     FrameSolver::new(p, *params).solve(&frame, u0, start, |r, _, _| on(r))
 }
 

@@ -5,9 +5,10 @@ use std::path::Path;
 use nalgebra::{Rotation3, Vector3};
 
 use super::super::raw::{RawClip, RawClipKind, RawMissing, RawPlane, RawRotation, RawStart};
-use super::super::{CaseError, ClipKind, ClipPlacement, ClipSource, SyntheticClip};
+use super::super::{CaseError, ClipKind, ClipPlacement, ClipSource, RecordingKeys, Section, SyntheticClip};
 use super::Validator;
 use crate::clip::missing::MissingData;
+use crate::clip::recording::{LengthUnit, UnitSpec};
 use crate::clip::synthetic::RollClipParams;
 use crate::clip::{ClipPlane, CLIP_SKIP_ELEMENTS, MAX_CLIP_POSITIONS, MIN_CLIP_ELEMENTS};
 use crate::model::mesh::Mesh;
@@ -18,7 +19,7 @@ impl Validator<'_> {
     /// `[clip]`: a recorded or synthetic clip. The stages, in the order their errors are
     /// reported: the mesh, the frame range and chart guard, the placement, the kind (with the
     /// `roll_3d` keys), the treatment of untracked nodes, the fit-quality gate.
-    pub(super) fn clip(&self, cl: &RawClip, mesh: &Mesh) -> Result<ClipSource, CaseError> {
+    pub(super) fn clip(&self, cl: &RawClip, mesh: &Mesh, section: &Section) -> Result<ClipSource, CaseError> {
         self.clip_mesh(cl, mesh)?;
         let base = self.path.parent().unwrap_or(Path::new(""));
         let frames = self.clip_frames(cl)?;
@@ -28,7 +29,8 @@ impl Validator<'_> {
         let placement = self.clip_placement(cl)?;
         let kind = self.clip_kind(cl, mesh)?;
         let missing = self.clip_missing(cl, &kind)?;
-        let gate = self.clip_gate(cl)?;
+        let gate = self.clip_gate(cl, section)?;
+        let recording = self.clip_recording(cl, &kind, &placement)?;
         Ok(ClipSource {
             kind,
             file: base.join(&cl.file),
@@ -45,7 +47,46 @@ impl Validator<'_> {
                 RawRotation::GlobalEuler => RotationTreatment::GlobalEuler,
             },
             placement,
+            recording,
         })
+    }
+
+    /// The keys of a recording's file: `clip.unit` with `clip.scale_m_per_px`, `clip.worm_id`
+    /// (WCON) and `clip.data_plane` (rotated by `clip.orientation`, as the data are).
+    fn clip_recording(
+        &self,
+        cl: &RawClip,
+        kind: &ClipKind,
+        placement: &ClipPlacement,
+    ) -> Result<RecordingKeys, CaseError> {
+        let given = cl.unit.is_some() || cl.scale_m_per_px.is_some() || cl.worm_id.is_some() || cl.data_plane.is_some();
+        if given && *kind != ClipKind::Recording {
+            return Err(
+                self.err("clip", "unit, scale_m_per_px, worm_id and data_plane apply to kind = \"recording\" only")
+            );
+        }
+        let unit = match &cl.unit {
+            None => None,
+            Some(u) => Some(LengthUnit::parse(u.trim()).ok_or_else(|| {
+                self.err("clip.unit", format!("\"{u}\" is not a unit of length: \"m\", \"mm\", \"um\" or \"px\""))
+            })?),
+        };
+        let m_per_px = cl.scale_m_per_px.as_ref().map(|v| self.positive("clip.scale_m_per_px", v)).transpose()?;
+        if m_per_px.is_some() && unit.is_some_and(|u| u != LengthUnit::Pixel) {
+            return Err(self.err("clip.scale_m_per_px", "applies to positions in pixels (clip.unit = \"px\") only"));
+        }
+        let data_plane = match cl.data_plane {
+            None => None,
+            Some(n) => {
+                let v = Vector3::from(n);
+                let norm = v.norm();
+                if !(norm.is_finite() && norm > 1e-12) {
+                    return Err(self.err("clip.data_plane", format!("must be a finite non-zero vector, got {n:?}")));
+                }
+                Some(placement.orientation * (v / norm))
+            }
+        };
+        Ok(RecordingKeys { units: UnitSpec { unit, m_per_px }, worm_id: cl.worm_id.clone(), data_plane })
     }
 
     /// A clip case's mesh has at least [`MIN_CLIP_ELEMENTS`] elements.
@@ -146,8 +187,10 @@ impl Validator<'_> {
         }
     }
 
-    /// `clip.gate_*`: the fit-quality gate, each bound positive, the default where absent.
-    fn clip_gate(&self, cl: &RawClip) -> Result<FitGate, CaseError> {
+    /// `clip.gate_*`, `clip.noise_m` and `clip.max_curvature_per_m`: the fit-quality gate, each
+    /// bound positive, the default where absent (the curvature's: the inverse of the
+    /// cross-section's smallest half-width, [`FitGate::curvature_bound`]).
+    fn clip_gate(&self, cl: &RawClip, section: &Section) -> Result<FitGate, CaseError> {
         let d = FitGate::default();
         let gate_key = |key: &str, v: Option<f64>, default: f64| match v {
             None => Ok(default),
@@ -158,6 +201,15 @@ impl Validator<'_> {
             noise_multiple: gate_key("clip.gate_noise_multiple", cl.gate_noise_multiple, d.noise_multiple)?,
             position_min: gate_key("clip.gate_position", cl.gate_position, d.position_min)?,
             tangent_min: gate_key("clip.gate_tangent", cl.gate_tangent, d.tangent_min)?,
+            noise_m: cl.noise_m.as_ref().map(|v| self.positive("clip.noise_m", v)).transpose()?,
+            max_curvature_per_m: match &cl.max_curvature_per_m {
+                Some(v) => self.positive("clip.max_curvature_per_m", v)?,
+                // a section given by its stiffnesses has no width: no bound unless stated
+                None => match section {
+                    Section::Shape(cs) => FitGate::curvature_bound(cs),
+                    Section::Stiffness(_) => f64::INFINITY,
+                },
+            },
         })
     }
 

@@ -1,9 +1,11 @@
 //! `[rod]`: the mesh, where its length comes from (`rod.length_m = "from_data"`), and the
 //! slenderness that double precision solves.
-use super::super::raw::{RawRod, Scalar};
-use super::super::{Analysis, ClipKind, DataSource, InverseSettings, RodLength, FROM_DATA, FROM_DATA_PLACEHOLDER_M};
+use super::super::raw::{RawAnalysis, RawCase, RawMaterial, RawRod, RawSection, Scalar};
+use super::super::{
+    Analysis, ClipKind, DataSource, InverseSettings, RodLength, Section, FROM_DATA, FROM_DATA_PLACEHOLDER_M,
+};
 use super::{CaseError, Validator, MAX_ELEMENTS};
-use crate::model::material::CrossSection;
+use crate::model::material::{CrossSection, Material, RodProperties, Stiffnesses};
 use crate::model::mesh::Mesh;
 
 impl Validator<'_> {
@@ -22,6 +24,32 @@ impl Validator<'_> {
             return Err(self.err("rod.elements", format!("at most {MAX_ELEMENTS} elements, got {}", rod.elements)));
         }
         Ok((Mesh::new(length, rod.elements), source))
+    }
+
+    /// `rod.section_length_m`: the body length [m] the case's `[cross_section]` describes; where
+    /// it is given and the rod's length is known, the section is scaled by `L / section_length_m`
+    /// (a worm of another length is taken as geometrically similar: its radius in proportion to
+    /// its length, so that its bending stiffness `E I` goes as `L⁴`). Until a length from the
+    /// data is read, the section is left as it is.
+    pub(super) fn scaled_section(
+        &self,
+        section: CrossSection,
+        rod: &RawRod,
+        mesh: &Mesh,
+        length: RodLength,
+    ) -> Result<CrossSection, CaseError> {
+        let Some(v) = &rod.section_length_m else { return Ok(section) };
+        let reference = self.positive("rod.section_length_m", v)?;
+        if length != RodLength::Given {
+            return Ok(section);
+        }
+        let k = mesh.length_m / reference;
+        Ok(match section {
+            CrossSection::Circle { radius_m } => CrossSection::Circle { radius_m: radius_m * k },
+            CrossSection::Rectangle { width_m, height_m } => {
+                CrossSection::Rectangle { width_m: width_m * k, height_m: height_m * k }
+            }
+        })
     }
 
     /// `rod.length_m = "from_data"` needs a recording to measure: an inverse case with a
@@ -48,12 +76,133 @@ impl Validator<'_> {
         ))
     }
 
+    /// `[cross_section]` and `[material]`: the section, the material (absent for a section given
+    /// by its stiffnesses, D24), the coefficients of the model and whether the inertias were
+    /// given (a dynamic analysis requires them).
+    pub(super) fn section_and_material(
+        &self,
+        raw: &RawCase,
+        kind: RawAnalysis,
+        mesh: &Mesh,
+        rod_length: RodLength,
+    ) -> Result<(Section, Option<Material>, RodProperties, bool), CaseError> {
+        match (&raw.cross_section, &raw.material) {
+            (RawSection::Stiffness { .. }, Some(_)) => Err(self.err(
+                "material",
+                "not used with cross_section.shape = \"stiffness\": the stiffnesses and inertias are given there (D24)",
+            )),
+            (RawSection::Stiffness { .. }, None) => {
+                let s = self.stiffnesses(&raw.cross_section, kind)?;
+                let given = s.rho_a_kg_per_m.is_some() && s.rho_i_kg_m.is_some();
+                Ok((Section::Stiffness(s), None, RodProperties::from_stiffnesses(&s), given))
+            }
+            (_, None) => Err(self.err(
+                "material",
+                "required with a circle or rectangle section (or give cross_section.shape = \"stiffness\" with the stiffnesses)",
+            )),
+            (shape, Some(m)) => {
+                let material = self.material(m, kind)?;
+                let section = self.scaled_section(self.shape(shape)?, &raw.rod, mesh, rod_length)?;
+                let props = RodProperties::new(&material, &section);
+                Ok((Section::Shape(section), Some(material), props, m.density_kg_m3.is_some()))
+            }
+        }
+    }
+
+    /// `[material]`; the density is required by a dynamic analysis only.
+    fn material(&self, m: &RawMaterial, kind: RawAnalysis) -> Result<Material, CaseError> {
+        let density = match (&m.density_kg_m3, kind) {
+            (Some(d), _) => self.positive("material.density_kg_m3", d)?,
+            (None, RawAnalysis::Static | RawAnalysis::Inverse) => 1.0,
+            (None, RawAnalysis::Dynamic) => {
+                return Err(self.err("material.density_kg_m3", "required for a dynamic analysis"))
+            }
+        };
+        Ok(Material {
+            young_modulus_pa: self.positive("material.young_modulus_pa", &m.young_modulus_pa)?,
+            shear_modulus_pa: self.positive("material.shear_modulus_pa", &m.shear_modulus_pa)?,
+            density_kg_m3: density,
+            shear_correction: self.positive("material.shear_correction", &m.shear_correction)?,
+        })
+    }
+
+    /// A circle or rectangle `[cross_section]`.
+    fn shape(&self, s: &RawSection) -> Result<CrossSection, CaseError> {
+        Ok(match s {
+            RawSection::Circle { radius_m } => {
+                CrossSection::Circle { radius_m: self.positive("cross_section.radius_m", radius_m)? }
+            }
+            RawSection::Rectangle { width_m, height_m } => CrossSection::Rectangle {
+                width_m: self.positive("cross_section.width_m", width_m)?,
+                height_m: self.positive("cross_section.height_m", height_m)?,
+            },
+            RawSection::Stiffness { .. } => unreachable!("a stiffness section is not a shape (section_and_material)"),
+        })
+    }
+
+    /// `shape = "stiffness"` (D24): every stiffness > 0; the inertias all or none, required by a
+    /// dynamic analysis.
+    fn stiffnesses(&self, s: &RawSection, kind: RawAnalysis) -> Result<Stiffnesses, CaseError> {
+        let RawSection::Stiffness {
+            ea_n,
+            ga1_n,
+            ga2_n,
+            ei1_nm2,
+            ei2_nm2,
+            gj_nm2,
+            rho_a_kg_per_m,
+            rho_i1_kg_m,
+            rho_i2_kg_m,
+            rho_j_kg_m,
+        } = s
+        else {
+            unreachable!("called for a stiffness section")
+        };
+        let p = |k: &str, v: &Scalar| self.positive(&format!("cross_section.{k}"), v);
+        let rho_a = rho_a_kg_per_m.as_ref().map(|v| p("rho_a_kg_per_m", v)).transpose()?;
+        let inertia = [("rho_i1_kg_m", rho_i1_kg_m), ("rho_i2_kg_m", rho_i2_kg_m), ("rho_j_kg_m", rho_j_kg_m)];
+        let given: Vec<f64> =
+            inertia.iter().filter_map(|(k, v)| v.as_ref().map(|v| p(k, v))).collect::<Result<_, _>>()?;
+        let rho_i = match given.len() {
+            0 => None,
+            3 => Some([given[0], given[1], given[2]]),
+            _ => {
+                let missing = inertia.iter().find(|(_, v)| v.is_none()).map(|(k, _)| *k).unwrap_or("rho_j_kg_m");
+                return Err(self.err(&format!("cross_section.{missing}"), "give all three rotary inertias or none"));
+            }
+        };
+        if kind == RawAnalysis::Dynamic {
+            if rho_a.is_none() {
+                return Err(self.err("cross_section.rho_a_kg_per_m", "required for a dynamic analysis"));
+            }
+            if rho_i.is_none() {
+                return Err(
+                    self.err("cross_section.rho_i1_kg_m", "the rotary inertias are required for a dynamic analysis")
+                );
+            }
+        }
+        Ok(Stiffnesses {
+            ea_n: p("ea_n", ea_n)?,
+            ga_n: [p("ga1_n", ga1_n)?, p("ga2_n", ga2_n)?],
+            ei_nm2: [p("ei1_nm2", ei1_nm2)?, p("ei2_nm2", ei2_nm2)?],
+            gj_nm2: p("gj_nm2", gj_nm2)?,
+            rho_a_kg_per_m: rho_a,
+            rho_i_kg_m: rho_i,
+        })
+    }
+
     /// The rod's geometry within what double precision solves: the cross section's area and
     /// second moments finite and > 0, and the slenderness `L / r_g` (`r_g = √(min(I1, I2)/A)`,
     /// the radius of gyration) at most `1/√ε` ≈ 6.7e7. The stretching stiffness `EA` exceeds
     /// the bending stiffness `EI/L²` by `(L/r_g)²`; beyond `1/ε` one matrix cannot hold both, and
     /// the tangent is singular in double precision (a length in the wrong unit, `1e200`, …).
-    pub(super) fn slenderness(&self, mesh: &Mesh, section: &CrossSection) -> Result<(), CaseError> {
+    pub(super) fn slenderness(&self, mesh: &Mesh, section: &Section) -> Result<(), CaseError> {
+        let section = match section {
+            Section::Shape(s) => s,
+            Section::Stiffness(s) => {
+                return self.slenderness_of(mesh, s.radius_of_gyration_m(), "cross_section.ei1_nm2")
+            }
+        };
         let (area, m) = (section.area_m2(), section.second_moments_m4());
         let key = match section {
             CrossSection::Circle { .. } => "cross_section.radius_m",
@@ -68,8 +217,15 @@ impl Validator<'_> {
                 ),
             ));
         }
-        let r_g = (m[0].min(m[1]) / area).sqrt();
+        self.slenderness_of(mesh, (m[0].min(m[1]) / area).sqrt(), key)
+    }
+
+    /// `L / r_g` within `1/√ε` ([`Validator::slenderness`]).
+    fn slenderness_of(&self, mesh: &Mesh, r_g: f64, key: &str) -> Result<(), CaseError> {
         let (slenderness, max) = (mesh.length_m / r_g, f64::EPSILON.sqrt().recip());
+        if !(r_g.is_finite() && r_g > 0.0) {
+            return Err(self.err(key, format!("the section's radius of gyration {r_g:e} m must be finite and > 0")));
+        }
         if slenderness.is_nan() || slenderness > max {
             return Err(self.err(
                 "rod.length_m",

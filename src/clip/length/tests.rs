@@ -180,3 +180,53 @@ fn body_length_is_a_robust_median() {
     assert_eq!(BodyLength::estimate(&[]), None);
     assert_eq!(BodyLength::estimate(&[vec![Vector3::zeros(); 4]]), None);
 }
+
+/// A planar recording's chords: noise in two coordinates. The mean of the corrected chord over
+/// 20 000 noisy copies of a chord of λ = 3, 7 and 20 noise levels (the Rice mean's expansion,
+/// inverted) is the true chord within 2 % at λ = 3 (measured 1.2 % short: the expansion's
+/// neglected λ⁻³ term) and 0.3 % from λ = 7 (the shortest mean chord step 1 uses; the sampling
+/// noise of the mean is 2e-4 of a chord there), where the 3D
+/// inversion takes off about twice the excess.
+#[test]
+fn planar_chords_are_corrected_with_two_noisy_coordinates() {
+    let mut g = Normal(17);
+    let s = 1.0;
+    for (lambda, tol) in [(3.0, 2e-2), (7.0, 3e-3), (20.0, 2e-3)] {
+        let n = 20_000;
+        let (mut planar, mut spatial) = (0.0, 0.0);
+        for _ in 0..n {
+            let c = Vector3::new(lambda + s * g.next(), s * g.next(), 0.0).norm();
+            planar += denoised_planar_chord(c, s);
+            spatial += denoised_chord(c, s);
+        }
+        let (planar, spatial) = (planar / n as f64 / lambda, spatial / n as f64 / lambda);
+        println!("λ = {lambda}: planar {planar:.5}, 3D inversion {spatial:.5}");
+        assert!((planar - 1.0).abs() < tol, "λ = {lambda}: planar {planar}");
+        // (at λ = 20 the 3D bias, 1/(2λ²) = 1.3e-3, is within the sampling noise of the mean)
+        assert!(lambda > 10.0 || spatial < 1.0 - 0.3 / (lambda * lambda), "λ = {lambda}: 3D {spatial}");
+    }
+}
+
+/// A planar arc of 49 nodes, 1.1 mm, with 1 µm of noise in x and y: the length measured in its
+/// plane is within 0.1 % of the arc, the 3D reading of the same frame (a third of its noise
+/// estimate's coordinates empty) about 0.2 % off.
+#[test]
+fn a_planar_frame_is_measured_in_its_plane() {
+    let mut g = Normal(5);
+    let (n, l, r) = (49, 1.1e-3, 0.4e-3);
+    let mut planar = Vec::new();
+    let mut spatial = Vec::new();
+    for _ in 0..50 {
+        let x: Vec<Vector3<f64>> = (0..n)
+            .map(|i| {
+                let th = l / r * i as f64 / (n - 1) as f64;
+                Vector3::new(r * th.sin() + 1e-6 * g.next(), r * (1.0 - th.cos()) + 1e-6 * g.next(), 0.0)
+            })
+            .collect();
+        planar.push(FrameLength::of_in(&x, Some(&Vector3::z())).corrected_m / l - 1.0);
+        spatial.push(FrameLength::of(&x).corrected_m / l - 1.0);
+    }
+    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
+    println!("planar {:.2e}, 3D reading {:.2e}", mean(&planar), mean(&spatial));
+    assert!(mean(&planar).abs() < 1e-3, "{}", mean(&planar));
+}

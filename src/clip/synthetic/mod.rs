@@ -333,7 +333,7 @@ impl RollClipGenerator {
             params.nodes,
             params.substeps
         );
-        Clip { frames: Vec::new(), dt_s: params.dt_s, source, length_m: params.length_m, tracked: None }
+        Clip::new(Vec::new(), params.dt_s, source, params.length_m)
     }
 
     /// Arc length of each node `s_i` [m] (as [`GroundTruth::node_s_m`]).

@@ -176,6 +176,7 @@ fn read_frames(
             x: block.iter().map(|r| v3(r, 2)).collect(),
             alpha: block.iter().map(|r| v3(r, 5)).collect(),
             chart: charts[local],
+            reference_x: None,
         };
         let objective = ObjectiveTerms {
             tracking: rep[5],

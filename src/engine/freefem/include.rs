@@ -59,7 +59,9 @@ pub fn include_file(case: &Case, opts: &RunOptions) -> String {
     write_rod(&mut o, case, &names);
     write_quadrature(&mut o, case);
     write_loads(&mut o, case, &names);
+    write_general_rod(&mut o, case, &names);
     write_solver(&mut o, case, &SolverSettings::of(case));
+    write_path(&mut o, case);
     if let Analysis::Inverse(inv) = &case.analysis {
         write_inverse(&mut o, case, inv, opts);
     }
@@ -138,6 +140,113 @@ fn write_loads(o: &mut String, case: &Case, names: &BTreeMap<String, String>) {
         for k in 0..3 {
             let _ = writeln!(o, "macro {prefix}{}{args} ({}) //", k + 1, case.loads.exprs[g][k].to_freefem(&rename));
         }
+    }
+}
+
+/// The general rod of D20–D23 (`freefem/forward.edp`'s header lists the keys): the chart, the
+/// reference configuration, the ends and the point loads; the paper's rod (`straightRest = 1`,
+/// clamped–free, no point loads) when the case has none of its own.
+/// Component `k` of `v` in FreeFEM's syntax: `s`, `t` as the macros' `S`, `T`, constants by
+/// their FreeFEM names.
+fn ff_component(v: &crate::model::loads::VectorExpr, k: usize, names: &BTreeMap<String, String>) -> String {
+    let rename = |v: &str| match v {
+        "s" => "S".to_string(),
+        "t" => "T".to_string(),
+        other => names.get(other).cloned().unwrap_or_else(|| other.to_string()),
+    };
+    v.exprs[k].to_freefem(&rename)
+}
+
+fn write_general_rod(o: &mut String, case: &Case, names: &BTreeMap<String, String>) {
+    use crate::model::ends::EndKind;
+    use crate::model::loads::VectorExpr;
+    let ff = |v: &VectorExpr, k: usize| ff_component(v, k, names);
+    let general = case.rod.general.as_ref();
+    let chart = general.map(|g| g.rest.chart).unwrap_or_default();
+    let b = chart.base;
+    let _ = writeln!(o, "// chart (D21): B maps space to chart coordinates, x~ = B x");
+    let entries: Vec<String> =
+        (0..9).map(|k| format!("B{}{} = {}", k / 3 + 1, k % 3 + 1, num(b[(k / 3, k % 3)]))).collect();
+    let _ = writeln!(o, "real {};", entries.join(", "));
+    let _ = writeln!(o, "// reference configuration (D20), space coordinates");
+    let _ = writeln!(o, "int straightRest = {};", i32::from(general.is_none()));
+    let (x0, q0) = general
+        .map(|g| (g.rest.positions[0], g.rest.frames[0]))
+        .unwrap_or((nalgebra::Vector3::zeros(), nalgebra::Matrix3::identity()));
+    let _ = writeln!(o, "real x0S1 = {}, x0S2 = {}, x0S3 = {};", num(x0[0]), num(x0[1]), num(x0[2]));
+    for i in 0..3 {
+        let _ = writeln!(
+            o,
+            "real d0S{i1}1 = {}, d0S{i1}2 = {}, d0S{i1}3 = {}; // d{i1} at s = 0",
+            num(q0[(i, 0)]),
+            num(q0[(i, 1)]),
+            num(q0[(i, 2)]),
+            i1 = i + 1
+        );
+    }
+    let curvature = general.map(|g| &g.rest.curvature);
+    for k in 0..3 {
+        let body = curvature.map(|c| ff(c, k)).unwrap_or_else(|| "0.".to_string());
+        let _ = writeln!(o, "macro KB{}(S) ({body}) //", k + 1);
+    }
+    let _ = writeln!(o, "int restSubsteps = {};", crate::model::geometry::REST_SUBSTEPS);
+    let _ = writeln!(o, "// ends (D22): kind 0 free, 1 pinned, 2 clamped; twistHeld (pinned); moving");
+    let ends = case.problem().ends().clone();
+    for (i, end) in [&ends.start, &ends.end].into_iter().enumerate() {
+        let (kind, twist) = match end.kind {
+            EndKind::Free => (0, 0),
+            EndKind::Pinned { twist_held } => (1, i32::from(twist_held)),
+            EndKind::Clamped => (2, 0),
+        };
+        let _ = writeln!(
+            o,
+            "int endKind{i} = {kind}, twistHeld{i} = {twist}, moving{i} = {};",
+            i32::from(end.motion.is_some())
+        );
+        let zero = VectorExpr::zero();
+        let (u, th) = end.motion.as_ref().map(|m| (&m.displacement, &m.rotation)).unwrap_or((&zero, &zero));
+        for (k, c) in ["x", "y", "z"].iter().enumerate() {
+            let _ = writeln!(o, "macro UM{i}{c}(T) ({}) //", ff(u, k));
+        }
+        for (k, c) in ["x", "y", "z"].iter().enumerate() {
+            let _ = writeln!(o, "macro TH{i}{c}(T) ({}) //", ff(th, k));
+        }
+    }
+    write_point_loads(o, case, names);
+}
+
+/// The point loads of D23: `npl`, their arc lengths, frames and components as functions.
+fn write_point_loads(o: &mut String, case: &Case, names: &BTreeMap<String, String>) {
+    let ff = |v: &crate::model::loads::VectorExpr, k: usize| ff_component(v, k, names);
+    let points = &case.loads.point;
+    let _ = writeln!(
+        o,
+        "// point loads (D23)
+int npl = {};",
+        points.len()
+    );
+    let list = |f: &dyn Fn(&crate::model::loads::PointLoad) -> String| {
+        if points.is_empty() {
+            "0".to_string()
+        } else {
+            points.iter().map(f).collect::<Vec<_>>().join(", ")
+        }
+    };
+    let _ = writeln!(o, "real[int] plS = [{}];", list(&|p| num(p.s_m)));
+    let _ = writeln!(o, "int[int] plLocal = [{}];", list(&|p| i32::from(p.frame == LoadFrame::Local).to_string()));
+    for (name, get) in [("plF", 0usize), ("plM", 1usize)] {
+        let _ = writeln!(o, "func real {name}(int k, int c, real T) {{");
+        for (k, p) in points.iter().enumerate() {
+            let v = if get == 0 { &p.force } else { &p.torque };
+            for c in 0..3 {
+                let _ = writeln!(o, "  if (k == {k} && c == {c}) return ({});", ff(v, c));
+            }
+        }
+        let _ = writeln!(
+            o,
+            "  return 0.;
+}}"
+        );
     }
 }
 
@@ -233,6 +342,47 @@ fn write_solver(o: &mut String, case: &Case, s: &SolverSettings) {
     );
 }
 
+/// `pathOn` and, for a static case followed by arc length (D25), `freefem/arclength.idp`'s keys:
+/// the path's parameters, the step's certificate bound and the divergence limits of the Rust
+/// engine (`solve::arclength`), and the nodes whose displacements each point records (the node
+/// nearest each of `path_record_points`, as `arclength::displacement_at`).
+fn write_path(o: &mut String, case: &Case) {
+    use crate::solve::{arclength, DIVERGED_ANGLE_RAD, DIVERGED_LENGTHS};
+    let (path, tolerance) = match &case.analysis {
+        Analysis::Static(p) => (p.path, p.tolerance),
+        _ => (None, 0.0),
+    };
+    // FreeFEM compiles the branch it does not take: the keys are written for every case
+    let p = path.unwrap_or(arclength::ArcLengthParams::new(0, 1.0, 1.0));
+    let mut nodes: Vec<String> = crate::engine::rust::path_record_points(case)
+        .iter()
+        .map(|&s| arclength::record_node(&case.mesh, s).to_string())
+        .collect();
+    if path.is_none() {
+        nodes = vec!["0".into()];
+    }
+    let _ = writeln!(
+        o,
+        "// path following by arc length (D25, freefem/arclength.idp); pathOn = 0: load steps (contSteps)
+int pathOn = {};
+int pathSteps = {}, pathTarget = {};
+real pathDl0 = {}, pathDlMin = {}, pathDlMax = {}, pathMaxLam = {};
+real pathCertTol = {}, pathFar = {}, pathAngle = {};
+int[int] pathRec = [{}];",
+        i32::from(path.is_some()),
+        p.steps,
+        p.target_iterations,
+        num(p.initial_increment),
+        num(p.min_increment),
+        num(p.max_increment),
+        num(p.max_load_factor),
+        num(arclength::step_certificate_bound(tolerance)),
+        num(DIVERGED_LENGTHS),
+        num(DIVERGED_ANGLE_RAD),
+        nodes.join(", ")
+    );
+}
+
 /// The inverse problem's weights of eq. (41), its frame settings, its solver and the clip
 /// driver's keys.
 fn write_inverse(o: &mut String, case: &Case, inv: &InverseSettings, opts: &RunOptions) {
@@ -268,6 +418,13 @@ fn write_inverse(o: &mut String, case: &Case, inv: &InverseSettings, opts: &RunO
         num(p.frame_interval_s),
         num(p.alpha0_rad),
         num(stab)
+    );
+    // a planar recording: alpha(0) = alpha0 on every frame (solve::sequence::SequenceParams::plane)
+    let planar = case.clip().is_some_and(|c| c.recording.data_plane.is_some());
+    let _ = writeln!(
+        o,
+        "int rollGauge = {}; // 1: alpha(0) = alpha0 on every frame (a planar recording)",
+        i32::from(planar)
     );
     let (method, warm) = match p.method {
         InverseMethod::FixedPoint => (0, 0.0),

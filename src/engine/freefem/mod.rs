@@ -10,6 +10,7 @@
 //! (`crate::engine` turns it into `RunError::Incomplete`).
 pub mod clip;
 pub mod include;
+pub mod path;
 pub mod progress;
 
 use std::collections::BTreeMap;
@@ -177,6 +178,7 @@ pub fn run_inverse(
             lambda_f: w.lambda_f,
             lambda_l: w.lambda_l,
         }),
+        path: None,
     };
     match stop {
         Some(source) => Err(FreeFemError::Incomplete { source, partial: Box::new(result) }),
@@ -220,7 +222,13 @@ fn read_inverse_nodes(case: &Case, workdir: &Path) -> Result<InverseNodes, FreeF
         });
     }
     let v3 = |k: usize| rows.iter().map(|r| Vector3::new(r[k], r[k + 1], r[k + 2])).collect();
-    let state = NodalState { s: rows.iter().map(|r| r[0]).collect(), x: v3(1), alpha: v3(4), chart: Chart::default() };
+    let state = NodalState {
+        s: rows.iter().map(|r| r[0]).collect(),
+        x: v3(1),
+        alpha: v3(4),
+        chart: Chart::default(),
+        reference_x: None,
+    };
     Ok(InverseNodes { state, xhat: v3(7), ahat: v3(10) })
 }
 
@@ -308,13 +316,9 @@ fn inverse_stop(
 /// A static run that ends stalled or at its iteration limit is [`FreeFemError::Incomplete`] with
 /// the Rust engine's error (`StaticSolution::converged`) and the last iterate.
 pub fn run(case: &Case, workdir: &Path) -> Result<RunResult, FreeFemError> {
-    let end = execute_to_end(
-        case,
-        workdir,
-        "forward.edp",
-        &["ff_nodes.csv", "ff_info.csv", "ff_history.csv", "ff_tip.csv"],
-        &RunOptions::default(),
-    )?;
+    let mut outputs = vec!["ff_nodes.csv", "ff_info.csv", "ff_history.csv", "ff_tip.csv"];
+    outputs.extend(path::PATH_OUTPUTS);
+    let end = execute_to_end(case, workdir, "forward.edp", &outputs, &RunOptions::default())?;
     let (result, certificate) = read_outputs(case, workdir)?;
     let newton = matches!(&case.analysis, Analysis::Static(p) if p.method == Method::Newton);
     let last = result.history.last();
@@ -452,7 +456,8 @@ fn read_outputs(case: &Case, dir: &Path) -> Result<(RunResult, Option<Certificat
         s: rows.iter().map(|r| r[0]).collect(),
         x: rows.iter().map(|r| Vector3::new(r[1], r[2], r[3])).collect(),
         alpha: rows.iter().map(|r| Vector3::new(r[4], r[5], r[6])).collect(),
-        chart: Chart::default(),
+        chart: case.rod.general.as_ref().map(|g| g.rest.chart).unwrap_or_default(),
+        reference_x: case.rod.general.as_ref().map(|g| g.rest.positions.clone()),
     };
     let info = read_info(&dir.join("ff_info.csv"))?;
     let get = |k: &str| info.get(k).copied();
@@ -490,5 +495,7 @@ fn read_outputs(case: &Case, dir: &Path) -> Result<(RunResult, Option<Certificat
             history.push(IterationRecord { step, iteration, change: r[1], certificate: r[2] });
         }
     }
-    Ok((RunResult { engine: Engine::Freefem, nodes, history, tip, stats, inverse: None }, certificate))
+    let followed = matches!(&case.analysis, Analysis::Static(p) if p.path.is_some());
+    let path = if followed { Some(path::read_path(case, dir, &info)?) } else { None };
+    Ok((RunResult { engine: Engine::Freefem, nodes, history, tip, stats, inverse: None, path }, certificate))
 }

@@ -1,7 +1,8 @@
 //! What a running FreeFEM script has done, read from its work folder while it runs, for a
 //! command that shows progress (`compare`): the clip driver's frames (`ff_clip_frames.csv`, a
 //! row appended per converged frame) and the dynamic forward run's time steps (`ff_tip.csv`, a
-//! row per step after the initial state). Other runs (static, a single inverse frame) have no
+//! row per step after the initial state), the arc-length path's steps (`ff_path.csv`, a row per
+//! point after the reference). Other runs (static, a single inverse frame) have no
 //! count and report nothing.
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
@@ -9,12 +10,15 @@ use std::time::{Duration, Instant};
 
 use super::include::RunOptions;
 use crate::case::{Analysis, Case};
+use crate::solve::statics::StaticParams;
 
 /// What a count counts.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Unit {
     Frames,
     Steps,
+    /// steps of an arc-length path (D25)
+    PathSteps,
 }
 
 /// `done` of `total` frames or time steps of the running script.
@@ -58,6 +62,9 @@ impl Watch {
         let (file, skip, total, unit) = match (script, &opts.clip, &case.analysis) {
             ("clip.edp", Some(clip), _) => ("ff_clip_frames.csv", 1, clip.frames, Unit::Frames),
             ("forward.edp", _, Analysis::Dynamic(p)) => ("ff_tip.csv", 2, p.steps, Unit::Steps),
+            ("forward.edp", _, Analysis::Static(StaticParams { path: Some(p), .. })) => {
+                ("ff_path.csv", 2, p.steps, Unit::PathSteps)
+            }
             _ => return None,
         };
         let watch =

@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 
 use nalgebra::{Matrix3, Vector3};
 
+use super::recording::{read_positions, ReadSpec, Recorded};
 use super::truth_file::{read_truth, truth_sidecar};
 use crate::case::sweep::SweepError;
 use crate::case::{Case, ClipKind, RodLength, FROM_DATA};
@@ -15,16 +16,12 @@ use crate::clip::{
     check_frame_range, clip_from_angles, polyline_length, rotate_frame, Clip, ClipError, KymogramParams,
     MAX_CLIP_POSITIONS, MAX_LENGTH_DEVIATION,
 };
-use crate::io::files::{csv_reader_capped, InputError};
+use crate::io::files::InputError;
 use crate::io::npy::read_npy;
 
-/// Column names of a CSV recording.
+/// Column names of a CSV recording in metres (the header's suffix is the unit:
+/// `frame,node,x_um,y_um` is a 2D recording in micrometres, [`super::recording`]).
 pub const RECORDING_HEADER: [&str; 5] = ["frame", "node", "x_m", "y_m", "z_m"];
-
-/// Largest CSV recording read [bytes]: 1 GiB. The paper's clip (1160 frames × 128 nodes) is
-/// about 11 MB as CSV; an hour at 30 frames/s with 128 nodes about 1 GB. (NPY recordings and
-/// kymograms: `io::npy::NPY_FILE_CAP_BYTES`.)
-pub const CSV_RECORDING_CAP_BYTES: u64 = 1 << 30;
 
 /// The folder of the `elegansbot` kymograms that `scripts/fetch_worm_data.sh` fetches.
 const FETCHED_DATA: [&str; 2] = ["data", "elegansbot"];
@@ -106,12 +103,17 @@ fn check_positions(path: &Path, frames: usize, nodes: usize) -> Result<(), ClipF
 /// corrected for the frame's noise ([`FrameLength`], docs/decisions.md D18), deviates from the
 /// rod length by more than [`MAX_LENGTH_DEVIATION`]; frames with too few tracked nodes are
 /// bridged from checked ones and not checked.
-fn check_lengths(path: &Path, clip: &Clip, first: usize, rod_m: f64) -> Result<(), ClipFileError> {
+fn check_lengths(
+    path: &Path,
+    clip: &Clip,
+    first: usize,
+    (rod_m, plane): (f64, Option<&Vector3<f64>>),
+) -> Result<(), ClipFileError> {
     for (k, f) in clip.frames.iter().enumerate() {
         if clip.nodes_tracked(k) < MIN_TRACKED {
             continue;
         }
-        let l = FrameLength::of(f);
+        let l = FrameLength::of_in(f, plane);
         let ratio = l.corrected_m / rod_m;
         if ratio.is_nan() || (ratio - 1.0).abs() > MAX_LENGTH_DEVIATION {
             return Err(ClipFileError::Length {
@@ -178,8 +180,7 @@ pub fn load_clip(case: &Case) -> Result<(Clip, Option<GroundTruth>), ClipFileErr
             (kymogram_clip(&src.file, &rows, &params), None)
         }
         ClipKind::Recording => {
-            let dt = case.inverse().map(|i| i.params.frame_interval_s).unwrap_or(f64::NAN);
-            let clip = read_recording_with(&src.file, dt, src.missing)?;
+            let clip = read_recording_as(&src.file, &read_spec(case, src))?;
             // a synthetic recording's ground truth, when its sidecar lies next to it
             let sidecar = truth_sidecar(&src.file);
             let truth = if sidecar.is_file() {
@@ -204,16 +205,21 @@ pub fn load_clip(case: &Case) -> Result<(Clip, Option<GroundTruth>), ClipFileErr
             expected: case.mesh.nodes(),
         });
     }
+    // the frame range in the file's numbers (a recording's may start anywhere)
+    let first = clip.recording.first_frame;
     if let Some((a, b)) = src.frames {
-        clip.select(a, b)?;
+        let (a0, b0) = (a.checked_sub(first), b.checked_sub(first));
+        let (a0, b0) = a0.zip(b0).ok_or(ClipError::FrameRange { first: a, end: b, frames: first })?;
+        clip.select(a0, b0)?;
         if let Some(t) = &mut truth {
-            t.select(a, b);
+            t.select(a0, b0);
         }
     }
     if src.kind == ClipKind::Recording {
         // Kymograms are scaled to the rod length by design; a recording's length is the user's.
         // (a bridged frame, too few tracked nodes, is an interpolation of checked ones)
-        check_lengths(&src.file, &clip, src.frames.map_or(0, |f| f.0), case.mesh.length_m)?;
+        let plane = clip.recording.plane_normal;
+        check_lengths(&src.file, &clip, src.frames.map_or(first, |f| f.0), (case.mesh.length_m, plane.as_ref()))?;
     }
     if src.placement.orientation != Matrix3::identity() {
         clip.rotate(&src.placement.orientation);
@@ -224,36 +230,75 @@ pub fn load_clip(case: &Case) -> Result<(Clip, Option<GroundTruth>), ClipFileErr
     Ok((clip, truth))
 }
 
-/// The case with `rod.length_m = "from_data"` resolved: the body length of its recording (the
-/// frames of its range), [`BodyLength::estimate`], is written into the case file's tables and
-/// the case validated again, so that everything derived from the length (the slenderness check,
-/// the default stabilisation) follows it; the estimate is kept in [`Case::rod_length`]. The
-/// clip file is written as an absolute path (a batch's recording replaces the file's). Any other
-/// case is returned as it is.
-pub fn resolve_length(case: &Case) -> Result<Case, ClipFileError> {
-    if case.rod.length != RodLength::FromData(None) {
+/// The case resolved against its recording (`kind = "recording"`; any other case is returned
+/// as it is), written into the case file's tables and validated again, so that everything
+/// derived from them follows (the slenderness check, the default stabilisation, the section
+/// scaled by `rod.section_length_m`, a sweep's points):
+/// - `rod.length_m = "from_data"`: the body length of the recording (the frames of its range;
+///   with missing data, the frames tracked whole, else every frame as filled),
+///   [`BodyLength::estimate_in`]; the estimate is kept in [`Case::body_length`];
+/// - a planar recording (`clip::recording`): `clip.data_plane`, its plane's normal, and, where
+///   the case gives no `clip.gauge`, the gauge along that normal, so that the bending of the
+///   data is κ2 with d2 along the normal (docs/rotation.md R7);
+/// - a recording numbered from frame `k > 0`, without `clip.frames`: `clip.frames` from `k`,
+///   so that every frame is reported under the file's number.
+///
+/// The clip file is written as an absolute path (a batch's recording replaces the file's).
+pub fn resolve_recording(case: &Case) -> Result<Case, ClipFileError> {
+    let Some(src) = case.clip().filter(|c| c.kind == ClipKind::Recording) else { return Ok(case.clone()) };
+    let src = clip_source(case).map(|_| src)?;
+    let mut clip = read_recording_as(&src.file, &read_spec(case, src))?;
+    let info = clip.recording.clone();
+    let mut overrides: Vec<(String, toml::Value)> = Vec::new();
+    let array = |v: &Vector3<f64>| toml::Value::Array(v.iter().map(|c| toml::Value::Float(*c)).collect());
+    if let (Some(n), None) = (&info.plane_normal, &src.recording.data_plane) {
+        overrides.push(("clip.data_plane".into(), array(n)));
+        let gauge_given = case.toml_table().and_then(|t| t.get("clip")).and_then(|c| c.get("gauge")).is_some();
+        if !gauge_given {
+            overrides.push(("clip.gauge".into(), array(n)));
+        }
+    }
+    if info.first_frame > 0 && src.frames.is_none() {
+        let end = info.first_frame + clip.frame_count();
+        let range = [info.first_frame, end].map(|v| toml::Value::Integer(v as i64));
+        overrides.push(("clip.frames".into(), toml::Value::Array(range.to_vec())));
+    }
+    let mut body = None;
+    if case.rod.length == RodLength::FromData(None) {
+        if let Some((a, b)) = src.frames {
+            let (a0, b0) = (a.saturating_sub(info.first_frame), b.saturating_sub(info.first_frame));
+            clip.select(a0, b0)?;
+        }
+        let whole: Vec<Vec<Vector3<f64>>> = (0..clip.frame_count())
+            .filter(|&k| clip.nodes_tracked(k) == clip.node_count())
+            .map(|k| clip.frames[k].clone())
+            .collect();
+        let frames = if whole.is_empty() { &clip.frames } else { &whole };
+        let b = BodyLength::estimate_in(frames, info.plane_normal.as_ref())
+            .ok_or_else(|| ClipFileError::NoBodyLength { path: src.file.clone() })?;
+        overrides.push(("rod.length_m".into(), toml::Value::Float(b.length_m)));
+        body = Some(b);
+    }
+    if overrides.is_empty() {
         return Ok(case.clone());
     }
-    let src = clip_source(case)?;
-    let mut clip = read_recording(&src.file, f64::NAN)?;
-    if let Some((a, b)) = src.frames {
-        clip.select(a, b)?;
-    }
-    let body =
-        BodyLength::estimate(&clip.frames).ok_or_else(|| ClipFileError::NoBodyLength { path: src.file.clone() })?;
     let file = std::path::absolute(&src.file).unwrap_or_else(|_| src.file.clone());
-    let overrides = [
-        ("rod.length_m".to_string(), toml::Value::Float(body.length_m)),
-        ("clip.file".to_string(), toml::Value::String(file.display().to_string())),
-    ];
+    overrides.push(("clip.file".into(), toml::Value::String(file.display().to_string())));
     let mut resolved = case.with_overrides(&overrides).map_err(|source| ClipFileError::FromData {
         path: src.file.clone(),
-        length_m: body.length_m,
+        length_m: body.map_or(case.mesh.length_m, |b| b.length_m),
         source,
     })?;
-    resolved.rod.length = RodLength::FromData(Some(body));
+    if let Some(b) = body {
+        resolved.rod.length = RodLength::FromData(Some(b));
+    }
     resolved.origin.source_sha256.clone_from(&case.origin.source_sha256);
     Ok(resolved)
+}
+
+/// [`resolve_recording`]: the name this had when it resolved the length only.
+pub fn resolve_length(case: &Case) -> Result<Case, ClipFileError> {
+    resolve_recording(case)
 }
 
 /// The clip section of a clip case whose file exists.
@@ -380,19 +425,22 @@ fn kymogram_clip(path: &Path, rows: &[Vec<f64>], params: &KymogramParams) -> Cli
     clip_from_angles(rows, params, source)
 }
 
-/// Read a user recording: `.csv` (header `frame,node,x_m,y_m,z_m`) or `.npy` (frames × nodes × 3,
-/// float64) [m]; `dt_s` is the time between frames [s].
+/// Read a user recording in metres as its file says ([`super::recording`]; a NaN is an error):
+/// CSV, NPY or WCON; `dt_s` is the time between frames [s].
 pub fn read_recording(path: &Path, dt_s: f64) -> Result<Clip, InputError> {
-    read_recording_marked(path, dt_s, MissingData::Error)
+    let spec = ReadSpec { dt_s, ..ReadSpec::default() };
+    let recorded = read_positions(path, &spec)?;
+    clip_of(path, recorded, dt_s, MissingData::Error)
 }
 
-/// [`read_recording`] with untracked nodes marked as `missing` says: with
-/// [`MissingData::Nan`], NaN coordinates are untracked nodes, filled and recorded in
+/// [`read_recording`] as the case's keys say (`spec`: unit, missing data, worm): with
+/// [`MissingData::Nan`], untracked nodes and lost frames are filled and recorded in
 /// [`Clip::tracked`] ([`fill_missing`]).
-pub fn read_recording_with(path: &Path, dt_s: f64, missing: MissingData) -> Result<Clip, ClipFileError> {
-    let mut clip = read_recording_marked(path, dt_s, missing)?;
-    if missing == MissingData::Nan {
-        let tracked = fill_missing(&mut clip.frames, 0)?;
+pub fn read_recording_as(path: &Path, spec: &ReadSpec) -> Result<Clip, ClipFileError> {
+    let recorded = read_positions(path, spec)?;
+    let mut clip = clip_of(path, recorded, spec.dt_s, spec.missing)?;
+    if spec.missing == MissingData::Nan {
+        let tracked = fill_missing(&mut clip.frames, clip.recording.first_frame)?;
         clip.length_m = polyline_length(&clip.frames[0]);
         if tracked.iter().any(|f| f.iter().any(|t| !t)) {
             clip.tracked = Some(tracked);
@@ -401,175 +449,33 @@ pub fn read_recording_with(path: &Path, dt_s: f64, missing: MissingData) -> Resu
     Ok(clip)
 }
 
-/// [`read_recording`], NaN coordinates accepted where `missing` says so (not filled).
-fn read_recording_marked(path: &Path, dt_s: f64, missing: MissingData) -> Result<Clip, InputError> {
-    if path.is_dir() {
-        return Err(InputError::Shape {
-            path: path.to_path_buf(),
-            reason: "is a directory, not a recording file (.csv or .npy)".into(),
-        });
+/// How the case reads its recording `src`.
+pub fn read_spec(case: &Case, src: &crate::case::ClipSource) -> ReadSpec {
+    ReadSpec {
+        units: src.recording.units,
+        missing: src.missing,
+        dt_s: case.inverse().map(|i| i.params.frame_interval_s).unwrap_or(f64::NAN),
+        worm_id: src.recording.worm_id.clone(),
     }
-    let frames = match path.extension().and_then(|e| e.to_str()) {
-        Some("npy") => recording_npy(path, missing)?,
-        Some("csv") => recording_csv(path, missing)?,
-        _ => {
-            return Err(InputError::Shape {
-                path: path.to_path_buf(),
-                reason: "unknown extension, expected .csv or .npy".into(),
-            })
-        }
-    };
+}
+
+/// The clip of what was read from `path`.
+fn clip_of(path: &Path, recorded: Recorded, dt_s: f64, missing: MissingData) -> Result<Clip, InputError> {
+    let Recorded { frames, info } = recorded;
     let length_m = polyline_length(&frames[0]);
     if length_m <= 0.0 && missing == MissingData::Error {
         return Err(InputError::Shape { path: path.to_path_buf(), reason: "frame 0 has zero length".into() });
     }
-    let source = format!("{} ({} frames × {} nodes)", path.display(), frames.len(), frames[0].len());
-    Ok(Clip { frames, dt_s, source, length_m, tracked: None })
-}
-
-/// A position's coordinates must be finite; with [`MissingData::Nan`] a NaN marks an untracked
-/// node (an infinity stays an error).
-fn check_position(
-    path: &Path,
-    frame: usize,
-    node: usize,
-    p: &Vector3<f64>,
-    missing: MissingData,
-) -> Result<(), InputError> {
-    let marked = |v: f64| missing == MissingData::Nan && v.is_nan();
-    match (0..3).find(|&k| !p[k].is_finite() && !marked(p[k])) {
-        Some(k) => Err(InputError::NonFinitePosition {
-            path: path.to_path_buf(),
-            frame,
-            node,
-            axis: ['x', 'y', 'z'][k],
-            value: p[k],
-        }),
-        None => Ok(()),
-    }
-}
-
-fn recording_npy(path: &Path, missing: MissingData) -> Result<Vec<Vec<Vector3<f64>>>, InputError> {
-    let a = read_npy(path)?;
-    let shape = |reason: String| InputError::Shape { path: path.to_path_buf(), reason };
-    let &[frames, nodes, 3] = a.shape.as_slice() else {
-        return Err(shape(format!("recording of shape {:?}, expected frames × nodes × 3", a.shape)));
-    };
-    if frames == 0 || nodes < 3 {
-        return Err(shape(format!("recording of shape {:?}: need at least 1 frame and 3 nodes", a.shape)));
-    }
-    // frames × nodes × 3 values were read: the product does not overflow.
-    if frames * nodes > MAX_CLIP_POSITIONS {
-        return Err(shape(format!(
-            "recording of shape {:?}: {} positions, more than the {MAX_CLIP_POSITIONS} a clip may hold",
-            a.shape,
-            frames * nodes
-        )));
-    }
-    let mut out = Vec::with_capacity(frames);
-    for (f, frame) in a.data.chunks_exact(3 * nodes).enumerate() {
-        let pts: Vec<Vector3<f64>> = frame.chunks_exact(3).map(|c| Vector3::new(c[0], c[1], c[2])).collect();
-        for (i, p) in pts.iter().enumerate() {
-            check_position(path, f, i, p, missing)?;
-        }
-        out.push(pts);
-    }
-    Ok(out)
-}
-
-/// One data row of a CSV recording.
-struct RecordingRow {
-    frame: usize,
-    node: usize,
-    row: usize,
-    position: Vector3<f64>,
-}
-
-/// The frames of a CSV recording. Every index read from the file is only compared and sorted,
-/// never used to size or index an allocation: the rows are sorted by (frame, node) and must run
-/// 0, 1, … in both, so the frames built hold exactly the rows the file has.
-fn recording_csv(path: &Path, missing: MissingData) -> Result<Vec<Vec<Vector3<f64>>>, InputError> {
-    let mut rdr = csv_reader_capped(path, CSV_RECORDING_CAP_BYTES, "recording", &RECORDING_HEADER)?;
-    let mut rows: Vec<RecordingRow> = Vec::new();
-    for (i, rec) in rdr.records().enumerate() {
-        let row = i + 1;
-        let bad = |reason: String| InputError::Row { path: path.to_path_buf(), row, reason };
-        let rec = rec.map_err(|e| bad(e.to_string()))?;
-        if rec.len() != 5 {
-            return Err(bad(format!("{} columns, expected 5", rec.len())));
-        }
-        if rows.len() == MAX_CLIP_POSITIONS {
-            return Err(bad(format!("more than {MAX_CLIP_POSITIONS} rows, the most positions a clip may hold")));
-        }
-        let index = |k: usize| {
-            rec[k]
-                .parse::<usize>()
-                .map_err(|_| bad(format!("{} `{}` is not a non-negative integer", RECORDING_HEADER[k], &rec[k])))
-        };
-        let (frame, node) = (index(0)?, index(1)?);
-        let coord =
-            |k: usize| rec[k].parse::<f64>().map_err(|e| bad(format!("{} `{}`: {e}", RECORDING_HEADER[k], &rec[k])));
-        let position = Vector3::new(coord(2)?, coord(3)?, coord(4)?);
-        check_position(path, frame, node, &position, missing)?;
-        rows.push(RecordingRow { frame, node, row, position });
-    }
-    if rows.is_empty() {
-        return Err(InputError::Shape { path: path.to_path_buf(), reason: "no data rows".into() });
-    }
-    // Stable: rows of one (frame, node) stay in file order.
-    rows.sort_by_key(|r| (r.frame, r.node));
-    // The first repeated row in file order.
-    if let Some(w) =
-        rows.windows(2).filter(|w| (w[0].frame, w[0].node) == (w[1].frame, w[1].node)).min_by_key(|w| w[1].row)
-    {
-        let (first, dup) = (&w[0], &w[1]);
-        return Err(InputError::DuplicateRow {
-            path: path.to_path_buf(),
-            row: dup.row,
-            first_row: first.row,
-            frame: dup.frame,
-            node: dup.node,
-        });
-    }
-    let missing = |frame: usize, node: usize| InputError::MissingRow { path: path.to_path_buf(), frame, node };
-    let mut frames: Vec<Vec<Vector3<f64>>> = Vec::new();
-    for r in &rows {
-        // The frame this row must belong to: the current one, or the next.
-        let current = frames.len().checked_sub(1);
-        if current != Some(r.frame) {
-            if let Some(c) = current {
-                close_frame(path, c, &frames)?;
-            }
-            let next = frames.len();
-            if r.frame != next {
-                return Err(InputError::FrameGap { path: path.to_path_buf(), frame: next, next: r.frame, row: r.row });
-            }
-            frames.push(Vec::new());
-        }
-        let pts = frames.last_mut().expect("a frame was pushed");
-        if r.node != pts.len() {
-            return Err(missing(r.frame, pts.len()));
-        }
-        pts.push(r.position);
-    }
-    close_frame(path, frames.len() - 1, &frames)?;
-    let expected = frames[0].len();
-    if expected < 3 {
-        return Err(InputError::Shape {
-            path: path.to_path_buf(),
-            reason: format!("{expected} nodes per frame, need at least 3"),
-        });
-    }
-    Ok(frames)
-}
-
-/// Frame `frame` of a CSV recording is complete: as many nodes as frame 0.
-fn close_frame(path: &Path, frame: usize, frames: &[Vec<Vector3<f64>>]) -> Result<(), InputError> {
-    let (nodes, expected) = (frames[frame].len(), frames[0].len());
-    if nodes != expected {
-        return Err(InputError::NodeCount { path: path.to_path_buf(), frame, nodes, expected });
-    }
-    Ok(())
+    let planar = if info.plane_normal.is_some() { ", planar" } else { "" };
+    let source = format!(
+        "{} ({} frames × {} nodes from frame {}, in {}{planar})",
+        path.display(),
+        frames.len(),
+        frames[0].len(),
+        info.first_frame,
+        info.unit.name()
+    );
+    Ok(Clip { frames, dt_s, source, length_m, tracked: None, recording: info })
 }
 
 #[cfg(test)]

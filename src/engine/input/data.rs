@@ -44,7 +44,8 @@ pub fn write_data(path: &Path, nodes: &NodalState) -> Result<(), OutputError> {
 /// node count are counted, not kept.
 pub fn read_data(path: &Path, mesh: &Mesh) -> Result<NodalState, InputError> {
     let mut rdr = csv_reader_capped(path, DATA_FILE_CAP_BYTES, "data file", &DATA_HEADER)?;
-    let mut nodes = NodalState { s: Vec::new(), x: Vec::new(), alpha: Vec::new(), chart: Chart::default() };
+    let mut nodes =
+        NodalState { s: Vec::new(), x: Vec::new(), alpha: Vec::new(), chart: Chart::default(), reference_x: None };
     let mut rows = 0;
     for (i, rec) in rdr.records().enumerate() {
         let row = i + 1;
@@ -93,6 +94,7 @@ mod tests {
             x: (0..n).map(|i| Vector3::new(0.1 / 3.0 * i as f64, (i as f64).sin() * 1e-4, mesh.node_s(i))).collect(),
             alpha: (0..n).map(|i| Vector3::new(std::f64::consts::PI / 7.0, -0.3 * i as f64, 0.25)).collect(),
             chart: Chart::default(),
+            reference_x: None,
         }
     }
 

@@ -3,10 +3,12 @@
 //! arrays the solvers allocate: per forward unknown the band LU (`linalg::band`, `2 kl + ku + 1`
 //! rows, `kl = ku = 2 b − 1` for blocks of `b` unknowns per node), per element the pattern's
 //! values, scaled copy and slots (`linalg::pattern`), a few dozen work vectors; a clip's frames
-//! and per-frame summary (`engine::rust::clip::ClipRun`); the dense matrices of the modal model
+//! (all of a clip read from a file, a window of a streamed one) and per-frame summary
+//! (`engine::rust::clip::ClipRun`); the dense matrices of the modal model
 //! (`solve::modes`, about twelve `n × n`). Checked against the peak resident size of real runs in
 //! `docs/results.md`: it errs high, never low by more than the process's fixed few MB.
-use crate::case::{Analysis, Case, ClipKind};
+use super::clip::STREAM_AHEAD;
+use crate::case::{Analysis, Case, ClipKind, WeightsRule};
 
 /// Bytes in a GiB.
 pub const GIB: f64 = 1024.0 * 1024.0 * 1024.0;
@@ -73,9 +75,20 @@ fn banded_bytes_per_element(b: f64) -> f64 {
     band + pattern + vectors
 }
 
-/// Node-frames of a clip case, from its settings or the size of its file, and what they were
-/// estimated from.
-fn clip_node_frames(case: &Case) -> Option<(f64, String)> {
+/// Bytes per node-frame of a clip held in memory: positions (3) + κ2, data κ, ω (3), truth (2),
+/// twice over while it is read.
+const CLIP_BYTES_PER_NODE_FRAME: f64 = 12.0 * 8.0;
+/// Bytes a solved frame leaves in the clip's summary (its report, roughness and truth scores,
+/// `engine::rust::clip_summary`; about 0.4 KB measured by `tests/memory_growth.rs`).
+const SUMMARY_BYTES_PER_FRAME: f64 = 1024.0;
+/// Frames a streamed clip holds at most: twice [`STREAM_AHEAD`] received (the run being solved
+/// and those waiting) and the output thread's 64 converged frames.
+const STREAMED_FRAMES_HELD: usize = 2 * STREAM_AHEAD + 64;
+
+/// Bytes of a clip case's frames and summary, from its settings or the size of its file, and
+/// what they were estimated from. A synthetic roll_3d clip with fixed weights is streamed
+/// (`crate::engine::ClipInput`): a window of its frames is held, not all of them.
+fn clip_bytes(case: &Case) -> Option<(f64, String)> {
     let c = case.clip()?;
     let nodes = case.mesh.nodes() as f64;
     let frames = match (&c.kind, c.frames) {
@@ -83,20 +96,25 @@ fn clip_node_frames(case: &Case) -> Option<(f64, String)> {
         (ClipKind::Roll3d(s), None) => Some((s.frames as f64, format!("clip.clip_frames = {}", s.frames))),
         _ => None,
     };
-    match frames {
-        Some((f, key)) => Some((f * nodes, format!("{key} × {nodes} nodes"))),
+    let streamed =
+        matches!(c.kind, ClipKind::Roll3d(_)) && case.inverse().is_some_and(|s| s.weights_rule != WeightsRule::Auto);
+    let (frames, basis) = match frames {
+        Some((f, key)) => (f, format!("{key} × {nodes} nodes")),
         None => {
             // a recording or kymogram: every number takes at least 8 bytes in the file; a
             // node-frame of a recording 3 numbers, a kymogram's frame of `nodes` nodes one
             // angle per joint
             let size = std::fs::metadata(&c.file).map(|m| m.len() as f64).unwrap_or(0.0);
-            let node_frames = match c.kind {
-                ClipKind::Kymogram => size / 8.0 * nodes,
-                _ => size / 24.0,
+            let frames = match c.kind {
+                ClipKind::Kymogram => size / 8.0,
+                _ => size / 24.0 / nodes,
             };
-            Some((node_frames, format!("{} ({:.0} MB)", c.file.display(), size / 1e6)))
+            (frames, format!("{} ({:.0} MB)", c.file.display(), size / 1e6))
         }
-    }
+    };
+    let held = if streamed { frames.min(STREAMED_FRAMES_HELD as f64) } else { frames };
+    let basis = if streamed { format!("{basis}, streamed: at most {held} frames held") } else { basis };
+    Some((held * nodes * CLIP_BYTES_PER_NODE_FRAME + frames * SUMMARY_BYTES_PER_FRAME, basis))
 }
 
 /// Bytes per time step of a dynamic run's tip history (`solve::dynamics::TipRecord` and its
@@ -127,10 +145,8 @@ pub fn estimate(case: &Case, what: Footprint) -> (f64, String, &'static str) {
                 // the KKT system (12 unknowns per node), the forward data solve beside it
                 let mut bytes = FIXED_BYTES + e * (banded_bytes_per_element(12.0) + banded_bytes_per_element(6.0));
                 let mut basis = basis;
-                if let Some((node_frames, what)) = clip_node_frames(case) {
-                    // positions (3) + κ2, data κ, ω (3), truth (2) per node-frame, twice over
-                    // while it is read
-                    bytes += node_frames * 12.0 * 8.0;
+                if let Some((clip, what)) = clip_bytes(case) {
+                    bytes += clip;
                     basis = format!("{basis}, {what}");
                 }
                 (bytes, basis, "rod.elements or the clip's frames")

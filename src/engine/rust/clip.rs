@@ -10,13 +10,17 @@ use nalgebra::{DVector, Vector3};
 
 use super::clip_frame::{frame_data, ClipFrameError, Converged, Deriver};
 pub use super::clip_frame::{
-    nodal_curvature, planar_xz_curvature, sign_alternation, ClipFrame, Controls, FrameRecord, PlanarCurvature,
-    TruthFrame, TRUTH_SKIP_NODES,
+    nodal_curvature, planar_xz_curvature, sign_alternation, ClipFrame, Controls, ElementFields, FrameRecord,
+    PlanarCurvature, TruthFrame, TRUTH_SKIP_NODES,
 };
+use super::clip_summary::Summary;
+pub use super::clip_summary::{ClipRun, Kymograph, KymographColumn, TruthRun, KYMOGRAPH_COLUMNS};
 use super::RunError;
 use crate::case::Case;
-use crate::clip::synthetic::{FrameComparison, FrameTruth, GroundTruth};
+use crate::clip::synthetic::{FrameTruth, GroundTruth};
 use crate::clip::Clip;
+use crate::io::files::JournalError;
+use crate::model::chart::Chart;
 use crate::model::rotation::Angles;
 use crate::solve::inverse::Records;
 use crate::solve::sequence::{
@@ -34,41 +38,6 @@ pub trait FrameSink: Send {
     fn finish(&mut self) -> Result<(), Self::Error>;
 }
 
-/// Summary of a clip run.
-#[derive(Clone, Debug)]
-pub struct ClipRun {
-    pub reports: Vec<FrameReport>,
-    /// per frame: sign alternation of the recovered κ2 and of the data's planar curvature
-    /// ([`sign_alternation`])
-    pub roughness: Vec<(f64, f64)>,
-    /// per frame: recovered κ2 at element midpoints and the data's planar curvature at the
-    /// interior nodes [1/m] (x–z clips: the bending curvature; [`planar_xz_curvature`])
-    pub kappa2: Vec<Vec<f64>>,
-    pub data_kappa: Vec<Vec<f64>>,
-    /// per frame: the angular velocity ωˡ per node [rad/s] ([`ClipFrame::omega`]); zeros on the
-    /// first frame
-    pub omega: Vec<Vec<Vector3<f64>>>,
-    /// synthetic clips: per frame the errors against the ground truth (end nodes skipped:
-    /// [`TRUTH_SKIP_NODES`]), and the true and recovered bending `κ1² + κ2²` [1/m²] per node
-    pub truth: Option<TruthRun>,
-    pub wall_time_s: f64,
-    pub source: String,
-    /// the weights `[inverse] weights = "auto"` chose (`super::weights`)
-    pub weights: Option<super::weights::ChosenWeights>,
-}
-
-/// Ground-truth scores of a synthetic clip run.
-#[derive(Clone, Debug, Default)]
-pub struct TruthRun {
-    pub comparisons: Vec<FrameComparison>,
-    /// true roll ψ of the bending plane per frame [rad]
-    pub roll_rad: Vec<f64>,
-    /// true twist κ3 per frame (mean over nodes) [rad/m]
-    pub twist_per_m: Vec<f64>,
-    pub bending_true: Vec<Vec<f64>>,
-    pub bending_recovered: Vec<Vec<f64>>,
-}
-
 /// How a clip run ended: its summary over the frames it solved (all of them, or those before
 /// it stopped) and, if it stopped early, why (a frame's error, a write error, or an interrupt:
 /// [`RunError::is_interrupted`]).
@@ -79,6 +48,10 @@ pub struct ClipOutcome {
     /// frames of the clip
     pub total: usize,
 }
+
+/// Frames a streamed clip's generator may be ahead of the solve (`crate::engine::run_clip_into`):
+/// with the frames of the run at hand, a streamed clip holds at most about twice this many.
+pub const STREAM_AHEAD: usize = 256;
 
 /// One frame of a streamed clip ([`ClipFrames::Streamed`]): its node positions [m] and, for a
 /// synthetic clip, its ground truth.
@@ -95,11 +68,16 @@ pub enum ClipFrames<'a> {
     Streamed { header: Clip, total: usize, truth: bool, frames: Receiver<StreamedFrame> },
 }
 
-/// The frames of a [`ClipFrames`] received so far.
+/// The frames of a [`ClipFrames`] at hand: all of a loaded clip; of a streamed one those
+/// received and not yet released (a window: the frames of a run and the one before, so that
+/// memory does not grow with the clip).
 struct Arrivals<'a> {
     input: ClipFrames<'a>,
+    /// streamed: the frames received and not released, the first of them frame `base` of the
+    /// clip, and their ground truth
     frames: Vec<Vec<Vector3<f64>>>,
     truth: Vec<FrameTruth>,
+    base: usize,
 }
 
 impl Arrivals<'_> {
@@ -111,15 +89,16 @@ impl Arrivals<'_> {
         }
     }
 
-    /// Wait until at least `n` frames are at hand, take every frame that has arrived, and
-    /// return how many are at hand.
+    /// Wait until at least the frames `..n` of the clip have arrived, take every frame that has
+    /// arrived, and return the end of the frames at hand (they are the frames `base..end`).
     fn wait(&mut self, n: usize) -> Result<usize, RunError> {
         let (rx, total) = match &self.input {
             ClipFrames::Loaded { clip, .. } => return Ok(clip.frame_count()),
             ClipFrames::Streamed { frames, total, .. } => (frames, *total),
         };
-        while self.frames.len() < n.min(total) {
-            let (x, t) = rx.recv().map_err(|_| RunError::Generator { received: self.frames.len(), total })?;
+        while self.base + self.frames.len() < n.min(total) {
+            let received = self.base + self.frames.len();
+            let (x, t) = rx.recv().map_err(|_| RunError::Generator { received, total })?;
             self.frames.push(x);
             self.truth.extend(t);
         }
@@ -127,10 +106,20 @@ impl Arrivals<'_> {
             self.frames.push(x);
             self.truth.extend(t);
         }
-        Ok(self.frames.len())
+        Ok(self.base + self.frames.len())
     }
 
-    /// Which nodes of each frame were tracked (`clip::missing`; `None`: all of them).
+    /// Release the streamed frames before frame `upto` of the clip (no longer solved or derived).
+    fn release(&mut self, upto: usize) {
+        if let ClipFrames::Streamed { .. } = &self.input {
+            let k = upto.saturating_sub(self.base).min(self.frames.len());
+            self.frames.drain(..k);
+            self.truth.drain(..k.min(self.truth.len()));
+            self.base += k;
+        }
+    }
+
+    /// Which nodes of each frame of the clip were tracked (`clip::missing`; `None`: all).
     fn tracked(&self) -> Option<&[Vec<bool>]> {
         match &self.input {
             ClipFrames::Loaded { clip, .. } => clip.tracked.as_deref(),
@@ -138,13 +127,36 @@ impl Arrivals<'_> {
         }
     }
 
-    /// The frames at hand and their ground truth.
+    /// The frames at hand and their ground truth, the first of them frame [`Arrivals::base`].
     fn frames(&self) -> (&[Vec<Vector3<f64>>], Option<&[FrameTruth]>) {
         match &self.input {
             ClipFrames::Loaded { clip, truth, .. } => (&clip.frames, truth.map(|t| &t.frames[..])),
             ClipFrames::Streamed { truth, .. } => (&self.frames, truth.then_some(&self.truth[..])),
         }
     }
+
+    /// The clip's index of the first frame at hand.
+    fn base(&self) -> usize {
+        match &self.input {
+            ClipFrames::Loaded { .. } => 0,
+            ClipFrames::Streamed { .. } => self.base,
+        }
+    }
+}
+
+/// The records of an earlier run's frames, in order, read one at a time
+/// (`crate::output::journal` reads them from its file): none are held.
+pub type ResumeRecords<'r> = &'r mut dyn Iterator<Item = Result<FrameRecord, JournalError>>;
+
+/// [`run_clip_resumed`] after the records `resume` at hand.
+pub fn run_clip<S: FrameSink>(
+    case: &Case,
+    frames: ClipFrames<'_>,
+    resume: &[FrameRecord],
+    sink: S,
+    progress: impl FnMut(usize, usize),
+) -> Result<ClipOutcome, RunError> {
+    run_clip_resumed(case, frames, &mut resume.iter().cloned().map(Ok), sink, progress)
 }
 
 /// Solve the clip of a clip case frame by frame in the Rust engine, handing every converged
@@ -156,10 +168,10 @@ impl Arrivals<'_> {
 /// error stops the clip at the next frame and is reported in its place. A streamed clip is
 /// solved in runs of the frames at hand, each resumed from the last two states
 /// ([`ResumeFrom`]): bit for bit the frames of one solve.
-pub fn run_clip<S: FrameSink>(
+pub fn run_clip_resumed<S: FrameSink>(
     case: &Case,
     frames: ClipFrames<'_>,
-    resume: &[FrameRecord],
+    resume: ResumeRecords<'_>,
     sink: S,
     mut progress: impl FnMut(usize, usize),
 ) -> Result<ClipOutcome, RunError> {
@@ -172,7 +184,7 @@ pub fn run_clip<S: FrameSink>(
         ClipFrames::Loaded { start, .. } => start.cloned(),
         ClipFrames::Streamed { .. } => None,
     };
-    let mut arrivals = Arrivals { input: frames, frames: Vec::new(), truth: Vec::new() };
+    let mut arrivals = Arrivals { input: frames, frames: Vec::new(), truth: Vec::new(), base: 0 };
     let (header, total, has_truth) = arrivals.header();
     let (dt_s, source) = (header.dt_s, header.source.clone());
     let deriver = Deriver {
@@ -184,8 +196,8 @@ pub fn run_clip<S: FrameSink>(
         dt_s,
     };
     let start = Instant::now();
-    let mut summary = Summary::new(has_truth);
-    resume_summary(&deriver, &mut arrivals, resume, sp.frame_offset, &mut summary)?;
+    let mut summary = Summary::new(has_truth, total);
+    let resumed = resume_summary(&deriver, &mut arrivals, resume, sp.frame_offset, &mut summary)?;
     // room for about 0.1 s of frames: the output thread falls behind while a streamed clip's
     // generator shares its core (the first 0.25 s of worm_roll_3d), and catches up after
     let (tx, rx) = std::sync::mpsc::sync_channel::<Converged>(64);
@@ -197,7 +209,7 @@ pub fn run_clip<S: FrameSink>(
             (summary, written)
         });
         let runs = Runs { problem: &problem, sp: &sp, total };
-        let result = runs.solve(&mut arrivals, frame0_start, resume, tx, &mut progress);
+        let result = runs.solve(&mut arrivals, frame0_start, resumed, tx, &mut progress);
         let written = io.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic));
         (result, written)
     });
@@ -215,18 +227,20 @@ pub fn run_clip<S: FrameSink>(
     Ok(ClipOutcome { run, stopped, total })
 }
 
-/// The frames of an earlier run (`resume`): checked against the case and summarised again
-/// from their records.
+/// The frames of an earlier run (`resume`, read one at a time): checked against the case and
+/// summarised again from their records; how many there were and the last two states, to
+/// resume the solve from.
 fn resume_summary(
     deriver: &Deriver,
     arrivals: &mut Arrivals<'_>,
-    resume: &[FrameRecord],
+    resume: ResumeRecords<'_>,
     first_frame: usize,
     summary: &mut Summary,
-) -> Result<(), RunError> {
-    arrivals.wait(resume.len())?;
+) -> Result<Resumed, RunError> {
     let unknowns = deriver.dofs.len();
-    for (i, r) in resume.iter().enumerate() {
+    let mut resumed = Resumed::default();
+    for (i, r) in resume.enumerate() {
+        let r = r.map_err(|e| RunError::Resume(ResumeError::Journal(e)))?;
         if r.report.frame != first_frame + i || r.state.len() != unknowns || r.adjoint.len() != unknowns {
             return Err(RunError::Resume(ResumeError::Record {
                 index: i,
@@ -236,8 +250,10 @@ fn resume_summary(
                 expected_unknowns: unknowns,
             }));
         }
+        arrivals.wait(i + 1)?;
         let frame_error = |e: ClipFrameError| RunError::Resume(ResumeError::Frame(e));
-        let (data, truth) = frame_data(first_frame, &r.report, arrivals.frames()).map_err(frame_error)?;
+        let (data, truth) =
+            frame_data(first_frame + arrivals.base(), &r.report, arrivals.frames()).map_err(frame_error)?;
         let c = Converged {
             report: r.report,
             u: vector_to_space(&deriver.dofs, &r.chart, &r.state, false),
@@ -249,21 +265,20 @@ fn resume_summary(
             truth,
         };
         summary.push(&deriver.derive(c).map_err(frame_error)?);
+        arrivals.release(i);
+        resumed.prev2 = resumed.prev.replace((r.chart, r.state));
+        resumed.count = i + 1;
     }
-    Ok(())
+    Ok(resumed)
 }
 
-/// Where the solve resumes after the frames of `resume` (the last two states).
-fn resume_from(resume: &[FrameRecord]) -> Option<ResumeFrom> {
-    match resume {
-        [] => None,
-        [.., a, b] => Some(ResumeFrom {
-            next: resume.len(),
-            prev: (b.chart, b.state.clone()),
-            prev2: Some((a.chart, a.state.clone())),
-        }),
-        [b] => Some(ResumeFrom { next: 1, prev: (b.chart, b.state.clone()), prev2: None }),
-    }
+/// The frames of an earlier run: how many, and the last two states (each in its chart) to
+/// resume the solve from (`ResumeFrom`).
+#[derive(Default)]
+struct Resumed {
+    count: usize,
+    prev: Option<(Chart, DVector<f64>)>,
+    prev2: Option<(Chart, DVector<f64>)>,
 }
 
 /// The output thread's work: each converged frame derived, handed to the sink and summarised
@@ -291,39 +306,41 @@ struct Runs<'a, 'p> {
 }
 
 impl Runs<'_, '_> {
-    /// Solve the frames after those of `resume` in runs of the frames at hand, each run resumed
-    /// from the last two states of the one before, every converged frame sent on `tx` (dropped
-    /// at the end, which ends the output thread).
+    /// Solve the frames after the `resumed` ones in runs of the frames at hand, each run resumed
+    /// from the last two states of the one before and given only its own frames and the one
+    /// before it (a streamed clip's earlier frames are released), every converged frame sent on
+    /// `tx` (dropped at the end, which ends the output thread).
     fn solve(
         &self,
         arrivals: &mut Arrivals<'_>,
         mut frame0_start: Option<DVector<f64>>,
-        resume: &[FrameRecord],
+        resumed: Resumed,
         tx: SyncSender<Converged>,
         progress: &mut impl FnMut(usize, usize),
     ) -> Result<(), RunError> {
         let (first_frame, total) = (self.sp.frame_offset, self.total);
-        let mut solved = resume.len();
-        let mut from = resume_from(resume);
+        let mut solved = resumed.count;
         // the last two states solved, to resume the next run of frames from
-        let (mut last, mut last2) = match &from {
-            Some(r) => (Some(r.prev.clone()), r.prev2.clone()),
-            None => (None, None),
-        };
+        let (mut last, mut last2) = (resumed.prev, resumed.prev2);
         while solved < total {
             let at_hand = arrivals.wait(solved + 1)?;
+            let base = arrivals.base();
             let view = arrivals.frames();
-            let data = ClipData { positions: &view.0[..at_hand], tracked: arrivals.tracked().map(|t| &t[..at_hand]) };
+            let tracked = arrivals.tracked().map(|t| &t[base..at_hand]);
+            let data = ClipData { positions: &view.0[..at_hand - base], tracked };
+            // the frames of the run counted from the first at hand
+            let sp = SequenceParams { frame_offset: first_frame + base, ..*self.sp };
+            let from = last.clone().map(|prev| ResumeFrom { next: solved - base, prev, prev2: last2.clone() });
             let run = solve_sequence_from(
                 self.problem,
-                self.sp,
+                &sp,
                 data,
                 frame0_start.take().as_ref().map_or(FirstStart::DataGuess, FirstStart::Near),
-                from.take(),
+                from,
                 |_, _| {},
                 |rep, frame| {
                     last2 = last.replace((frame.chart, frame.state.clone()));
-                    let (data, truth) = frame_data(first_frame, rep, view)?;
+                    let (data, truth) = frame_data(first_frame + base, rep, view)?;
                     let c = Converged {
                         report: *rep,
                         u: frame.solution.u.clone(),
@@ -339,9 +356,10 @@ impl Runs<'_, '_> {
                     Ok(())
                 },
             );
-            run.map_err(|e| RunError::from(clip_total(e, total)))?;
+            run.map_err(|e| RunError::from(clip_total(e, base, total)))?;
             solved = at_hand;
-            from = last.clone().map(|prev| ResumeFrom { next: solved, prev, prev2: last2.clone() });
+            // the next run starts after the last frame solved, which stays at hand
+            arrivals.release(solved - 1);
         }
         Ok(())
     }
@@ -377,60 +395,18 @@ pub enum ResumeError {
     /// A recorded frame could not be derived again.
     #[error(transparent)]
     Frame(#[from] ClipFrameError),
+    /// The records could not be read.
+    #[error(transparent)]
+    Journal(#[from] JournalError),
 }
 
-/// An interrupt of a run of a streamed clip's frames, counted against the whole clip's
-/// `total` frames (the run saw only the frames at hand).
-fn clip_total(e: SequenceError, total: usize) -> SequenceError {
+/// An interrupt of a run of a clip's frames (the frames at hand, the first of them frame
+/// `base` of the clip), counted against the whole clip's `total` frames.
+fn clip_total(e: SequenceError, base: usize, total: usize) -> SequenceError {
     match e {
         SequenceError::Solve(SolveError::Interrupted { what, done, .. }) => {
-            SequenceError::Solve(SolveError::Interrupted { what, done, total })
+            SequenceError::Solve(SolveError::Interrupted { what, done: done + base, total })
         }
         e => e,
-    }
-}
-
-/// The per-frame summary of a clip run, frame by frame.
-struct Summary {
-    run: ClipRun,
-}
-
-impl Summary {
-    fn new(truth: bool) -> Self {
-        Summary {
-            run: ClipRun {
-                reports: Vec::new(),
-                roughness: Vec::new(),
-                kappa2: Vec::new(),
-                data_kappa: Vec::new(),
-                omega: Vec::new(),
-                truth: truth.then(TruthRun::default),
-                wall_time_s: 0.0,
-                source: String::new(),
-                weights: None,
-            },
-        }
-    }
-
-    fn push(&mut self, f: &ClipFrame) {
-        let r = &mut self.run;
-        r.reports.push(f.report);
-        r.roughness.push(f.planar.roughness);
-        r.kappa2.push(f.planar.kappa2.clone());
-        r.data_kappa.push(f.planar.data_kappa.clone());
-        r.omega.push(f.omega.clone().unwrap_or_else(|| vec![Vector3::zeros(); f.nodes.alpha.len()]));
-        if let (Some(tr), Some(t)) = (&mut r.truth, &f.truth) {
-            tr.comparisons.push(t.comparison);
-            tr.roll_rad.push(t.roll_rad);
-            tr.twist_per_m.push(t.twist_per_m);
-            tr.bending_true.push(t.bending_true.clone());
-            tr.bending_recovered.push(t.bending_recovered.clone());
-        }
-    }
-
-    fn finish(mut self, wall_time_s: f64, source: String) -> ClipRun {
-        self.run.wall_time_s = wall_time_s;
-        self.run.source = source;
-        self.run
     }
 }

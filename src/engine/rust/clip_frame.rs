@@ -10,6 +10,7 @@ use crate::clip::synthetic::{compare_frame, FrameComparison, FrameTruth, Recover
 use crate::clip::ClipError;
 use crate::model::chart::Chart;
 use crate::model::mesh::{DofMap, Field};
+use crate::model::resultants::Resultants;
 use crate::model::rotation::Angles;
 use crate::solve::inverse::measures::angular_velocity;
 use crate::solve::inverse::Weights;
@@ -86,15 +87,23 @@ pub struct ClipFrame {
     /// penalised, α_{n−1} the previous frame's angles in this frame's chart. `None` on the
     /// first frame, which has no previous frame (Remark 6)
     pub omega: Option<Vec<Vector3<f64>>>,
-    /// element-midpoint curvature `(s [m], κ = A ∂sα [1/m])` (eq. 28), computed once for every
-    /// consumer of the frame
-    pub kappa: Vec<(f64, Vector3<f64>)>,
+    /// per element: the curvature and the stress resultants
+    pub elements: ElementFields,
     /// recovered κ2 and the data's planar curvature, and their roughness
     pub planar: PlanarCurvature,
     /// synthetic clips: the frame against its ground truth
     pub truth: Option<TruthFrame>,
     /// what the frame is derived from (the resume journal)
     pub record: FrameRecord,
+}
+
+/// The per-element values of a frame, computed once for every consumer of the frame.
+#[derive(Clone, Debug)]
+pub struct ElementFields {
+    /// element-midpoint curvature `(s [m], κ = A ∂sα [1/m])` (eq. 28)
+    pub kappa: Vec<(f64, Vector3<f64>)>,
+    /// internal force n [N] and moment m [N m] (eqs. 13, 15; [`NodalState::resultants`])
+    pub resultants: Vec<Resultants>,
 }
 
 /// The controls of a frame per node: f = x̂/λf [N/m] and l = α̂/λl [N m/m] (eq. 54).
@@ -105,8 +114,8 @@ pub struct Controls {
 }
 
 /// A frame's planar curvature: the recovered κ2 at the element midpoints and the data's planar
-/// curvature at the interior nodes [1/m] ([`super::clip::ClipRun::kappa2`],
-/// [`super::clip::ClipRun::data_kappa`]), and the sign alternation of each ([`sign_alternation`]).
+/// curvature at the interior nodes [1/m] (the kymographs' `super::clip_summary::KymographColumn`),
+/// and the sign alternation of each ([`sign_alternation`]).
 #[derive(Clone, Debug)]
 pub struct PlanarCurvature {
     pub kappa2: Vec<f64>,
@@ -199,6 +208,7 @@ impl Deriver<'_> {
             })
             .unzip();
         let kappa = nodes.element_curvature();
+        let resultants = nodes.resultants(&self.case.props, self.case.quadrature, None);
         let k2: Vec<f64> = kappa.iter().map(|(_, k)| k[1]).collect();
         // The data's curvature in the plane normal to the chart's axis (exactly the x–z
         // curvature for an x–z clip; rotates with the data, R5).
@@ -219,7 +229,7 @@ impl Deriver<'_> {
             controls: Controls { force, torque },
             data,
             omega,
-            kappa,
+            elements: ElementFields { kappa, resultants },
             planar: PlanarCurvature { kappa2: k2, data_kappa: kd, roughness },
             truth: truth_frame,
             record: FrameRecord { report: rep, chart, state, adjoint, previous },

@@ -52,6 +52,7 @@ pub fn frame_result(
         x: data.to_vec(),
         alpha: vec![Vector3::zeros(); data.len()],
         chart: nodes.chart,
+        reference_x: None,
     };
     RunResult {
         engine,
@@ -76,6 +77,7 @@ pub fn frame_result(
             lambda_f: w.map_or(1.0, |w| w.lambda_f),
             lambda_l: w.map_or(1.0, |w| w.lambda_l),
         }),
+        path: None,
     }
 }
 

@@ -33,7 +33,39 @@ pub fn physical_metrics(r: &RunResult) -> Metrics {
         m.insert("tip_max_abs_beta_rad".into(), max_abs_a(1));
         m.insert("tip_max_abs_gamma_rad".into(), max_abs_a(2));
     }
+    if let Some(p) = &r.path {
+        path_metrics(p, &mut m);
+    }
+    for (k, c) in centroid(&r.nodes.s, &r.nodes.x).iter().enumerate() {
+        m.insert(format!("centroid_{}_m", ["x", "y", "z"][k]), *c);
+    }
     m
+}
+
+/// The centreline's mean position `∫ x ds / L` [m] of the P1 interpolant (exact: the
+/// trapezoidal rule per element); the centre of mass where ρA is uniform.
+pub fn centroid(s: &[f64], x: &[Vector3<f64>]) -> Vector3<f64> {
+    let mut sum = Vector3::zeros();
+    for i in 1..s.len() {
+        sum += (x[i] + x[i - 1]) * (0.5 * (s[i] - s[i - 1]));
+    }
+    sum / (s[s.len() - 1] - s[0])
+}
+
+/// An arc-length path's metrics (D25): the load factor where it ended, the first limit and
+/// bifurcation points' load factors, its points.
+fn path_metrics(p: &super::PathOutput, m: &mut Metrics) {
+    use crate::solve::arclength::Critical;
+    if let Some(last) = p.points.last() {
+        m.insert("final_load_factor".into(), last.load_factor);
+    }
+    m.insert("path_points".into(), p.points.len() as f64);
+    if let Some(c) = p.critical.iter().find(|c| matches!(c, Critical::Limit { .. })) {
+        m.insert("limit_load_factor".into(), c.load_factor());
+    }
+    if let Some(c) = p.critical.iter().find(|c| matches!(c, Critical::Bifurcation { .. })) {
+        m.insert("bifurcation_load_factor".into(), c.load_factor());
+    }
 }
 
 /// Edge elements left out of the "inner" curvature error: the ends carry the boundary layer of
@@ -122,7 +154,8 @@ pub fn reference_metrics(case: &Case, r: &RunResult, m: &mut Metrics) -> Result<
 }
 
 /// All metrics written to `metrics.json`: physical ones, errors against the case's
-/// `[reference]` theory, and solver statistics.
+/// `[reference]` theory, solver statistics, and its published values (`reference.*`,
+/// `super::published`).
 pub fn all_metrics(case: &Case, r: &RunResult) -> Result<Metrics, ReferenceError> {
     let mut m = physical_metrics(r);
     m.extend(inverse_metrics(r));
@@ -141,6 +174,8 @@ pub fn all_metrics(case: &Case, r: &RunResult) -> Result<Metrics, ReferenceError
         m.insert("certificate".into(), v);
     }
     m.insert("wall_time_s".into(), r.stats.wall_time_s);
+    let published = super::published::evaluate(case, r, &m);
+    m.extend(super::published::metric_entries(&published));
     Ok(m)
 }
 
@@ -206,9 +241,20 @@ pub fn differences(a: &RunResult, b: &RunResult, iterations: bool) -> Vec<Differ
     }
     let (ma, mb) = (physical_metrics(a), physical_metrics(b));
     for (name, &x) in &ma {
-        let bound =
-            if name.ends_with("_rad") { (Group::Angles, angle_scale) } else { (Group::Displacement, disp_scale) };
-        rows.push(Difference::scalar(name, Group::Metric, Some(x), mb.get(name).copied(), Some(bound)));
+        let bound = if name.ends_with("_rad") {
+            Some((Group::Angles, angle_scale))
+        } else if name.ends_with("load_factor") {
+            // a load factor on the path moves with the state it balances, R(u, λ) = 0: relatively
+            Some((Group::Displacement, x.abs()))
+        } else if name == "path_points" {
+            None // a count: equal, or the paths took different steps
+        } else {
+            Some((Group::Displacement, disp_scale))
+        };
+        rows.push(Difference::scalar(name, Group::Metric, Some(x), mb.get(name).copied(), bound));
+    }
+    if let (Some(p), Some(q)) = (&a.path, &b.path) {
+        rows.extend(path_differences(p, q));
     }
     if a.tip.len() == b.tip.len() && !a.tip.is_empty() {
         let p: Vec<_> = a.tip.iter().map(|t| t.position_m - a.tip[0].position_m).collect();
@@ -244,6 +290,29 @@ pub fn differences(a: &RunResult, b: &RunResult, iterations: bool) -> Vec<Differ
     if iterations {
         let (x, y) = (a.stats.iterations as f64, b.stats.iterations as f64);
         rows.push(Difference::scalar("iterations", Group::Iterations, Some(x), Some(y), None));
+    }
+    rows
+}
+
+/// Two arc-length paths (D25): the number of critical points and, over paths of as many points,
+/// the load factors and the recorded displacements point by point (relative to their largest).
+fn path_differences(p: &super::PathOutput, q: &super::PathOutput) -> Vec<Difference> {
+    let count = |p: &super::PathOutput| Some(p.critical.len() as f64);
+    let mut rows = vec![Difference::scalar("critical_points", Group::Metric, count(p), count(q), None)];
+    if p.points.len() == q.points.len() {
+        let lambda = |p: &super::PathOutput| p.points.iter().map(|r| Vector3::new(r.load_factor, 0.0, 0.0)).collect();
+        let disp = |p: &super::PathOutput| p.points.iter().flat_map(|r| r.displacements.clone()).collect::<Vec<_>>();
+        let (lp, lq): (Vec<_>, Vec<_>) = (lambda(p), lambda(q));
+        rows.push(Difference::field(
+            "path_rel_diff_load_factor",
+            Group::Displacement,
+            max_relative_difference(&lp, &lq),
+        ));
+        rows.push(Difference::field(
+            "path_rel_diff_displacement",
+            Group::Displacement,
+            max_relative_difference(&disp(p), &disp(q)),
+        ));
     }
     rows
 }

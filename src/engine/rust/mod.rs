@@ -7,8 +7,10 @@ pub mod budget;
 pub mod clip;
 pub mod clip_frame;
 pub mod clip_metrics;
+pub mod clip_summary;
 pub mod frames;
 pub mod metrics;
+pub mod published;
 pub mod result;
 pub mod weights;
 
@@ -16,14 +18,15 @@ use std::time::Instant;
 
 use nalgebra::{DVector, Vector3};
 
-pub use result::{Engine, InverseOutput, NodalState, RunResult, SolverStats};
+pub use result::{Engine, InverseOutput, NodalState, PathOutput, PathRecord, RunResult, SolverStats};
 
 use crate::case::{Analysis, Case, DataSource};
 use crate::clip::ClipError;
 use crate::model::mesh::Field;
 use crate::solve::inverse::{Frame, FrameSolver, InverseRecord, Start};
 use crate::solve::sequence::{first_chart, SequenceError};
-use crate::solve::{dynamics, statics, SolveError};
+use crate::solve::statics::StaticParams;
+use crate::solve::{arclength, dynamics, statics, SolveError};
 use metrics::INNER_SKIP_ELEMENTS;
 
 /// Errors of running a case.
@@ -105,11 +108,15 @@ fn run_forward_solve(case: &Case, mut progress: impl FnMut(usize, usize)) -> Res
     let problem = case.problem();
     let start = Instant::now();
     match &case.analysis {
+        Analysis::Static(StaticParams { path: Some(path), tolerance, max_iterations, .. }) => {
+            let sol = arclength::follow(&problem, path, *tolerance, *max_iterations, &mut progress)?;
+            Ok(path_result(case, &problem, sol, start.elapsed().as_secs_f64()))
+        }
         Analysis::Static(params) => {
             let sol = statics::solve(&problem, params, |r| progress(r.iteration, params.max_iterations))?;
             let result = RunResult {
                 engine: Engine::Rust,
-                nodes: NodalState::from_vector(&case.mesh, &sol.u),
+                nodes: NodalState::of_forward(case, &sol.u),
                 history: sol.history.clone(),
                 tip: Vec::new(),
                 stats: SolverStats {
@@ -121,6 +128,7 @@ fn run_forward_solve(case: &Case, mut progress: impl FnMut(usize, usize)) -> Res
                     wall_time_s: start.elapsed().as_secs_f64(),
                 },
                 inverse: None,
+                path: None,
             };
             match sol.converged() {
                 Ok(_) => Ok(result),
@@ -128,10 +136,14 @@ fn run_forward_solve(case: &Case, mut progress: impl FnMut(usize, usize)) -> Res
             }
         }
         Analysis::Dynamic(params) => {
-            let sol = dynamics::solve(&problem, params, &mut progress)?;
+            let mut sol = dynamics::solve(&problem, params, &mut progress)?;
+            let chart = problem.chart();
+            if !chart.is_identity() {
+                sol.tip.iter_mut().for_each(|t| t.position_m = chart.to_space(&t.position_m));
+            }
             Ok(RunResult {
                 engine: Engine::Rust,
-                nodes: NodalState::from_vector(&case.mesh, &sol.u),
+                nodes: NodalState::of_forward(case, &sol.u),
                 history: Vec::new(),
                 tip: sol.tip,
                 stats: SolverStats {
@@ -143,9 +155,64 @@ fn run_forward_solve(case: &Case, mut progress: impl FnMut(usize, usize)) -> Res
                     wall_time_s: start.elapsed().as_secs_f64(),
                 },
                 inverse: None,
+                path: None,
             })
         }
         Analysis::Inverse(_) => Err(RunError::kind(case, "a forward case")),
+    }
+}
+
+/// The arc lengths [m] a path records: each point load's and s = L, ascending.
+pub fn path_record_points(case: &Case) -> Vec<f64> {
+    let mut s: Vec<f64> = case.loads.point.iter().map(|p| p.s_m).chain([case.mesh.length_m]).collect();
+    s.sort_by(f64::total_cmp);
+    s.dedup();
+    s
+}
+
+/// The result of an arc-length path (D25): the last point's state, every Newton iteration,
+/// and the path.
+fn path_result(
+    case: &Case,
+    problem: &crate::solve::Problem,
+    sol: arclength::PathSolution,
+    wall_time_s: f64,
+) -> RunResult {
+    let record_s_m = path_record_points(case);
+    let points = sol
+        .points
+        .iter()
+        .map(|p| result::PathRecord {
+            step: p.step,
+            load_factor: p.load_factor,
+            arc_length: p.arc_length,
+            determinant_sign: p.determinant_sign,
+            iterations: p.iterations,
+            certificate: p.certificate,
+            displacements: record_s_m.iter().map(|&s| arclength::displacement_at(problem, &p.u, s)).collect(),
+        })
+        .collect();
+    let last = sol.points.last().expect("the path's reference point");
+    RunResult {
+        engine: Engine::Rust,
+        nodes: NodalState::of_forward(case, &last.u),
+        stats: SolverStats {
+            iterations: sol.history.len(),
+            last_change: sol.history.last().map(|r| r.change),
+            residual: None,
+            max_newton_iterations: sol.points.iter().map(|p| p.iterations).max(),
+            certificate: Some(last.certificate),
+            wall_time_s,
+        },
+        history: sol.history,
+        tip: Vec::new(),
+        inverse: None,
+        path: Some(result::PathOutput {
+            record_s_m,
+            points,
+            critical: sol.critical,
+            reached_end: sol.end == arclength::PathEnd::ReachedLoad,
+        }),
     }
 }
 
@@ -209,7 +276,7 @@ pub fn run_inverse(
         }
         progress(r.iteration, params.max_iterations)
     };
-    let frame = Frame { index: 0, x_g: &data.x, previous: None, weight: None };
+    let frame = Frame { index: 0, x_g: &data.x, previous: None, weight: None, fix_roll: false };
     let solve = || FrameSolver::new(&problem, params).solve(&frame, &problem.reference_state(), Start::Guess, observer);
     let sol = match std::panic::catch_unwind(std::panic::AssertUnwindSafe(solve)) {
         Ok(solved) => solved?,
@@ -245,6 +312,7 @@ pub fn run_inverse(
             lambda_f: params.weights.lambda_f,
             lambda_l: params.weights.lambda_l,
         }),
+        path: None,
     };
     match sol.converged(0) {
         Ok(_) => Ok(result),

@@ -3,8 +3,10 @@
 use nalgebra::{DVector, Vector3};
 
 use crate::model::chart::Chart;
-use crate::model::element::midpoint_curvatures;
-use crate::model::mesh::{Field, Mesh};
+use crate::model::element::{midpoint_curvatures, ElementRest};
+use crate::model::material::RodProperties;
+use crate::model::mesh::{Field, Mesh, QuadratureScheme};
+use crate::model::resultants::{element_resultants, Resultants};
 use crate::solve::dynamics::TipRecord;
 use crate::solve::inverse::InverseRecord;
 use crate::solve::statics::IterationRecord;
@@ -35,8 +37,11 @@ pub struct NodalState {
     /// angles (α, β, γ) [rad] in `chart`
     pub alpha: Vec<Vector3<f64>>,
     /// the angles' chart (`crate::model::chart`; the paper's global chart unless a clip was
-    /// rebased)
+    /// rebased or a forward case has a chart of its own, D21)
     pub chart: Chart,
+    /// the reference positions [m] of a rod with a reference configuration of its own (D20);
+    /// `None`: the paper's straight rod `(0, 0, s)`
+    pub reference_x: Option<Vec<Vector3<f64>>>,
 }
 
 impl NodalState {
@@ -48,12 +53,50 @@ impl NodalState {
             x: dofs.field(u, Field::X),
             alpha: dofs.field(u, Field::Alpha),
             chart: Chart::default(),
+            reference_x: None,
         }
+    }
+
+    /// The nodal fields of a forward case's state `u` (chart coordinates, D21): positions in
+    /// space, angles in the case's chart, the case's reference positions.
+    pub fn of_forward(case: &crate::case::Case, u: &DVector<f64>) -> Self {
+        let mut n = NodalState::from_vector(&case.mesh, u);
+        if let Some(rod) = &case.rod.general {
+            let chart = rod.rest.chart;
+            if !chart.is_identity() {
+                n.x.iter_mut().for_each(|x| *x = chart.to_space(x));
+            }
+            n.chart = chart;
+            n.reference_x = Some(rod.rest.positions.clone());
+        }
+        n
     }
     /// Element-midpoint curvature `κˡ = A(α) ∂s α` [1/m] with the midpoint arc length [m]
     /// (eq. 28, [`midpoint_curvatures`]).
     pub fn element_curvature(&self) -> Vec<(f64, Vector3<f64>)> {
         midpoint_curvatures(&self.s, &self.alpha)
+    }
+    /// The internal force `n` [N] and moment `m` [N m] of every element (eqs. 13, 15, 28),
+    /// the means of `scheme`'s rules ([`crate::model::resultants::resultants`]), their global
+    /// components in space coordinates (the state is solved in its chart, R3: the resultants
+    /// are rotated back), their local ones on the directors.
+    /// `rest`: the reference strains per element of a rod with a reference of its own (D20).
+    pub fn resultants(
+        &self,
+        props: &RodProperties,
+        scheme: QuadratureScheme,
+        rest: Option<&[ElementRest]>,
+    ) -> Vec<Resultants> {
+        if self.chart.is_identity() {
+            return element_resultants(props, scheme, (&self.s, &self.x, &self.alpha), rest);
+        }
+        let x: Vec<Vector3<f64>> = self.x.iter().map(|v| self.chart.to_chart(v)).collect();
+        let mut r = element_resultants(props, scheme, (&self.s, &x, &self.alpha), rest);
+        for e in &mut r {
+            e.n = self.chart.to_space(&e.n);
+            e.m = self.chart.to_space(&e.m);
+        }
+        r
     }
     /// Directors `d1, d2, d3` per node (rows of Q, eq. 2).
     pub fn directors(&self) -> Vec<[Vector3<f64>; 3]> {
@@ -65,9 +108,12 @@ impl NodalState {
             })
             .collect()
     }
-    /// Displacement from the reference configuration `(0, 0, s)` [m].
+    /// Displacement from the reference configuration [m]: the rod's (D20), or `(0, 0, s)`.
     pub fn displacement(&self) -> Vec<Vector3<f64>> {
-        self.x.iter().zip(&self.s).map(|(x, s)| x - Vector3::new(0.0, 0.0, *s)).collect()
+        match &self.reference_x {
+            Some(x0) => self.x.iter().zip(x0).map(|(x, x0)| x - x0).collect(),
+            None => self.x.iter().zip(&self.s).map(|(x, s)| x - Vector3::new(0.0, 0.0, *s)).collect(),
+        }
     }
 }
 
@@ -102,6 +148,36 @@ pub struct RunResult {
     pub stats: SolverStats,
     /// inverse cases: data, adjoint (controls) and per-iteration history
     pub inverse: Option<InverseOutput>,
+    /// a static case followed by arc length (D25): its path
+    pub path: Option<PathOutput>,
+}
+
+/// The path of an arc-length continuation (D25), the same for both engines.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PathOutput {
+    /// arc lengths [m] whose displacements each point records: the point loads' and s = L
+    pub record_s_m: Vec<f64>,
+    pub points: Vec<PathRecord>,
+    /// limit and bifurcation points (`solve::arclength::Critical`)
+    pub critical: Vec<crate::solve::arclength::Critical>,
+    /// whether λ reached the case's `max_load_factor`
+    pub reached_end: bool,
+}
+
+/// One converged point of a path.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PathRecord {
+    pub step: usize,
+    /// load factor λ [-]
+    pub load_factor: f64,
+    /// arc length travelled in the scaled norm of D25 [-]
+    pub arc_length: f64,
+    /// sign of the tangent's determinant relative to the reference's
+    pub determinant_sign: i8,
+    pub iterations: usize,
+    pub certificate: f64,
+    /// displacement [m] (space components) at each of `PathOutput::record_s_m`
+    pub displacements: Vec<Vector3<f64>>,
 }
 
 /// What an inverse run adds to its [`RunResult`].

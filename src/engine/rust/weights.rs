@@ -1,7 +1,7 @@
 //! `[inverse] weights = "auto"`: the tracking weight λg of eq. (41) chosen from the recording
 //! (`docs/noise.md`, N2).
 //!
-//! The recording's noise level is `σ̂ = median over frames of fit::noise_level(frame)` (per
+//! The recording's noise level is `σ̂ = median over frames of fit::noise_level_in(frame)` (per
 //! coordinate [m]). λg is then set by Morozov's discrepancy principle: the fit's RMS distance
 //! to the data per coordinate on the clip's first [`CALIBRATION_FRAMES`] frames,
 //!
@@ -24,7 +24,7 @@
 use nalgebra::{DVector, Vector3};
 
 use crate::case::{Analysis, Case, WeightsRule};
-use crate::solve::fit::noise_level;
+use crate::solve::fit::noise_level_in;
 use crate::solve::sequence::{solve_sequence, FirstStart, SequenceParams};
 
 /// Frames of the clip's start on which `r(λg)` is measured.
@@ -80,9 +80,15 @@ pub fn noise_stabilisation(sigma: f64, nodes: usize, length_m: f64, case_eps: f6
     case_eps.max(ratio.min(MAX_NOISE_STABILISATION))
 }
 
-/// The noise level σ̂ of a recording [m]: the median of the frames' [`noise_level`].
+/// The noise level σ̂ of a recording [m]: the median of the frames' [`crate::solve::fit::noise_level`].
 pub fn recording_noise(frames: &[Vec<Vector3<f64>>]) -> f64 {
-    let mut v: Vec<f64> = frames.iter().map(|f| noise_level(f)).filter(|v| v.is_finite()).collect();
+    recording_noise_in(frames, None)
+}
+
+/// [`recording_noise`] of a recording whose noise lies in the plane normal to `plane` (a planar
+/// recording: the two coordinates that carry data, [`noise_level_in`]).
+pub fn recording_noise_in(frames: &[Vec<Vector3<f64>>], plane: Option<&Vector3<f64>>) -> f64 {
+    let mut v: Vec<f64> = frames.iter().map(|f| noise_level_in(f, plane)).filter(|v| v.is_finite()).collect();
     if v.is_empty() {
         return 0.0;
     }
@@ -99,7 +105,8 @@ pub fn choose_weights(case: &Case, frames: &[Vec<Vector3<f64>>]) -> Option<Auto>
     if rule != WeightsRule::Auto || frames.is_empty() {
         return None;
     }
-    let sigma = recording_noise(frames);
+    // the noise the case states, else the recording's (in its plane, for planar data)
+    let sigma = sp.gate.noise_m.unwrap_or_else(|| recording_noise_in(frames, sp.plane.as_ref()));
     let cap = sp.inverse.weights.lambda_g;
     let mut sp = sp;
     let eps = noise_stabilisation(sigma, frames[0].len(), case.mesh.length_m, sp.inverse.stabilisation);

@@ -7,7 +7,7 @@ use super::tracking::weight_at;
 use super::{Frame, InverseParams, Tracking};
 use crate::assemble::{assemble, Tangent};
 use crate::linalg::Pattern;
-use crate::model::element::{frozen_operator, interpolate, LocalMat, LocalVec};
+use crate::model::element::{frozen_operator, interpolate, ElementRest, LocalMat, LocalVec};
 use crate::model::mesh::{DofMap, Field, GAUSS2};
 use crate::model::rotation::{a_matrix, d3, rotation_derivatives};
 use crate::solve::certificate::{of_system, Certificate};
@@ -174,7 +174,8 @@ pub(crate) fn element_system(
     let h = problem.mesh.h();
     let mut r = KktVec::zeros();
     // Frozen operator: primal rows (hat test) × state columns, and its transpose.
-    let (l, b) = frozen_operator(&problem.props, problem.scheme, h, uk);
+    // (the inverse problem keeps the straight reference, D20)
+    let (l, b) = frozen_operator(&problem.props, problem.scheme, h, uk, &ElementRest::ZERO);
     for i in 0..12 {
         r[kkt(i, true)] += b[i];
     }
@@ -313,7 +314,8 @@ pub(crate) fn add_node_pairs(
 }
 
 /// Dirichlet unknowns of I5 (KKT layout) with their values: `x = x_g` and `x̂ = α̂ = 0` at
-/// both ends, and on the first frame `α(0) = α0` (first angle only, Remark 6).
+/// both ends, and on the first frame `α(0) = α0` (first angle only, Remark 6; on every frame of
+/// a planar recording, [`Frame::fix_roll`]).
 pub fn dirichlet(dofs: &DofMap, alpha0: f64, frame: &Frame) -> Vec<(usize, f64)> {
     let mut fixed = Vec::new();
     dirichlet_into(dofs, alpha0, frame, &mut fixed);
@@ -334,7 +336,7 @@ pub(crate) fn dirichlet_into(dofs: &DofMap, alpha0: f64, frame: &Frame, fixed: &
             }
         }
     }
-    if frame.is_first() {
+    if frame.fixes_alpha0() {
         fixed.push((dofs.index(0, Field::Alpha, 0), alpha0));
     }
 }

@@ -143,11 +143,20 @@ pub struct Frame<'a> {
     pub previous: Option<&'a [Angles]>,
     /// the nodal weight `w_i` of the tracking term (`clip::missing`, I14); `None`: w ≡ 1
     pub weight: Option<&'a [f64]>,
+    /// `α(0) = α0` on this frame too although it is not the first (a planar recording, whose
+    /// data do not hold the roll about the centreline: `solve::sequence::SequenceParams::plane`)
+    pub fix_roll: bool,
 }
 
 impl<'a> Frame<'a> {
     pub fn is_first(&self) -> bool {
         self.previous.is_none()
+    }
+
+    /// Does the frame have the Dirichlet value `α(0) = α0` (the first frame, Remark 6, and every
+    /// frame with [`Frame::fix_roll`])?
+    pub fn fixes_alpha0(&self) -> bool {
+        self.is_first() || self.fix_roll
     }
 
     /// The data of the tracking term: positions and weights.

@@ -34,7 +34,7 @@ use super::measures::{position_error, record};
 use super::{early_divergence, Frame, FrameSolver, InverseParams, InverseRecord, InverseSolution, Records};
 use crate::assemble::{assemble, Tangent};
 use crate::linalg::Pattern;
-use crate::model::element::{internal_force, interpolate, LocalMat};
+use crate::model::element::{internal_force, interpolate, ElementRest, LocalMat};
 use crate::model::mesh::DofMap;
 use crate::model::rotation::{
     a_matrix, a_matrix_derivatives, d3, d3_second_derivatives, rotation, rotation_derivatives, skew, PointFrame,
@@ -90,7 +90,7 @@ fn coefficient_derivative(
     let (state, adj) = (element_part(ue, false), element_part(ue, true));
     // Primal rows: ∂G/∂u − L(u).
     let mut t = LocalMat::zeros();
-    internal_force(props, problem.scheme, h, &state, Some(&mut t));
+    internal_force(props, problem.scheme, h, &state, &ElementRest::ZERO, Some(&mut t));
     add_operator_blocks(e, &(t - l), false);
     let K = Matrix3::from_diagonal(&props.shear_stretch_n);
     let Jm = Matrix3::from_diagonal(&props.bend_twist_nm2);
