@@ -17,7 +17,8 @@ use std::time::Duration;
 use anyhow::{Context, Result};
 
 use cosserat::io::compact::OutputFormat;
-use cosserat::jobs::batch::{self, gather, list_recordings, run_batch, run_task, BatchRow, Plan, SUMMARY};
+use cosserat::jobs::batch::{self, gather, list_recordings, run_batch, BatchRow, Plan, SUMMARY};
+use cosserat::jobs::batch_task::run_task;
 use cosserat::jobs::slurm;
 
 use progress::Progress;

@@ -506,20 +506,6 @@ pub fn run_batch(plan: &Plan, out: &Path, jobs: usize, tick: impl Fn() + Sync) -
     Ok(ran)
 }
 
-/// Run the recordings of Slurm array task `index` of the plan in `out`, one after the other;
-/// `progress(done, total)` after each.
-pub fn run_task(out: &Path, index: usize, mut progress: impl FnMut(usize, usize)) -> Result<Vec<Ran>, BatchError> {
-    let plan = Plan::read(out)?;
-    let entries = plan.task(index)?;
-    let (case, case_file) = plan_case(&plan)?;
-    let mut ran = Vec::with_capacity(entries.len());
-    for e in entries {
-        ran.push(run_recording(&case, &case_file, e, out, plan.format));
-        progress(ran.len(), entries.len());
-    }
-    Ok(ran)
-}
-
 /// The rows of the plan in `out` from its recordings' folders (`missing` where a folder holds
 /// no row), and `summary.csv` written from them.
 pub fn gather(out: &Path) -> Result<Vec<BatchRow>, BatchError> {

@@ -2,8 +2,9 @@
 //! ([`solved`], the run manifest of a job [`job`]), a sweep of one parameter ([`sweep`]), both
 //! engines on the same case and their differences ([`compare`], the published values of both:
 //! [`compare_published`]), a batch of recordings
-//! ([`batch`], on Slurm: [`slurm`]).
+//! ([`batch`], on Slurm: [`slurm`], a task of it: [`batch_task`]).
 pub mod batch;
+pub mod batch_task;
 pub mod compare;
 pub mod compare_published;
 pub mod job;

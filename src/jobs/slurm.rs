@@ -1,6 +1,6 @@
 //! A batch as a Slurm job array (`cosserat batch --slurm`): the job script `OUT/batch.sbatch`
 //! runs `cosserat batch-task OUT --index $SLURM_ARRAY_TASK_ID` in every task (the recordings
-//! of the plan's chunk, exactly as a local batch runs them: `super::batch::run_task`), `sbatch`
+//! of the plan's chunk, exactly as a local batch runs them: `super::batch_task::run_task`), `sbatch`
 //! submits it, and `squeue` tells when the array has left the queue. The output folder must be
 //! on a filesystem that every node sees under the same path. The Slurm clients find their
 //! cluster as usual (`SLURM_CONF`, or the system's configuration).

@@ -437,8 +437,17 @@ fn length_ratios_of_the_clip_cases() {
         println!("SKIPPED: data/elegansbot is absent (run scripts/fetch_worm_data.sh)");
         return;
     }
-    let deviation =
-        |c: &Clip, l: f64| c.frames.iter().map(|f| (polyline_length(f) / l - 1.0).abs()).fold(0.0, f64::max);
+    // over the fully tracked frames: a frame with lost nodes is filled from its neighbours
+    // (`clip::missing`), so its length is not the tracker's
+    let deviation = |c: &Clip, l: f64| {
+        let whole = |i: usize| c.tracked.as_ref().is_none_or(|t| t[i].iter().all(|&k| k));
+        c.frames
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| whole(*i))
+            .map(|(_, f)| (polyline_length(f) / l - 1.0).abs())
+            .fold(0.0, f64::max)
+    };
     for path in crate::case::case_files(&root.join("cases")).unwrap() {
         let case = Case::from_file(&path).unwrap();
         let Some(src) = case.clip() else { continue };
@@ -458,6 +467,10 @@ fn length_ratios_of_the_clip_cases() {
             assert!(unscaled < MAX_LENGTH_DEVIATION / 10.0, "{line}");
         }
         println!("{line}");
-        assert!(dev < MAX_LENGTH_DEVIATION / 100.0, "{line}");
+        // a tracker's recording carries its noise into the polyline (1 µm on 49 nodes: 5e-3,
+        // the table of MAX_LENGTH_DEVIATION); the clips of the paper have none
+        let bound =
+            if src.kind == ClipKind::Recording { MAX_LENGTH_DEVIATION / 10.0 } else { MAX_LENGTH_DEVIATION / 100.0 };
+        assert!(dev < bound, "{line}");
     }
 }
