@@ -27,6 +27,7 @@ fn static_tip(case: &Case, method: Method, tol: f64) -> (f64, f64, usize) {
             continuation_steps: 1,
             certificate_tolerance: DEFAULT_CERTIFICATE_TOLERANCE,
             path: None,
+            buckling_modes: 0,
         },
         |_| {},
     )
@@ -253,6 +254,7 @@ fn follower_load_eq64_large_bend() {
             continuation_steps: 1,
             certificate_tolerance: DEFAULT_CERTIFICATE_TOLERANCE,
             path: None,
+            buckling_modes: 0,
         },
         |_| {},
     )
@@ -267,6 +269,7 @@ fn follower_load_eq64_large_bend() {
             continuation_steps: 5,
             certificate_tolerance: DEFAULT_CERTIFICATE_TOLERANCE,
             path: None,
+            buckling_modes: 0,
         },
         |_| {},
     )
@@ -302,6 +305,7 @@ fn follower_load_eq65_needs_newton() {
             continuation_steps: 10,
             certificate_tolerance: DEFAULT_CERTIFICATE_TOLERANCE,
             path: None,
+            buckling_modes: 0,
         },
         |_| {},
     )
@@ -325,6 +329,7 @@ fn follower_load_eq65_needs_newton() {
             continuation_steps: 1,
             certificate_tolerance: DEFAULT_CERTIFICATE_TOLERANCE,
             path: None,
+            buckling_modes: 0,
         },
         |_| {},
     )

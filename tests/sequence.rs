@@ -48,6 +48,7 @@ fn forward(p: &Problem, steps: usize) -> DVector<f64> {
         continuation_steps: steps,
         certificate_tolerance: DEFAULT_CERTIFICATE_TOLERANCE,
         path: None,
+        buckling_modes: 0,
     };
     statics::solve(p, &params, |_| {}).and_then(|s| s.converged()).expect("forward").u
 }

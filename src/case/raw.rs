@@ -372,6 +372,8 @@ pub(super) struct RawSolver {
     pub(super) continuation: Option<RawContinuation>,
     /// the residual certificate a converged result must meet (docs/certificate.md)
     pub(super) certificate_tolerance: Option<f64>,
+    /// static: the lowest critical load factors to compute with their modes (D27)
+    pub(super) buckling_modes: Option<usize>,
 }
 pub(super) fn one() -> usize {
     1

@@ -143,9 +143,11 @@ impl<'a> Validator<'a> {
             ));
         }
         let analysis = match kind {
-            RawAnalysis::Static => {
-                Analysis::Static(StaticParams { path: self.path(&raw)?, ..self.static_solve("solver", &raw.solver)? })
-            }
+            RawAnalysis::Static => Analysis::Static(StaticParams {
+                path: self.path(&raw)?,
+                buckling_modes: self.buckling_modes(raw.solver.buckling_modes, &mesh)?,
+                ..self.static_solve("solver", &raw.solver)?
+            }),
             RawAnalysis::Dynamic => Analysis::Dynamic(self.dynamic(&raw.solver, raw.time.as_ref())?),
             RawAnalysis::Inverse => Analysis::Inverse(self.inverse(&raw, (&mesh, &section), &props)?),
         };
@@ -290,7 +292,27 @@ impl<'a> Validator<'a> {
             certificate_tolerance: self
                 .certificate_tolerance(&format!("{table}.certificate_tolerance"), s.certificate_tolerance)?,
             path: None,
+            buckling_modes: 0,
         })
+    }
+
+    /// `solver.buckling_modes` of a static analysis (D27): at least 1 when given, on a mesh
+    /// the dense eigen-analysis takes.
+    fn buckling_modes(&self, modes: Option<usize>, mesh: &crate::model::mesh::Mesh) -> Result<usize, CaseError> {
+        let Some(n) = modes else { return Ok(0) };
+        let key = "solver.buckling_modes";
+        if n == 0 {
+            return Err(self.err(key, "must be at least 1 (leave it out for no buckling analysis)"));
+        }
+        let unknowns = mesh.dofs().len();
+        let limit = crate::solve::stability::DENSE_LIMIT;
+        if unknowns > limit {
+            return Err(self.err(
+                key,
+                format!("the buckling analysis is dense (D27): at most {limit} unknowns (300 elements), this rod has {unknowns}"),
+            ));
+        }
+        Ok(n)
     }
 
     /// `[solver]` and `[time]` of a dynamic analysis.
@@ -303,6 +325,9 @@ impl<'a> Validator<'a> {
         }
         if s.continuation_steps != 1 {
             return Err(self.err("solver.continuation_steps", "only for a static analysis"));
+        }
+        if s.buckling_modes.is_some() {
+            return Err(self.err("solver.buckling_modes", "only for a static analysis (D27)"));
         }
         let t = time.ok_or_else(|| self.err("time", "required when solver.analysis = \"dynamic\""))?;
         Ok(DynamicParams {
@@ -364,6 +389,9 @@ impl<'a> Validator<'a> {
         let method = self.inverse_method(s)?;
         if s.continuation_steps != 1 {
             return Err(self.err("solver.continuation_steps", "not used by an inverse analysis"));
+        }
+        if s.buckling_modes.is_some() {
+            return Err(self.err("solver.buckling_modes", "only for a static analysis (D27)"));
         }
         let data = self.data_source(raw, mesh, section)?;
         let inv = raw.inverse.as_ref().ok_or_else(|| {
@@ -453,6 +481,7 @@ impl<'a> Validator<'a> {
             continuation_steps: d.continuation_steps,
             certificate_tolerance: self.certificate_tolerance("data.certificate_tolerance", d.certificate_tolerance)?,
             path: None,
+            buckling_modes: 0,
         })
     }
 

@@ -32,7 +32,8 @@ pub enum RunStatus {
     /// (`solve::Stop::Stalled`); the metrics are those of the last iterate
     Stalled,
     /// a clip solved whole, with frames over the fit-quality gate (`solve::fit`): every frame
-    /// is certified, but some do not follow their data
+    /// is certified, but some do not follow their data; or a static state that is certified but
+    /// not stable (D27)
     Warnings,
     Failed,
     /// stopped by a signal (or not started because of one)
@@ -197,12 +198,28 @@ fn solve_single(case: &Case, engine: Engine, dir: &Path, progress: impl FnMut(us
         Ok(m) => m,
         Err(e) => return Solved::failed(format!("{}: {}", case_label(case), chain(&e))),
     };
+    let (status, error) = match unstable_message(case, &m) {
+        Some(message) if status == RunStatus::Ok => (RunStatus::Warnings, Some(message)),
+        _ => (status, error),
+    };
     match write_run(case, &r, &m, dir) {
         Ok(_) => {
             Solved { status, error, metrics: Some(m), single: Some(r), clip: None, frames: None, disk_full: false }
         }
         Err(e) => Solved::failed_by(format!("{}: {}", case_label(case), chain(&e)), &e),
     }
+}
+
+/// The warning of a static result that is not stable (D27): the smallest eigenvalue `μ` of its
+/// tangent against the unloaded rod's is not positive.
+fn unstable_message(case: &Case, m: &Metrics) -> Option<String> {
+    let w2 = *m.get("tangent_smallest_eigenvalue_per_s2")?;
+    (m.get("stable") == Some(&0.0)).then(|| {
+        format!(
+            "{}: UNSTABLE: the static state returned is not stable: the rod linearised about it has omega^2 = {w2:.4e} 1/s^2 < 0 (the smallest eigenvalue of its tangent against its mass, D27): the loads exceed a critical load and the rod would leave this state; follow the path with solver.continuation = \"arc_length\" (and an imperfection) for the buckled one",
+            case_label(case)
+        )
+    })
 }
 
 /// Did the engine stop because a stop was requested (`crate::interrupt`)?

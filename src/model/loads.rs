@@ -88,6 +88,19 @@ pub struct Loads {
 }
 
 impl Loads {
+    /// Every load a dead force (global frame, no applied moment): conservative (D27). A
+    /// follower load is not, nor is a moment: one of fixed axis (an axial vector) is not the
+    /// gradient of a potential for finite rotations in 3D (Ziegler, Principles of Structural
+    /// Stability, 1977, §2.6).
+    pub fn conservative(&self) -> bool {
+        // compiled in the order of `exprs`: force, torque, end force, end torque, 3 each
+        let zero = |group: usize| self.compiled[3 * group..3 * group + 3].iter().all(|c| c.as_constant() == Some(0.0));
+        self.frame == LoadFrame::Global
+            && zero(1)
+            && zero(3)
+            && self.point.iter().all(|p| p.frame == LoadFrame::Global && p.torque.is_zero())
+    }
+
     pub fn new(
         frame: LoadFrame,
         force: [Expr; 3],

@@ -1,6 +1,7 @@
 //! The files of an arc-length path (D25): `path.csv` (one row per converged point, the load
 //! factor and the displacement at each recorded arc length), `critical_points.csv` (limit and
-//! bifurcation points) and the load–displacement panel of `plot.svg`.
+//! bifurcation points) and the load–displacement panel of `plot.svg`; and a static case's
+//! buckling modes (D27), `buckling.csv`.
 use nalgebra::Vector3;
 
 use crate::case::Case;
@@ -9,6 +10,19 @@ use crate::figures::plot::{LinePlot, Mark, Series};
 use crate::io::files::csv_text_int;
 use crate::model::loads::LoadFrame;
 use crate::solve::arclength::Critical;
+
+/// `buckling.csv` (D27): a row per buckling mode and node: the mode (1, 2, …), its critical load
+/// factor, the node's arc length and the mode's displacement in space, scaled so that the mode
+/// has `‖φ‖_w = 1` (positions over the rod length, RMS over the nodes, with the angles).
+pub fn buckling_csv(st: &crate::engine::rust::result::StabilityOutput, s_m: &[f64]) -> String {
+    let h = ["mode", "load_factor", "s_m", "ux_m", "uy_m", "uz_m"];
+    let rows = st.modes.iter().enumerate().flat_map(|(k, m)| {
+        m.displacement.iter().zip(s_m).map(move |(d, s)| {
+            vec![Some((k + 1) as f64), Some(m.load_factor), Some(*s), Some(d[0]), Some(d[1]), Some(d[2])]
+        })
+    });
+    csv_text_int(&h, &["mode"], rows)
+}
 
 /// `path.csv`: step, λ, arc length, determinant sign, iterations, certificate, then
 /// `u{x,y,z}_m_at_s_{s}` per recorded arc length `s` [m] (each point load's and s = L).

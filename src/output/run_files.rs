@@ -82,6 +82,9 @@ pub fn write_run(case: &Case, r: &RunResult, metrics: &Metrics, dir: &Path) -> R
         put("path.csv", super::path_files::path_csv(p).into_bytes())?;
         put("critical_points.csv", super::path_files::critical_csv(p).into_bytes())?;
     }
+    if let Some(st) = r.stability.as_ref().filter(|st| !st.modes.is_empty()) {
+        put("buckling.csv", super::path_files::buckling_csv(st, &r.nodes.s).into_bytes())?;
+    }
     write_metrics(case, r, metrics, &mut put)?;
     let plot_path = dir.join("plot.svg");
     write_plot(&plot_path, render_panels_svg(&headline_panels(case, r), 2))?;

@@ -14,6 +14,7 @@ pub mod modes;
 pub mod problem;
 pub mod sequence;
 pub mod smoothing;
+pub mod stability;
 pub mod statics;
 
 pub use problem::Problem;

@@ -38,6 +38,9 @@ pub struct StaticParams {
     /// path following through limit points instead of load steps (`solver.continuation =
     /// "arc_length"`, D25)
     pub path: Option<super::continuation::ArcLengthParams>,
+    /// the lowest critical load factors of the case's loads about the reference to compute with
+    /// their modes (`solver.buckling_modes`, D27); 0: none
+    pub buckling_modes: usize,
 }
 
 impl StaticParams {
@@ -50,6 +53,7 @@ impl StaticParams {
             continuation_steps,
             certificate_tolerance: DEFAULT_CERTIFICATE_TOLERANCE,
             path: None,
+            buckling_modes: 0,
         }
     }
 }

@@ -621,6 +621,10 @@ case("range_tolerance_nan", "base_static", [("tolerance = 1e-9", "tolerance = na
      "a NaN tolerance")
 case("range_lambda_f_inf", "base_inverse", [("lambda_f = 1", "lambda_f = inf")], ["lambda_f", "inf|finite"],
      "an infinite force weight")
+case("range_buckling_modes_zero", "base_newton", [("continuation_steps = 10", "continuation_steps = 10\nbuckling_modes = 0")],
+     ["buckling_modes", COUNT], "zero buckling modes asked for")
+case("contra_buckling_modes_dynamic", "base_dynamic", [("max_iterations = 25", "max_iterations = 25\nbuckling_modes = 2")],
+     ["buckling_modes", "static"], "buckling modes of a dynamic analysis")
 case("range_substeps_zero", "base_roll", [("clip_frames = 3", "clip_frames = 3\nsubsteps = 0")],
      ["substeps", COUNT], "zero integration substeps of a synthetic clip")
 case("range_steps_huge", "base_dynamic", [("steps = 20", "steps = 1000000000000")],

@@ -111,6 +111,7 @@ pub fn forward_data(case: &Case, steps: usize) -> (nalgebra::DVector<f64>, Vec<n
             continuation_steps: steps,
             certificate_tolerance: DEFAULT_CERTIFICATE_TOLERANCE,
             path: None,
+            buckling_modes: 0,
         },
         |_| {},
     )

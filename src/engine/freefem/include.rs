@@ -62,6 +62,7 @@ pub fn include_file(case: &Case, opts: &RunOptions) -> String {
     write_general_rod(&mut o, case, &names);
     write_solver(&mut o, case, &SolverSettings::of(case));
     write_path(&mut o, case);
+    write_stability(&mut o, case);
     if let Analysis::Inverse(inv) = &case.analysis {
         write_inverse(&mut o, case, inv, opts);
     }
@@ -339,6 +340,22 @@ fn write_solver(o: &mut String, case: &Case, s: &SolverSettings) {
         "real Tend = {};\nint nsteps = {steps};\nreal newtonTol = {};\nint newtonMaxit = {maxit};",
         num(tend),
         num(tol)
+    );
+}
+
+/// `freefem/stability.idp`'s keys (D27): the buckling modes asked for (`solver.buckling_modes`, 0
+/// for other analyses) and the dense limit of `solve::stability`.
+fn write_stability(o: &mut String, case: &Case) {
+    let modes = match &case.analysis {
+        Analysis::Static(p) => p.buckling_modes,
+        _ => 0,
+    };
+    let _ = writeln!(
+        o,
+        "// the stability of a static result and its buckling modes (D27, freefem/stability.idp)
+int buckModes = {modes};
+int denseLimit = {};",
+        crate::solve::stability::DENSE_LIMIT
     );
 }
 

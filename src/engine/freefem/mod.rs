@@ -12,6 +12,7 @@ pub mod clip;
 pub mod include;
 pub mod path;
 pub mod progress;
+pub mod stability;
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -179,6 +180,7 @@ pub fn run_inverse(
             lambda_l: w.lambda_l,
         }),
         path: None,
+        stability: None,
     };
     match stop {
         Some(source) => Err(FreeFemError::Incomplete { source, partial: Box::new(result) }),
@@ -318,6 +320,7 @@ fn inverse_stop(
 pub fn run(case: &Case, workdir: &Path) -> Result<RunResult, FreeFemError> {
     let mut outputs = vec!["ff_nodes.csv", "ff_info.csv", "ff_history.csv", "ff_tip.csv"];
     outputs.extend(path::PATH_OUTPUTS);
+    outputs.push(stability::BUCKLING_OUTPUT);
     let end = execute_to_end(case, workdir, "forward.edp", &outputs, &RunOptions::default())?;
     let (result, certificate) = read_outputs(case, workdir)?;
     let newton = matches!(&case.analysis, Analysis::Static(p) if p.method == Method::Newton);
@@ -497,5 +500,6 @@ fn read_outputs(case: &Case, dir: &Path) -> Result<(RunResult, Option<Certificat
     }
     let followed = matches!(&case.analysis, Analysis::Static(p) if p.path.is_some());
     let path = if followed { Some(path::read_path(case, dir, &info)?) } else { None };
-    Ok((RunResult { engine: Engine::Freefem, nodes, history, tip, stats, inverse: None, path }, certificate))
+    let stability = stability::read_stability(case, dir)?;
+    Ok((RunResult { engine: Engine::Freefem, nodes, history, tip, stats, inverse: None, path, stability }, certificate))
 }

@@ -78,6 +78,7 @@ pub fn frame_result(
             lambda_l: w.map_or(1.0, |w| w.lambda_l),
         }),
         path: None,
+        stability: None,
     }
 }
 

@@ -36,6 +36,9 @@ pub fn physical_metrics(r: &RunResult) -> Metrics {
     if let Some(p) = &r.path {
         path_metrics(p, &mut m);
     }
+    if let Some(st) = &r.stability {
+        stability_metrics(st, &mut m);
+    }
     for (k, c) in centroid(&r.nodes.s, &r.nodes.x).iter().enumerate() {
         m.insert(format!("centroid_{}_m", ["x", "y", "z"][k]), *c);
     }
@@ -50,6 +53,21 @@ pub fn centroid(s: &[f64], x: &[Vector3<f64>]) -> Vector3<f64> {
         sum += (x[i] + x[i - 1]) * (0.5 * (s[i] - s[i - 1]));
     }
     sum / (s[s.len() - 1] - s[0])
+}
+
+/// A static result's stability and its buckling load factors (D27):
+/// `tangent_smallest_eigenvalue_per_s2` (`min Re ω²`), `stable` (conservative loads only: 1
+/// when it is positive, else 0), `buckling_{k}_load_factor` (k = 1, 2, …, ascending).
+fn stability_metrics(st: &super::result::StabilityOutput, m: &mut Metrics) {
+    if let Some(mu) = st.smallest_eigenvalue_per_s2 {
+        m.insert("tangent_smallest_eigenvalue_per_s2".into(), mu);
+        if st.conservative {
+            m.insert("stable".into(), if mu > 0.0 { 1.0 } else { 0.0 });
+        }
+    }
+    for (k, mode) in st.modes.iter().enumerate() {
+        m.insert(format!("buckling_{}_load_factor", k + 1), mode.load_factor);
+    }
 }
 
 /// An arc-length path's metrics (D25): the load factor where it ended, the first limit and
@@ -216,6 +234,10 @@ pub struct Difference {
     pub bound: Option<(Group, f64)>,
 }
 
+/// Metrics the FreeFEM engine does not compute (the mass-matrix eigen-analysis of a static
+/// state, D27): compared only when both runs have them.
+pub const RUST_ONLY_METRICS: [&str; 2] = ["tangent_smallest_eigenvalue_per_s2", "stable"];
+
 /// The quantities two runs of the same case are compared on: node-wise displacement, angles
 /// and (inverse) adjoints, the tip history of a dynamic run, the physical metrics, the recovery
 /// errors and, with `iterations`, the iteration counts.
@@ -241,13 +263,18 @@ pub fn differences(a: &RunResult, b: &RunResult, iterations: bool) -> Vec<Differ
     }
     let (ma, mb) = (physical_metrics(a), physical_metrics(b));
     for (name, &x) in &ma {
+        if RUST_ONLY_METRICS.contains(&name.as_str()) && !mb.contains_key(name) {
+            continue;
+        }
         let bound = if name.ends_with("_rad") {
             Some((Group::Angles, angle_scale))
         } else if name.ends_with("load_factor") {
             // a load factor on the path moves with the state it balances, R(u, λ) = 0: relatively
             Some((Group::Displacement, x.abs()))
-        } else if name == "path_points" {
-            None // a count: equal, or the paths took different steps
+        } else if name == "path_points" || name == "stable" {
+            None // a count or a verdict: equal, or the runs differ
+        } else if name == "tangent_smallest_eigenvalue_per_s2" {
+            Some((Group::Displacement, x.abs()))
         } else {
             Some((Group::Displacement, disp_scale))
         };

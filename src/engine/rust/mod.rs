@@ -12,6 +12,7 @@ pub mod frames;
 pub mod metrics;
 pub mod published;
 pub mod result;
+pub mod stability;
 pub mod weights;
 
 use std::time::Instant;
@@ -44,6 +45,8 @@ pub enum RunError {
         "case `{case}`: the single-frame inverse path solves a clip's first frame alone, in the paper's angle chart (eq. 1) from the straight reference state, but this clip's first frame is solved in the rebased chart with singular axis ({:.3}, {:.3}, {:.3}) (clip.rotation = \"rebased\" with clip.gauge or clip.orientation away from e2). `cosserat run` and `cosserat compare` solve the clip frame by frame in its charts; for the single-frame path set clip.rotation = \"global_euler\" or a gauge along e2", axis[0], axis[1], axis[2]
     )]
     Chart { case: String, axis: [f64; 3] },
+    #[error("rust engine: the eigen-analysis of the static result (D27)")]
+    Stability(#[from] crate::solve::stability::StabilityError),
     #[error("writing the clip")]
     Sink(#[source] Box<dyn std::error::Error + Send + Sync>),
     #[error("resuming the clip: {0}")]
@@ -110,10 +113,21 @@ fn run_forward_solve(case: &Case, mut progress: impl FnMut(usize, usize)) -> Res
     match &case.analysis {
         Analysis::Static(StaticParams { path: Some(path), tolerance, max_iterations, .. }) => {
             let sol = arclength::follow(&problem, path, *tolerance, *max_iterations, &mut progress)?;
-            Ok(path_result(case, &problem, sol, start.elapsed().as_secs_f64()))
+            let last = sol.points.last().expect("the path's reference point");
+            let at = crate::solve::Problem { load_factor: last.load_factor, ..problem };
+            let stability = stability::output(case, &at, &last.u)?;
+            Ok(RunResult {
+                stability: Some(stability),
+                ..path_result(case, &problem, sol, start.elapsed().as_secs_f64())
+            })
         }
         Analysis::Static(params) => {
             let sol = statics::solve(&problem, params, |r| progress(r.iteration, params.max_iterations))?;
+            // the stability of a solution only (D27): an unconverged iterate has none
+            let stability = match sol.stop {
+                crate::solve::Stop::Converged => Some(stability::output(case, &problem, &sol.u)?),
+                _ => None,
+            };
             let result = RunResult {
                 engine: Engine::Rust,
                 nodes: NodalState::of_forward(case, &sol.u),
@@ -129,6 +143,7 @@ fn run_forward_solve(case: &Case, mut progress: impl FnMut(usize, usize)) -> Res
                 },
                 inverse: None,
                 path: None,
+                stability,
             };
             match sol.converged() {
                 Ok(_) => Ok(result),
@@ -156,6 +171,7 @@ fn run_forward_solve(case: &Case, mut progress: impl FnMut(usize, usize)) -> Res
                 },
                 inverse: None,
                 path: None,
+                stability: None,
             })
         }
         Analysis::Inverse(_) => Err(RunError::kind(case, "a forward case")),
@@ -213,6 +229,7 @@ fn path_result(
             critical: sol.critical,
             reached_end: sol.end == arclength::PathEnd::ReachedLoad,
         }),
+        stability: None,
     }
 }
 
@@ -313,6 +330,7 @@ pub fn run_inverse(
             lambda_l: params.weights.lambda_l,
         }),
         path: None,
+        stability: None,
     };
     match sol.converged(0) {
         Ok(_) => Ok(result),

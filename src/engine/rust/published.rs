@@ -165,6 +165,13 @@ pub fn metric_keys(case: &Case) -> Vec<String> {
         }
         Analysis::Static(_) => {}
     }
+    if let Analysis::Static(p) = &case.analysis {
+        if super::stability::fits(case) {
+            // `stable`: conservative loads only (D27)
+            keys.extend(["tangent_smallest_eigenvalue_per_s2", "stable"].map(String::from));
+        }
+        keys.extend((1..=p.buckling_modes).map(|k| format!("buckling_{k}_load_factor")));
+    }
     if let Some(Reference::TipLoadedCantilever { .. }) = case.checks.reference {
         for name in ["eq63", "elastica", "reissner"] {
             keys.extend([format!("{name}_tip_y_m"), format!("{name}_rel_error")]);

@@ -150,6 +150,34 @@ pub struct RunResult {
     pub inverse: Option<InverseOutput>,
     /// a static case followed by arc length (D25): its path
     pub path: Option<PathOutput>,
+    /// a static case: the stability of its state and its buckling modes (D27)
+    pub stability: Option<StabilityOutput>,
+}
+
+/// The stability of a static result and the case's linearised buckling (D27), the same for
+/// both engines.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct StabilityOutput {
+    /// `min Re ω²` of the rod linearised about the result [1/s²] (≤ 0 unstable; unit inertias
+    /// where the case has none: then its sign only); `None` above the dense limit
+    /// (`solve::stability::DENSE_LIMIT`) and in the FreeFEM engine (which has no mass-matrix
+    /// eigen-analysis of a static state)
+    pub smallest_eigenvalue_per_s2: Option<f64>,
+    /// every load is a dead force, so that the sign of `smallest_eigenvalue_per_s2` says stable or not
+    /// (`solve::stability::Stability::conservative`); follower loads: `false`
+    pub conservative: bool,
+    /// the lowest critical load factors about the reference (`solver.buckling_modes`), ascending
+    pub modes: Vec<BucklingRecord>,
+}
+
+/// One buckling mode: its critical load factor and its shape at the nodes.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BucklingRecord {
+    /// critical load factor λ_cr [-]
+    pub load_factor: f64,
+    /// the mode's displacement per node in space, scaled so that `‖φ‖_w = 1` (D27) [m per m of
+    /// rod length]
+    pub displacement: Vec<Vector3<f64>>,
 }
 
 /// The path of an arc-length continuation (D25), the same for both engines.

@@ -34,6 +34,7 @@ fn result(nodes: NodalState) -> RunResult {
         stats: SolverStats::default(),
         inverse: None,
         path: None,
+        stability: None,
     }
 }
 

@@ -1,0 +1,40 @@
+//! The stability of a static result and the case's linearised buckling (D27) as a run's output.
+use nalgebra::DVector;
+
+use super::result::{BucklingRecord, StabilityOutput};
+use super::RunError;
+use crate::case::{Analysis, Case};
+use crate::model::mesh::Field;
+use crate::solve::stability::{buckling, stability, StabilityError, DENSE_LIMIT};
+use crate::solve::Problem;
+
+/// The stability of the static state `u` of `problem` (at its load factor) and, with
+/// `solver.buckling_modes`, the case's lowest critical load factors and modes. Above the dense
+/// limit the stability is `None` (buckling is refused there when the case is read).
+pub fn output(case: &Case, problem: &Problem, u: &DVector<f64>) -> Result<StabilityOutput, RunError> {
+    let modes = match &case.analysis {
+        Analysis::Static(p) => p.buckling_modes,
+        _ => 0,
+    };
+    let (smallest_eigenvalue_per_s2, conservative) = match stability(problem, u) {
+        Ok(s) => (Some(s.smallest_eigenvalue_per_s2), s.conservative),
+        Err(StabilityError::TooLarge { .. }) => (None, false),
+        Err(e) => return Err(e.into()),
+    };
+    let modes = if modes > 0 { buckling(problem, modes)? } else { Vec::new() };
+    let dofs = problem.dofs();
+    let chart = problem.chart();
+    let modes = modes
+        .into_iter()
+        .map(|m| BucklingRecord {
+            load_factor: m.load_factor,
+            displacement: (0..dofs.nodes()).map(|i| chart.to_space(&dofs.get(&m.shape, i, Field::X))).collect(),
+        })
+        .collect();
+    Ok(StabilityOutput { smallest_eigenvalue_per_s2, conservative, modes })
+}
+
+/// Whether a case's dense eigen-analyses fit (D27): its unknowns at most [`DENSE_LIMIT`].
+pub fn fits(case: &Case) -> bool {
+    case.problem().dofs().len() <= DENSE_LIMIT
+}

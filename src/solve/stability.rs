@@ -1,0 +1,204 @@
+//! Stability of a static state and linearised buckling (`docs/decisions.md`, D27).
+//!
+//! Both work on Newton's matrix of the static equations `R(u, λ) = G(u) − λ F₁(u) = 0` (D3,
+//! with the held rows of D22), `K(u, λ) = ∂R/∂u`:
+//!
+//! ```text
+//!   stability of (u, λ):   M(u) φ̈ + K(u, λ) φ = 0 on the unknowns not held,  ω² = eig(M⁻¹K),
+//!                          ω²_min = min Re ω² [1/s²]
+//!   linearised buckling:   (K₀ + λ K_σ) φ = 0,  K₀ = K(u_ref, 0),  K_σ = d/dε K(u_ref + ε u₁, ε)|₀,  K₀ u₁ = ∂F/∂λ
+//! ```
+//! `M = ∂P/∂u̇` (D6). The paper's weak form tests the moment balance with δα (D9), in `K` and in
+//! `M` alike, so `M⁻¹K` is similar to the virtual-work form's `M_s⁻¹ K_s` and its eigenvalues
+//! do not depend on the angle chart: for dead loads `K_s` is the energy's Hessian, the `ω²` are
+//! real, and `ω²_min ≤ 0` exactly when the second variation has a non-positive direction (an
+//! unstable state). A measure against `K₀` alone (`K φ = μ K₀ φ`) is not chart-free: it is
+//! negative on stable cantilevers bent by a dead load (measured on Bisshopp–Drucker, −0.93).
+//! Follower loads, and moments (a dead moment of fixed axis is not conservative in 3D: Ziegler),
+//! make `K_s` non-symmetric and can lose stability by flutter (complex `ω²`): `ω²_min` is then
+//! reported without a verdict. `K_σ` is taken by central differences (ε such
+//! that `‖ε u₁‖_w = 10⁻⁵`); the critical load factors are the reciprocals of the positive real
+//! eigenvalues of `−K₀⁻¹ K_σ` and each mode is the null vector of `K₀ + λ_cr K_σ` (its smallest
+//! singular vector). Held unknowns have identity rows in `K₀` and `K_σ = 0` there: no critical
+//! load.
+//!
+//! Dense: up to [`DENSE_LIMIT`] unknowns (300 elements); above it the stability is not computed
+//! (`None`) and buckling is refused.
+use nalgebra::{DMatrix, DVector};
+
+use super::arclength::{load_rate, newton_system, wnorm2};
+use super::problem::{FrameAt, HeldRows};
+use super::{Problem, SolveError};
+use crate::assemble::Tangent;
+use crate::model::mesh::Field;
+
+/// Most unknowns of the dense eigen-analyses (6 per node: 300 elements).
+pub const DENSE_LIMIT: usize = 1806;
+
+/// The stability of a static state.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Stability {
+    /// `min Re ω²` of the rod linearised about the state [1/s²] (with unit inertias where the
+    /// case has none: then only its sign is physical): ≤ 0 unstable
+    pub smallest_eigenvalue_per_s2: f64,
+    /// how many `μ` have a negative real part
+    pub negative: usize,
+    /// every load is dead (global frame, [`crate::model::loads::Loads::conservative`]): the
+    /// sign of `μ_min` is a verdict; follower loads can lose stability by flutter, which no
+    /// static eigenvalue sees
+    pub conservative: bool,
+}
+
+impl Stability {
+    /// Stable: the loads are conservative and every `ω²` is positive; `None` for
+    /// non-conservative loads (follower loads and moments: a flutter has no static sign).
+    pub fn stable(&self) -> Option<bool> {
+        self.conservative.then_some(self.smallest_eigenvalue_per_s2 > 0.0)
+    }
+}
+
+/// One buckling mode of the linearised problem.
+#[derive(Clone, Debug)]
+pub struct BucklingMode {
+    /// the critical load factor `λ_cr` [-] (the case's loads times it buckle the rod)
+    pub load_factor: f64,
+    /// the mode: increments of the unknowns `(x, α)` in the problem's layout, scaled so that
+    /// `‖φ‖_w = 1` (positions relative to the rod length) with its largest entry positive
+    pub shape: DVector<f64>,
+}
+
+/// Errors of the eigen-analyses.
+#[derive(Debug, thiserror::Error)]
+pub enum StabilityError {
+    #[error("{unknowns} unknowns: the dense eigen-analysis takes at most {limit} (300 elements)")]
+    TooLarge { unknowns: usize, limit: usize },
+    #[error("the unloaded rod's Newton matrix K0 is singular (a rigid-body motion is left free)")]
+    SingularReference,
+    #[error("the mass matrix is singular (the chart's singular set, cos β = 0, at a node?)")]
+    SingularMass,
+    #[error("the eigenvalues did not converge (QR iteration on {0} x {0})")]
+    NoEigenvalues(usize),
+    #[error(transparent)]
+    Solve(#[from] SolveError),
+}
+
+/// `K(u, λ)` as a dense matrix.
+fn dense_tangent(problem: &Problem, u: &DVector<f64>, lambda: f64) -> DMatrix<f64> {
+    let pattern = problem.dofs().pattern();
+    let mut values = vec![0.0; pattern.nnz()];
+    newton_system(problem, u, lambda, &pattern, &mut values);
+    pattern.to_dense(&values)
+}
+
+fn check_size(problem: &Problem) -> Result<usize, StabilityError> {
+    let n = problem.dofs().len();
+    if n > DENSE_LIMIT {
+        return Err(StabilityError::TooLarge { unknowns: n, limit: DENSE_LIMIT });
+    }
+    Ok(n)
+}
+
+/// The eigenvalues (re, im) of a square matrix (faer's Hessenberg–Schur QR).
+fn eigenvalues(m: DMatrix<f64>) -> Result<Vec<(f64, f64)>, StabilityError> {
+    let n = m.nrows();
+    let f = faer::Mat::<f64>::from_fn(n, n, |i, j| m[(i, j)]);
+    let values = f.eigenvalues().map_err(|_| StabilityError::NoEigenvalues(n))?;
+    Ok(values.iter().map(|z| (z.re, z.im)).collect())
+}
+
+/// The stability of the static state `u` at the problem's load factor (D27).
+pub fn stability(problem: &Problem, u: &DVector<f64>) -> Result<Stability, StabilityError> {
+    check_size(problem)?;
+    let (w, negative) = lowest_frequency_squared(problem, u, problem.load_factor)?;
+    Ok(Stability { smallest_eigenvalue_per_s2: w, negative, conservative: problem.loads.conservative() })
+}
+
+/// `min Re ω²` of the rod linearised about `(u, λ)`, `M(u) φ̈ + K(u, λ) φ = 0` on the unknowns
+/// that are not held, and how many `ω²` have a negative real part.
+fn lowest_frequency_squared(problem: &Problem, u: &DVector<f64>, lambda: f64) -> Result<(f64, usize), StabilityError> {
+    let held = problem.clamped_dofs();
+    let free: Vec<usize> = (0..problem.dofs().len()).filter(|i| !held.contains(i)).collect();
+    let pick = |m: &DMatrix<f64>| DMatrix::from_fn(free.len(), free.len(), |i, j| m[(free[i], free[j])]);
+    let k = pick(&dense_tangent(problem, u, lambda));
+    let m = pick(&dense_mass(problem, u));
+    let w2 = eigenvalues(m.lu().solve(&k).ok_or(StabilityError::SingularMass)?)?;
+    let smallest = w2.iter().map(|z| z.0).fold(f64::INFINITY, f64::min);
+    Ok((smallest, w2.iter().filter(|z| z.0 < 0.0).count()))
+}
+
+/// `∂P/∂u̇` at `u` (u̇ = 0, D6) with a twist-held pin's rows combined as the tangent's (D22). A
+/// static case without inertias gets unit ones: ρA = 1 kg/m and ρI = (EI1, EI2, EI1 + EI2)/EA
+/// (kg m; the radii of gyration of a homogeneous section), which move the `ω²` but not their
+/// signs, and not the ratio `μ_min` along a straight path.
+fn dense_mass(problem: &Problem, u: &DVector<f64>) -> DMatrix<f64> {
+    let mut props = problem.props;
+    if props.mass_per_length_kg_m <= 0.0 {
+        let (j, ea) = (props.bend_twist_nm2, props.shear_stretch_n[2]);
+        props.mass_per_length_kg_m = 1.0;
+        props.rotary_inertia_kg_m = nalgebra::Vector3::new(j[0], j[1], j[0] + j[1]) / ea;
+    }
+    let p = Problem { props, ..*problem };
+    let pattern = p.dofs().pattern();
+    let mut values = vec![0.0; pattern.nnz()];
+    let zero = p.dofs().zeros();
+    p.momentum(u, &zero, Some((Tangent::new(&pattern, &mut values, 0.0), 1.0)));
+    let mut r = p.dofs().zeros();
+    p.apply_held(&pattern, Some(&mut values), &mut r, &p.held_static(), HeldRows::Values, FrameAt::of(u));
+    pattern.to_dense(&values)
+}
+
+/// The lowest `count` positive critical load factors of the case's loads about the reference,
+/// with their modes (D27), ascending.
+pub fn buckling(problem: &Problem, count: usize) -> Result<Vec<BucklingMode>, StabilityError> {
+    check_size(problem)?;
+    let pattern = problem.dofs().pattern();
+    let u0 = problem.reference_state();
+    let k0 = dense_tangent(problem, &u0, 0.0);
+    let q = load_rate(problem, &u0, 0.0, &pattern);
+    let lu = k0.clone().lu();
+    let u1 = lu.solve(&q).ok_or(StabilityError::SingularReference)?;
+    let size = wnorm2(problem, &u1, &u1).sqrt();
+    if size == 0.0 || !size.is_finite() {
+        return Ok(Vec::new()); // no load: nothing buckles
+    }
+    let eps = 1e-5 / size;
+    let kp = dense_tangent(problem, &(&u0 + &u1 * eps), eps);
+    let km = dense_tangent(problem, &(&u0 - &u1 * eps), -eps);
+    let k_sigma = (kp - km) / (2.0 * eps);
+    let b = -lu.solve(&k_sigma).ok_or(StabilityError::SingularReference)?;
+    let nu = eigenvalues(b)?;
+    let mut factors: Vec<f64> = nu
+        .iter()
+        .filter(|z| {
+            z.0 > 0.0 && z.1.abs() <= 1e-8 * z.0 && z.0 > 1e-12 * nu.iter().map(|z| z.0.abs()).fold(0.0, f64::max)
+        })
+        .map(|z| 1.0 / z.0)
+        .collect();
+    factors.sort_by(f64::total_cmp);
+    factors.truncate(count);
+    Ok(factors
+        .into_iter()
+        .map(|lambda| BucklingMode { load_factor: lambda, shape: mode_shape(problem, &k0, &k_sigma, lambda) })
+        .collect())
+}
+
+/// The null vector of `K₀ + λ K_σ`, scaled to `‖φ‖_w = 1` with its largest entry positive.
+fn mode_shape(problem: &Problem, k0: &DMatrix<f64>, k_sigma: &DMatrix<f64>, lambda: f64) -> DVector<f64> {
+    let svd = (k0 + k_sigma * lambda).svd(false, true);
+    let vt = svd.v_t.expect("requested");
+    let (k, _) = svd.singular_values.argmin();
+    let mut phi: DVector<f64> = vt.row(k).transpose();
+    // a held unknown does not move (its row of K₀ + λ K_σ is the identity's); the SVD leaves ~1e-8
+    for d in problem.clamped_dofs() {
+        phi[d] = 0.0;
+    }
+    let norm = wnorm2(problem, &phi, &phi).sqrt();
+    phi /= norm;
+    let dofs = problem.dofs();
+    let scaled = |i: usize| if dofs.field_of(i) == Field::X { phi[i] / problem.mesh.length_m } else { phi[i] };
+    let big = (0..phi.len()).max_by(|&i, &j| scaled(i).abs().total_cmp(&scaled(j).abs())).unwrap_or(0);
+    if phi[big] < 0.0 {
+        phi = -phi;
+    }
+    phi
+}
