@@ -11,7 +11,7 @@ use cosserat::output::run_folder::Mode;
 mod cli;
 
 use cli::args::{Cli, Command};
-use cli::commands::{cmd_audit, cmd_compare, cmd_modes, cmd_run, cmd_sweep};
+use cli::commands::{cmd_audit, cmd_buckling, cmd_compare, cmd_modes, cmd_run, cmd_sweep};
 
 /// Exit status of a run stopped by SIGINT/SIGTERM (128 + SIGINT, the shell's convention).
 const EXIT_INTERRUPTED: u8 = 130;
@@ -73,6 +73,7 @@ fn dispatch(cli: Cli) -> Result<ExitCode> {
         Command::NoiseStudy(a) => cli::noise_study::cmd_noise_study(a),
         Command::List { dir } => cli::list::cmd_list(&dir),
         Command::Modes { case, count, limits } => cmd_modes(&case, count, limits),
+        Command::Buckling { case, count } => cmd_buckling(&case, count),
     }
 }
 

@@ -186,3 +186,12 @@ fn run_warns_of_an_unstable_static_state_and_writes_its_eigenvalue() {
         .unwrap();
     assert_eq!(strict.status.code(), Some(1));
 }
+
+#[test]
+fn a_load_that_turns_the_sections_is_refused_with_the_path_to_take() {
+    // the linear response to a transverse tip load turns the sections: the linear eigenproblem
+    // in the angle chart would call the stable cantilever buckled at 0.30 of its load (D27)
+    let case = Case::from_file(std::path::Path::new("cases/timoshenko_5pct.toml")).unwrap();
+    let e = buckling(&case.problem(), 2).unwrap_err().to_string();
+    assert!(e.contains("turns the sections") && e.contains("arc_length"), "{e}");
+}

@@ -182,6 +182,16 @@ pub enum Command {
         #[arg(default_value = "cases")]
         dir: PathBuf,
     },
+    /// Critical load factors of a static case's loads about its reference (linearised
+    /// buckling, D27), with each mode's largest displacement; `solver.buckling_modes` of the case
+    /// writes the same in `run` (both engines) with the modes in buckling.csv.
+    Buckling {
+        /// Static case file (TOML): its loads are scaled by the factors printed
+        case: PathBuf,
+        /// How many critical load factors to print (at least 1)
+        #[arg(long, default_value_t = 6, allow_hyphen_values = true, value_parser = super::parse_count)]
+        count: usize,
+    },
     /// Natural frequencies of the rod linearised about its rest state (clamped at s = 0).
     Modes {
         /// Case file (TOML); loads and time settings are ignored

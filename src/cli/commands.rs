@@ -356,6 +356,39 @@ fn audit_summary(report: &cosserat::audit::AuditReport, specs: usize, out: &Path
     }
 }
 
+/// `cosserat buckling`: the lowest `count` critical load factors of a static case (D27).
+pub fn cmd_buckling(path: &Path, count: usize) -> Result<ExitCode> {
+    let case = load(path)?;
+    if !matches!(case.analysis, cosserat::case::Analysis::Static(_)) {
+        anyhow::bail!(
+            "{}: `buckling` takes a static case (solver.analysis = \"static\"): its loads are what buckles the rod",
+            path.display()
+        );
+    }
+    let problem = case.problem();
+    let modes = cosserat::solve::stability::buckling(&problem, count)?;
+    println!(
+        "{}: critical load factors of the case's loads about the reference ({} elements, D27)",
+        case.name, case.mesh.elements
+    );
+    if modes.is_empty() {
+        println!("none: the loads do not buckle the rod (no positive critical load factor)");
+        return Ok(ExitCode::SUCCESS);
+    }
+    println!("{:>4} {:>16} {:>24}", "mode", "load_factor", "largest_displacement_at_s_m");
+    let dofs = problem.dofs();
+    for (i, m) in modes.iter().enumerate() {
+        let node = (0..dofs.nodes())
+            .max_by(|&a, &b| {
+                let d = |n| dofs.get(&m.shape, n, cosserat::model::mesh::Field::X).norm();
+                d(a).total_cmp(&d(b))
+            })
+            .unwrap_or(0);
+        println!("{:>4} {:>16.9} {:>24.6}", i + 1, m.load_factor, case.mesh.node_s(node));
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
 pub fn cmd_modes(path: &Path, count: usize, limits: Limits) -> Result<ExitCode> {
     let case = load(path)?;
     if !case.density_given() {

@@ -14,6 +14,13 @@
 //! real, and `ω²_min ≤ 0` exactly when the second variation has a non-positive direction (an
 //! unstable state). A measure against `K₀` alone (`K φ = μ K₀ φ`) is not chart-free: it is
 //! negative on stable cantilevers bent by a dead load (measured on Bisshopp–Drucker, −0.93).
+//! **Which loads.** In the angle chart the first-order change of `K` along `u₁` holds, besides
+//! the stresses' geometric stiffness, the turning of the stiff axial and shear directions with the
+//! sections (terms of order EA·α₁), which only the second order balances: for a transverse tip
+//! load the linear eigenproblem gave a critical factor 0.30 where the rod stays stable to 1 and
+//! beyond (`timoshenko_5pct`). So buckling is computed only where `u₁` turns no section
+//! (`|α₁| ≤ 10⁻⁸ |x₁|/L`: columns under end forces or end shortening) and refused otherwise; a
+//! path by arc length finds the critical points of any load (D25).
 //! Follower loads, and moments (a dead moment of fixed axis is not conservative in 3D: Ziegler),
 //! make `K_s` non-symmetric and can lose stability by flutter (complex `ω²`): `ω²_min` is then
 //! reported without a verdict. `K_σ` is taken by central differences (ε such
@@ -31,6 +38,10 @@ use super::problem::{FrameAt, HeldRows};
 use super::{Problem, SolveError};
 use crate::assemble::Tangent;
 use crate::model::mesh::Field;
+
+/// The largest rotation of the sections in the linear pre-buckling response, relative to its
+/// largest displacement over the rod length, for which the linearised buckling is computed.
+pub const PREBUCKLING_TURN: f64 = 1e-8;
 
 /// Most unknowns of the dense eigen-analyses (6 per node: 300 elements).
 pub const DENSE_LIMIT: usize = 1806;
@@ -72,6 +83,8 @@ pub struct BucklingMode {
 pub enum StabilityError {
     #[error("{unknowns} unknowns: the dense eigen-analysis takes at most {limit} (300 elements)")]
     TooLarge { unknowns: usize, limit: usize },
+    #[error("the linear response to the loads turns the sections (by {turn_rad:.3e} rad per unit load factor, against a displacement of {shift:.3e} rod lengths): linearised buckling about the reference is computed only for loads that compress or stretch the rod without turning it (a column, D27); follow the path with solver.continuation = \"arc_length\", whose critical_points.csv holds its limit and bifurcation points")]
+    TurningPrebuckling { turn_rad: f64, shift: f64 },
     #[error("the unloaded rod's Newton matrix K0 is singular (a rigid-body motion is left free)")]
     SingularReference,
     #[error("the mass matrix is singular (the chart's singular set, cos β = 0, at a node?)")]
@@ -160,6 +173,19 @@ pub fn buckling(problem: &Problem, count: usize) -> Result<Vec<BucklingMode>, St
     let size = wnorm2(problem, &u1, &u1).sqrt();
     if size == 0.0 || !size.is_finite() {
         return Ok(Vec::new()); // no load: nothing buckles
+    }
+    // the linear pre-buckling response must keep the sections' orientation (module doc)
+    let dofs = problem.dofs();
+    let (mut turn, mut shift) = (0.0_f64, 0.0_f64);
+    for (i, v) in u1.iter().enumerate() {
+        if dofs.field_of(i) == Field::X {
+            shift = shift.max(v.abs() / problem.mesh.length_m);
+        } else {
+            turn = turn.max(v.abs());
+        }
+    }
+    if turn > PREBUCKLING_TURN * shift {
+        return Err(StabilityError::TurningPrebuckling { turn_rad: turn, shift });
     }
     let eps = 1e-5 / size;
     let kp = dense_tangent(problem, &(&u0 + &u1 * eps), eps);
