@@ -182,9 +182,12 @@ pub enum Command {
         #[arg(default_value = "cases")]
         dir: PathBuf,
     },
-    /// Critical load factors of a static case's loads about its reference (linearised
-    /// buckling, D27), with each mode's largest displacement; `solver.buckling_modes` of the case
-    /// writes the same in `run` (both engines) with the modes in buckling.csv.
+    /// Critical load factors of a static case's loads (linearised buckling about the reference).
+    ///
+    /// Each with the arc length where its mode moves most (docs/decisions.md D27). Computed for
+    /// loads that compress or stretch the rod without turning its sections (columns); others are
+    /// refused with the arc-length path to take. `solver.buckling_modes` in the case writes the
+    /// same from `run`, in both engines, with the modes in buckling.csv.
     Buckling {
         /// Static case file (TOML): its loads are scaled by the factors printed
         case: PathBuf,
