@@ -138,7 +138,9 @@ fn an_interrupted_batch_stops_at_the_next_frame_and_says_what_it_kept() {
         .expect("batch");
     let frames = out.join(format!(".roll_000.staging-{}", child.id())).join("frames.csv");
     let start = std::time::Instant::now();
-    while std::fs::read_to_string(&frames).map(|t| t.lines().count()).unwrap_or(0) < 20 {
+    // frames.csv: a header line, then one newline-terminated row per finished frame
+    let rows_written = || std::fs::read_to_string(&frames).map(|t| t.matches('\n').count()).unwrap_or(0);
+    while rows_written() < 1 + 20 {
         assert!(start.elapsed().as_secs() < 60 && child.try_wait().expect("try_wait").is_none(), "no progress");
         std::thread::sleep(std::time::Duration::from_millis(5));
     }
