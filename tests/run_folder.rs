@@ -48,7 +48,7 @@ fn staging(target: &Path, pid: u32) -> PathBuf {
 fn wait_for_frames(child: &mut Child, dir: &Path, frames: usize) {
     let start = Instant::now();
     loop {
-        let n = std::fs::read_to_string(dir.join("frames.csv")).map(|t| t.lines().count()).unwrap_or(0);
+        let n = std::fs::read_to_string(dir.join("frames.csv")).map(|t| t.matches('\n').count()).unwrap_or(0);
         if n > frames {
             return;
         }
@@ -316,11 +316,11 @@ fn runs_beyond_the_memory_limit_are_refused_before_allocating() {
 }
 
 /// Wait until a file under the staging folder of `target` (written by `child`) has `lines`
-/// lines: `rel` is its path under the staging folder.
+/// newline-terminated lines (a header counts): `rel` is its path under the staging folder.
 fn wait_for_lines(child: &mut Child, target: &Path, rel: &str, lines: usize) {
     let stage = staging(target, child.id());
     let start = Instant::now();
-    while std::fs::read_to_string(stage.join(rel)).map(|t| t.lines().count()).unwrap_or(0) < lines {
+    while std::fs::read_to_string(stage.join(rel)).map(|t| t.matches('\n').count()).unwrap_or(0) < lines {
         assert!(child.try_wait().expect("try_wait").is_none(), "ended before it was interrupted");
         assert!(start.elapsed() < Duration::from_secs(120), "no progress in {}", stage.join(rel).display());
         std::thread::sleep(Duration::from_millis(5));
@@ -335,7 +335,7 @@ fn an_interrupted_sweep_stops_every_point_and_says_what_it_kept() {
     let dir = tempfile::tempdir().expect("tempdir");
     let out = dir.path().join("clips");
     let mut child = spawn(&["sweep", CLIP, "--quiet", "--jobs", "2", "--set", "lambda_d=1,2,3"], &out);
-    wait_for_lines(&mut child, &out, "lambda_d=1/frames.csv", 20);
+    wait_for_lines(&mut child, &out, "lambda_d=1/frames.csv", 1 + 20);
     signal(&child, "-INT");
     let o = child.wait_with_output().expect("wait");
     let stderr = String::from_utf8_lossy(&o.stderr);
