@@ -274,6 +274,24 @@ fn read_opened_capped(path: &Path, cap: u64, what: &'static str, piped: bool) ->
     Ok(bytes)
 }
 
+/// Open the regular file `path` to be read as it goes (not held whole) if it has at most `cap`
+/// bytes; the same errors as [`read_capped`]. Returns the file and its size [bytes].
+pub fn open_capped(path: &Path, cap: u64, what: &'static str) -> Result<(std::fs::File, u64), InputError> {
+    check_regular(path, what)?;
+    let open = |source| InputError::Open { path: path.to_path_buf(), source };
+    let file = std::fs::File::open(path).map_err(open)?;
+    let meta = file.metadata().map_err(open)?;
+    if !meta.is_file() {
+        // replaced between the check and the open
+        let kind = crate::file_kind::FileKind::of(&meta);
+        return Err(InputError::NotRegular { path: path.to_path_buf(), what, kind });
+    }
+    if meta.len() > cap {
+        return Err(InputError::TooLarge { path: path.to_path_buf(), what, size: Some(meta.len()), cap });
+    }
+    Ok((file, meta.len()))
+}
+
 /// `Ok` if `path` is a regular file (symbolic links followed), found without opening it
 /// (`crate::file_kind`); the error names the input (`what`) and what the path is instead.
 pub fn check_regular(path: &Path, what: &'static str) -> Result<(), InputError> {

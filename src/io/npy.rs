@@ -11,10 +11,12 @@
 //!
 //! Anything else (another dtype, big-endian, Fortran order, a data block of the wrong length)
 //! is an error that says what was found; no value is guessed or converted.
-use std::path::Path;
+use std::fs::File;
+use std::io::{BufReader, Read};
+use std::path::{Path, PathBuf};
 
 pub use super::files::NpyError;
-use super::files::{read_capped, write_atomic, InputError, OutputError, MAX_AXES};
+use super::files::{open_capped, read_capped, write_atomic, InputError, OutputError, MAX_AXES};
 
 const MAGIC: &[u8] = b"\x93NUMPY";
 
@@ -35,6 +37,59 @@ pub struct NpyArray {
 pub fn read_npy(path: &Path) -> Result<NpyArray, InputError> {
     let bytes = read_capped(path, NPY_FILE_CAP_BYTES, ".npy file")?;
     parse_npy(&bytes).map_err(|reason| InputError::Npy { path: path.to_path_buf(), reason: Box::new(reason) })
+}
+
+/// A little-endian float64, C-order `.npy` file of at most [`NPY_FILE_CAP_BYTES`] opened for
+/// reading its values in order, a block at a time ([`NpyStream::read`]), so that a reader that
+/// converts them as they come never holds the file and its array at once. Opening reads and
+/// checks the header, and the length of the data against the shape, as [`read_npy`] does.
+pub struct NpyStream {
+    /// Extent of each axis.
+    pub shape: Vec<usize>,
+    path: PathBuf,
+    reader: BufReader<File>,
+    /// values not yet read
+    left: usize,
+}
+
+/// Open `path` as an [`NpyStream`]: the same checks and errors as [`read_npy`].
+pub fn open_npy(path: &Path) -> Result<NpyStream, InputError> {
+    let open = |source| InputError::Open { path: path.to_path_buf(), source };
+    let npy = |reason| InputError::Npy { path: path.to_path_buf(), reason: Box::new(reason) };
+    let (file, len) = open_capped(path, NPY_FILE_CAP_BYTES, ".npy file")?;
+    let mut reader = BufReader::new(file);
+    // the magic string, the version and the header length, then the header (≤ the file's size)
+    let mut head = vec![0u8; len.min(HEADER_LENGTH_END as u64) as usize];
+    reader.read_exact(&mut head).map_err(open)?;
+    let end = header_end(&head).map_err(npy)?;
+    if end as u64 > len {
+        return Err(npy(NpyError::TruncatedHeader { header_len: end - header_length_start(&head) }));
+    }
+    let known = head.len();
+    head.resize(end, 0);
+    reader.read_exact(&mut head[known..]).map_err(open)?;
+    let (descr, shape, _) = npy_payload(&head).map_err(npy)?;
+    let count = check_data(&descr, &shape, (len - end as u64) as usize).map_err(npy)?;
+    Ok(NpyStream { shape, path: path.to_path_buf(), reader, left: count })
+}
+
+impl NpyStream {
+    /// Fill `out` with the next `out.len()` values (C order); asking for more than are left is
+    /// an error.
+    pub fn read(&mut self, out: &mut [f64]) -> Result<(), InputError> {
+        let open = |source| InputError::Open { path: self.path.clone(), source };
+        if out.len() > self.left {
+            let e = std::io::Error::new(std::io::ErrorKind::UnexpectedEof, "read past the array's values");
+            return Err(open(e));
+        }
+        let mut bytes = [0u8; 8];
+        for v in out.iter_mut() {
+            self.reader.read_exact(&mut bytes).map_err(open)?;
+            *v = f64::from_le_bytes(bytes);
+        }
+        self.left -= out.len();
+        Ok(())
+    }
 }
 
 /// Write `data` (C order) with the given shape as a version 1.0 `.npy` file, atomically.
@@ -83,50 +138,70 @@ pub fn npy_header(descr: &str, shape: &[usize]) -> Vec<u8> {
 /// before anything is allocated or indexed.
 pub fn parse_npy(bytes: &[u8]) -> Result<NpyArray, NpyError> {
     let (descr, shape, body) = npy_payload(bytes)?;
+    check_data(&descr, &shape, body.len())?;
+    let data = body.chunks_exact(8).map(|c| f64::from_le_bytes(c.try_into().expect("chunks of 8"))).collect();
+    Ok(NpyArray { shape, data })
+}
+
+/// The number of values of a float64 array of `shape` whose data are `found` bytes: an error
+/// for another dtype than `<f8` or data of another length than the shape's.
+fn check_data(descr: &str, shape: &[usize], found: usize) -> Result<usize, NpyError> {
     if descr != "<f8" {
-        return Err(NpyError::Dtype { descr: preview(&descr) });
+        return Err(NpyError::Dtype { descr: preview(descr) });
     }
     let count = shape.iter().try_fold(1usize, |a, &n| a.checked_mul(n)).ok_or(NpyError::ShapeOverflow)?;
     let expected = count.checked_mul(8).ok_or(NpyError::ShapeOverflow)?;
-    if body.len() < expected {
-        return Err(NpyError::TruncatedData { shape, expected, found: body.len() });
+    if found < expected {
+        return Err(NpyError::TruncatedData { shape: shape.to_vec(), expected, found });
     }
-    if body.len() > expected {
-        return Err(NpyError::TrailingBytes { extra: body.len() - expected, shape, expected });
+    if found > expected {
+        return Err(NpyError::TrailingBytes { extra: found - expected, shape: shape.to_vec(), expected });
     }
-    let data = body.chunks_exact(8).map(|c| f64::from_le_bytes(c.try_into().expect("chunks of 8"))).collect();
-    Ok(NpyArray { shape, data })
+    Ok(count)
+}
+
+/// The byte after the header length of a version 2.0 or 3.0 file (version 1.0: two before).
+const HEADER_LENGTH_END: usize = MAGIC.len() + 2 + 4;
+
+/// Where the header of an `.npy` file starts, from its first [`HEADER_LENGTH_END`] bytes (or
+/// fewer): after the magic string, the version and the header length, 2 bytes (1.0) or 4.
+fn header_length_start(bytes: &[u8]) -> usize {
+    MAGIC.len() + 2 + if bytes.get(MAGIC.len()) == Some(&1) { 2 } else { 4 }
+}
+
+/// Where the header of an `.npy` file ends (its data start), from the first
+/// [`HEADER_LENGTH_END`] bytes of the file (or fewer): the magic string, the version and the
+/// header length checked.
+fn header_end(bytes: &[u8]) -> Result<usize, NpyError> {
+    if bytes.len() < MAGIC.len() + 2 || &bytes[..MAGIC.len()] != MAGIC {
+        return Err(NpyError::NoMagic);
+    }
+    let start = MAGIC.len() + 2;
+    let header_len = match bytes[MAGIC.len()] {
+        1 => {
+            let b = bytes.get(start..start + 2).ok_or(NpyError::TruncatedHeaderLength)?;
+            u16::from_le_bytes([b[0], b[1]]) as usize
+        }
+        2 | 3 => {
+            let b = bytes.get(start..start + 4).ok_or(NpyError::TruncatedHeaderLength)?;
+            u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize
+        }
+        major => return Err(NpyError::Version { major }),
+    };
+    Ok(header_length_start(bytes) + header_len)
 }
 
 /// The dtype, shape and data bytes of a C-order `.npy` file (the data not checked against the
 /// shape).
 pub fn npy_payload(bytes: &[u8]) -> Result<(String, Vec<usize>, &[u8]), NpyError> {
-    if bytes.len() < MAGIC.len() + 2 || &bytes[..MAGIC.len()] != MAGIC {
-        return Err(NpyError::NoMagic);
-    }
-    let major = bytes[MAGIC.len()];
-    let start = MAGIC.len() + 2;
-    let (header_len, data_start) = match major {
-        1 => {
-            let b = bytes.get(start..start + 2).ok_or(NpyError::TruncatedHeaderLength)?;
-            (u16::from_le_bytes([b[0], b[1]]) as usize, start + 2)
-        }
-        2 | 3 => {
-            let b = bytes.get(start..start + 4).ok_or(NpyError::TruncatedHeaderLength)?;
-            (u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize, start + 4)
-        }
-        major => return Err(NpyError::Version { major }),
-    };
-    let header = data_start
-        .checked_add(header_len)
-        .and_then(|end| bytes.get(data_start..end))
-        .ok_or(NpyError::TruncatedHeader { header_len })?;
+    let (start, end) = (header_length_start(bytes), header_end(bytes)?);
+    let header = bytes.get(start..end).ok_or(NpyError::TruncatedHeader { header_len: end - start })?;
     let header = std::str::from_utf8(header).map_err(|_| NpyError::HeaderNotText)?;
     let (descr, fortran, shape) = parse_header(header)?;
     if fortran {
         return Err(NpyError::FortranOrder);
     }
-    Ok((descr, shape, &bytes[data_start + header_len..]))
+    Ok((descr, shape, &bytes[end..]))
 }
 
 /// The three entries of the header dictionary: `descr`, `fortran_order`, `shape`.
@@ -268,6 +343,42 @@ mod tests {
         assert!(e.contains("'-3'"), "{e}");
         let e = parse_npy(&edit("'fortran_order'", "'descr'        ")).unwrap_err().to_string();
         assert_eq!(e, "header: key 'descr' given twice");
+    }
+
+    /// The stream reads what the whole-file reader reads, in blocks of any size, and refuses
+    /// what it refuses with the same message: well-formed files of versions 1 and 2, and files
+    /// cut at every length, with bytes after the data, of another dtype or a header length beyond
+    /// the file.
+    #[test]
+    fn the_stream_reads_and_refuses_as_the_whole_file_reader() {
+        let dir = tempfile::tempdir().unwrap();
+        let data: Vec<f64> = (0..24).map(|i| (i as f64 * 0.7).cos() * 1e-4).collect();
+        let good = npy_bytes(&[2, 4, 3], &data);
+        let mut v2 = MAGIC.to_vec();
+        let header = "{'descr': '<f8', 'fortran_order': False, 'shape': (2, 12), }\n";
+        v2.extend_from_slice(&[2, 0]);
+        v2.extend_from_slice(&(header.len() as u32).to_le_bytes());
+        v2.extend_from_slice(header.as_bytes());
+        v2.extend(data.iter().flat_map(|v| v.to_le_bytes()));
+        let mut files = vec![good.clone(), v2, [good.clone(), vec![0; 8]].concat()];
+        files.extend((0..good.len()).step_by(7).map(|n| good[..n].to_vec()));
+        files.push(String::from_utf8_lossy(&good).replacen("<f8", "<f4", 1).into_bytes());
+        files.push([MAGIC, &[1, 0, 0xff, 0xff]].concat());
+        for (k, bytes) in files.iter().enumerate() {
+            let path = dir.path().join(format!("f{k}.npy"));
+            std::fs::write(&path, bytes).unwrap();
+            let whole = read_npy(&path).map_err(|e| e.to_string());
+            let streamed = open_npy(&path).map_err(|e| e.to_string()).and_then(|mut a| {
+                let mut values = vec![0.0; a.shape.iter().product()];
+                for block in values.chunks_mut(5) {
+                    a.read(block).map_err(|e| e.to_string())?;
+                }
+                assert!(a.read(&mut [0.0]).is_err(), "nothing after the last value");
+                Ok(NpyArray { shape: a.shape.clone(), data: values })
+            });
+            assert_eq!(streamed, whole, "file {k} ({} bytes)", bytes.len());
+        }
+        assert!(read_npy(&dir.path().join("f0.npy")).is_ok() && read_npy(&dir.path().join("f3.npy")).is_err());
     }
 
     /// Lengths from the file (header length, shape) that overflow or exceed the bytes present.

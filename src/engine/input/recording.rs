@@ -30,8 +30,8 @@ pub mod wcon;
 use crate::clip::missing::MissingData;
 use crate::clip::recording::{constant_axis, LengthUnit, RecordingInfo, UnitSpec};
 use crate::clip::MAX_CLIP_POSITIONS;
-use crate::io::files::{read_capped, InputError};
-use crate::io::npy::read_npy;
+use crate::io::files::{open_capped, InputError};
+use crate::io::npy::open_npy;
 
 /// Largest CSV or WCON recording read [bytes]: 1 GiB. The paper's clip (1160 frames × 128
 /// nodes) is about 11 MB as CSV; an hour at 30 frames/s with 128 nodes about 1 GB. (NPY
@@ -65,7 +65,7 @@ pub fn read_positions(path: &Path, spec: &ReadSpec) -> Result<Recorded, InputErr
     }
     let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
     let table = match ext.as_deref() {
-        Some("npy") => npy_table(path, spec)?,
+        Some("npy") => return npy_recorded(path, spec),
         Some("csv") => csv_table(path, spec)?,
         Some("wcon") | Some("json") => wcon::read(path, spec)?,
         _ => return Err(shape("unknown extension, expected .csv, .npy, .wcon or .json".into())),
@@ -168,15 +168,7 @@ impl Table {
             }
             out.push(pts);
         }
-        let info = RecordingInfo {
-            first_frame: first,
-            unit: self.unit,
-            plane_normal: if self.planar {
-                Some(Vector3::z())
-            } else {
-                constant_axis(&out).map(|k| Vector3::ith(k, 1.0))
-            },
-        };
+        let info = recording_info(first, self.unit, self.planar, &out);
         Ok(Recorded { frames: out, info })
     }
 }
@@ -285,8 +277,9 @@ fn csv_header(path: &Path, header: &[String]) -> Result<(LengthUnit, bool), Inpu
 
 /// The rows of a CSV recording (module doc).
 fn csv_table(path: &Path, spec: &ReadSpec) -> Result<Table, InputError> {
-    let bytes = read_capped(path, RECORDING_CAP_BYTES, "recording")?;
-    let mut rdr = csv::ReaderBuilder::new().trim(csv::Trim::All).flexible(true).from_reader(bytes.as_slice());
+    // read as it goes: an hour's CSV (about 1 GB) is never held beside its rows
+    let (file, _) = open_capped(path, RECORDING_CAP_BYTES, "recording")?;
+    let mut rdr = csv::ReaderBuilder::new().trim(csv::Trim::All).flexible(true).buffer_capacity(1 << 20).from_reader(file);
     let csv_err = |source| InputError::Csv { path: path.to_path_buf(), source };
     let header: Vec<String> = rdr.headers().map_err(csv_err)?.iter().map(String::from).collect();
     let (file_unit, planar) = csv_header(path, &header)?;
@@ -330,9 +323,11 @@ fn csv_table(path: &Path, spec: &ReadSpec) -> Result<Table, InputError> {
     Ok(Table { rows, planar, unit })
 }
 
-/// The rows of an NPY recording, `frames × nodes × 3` or `× 2` (frames numbered from 0).
-fn npy_table(path: &Path, spec: &ReadSpec) -> Result<Table, InputError> {
-    let a = read_npy(path)?;
+/// An NPY recording, `frames × nodes × 3` or `× 2` (frames numbered from 0): a full grid, so
+/// its frames are laid out as the file is read, a frame at a time (an hour of 128 nodes at 30
+/// frames/s is 330 MB of positions: never held twice).
+fn npy_recorded(path: &Path, spec: &ReadSpec) -> Result<Recorded, InputError> {
+    let mut a = open_npy(path)?;
     let shape = |reason: String| InputError::Shape { path: path.to_path_buf(), reason };
     let &[frames, nodes, dims @ (2 | 3)] = a.shape.as_slice() else {
         return Err(shape(format!("recording of shape {:?}, expected frames × nodes × 3 (or × 2)", a.shape)));
@@ -340,7 +335,7 @@ fn npy_table(path: &Path, spec: &ReadSpec) -> Result<Table, InputError> {
     if frames == 0 || nodes < 3 {
         return Err(shape(format!("recording of shape {:?}: need at least 1 frame and 3 nodes", a.shape)));
     }
-    // frames × nodes × dims values were read: the product does not overflow.
+    // the shape's product was checked by open_npy: it does not overflow
     if frames * nodes > MAX_CLIP_POSITIONS {
         return Err(shape(format!(
             "recording of shape {:?}: {} positions, more than the {MAX_CLIP_POSITIONS} a clip may hold",
@@ -349,15 +344,27 @@ fn npy_table(path: &Path, spec: &ReadSpec) -> Result<Table, InputError> {
         )));
     }
     let (unit, metres) = resolve_unit(path, None, &spec.units, "the NPY file")?;
-    let mut rows = Vec::with_capacity(frames * nodes);
-    for (k, c) in a.data.chunks_exact(dims).enumerate() {
-        let (f, i) = (k / nodes, k % nodes);
-        let p = Vector3::new(c[0], c[1], if dims == 3 { c[2] } else { 0.0 });
-        check_position(path, (f, i), &p, spec.missing)?;
-        let p = if p.iter().any(|v| v.is_nan()) { Vector3::repeat(f64::NAN) } else { p * metres };
-        rows.push((f, i, p, 0));
+    let mut values = vec![0.0; nodes * dims];
+    let mut out = Vec::with_capacity(frames);
+    for f in 0..frames {
+        a.read(&mut values)?;
+        let mut pts = Vec::with_capacity(nodes);
+        for (i, c) in values.chunks_exact(dims).enumerate() {
+            let p = Vector3::new(c[0], c[1], if dims == 3 { c[2] } else { 0.0 });
+            check_position(path, (f, i), &p, spec.missing)?;
+            pts.push(if p.iter().any(|v| v.is_nan()) { Vector3::repeat(f64::NAN) } else { p * metres });
+        }
+        out.push(pts);
     }
-    Ok(Table { rows, planar: dims == 2, unit })
+    let info = recording_info(0, unit, dims == 2, &out);
+    Ok(Recorded { frames: out, info })
+}
+
+/// What a recording says about itself: its first frame number, its unit and its plane (z = 0
+/// for two coordinates, else an axis along which every position is the same).
+fn recording_info(first_frame: usize, unit: LengthUnit, planar: bool, frames: &[Vec<Vector3<f64>>]) -> RecordingInfo {
+    let plane_normal = if planar { Some(Vector3::z()) } else { constant_axis(frames).map(|k| Vector3::ith(k, 1.0)) };
+    RecordingInfo { first_frame, unit, plane_normal }
 }
 
 #[cfg(test)]
