@@ -19,7 +19,7 @@ use std::sync::OnceLock;
 
 use common::fixed_point::{paper, run, Data, Run};
 use common::with_weights;
-use cosserat::engine::rust::metrics::curvature_error;
+use cosserat::engine::metrics::curvature_error;
 use cosserat::solve::inverse::InverseParams;
 use rayon::prelude::*;
 

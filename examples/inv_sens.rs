@@ -3,7 +3,7 @@
 //! `cargo run --release --example inv_sens -- cases/inverse_bend.toml [eps]`
 use anyhow::{Context, Result};
 use cosserat::case::{Analysis, Case};
-use cosserat::engine::rust::metrics::max_relative_difference;
+use cosserat::engine::metrics::max_relative_difference;
 use cosserat::engine::rust::{forward_data, run_inverse};
 
 fn main() -> Result<()> {

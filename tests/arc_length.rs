@@ -9,7 +9,7 @@ mod common;
 
 use common::case_from;
 use cosserat::case::{Analysis, Case};
-use cosserat::engine::rust::RunResult;
+use cosserat::engine::RunResult;
 use cosserat::jobs::compare::{compare_case, CompareOptions};
 use cosserat::solve::arclength::{self, Critical};
 use cosserat::solve::statics::StaticParams;

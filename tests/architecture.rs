@@ -7,6 +7,10 @@
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
+#[path = "architecture/source.rs"]
+mod source;
+use source::{code_only, cycles, functions, paths, pub_structs, resolve};
+
 /// Layers, lowest first; a module may use its own top-level module and those of lower layers.
 const LAYERS: &[&[&str]] = &[
     &["expr", "linalg", "reference", "interrupt", "file_kind"],
@@ -25,10 +29,39 @@ const LAYERS: &[&[&str]] = &[
 ];
 
 /// The same rule inside a folder, between its sub-folders (lowest first; a module in none of
-/// them is its folder's top): the Rust engine knows neither FreeFEM nor the files the engines
-/// read; the FreeFEM engine gives the Rust engine's results; `engine` itself (`run_case`) is
-/// the interface above both.
-const SUBLAYERS: &[&[&str]] = &[&["engine::rust"], &["engine::input"], &["engine::freefem"], &["engine"]];
+/// them is its folder's top): what both engines give (`engine::common`: results, metrics, clip
+/// frames) below the files they read (`engine::input`), below the two engines side by side,
+/// below `engine` itself (`run_case`), the interface above both.
+const SUBLAYERS: &[&[&str]] =
+    &[&["engine::common"], &["engine::input"], &["engine::rust", "engine::freefem"], &["engine"]];
+
+/// Sub-folders of one sub-layer that import each other in neither direction: the engines.
+const SIBLINGS: &[(&str, &str)] = &[("engine::rust", "engine::freefem")];
+
+/// Folders whose sub-folders the layers above reach only through the folder's own module (its
+/// `mod.rs`, the interface): above `engine`, `crate::engine::RunResult`, never
+/// `crate::engine::rust::…`; except the sub-folders of [`OPEN`].
+const SEALED: &[&str] = &["engine"];
+
+/// Sub-folders of a [`SEALED`] folder that are part of its interface: the files the engines
+/// read (`engine::input`: data files, recordings, their ground truth, the synthetic corpora).
+const OPEN: &[&str] = &["engine::input"];
+
+fn within(module: &str, folder: &str) -> bool {
+    module == folder || module.starts_with(&format!("{folder}::"))
+}
+
+/// Does an import `from` → `to` break a [`SIBLINGS`] or a [`SEALED`] rule? Its reason.
+fn crosses_seam(from: &str, to: &str) -> Option<&'static str> {
+    if SIBLINGS.iter().any(|(a, b)| (within(from, a) && within(to, b)) || (within(from, b) && within(to, a))) {
+        return Some("the engines import each other");
+    }
+    let open = OPEN.iter().any(|o| within(to, o));
+    if !open && SEALED.iter().any(|f| !within(from, f) && within(to, f) && to != *f) {
+        return Some("past the engine's interface");
+    }
+    None
+}
 
 /// Longest source file allowed [lines].
 const MAX_LINES: usize = 600;
@@ -73,214 +106,6 @@ fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
     }
 }
 
-/// The code of a Rust file without comments and string literals (paths in docs and messages
-/// are not imports).
-fn code_only(text: &str) -> String {
-    let b: Vec<char> = text.chars().collect();
-    let mut out = String::with_capacity(text.len());
-    let mut i = 0;
-    while i < b.len() {
-        if b[i] == '/' && b.get(i + 1) == Some(&'/') {
-            while i < b.len() && b[i] != '\n' {
-                i += 1;
-            }
-        } else if b[i] == '/' && b.get(i + 1) == Some(&'*') {
-            i += 2;
-            while i + 1 < b.len() && !(b[i] == '*' && b[i + 1] == '/') {
-                if b[i] == '\n' {
-                    out.push('\n'); // keep line numbers
-                }
-                i += 1;
-            }
-            i += 2;
-        } else if b[i] == '"' {
-            i += 1;
-            let mut newlines = 0;
-            while i < b.len() && b[i] != '"' {
-                newlines += usize::from(b[i] == '\n');
-                i += if b[i] == '\\' { 2 } else { 1 };
-            }
-            i += 1;
-            out.push_str("\"\"");
-            out.extend(std::iter::repeat_n('\n', newlines));
-        } else if b[i] == '\'' && b.get(i + 2) == Some(&'\'') {
-            i += 3; // a char literal such as '"'
-        } else {
-            out.push(b[i]);
-            i += 1;
-        }
-    }
-    out
-}
-
-/// Every path that starts with `crate`, `super`, `self` or `cosserat` in `code`, with `use`
-/// groups `a::{b, c::d}` expanded.
-fn paths(code: &str) -> Vec<Vec<String>> {
-    let chars: Vec<char> = code.chars().collect();
-    let mut out = Vec::new();
-    let ident = |c: char| c.is_alphanumeric() || c == '_';
-    let mut i = 0;
-    while i < chars.len() {
-        if ident(chars[i]) && (i == 0 || !(ident(chars[i - 1]) || chars[i - 1] == ':')) {
-            let start = i;
-            while i < chars.len() && ident(chars[i]) {
-                i += 1;
-            }
-            let word: String = chars[start..i].iter().collect();
-            if matches!(word.as_str(), "crate" | "super" | "self" | "cosserat") && chars.get(i) == Some(&':') {
-                let mut prefix = vec![word];
-                i = read_path(&chars, i, &mut prefix, &mut out);
-            }
-        } else {
-            i += 1;
-        }
-    }
-    out
-}
-
-/// Continue a path after `prefix` at `i` (which points at `::`), pushing complete paths.
-fn read_path(chars: &[char], mut i: usize, prefix: &mut Vec<String>, out: &mut Vec<Vec<String>>) -> usize {
-    let ident = |c: char| c.is_alphanumeric() || c == '_';
-    while chars.get(i) == Some(&':') && chars.get(i + 1) == Some(&':') {
-        i += 2;
-        while chars.get(i).is_some_and(|c| c.is_whitespace()) {
-            i += 1;
-        }
-        if chars.get(i) == Some(&'{') {
-            i += 1;
-            loop {
-                while chars.get(i).is_some_and(|c| c.is_whitespace() || *c == ',') {
-                    i += 1;
-                }
-                match chars.get(i) {
-                    None => return i,
-                    Some('}') => return i + 1,
-                    _ => {}
-                }
-                let start = i;
-                while chars.get(i).is_some_and(|c| ident(*c) || *c == '*') {
-                    i += 1;
-                }
-                let mut p = prefix.clone();
-                p.push(chars[start..i].iter().collect());
-                i = read_path(chars, i, &mut p, out);
-                // skip `as name`
-                while chars.get(i).is_some_and(|c| *c != ',' && *c != '}') {
-                    i += 1;
-                }
-            }
-        }
-        let start = i;
-        while chars.get(i).is_some_and(|c| ident(*c) || *c == '*') {
-            i += 1;
-        }
-        if start == i {
-            break;
-        }
-        prefix.push(chars[start..i].iter().collect());
-    }
-    out.push(prefix.clone());
-    i
-}
-
-/// The module a path in `from` refers to: the longest prefix that is a known module.
-fn resolve(from: &str, path: &[String], modules: &BTreeSet<String>) -> Option<String> {
-    let mut base: Vec<String> = match path[0].as_str() {
-        "crate" | "cosserat" => Vec::new(),
-        "self" | "super" => {
-            // `self` is the file's module, `super` its parent (inline `mod tests` blocks use
-            // `super` for their file: an edge to the parent, which is not counted)
-            let mut b: Vec<String> =
-                if from.is_empty() { Vec::new() } else { from.split("::").map(String::from).collect() };
-            if path[0] == "super" {
-                b.pop();
-            }
-            b
-        }
-        _ => return None,
-    };
-    let mut rest = &path[1..];
-    while rest.first().is_some_and(|s| s == "super") {
-        base.pop();
-        rest = &rest[1..];
-    }
-    let mut best = None;
-    let mut cur = base.clone();
-    if !cur.is_empty() && modules.contains(&cur.join("::")) {
-        best = Some(cur.join("::"));
-    }
-    for seg in rest {
-        cur.push(seg.clone());
-        let name = cur.join("::");
-        if modules.contains(&name) {
-            best = Some(name);
-        }
-    }
-    best
-}
-
-/// Strongly connected components with more than one module (Tarjan).
-fn cycles(graph: &BTreeMap<String, BTreeSet<String>>) -> Vec<Vec<String>> {
-    struct T<'a> {
-        g: &'a BTreeMap<String, BTreeSet<String>>,
-        index: BTreeMap<&'a str, usize>,
-        low: BTreeMap<&'a str, usize>,
-        stack: Vec<&'a str>,
-        on: BTreeSet<&'a str>,
-        next: usize,
-        out: Vec<Vec<String>>,
-    }
-    fn visit<'a>(t: &mut T<'a>, v: &'a str) {
-        t.index.insert(v, t.next);
-        t.low.insert(v, t.next);
-        t.next += 1;
-        t.stack.push(v);
-        t.on.insert(v);
-        for w in t.g.get(v).into_iter().flatten() {
-            let w = w.as_str();
-            if !t.index.contains_key(w) {
-                visit(t, w);
-                let lw = t.low[w];
-                let lv = t.low.get_mut(v).expect("low");
-                *lv = (*lv).min(lw);
-            } else if t.on.contains(w) {
-                let iw = t.index[w];
-                let lv = t.low.get_mut(v).expect("low");
-                *lv = (*lv).min(iw);
-            }
-        }
-        if t.low[v] == t.index[v] {
-            let mut comp = Vec::new();
-            while let Some(w) = t.stack.pop() {
-                t.on.remove(w);
-                comp.push(w.to_string());
-                if w == v {
-                    break;
-                }
-            }
-            if comp.len() > 1 {
-                comp.sort();
-                t.out.push(comp);
-            }
-        }
-    }
-    let mut t = T {
-        g: graph,
-        index: BTreeMap::new(),
-        low: BTreeMap::new(),
-        stack: Vec::new(),
-        on: BTreeSet::new(),
-        next: 0,
-        out: Vec::new(),
-    };
-    for v in graph.keys() {
-        if !t.index.contains_key(v.as_str()) {
-            visit(&mut t, v);
-        }
-    }
-    t.out
-}
-
 #[test]
 fn layers_are_imported_downward_only_without_cycles_and_files_are_short() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
@@ -292,6 +117,7 @@ fn layers_are_imported_downward_only_without_cycles_and_files_are_short() {
         files.iter().map(|f| module_of(&src, f)).filter(|m| !m.is_empty() && m != "main").collect();
     let mut graph: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
     let mut upward = Vec::new();
+    let mut seams = Vec::new();
     let mut long = Vec::new();
     for f in &files {
         let text = std::fs::read_to_string(f).expect("source");
@@ -310,6 +136,9 @@ fn layers_are_imported_downward_only_without_cycles_and_files_are_short() {
             graph.entry(from.clone()).or_default().insert(to.clone());
             if goes_up(&from, &to) {
                 upward.push(format!("{from} → {to} ({})", p.join("::")));
+            }
+            if let Some(why) = crosses_seam(&from, &to) {
+                seams.push(format!("{from} → {to} ({}): {why}", p.join("::")));
             }
         }
     }
@@ -332,6 +161,18 @@ fn layers_are_imported_downward_only_without_cycles_and_files_are_short() {
     );
     assert!(cyc.is_empty(), "import cycles: {cyc:?}");
     assert!(upward.is_empty(), "imports from a lower layer to a higher one:\n{}", upward.join("\n"));
+    // who imports each part of `engine/`: modules above it, and the engines themselves
+    let importers = |e: &str, from: &dyn Fn(&str) -> bool| {
+        graph.iter().filter(|(f, to)| from(f) && !within(f, e) && to.iter().any(|t| within(t, e))).count()
+    };
+    let engines = |f: &str| within(f, "engine::rust") || within(f, "engine::freefem");
+    for e in ["engine::rust", "engine::freefem", "engine::common", "engine::input"] {
+        let above = importers(e, &|f| !within(f, "engine"));
+        println!("{e}: imported by {above} modules above engine/, {} modules of the engines", importers(e, &engines));
+    }
+    let interface = graph.iter().filter(|(f, to)| !within(f, "engine") && to.contains("engine")).count();
+    println!("engine (the interface, engine/mod.rs): imported by {interface} modules above engine/");
+    assert!(seams.is_empty(), "imports across the engine seam:\n{}", seams.join("\n"));
     let mut test_files = Vec::new();
     rust_files(&root.join("tests"), &mut test_files);
     rust_files(&root.join("examples"), &mut test_files);
@@ -346,63 +187,6 @@ fn layers_are_imported_downward_only_without_cycles_and_files_are_short() {
 
 /// Longest function allowed outside tests [lines, from `fn` to its closing brace].
 const MAX_FN_LINES: usize = 80;
-
-/// Every function of `code` (as given by [`code_only`]) outside `#[cfg(test)]` items: its name,
-/// first line (1-based) and length in lines from the line of `fn` to that of its closing brace.
-fn functions(code: &str) -> Vec<(String, usize, usize)> {
-    let chars: Vec<char> = code.chars().collect();
-    let ident = |c: char| c.is_alphanumeric() || c == '_';
-    let line_at = |i: usize| 1 + chars[..i].iter().filter(|c| **c == '\n').count();
-    // the closing brace matching the opening one at `open`
-    let close = |open: usize| block_end(chars.iter().copied().enumerate().skip(open)).unwrap_or(chars.len() - 1);
-    let mut out = Vec::new();
-    let mut i = 0;
-    while i < chars.len() {
-        if chars[i..].starts_with(&['#', '[', 'c', 'f', 'g', '(', 't', 'e', 's', 't', ')', ']']) {
-            // skip the item that follows up to its block (a `mod tests { .. }` or a function)
-            let mut k = i;
-            while k < chars.len() && chars[k] != '{' && chars[k] != ';' {
-                k += 1;
-            }
-            i = if chars.get(k) == Some(&'{') { close(k) + 1 } else { k + 1 };
-            continue;
-        }
-        let word_start = ident(chars[i]) && (i == 0 || !ident(chars[i - 1]));
-        if word_start && chars[i..].starts_with(&['f', 'n']) && chars.get(i + 2).is_some_and(|c| c.is_whitespace()) {
-            let mut k = i + 2;
-            while chars.get(k).is_some_and(|c| c.is_whitespace()) {
-                k += 1;
-            }
-            let start = k;
-            while chars.get(k).is_some_and(|c| ident(*c)) {
-                k += 1;
-            }
-            let name: String = chars[start..k].iter().collect();
-            // the body: the first `{` at bracket depth 0 before any `;` (a declaration has none)
-            let mut depth = 0i32;
-            while k < chars.len() {
-                match chars[k] {
-                    '(' | '[' | '<' => depth += 1,
-                    ')' | ']' => depth -= 1,
-                    '>' if chars[k - 1] != '-' => depth -= 1,
-                    '{' if depth <= 0 => break,
-                    ';' if depth <= 0 => break,
-                    _ => {}
-                }
-                k += 1;
-            }
-            if chars.get(k) == Some(&'{') {
-                let end = close(k);
-                let first = line_at(i);
-                out.push((name, first, line_at(end) - first + 1));
-            }
-            i += 2; // nested functions are counted too
-            continue;
-        }
-        i += 1;
-    }
-    out
-}
 
 /// Functions still over [`MAX_FN_LINES`] (`file:name`), to be split: the list may only shrink
 /// (a listed function that became short must leave it).
@@ -472,78 +256,6 @@ const LARGE_STRUCTS_LEFT: &[&str] = &[
     "src/study/mod.rs:StudyRow",
 ];
 
-/// Every `pub struct` with named fields in `code` (as given by [`code_only`]) outside
-/// `#[cfg(test)]` items: its name, line (1-based) and number of named fields (the commas at
-/// the top level of its braces, plus one for a last field without a trailing comma).
-fn pub_structs(code: &str) -> Vec<(String, usize, usize)> {
-    let mut out = Vec::new();
-    let mut skip_to = 0;
-    for (i, _) in code.char_indices() {
-        if i < skip_to {
-            continue;
-        }
-        let rest = &code[i..];
-        if rest.starts_with("#[cfg(test)]") {
-            // skip the item that follows up to the end of its block
-            let open = rest.find(['{', ';']).unwrap_or(rest.len());
-            skip_to = i + if rest[open..].starts_with('{') {
-                block_end(rest.char_indices()).unwrap_or(rest.len())
-            } else {
-                open
-            };
-            continue;
-        }
-        let word_start = code[..i].chars().next_back().is_none_or(|c| !(c.is_alphanumeric() || c == '_'));
-        if !word_start || !rest.starts_with("pub") {
-            continue;
-        }
-        let after_vis = rest[3..].trim_start();
-        let after_vis = if after_vis.starts_with('(') {
-            after_vis[after_vis.find(')').map_or(0, |k| k + 1)..].trim_start()
-        } else {
-            after_vis
-        };
-        let Some(decl) = after_vis.strip_prefix("struct ") else { continue };
-        let name: String = decl.trim_start().chars().take_while(|c| c.is_alphanumeric() || *c == '_').collect();
-        // named fields: a `{` before any `;` or `(` (a unit or tuple struct has none)
-        let Some(open) = decl.find(['{', ';', '(']).filter(|&k| decl[k..].starts_with('{')) else { continue };
-        let body = &decl[open + 1..block_end(decl.char_indices().skip_while(|&(k, _)| k < open)).unwrap_or(decl.len())];
-        let (mut depth, mut commas, mut prev) = (0i32, 0, ' ');
-        for c in body.chars() {
-            match c {
-                '(' | '[' | '{' | '<' => depth += 1,
-                ')' | ']' | '}' => depth -= 1,
-                '>' if prev != '-' => depth -= 1,
-                ',' if depth == 0 => commas += 1,
-                _ => {}
-            }
-            prev = c;
-        }
-        let trailing = body.trim_end().ends_with(',') || body.trim().is_empty();
-        let line = 1 + code[..i].matches('\n').count();
-        out.push((name, line, commas + usize::from(!trailing)));
-    }
-    out
-}
-
-/// The position (as `chars` numbers it) of the `}` that closes the first `{` of `chars`, if any.
-fn block_end(chars: impl Iterator<Item = (usize, char)>) -> Option<usize> {
-    let mut depth = 0usize;
-    for (k, c) in chars {
-        match c {
-            '{' => depth += 1,
-            '}' => {
-                depth -= 1;
-                if depth == 0 {
-                    return Some(k);
-                }
-            }
-            _ => {}
-        }
-    }
-    None
-}
-
 #[test]
 fn no_pub_struct_has_more_than_10_fields_outside_tests() {
     let (large, done) = over_limit(pub_structs, MAX_STRUCT_FIELDS, LARGE_STRUCTS_LEFT, "fields");
@@ -586,7 +298,15 @@ fn the_checker_sees_imports_and_cycles() {
     assert_eq!(cycles(&g), vec![vec!["a".to_string(), "b".to_string(), "c".to_string()]]);
     assert!(layer("output::journal") > layer("engine::rust::clip") && layer("model::mesh") < layer("assemble"));
     assert!(
-        goes_up("engine::rust::clip", "engine::freefem") && !goes_up("engine::freefem::clip", "engine::rust::frames")
+        goes_up("engine::common::frames", "engine::freefem") && !goes_up("engine::freefem::clip", "engine::common")
+    );
+    assert!(!goes_up("engine::rust::clip", "engine::freefem") && !goes_up("engine::freefem", "engine::rust::frames"));
+    assert!(crosses_seam("engine::rust::clip", "engine::freefem").is_some());
+    assert!(crosses_seam("engine::freefem::clip", "engine::rust::frames").is_some());
+    assert!(crosses_seam("output::clip_run", "engine::rust::clip").is_some());
+    assert!(
+        crosses_seam("output::clip_run", "engine").is_none()
+            && crosses_seam("engine::rust", "engine::common").is_none()
     );
     assert!(goes_up("engine::input::data", "engine") && !goes_up("engine", "engine::input::data"));
     let f = functions(&code_only(

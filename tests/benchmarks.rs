@@ -14,10 +14,10 @@ use std::process::Command;
 
 use cosserat::case::published::{Axis, NodeField, Quantity, VOCABULARY};
 use cosserat::case::{case_files, Case};
+use cosserat::engine::metrics::all_metrics;
+use cosserat::engine::published::{evaluate, unavailable};
 use cosserat::engine::run_case;
-use cosserat::engine::rust::metrics::all_metrics;
-use cosserat::engine::rust::published::{evaluate, unavailable};
-use cosserat::engine::rust::Engine;
+use cosserat::engine::Engine;
 use cosserat::jobs::compare::{compare_case, CompareOptions, Horizon};
 use cosserat::reference::{tip_loaded_cantilever, PlanarRod};
 

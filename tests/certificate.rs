@@ -4,7 +4,8 @@
 mod common;
 
 use common::{case_from, case_text, edit, forward_data, short_roll_case, worm_data_present};
-use cosserat::engine::rust::{run_rust, RunError};
+use cosserat::engine::rust::run_rust;
+use cosserat::engine::RunError;
 use cosserat::model::mesh::Field;
 use cosserat::solve::certificate::{Certificate, CERTIFICATE_FLOOR};
 use cosserat::solve::inverse::kkt::certificate;
@@ -179,7 +180,7 @@ fn lambda_kappa_one_is_solved() {
     let text = edit(&text, "tolerance = 3e-6", "tolerance = 1e-10");
     let small = edit(&text, "lambda_kappa = [0, 0, 1]", "lambda_kappa = [0, 0, 1e-10]");
     let reference = run_rust(&case_from(&small, "lk10"), |_, _| {}).expect("λκ3 = 1e-10");
-    let k_ref = cosserat::engine::rust::metrics::inverse_metrics(&reference)["kappa_err_rel_inner"];
+    let k_ref = cosserat::engine::metrics::inverse_metrics(&reference)["kappa_err_rel_inner"];
     for (label, t) in [
         ("selective", text.clone()),
         ("gauss2", edit(&text, "analysis = \"inverse\"", "analysis = \"inverse\"\nquadrature = \"gauss2\"")),
@@ -187,7 +188,7 @@ fn lambda_kappa_one_is_solved() {
         let r = run_rust(&case_from(&t, label), |_, _| {})
             .unwrap_or_else(|e| panic!("{label}: {}", common::error_chain(&e)));
         let c = r.stats.certificate.unwrap();
-        let k = cosserat::engine::rust::metrics::inverse_metrics(&r)["kappa_err_rel_inner"];
+        let k = cosserat::engine::metrics::inverse_metrics(&r)["kappa_err_rel_inner"];
         eprintln!(
             "λκ3 = 1, {label}: {} iterations, certificate {c:e}, κ error inner {k:.4} (λκ3 = 1e-10: {k_ref:.4})",
             r.stats.iterations

@@ -14,9 +14,10 @@ use common::{short_roll_case, worm_data_present, Collect};
 use cosserat::case::Case;
 use cosserat::clip::synthetic::{FrameTruth, GroundTruth};
 use cosserat::clip::Clip;
+use cosserat::engine::clip::{ClipFrame, ClipOutcome};
 use cosserat::engine::input::clip_files::load_clip;
-use cosserat::engine::rust::clip::{run_clip, ClipFrame, ClipFrames, ClipOutcome, StreamedFrame};
-use cosserat::engine::rust::RunError;
+use cosserat::engine::rust::clip::{run_clip, ClipFrames, StreamedFrame};
+use cosserat::engine::RunError;
 
 const FRAMES: usize = 20;
 const NODES: usize = 16;

@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 
 use assert_cmd::Command;
 use common::{short_roll_case, worm_data_present};
-use cosserat::engine::rust::clip::nodal_curvature;
+use cosserat::engine::clip::nodal_curvature;
 use cosserat::io::compact::{read_compact, CompactClip, OutputFormat, COMPACT_FILE, CURVATURE_COLUMNS, RAW_FIELDS};
 use cosserat::output::clip_output::CLIP_FIELD_COLUMNS;
 use cosserat::output::clip_run::{run_clip_to, ClipOptions};

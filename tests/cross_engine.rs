@@ -13,11 +13,11 @@ mod common;
 use std::path::Path;
 
 use cosserat::case::{case_files, Analysis, Case};
+use cosserat::engine::clip::solve_frames;
 use cosserat::engine::freefem::clip::read_clip_run;
 use cosserat::engine::input::clip_files::load_clip;
 use cosserat::engine::load_data;
-use cosserat::engine::rust::frames::solve_frames;
-use cosserat::engine::rust::{run_forward, run_inverse, NodalState, RunError, RunResult};
+use cosserat::engine::{run_forward, run_inverse, NodalState, RunError, RunResult};
 use cosserat::jobs::compare::{
     compare_case, perturb_material, perturb_positions, CompareOptions, CompareReport, Horizon, SAFETY, SHORT_FRAMES,
     SHORT_STEPS,

@@ -50,7 +50,7 @@ fn solve(case: &Case) -> DVector<f64> {
 
 /// Positions in space of a solved state.
 fn positions(case: &Case, u: &DVector<f64>) -> Vec<Vector3<f64>> {
-    cosserat::engine::rust::NodalState::of_forward(case, u).x
+    cosserat::engine::NodalState::of_forward(case, u).x
 }
 
 #[test]

@@ -2,7 +2,7 @@
 mod common;
 
 use common::{case_from, case_text};
-use cosserat::engine::rust::metrics::curvature_error;
+use cosserat::engine::metrics::curvature_error;
 use cosserat::model::mesh::Field;
 use cosserat::solve::inverse::{InverseRecord, Start};
 
@@ -175,7 +175,7 @@ fn adjoint_gradient_matches_finite_differences() {
 /// 0.066 / 0.005). Asserted with a margin of about 1.5×.
 #[test]
 fn recovers_eq65_bend_and_twist_from_the_case_file() {
-    use cosserat::engine::rust::metrics::inverse_metrics;
+    use cosserat::engine::metrics::inverse_metrics;
     let case = case_from(&case_text("inverse_bend_twist"), "inverse_bend_twist");
     let (r, stop) = common::run_any(&case);
     assert!(matches!(stop, Some(cosserat::solve::SolveError::Stalled(_))), "{stop:?}");

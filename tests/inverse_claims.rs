@@ -7,7 +7,7 @@
 mod common;
 
 use common::fixed_point::{paper, run, Data};
-use cosserat::engine::rust::NodalState;
+use cosserat::engine::NodalState;
 use cosserat::model::mesh::{DofMap, Field};
 use cosserat::model::rotation::{angles_from_rotation, rotation};
 use cosserat::solve::inverse::InverseParams;

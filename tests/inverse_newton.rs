@@ -2,8 +2,8 @@
 mod common;
 
 use common::{case_from, case_text, solve_frame_any, solve_newton, with_weights};
-use cosserat::engine::rust::metrics::curvature_error;
-use cosserat::engine::rust::NodalState;
+use cosserat::engine::metrics::curvature_error;
+use cosserat::engine::NodalState;
 use cosserat::linalg::{LinearSolver, Pattern};
 use cosserat::model::mesh::{DofMap, Field, Mesh};
 use cosserat::solve::inverse::kkt::{assemble_system, dirichlet};

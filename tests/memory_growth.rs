@@ -15,7 +15,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 use cosserat::case::Case;
 use cosserat::engine::input::corpus::{write_corpus, CorpusParams};
-use cosserat::engine::rust::Engine;
+use cosserat::engine::Engine;
 use cosserat::io::compact::{OutputFormat, CURVATURE_COLUMNS, RAW_CURVATURE, RAW_FIELDS};
 use cosserat::io::compact_write::{write_compact, BLOCK_BYTES};
 use cosserat::jobs::solved::{solve_into, RunStatus};

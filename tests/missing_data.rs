@@ -36,8 +36,9 @@ use std::sync::{Arc, Mutex};
 use assert_cmd::Command;
 use common::{freefem_required, worm_data_present, Collect};
 use cosserat::case::Case;
+use cosserat::engine::clip::ClipFrame;
 use cosserat::engine::input::clip_files::load_clip;
-use cosserat::engine::rust::clip::{run_clip, ClipFrame, ClipFrames};
+use cosserat::engine::rust::clip::{run_clip, ClipFrames};
 use cosserat::io::npy::{read_npy, write_npy};
 use nalgebra::Vector3;
 
@@ -47,7 +48,7 @@ const NODES: usize = 33;
 const SIGMA_M: f64 = 1e-7;
 /// rod length of the batch case [m]
 const LENGTH_M: f64 = 1e-3;
-/// nodes left out at each end by the bending scores (`engine::rust::clip::TRUTH_SKIP_NODES`)
+/// nodes left out at each end by the bending scores (`engine::clip::TRUTH_SKIP_NODES`)
 const SKIP: usize = 5;
 
 fn root() -> &'static Path {

@@ -8,11 +8,11 @@ mod common;
 use std::collections::BTreeMap;
 
 use cosserat::case::{case_files, Case};
+use cosserat::engine::clip::solve_frames;
 use cosserat::engine::input::clip_files::load_clip;
-use cosserat::engine::rust::frames::solve_frames;
-use cosserat::engine::rust::metrics::all_metrics;
-use cosserat::engine::rust::{Engine, RunError, RunResult};
+use cosserat::engine::metrics::all_metrics;
 use cosserat::engine::{run_case, EngineError};
+use cosserat::engine::{Engine, RunError, RunResult};
 use cosserat::solve::SolveError;
 
 /// Significant digits kept for physical metrics of static cases (deterministic to ~1e-10).

@@ -198,7 +198,7 @@ fn a_carried_frame_over_the_curvature_bound_is_solved_again_from_its_data() {
 
 /// The recovered κ2 [1/m] of frame `k` of a clip short enough that the kymographs draw every
 /// frame (at most 150).
-fn kappa2_of(run: &cosserat::engine::rust::clip::ClipRun, k: usize) -> &[f64] {
+fn kappa2_of(run: &cosserat::engine::clip::ClipRun, k: usize) -> &[f64] {
     let column = run.kymograph.columns.iter().find(|c| c.index == k);
     &column.unwrap_or_else(|| panic!("frame {k} is not drawn (stride {})", run.kymograph.stride)).kappa2
 }

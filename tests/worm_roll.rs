@@ -7,10 +7,10 @@ use std::f64::consts::PI;
 
 use common::{case_from, case_text_with_data, edit, worm_data_present};
 use cosserat::clip::synthetic::{roll_clip, RollClipParams, TimeMapping};
+use cosserat::engine::clip::ClipRun;
 use cosserat::engine::input::clip_files::kymogram_rows;
-use cosserat::engine::rust::clip::ClipRun;
-use cosserat::engine::rust::RunError;
 use cosserat::engine::EngineError;
+use cosserat::engine::RunError;
 use cosserat::output::clip_run::run_clip_case;
 use cosserat::solve::sequence::SequenceError;
 use nalgebra::{Rotation3, Vector3};

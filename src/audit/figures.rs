@@ -9,7 +9,7 @@ use super::measures::modal_tip_history;
 use super::spec::{PlotKind, PlotSpec, Selector, Spec};
 use super::{PointResult, RunResults};
 use crate::case::{Case, Reference};
-use crate::engine::rust::metrics::INNER_SKIP_ELEMENTS;
+use crate::engine::metrics::INNER_SKIP_ELEMENTS;
 use crate::figures::heatmap::{render_heatmaps_svg, Heatmap};
 use crate::figures::plot::{render_panels_svg, render_svg, Band, Legend, LinePlot, Mark, Series};
 use crate::figures::posture::{render_postures_svg, PosturePanel};
@@ -509,9 +509,9 @@ fn omega(spec: &Spec, title: &str, names: &[String], runs: &[RunResults]) -> Opt
 
 /// The frames of a clip point to draw: those asked for, else (a clip excerpt in --quick that
 /// ends before them) its last frame.
-fn shown_frames<'a>(p: &'a PointResult, frames: &[usize]) -> Vec<&'a crate::engine::rust::clip::ClipFrame> {
+fn shown_frames<'a>(p: &'a PointResult, frames: &[usize]) -> Vec<&'a crate::engine::clip::ClipFrame> {
     let Some(s) = p.series.as_ref() else { return Vec::new() };
-    let mut shown: Vec<&crate::engine::rust::clip::ClipFrame> =
+    let mut shown: Vec<&crate::engine::clip::ClipFrame> =
         frames.iter().filter_map(|f| s.kept.iter().find(|k| k.report.frame == *f)).collect();
     if shown.is_empty() {
         shown.extend(s.last.as_ref());
@@ -521,7 +521,7 @@ fn shown_frames<'a>(p: &'a PointResult, frames: &[usize]) -> Vec<&'a crate::engi
 
 /// Figs. 16, 21, 22: the kept frames of a clip run, three projections each, with the directors
 /// d1 (ticks), d3 (arrows) and the tangent, the centreline coloured by |κ| [1/mm] (the node
-/// average of the element curvatures, `engine::rust::clip::nodal_curvature`). For a run with a grid,
+/// average of the element curvatures, `engine::clip::nodal_curvature`). For a run with a grid,
 /// beneath them the quantity its swept weight penalises along the body at the first frame
 /// shown, one curve per grid point: the angle between d3 and the chord of each element (λd,
 /// Fig. 21: the detachment the λd term penalises) or κ3 (λκ3, Fig. 22).
@@ -531,7 +531,7 @@ fn postures(title: &str, p: &PointResult, frames: &[usize], all: &RunResults) ->
         .map(|k| {
             let d = k.nodes.directors();
             let colour =
-                crate::engine::rust::clip::nodal_curvature(&k.elements.kappa).iter().map(|v| v.norm() * 1e-3).collect();
+                crate::engine::clip::nodal_curvature(&k.elements.kappa).iter().map(|v| v.norm() * 1e-3).collect();
             PosturePanel {
                 label: format!("frame {} (t = {} s)", k.report.frame, crate::figures::plot::format_tick(k.time_s)),
                 x: k.nodes.x.clone(),

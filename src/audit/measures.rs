@@ -39,9 +39,9 @@
 use nalgebra::{DVector, Vector3};
 
 use crate::case::{Analysis, Case, Reference};
-use crate::engine::rust::clip::ClipFrame;
-use crate::engine::rust::metrics::{Metrics, INNER_SKIP_ELEMENTS};
-use crate::engine::rust::RunResult;
+use crate::engine::clip::ClipFrame;
+use crate::engine::metrics::{Metrics, INNER_SKIP_ELEMENTS};
+use crate::engine::RunResult;
 use crate::model::mesh::Field;
 use crate::reference::timoshenko_deflection;
 use crate::solve::modes::modal_model;
@@ -130,7 +130,7 @@ pub fn derived_metrics(case: &Case, run: Option<&RunResult>, series: Option<&Cli
             let n = k.len();
             let inner = k.iter().skip(INNER_SKIP_ELEMENTS).take(n.saturating_sub(2 * INNER_SKIP_ELEMENTS));
             m.insert("kappa3_max_abs_per_m".into(), inner.map(|(_, k)| k[2].abs()).fold(0.0, f64::max));
-            let own = crate::engine::rust::metrics::inverse_metrics(r);
+            let own = crate::engine::metrics::inverse_metrics(r);
             let (fc, lc) = (own.get("force_l2_n_per_m05"), own.get("torque_l2_n_m05"));
             if let (Some((f, l)), Some(fc), Some(lc)) = (design_norms(case), fc, lc) {
                 m.insert("force_to_design_l2".into(), fc / f);

@@ -508,7 +508,7 @@ fn check_metric_name(spec: &Spec, claim: &Claim, runs: &[RunResults]) -> Result<
     let Some(metric) = claim.check.metric() else { return Ok(()) };
     for run in claim.check.runs() {
         let Some(rr) = runs.iter().find(|r| r.name == run) else { continue };
-        let reported: Vec<&crate::engine::rust::metrics::Metrics> =
+        let reported: Vec<&crate::engine::metrics::Metrics> =
             rr.points.iter().filter_map(|p| p.outcome.metrics.as_ref()).collect();
         if reported.is_empty() || reported.iter().any(|m| m.contains_key(metric)) {
             continue;

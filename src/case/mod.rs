@@ -252,7 +252,7 @@ pub const DEFAULT_COMPARE_FRAMES: usize = 10;
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Reference {
     /// Eq. (63), the Kirchhoff elastica and the planar Reissner rod for a dead end force of
-    /// magnitude `force_n` [N] along −e2 (see `engine::rust::metrics`).
+    /// magnitude `force_n` [N] along −e2 (see `engine::metrics`).
     TipLoadedCantilever { force_n: f64 },
 }
 

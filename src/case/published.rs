@@ -1,12 +1,12 @@
 //! Published values a case is checked against (`[[reference.values]]`): what is measured (a
 //! [`Quantity`] of the vocabulary, parsed once here), the published number, the tolerance and
-//! the source. `run` evaluates every row on its result (`engine::rust::published`) and writes
+//! the source. `run` evaluates every row on its result (`engine::published`) and writes
 //! them beside its metrics; `compare` does so for both engines; `tests/benchmarks.rs` runs every
 //! case of `cases/benchmarks/` and asserts every row.
 //!
 //! The vocabulary is open: a family of quantities (`tip.…`, `node(s=…).…`, `metric.…`) is a
 //! variant of [`Quantity`], a branch of [`Quantity::parse`], a row of [`VOCABULARY`] and a branch
-//! of the evaluator (`engine::rust::published::value`). A new family (a buckling load factor, a
+//! of the evaluator (`engine::published::value`). A new family (a buckling load factor, a
 //! natural frequency, a limit load) adds exactly these four.
 use std::fmt;
 

@@ -23,7 +23,7 @@ static FAILED: AtomicBool = AtomicBool::new(false);
 /// Read the address-space limit, and keep malloc to one arena under it. Call first in `main`,
 /// before any other thread starts.
 pub fn at_start() {
-    let Some(limit) = cosserat::engine::rust::budget::address_space_limit() else { return };
+    let Some(limit) = cosserat::engine::budget::address_space_limit() else { return };
     LIMIT.store(limit as u64, Ordering::SeqCst);
     #[cfg(all(target_os = "linux", target_env = "gnu"))]
     {

@@ -3,7 +3,7 @@ use std::path::PathBuf;
 
 use clap::{Parser, Subcommand};
 
-use cosserat::engine::rust::Engine;
+use cosserat::engine::Engine;
 use cosserat::io::compact::OutputFormat;
 
 /// Forward Cosserat rods after Wang et al. (Comput. Mech. 71, 2023), in Rust and FreeFEM.

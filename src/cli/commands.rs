@@ -8,8 +8,8 @@ use anyhow::{bail, Context, Result};
 use super::args::Limits;
 use super::progress::{FreefemProgress, Progress};
 use cosserat::case::Case;
-use cosserat::engine::rust::budget::{self, default_limit_bytes, Footprint, GIB};
-use cosserat::engine::rust::Engine;
+use cosserat::engine::budget::{self, default_limit_bytes, Footprint, GIB};
+use cosserat::engine::Engine;
 use cosserat::io::compact::OutputFormat;
 use cosserat::jobs::job::{case_label, run_into, run_manifest};
 use cosserat::jobs::sweep::RunStatus;
@@ -71,7 +71,7 @@ pub fn cmd_compare(
 ) -> Result<ExitCode> {
     use cosserat::jobs::compare::default_dir;
     let case = load(path)?;
-    if let Some(why) = cosserat::engine::rust::published::unavailable(&case) {
+    if let Some(why) = cosserat::engine::published::unavailable(&case) {
         bail!(why);
     }
     check_memory(&case, Footprint::Run, limits)?;

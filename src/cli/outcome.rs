@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use cosserat::case::Case;
-use cosserat::engine::rust::Engine;
+use cosserat::engine::Engine;
 use cosserat::jobs::sweep::RunStatus;
 use cosserat::output::run_folder::{Manifest, Status};
 
@@ -159,7 +159,7 @@ pub fn run_end(
 /// The published values (`[[reference.values]]`) of a complete single run on stderr, one line
 /// each, and a line with the number missed; returns that number.
 fn published_values(end: &cosserat::jobs::job::JobEnd, (case, engine): (&Case, Engine), strict: bool) -> usize {
-    use cosserat::engine::rust::{metrics::all_metrics, published::evaluate};
+    use cosserat::engine::{metrics::all_metrics, published::evaluate};
     let Some(r) = &end.single else { return 0 };
     let rows = match all_metrics(case, r) {
         Ok(m) => evaluate(case, r, &m),
@@ -168,7 +168,7 @@ fn published_values(end: &cosserat::jobs::job::JobEnd, (case, engine): (&Case, E
     for row in &rows {
         eprintln!("{} [{engine}] published {}", case.name, row.summary());
     }
-    for s in cosserat::engine::rust::published::sources(&rows) {
+    for s in cosserat::engine::published::sources(&rows) {
         eprintln!("  source: {s}");
     }
     let missed = rows.iter().filter(|r| !r.pass).count();

@@ -187,7 +187,7 @@ impl Drop for Progress {
 }
 
 /// The progress of the FreeFEM runs of a command (`compare`): the frames of a clip or the time
-/// steps of a dynamic run as FreeFEM writes them (`cosserat::engine::freefem::progress`), shown as
+/// steps of a dynamic run as FreeFEM writes them (`cosserat::engine::freefem_progress`), shown as
 /// [`Progress`] shows a command's own (a bar, or lines every 10 s and a final line).
 pub struct FreefemProgress {
     shown: Arc<Mutex<Option<Progress>>>,
@@ -196,7 +196,7 @@ pub struct FreefemProgress {
 impl FreefemProgress {
     /// Shows the counts of every FreeFEM run until [`FreefemProgress::finish`], as `label`.
     pub fn start(label: &str) -> FreefemProgress {
-        use cosserat::engine::freefem::progress::{observe, Count, Unit};
+        use cosserat::engine::freefem_progress::{observe, Count, Unit};
         let shown: Arc<Mutex<Option<Progress>>> = Arc::new(Mutex::new(None));
         let into = Arc::clone(&shown);
         let label = label.to_string();
@@ -218,7 +218,7 @@ impl FreefemProgress {
 
 impl Drop for FreefemProgress {
     fn drop(&mut self) {
-        cosserat::engine::freefem::progress::observe(None);
+        cosserat::engine::freefem_progress::observe(None);
         if let Some(p) = self.shown.lock().unwrap_or_else(|e| e.into_inner()).take() {
             p.finish();
         }

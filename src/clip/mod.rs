@@ -57,11 +57,11 @@ pub const KYMOGRAM_FPS: f64 = 32.0;
 pub const PAPER_NODES: usize = 128;
 
 /// Elements left out at each end by the measures of a clip run: the inner curvature errors
-/// (`engine::rust::metrics::INNER_SKIP_ELEMENTS`) and the ground-truth scores (`engine::rust::clip::TRUTH_SKIP_NODES`
+/// (`engine::metrics::INNER_SKIP_ELEMENTS`) and the ground-truth scores (`engine::clip::TRUTH_SKIP_NODES`
 /// nodes); equal to both (tested in `engine::input::clip_files`).
 pub const CLIP_SKIP_ELEMENTS: usize = 5;
 /// Fewest elements of a clip case's mesh: the measures leave out [`CLIP_SKIP_ELEMENTS`] at
-/// each end and must keep one, and the roughness (`engine::rust::clip::sign_alternation`) of the data's
+/// each end and must keep one, and the roughness (`engine::clip::sign_alternation`) of the data's
 /// curvature at the `elements − 1` interior nodes needs 3 values. A smaller mesh would run and
 /// write results without these measures.
 pub const MIN_CLIP_ELEMENTS: usize = 2 * CLIP_SKIP_ELEMENTS + 1;

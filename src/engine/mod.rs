@@ -4,22 +4,42 @@
 //! `cosserat compare` do for a single-frame case; and a clip case's frames ([`ClipInput`]) in the
 //! Rust engine, each converged frame handed to any [`FrameSink`] ([`run_clip_into`]; the output
 //! folder's writer is `crate::output::clip_run`'s).
+pub mod common;
 pub mod freefem;
 pub mod input;
 pub mod rust;
+
+// The interface: what the layers above name of the engines, engine-neutral where it can be.
+pub use self::common::result::{
+    BucklingRecord, Engine, InverseOutput, NodalState, PathOutput, PathRecord, RunResult, SolverStats, StabilityOutput,
+};
+pub use self::common::{angles_known, clip_metrics, frames, metrics, path_record_points, published};
+/// The FreeFEM engine's own entry points, for what runs both engines on the same data
+/// (`crate::jobs::compare`) and shows its progress (`freefem_progress`).
+pub use self::freefem::{
+    clip::{run_clip as run_freefem_clip, FreeFemFrames},
+    progress as freefem_progress, run as run_freefem, run_inverse as run_freefem_inverse, RunOptions,
+};
+pub use self::rust::{budget, run_forward, run_inverse, weights, RunError};
+
+/// A clip's frames as every consumer sees them, its summary, and how a clip run ended.
+pub mod clip {
+    pub use super::common::clip_frame::*;
+    pub use super::common::clip_summary::*;
+    pub use super::rust::clip::{ClipOutcome, ResumeError};
+    pub use super::rust::frames::solve_frames;
+}
 
 use std::path::Path;
 
 use nalgebra::Vector3;
 
+use self::common::clip_frame::FrameSink;
 use self::freefem::FreeFemError;
 use self::input::clip_files::{load_clip, roll_stream, ClipFileError, RollStream};
 use self::input::data::{read_data, write_data};
-use self::rust::clip::{
-    run_clip_resumed, ClipFrames, ClipOutcome, FrameSink, ResumeRecords, StreamedFrame, STREAM_AHEAD,
-};
+use self::rust::clip::{run_clip_resumed, ClipFrames, ClipOutcome, ResumeRecords, StreamedFrame, STREAM_AHEAD};
 use self::rust::weights::{choose_weights, Auto};
-use self::rust::{Engine, NodalState, RunError, RunResult};
 use crate::case::{Case, DataSource, WeightsRule};
 use crate::clip::synthetic::GroundTruth;
 use crate::clip::Clip;

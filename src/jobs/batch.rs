@@ -16,9 +16,9 @@ use std::time::Instant;
 
 use super::solved::{chain, solve_into, RunStatus};
 use crate::case::{Analysis, Case, CaseError, DataSource};
+use crate::engine::clip_metrics::clip_metrics;
 use crate::engine::input::truth_file::{is_truth_sidecar, truth_sidecar};
-use crate::engine::rust::clip_metrics::clip_metrics;
-use crate::engine::rust::Engine;
+use crate::engine::Engine;
 use crate::io::compact::OutputFormat;
 use crate::io::files::{write_atomic, OutputError};
 use crate::output::clip_run::ClipOptions;

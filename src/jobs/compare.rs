@@ -6,7 +6,7 @@
 //!   compared at the same iterate: FreeFEM runs exactly the iterations Rust needed
 //!   (`exactIters`), and the iteration at which FreeFEM first met the tolerance is a row of
 //!   its own. Clips: the first `frames` frames, consecutive, warm-started and re-based by
-//!   both engines ([`crate::engine::freefem::clip`]).
+//!   both engines ([`crate::engine::run_freefem_clip`]).
 //! - **Tolerances.** The Rust engine runs the case a second time with its input perturbed at
 //!   [`PERTURBATION`] (relative): the data x_g of an inverse case or a clip, the stiffnesses
 //!   and inertias of a forward case. For every compared quantity q, with σ_q the perturbed
@@ -24,14 +24,14 @@ use std::path::{Path, PathBuf};
 use nalgebra::Vector3;
 
 use crate::case::{Analysis, Case, CompareOverrides};
-use crate::engine::freefem::clip::{run_clip, FreeFemFrames};
-use crate::engine::freefem::{self, RunOptions};
+use crate::engine::clip::solve_frames;
+use crate::engine::frames::{SolvedFrame, SolvedFrames};
 use crate::engine::input::clip_files::load_clip;
 use crate::engine::input::data::write_data;
-use crate::engine::rust::frames::{solve_frames, SolvedFrame, SolvedFrames};
-use crate::engine::rust::metrics::{all_metrics, differences, ComparisonRow, Difference, Group};
-use crate::engine::rust::{run_forward, run_inverse, NodalState, RunError, RunResult};
+use crate::engine::metrics::{all_metrics, differences, ComparisonRow, Difference, Group};
 use crate::engine::{load_data, EngineError};
+use crate::engine::{run_forward, run_inverse, NodalState, RunError, RunResult};
+use crate::engine::{run_freefem, run_freefem_clip, run_freefem_inverse, FreeFemFrames, RunOptions};
 use crate::io::files::{write_atomic, OutputError};
 use crate::output::run_files::write_run;
 use crate::solve::certificate::CERTIFICATE_FLOOR;
@@ -321,7 +321,7 @@ fn compare_single(case: &Case, dir: &Path, opts: &CompareOptions) -> Result<Comp
             (rust, p, None)
         };
         let ro = RunOptions { exact_iterations: exact, clip: None };
-        let ff = freefem::run_inverse(&case, data, &path, &work, &ro).map_err(EngineError::from)?;
+        let ff = run_freefem_inverse(&case, data, &path, &work, &ro).map_err(EngineError::from)?;
         let what = match exact {
             Some(n) => format!("inverse fixed point, both engines at iteration {n}"),
             None => format!("inverse Newton (I8) to the root, tolerance {:e}", inv.params.tolerance),
@@ -330,7 +330,7 @@ fn compare_single(case: &Case, dir: &Path, opts: &CompareOptions) -> Result<Comp
     } else {
         let rust = run_forward(&case, |_, _| {})?;
         let p = run_forward(&perturb_material(&case), |_, _| {}).map_err(|e| CompareError::Perturbed(e.into()))?;
-        let ff = freefem::run(&case, &work).map_err(EngineError::from)?;
+        let ff = run_freefem(&case, &work).map_err(EngineError::from)?;
         let what = match &case.analysis {
             Analysis::Dynamic(p) => format!("dynamic, {} time steps", p.steps),
             Analysis::Static(p) if p.path.is_some() => "static arc-length path (D25), to the tolerance".to_string(),
@@ -371,7 +371,7 @@ fn compare_single(case: &Case, dir: &Path, opts: &CompareOptions) -> Result<Comp
 fn compare_clip(case: &Case, dir: &Path, opts: &CompareOptions) -> Result<CompareReport, CompareError> {
     let (clip, _) = load_clip(case).map_err(EngineError::from)?;
     // weights = "auto": λg chosen once (in Rust, docs/noise.md N2), then both engines use it
-    let auto = crate::engine::rust::weights::choose_weights(case, &clip.frames);
+    let auto = crate::engine::weights::choose_weights(case, &clip.frames);
     let case = auto.as_ref().map_or(case, |a| &a.case);
     let default = match opts.horizon {
         Horizon::Full => case.checks.compare.frames,
@@ -434,8 +434,8 @@ fn solve_clip_both(case: &Case, clip: ClipData<'_>, dir: &Path) -> Result<ClipRu
     let n = |f: &SolvedFrame| if is_fixed_point_inverse(case) { f.result.stats.iterations } else { 0 };
     let exact: Option<Vec<(usize, bool)>> = Some(rust.frames.iter().map(|f| (n(f), f.restarted)).collect());
     let work = dir.join("freefem_work");
-    let freefem =
-        run_clip(case, ClipData { positions: frames, tracked }, exact.as_deref(), &work).map_err(EngineError::from)?;
+    let freefem = run_freefem_clip(case, ClipData { positions: frames, tracked }, exact.as_deref(), &work)
+        .map_err(EngineError::from)?;
     Ok(ClipRuns { rust, perturbed, freefem })
 }
 

@@ -1,11 +1,11 @@
 //! The published values of a case (`[[reference.values]]`) in both engines of `cosserat
 //! compare`: each value evaluated on the Rust and on the FreeFEM result
-//! (`engine::rust::published`), reported side by side (a table, `reference.csv`) and counted
+//! (`engine::published`), reported side by side (a table, `reference.csv`) and counted
 //! in the comparison's exit status.
 use super::compare::{CompareReport, Horizon, SHORT_STEPS};
 use crate::case::{Analysis, Case};
-use crate::engine::rust::metrics::all_metrics;
-use crate::engine::rust::published::{evaluate, sources, PublishedRow};
+use crate::engine::metrics::all_metrics;
+use crate::engine::published::{evaluate, sources, PublishedRow};
 use crate::reference::ReferenceError;
 use crate::solve::inverse::InverseMethod;
 

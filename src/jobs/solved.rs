@@ -7,12 +7,12 @@ use std::path::Path;
 
 use crate::case::Case;
 use crate::clip::missing::MIN_TRACKED;
+use crate::engine::clip::{ClipFrame, ClipRun};
+use crate::engine::clip_metrics::clip_metrics;
 use crate::engine::input::data::write_data;
-use crate::engine::rust::clip::{ClipFrame, ClipRun};
-use crate::engine::rust::clip_metrics::clip_metrics;
-use crate::engine::rust::metrics::{all_metrics, Metrics};
-use crate::engine::rust::{Engine, RunError, RunResult};
+use crate::engine::metrics::{all_metrics, Metrics};
 use crate::engine::{load_data, run_case, run_inverse_on, EngineError};
+use crate::engine::{Engine, RunError, RunResult};
 use crate::output::clip_output::remove_raw;
 use crate::output::clip_run::{run_clip_to, write_clip_figures, ClipOptions};
 use crate::output::journal::remove_journal;
@@ -75,7 +75,7 @@ pub struct Solved {
     /// why it failed or stopped (the error and its causes, prefixed by the case)
     pub error: Option<String>,
     /// the metrics of a single run (also of the last iterate of one that did not converge) or
-    /// of a complete clip (`engine::rust::clip_metrics`)
+    /// of a complete clip (`engine::clip_metrics`)
     pub metrics: Option<Metrics>,
     /// a single run's result
     pub single: Option<RunResult>,
@@ -295,11 +295,11 @@ fn flag_message(case: &Case, flagged: &[&FrameReport], done: usize) -> String {
 
 /// The case's name and file, for messages.
 /// Why `engine` cannot solve `case` into a folder, if it cannot: a published value the run
-/// cannot compute (`engine::rust::published::unavailable`), a clip in FreeFEM (`run` solves
+/// cannot compute (`engine::published::unavailable`), a clip in FreeFEM (`run` solves
 /// clips in the Rust engine; `compare` runs FreeFEM's clip script frame by frame against it). A
 /// command checks this before it prepares any folder.
 pub fn unsupported(case: &Case, engine: Engine) -> Option<String> {
-    if let Some(why) = crate::engine::rust::published::unavailable(case) {
+    if let Some(why) = crate::engine::published::unavailable(case) {
         return Some(why);
     }
     (engine != Engine::Rust && case.clip().is_some()).then(|| {

@@ -2,16 +2,16 @@
 //! last iterate when the point did not converge, and the point's `run.json` saying which) and
 //! `summary.csv`. The
 //! grid itself is `case::sweep`'s. A point of a clip case solves the whole clip (the frames
-//! of `run` on a clip, its row the metrics of `engine::rust::clip_metrics`).
+//! of `run` on a clip, its row the metrics of `engine::clip_metrics`).
 use std::path::Path;
 
 pub use super::solved::{case_label, chain, RunStatus, Solved as SweepOutcome};
 use super::solved::{solve_into, Solved};
 use crate::case::sweep::Point;
 use crate::case::Case;
-use crate::engine::rust::clip::ClipFrame;
-use crate::engine::rust::metrics::Metrics;
-use crate::engine::rust::{Engine, RunResult};
+use crate::engine::clip::ClipFrame;
+use crate::engine::metrics::Metrics;
+use crate::engine::{Engine, RunResult};
 use crate::io::files::OutputError;
 use crate::output::clip_run::ClipOptions;
 use crate::output::run_folder::Manifest;
@@ -44,7 +44,7 @@ pub struct SummaryRow {
     pub error: Option<String>,
 }
 
-/// Columns of the summary table of a clip case after the swept keys (`engine::rust::clip_metrics`).
+/// Columns of the summary table of a clip case after the swept keys (`engine::clip_metrics`).
 pub const CLIP_SUMMARY_METRICS: [&str; 12] = [
     "frames",
     "certificate",
@@ -228,7 +228,7 @@ pub const NOT_STARTED: &str = "not started: a stop was requested before its turn
 fn with_kept_frames(case: &Case, outcome: Solved) -> Solved {
     match (&outcome.metrics, &outcome.clip) {
         (None, Some(c)) if !c.reports.is_empty() => {
-            Solved { metrics: Some(crate::engine::rust::clip_metrics::clip_metrics(case, c)), ..outcome }
+            Solved { metrics: Some(crate::engine::clip_metrics::clip_metrics(case, c)), ..outcome }
         }
         _ => outcome,
     }

@@ -3,7 +3,7 @@
 use std::path::Path;
 
 use crate::case::Case;
-use crate::engine::rust::clip::{ClipRun, KymographColumn};
+use crate::engine::clip::{ClipRun, KymographColumn};
 use crate::figures::decimate::{min_max, MAX_LINE_POINTS};
 use crate::figures::heatmap::{render_marked_heatmaps_svg, ColourScale, ColumnMarks, Heatmap};
 use crate::figures::plot::{render_panels_svg, LinePlot, Series};

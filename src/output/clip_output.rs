@@ -1,6 +1,6 @@
 //! The files of a clip run: `frames.csv`, `fields.csv`, `curvature.csv`, `truth.csv`
 //! (synthetic clips), ParaView `vtk/frame_NNNNN.vtp` + `clip.pvd` streamed frame by frame
-//! ([`ClipWriter`], the [`FrameSink`] of `engine::rust::clip`), or in the compact format one
+//! ([`ClipWriter`], the [`FrameSink`] of `engine::clip`), or in the compact format one
 //! `fields.npz` (`crate::io::compact`); the summary figures are `super::clip_figures`.
 use std::io::{Seek, Write};
 use std::path::{Path, PathBuf};
@@ -11,7 +11,7 @@ pub(crate) use super::clip_figures::abs_percentile_99;
 pub use super::clip_figures::{write_clip_kymographs, write_clip_plot, write_omega_kymographs, write_truth_plot};
 use super::journal::{Entry, Journal, JournalScan, Offsets, JOURNAL};
 use super::run_files::element_row;
-use crate::engine::rust::clip::{nodal_curvature, ClipFrame, Controls, FrameSink};
+use crate::engine::clip::{nodal_curvature, ClipFrame, Controls, FrameSink};
 use crate::io::compact::{OutputFormat, CURVATURE_COLUMNS, RAW_CURVATURE, RAW_FIELDS};
 use crate::io::compact_write::write_compact;
 use crate::io::files::OutputError;
@@ -50,7 +50,7 @@ fn row_files(format: OutputFormat) -> [&'static str; 2] {
 /// `min_abs_cos_beta` is the chart's (the angles of `fields.csv` are in the frame's chart
 /// `Q = Q_E(α) B`, whose singular axis `n = Bᵀ e2` is `chart_axis_*`; `docs/rotation.md`);
 /// `max_abs_omega_rad_per_s` is the largest |ωˡ| over the nodes [rad/s] (eq. 27, 0 on the
-/// first frame; `engine::rust::clip::ClipFrame::omega`). `nodes_tracked`: the nodes of the frame that were
+/// first frame; `engine::clip::ClipFrame::omega`). `nodes_tracked`: the nodes of the frame that were
 /// tracked (`clip.missing`; all of them without missing data); `x_err_rel` and the `fit_*`
 /// columns measure the fit over those nodes. `lost`: fewer than 2 nodes tracked, the frame
 /// bridged in time from its neighbours; `filled`: some of its nodes filled; `resolved`: solved
@@ -96,7 +96,7 @@ pub const CLIP_FRAME_COLUMNS: [&str; 33] = [
 /// Columns of `fields.csv`, one row per frame and node: position [m], the angles [rad] in the
 /// frame's chart, the directors d1–d3 (rows of Q, eq. 2), the controls f [N/m] and l [N m/m]
 /// (eq. 54), the data position [m] and the angular velocity ωˡ [rad/s] in the local frame
-/// (eq. 27, as κ; 0 on the first frame; `engine::rust::clip::ClipFrame::omega`).
+/// (eq. 27, as κ; 0 on the first frame; `engine::clip::ClipFrame::omega`).
 pub const CLIP_FIELD_COLUMNS: [&str; 30] = [
     "frame",
     "node",

@@ -8,7 +8,7 @@ use super::clip_output::{
 };
 use super::journal::{journal_records, scan_journal, JournalScan};
 use crate::case::Case;
-use crate::engine::rust::clip::{ClipFrame, ClipOutcome, ClipRun, FrameSink};
+use crate::engine::clip::{ClipFrame, ClipOutcome, ClipRun, FrameSink};
 use crate::engine::{run_clip_into, ClipInput, EngineError};
 use crate::io::compact::OutputFormat;
 use crate::io::files::{JournalError, OutputError};

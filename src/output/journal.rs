@@ -9,7 +9,7 @@
 use std::io::{BufRead, Write};
 use std::path::{Path, PathBuf};
 
-use crate::engine::rust::clip::FrameRecord;
+use crate::engine::clip::FrameRecord;
 use crate::io::files::{JournalError, OutputError};
 
 /// File name of the journal in a clip's output folder.

@@ -87,7 +87,7 @@ pub struct Manifest {
     pub certificate: Option<CertificateSummary>,
     /// clips with `[inverse] weights = "auto"`: the noise level and the weights chosen
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub weights: Option<crate::engine::rust::weights::ChosenWeights>,
+    pub weights: Option<crate::engine::weights::ChosenWeights>,
     /// what the recording said of itself and of its frames: its body length, its plane, its
     /// lost, filled and re-solved frames
     #[serde(flatten)]

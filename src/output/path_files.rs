@@ -5,7 +5,7 @@
 use nalgebra::Vector3;
 
 use crate::case::Case;
-use crate::engine::rust::PathOutput;
+use crate::engine::PathOutput;
 use crate::figures::plot::{LinePlot, Mark, Series};
 use crate::io::files::csv_text_int;
 use crate::model::loads::LoadFrame;
@@ -14,7 +14,7 @@ use crate::solve::arclength::Critical;
 /// `buckling.csv` (D27): a row per buckling mode and node: the mode (1, 2, …), its critical load
 /// factor, the node's arc length and the mode's displacement in space, scaled so that the mode
 /// has `‖φ‖_w = 1` (positions over the rod length, RMS over the nodes, with the angles).
-pub fn buckling_csv(st: &crate::engine::rust::result::StabilityOutput, s_m: &[f64]) -> String {
+pub fn buckling_csv(st: &crate::engine::StabilityOutput, s_m: &[f64]) -> String {
     let h = ["mode", "load_factor", "s_m", "ux_m", "uy_m", "uz_m"];
     let rows = st.modes.iter().enumerate().flat_map(|(k, m)| {
         m.displacement.iter().zip(s_m).map(move |(d, s)| {

@@ -1,7 +1,7 @@
 //! `reference.csv`: a run's published values (`[[reference.values]]`) against what it
 //! computed, one row per value ([`run_csv`]); `compare` writes both engines side by side
 //! ([`compare_csv`]). Numbers at full precision; the verdict `true`/`false`.
-use crate::engine::rust::published::PublishedRow;
+use crate::engine::published::PublishedRow;
 
 /// The columns of a run's `reference.csv` (the unit of each row is in `unit`).
 pub const RUN_HEADER: [&str; 8] = ["quantity", "unit", "published", "computed", "error", "tolerance", "pass", "source"];

@@ -3,8 +3,8 @@
 use std::path::{Path, PathBuf};
 
 use crate::case::Case;
-use crate::engine::rust::metrics::Metrics;
-use crate::engine::rust::{InverseOutput, RunResult};
+use crate::engine::metrics::Metrics;
+use crate::engine::{InverseOutput, RunResult};
 use crate::figures::plot::{render_panels_svg, LinePlot, Mark, Series};
 use crate::io::compact::CURVATURE_COLUMNS;
 use crate::io::files::{csv_text, csv_text_int, write_atomic, write_plot, OutputError};
@@ -101,7 +101,7 @@ fn write_metrics(
 ) -> Result<(), OutputError> {
     let json = serde_json::to_string_pretty(metrics).unwrap_or_else(|_| "{}".into());
     put("metrics.json", json.into_bytes())?;
-    let published = crate::engine::rust::published::evaluate(case, r, metrics);
+    let published = crate::engine::published::evaluate(case, r, metrics);
     if !published.is_empty() {
         put("reference.csv", super::reference_file::run_csv(&published).into_bytes())?;
     }

@@ -318,7 +318,7 @@ pub enum FirstStart<'a> {
     DataGuess,
     /// a guess: the fixed point's warm start runs first (I8)
     Guess(&'a DVector<f64>),
-    /// a state near the frame's solution (its solution at a nearby λg, `engine::rust::weights`): Newton
+    /// a state near the frame's solution (its solution at a nearby λg, `engine::weights`): Newton
     /// directly, as from a previous frame, and the data guess if that fails
     Near(&'a DVector<f64>),
 }

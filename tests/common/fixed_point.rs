@@ -2,7 +2,7 @@
 //! state after each: what `tests/inverse_claims.rs` (rigid motions) and
 //! `examples/eq64_findings.rs` (the regularisation sweeps of §5.2) measure.
 use cosserat::case::Case;
-use cosserat::engine::rust::metrics::curvature_error;
+use cosserat::engine::metrics::curvature_error;
 use cosserat::solve::inverse::{InverseParams, InverseRecord, Start};
 use cosserat::solve::Problem;
 use nalgebra::{DVector, Vector3};

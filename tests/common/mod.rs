@@ -205,10 +205,10 @@ pub fn solve_frame_any(
 
 /// A run of a case in the Rust engine that may end stalled or at its iteration limit: the
 /// result (the last iterate) and, for such an end, the solver's error.
-pub fn run_any(case: &Case) -> (cosserat::engine::rust::RunResult, Option<SolveError>) {
+pub fn run_any(case: &Case) -> (cosserat::engine::RunResult, Option<SolveError>) {
     match cosserat::engine::rust::run_rust(case, |_, _| {}) {
         Ok(r) => (r, None),
-        Err(cosserat::engine::rust::RunError::Incomplete { source, partial }) => (*partial, Some(source)),
+        Err(cosserat::engine::RunError::Incomplete { source, partial }) => (*partial, Some(source)),
         Err(e) => panic!("{}: {}", case.name, error_chain(&e)),
     }
 }
@@ -274,11 +274,11 @@ pub fn error_chain(e: &dyn std::error::Error) -> String {
 }
 
 /// A clip sink that keeps every frame handed to it.
-pub struct Collect(pub std::sync::Arc<std::sync::Mutex<Vec<cosserat::engine::rust::clip::ClipFrame>>>);
+pub struct Collect(pub std::sync::Arc<std::sync::Mutex<Vec<cosserat::engine::clip::ClipFrame>>>);
 
-impl cosserat::engine::rust::clip::FrameSink for Collect {
+impl cosserat::engine::clip::FrameSink for Collect {
     type Error = std::convert::Infallible;
-    fn frame(&mut self, frame: &cosserat::engine::rust::clip::ClipFrame) -> Result<(), Self::Error> {
+    fn frame(&mut self, frame: &cosserat::engine::clip::ClipFrame) -> Result<(), Self::Error> {
         self.0.lock().expect("frames").push(frame.clone());
         Ok(())
     }

@@ -11,7 +11,7 @@ impl Validator<'_> {
     /// The published values of `[reference]` and its `short` variant. A quantity that this
     /// case cannot compute (a node beyond the rod, any value of a clip, which has no single
     /// final state) is refused here; a `metric.KEY` that the run does not write is refused
-    /// before the run (`engine::rust::published::unavailable`).
+    /// before the run (`engine::published::unavailable`).
     pub(super) fn published(
         &self,
         r: Option<&RawReference>,

@@ -10,11 +10,11 @@ use std::path::Path;
 use nalgebra::Vector3;
 
 use crate::case::Case;
+use crate::engine::common::frames::{frame_result, FrameSolution, SolvedFrame};
+use crate::engine::common::result::{Engine, NodalState};
 use crate::engine::freefem::{
     execute, info_certificate, io, read_info, read_table, ClipInclude, FreeFemError, RunOptions,
 };
-use crate::engine::rust::frames::{frame_result, SolvedFrame};
-use crate::engine::rust::{Engine, NodalState};
 use crate::model::chart::Chart;
 use crate::solve::certificate::Certificate;
 use crate::solve::inverse::{InverseRecord, ObjectiveTerms};
@@ -196,17 +196,16 @@ fn read_frames(
             // the certificate of the frame's solution (`FrameReport::certificate`)
             certificate: Some(rep[16]),
         };
-        let result = frame_result(
-            case,
-            Engine::Freefem,
+        let solution = FrameSolution {
             nodes,
-            &frames[local],
-            block.iter().map(|r| v3(r, 8)).collect(),
-            block.iter().map(|r| v3(r, 11)).collect(),
+            data: &frames[local],
+            xhat: block.iter().map(|r| v3(r, 8)).collect(),
+            ahat: block.iter().map(|r| v3(r, 11)).collect(),
             last,
-            rep[1] as usize,
-            rep[15],
-        );
+            iterations: rep[1] as usize,
+            wall_time_s: rep[15],
+        };
+        let result = frame_result(case, Engine::Freefem, solution);
         out.push(SolvedFrame { frame, restarted: rep[14] != 0.0, result });
     }
     Ok(out)

@@ -371,7 +371,7 @@ fn write_path(o: &mut String, case: &Case) {
     };
     // FreeFEM compiles the branch it does not take: the keys are written for every case
     let p = path.unwrap_or(arclength::ArcLengthParams::new(0, 1.0, 1.0));
-    let mut nodes: Vec<String> = crate::engine::rust::path_record_points(case)
+    let mut nodes: Vec<String> = crate::engine::common::path_record_points(case)
         .iter()
         .map(|&s| arclength::record_node(&case.mesh, s).to_string())
         .collect();

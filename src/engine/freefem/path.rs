@@ -9,7 +9,8 @@ use nalgebra::Vector3;
 
 use super::{read_table, FreeFemError};
 use crate::case::Case;
-use crate::engine::rust::{path_record_points, PathOutput, PathRecord};
+use crate::engine::common::path_record_points;
+use crate::engine::common::result::{PathOutput, PathRecord};
 use crate::solve::arclength::Critical;
 
 /// The outputs `arclength.idp` writes besides `forward.edp`'s.

@@ -8,7 +8,7 @@ use nalgebra::Vector3;
 
 use super::{read_table, FreeFemError};
 use crate::case::{Analysis, Case};
-use crate::engine::rust::result::{BucklingRecord, StabilityOutput};
+use crate::engine::common::result::{BucklingRecord, StabilityOutput};
 
 /// The output `stability.idp` writes besides `forward.edp`'s.
 pub const BUCKLING_OUTPUT: &str = "ff_buckling.csv";

@@ -8,7 +8,7 @@ use std::path::Path;
 
 use nalgebra::Vector3;
 
-use crate::engine::rust::NodalState;
+use crate::engine::common::result::NodalState;
 use crate::io::files::{csv_reader_capped, write_atomic, InputError, OutputError};
 use crate::model::chart::Chart;
 use crate::model::mesh::Mesh;

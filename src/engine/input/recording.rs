@@ -279,7 +279,8 @@ fn csv_header(path: &Path, header: &[String]) -> Result<(LengthUnit, bool), Inpu
 fn csv_table(path: &Path, spec: &ReadSpec) -> Result<Table, InputError> {
     // read as it goes: an hour's CSV (about 1 GB) is never held beside its rows
     let (file, _) = open_capped(path, RECORDING_CAP_BYTES, "recording")?;
-    let mut rdr = csv::ReaderBuilder::new().trim(csv::Trim::All).flexible(true).buffer_capacity(1 << 20).from_reader(file);
+    let mut rdr =
+        csv::ReaderBuilder::new().trim(csv::Trim::All).flexible(true).buffer_capacity(1 << 20).from_reader(file);
     let csv_err = |source| InputError::Csv { path: path.to_path_buf(), source };
     let header: Vec<String> = rdr.headers().map_err(csv_err)?.iter().map(String::from).collect();
     let (file_unit, planar) = csv_header(path, &header)?;

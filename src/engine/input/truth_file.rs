@@ -1,7 +1,7 @@
 //! The ground-truth sidecar of a synthetic recording: `NAME.truth.npy` next to `NAME.npy` (or
 //! `NAME.csv`), written by `cosserat synth` ([`super::corpus`]). When a recording has one, the
 //! clip is scored against it exactly as the `roll_3d` clip is against its generator
-//! (`crate::engine::rust::clip::TruthRun`): recovered curvature, frames and positions.
+//! (`crate::engine::common::clip_frame::TruthRun`): recovered curvature, frames and positions.
 //!
 //! Layout: float64, frames × nodes × 13, per node the rows of the frame `Q` (`d1`, `d2`, `d3`:
 //! 9 values [–]), the local curvature `κˡ` (3 values [1/m]) and the frame's roll angle `ψ` of

@@ -8,17 +8,13 @@ use std::time::Instant;
 
 use nalgebra::{DVector, Vector3};
 
-use super::clip_frame::{frame_data, ClipFrameError, Converged, Deriver};
-pub use super::clip_frame::{
-    nodal_curvature, planar_xz_curvature, sign_alternation, ClipFrame, Controls, ElementFields, FrameRecord,
-    PlanarCurvature, TruthFrame, TRUTH_SKIP_NODES,
-};
-use super::clip_summary::Summary;
-pub use super::clip_summary::{ClipRun, Kymograph, KymographColumn, TruthRun, KYMOGRAPH_COLUMNS};
+use super::derive::{frame_data, ClipFrameError, Converged, Deriver};
 use super::RunError;
 use crate::case::Case;
 use crate::clip::synthetic::{FrameTruth, GroundTruth};
 use crate::clip::Clip;
+use crate::engine::common::clip_frame::{FrameRecord, FrameSink};
+use crate::engine::common::clip_summary::{ClipRun, Summary};
 use crate::io::files::JournalError;
 use crate::model::chart::Chart;
 use crate::model::rotation::Angles;
@@ -27,16 +23,6 @@ use crate::solve::sequence::{
     solve_sequence_from, vector_to_space, ClipData, FirstStart, FrameReport, ResumeFrom, SequenceError, SequenceParams,
 };
 use crate::solve::{Problem, SolveError};
-
-/// Where the frames of a clip go (`crate::engine::input::clip_files::ClipWriter` streams them to disk).
-/// Called from a second thread, in frame order.
-pub trait FrameSink: Send {
-    type Error: std::error::Error + Send + Sync + 'static;
-    /// One converged frame.
-    fn frame(&mut self, frame: &ClipFrame) -> Result<(), Self::Error>;
-    /// After the last frame handed over (also when the clip stopped early).
-    fn finish(&mut self) -> Result<(), Self::Error>;
-}
 
 /// How a clip run ended: its summary over the frames it solved (all of them, or those before
 /// it stopped) and, if it stopped early, why (a frame's error, a write error, or an interrupt:

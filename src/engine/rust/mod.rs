@@ -5,13 +5,10 @@
 //! folder `crate::output`'s.
 pub mod budget;
 pub mod clip;
-pub mod clip_frame;
-pub mod clip_metrics;
-pub mod clip_summary;
+mod derive;
 pub mod frames;
-pub mod metrics;
-pub mod published;
-pub mod result;
+#[cfg(test)]
+mod published_tests;
 pub mod stability;
 pub mod weights;
 
@@ -19,16 +16,17 @@ use std::time::Instant;
 
 use nalgebra::{DVector, Vector3};
 
-pub use result::{Engine, InverseOutput, NodalState, PathOutput, PathRecord, RunResult, SolverStats};
+use super::common::metrics::{self, INNER_SKIP_ELEMENTS};
+use super::common::result::{self, Engine, InverseOutput, NodalState, RunResult, SolverStats};
+use super::common::{angles_known, path_record_points};
 
-use crate::case::{Analysis, Case, DataSource};
+use crate::case::{Analysis, Case};
 use crate::clip::ClipError;
 use crate::model::mesh::Field;
 use crate::solve::inverse::{Frame, FrameSolver, InverseRecord, Start};
 use crate::solve::sequence::{first_chart, SequenceError};
 use crate::solve::statics::StaticParams;
 use crate::solve::{arclength, dynamics, statics, SolveError};
-use metrics::INNER_SKIP_ELEMENTS;
 
 /// Errors of running a case.
 #[derive(Debug, thiserror::Error)]
@@ -178,14 +176,6 @@ fn run_forward_solve(case: &Case, mut progress: impl FnMut(usize, usize)) -> Res
     }
 }
 
-/// The arc lengths [m] a path records: each point load's and s = L, ascending.
-pub fn path_record_points(case: &Case) -> Vec<f64> {
-    let mut s: Vec<f64> = case.loads.point.iter().map(|p| p.s_m).chain([case.mesh.length_m]).collect();
-    s.sort_by(f64::total_cmp);
-    s.dedup();
-    s
-}
-
 /// The result of an arc-length path (D25): the last point's state, every Newton iteration,
 /// and the path.
 fn path_result(
@@ -241,11 +231,6 @@ pub fn forward_data(case: &Case) -> Result<NodalState, RunError> {
         Err(RunError::Incomplete { source, .. }) => Err(source.into()),
         Err(e) => Err(e),
     }
-}
-
-/// Does the data source of an inverse case carry the true angles (synthetic forward data)?
-pub fn angles_known(case: &Case) -> bool {
-    matches!(case.inverse().map(|i| &i.data), Some(DataSource::Forward(_)))
 }
 
 /// The single-frame path (`run_inverse`: `compare` and `sweep` on a clip case) solves a clip's

@@ -1,11 +1,11 @@
 //! The stability of a static result and the case's linearised buckling (D27) as a run's output.
 use nalgebra::DVector;
 
-use super::result::{BucklingRecord, StabilityOutput};
 use super::RunError;
 use crate::case::{Analysis, Case};
+use crate::engine::common::result::{BucklingRecord, StabilityOutput};
 use crate::model::mesh::Field;
-use crate::solve::stability::{buckling, stability, StabilityError, DENSE_LIMIT};
+use crate::solve::stability::{buckling, stability, StabilityError};
 use crate::solve::Problem;
 
 /// The stability of the static state `u` of `problem` (at its load factor) and, with
@@ -32,9 +32,4 @@ pub fn output(case: &Case, problem: &Problem, u: &DVector<f64>) -> Result<Stabil
         })
         .collect();
     Ok(StabilityOutput { smallest_eigenvalue_per_s2, conservative, modes })
-}
-
-/// Whether a case's dense eigen-analyses fit (D27): its unknowns at most [`DENSE_LIMIT`].
-pub fn fits(case: &Case) -> bool {
-    case.problem().dofs().len() <= DENSE_LIMIT
 }

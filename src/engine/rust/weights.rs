@@ -24,6 +24,7 @@
 use nalgebra::{DVector, Vector3};
 
 use crate::case::{Analysis, Case, WeightsRule};
+pub use crate::engine::common::clip_summary::ChosenWeights;
 use crate::solve::fit::noise_level_in;
 use crate::solve::sequence::{solve_sequence, FirstStart, SequenceParams};
 
@@ -44,26 +45,6 @@ pub const START_RATIO: f64 = 1e-3;
 /// frame 0 solves from the data guess (at a higher cost: 13–44 ms of the 30–60 ms of a search
 /// on 3 frames of 33 nodes started there).
 pub const SMOOTH_START_RATIO: f64 = 1e-6;
-
-/// The weights `"auto"` chose, for run.json and the batch summary.
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct ChosenWeights {
-    /// the recording's noise level σ̂ per coordinate [m]
-    pub noise_m: f64,
-    /// the chosen tracking weight λg
-    pub lambda_g: f64,
-    /// the case's `lambda_g`: the largest allowed
-    pub lambda_g_max: f64,
-    /// the fit's RMS distance to the data per coordinate at the chosen λg, `r` [m]
-    pub fit_residual_m: f64,
-    /// frames of the clip's start the choice was calibrated on
-    pub calibration_frames: usize,
-    /// calibration solves
-    pub solves: usize,
-    /// the stabilisation ε of the λd term's rule (I11) the noise asked for, [`noise_stabilisation`]
-    #[serde(default)]
-    pub stabilisation: f64,
-}
 
 /// Largest stabilisation [`noise_stabilisation`] chooses.
 pub const MAX_NOISE_STABILISATION: f64 = 0.1;

@@ -415,8 +415,8 @@ fn a_missing_clip_file_names_the_case_key() {
 #[test]
 fn the_minimum_clip_mesh_matches_the_measures() {
     use crate::clip::{CLIP_SKIP_ELEMENTS, MIN_CLIP_ELEMENTS};
-    use crate::engine::rust::clip::{planar_xz_curvature, sign_alternation, TRUTH_SKIP_NODES};
-    use crate::engine::rust::metrics::INNER_SKIP_ELEMENTS;
+    use crate::engine::common::clip_frame::{planar_xz_curvature, sign_alternation, TRUTH_SKIP_NODES};
+    use crate::engine::common::metrics::INNER_SKIP_ELEMENTS;
     assert_eq!((CLIP_SKIP_ELEMENTS, TRUTH_SKIP_NODES), (INNER_SKIP_ELEMENTS, INNER_SKIP_ELEMENTS));
     assert_eq!((MIN_CLIP_ELEMENTS, 2 * INNER_SKIP_ELEMENTS + 1, 2 * TRUTH_SKIP_NODES + 1), (11, 11, 11));
     // A zig-zag centreline on the smallest mesh: its data curvature alternates in sign.

@@ -1,7 +1,7 @@
 //! Metrics of a whole clip run (the row of a clip in `cosserat sweep`'s summary and in the
 //! audit): per-frame numbers of [`FrameReport`] reduced over the frames, with SI units in
 //! their names.
-use super::clip::ClipRun;
+use super::clip_summary::ClipRun;
 use super::metrics::Metrics;
 use crate::case::Case;
 use crate::solve::sequence::FrameReport;

@@ -34,7 +34,7 @@ pub struct PublishedRow {
 }
 
 impl PublishedRow {
-    fn new(v: &PublishedValue, computed: Result<f64, String>) -> Self {
+    pub(crate) fn new(v: &PublishedValue, computed: Result<f64, String>) -> Self {
         let tolerance = v.tolerance.bound(v.value);
         let error = computed.as_ref().map_or(f64::NAN, |c| c - v.value);
         // NaN fails: a value that is not a number is no agreement
@@ -166,7 +166,7 @@ pub fn metric_keys(case: &Case) -> Vec<String> {
         Analysis::Static(_) => {}
     }
     if let Analysis::Static(p) = &case.analysis {
-        if super::stability::fits(case) {
+        if super::dense_analyses_fit(case) {
             // `stable`: conservative loads only (D27)
             keys.extend(["tangent_smallest_eigenvalue_per_s2", "stable"].map(String::from));
         }
@@ -197,6 +197,3 @@ pub fn unavailable(case: &Case) -> Option<String> {
         _ => None,
     })
 }
-
-#[cfg(test)]
-mod tests;

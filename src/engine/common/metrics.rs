@@ -5,7 +5,7 @@ use std::collections::BTreeMap;
 use nalgebra::{DVector, Vector3};
 
 use super::result::InverseOutput;
-use super::{NodalState, RunResult};
+use super::result::{NodalState, PathOutput, RunResult};
 use crate::case::{Case, Reference};
 use crate::model::mesh::Mesh;
 use crate::reference::{timoshenko_tip_deflection, tip_loaded_cantilever, PlanarRod, ReferenceError};
@@ -72,7 +72,7 @@ fn stability_metrics(st: &super::result::StabilityOutput, m: &mut Metrics) {
 
 /// An arc-length path's metrics (D25): the load factor where it ended, the first limit and
 /// bifurcation points' load factors, its points.
-fn path_metrics(p: &super::PathOutput, m: &mut Metrics) {
+fn path_metrics(p: &PathOutput, m: &mut Metrics) {
     use crate::solve::arclength::Critical;
     if let Some(last) = p.points.last() {
         m.insert("final_load_factor".into(), last.load_factor);
@@ -323,12 +323,12 @@ pub fn differences(a: &RunResult, b: &RunResult, iterations: bool) -> Vec<Differ
 
 /// Two arc-length paths (D25): the number of critical points and, over paths of as many points,
 /// the load factors and the recorded displacements point by point (relative to their largest).
-fn path_differences(p: &super::PathOutput, q: &super::PathOutput) -> Vec<Difference> {
-    let count = |p: &super::PathOutput| Some(p.critical.len() as f64);
+fn path_differences(p: &PathOutput, q: &PathOutput) -> Vec<Difference> {
+    let count = |p: &PathOutput| Some(p.critical.len() as f64);
     let mut rows = vec![Difference::scalar("critical_points", Group::Metric, count(p), count(q), None)];
     if p.points.len() == q.points.len() {
-        let lambda = |p: &super::PathOutput| p.points.iter().map(|r| Vector3::new(r.load_factor, 0.0, 0.0)).collect();
-        let disp = |p: &super::PathOutput| p.points.iter().flat_map(|r| r.displacements.clone()).collect::<Vec<_>>();
+        let lambda = |p: &PathOutput| p.points.iter().map(|r| Vector3::new(r.load_factor, 0.0, 0.0)).collect();
+        let disp = |p: &PathOutput| p.points.iter().flat_map(|r| r.displacements.clone()).collect::<Vec<_>>();
         let (lp, lq): (Vec<_>, Vec<_>) = (lambda(p), lambda(q));
         rows.push(Difference::field(
             "path_rel_diff_load_factor",

@@ -28,7 +28,7 @@ pub struct ClipRun {
     pub wall_time_s: f64,
     pub source: String,
     /// the weights `[inverse] weights = "auto"` chose (`super::weights`)
-    pub weights: Option<super::weights::ChosenWeights>,
+    pub weights: Option<ChosenWeights>,
 }
 
 /// Ground-truth scores of a synthetic clip run, per frame.
@@ -93,13 +93,13 @@ impl Kymograph {
 }
 
 /// The summary of a clip run, frame by frame.
-pub(super) struct Summary {
+pub(crate) struct Summary {
     run: ClipRun,
 }
 
 impl Summary {
     /// The summary of a run of a clip of `frames` frames (`truth`: with a ground truth).
-    pub(super) fn new(truth: bool, frames: usize) -> Self {
+    pub(crate) fn new(truth: bool, frames: usize) -> Self {
         Summary {
             run: ClipRun {
                 reports: Vec::new(),
@@ -113,7 +113,7 @@ impl Summary {
         }
     }
 
-    pub(super) fn push(&mut self, f: &ClipFrame) {
+    pub(crate) fn push(&mut self, f: &ClipFrame) {
         let r = &mut self.run;
         r.kymograph.push(r.reports.len(), f);
         r.reports.push(f.report);
@@ -125,9 +125,30 @@ impl Summary {
         }
     }
 
-    pub(super) fn finish(mut self, wall_time_s: f64, source: String) -> ClipRun {
+    pub(crate) fn finish(mut self, wall_time_s: f64, source: String) -> ClipRun {
         self.run.wall_time_s = wall_time_s;
         self.run.source = source;
         self.run
     }
+}
+
+/// The weights `"auto"` chose, for run.json and the batch summary.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct ChosenWeights {
+    /// the recording's noise level σ̂ per coordinate [m]
+    pub noise_m: f64,
+    /// the chosen tracking weight λg
+    pub lambda_g: f64,
+    /// the case's `lambda_g`: the largest allowed
+    pub lambda_g_max: f64,
+    /// the fit's RMS distance to the data per coordinate at the chosen λg, `r` [m]
+    pub fit_residual_m: f64,
+    /// frames of the clip's start the choice was calibrated on
+    pub calibration_frames: usize,
+    /// calibration solves
+    pub solves: usize,
+    /// the stabilisation ε of the λd term's rule (I11) the noise asked for
+    /// (`crate::engine::weights::noise_stabilisation`)
+    #[serde(default)]
+    pub stabilisation: f64,
 }

@@ -1,13 +1,16 @@
-//! Tests of the evaluator: interpolation against an analytic linear field, verdicts, the
+//! Tests of the published values' evaluator (`crate::engine::common::published`) on Rust engine runs: interpolation against an analytic linear field, verdicts, the
 //! metrics.json entries, and the list of metric keys against what a run writes.
 use std::path::Path;
 
 use nalgebra::Vector3;
 
-use super::*;
-use crate::case::published::{Axis, Tolerance};
-use crate::engine::rust::metrics::{all_metrics, Metrics};
-use crate::engine::rust::{run_forward, run_inverse, Engine, RunError, SolverStats};
+use super::{run_forward, run_inverse, RunError};
+use crate::case::published::{Axis, NodeField, PublishedValue, Quantity, Tolerance};
+use crate::case::{Analysis, Case};
+use crate::engine::common::metrics::{all_metrics, Metrics};
+use crate::engine::common::published::*;
+use crate::engine::common::result::{Engine, SolverStats};
+use crate::engine::common::result::{NodalState, RunResult};
 use crate::model::chart::Chart;
 
 /// A state whose every field is linear in s on uneven nodes: x = a + b s, α = c + d s.
