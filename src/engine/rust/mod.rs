@@ -265,9 +265,6 @@ pub fn run_inverse(
     let truth: Vec<Vector3<f64>> = data.element_curvature().into_iter().map(|(_, k)| k).collect();
     let mut kappa_err = Vec::new();
     let observer = |r: &InverseRecord, u: &DVector<f64>, _: &DVector<f64>| {
-        if crate::interrupt::requested() {
-            std::panic::resume_unwind(Box::new(StopRequested { iteration: r.iteration }));
-        }
         if known {
             let k: Vec<Vector3<f64>> =
                 NodalState::from_vector(&case.mesh, u).element_curvature().into_iter().map(|(_, k)| k).collect();
@@ -279,17 +276,13 @@ pub fn run_inverse(
         progress(r.iteration, params.max_iterations)
     };
     let frame = Frame { index: 0, x_g: &data.x, previous: None, weight: None, fix_roll: false };
-    let solve = || FrameSolver::new(&problem, params).solve(&frame, &problem.reference_state(), Start::Guess, observer);
-    let sol = match std::panic::catch_unwind(std::panic::AssertUnwindSafe(solve)) {
-        Ok(solved) => solved?,
-        Err(payload) => match payload.downcast::<StopRequested>() {
-            Ok(stop) => {
-                let total = params.max_iterations;
-                return Err(SolveError::Interrupted { what: "iterations", done: stop.iteration, total }.into());
-            }
-            Err(panic) => std::panic::resume_unwind(panic),
-        },
-    };
+    // stopped at its next iteration once a stop is requested (crate::interrupt)
+    let sol = FrameSolver::new(&problem, params).stopped_by(crate::interrupt::requested).solve(
+        &frame,
+        &problem.reference_state(),
+        Start::Guess,
+        observer,
+    )?;
     let dofs = problem.dofs();
     let result = RunResult {
         engine: Engine::Rust,
@@ -321,15 +314,6 @@ pub fn run_inverse(
         Ok(_) => Ok(result),
         Err(source) => Err(RunError::Incomplete { source, partial: Box::new(result) }),
     }
-}
-
-/// The unwind that stops an inverse solve at its next iteration once a stop is requested
-/// (`crate::interrupt`): the frame solver (`solve::inverse`) checks for no stop itself and its
-/// observer can only watch, so the observer unwinds out of it with this payload (no panic
-/// message: `resume_unwind` skips the panic hook) and [`run_inverse`] turns it into
-/// `SolveError::Interrupted`. The solver's state is dropped; nothing of it is kept.
-struct StopRequested {
-    iteration: usize,
 }
 
 /// Run `case` in the Rust engine from memory: a forward case, or a synthetic inverse case on

@@ -11,6 +11,8 @@
 //!
 //! ## References
 //! 1. Wang et al., Comput. Mech. 71 (2023), eq. (61), Remark 10.
+use std::ops::ControlFlow;
+
 use nalgebra::DVector;
 
 use super::measures::record;
@@ -38,7 +40,7 @@ pub(crate) fn solve(
     params: &InverseParams,
     frame: &Frame,
     u0: &DVector<f64>,
-    observer: &mut impl FnMut(&InverseRecord, &DVector<f64>, &DVector<f64>),
+    observer: &mut impl FnMut(&InverseRecord, &DVector<f64>, &DVector<f64>) -> ControlFlow<()>,
 ) -> Result<InverseSolution, SolveError> {
     run(s, params, frame, u0, StopRule::Plateau, observer)
 }
@@ -50,7 +52,7 @@ pub(crate) fn run(
     frame: &Frame,
     u0: &DVector<f64>,
     rule: StopRule,
-    observer: &mut impl FnMut(&InverseRecord, &DVector<f64>, &DVector<f64>),
+    observer: &mut impl FnMut(&InverseRecord, &DVector<f64>, &DVector<f64>) -> ControlFlow<()>,
 ) -> Result<InverseSolution, SolveError> {
     let fwd = s.problem.dofs();
     let mut u = u0.clone();
@@ -84,8 +86,11 @@ pub(crate) fn run(
             ..record(s.problem, params, frame, previous, k, rel_change, &u, &adjoint, None)
         };
         rec.divergence(frame.index, &u, &adjoint)?;
-        observer(&rec, &u, &adjoint);
+        let stop_requested = observer(&rec, &u, &adjoint).is_break();
         history.push(rec);
+        if stop_requested {
+            return Err(SolveError::Interrupted { what: "iterations", done: 0, total: 0 });
+        }
         if stop {
             let stop = match rule {
                 StopRule::FirstDip => Stop::Converged,

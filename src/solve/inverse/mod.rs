@@ -32,6 +32,8 @@ pub mod tracking;
 
 pub use tracking::Tracking;
 
+use std::ops::ControlFlow;
+
 use nalgebra::{DVector, Vector3};
 
 use super::certificate::Certificate;
@@ -367,6 +369,9 @@ pub struct FrameSolver<'p> {
     pub(crate) no_previous: Vec<Angles>,
     /// which Newton iterations keep a record
     pub(crate) records: Records,
+    /// polled after every recorded iteration: `true` stops the solve there with
+    /// [`SolveError::Interrupted`] ([`FrameSolver::stopped_by`])
+    pub(crate) stop: Option<fn() -> bool>,
 }
 
 /// The Dirichlet conditions of I5 of a frame, refilled per frame: the positions depend only
@@ -407,6 +412,7 @@ impl<'p> FrameSolver<'p> {
             work: Workspace { values, merit_weights: Vec::new(), cert_values: Vec::new() },
             no_previous: vec![Vector3::zeros(); problem.mesh.nodes()],
             records: Records::Every,
+            stop: None,
         }
     }
 
@@ -414,6 +420,13 @@ impl<'p> FrameSolver<'p> {
     /// keeps every record).
     pub fn with_records(self, records: Records) -> Self {
         FrameSolver { records, ..self }
+    }
+
+    /// Stop a solve at its next recorded iteration once `requested()` says so (e.g.
+    /// `crate::interrupt::requested`): the solve returns [`SolveError::Interrupted`] with that
+    /// iteration. Without it a solve runs to its end (a clip stops between frames instead).
+    pub fn stopped_by(self, requested: fn() -> bool) -> Self {
+        FrameSolver { stop: Some(requested), ..self }
     }
 
     pub fn params(&self) -> &InverseParams {
@@ -444,15 +457,29 @@ impl<'p> FrameSolver<'p> {
         }
         self.set_dirichlet(frame);
         let params = self.params;
+        // the observer, then the stop token: the iteration a stop was requested after
+        let (stop, mut stopped_at) = (self.stop, 0);
+        let mut watch = |r: &InverseRecord, u: &DVector<f64>, a: &DVector<f64>| {
+            observer(r, u, a);
+            stopped_at = r.iteration;
+            if stop.is_some_and(|requested| requested()) {
+                ControlFlow::Break(())
+            } else {
+                ControlFlow::Continue(())
+            }
+        };
         let solved = match (params.method, start) {
-            (InverseMethod::FixedPoint, _) => fixed_point::solve(self, &params, frame, u0, &mut observer),
-            (InverseMethod::Newton { .. }, Start::Near) => newton::solve(self, &params, frame, u0, &mut observer),
+            (InverseMethod::FixedPoint, _) => fixed_point::solve(self, &params, frame, u0, &mut watch),
+            (InverseMethod::Newton { .. }, Start::Near) => newton::solve(self, &params, frame, u0, &mut watch),
             (InverseMethod::Newton { warm_start_tolerance }, Start::Guess) => {
-                newton::solve_warm(self, warm_start_tolerance, frame, u0, &mut observer)
+                newton::solve_warm(self, warm_start_tolerance, frame, u0, &mut watch)
             }
         };
         solved.map_err(|e| match e {
             SolveError::Linear(LinearError::ZeroPivot { column, .. }) => self.singular(frame.index, column),
+            SolveError::Interrupted { what, .. } => {
+                SolveError::Interrupted { what, done: stopped_at, total: params.max_iterations }
+            }
             e => e,
         })
     }

@@ -27,6 +27,8 @@
 //!
 //! ## References
 //! 1. Wang et al., Comput. Mech. 71 (2023), §3–4, eqs. (52)–(61), Remark 8, Remark 10.
+use std::ops::ControlFlow;
+
 use nalgebra::{DVector, Matrix3, Vector3};
 
 use super::kkt::{add_node_pairs, add_operator_blocks, element_part, element_system, KktMat, KktVec, PointRule, AL, X};
@@ -228,7 +230,7 @@ pub(crate) fn solve(
     params: &InverseParams,
     frame: &Frame,
     u0: &DVector<f64>,
-    observer: &mut impl FnMut(&InverseRecord, &DVector<f64>, &DVector<f64>),
+    observer: &mut impl FnMut(&InverseRecord, &DVector<f64>, &DVector<f64>) -> ControlFlow<()>,
 ) -> Result<InverseSolution, SolveError> {
     solve_from(s, params, frame, u0, false, observer)
 }
@@ -243,7 +245,7 @@ fn solve_from(
     frame: &Frame,
     u0: &DVector<f64>,
     rescale: bool,
-    observer: &mut impl FnMut(&InverseRecord, &DVector<f64>, &DVector<f64>),
+    observer: &mut impl FnMut(&InverseRecord, &DVector<f64>, &DVector<f64>) -> ControlFlow<()>,
 ) -> Result<InverseSolution, SolveError> {
     // Consistent start: one linear solve of the fixed point at u0.
     let big = s.solve_linearised(params, frame, u0, rescale)?;
@@ -385,7 +387,7 @@ impl Newton<'_, '_, '_> {
         &mut self,
         it: &mut Iterate,
         k: usize,
-        observer: &mut impl FnMut(&InverseRecord, &DVector<f64>, &DVector<f64>),
+        observer: &mut impl FnMut(&InverseRecord, &DVector<f64>, &DVector<f64>) -> ControlFlow<()>,
     ) -> Result<Attempt, SolveError> {
         let chord = it.mode == Mode::Chord;
         let r = match it.next.take() {
@@ -442,7 +444,7 @@ impl Newton<'_, '_, '_> {
         it: &mut Iterate,
         k: usize,
         phi: f64,
-        observer: &mut impl FnMut(&InverseRecord, &DVector<f64>, &DVector<f64>),
+        observer: &mut impl FnMut(&InverseRecord, &DVector<f64>, &DVector<f64>) -> ControlFlow<()>,
     ) -> (Stop, Certificate) {
         let c = self.certify(&it.big);
         let stop = if c.within(self.params.certificate_tolerance) { Stop::Converged } else { Stop::Stalled };
@@ -451,7 +453,8 @@ impl Newton<'_, '_, '_> {
                 certificate: Some(c.value),
                 ..self.record(k - 1, it.previous, &it.u, &it.adjoint, Some(phi / it.phi0))
             };
-            observer(&rec, &it.u, &it.adjoint);
+            // the solve ends here whatever the observer asks
+            let _ = observer(&rec, &it.u, &it.adjoint);
             it.history.push(rec);
         }
         (stop, c)
@@ -506,7 +509,7 @@ impl Newton<'_, '_, '_> {
         trial: DVector<f64>,
         full: bool,
         phi_t: f64,
-        observer: &mut impl FnMut(&InverseRecord, &DVector<f64>, &DVector<f64>),
+        observer: &mut impl FnMut(&InverseRecord, &DVector<f64>, &DVector<f64>) -> ControlFlow<()>,
     ) -> Result<Attempt, SolveError> {
         let dofs = self.s.dofs;
         let u_old = dofs.kkt_state(&it.big);
@@ -527,8 +530,11 @@ impl Newton<'_, '_, '_> {
                 ..self.record(k, rel_change, &it.u, &it.adjoint, residual)
             };
             rec.divergence(self.frame.index, &it.u, &it.adjoint)?;
-            observer(&rec, &it.u, &it.adjoint);
+            let stop_requested = observer(&rec, &it.u, &it.adjoint).is_break();
             it.history.push(rec);
+            if stop_requested {
+                return Err(SolveError::Interrupted { what: "iterations", done: 0, total: 0 });
+            }
         }
         match cert {
             Some(c) if full && c.within(self.params.certificate_tolerance) => {
@@ -554,7 +560,7 @@ pub(crate) fn solve_warm(
     warm_start_tolerance: f64,
     frame: &Frame,
     u0: &DVector<f64>,
-    observer: &mut impl FnMut(&InverseRecord, &DVector<f64>, &DVector<f64>),
+    observer: &mut impl FnMut(&InverseRecord, &DVector<f64>, &DVector<f64>) -> ControlFlow<()>,
 ) -> Result<InverseSolution, SolveError> {
     let p = s.params;
     let warm = InverseParams { tolerance: warm_start_tolerance.max(p.tolerance), ..p };
@@ -565,7 +571,7 @@ pub(crate) fn solve_warm(
     let done = start.history.len();
     let rest = InverseParams { max_iterations: p.max_iterations.saturating_sub(done).max(1), ..p };
     let newton = solve_from(s, &rest, frame, &start.u, true, &mut |r, u, a| {
-        observer(&InverseRecord { iteration: r.iteration + done, ..*r }, u, a);
+        observer(&InverseRecord { iteration: r.iteration + done, ..*r }, u, a)
     })?;
     let mut history = start.history;
     history.extend(newton.history.into_iter().map(|r| InverseRecord { iteration: r.iteration + done, ..r }));
