@@ -12,7 +12,7 @@ use cosserat::linalg::LinearSolver;
 use cosserat::model::mesh::Field;
 use cosserat::solve::inverse::kkt::dirichlet;
 use cosserat::solve::inverse::newton::assemble_residual;
-use cosserat::solve::inverse::{Frame, FrameSolver, InverseMethod, InverseParams, Start};
+use cosserat::solve::inverse::{Frame, FrameProblem, FrameSolver, InverseMethod, InverseParams, Start};
 use cosserat::solve::sequence::data_frame_guess;
 use nalgebra::DVector;
 
@@ -73,7 +73,12 @@ fn main() -> Result<()> {
     let t = Clock::now();
     let mut r = DVector::zeros(0);
     for _ in 0..reps {
-        r = assemble_residual(&problem, &base, &frame, &prev, &big, &fixed, Some((&pattern, &mut values, &rows)));
+        r = assemble_residual(
+            FrameProblem { problem: &problem, params: &base, frame: &frame, alpha_prev: &prev },
+            &big,
+            &fixed,
+            Some((&pattern, &mut values, &rows)),
+        );
     }
     let assemble = elapsed(&t) / reps as f64;
     let t = Clock::now();

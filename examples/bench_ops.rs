@@ -10,7 +10,7 @@ use anyhow::{Context, Result};
 use cosserat::case::Case;
 use cosserat::engine::input::clip_files::load_clip;
 use cosserat::linalg::LinearSolver;
-use cosserat::solve::inverse::{kkt, measures, newton, Frame};
+use cosserat::solve::inverse::{kkt, measures, newton, Frame, FrameProblem};
 use cosserat::solve::sequence::{solve_sequence, FirstStart, FrameSolution};
 use nalgebra::{DVector, Vector3};
 
@@ -57,19 +57,18 @@ fn main() -> Result<()> {
         }
         println!("{name:32} {:8.1} µs", t.elapsed().as_secs_f64() * 1e6 / reps as f64);
     };
-    let rhs = kkt::assemble_system(&problem, &params, false, &pattern, &mut values, &u, x_g, &prev);
+    let fp = FrameProblem { problem: &problem, params: &params, frame: &frame, alpha_prev: &prev };
+    let rhs = kkt::assemble_system(fp, &pattern, &mut values, &u);
     pattern.set_identity_rows(&mut values, &rows);
     let mut solver = LinearSolver::new(&pattern);
     let big: DVector<f64> = solver.solve_equilibrated(&values, &rhs)?;
     time("KKT system", &mut || {
-        std::hint::black_box(kkt::assemble_system(&problem, &params, false, &pattern, &mut values, &u, x_g, &prev));
+        std::hint::black_box(kkt::assemble_system(fp, &pattern, &mut values, &u));
     });
     time("residual", &mut || {
-        std::hint::black_box(newton::assemble_residual(&problem, &params, &frame, &prev, &big, &fixed, None));
+        std::hint::black_box(newton::assemble_residual(fp, &big, &fixed, None));
     });
-    let jacobian = |values: &mut [f64]| {
-        newton::assemble_residual(&problem, &params, &frame, &prev, &big, &fixed, Some((&pattern, values, &rows)))
-    };
+    let jacobian = |values: &mut [f64]| newton::assemble_residual(fp, &big, &fixed, Some((&pattern, values, &rows)));
     time("residual + Jacobian", &mut || {
         std::hint::black_box(jacobian(&mut values));
     });

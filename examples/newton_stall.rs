@@ -13,7 +13,7 @@
 use cosserat::case::Case;
 use cosserat::solve::inverse::kkt::dirichlet;
 
-use cosserat::solve::inverse::{Frame, FrameSolver, InverseMethod, Start};
+use cosserat::solve::inverse::{Frame, FrameProblem, FrameSolver, InverseMethod, Start};
 use nalgebra::{DVector, Vector3};
 
 fn big_of(case: &Case, u: &DVector<f64>, a: &DVector<f64>) -> DVector<f64> {
@@ -47,7 +47,12 @@ fn main() {
     let cert = |u: &DVector<f64>, a: &DVector<f64>| {
         let pt = kd.pattern();
         let mut v = vec![0.0; pt.nnz()];
-        cosserat::solve::inverse::kkt::certificate(&p, &params, &frame, &prev, &big_of(&case, u, a), &pt, &mut v)
+        cosserat::solve::inverse::kkt::certificate(
+            FrameProblem { problem: &p, params: &params, frame: &frame, alpha_prev: &prev },
+            &big_of(&case, u, a),
+            &pt,
+            &mut v,
+        )
     };
     let mut k = 0;
     let fp = FrameSolver::new(&p, params)
@@ -79,10 +84,7 @@ fn main() {
         let mut values = vec![0.0; pattern.nnz()];
         let rows: Vec<usize> = fixed.iter().map(|f| f.0).collect();
         let r = cosserat::solve::inverse::newton::assemble_residual(
-            &p,
-            &params,
-            &frame,
-            &prev,
+            FrameProblem { problem: &p, params: &params, frame: &frame, alpha_prev: &prev },
             &big,
             &fixed,
             Some((&pattern, &mut values, &rows)),
@@ -160,7 +162,12 @@ fn main() {
             let c = {
                 let pt = kd.pattern();
                 let mut v = vec![0.0; pt.nnz()];
-                cosserat::solve::inverse::kkt::certificate(&p, &np, &frame, &prev, &big_of(&case, u, a), &pt, &mut v)
+                cosserat::solve::inverse::kkt::certificate(
+                    FrameProblem { problem: &p, params: &np, frame: &frame, alpha_prev: &prev },
+                    &big_of(&case, u, a),
+                    &pt,
+                    &mut v,
+                )
             };
             if k < 30 || k % 50 == 0 {
                 eprintln!(

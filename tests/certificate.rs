@@ -9,7 +9,7 @@ use cosserat::engine::RunError;
 use cosserat::model::mesh::Field;
 use cosserat::solve::certificate::{Certificate, CERTIFICATE_FLOOR};
 use cosserat::solve::inverse::kkt::certificate;
-use cosserat::solve::inverse::{Frame, FrameSolver, Start};
+use cosserat::solve::inverse::{Frame, FrameProblem, FrameSolver, Start};
 use cosserat::solve::{statics, SolveError, Stop, PLATEAU_ITERATIONS};
 use nalgebra::{DVector, Vector3};
 
@@ -27,7 +27,12 @@ fn kkt_certificate(
     let frame = Frame { index: 0, x_g, previous: None, weight: None, fix_roll: false };
     let prev = vec![Vector3::zeros(); case.mesh.nodes()];
     let params = case.inverse().expect("inverse").params;
-    certificate(&p, &params, &frame, &prev, &kd.kkt_join(u, a), &pattern, &mut values)
+    certificate(
+        FrameProblem { problem: &p, params: &params, frame: &frame, alpha_prev: &prev },
+        &kd.kkt_join(u, a),
+        &pattern,
+        &mut values,
+    )
 }
 
 /// A Newton root is certified at the round-off floor; a fixed point stopped on the paper's

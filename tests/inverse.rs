@@ -4,7 +4,7 @@ mod common;
 use common::{case_from, case_text};
 use cosserat::engine::metrics::curvature_error;
 use cosserat::model::mesh::Field;
-use cosserat::solve::inverse::{InverseRecord, Start};
+use cosserat::solve::inverse::{FrameProblem, InverseRecord, Start};
 
 /// Paper §5.2, first test: λf = 1, λl = 1e-10, λd = 1e-6, Λκ = diag(0, 0, 1e-10), Λω = 0.
 /// The printed fixed point converges sublinearly: an independent re-implementation
@@ -75,7 +75,10 @@ fn adjoint_gradient_matches_finite_differences() {
     let params = common::all_terms_params();
     let pattern = kd.pattern();
     let mut values = vec![0.0; pattern.nnz()];
-    let rhs = assemble_system(&p, &params, false, &pattern, &mut values, &uk, &xg, &prev);
+    // a frame after the first: the Λω term against `prev` is on
+    let frame = Frame { index: 1, x_g: &xg, previous: Some(&prev), weight: None, fix_roll: false };
+    let fp = FrameProblem { problem: &p, params: &params, frame: &frame, alpha_prev: &prev };
+    let rhs = assemble_system(fp, &pattern, &mut values, &uk);
     let k = pattern.to_dense(&values);
     // Index sets (KKT layout).
     let set = |nodes: &[usize], fields: &[Field]| -> Vec<usize> {

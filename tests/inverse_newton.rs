@@ -8,7 +8,7 @@ use cosserat::linalg::{LinearSolver, Pattern};
 use cosserat::model::mesh::{DofMap, Field, Mesh};
 use cosserat::solve::inverse::kkt::{assemble_system, dirichlet};
 use cosserat::solve::inverse::newton::assemble_residual;
-use cosserat::solve::inverse::{Frame, InverseParams, InverseRecord, Start};
+use cosserat::solve::inverse::{Frame, FrameProblem, InverseParams, InverseRecord, Start};
 use cosserat::solve::Problem;
 use nalgebra::{DVector, Vector3};
 
@@ -29,7 +29,8 @@ fn newton_residual(
 ) -> DVector<f64> {
     let fixed = dirichlet(&p.mesh.kkt_dofs(), params.alpha0_rad, frame);
     let rows: Vec<usize> = fixed.iter().map(|f| f.0).collect();
-    assemble_residual(p, params, frame, prev, big, &fixed, jacobian.map(|(pt, v)| (pt, v, rows.as_slice())))
+    let fp = FrameProblem { problem: p, params, frame, alpha_prev: prev };
+    assemble_residual(fp, big, &fixed, jacobian.map(|(pt, v)| (pt, v, rows.as_slice())))
 }
 
 /// The fixed point's matrix K(u) with its Dirichlet rows, and its right-hand side.
@@ -42,7 +43,7 @@ fn fixed_point_system(
     pattern: &Pattern,
 ) -> (Vec<f64>, DVector<f64>) {
     let mut kv = vec![0.0; pattern.nnz()];
-    let rhs = assemble_system(p, params, frame.is_first(), pattern, &mut kv, u, frame.x_g, prev);
+    let rhs = assemble_system(FrameProblem { problem: p, params, frame, alpha_prev: prev }, pattern, &mut kv, u);
     let rows: Vec<usize> = dirichlet(&p.mesh.kkt_dofs(), params.alpha0_rad, frame).iter().map(|f| f.0).collect();
     pattern.set_identity_rows(&mut kv, &rows);
     (kv, rhs)

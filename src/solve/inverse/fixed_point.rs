@@ -16,7 +16,7 @@ use std::ops::ControlFlow;
 use nalgebra::DVector;
 
 use super::measures::record;
-use super::{Frame, FrameSolver, InverseParams, InverseRecord, InverseSolution, Records};
+use super::{Frame, FrameProblem, FrameSolver, InverseParams, InverseRecord, InverseSolution, Records};
 use crate::solve::certificate::Certificate;
 use crate::solve::statics::relative_change;
 use crate::solve::{SolveError, Stop, PLATEAU_ITERATIONS};
@@ -83,7 +83,13 @@ pub(crate) fn run(
         let previous = frame.previous.unwrap_or(&s.no_previous);
         let rec = InverseRecord {
             certificate: cert.map(|c| c.value),
-            ..record(s.problem, params, frame, previous, k, rel_change, &u, &adjoint, None)
+            ..record(
+                FrameProblem { problem: s.problem, params, frame, alpha_prev: previous },
+                (k, rel_change),
+                &u,
+                &adjoint,
+                None,
+            )
         };
         rec.divergence(frame.index, &u, &adjoint)?;
         let stop_requested = observer(&rec, &u, &adjoint).is_break();

@@ -4,7 +4,7 @@
 use nalgebra::{DVector, Matrix3, SMatrix, SVector, Vector3};
 
 use super::tracking::weight_at;
-use super::{Frame, InverseParams, Tracking};
+use super::{Frame, FrameProblem, InverseParams};
 use crate::assemble::{assemble, Tangent};
 use crate::linalg::Pattern;
 use crate::model::element::{frozen_operator, interpolate, ElementRest, LocalMat, LocalVec};
@@ -343,18 +343,9 @@ pub(crate) fn dirichlet_into(dofs: &DofMap, alpha0: f64, frame: &Frame, fixed: &
 
 /// Assemble the KKT matrix (replacing `values`) and right-hand side of I4 with the
 /// coefficients frozen at the state `u` (forward layout); boundary conditions not applied.
-#[allow(clippy::too_many_arguments)]
-pub fn assemble_system<'a>(
-    problem: &Problem,
-    p: &InverseParams,
-    first_frame: bool,
-    pattern: &Pattern,
-    values: &mut [f64],
-    u: &DVector<f64>,
-    data: impl Into<Tracking<'a>>,
-    alpha_prev: &[Vector3<f64>],
-) -> DVector<f64> {
-    let data = data.into();
+pub fn assemble_system(fp: FrameProblem<'_>, pattern: &Pattern, values: &mut [f64], u: &DVector<f64>) -> DVector<f64> {
+    let FrameProblem { problem, params: p, frame, alpha_prev } = fp;
+    let (first_frame, data) = (frame.is_first(), frame.tracking());
     let fwd = problem.dofs();
     let kkt_dofs = problem.mesh.kkt_dofs();
 
@@ -373,16 +364,8 @@ pub fn assemble_system<'a>(
 /// coefficient at the state of `big` itself, against `|K(u)| |U| + |r(u)|`, positions measured
 /// from the data's first node (so that a translation of the data leaves it unchanged).
 /// `values`: scratch of `pattern`'s size.
-#[allow(clippy::too_many_arguments)]
-pub fn certificate(
-    problem: &Problem,
-    p: &InverseParams,
-    frame: &Frame,
-    alpha_prev: &[Vector3<f64>],
-    big: &DVector<f64>,
-    pattern: &Pattern,
-    values: &mut [f64],
-) -> Certificate {
+pub fn certificate(fp: FrameProblem<'_>, big: &DVector<f64>, pattern: &Pattern, values: &mut [f64]) -> Certificate {
+    let FrameProblem { problem, params: p, frame, .. } = fp;
     let kd = problem.mesh.kkt_dofs();
     let origin = frame.x_g[0];
     let x_g: Vec<Vector3<f64>> = frame.x_g.iter().map(|x| x - origin).collect();
@@ -393,7 +376,8 @@ pub fn certificate(
     }
     let shifted = Frame { x_g: &x_g, ..*frame };
     let u = kd.kkt_state(&big);
-    let mut rhs = assemble_system(problem, p, frame.is_first(), pattern, values, &u, shifted.tracking(), alpha_prev);
+    let shifted_fp = FrameProblem { frame: &shifted, ..fp };
+    let mut rhs = assemble_system(shifted_fp, pattern, values, &u);
     let fixed = dirichlet(&kd, p.alpha0_rad, &shifted);
     for &(d, v) in &fixed {
         rhs[d] = v;

@@ -4,7 +4,7 @@ use nalgebra::{DVector, Vector3};
 
 use super::kkt::PointRule;
 use super::tracking::weight_at;
-use super::{Frame, InverseParams, InverseRecord, ObjectiveTerms, Tracking};
+use super::{FrameProblem, InverseParams, InverseRecord, ObjectiveTerms, Tracking};
 use crate::assemble::integrate;
 use crate::model::element::{interpolate, LocalVec, PointState};
 use crate::model::rotation::{a_matrix, curvature, d3, Angles};
@@ -106,18 +106,15 @@ fn data_misfit(data: &Tracking, e: usize, q: &PointState) -> (f64, f64, f64) {
 
 /// The per-iteration record of `frame` at the state `u` with the adjoint `adjoint` (fit
 /// measures and the objective terms of (41)).
-#[allow(clippy::too_many_arguments)]
+/// `(iteration, rel_change)`: the iteration's number and relative change.
 pub(crate) fn record(
-    problem: &Problem,
-    p: &InverseParams,
-    frame: &Frame,
-    alpha_prev: &[Vector3<f64>],
-    iteration: usize,
-    rel_change: f64,
+    fp: FrameProblem<'_>,
+    (iteration, rel_change): (usize, f64),
     u: &DVector<f64>,
     adjoint: &DVector<f64>,
     residual: Option<f64>,
 ) -> InverseRecord {
+    let FrameProblem { problem, params: p, frame, alpha_prev } = fp;
     let m = measures(problem, p, frame.is_first(), u, adjoint, frame.tracking(), alpha_prev);
     let (x_err_rel, tangent_misfit, objective) = (m.x_err_rel, m.tangent_misfit, m.objective);
     InverseRecord { iteration, rel_change, x_err_rel, tangent_misfit, objective, residual, certificate: None }

@@ -167,6 +167,17 @@ impl<'a> Frame<'a> {
     }
 }
 
+/// One frame's problem as the inverse kernels take it: the rod, the inverse parameters, the
+/// frame, and the previous frame's angles `α_{n−1}` per node in the frame's chart (zeros on a
+/// first frame, whose Λω term is off).
+#[derive(Clone, Copy)]
+pub struct FrameProblem<'a> {
+    pub problem: &'a Problem<'a>,
+    pub params: &'a InverseParams,
+    pub frame: &'a Frame<'a>,
+    pub alpha_prev: &'a [Vector3<f64>],
+}
+
 /// Where a frame's solve starts from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Start {
@@ -516,8 +527,9 @@ impl<'p> FrameSolver<'p> {
     /// [`FrameSolver::certify`] of a KKT vector.
     pub(crate) fn certify_kkt(&mut self, frame: &Frame, big: &DVector<f64>) -> Certificate {
         self.work.cert_values.resize(self.pattern.nnz(), 0.0);
-        let previous = frame.previous.unwrap_or(&self.no_previous);
-        kkt::certificate(self.problem, &self.params, frame, previous, big, &self.pattern, &mut self.work.cert_values)
+        let alpha_prev = frame.previous.unwrap_or(&self.no_previous);
+        let fp = FrameProblem { problem: self.problem, params: &self.params, frame, alpha_prev };
+        kkt::certificate(fp, big, &self.pattern, &mut self.work.cert_values)
     }
 
     /// Dirichlet rows and values of I5 for the frame.
@@ -537,17 +549,9 @@ impl<'p> FrameSolver<'p> {
         u: &DVector<f64>,
         rescale: bool,
     ) -> Result<DVector<f64>, SolveError> {
-        let previous = frame.previous.unwrap_or(&self.no_previous);
-        let mut rhs = kkt::assemble_system(
-            self.problem,
-            params,
-            frame.is_first(),
-            &self.pattern,
-            &mut self.work.values,
-            u,
-            frame.tracking(),
-            previous,
-        );
+        let alpha_prev = frame.previous.unwrap_or(&self.no_previous);
+        let fp = FrameProblem { problem: self.problem, params, frame, alpha_prev };
+        let mut rhs = kkt::assemble_system(fp, &self.pattern, &mut self.work.values, u);
         for &(d, v) in &self.dirichlet.fixed {
             rhs[d] = v;
         }

@@ -33,7 +33,9 @@ use nalgebra::{DVector, Matrix3, Vector3};
 
 use super::kkt::{add_node_pairs, add_operator_blocks, element_part, element_system, KktMat, KktVec, PointRule, AL, X};
 use super::measures::{position_error, record};
-use super::{early_divergence, Frame, FrameSolver, InverseParams, InverseRecord, InverseSolution, Records};
+use super::{
+    early_divergence, Frame, FrameProblem, FrameSolver, InverseParams, InverseRecord, InverseSolution, Records,
+};
 use crate::assemble::{assemble, Tangent};
 use crate::linalg::Pattern;
 use crate::model::element::{internal_force, interpolate, ElementRest, LocalMat};
@@ -167,16 +169,13 @@ fn product_rule(
 /// `fixed`, I5) and, when `jacobian = Some((pattern, values, rows))`, its exact Jacobian `J(U)`
 /// into `values` (the Dirichlet `rows` identity). One pass of the element loop; without the
 /// Jacobian the same element sums in the same order, so the same residual.
-#[allow(clippy::too_many_arguments)]
 pub fn assemble_residual(
-    problem: &Problem,
-    p: &InverseParams,
-    frame: &Frame,
-    alpha_prev: &[Vector3<f64>],
+    fp: FrameProblem<'_>,
     big: &DVector<f64>,
     fixed: &[(usize, f64)],
     jacobian: Option<(&Pattern, &mut [f64], &[usize])>,
 ) -> DVector<f64> {
+    let FrameProblem { problem, params: p, frame, alpha_prev } = fp;
     let dofs = problem.mesh.kkt_dofs();
     let first = frame.is_first();
     let data = frame.tracking();
@@ -345,16 +344,18 @@ impl Newton<'_, '_, '_> {
     /// values if `jacobian`.
     fn residual(&mut self, big: &DVector<f64>, jacobian: bool) -> DVector<f64> {
         let s = &mut *self.s;
-        let previous = self.frame.previous.unwrap_or(s.no_previous.as_slice());
+        let alpha_prev = self.frame.previous.unwrap_or(s.no_previous.as_slice());
+        let fp = FrameProblem { problem: s.problem, params: self.params, frame: self.frame, alpha_prev };
         let jacobian = jacobian.then_some((&s.pattern, s.work.values.as_mut_slice(), s.dirichlet.rows.as_slice()));
-        assemble_residual(s.problem, self.params, self.frame, previous, big, &s.dirichlet.fixed, jacobian)
+        assemble_residual(fp, big, &s.dirichlet.fixed, jacobian)
     }
 
     /// The residual certificate of `big` (`kkt::certificate`).
     fn certify(&mut self, big: &DVector<f64>) -> Certificate {
         let s = &mut *self.s;
-        let previous = self.frame.previous.unwrap_or(s.no_previous.as_slice());
-        super::kkt::certificate(s.problem, self.params, self.frame, previous, big, &s.pattern, &mut s.work.cert_values)
+        let alpha_prev = self.frame.previous.unwrap_or(s.no_previous.as_slice());
+        let fp = FrameProblem { problem: s.problem, params: self.params, frame: self.frame, alpha_prev };
+        super::kkt::certificate(fp, big, &s.pattern, &mut s.work.cert_values)
     }
 
     /// The record of iteration `k` (`measures::record`).
@@ -366,8 +367,9 @@ impl Newton<'_, '_, '_> {
         adjoint: &DVector<f64>,
         residual: Option<f64>,
     ) -> InverseRecord {
-        let previous = self.frame.previous.unwrap_or(self.s.no_previous.as_slice());
-        record(self.s.problem, self.params, self.frame, previous, k, change, u, adjoint, residual)
+        let alpha_prev = self.frame.previous.unwrap_or(self.s.no_previous.as_slice());
+        let fp = FrameProblem { problem: self.s.problem, params: self.params, frame: self.frame, alpha_prev };
+        record(fp, (k, change), u, adjoint, residual)
     }
 
     fn done(&self, it: Iterate, stop: Stop, certificate: Certificate) -> InverseSolution {
