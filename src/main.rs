@@ -59,13 +59,8 @@ fn dispatch(cli: Cli) -> Result<ExitCode> {
         Command::Compare { case, out, short, frames, force, limits } => {
             cmd_compare(&case, out, short, frames, force, limits)
         }
-        Command::Sweep { case, set, out, force, limits, jobs, quiet } => {
-            cmd_sweep(&case, &set, out, force, limits, jobs, quiet)
-        }
-        Command::Audit { specs, quick, out, force, jobs, quiet, fields, vtk, resume } => {
-            let fields = cosserat::audit::PointFields::from_flags(fields, vtk);
-            cmd_audit(&specs, quick, out, (!resume).then_some(force), jobs, quiet, fields)
-        }
+        Command::Sweep(a) => cmd_sweep(a),
+        Command::Audit(a) => cmd_audit(a),
         Command::Batch(a) => cli::cmd_batch(a),
         Command::BatchTask(a) => cli::cmd_batch_task(a),
         Command::Gather { out } => cli::cmd_gather(&out),

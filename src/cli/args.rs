@@ -98,32 +98,7 @@ pub enum Command {
     /// point (the folder holds the files of `run` on the clip; the summary has one row per
     /// point: frames, iterations, worst fit, tangent misfit, |j - 1|, objective). Exit status 1
     /// if any run failed or did not converge (after writing everything).
-    Sweep {
-        /// Case file (TOML)
-        case: PathBuf,
-        /// Parameter and values, e.g. `--set lambda_d=1e-6,1e-4`; repeat for a cartesian
-        /// product. Each value is set in the case file's table and the case validated again.
-        /// Inverse cases: lambda_g, lambda_f, lambda_l, lambda_d, lambda_kappa1..3,
-        /// lambda_omega1..3, relaxation, warm_start_tolerance, tolerance, max_iterations,
-        /// elements, stabilisation. Static: relaxation, tolerance, max_iterations,
-        /// continuation_steps, elements. Dynamic: tolerance, max_iterations, steps, elements
-        #[arg(long = "set", value_name = "KEY=V1,V2,...", required = true)]
-        set: Vec<String>,
-        /// Output directory [default: out/<case name>/sweep]
-        #[arg(long)]
-        out: Option<PathBuf>,
-        /// Replace the output directory even if it holds files but no run.json
-        #[arg(long)]
-        force: bool,
-        #[command(flatten)]
-        limits: Limits,
-        /// Parallel runs [default: number of cores]
-        #[arg(long)]
-        jobs: Option<usize>,
-        /// Do not show progress (a bar on a terminal, else a line every 10 s)
-        #[arg(long)]
-        quiet: bool,
-    },
+    Sweep(SweepArgs),
     /// Audit the paper: regenerate its figures and judge its claims (§5-6).
     ///
     /// Reads the audit specs (default: every *.toml of cases/paper/), runs every point of every
@@ -133,34 +108,7 @@ pub enum Command {
     /// report.csv. `--quick` runs the specs' short grids and clip excerpts (the subset asserted by
     /// `cargo test`). Exit status 1 if a claim's verdict is not the one its spec expects (the
     /// report is written first).
-    Audit {
-        /// Audit specs (TOML) or folders of them [default: cases/paper]
-        specs: Vec<PathBuf>,
-        /// Short grids and clip excerpts (`quick_grid`, `quick_set` of the specs)
-        #[arg(long)]
-        quick: bool,
-        /// Output directory [default: out/audit, out/audit-quick with --quick]; replaced whole
-        #[arg(long)]
-        out: Option<PathBuf>,
-        /// Replace the output directory even if it holds files but no run.json
-        #[arg(long)]
-        force: bool,
-        /// Parallel runs [default: number of cores]
-        #[arg(long)]
-        jobs: Option<usize>,
-        /// Do not show progress (a bar on a terminal, else a line every 10 s)
-        #[arg(long)]
-        quiet: bool,
-        /// Clip points keep compact fields.npz and figures [default: tables only, ≤ 200 MB]
-        #[arg(long, conflicts_with = "vtk")]
-        fields: bool,
-        /// Clip points keep fields.csv, curvature.csv, VTK and figures (GBs for the full audit)
-        #[arg(long)]
-        vtk: bool,
-        /// Continue the unfinished audit of --out: keep the specs it judged whole, rerun the rest
-        #[arg(long, conflicts_with = "force")]
-        resume: bool,
-    },
+    Audit(AuditArgs),
     /// Run a clip case over many recordings (here, or as a Slurm job array with --slurm).
     Batch(super::BatchArgs),
     /// Run one task of a batch's Slurm job array (called by the job script).
@@ -214,4 +162,64 @@ pub struct Limits {
     /// memory]
     #[arg(long, value_name = "GIB")]
     pub max_memory_gib: Option<f64>,
+}
+
+/// The options of `cosserat sweep` (its help is the `Sweep` command's).
+#[derive(clap::Args, Debug)]
+pub struct SweepArgs {
+    /// Case file (TOML)
+    pub case: PathBuf,
+    /// Parameter and values, e.g. `--set lambda_d=1e-6,1e-4`; repeat for a cartesian
+    /// product. Each value is set in the case file's table and the case validated again.
+    /// Inverse cases: lambda_g, lambda_f, lambda_l, lambda_d, lambda_kappa1..3,
+    /// lambda_omega1..3, relaxation, warm_start_tolerance, tolerance, max_iterations,
+    /// elements, stabilisation. Static: relaxation, tolerance, max_iterations,
+    /// continuation_steps, elements. Dynamic: tolerance, max_iterations, steps, elements
+    #[arg(long = "set", value_name = "KEY=V1,V2,...", required = true)]
+    pub set: Vec<String>,
+    /// Output directory [default: out/<case name>/sweep]
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Replace the output directory even if it holds files but no run.json
+    #[arg(long)]
+    pub force: bool,
+    #[command(flatten)]
+    pub limits: Limits,
+    /// Parallel runs [default: number of cores]
+    #[arg(long)]
+    pub jobs: Option<usize>,
+    /// Do not show progress (a bar on a terminal, else a line every 10 s)
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+/// The options of `cosserat audit` (its help is the `Audit` command's).
+#[derive(clap::Args, Debug)]
+pub struct AuditArgs {
+    /// Audit specs (TOML) or folders of them [default: cases/paper]
+    pub specs: Vec<PathBuf>,
+    /// Short grids and clip excerpts (`quick_grid`, `quick_set` of the specs)
+    #[arg(long)]
+    pub quick: bool,
+    /// Output directory [default: out/audit, out/audit-quick with --quick]; replaced whole
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Replace the output directory even if it holds files but no run.json
+    #[arg(long)]
+    pub force: bool,
+    /// Parallel runs [default: number of cores]
+    #[arg(long)]
+    pub jobs: Option<usize>,
+    /// Do not show progress (a bar on a terminal, else a line every 10 s)
+    #[arg(long)]
+    pub quiet: bool,
+    /// Clip points keep compact fields.npz and figures [default: tables only, ≤ 200 MB]
+    #[arg(long, conflicts_with = "vtk")]
+    pub fields: bool,
+    /// Clip points keep fields.csv, curvature.csv, VTK and figures (GBs for the full audit)
+    #[arg(long)]
+    pub vtk: bool,
+    /// Continue the unfinished audit of --out: keep the specs it judged whole, rerun the rest
+    #[arg(long, conflicts_with = "force")]
+    pub resume: bool,
 }

@@ -5,7 +5,7 @@ use std::process::ExitCode;
 
 use anyhow::{bail, Context, Result};
 
-use super::args::Limits;
+use super::args::{AuditArgs, Limits, SweepArgs};
 use super::progress::{FreefemProgress, Progress};
 use cosserat::case::Case;
 use cosserat::engine::budget::{self, default_limit_bytes, Footprint, GIB};
@@ -154,16 +154,9 @@ fn compare_published(
     Ok(missed)
 }
 
-#[allow(clippy::too_many_arguments)]
-pub fn cmd_sweep(
-    path: &Path,
-    set: &[String],
-    out: Option<PathBuf>,
-    force: bool,
-    limits: Limits,
-    jobs: Option<usize>,
-    quiet: bool,
-) -> Result<ExitCode> {
+pub fn cmd_sweep(args: SweepArgs) -> Result<ExitCode> {
+    let SweepArgs { case: path, set, out, force, limits, jobs, quiet } = args;
+    let path = path.as_path();
     use cosserat::case::sweep::{parse_set, product};
     use cosserat::jobs::sweep::sweep_into;
     let case = load(path)?;
@@ -235,16 +228,12 @@ pub fn cmd_sweep(
     })
 }
 
-pub fn cmd_audit(
-    paths: &[PathBuf],
-    quick: bool,
-    out: Option<PathBuf>,
-    force: Option<bool>,
-    jobs: Option<usize>,
-    quiet: bool,
-    fields: cosserat::audit::PointFields,
-) -> Result<ExitCode> {
-    use cosserat::audit::{run_audit, spec::read_spec, AuditOptions, AuditStatus};
+pub fn cmd_audit(args: AuditArgs) -> Result<ExitCode> {
+    use cosserat::audit::{run_audit, spec::read_spec, AuditOptions, AuditStatus, PointFields};
+    let AuditArgs { specs: paths, quick, out, force, jobs, quiet, fields, vtk, resume } = args;
+    let (paths, fields) = (paths.as_slice(), PointFields::from_flags(fields, vtk));
+    // --resume keeps what the folder holds: no replacing it (`None`)
+    let force = (!resume).then_some(force);
     let files = audit_spec_files(paths)?;
     let specs = files.iter().map(|f| read_spec(f, quick)).collect::<Result<Vec<_>, _>>()?;
     let out = out.unwrap_or_else(|| PathBuf::from(if quick { "out/audit-quick" } else { "out/audit" }));

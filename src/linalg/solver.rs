@@ -77,16 +77,14 @@ impl LinearSolver {
         // the copy into the band also takes Ruiz's first row and column maxima (each column
         // while it is in cache), so `ruiz` starts with its first scaling
         self.load_with_maxima(values);
-        ruiz(
-            &self.cols,
-            self.lu.band_mut(),
-            &mut self.dr,
-            &mut self.dc,
-            &mut self.rmax,
-            &mut self.cmax,
-            &mut self.rnext,
-            true,
-        );
+        let work = RuizWork {
+            dr: &mut self.dr,
+            dc: &mut self.dc,
+            r: &mut self.rmax,
+            c: &mut self.cmax,
+            r_next: &mut self.rnext,
+        };
+        ruiz(&self.cols, self.lu.band_mut(), work, FirstMaxima::Taken);
         let solved = self.factor_and_solve_scaled(b);
         self.unscaled_if_zero_pivot(solved, values, b)
     }
@@ -132,7 +130,8 @@ impl LinearSolver {
         let (mut dr, mut dc) = (vec![1.0; n], vec![1.0; n]);
         let (mut r, mut c, mut r_next) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
         let csc = Columns { band: self.cols.csc.clone(), ..self.cols.clone() };
-        ruiz(&csc, &mut a, &mut dr, &mut dc, &mut r, &mut c, &mut r_next, false);
+        let work = RuizWork { dr: &mut dr, dc: &mut dc, r: &mut r, c: &mut c, r_next: &mut r_next };
+        ruiz(&csc, &mut a, work, FirstMaxima::ToTake);
         (a, dr, dc)
     }
 
@@ -322,22 +321,32 @@ unsafe fn scale_and_measure_avx2(a: &mut [f64], r: &[f64], c: f64, next: &mut [f
     best
 }
 
+/// The row and column factors Ruiz's passes accumulate (`dr`, `dc`) and its scratch: the row
+/// and column maxima of the current pass (`r`, `c`) and the row maxima of the next (`r_next`).
+struct RuizWork<'a> {
+    dr: &'a mut [f64],
+    dc: &'a mut [f64],
+    r: &'a mut [f64],
+    c: &'a mut [f64],
+    r_next: &'a mut [f64],
+}
+
+/// Whether the first pass's row and column maxima are in `RuizWork::r`, `RuizWork::c`
+/// already (taken while the values were copied into the band) or still to take.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum FirstMaxima {
+    Taken,
+    ToTake,
+}
+
 /// Five passes of Ruiz row/column max-norm scaling of the values in `a` (column `j` of the
 /// pattern at `a[cols.band[j]..][..cols.len[j]]`, rows from `cols.first[j]`), in place, with the
-/// accumulated row and column factors in `dr`, `dc` (`r`, `c`, `r_next`: scratch). Each pass
-/// takes the row and column maxima of `a`, then scales `a_ij ← a_ij (1/√r_i)(1/√c_j)`; the
-/// scaling of one pass and the maxima of the next share one sweep over the values.
-#[allow(clippy::too_many_arguments)]
-fn ruiz(
-    cols: &Columns,
-    a: &mut [f64],
-    dr: &mut [f64],
-    dc: &mut [f64],
-    r: &mut [f64],
-    c: &mut [f64],
-    r_next: &mut [f64],
-    maxima_ready: bool,
-) {
+/// accumulated row and column factors in `work.dr`, `work.dc`. Each pass takes the row and
+/// column maxima of `a`, then scales `a_ij ← a_ij (1/√r_i)(1/√c_j)`; the scaling of one pass
+/// and the maxima of the next share one sweep over the values.
+fn ruiz(cols: &Columns, a: &mut [f64], work: RuizWork<'_>, first: FirstMaxima) {
+    let RuizWork { dr, dc, r, c, r_next } = work;
+    let maxima_ready = first == FirstMaxima::Taken;
     let n = cols.len.len();
     #[cfg(target_arch = "x86_64")]
     let wide = Avx2::detect();

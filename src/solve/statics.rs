@@ -142,16 +142,15 @@ pub fn solve(
     mut progress: impl FnMut(&IterationRecord),
 ) -> Result<StaticSolution, SolveError> {
     let pattern = problem.dofs().pattern();
-    let mut solver = LinearSolver::new(&pattern);
+    let solver = LinearSolver::new(&pattern);
+    let mut shared = Steps { params, pattern, solver, history: Vec::new(), progress: &mut progress };
     let steps = params.continuation_steps.max(1);
     let mut u = problem.reference_state();
-    let mut history = Vec::new();
     let mut last_change = f64::NAN;
     let mut stop = Stop::Converged;
     for step in 1..=steps {
         let p = Problem { load_factor: problem.load_factor * step as f64 / steps as f64, ..*problem };
-        let (u_new, change, step_stop) =
-            solve_step(&p, params, &pattern, &mut solver, u, step, &mut history, &mut progress)?;
+        let (u_new, change, step_stop) = solve_step(&p, &mut shared, u, step)?;
         u = u_new;
         last_change = change;
         if step_stop != Stop::Converged {
@@ -159,6 +158,7 @@ pub fn solve(
             break;
         }
     }
+    let history = shared.history;
     let residual = relative_residual(problem, &u);
     let certificate = certificate(problem, &u);
     if stop == Stop::Converged && !certificate.within(params.certificate_tolerance) {
@@ -177,19 +177,26 @@ pub fn solve(
     })
 }
 
-/// One continuation step: iterate from `u` to the stopping rule of D5 (or the iteration
-/// limit): the last iterate, its change and why it stopped.
-#[allow(clippy::too_many_arguments)]
+/// What the continuation steps of one static solve share: its parameters, the pattern of the
+/// tangent and its solver, the iteration history and the progress callback.
+struct Steps<'a, F> {
+    params: &'a StaticParams,
+    pattern: Pattern,
+    solver: LinearSolver,
+    history: Vec<IterationRecord>,
+    progress: F,
+}
+
+/// One continuation step (number `step`): iterate from `u` to the stopping rule of D5 (or the
+/// iteration limit): the last iterate, its change and why it stopped.
 fn solve_step(
     problem: &Problem,
-    params: &StaticParams,
-    pattern: &Pattern,
-    solver: &mut LinearSolver,
+    shared: &mut Steps<'_, impl FnMut(&IterationRecord)>,
     mut u: DVector<f64>,
     step: usize,
-    history: &mut Vec<IterationRecord>,
-    progress: &mut impl FnMut(&IterationRecord),
 ) -> Result<(DVector<f64>, f64, Stop), SolveError> {
+    let Steps { params, pattern, solver, history, progress } = shared;
+    let (params, pattern) = (*params, &*pattern);
     let dofs = problem.dofs();
     let held = problem.held_static();
     let mut values = vec![0.0; pattern.nnz()];
