@@ -6,8 +6,6 @@ use std::process::ExitCode;
 use anyhow::Result;
 use clap::Parser;
 
-use cosserat::output::run_folder::Mode;
-
 mod cli;
 
 use cli::args::{Cli, Command};
@@ -52,10 +50,7 @@ fn main() -> ExitCode {
 
 fn dispatch(cli: Cli) -> Result<ExitCode> {
     match cli.command {
-        Command::Run { case, engine, out, force, resume, output_format, limits, quiet, strict } => {
-            let mode = if resume { Mode::Resume } else { Mode::Fresh { force } };
-            cmd_run(&case, engine, out, (mode, output_format), limits, (quiet, strict))
-        }
+        Command::Run(a) => cmd_run(a),
         Command::Compare { case, out, short, frames, force, limits } => {
             cmd_compare(&case, out, short, frames, force, limits)
         }

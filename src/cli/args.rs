@@ -25,38 +25,7 @@ pub enum Command {
     /// Exit status: 0 the run is complete; 1 it failed, did not converge or stalled (the folder's
     /// run.json says which), or, with --strict, a published value missed its tolerance or a
     /// clip has frames over the fit-quality gate; 130 stopped by a signal.
-    Run {
-        /// Case file (TOML), e.g. cases/timoshenko_10pct.toml
-        case: PathBuf,
-        /// Which engine to run
-        #[arg(long, value_enum, default_value_t = Engine::Rust)]
-        engine: Engine,
-        /// Output directory [default: out/<case name>/<engine>]. The run writes into a staging
-        /// folder beside it that replaces it whole at the end; run.json says what it holds
-        #[arg(long)]
-        out: Option<PathBuf>,
-        /// Replace the output directory even if it holds files but no run.json
-        #[arg(long)]
-        force: bool,
-        /// Continue the interrupted, failed or killed clip of the output directory from its
-        /// last converged frame (same case file and clip file), in a staging folder of its own;
-        /// the CSVs are then byte for byte those of an uninterrupted run
-        #[arg(long, conflicts_with = "force")]
-        resume: bool,
-        /// Clips: per-node fields as CSV + ParaView VTK, or all in one fields.npz (docs/output.md)
-        #[arg(long, value_enum, default_value_t = OutputFormat::Csv)]
-        output_format: OutputFormat,
-        #[command(flatten)]
-        limits: Limits,
-        /// Do not show progress (a bar on a terminal, else a line every 10 s)
-        #[arg(long)]
-        quiet: bool,
-        /// Exit with status 1 when a published value ([[reference.values]]) misses its
-        /// tolerance, or a clip has frames over the fit-quality gate (run.json says complete,
-        /// or complete_with_warnings, either way)
-        #[arg(long)]
-        strict: bool,
-    },
+    Run(RunArgs),
     /// Run both engines and compare them; exit status 1 if any row fails.
     ///
     /// Newton runs are compared at their roots, an inverse fixed point at the same iteration
@@ -222,4 +191,73 @@ pub struct AuditArgs {
     /// Continue the unfinished audit of --out: keep the specs it judged whole, rerun the rest
     #[arg(long, conflicts_with = "force")]
     pub resume: bool,
+}
+
+/// The options of `cosserat run` (its help is the `Run` command's).
+#[derive(clap::Args, Debug)]
+pub struct RunArgs {
+    /// Case file (TOML), e.g. cases/timoshenko_10pct.toml
+    pub case: PathBuf,
+    /// Which engine to run
+    #[arg(long, value_enum, default_value_t = EngineArg::Rust)]
+    pub engine: EngineArg,
+    /// Output directory [default: out/<case name>/<engine>]. The run writes into a staging
+    /// folder beside it that replaces it whole at the end; run.json says what it holds
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Replace the output directory even if it holds files but no run.json
+    #[arg(long)]
+    pub force: bool,
+    /// Continue the interrupted, failed or killed clip of the output directory from its
+    /// last converged frame (same case file and clip file), in a staging folder of its own;
+    /// the CSVs are then byte for byte those of an uninterrupted run
+    #[arg(long, conflicts_with = "force")]
+    pub resume: bool,
+    /// Clips: per-node fields as CSV + ParaView VTK, or all in one fields.npz (docs/output.md)
+    #[arg(long, value_enum, default_value_t = OutputFormatArg::Csv)]
+    pub output_format: OutputFormatArg,
+    #[command(flatten)]
+    pub limits: Limits,
+    /// Do not show progress (a bar on a terminal, else a line every 10 s)
+    #[arg(long)]
+    pub quiet: bool,
+    /// Exit with status 1 when a published value ([[reference.values]]) misses its
+    /// tolerance, or a clip has frames over the fit-quality gate (run.json says complete,
+    /// or complete_with_warnings, either way)
+    #[arg(long)]
+    pub strict: bool,
+}
+
+/// `--engine` as the command line spells it (the library's [`Engine`] knows no command line).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum EngineArg {
+    Rust,
+    Freefem,
+}
+
+impl From<EngineArg> for Engine {
+    fn from(e: EngineArg) -> Self {
+        match e {
+            EngineArg::Rust => Engine::Rust,
+            EngineArg::Freefem => Engine::Freefem,
+        }
+    }
+}
+
+/// `--output-format` as the command line spells it ([`OutputFormat`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum OutputFormatArg {
+    /// `fields.csv`, `curvature.csv` and ParaView `vtk/frame_NNNNN.vtp` + `clip.pvd`
+    Csv,
+    /// one `fields.npz` (NumPy) with every per-node field at full precision, 4-6x smaller
+    Compact,
+}
+
+impl From<OutputFormatArg> for OutputFormat {
+    fn from(f: OutputFormatArg) -> Self {
+        match f {
+            OutputFormatArg::Csv => OutputFormat::Csv,
+            OutputFormatArg::Compact => OutputFormat::Compact,
+        }
+    }
 }

@@ -5,7 +5,7 @@ use std::process::ExitCode;
 
 use anyhow::{bail, Context, Result};
 
-use super::args::{AuditArgs, Limits, SweepArgs};
+use super::args::{AuditArgs, Limits, RunArgs, SweepArgs};
 use super::progress::{FreefemProgress, Progress};
 use cosserat::case::Case;
 use cosserat::engine::budget::{self, default_limit_bytes, Footprint, GIB};
@@ -27,14 +27,10 @@ fn check_memory(case: &Case, what: Footprint, limits: Limits) -> Result<()> {
     Ok(budget::check(case, what, limit)?)
 }
 
-pub fn cmd_run(
-    path: &Path,
-    engine: Engine,
-    out: Option<PathBuf>,
-    mode: (Mode, OutputFormat),
-    limits: Limits,
-    (quiet, strict): (bool, bool),
-) -> Result<ExitCode> {
+pub fn cmd_run(args: RunArgs) -> Result<ExitCode> {
+    let RunArgs { case: path, engine, out, force, resume, output_format, limits, quiet, strict } = args;
+    let (path, engine) = (path.as_path(), Engine::from(engine));
+    let mode = (if resume { Mode::Resume } else { Mode::Fresh { force } }, OutputFormat::from(output_format));
     let case = load(path)?;
     if let Some(why) = cosserat::jobs::solved::unsupported(&case, engine) {
         bail!(why);

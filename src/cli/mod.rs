@@ -16,7 +16,7 @@ use std::time::Duration;
 
 use anyhow::{Context, Result};
 
-use cosserat::io::compact::OutputFormat;
+use args::OutputFormatArg;
 use cosserat::jobs::batch::{self, gather, list_recordings, run_batch, BatchRow, Plan, SUMMARY};
 use cosserat::jobs::batch_task::run_task;
 use cosserat::jobs::slurm;
@@ -45,8 +45,8 @@ pub struct BatchArgs {
     /// A batch writes the compact format unless told otherwise: about 31 KB per frame of 128
     /// nodes against about 130 KB as CSV and VTK (docs/results.md, "Memory and output of long
     /// recordings")
-    #[arg(long, value_enum, default_value_t = OutputFormat::Compact)]
-    output_format: OutputFormat,
+    #[arg(long, value_enum, default_value_t = OutputFormatArg::Compact)]
+    output_format: OutputFormatArg,
     /// Do not show progress (a bar on a terminal, else a line every 10 s)
     #[arg(long)]
     quiet: bool,
@@ -154,7 +154,7 @@ pub fn cmd_batch(a: BatchArgs) -> Result<ExitCode> {
     let recordings = list_recordings(&a.recordings)?;
     let per_task = if a.slurm.submit { a.slurm.per_task as usize } else { 1 };
     let mut plan = Plan::new(&a.case, &recordings, per_task);
-    plan.format = a.output_format;
+    plan.format = a.output_format.into();
     // the case is read (and refused if it is not a clip case) before anything is written
     let (case, _) = batch::plan_case(&plan).with_context(|| format!("batch of {}", a.case.display()))?;
     let _lock = lock_batch(&a.out)?;

@@ -48,7 +48,7 @@ pub const CURVATURE_COLUMNS: [&str; 16] = [
 pub const COMPACT_FILE_CAP_BYTES: u64 = 1 << 32;
 
 /// How the per-node output of a clip is written.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum, serde::Serialize, serde::Deserialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum OutputFormat {
     /// `fields.csv`, `curvature.csv` and ParaView `vtk/frame_NNNNN.vtp` + `clip.pvd`

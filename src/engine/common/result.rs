@@ -12,7 +12,7 @@ use crate::solve::inverse::InverseRecord;
 use crate::solve::statics::IterationRecord;
 
 /// Which implementation produced a result.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Engine {
     Rust,
     Freefem,
