@@ -77,14 +77,15 @@ impl LinearSolver {
         // the copy into the band also takes Ruiz's first row and column maxima (each column
         // while it is in cache), so `ruiz` starts with its first scaling
         self.load_with_maxima(values);
-        let work = RuizWork {
-            dr: &mut self.dr,
-            dc: &mut self.dc,
-            r: &mut self.rmax,
-            c: &mut self.cmax,
-            r_next: &mut self.rnext,
-        };
-        ruiz(&self.cols, self.lu.band_mut(), work, FirstMaxima::Taken);
+        ruiz(
+            &self.cols,
+            self.lu.band_mut(),
+            &mut self.dr,
+            &mut self.dc,
+            &mut self.rmax,
+            &mut self.cmax,
+            &mut self.rnext,
+        );
         let solved = self.factor_and_solve_scaled(b);
         self.unscaled_if_zero_pivot(solved, values, b)
     }
@@ -130,8 +131,8 @@ impl LinearSolver {
         let (mut dr, mut dc) = (vec![1.0; n], vec![1.0; n]);
         let (mut r, mut c, mut r_next) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
         let csc = Columns { band: self.cols.csc.clone(), ..self.cols.clone() };
-        let work = RuizWork { dr: &mut dr, dc: &mut dc, r: &mut r, c: &mut c, r_next: &mut r_next };
-        ruiz(&csc, &mut a, work, FirstMaxima::ToTake);
+        column_maxima(&csc, &a, &mut r, &mut c);
+        ruiz(&csc, &mut a, &mut dr, &mut dc, &mut r, &mut c, &mut r_next);
         (a, dr, dc)
     }
 
@@ -321,32 +322,32 @@ unsafe fn scale_and_measure_avx2(a: &mut [f64], r: &[f64], c: f64, next: &mut [f
     best
 }
 
-/// The row and column factors Ruiz's passes accumulate (`dr`, `dc`) and its scratch: the row
-/// and column maxima of the current pass (`r`, `c`) and the row maxima of the next (`r_next`).
-struct RuizWork<'a> {
-    dr: &'a mut [f64],
-    dc: &'a mut [f64],
-    r: &'a mut [f64],
-    c: &'a mut [f64],
-    r_next: &'a mut [f64],
-}
-
-/// Whether the first pass's row and column maxima are in `RuizWork::r`, `RuizWork::c`
-/// already (taken while the values were copied into the band) or still to take.
-#[derive(Clone, Copy, PartialEq, Eq)]
-enum FirstMaxima {
-    Taken,
-    ToTake,
+/// The row and column maxima of the unscaled values `a` (laid out as [`ruiz`] says) into `r`
+/// and `c`: what [`ruiz`] starts from.
+fn column_maxima(cols: &Columns, a: &[f64], r: &mut [f64], c: &mut [f64]) {
+    r.iter_mut().for_each(|v| *v = 0.0);
+    for j in 0..cols.len.len() {
+        let (k0, k1, first) = (cols.band[j], cols.band[j] + cols.len[j], cols.first[j]);
+        c[j] = row_col_max(&mut r[first..first + (k1 - k0)], &a[k0..k1]);
+    }
 }
 
 /// Five passes of Ruiz row/column max-norm scaling of the values in `a` (column `j` of the
 /// pattern at `a[cols.band[j]..][..cols.len[j]]`, rows from `cols.first[j]`), in place, with the
-/// accumulated row and column factors in `work.dr`, `work.dc`. Each pass takes the row and
-/// column maxima of `a`, then scales `a_ij ← a_ij (1/√r_i)(1/√c_j)`; the scaling of one pass
-/// and the maxima of the next share one sweep over the values.
-fn ruiz(cols: &Columns, a: &mut [f64], work: RuizWork<'_>, first: FirstMaxima) {
-    let RuizWork { dr, dc, r, c, r_next } = work;
-    let maxima_ready = first == FirstMaxima::Taken;
+/// accumulated row and column factors in `dr`, `dc`, from the row and column maxima of `a` in
+/// `r`, `c` ([`column_maxima`], or taken while the values were copied into the band; `r_next`:
+/// scratch). Each pass scales `a_ij ← a_ij (1/√r_i)(1/√c_j)` and takes the maxima of the next
+/// in the same sweep over the values. (The slices are arguments of their own: gathered in a
+/// struct they lose the compiler's no-alias knowledge, 9.5 % more instructions here.)
+fn ruiz(
+    cols: &Columns,
+    a: &mut [f64],
+    dr: &mut [f64],
+    dc: &mut [f64],
+    r: &mut [f64],
+    c: &mut [f64],
+    r_next: &mut [f64],
+) {
     let n = cols.len.len();
     #[cfg(target_arch = "x86_64")]
     let wide = Avx2::detect();
@@ -354,14 +355,6 @@ fn ruiz(cols: &Columns, a: &mut [f64], work: RuizWork<'_>, first: FirstMaxima) {
     dc.iter_mut().for_each(|v| *v = 1.0);
     // the rows of a column are contiguous (block-tridiagonal pattern): slices, no gathers
     let column = |j: usize| (cols.band[j], cols.band[j] + cols.len[j], cols.first[j]);
-    // maxima of the unscaled values (unless the caller took them already, into `r` and `c`)
-    if !maxima_ready {
-        r.iter_mut().for_each(|v| *v = 0.0);
-        for j in 0..n {
-            let (k0, k1, first) = column(j);
-            c[j] = row_col_max(&mut r[first..first + (k1 - k0)], &a[k0..k1]);
-        }
-    }
     for pass in 0..RUIZ_PASSES {
         // the factors of this pass, 1/√r and 1/√c, once per row and column
         inv_sqrt_all(r);
