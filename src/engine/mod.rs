@@ -116,13 +116,19 @@ pub fn run_case(
 ) -> Result<RunResult, EngineError> {
     if case.inverse().is_some() {
         let path = workdir.join("data.csv");
-        write_data(&path, &load_data(case)?).map_err(EngineError::DataOutput)?;
+        stage_data(case, &path)?;
         return run_inverse_on(case, engine, &path, workdir, progress);
     }
     match engine {
         Engine::Rust => Ok(rust::run_forward(case, progress)?),
         Engine::Freefem => Ok(freefem::run(case, workdir)?),
     }
+}
+
+/// Write the data of the inverse case `case` ([`load_data`]) to `path`, the `data.csv` (I7) that
+/// both engines then read: the one place a run's data file is made.
+pub fn stage_data(case: &Case, path: &Path) -> Result<(), EngineError> {
+    write_data(path, &load_data(case)?).map_err(EngineError::DataOutput)
 }
 
 /// Run an inverse case in the chosen engine on the data file `data_path` (I7); FreeFEM works in

@@ -9,9 +9,8 @@ use crate::case::Case;
 use crate::clip::missing::MIN_TRACKED;
 use crate::engine::clip::{ClipFrame, ClipRun};
 use crate::engine::clip_metrics::clip_metrics;
-use crate::engine::input::data::write_data;
 use crate::engine::metrics::{all_metrics, Metrics};
-use crate::engine::{load_data, run_case, run_inverse_on, EngineError};
+use crate::engine::{run_case, run_inverse_on, stage_data, EngineError};
 use crate::engine::{Engine, RunError, RunResult};
 use crate::output::clip_output::remove_raw;
 use crate::output::clip_run::{run_clip_to, write_clip_figures, ClipOptions};
@@ -171,7 +170,7 @@ fn solve_single(case: &Case, engine: Engine, dir: &Path, progress: impl FnMut(us
     let work = dir.join("freefem_work");
     let result = if case.inverse().is_some() {
         let path = dir.join("data.csv");
-        match load_data(case).and_then(|d| Ok(write_data(&path, &d)?)) {
+        match stage_data(case, &path) {
             Ok(()) => run_inverse_on(case, engine, &path, &work, progress),
             Err(e) => {
                 let status = if interrupted(&e) { RunStatus::Interrupted } else { RunStatus::Failed };
