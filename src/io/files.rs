@@ -231,8 +231,8 @@ pub fn human_bytes(n: u64) -> String {
 /// refused by its size before it is read, and read through `Read::take(cap + 1)` in case it
 /// grows meanwhile. The caps are chosen per reader, far above any real input of its kind.
 pub fn read_capped(path: &Path, cap: u64, what: &'static str) -> Result<Vec<u8>, InputError> {
-    check_regular(path, what)?;
-    read_opened_capped(path, cap, what, false)
+    let (file, size) = open_capped(path, cap, what)?;
+    read_to_cap(path, file, Some(size), (cap, what))
 }
 
 /// [`read_capped`] that also takes the pipe of this process's standard input
@@ -240,42 +240,42 @@ pub fn read_capped(path: &Path, cap: u64, what: &'static str) -> Result<Vec<u8>,
 /// named pipe would still block its open, a device never end, so both are refused.
 pub fn read_capped_or_stdin(path: &Path, cap: u64, what: &'static str) -> Result<Vec<u8>, InputError> {
     use crate::file_kind::{is_standard_input, kind, FileKind};
-    let piped = match kind(path) {
-        Ok(FileKind::Regular) => false,
-        Ok(FileKind::Fifo) if is_standard_input(path) => true,
-        Ok(kind) => return Err(InputError::NotRegular { path: path.to_path_buf(), what, kind }),
-        Err(source) => return Err(InputError::Open { path: path.to_path_buf(), source }),
-    };
-    read_opened_capped(path, cap, what, piped)
+    match kind(path) {
+        Ok(FileKind::Regular) => read_capped(path, cap, what),
+        Ok(FileKind::Fifo) if is_standard_input(path) => {
+            let file =
+                std::fs::File::open(path).map_err(|source| InputError::Open { path: path.to_path_buf(), source })?;
+            read_to_cap(path, file, None, (cap, what))
+        }
+        Ok(kind) => Err(InputError::NotRegular { path: path.to_path_buf(), what, kind }),
+        Err(source) => Err(InputError::Open { path: path.to_path_buf(), source }),
+    }
 }
 
-/// The reading of [`read_capped`] once the kind of `path` was accepted (`piped`: the standard
-/// input's pipe, which is not a regular file).
-fn read_opened_capped(path: &Path, cap: u64, what: &'static str, piped: bool) -> Result<Vec<u8>, InputError> {
-    let open = |source| InputError::Open { path: path.to_path_buf(), source };
-    let too_large = |size| InputError::TooLarge { path: path.to_path_buf(), what, size, cap };
-    let file = std::fs::File::open(path).map_err(open)?;
-    let meta = file.metadata().map_err(open)?;
-    if !meta.is_file() && !piped {
-        // replaced between the check and the open
-        let kind = crate::file_kind::FileKind::of(&meta);
-        return Err(InputError::NotRegular { path: path.to_path_buf(), what, kind });
-    }
-    if meta.is_file() && meta.len() > cap {
-        return Err(too_large(Some(meta.len())));
-    }
-    let expected = if meta.is_file() { meta.len() } else { 0 };
-    let mut bytes = Vec::with_capacity(usize::try_from(expected.min(cap)).unwrap_or(0));
-    file.take(cap.saturating_add(1)).read_to_end(&mut bytes).map_err(open)?;
+/// Read the opened `file` (`path`; `size` [bytes] of a regular file, `None` for the standard
+/// input's pipe) to its end through `Read::take(cap + 1)`: refused if it holds more than `cap`
+/// bytes (a regular file that grew while it was read).
+fn read_to_cap(
+    path: &Path,
+    file: std::fs::File,
+    size: Option<u64>,
+    (cap, what): (u64, &'static str),
+) -> Result<Vec<u8>, InputError> {
+    let mut bytes = Vec::with_capacity(usize::try_from(size.unwrap_or(0).min(cap)).unwrap_or(0));
+    file.take(cap.saturating_add(1))
+        .read_to_end(&mut bytes)
+        .map_err(|source| InputError::Open { path: path.to_path_buf(), source })?;
     if bytes.len() as u64 > cap {
         // A regular file that grew while it was read has at least this many bytes.
-        return Err(too_large(meta.is_file().then_some(bytes.len() as u64)));
+        let size = size.map(|_| bytes.len() as u64);
+        return Err(InputError::TooLarge { path: path.to_path_buf(), what, size, cap });
     }
     Ok(bytes)
 }
 
 /// Open the regular file `path` to be read as it goes (not held whole) if it has at most `cap`
-/// bytes; the same errors as [`read_capped`]. Returns the file and its size [bytes].
+/// bytes: refused before it is opened if it is not a regular file ([`check_regular`]), and by
+/// its size. Returns the file and its size [bytes].
 pub fn open_capped(path: &Path, cap: u64, what: &'static str) -> Result<(std::fs::File, u64), InputError> {
     check_regular(path, what)?;
     let open = |source| InputError::Open { path: path.to_path_buf(), source };
