@@ -10,7 +10,7 @@ use std::sync::mpsc::{channel, Sender};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
-use common::{short_roll_case, worm_data_present, Collect};
+use common::{frame_bits as bits, short_roll_case, worm_data_present, Collect};
 use cosserat::case::Case;
 use cosserat::clip::synthetic::{FrameTruth, GroundTruth};
 use cosserat::clip::Clip;
@@ -46,26 +46,6 @@ fn solve(case: &Case, frames: ClipFrames<'_>) -> (ClipOutcome, Vec<ClipFrame>) {
     (out, got)
 }
 
-/// Every number of a frame that derives from its solve, as bits.
-fn bits(f: &ClipFrame) -> Vec<u64> {
-    let r = &f.report;
-    let mut v: Vec<u64> = [
-        r.convergence.last_change,
-        r.misfit.x_err_rel,
-        r.misfit.tangent_misfit,
-        r.misfit.objective.tracking,
-        r.conditioning.min_cos_beta,
-    ]
-    .iter()
-    .map(|x| x.to_bits())
-    .collect();
-    v.push(r.convergence.iterations as u64);
-    v.extend(f.record.state.iter().chain(f.record.adjoint.iter()).map(|x| x.to_bits()));
-    v.extend(f.planar.kappa2.iter().map(|x| x.to_bits()));
-    v.extend(f.truth.iter().flat_map(|t| t.bending_recovered.iter().map(|x| x.to_bits())));
-    v
-}
-
 /// Send frames `0..count` of the loaded clip, waiting `pause` before each.
 fn feed(tx: Sender<StreamedFrame>, clip: &Clip, truth: &[FrameTruth], count: usize, pause: Duration) {
     for i in 0..count {
@@ -91,7 +71,10 @@ fn a_streamed_clip_gives_the_frames_of_one_solve_bit_for_bit() {
         let (tx, rx) = channel();
         let (out, got) = std::thread::scope(|s| {
             s.spawn(|| feed(tx, &clip, &truth.frames, FRAMES, pause));
-            solve(&case, ClipFrames::Streamed { header: header(&clip), total: FRAMES, truth: true, frames: rx })
+            solve(
+                &case,
+                ClipFrames::Streamed { header: header(&clip), total: FRAMES, truth: true, frames: rx, start: None },
+            )
         });
         assert!(out.stopped.is_none(), "pause {pause:?}: {:?}", out.stopped);
         assert_eq!(got.len(), FRAMES);
@@ -111,8 +94,10 @@ fn a_stream_that_ends_early_stops_the_clip_with_an_error() {
     };
     let (tx, rx) = channel();
     feed(tx, &clip, &truth.frames, 5, Duration::ZERO);
-    let (out, got) =
-        solve(&case, ClipFrames::Streamed { header: header(&clip), total: FRAMES, truth: true, frames: rx });
+    let (out, got) = solve(
+        &case,
+        ClipFrames::Streamed { header: header(&clip), total: FRAMES, truth: true, frames: rx, start: None },
+    );
     assert_eq!(got.len(), 5, "the frames that arrived are solved and handed over");
     match out.stopped {
         Some(RunError::Generator { received: 5, total: FRAMES }) => {}

@@ -77,7 +77,7 @@ pub enum RodLength {
     /// a number or an expression of the case file
     Given,
     /// `"from_data"`: the body length of the recording, estimated when it is read
-    /// (`engine::input::clip_files::resolve_length`, `clip::length`); `None` until then, when the mesh's
+    /// (`engine::input::resolve::resolve_recording`, `clip::length`); `None` until then, when the mesh's
     /// length is [`FROM_DATA_PLACEHOLDER_M`]
     FromData(Option<BodyLength>),
 }
@@ -165,7 +165,7 @@ pub struct RecordingKeys {
     pub worm_id: Option<String>,
     /// `clip.data_plane`: the unit normal of a planar recording's plane in space coordinates
     /// (after `clip.orientation`); set when a planar recording is read
-    /// (`engine::input::clip_files::resolve_recording`)
+    /// (`engine::input::resolve::resolve_recording`)
     pub data_plane: Option<Vector3<f64>>,
 }
 

@@ -18,7 +18,7 @@ use cosserat::solve::modes::modal_model;
 
 /// The case of `path`, its `rod.length_m = "from_data"` resolved from its recording.
 fn load(path: &Path) -> Result<Case> {
-    Ok(cosserat::engine::input::clip_files::resolve_length(&Case::from_file(path)?)?)
+    Ok(cosserat::engine::input::resolve::resolve_recording(&Case::from_file(path)?)?)
 }
 
 /// Refuse a run whose estimated memory exceeds the limit (`--max-memory-gib`).

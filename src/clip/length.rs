@@ -368,7 +368,12 @@ impl BodyLength {
     /// [`BodyLength::estimate`] of a recording whose noise lies in the plane normal to `plane`
     /// ([`FrameLength::of_in`]).
     pub fn estimate_in(frames: &[Vec<Vector3<f64>>], plane: Option<&Vector3<f64>>) -> Option<BodyLength> {
-        let lengths: Vec<FrameLength> = frames.iter().map(|f| FrameLength::of_in(f, plane)).collect();
+        BodyLength::of_lengths(&frames.iter().map(|f| FrameLength::of_in(f, plane)).collect::<Vec<_>>())
+    }
+
+    /// [`BodyLength::estimate_in`] of the frames' lengths (each [`FrameLength::of_in`]), taken
+    /// as the frames were read.
+    pub fn of_lengths(lengths: &[FrameLength]) -> Option<BodyLength> {
         let mut l: Vec<f64> = lengths.iter().map(|f| f.corrected_m).filter(|v| v.is_finite()).collect();
         let length_m = median(&mut l)?;
         if length_m.is_nan() || length_m <= 0.0 {

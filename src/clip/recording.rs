@@ -83,15 +83,36 @@ pub struct RecordingInfo {
 /// axis does (z before y before x): the normal of a planar recording written with three
 /// columns. `None` if no axis is constant or nothing is finite.
 pub fn constant_axis(frames: &[Vec<Vector3<f64>>]) -> Option<usize> {
-    let mut finite = frames.iter().flatten().filter(|p| p.iter().all(|v| v.is_finite()));
-    let first = *finite.next()?;
-    let mut constant = [true; 3];
-    for p in finite {
-        for k in 0..3 {
-            constant[k] &= p[k] == first[k];
+    let mut axes = ConstantAxes::default();
+    frames.iter().for_each(|f| axes.push(f));
+    axes.axis()
+}
+
+/// [`constant_axis`] of frames that arrive one at a time (a recording read from its file a
+/// frame at a time): the first finite position and, per axis, whether every finite position
+/// since has had its value.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct ConstantAxes {
+    first: Option<Vector3<f64>>,
+    varies: [bool; 3],
+}
+
+impl ConstantAxes {
+    /// Take the positions of one more frame.
+    pub fn push(&mut self, frame: &[Vector3<f64>]) {
+        for p in frame.iter().filter(|p| p.iter().all(|v| v.is_finite())) {
+            let first = *self.first.get_or_insert(*p);
+            for k in 0..3 {
+                self.varies[k] |= p[k] != first[k];
+            }
         }
     }
-    [2, 1, 0].into_iter().find(|&k| constant[k])
+
+    /// The constant axis of the frames taken ([`constant_axis`]).
+    pub fn axis(&self) -> Option<usize> {
+        self.first?;
+        [2, 1, 0].into_iter().find(|&k| !self.varies[k])
+    }
 }
 
 pub use crate::solve::fit::plane_basis;

@@ -38,8 +38,9 @@ use self::common::clip_frame::FrameSink;
 use self::freefem::FreeFemError;
 use self::input::clip_files::{load_clip, roll_stream, ClipFileError, RollStream};
 use self::input::data::{read_data, write_data};
+use self::input::recording_stream::{recording_stream, RecordingStream};
 use self::rust::clip::{run_clip_resumed, ClipFrames, ClipOutcome, ResumeRecords, StreamedFrame, STREAM_AHEAD};
-use self::rust::weights::{choose_weights, Auto};
+use self::rust::weights::{choose_weights, choose_weights_on, Auto};
 use crate::case::{Case, DataSource, WeightsRule};
 use crate::clip::synthetic::GroundTruth;
 use crate::clip::Clip;
@@ -149,26 +150,33 @@ pub fn run_inverse_on(
 }
 
 /// The frames of a clip case for the Rust engine: a synthetic roll_3d clip is integrated on a
-/// second thread while its first frames are solved ([`ClipInput::Streamed`]); other clips, and
-/// every clip whose weights are `"auto"` (the noise level needs every frame before the first
-/// solve, N2), are read at once with the weights chosen on them.
+/// second thread while its first frames are solved ([`ClipInput::Streamed`]), unless its weights
+/// are `"auto"` (the noise level needs every frame before the first solve, N2); an NPY recording
+/// every node of which is tracked is read from its file on a second thread
+/// ([`ClipInput::Recorded`]: the noise level and the calibration frames found in a pass before,
+/// `engine::input::recording_stream`); other clips are read at once. The weights are chosen on
+/// the clip where they are `"auto"`.
 pub enum ClipInput {
     Streamed(RollStream),
+    Recorded { stream: RecordingStream, chosen: Option<Box<Auto>> },
     Loaded { clip: Clip, truth: Option<GroundTruth>, chosen: Option<Box<Auto>> },
 }
 
 impl ClipInput {
-    /// The frames of `case`'s clip (read, or ready to be integrated).
+    /// The frames of `case`'s clip (read, or ready to be integrated or read).
     pub fn of(case: &Case) -> Result<Self, EngineError> {
         let auto = case.inverse().is_some_and(|s| s.weights_rule == WeightsRule::Auto);
-        Ok(match roll_stream(case)?.filter(|_| !auto) {
-            Some(stream) => ClipInput::Streamed(stream),
-            None => {
-                let (clip, truth) = load_clip(case)?;
-                let chosen = choose_weights(case, &clip.frames).map(Box::new);
-                ClipInput::Loaded { clip, truth, chosen }
-            }
-        })
+        if let Some(stream) = roll_stream(case)?.filter(|_| !auto) {
+            return Ok(ClipInput::Streamed(stream));
+        }
+        if let Some(stream) = recording_stream(case)? {
+            let noise = || weights::median_noise(stream.noise_levels().iter().copied());
+            let chosen = choose_weights_on(case, stream.calibration(), noise).map(Box::new);
+            return Ok(ClipInput::Recorded { stream, chosen });
+        }
+        let (clip, truth) = load_clip(case)?;
+        let chosen = choose_weights(case, &clip.frames).map(Box::new);
+        Ok(ClipInput::Loaded { clip, truth, chosen })
     }
 
     /// Does the clip come with its ground truth (a synthetic clip, or a recording with a truth
@@ -176,6 +184,7 @@ impl ClipInput {
     pub fn has_truth(&self) -> bool {
         match self {
             ClipInput::Streamed(_) => true,
+            ClipInput::Recorded { .. } => false,
             ClipInput::Loaded { truth, .. } => truth.is_some(),
         }
     }
@@ -200,8 +209,30 @@ pub fn run_clip_into<S: FrameSink>(
             let stream = &stream;
             // stops at the first frame the solve no longer takes (it ended early)
             scope.spawn(move || (0..total).try_for_each(|i| tx.send(stream_frame(stream, i))));
-            let frames = ClipFrames::Streamed { header, total, truth: true, frames: rx };
+            let frames = ClipFrames::Streamed { header, total, truth: true, frames: rx, start: None };
             Ok(run_clip_resumed(case, frames, records, sink, progress)?)
+        }),
+        ClipInput::Recorded { stream, chosen } => std::thread::scope(|scope| {
+            // at most STREAM_AHEAD frames read ahead of the solve: a recording of any length is
+            // held a window at a time
+            let (tx, rx) = std::sync::mpsc::sync_channel(STREAM_AHEAD);
+            let (header, total) = (stream.header(), stream.len());
+            let mut frames = stream.frames().map_err(ClipFileError::from)?;
+            // stops at the first frame the solve no longer takes (it ended early), or that
+            // cannot be read (the file changed since it was read through): its error
+            let reader = scope.spawn(move || {
+                frames.try_for_each(|x| x.map_err(Some).and_then(|x| tx.send((x, None)).map_err(|_| None)))
+            });
+            let case = chosen.as_ref().map_or(case, |a| &a.case);
+            let start = chosen.as_ref().and_then(|a| a.start.as_ref());
+            let frames = ClipFrames::Streamed { header, total, truth: false, frames: rx, start };
+            let mut out = run_clip_resumed(case, frames, records, sink, progress)?;
+            out.run.weights = chosen.map(|a| a.chosen);
+            let read = reader.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+            if let (Some(RunError::Generator { received, total }), Err(Some(source))) = (&out.stopped, read) {
+                out.stopped = Some(RunError::Recording { received: *received, total: *total, source });
+            }
+            Ok(out)
         }),
         ClipInput::Loaded { clip, truth, chosen } => {
             let case = chosen.as_ref().map_or(case, |a| &a.case);

@@ -399,7 +399,7 @@ pub fn run_recording(case: &Case, case_file: &InputFile, entry: &PlanEntry, out:
         Err(e) => return failed(chain(&e)),
     };
     // rod.length_m = "from_data": this recording's body length
-    let case = match crate::engine::input::clip_files::resolve_length(&case) {
+    let case = match crate::engine::input::resolve::resolve_recording(&case) {
         Ok(c) => c,
         Err(e) => return failed(chain(&e)),
     };

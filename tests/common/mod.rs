@@ -88,7 +88,7 @@ pub fn with_clip_data(case: Case) -> Option<Case> {
         write_tracker_corpus(&root.join("data/tracker"), &kymograms, &TrackerParams::default())
             .unwrap_or_else(|e| panic!("the tracker recordings of {}: {e}", case.name));
     }
-    let resolved = cosserat::engine::input::clip_files::resolve_recording(&case);
+    let resolved = cosserat::engine::input::resolve::resolve_recording(&case);
     Some(resolved.unwrap_or_else(|e| panic!("{}: {}", case.name, error_chain(&e))))
 }
 
@@ -285,4 +285,24 @@ impl cosserat::engine::clip::FrameSink for Collect {
     fn finish(&mut self) -> Result<(), Self::Error> {
         Ok(())
     }
+}
+
+/// Every number of a frame that derives from its solve, as bits.
+pub fn frame_bits(f: &cosserat::engine::clip::ClipFrame) -> Vec<u64> {
+    let r = &f.report;
+    let mut v: Vec<u64> = [
+        r.convergence.last_change,
+        r.misfit.x_err_rel,
+        r.misfit.tangent_misfit,
+        r.misfit.objective.tracking,
+        r.conditioning.min_cos_beta,
+    ]
+    .iter()
+    .map(|x| x.to_bits())
+    .collect();
+    v.push(r.convergence.iterations as u64);
+    v.extend(f.record.state.iter().chain(f.record.adjoint.iter()).map(|x| x.to_bits()));
+    v.extend(f.planar.kappa2.iter().map(|x| x.to_bits()));
+    v.extend(f.truth.iter().flat_map(|t| t.bending_recovered.iter().map(|x| x.to_bits())));
+    v
 }

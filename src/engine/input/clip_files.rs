@@ -9,8 +9,9 @@ use super::recording::{read_positions, ReadSpec, Recorded};
 use super::truth_file::{read_truth, truth_sidecar};
 use crate::case::sweep::SweepError;
 use crate::case::{Case, ClipKind, RodLength, FROM_DATA};
-use crate::clip::length::{BodyLength, FrameLength};
+use crate::clip::length::FrameLength;
 use crate::clip::missing::{fill_missing, MissingData, MIN_TRACKED};
+use crate::clip::recording::RecordingInfo;
 use crate::clip::synthetic::{roll_clip, FrameTruth, GroundTruth, RollClipGenerator};
 use crate::clip::{
     check_frame_range, clip_from_angles, polyline_length, rotate_frame, Clip, ClipError, KymogramParams,
@@ -230,79 +231,8 @@ pub fn load_clip(case: &Case) -> Result<(Clip, Option<GroundTruth>), ClipFileErr
     Ok((clip, truth))
 }
 
-/// The case resolved against its recording (`kind = "recording"`; any other case is returned
-/// as it is), written into the case file's tables and validated again, so that everything
-/// derived from them follows (the slenderness check, the default stabilisation, the section
-/// scaled by `rod.section_length_m`, a sweep's points):
-/// - `rod.length_m = "from_data"`: the body length of the recording (the frames of its range;
-///   with missing data, the frames tracked whole, else every frame as filled),
-///   [`BodyLength::estimate_in`]; the estimate is kept in [`Case::body_length`];
-/// - a planar recording (`clip::recording`): `clip.data_plane`, its plane's normal, and, where
-///   the case gives no `clip.gauge`, the gauge along that normal, so that the bending of the
-///   data is κ2 with d2 along the normal (docs/rotation.md R7);
-/// - a recording numbered from frame `k > 0`, without `clip.frames`: `clip.frames` from `k`,
-///   so that every frame is reported under the file's number.
-///
-/// The clip file is written as an absolute path (a batch's recording replaces the file's).
-pub fn resolve_recording(case: &Case) -> Result<Case, ClipFileError> {
-    let Some(src) = case.clip().filter(|c| c.kind == ClipKind::Recording) else { return Ok(case.clone()) };
-    let src = clip_source(case).map(|_| src)?;
-    let mut clip = read_recording_as(&src.file, &read_spec(case, src))?;
-    let info = clip.recording.clone();
-    let mut overrides: Vec<(String, toml::Value)> = Vec::new();
-    let array = |v: &Vector3<f64>| toml::Value::Array(v.iter().map(|c| toml::Value::Float(*c)).collect());
-    if let (Some(n), None) = (&info.plane_normal, &src.recording.data_plane) {
-        overrides.push(("clip.data_plane".into(), array(n)));
-        let gauge_given = case.toml_table().and_then(|t| t.get("clip")).and_then(|c| c.get("gauge")).is_some();
-        if !gauge_given {
-            overrides.push(("clip.gauge".into(), array(n)));
-        }
-    }
-    if info.first_frame > 0 && src.frames.is_none() {
-        let end = info.first_frame + clip.frame_count();
-        let range = [info.first_frame, end].map(|v| toml::Value::Integer(v as i64));
-        overrides.push(("clip.frames".into(), toml::Value::Array(range.to_vec())));
-    }
-    let mut body = None;
-    if case.rod.length == RodLength::FromData(None) {
-        if let Some((a, b)) = src.frames {
-            let (a0, b0) = (a.saturating_sub(info.first_frame), b.saturating_sub(info.first_frame));
-            clip.select(a0, b0)?;
-        }
-        let whole: Vec<Vec<Vector3<f64>>> = (0..clip.frame_count())
-            .filter(|&k| clip.nodes_tracked(k) == clip.node_count())
-            .map(|k| clip.frames[k].clone())
-            .collect();
-        let frames = if whole.is_empty() { &clip.frames } else { &whole };
-        let b = BodyLength::estimate_in(frames, info.plane_normal.as_ref())
-            .ok_or_else(|| ClipFileError::NoBodyLength { path: src.file.clone() })?;
-        overrides.push(("rod.length_m".into(), toml::Value::Float(b.length_m)));
-        body = Some(b);
-    }
-    if overrides.is_empty() {
-        return Ok(case.clone());
-    }
-    let file = std::path::absolute(&src.file).unwrap_or_else(|_| src.file.clone());
-    overrides.push(("clip.file".into(), toml::Value::String(file.display().to_string())));
-    let mut resolved = case.with_overrides(&overrides).map_err(|source| ClipFileError::FromData {
-        path: src.file.clone(),
-        length_m: body.map_or(case.mesh.length_m, |b| b.length_m),
-        source,
-    })?;
-    if let Some(b) = body {
-        resolved.rod.length = RodLength::FromData(Some(b));
-    }
-    resolved.origin.source_sha256.clone_from(&case.origin.source_sha256);
-    Ok(resolved)
-}
-
-/// [`resolve_recording`]: the name this had when it resolved the length only.
-pub fn resolve_length(case: &Case) -> Result<Case, ClipFileError> {
-    resolve_recording(case)
-}
-
 /// The clip section of a clip case whose file exists.
-fn clip_source(case: &Case) -> Result<&crate::case::ClipSource, ClipFileError> {
+pub(super) fn clip_source(case: &Case) -> Result<&crate::case::ClipSource, ClipFileError> {
     let src = case.clip().ok_or_else(|| ClipFileError::NotAClip(case.name.clone()))?;
     if !src.file.exists() {
         let hint = if is_fetched_data(&src.file) {
@@ -466,16 +396,20 @@ fn clip_of(path: &Path, recorded: Recorded, dt_s: f64, missing: MissingData) -> 
     if length_m <= 0.0 && missing == MissingData::Error {
         return Err(InputError::Shape { path: path.to_path_buf(), reason: "frame 0 has zero length".into() });
     }
+    let source = recording_source(path, (frames.len(), frames[0].len()), &info);
+    Ok(Clip { frames, dt_s, source, length_m, tracked: None, recording: info })
+}
+
+/// The source of a recording's clip (`Clip::source`): its file, `frames × nodes` and what it
+/// says about itself.
+pub(super) fn recording_source(path: &Path, (frames, nodes): (usize, usize), info: &RecordingInfo) -> String {
     let planar = if info.plane_normal.is_some() { ", planar" } else { "" };
-    let source = format!(
-        "{} ({} frames × {} nodes from frame {}, in {}{planar})",
+    format!(
+        "{} ({frames} frames × {nodes} nodes from frame {}, in {}{planar})",
         path.display(),
-        frames.len(),
-        frames[0].len(),
         info.first_frame,
         info.unit.name()
-    );
-    Ok(Clip { frames, dt_s, source, length_m, tracked: None, recording: info })
+    )
 }
 
 #[cfg(test)]

@@ -7,5 +7,7 @@ pub mod clip_files;
 pub mod corpus;
 pub mod data;
 pub mod recording;
+pub mod recording_stream;
+pub mod resolve;
 pub mod tracker;
 pub mod truth_file;

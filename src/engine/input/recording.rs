@@ -328,43 +328,109 @@ fn csv_table(path: &Path, spec: &ReadSpec) -> Result<Table, InputError> {
 /// its frames are laid out as the file is read, a frame at a time (an hour of 128 nodes at 30
 /// frames/s is 330 MB of positions: never held twice).
 fn npy_recorded(path: &Path, spec: &ReadSpec) -> Result<Recorded, InputError> {
-    let mut a = open_npy(path)?;
-    let shape = |reason: String| InputError::Shape { path: path.to_path_buf(), reason };
-    let &[frames, nodes, dims @ (2 | 3)] = a.shape.as_slice() else {
-        return Err(shape(format!("recording of shape {:?}, expected frames × nodes × 3 (or × 2)", a.shape)));
-    };
-    if frames == 0 || nodes < 3 {
-        return Err(shape(format!("recording of shape {:?}: need at least 1 frame and 3 nodes", a.shape)));
-    }
-    // the shape's product was checked by open_npy: it does not overflow
-    if frames * nodes > MAX_CLIP_POSITIONS {
-        return Err(shape(format!(
-            "recording of shape {:?}: {} positions, more than the {MAX_CLIP_POSITIONS} a clip may hold",
-            a.shape,
-            frames * nodes
-        )));
-    }
-    let (unit, metres) = resolve_unit(path, None, &spec.units, "the NPY file")?;
-    let mut values = vec![0.0; nodes * dims];
-    let mut out = Vec::with_capacity(frames);
-    for f in 0..frames {
-        a.read(&mut values)?;
-        let mut pts = Vec::with_capacity(nodes);
-        for (i, c) in values.chunks_exact(dims).enumerate() {
-            let p = Vector3::new(c[0], c[1], if dims == 3 { c[2] } else { 0.0 });
-            check_position(path, (f, i), &p, spec.missing)?;
-            pts.push(if p.iter().any(|v| v.is_nan()) { Vector3::repeat(f64::NAN) } else { p * metres });
-        }
+    let mut reader = NpyFrames::open(path, spec)?;
+    let mut out = Vec::with_capacity(reader.frames());
+    while let Some(pts) = reader.next_frame()? {
         out.push(pts);
     }
-    let info = recording_info(0, unit, dims == 2, &out);
+    let info = recording_info(0, reader.unit(), reader.planar(), &out);
     Ok(Recorded { frames: out, info })
+}
+
+/// An NPY recording (`frames × nodes × 3` or `× 2`) read a frame at a time, each frame checked
+/// and converted to metres as [`read_positions`] does (a 2D recording placed at z = 0, a node
+/// untracked in one coordinate untracked in all): what a clip streamed from its file reads
+/// (`super::recording_stream`), and the reader of [`read_positions`].
+pub struct NpyFrames {
+    stream: crate::io::npy::NpyStream,
+    path: std::path::PathBuf,
+    missing: MissingData,
+    unit: LengthUnit,
+    /// metres per unit of the file
+    metres: f64,
+    frames: usize,
+    nodes: usize,
+    /// coordinates per position (2 or 3)
+    dims: usize,
+    /// the index of the next frame
+    next: usize,
+    values: Vec<f64>,
+}
+
+impl NpyFrames {
+    /// Open the NPY recording `path` as `spec` says: its shape, size and unit checked.
+    pub fn open(path: &Path, spec: &ReadSpec) -> Result<NpyFrames, InputError> {
+        let stream = open_npy(path)?;
+        let shape = |reason: String| InputError::Shape { path: path.to_path_buf(), reason };
+        let &[frames, nodes, dims @ (2 | 3)] = stream.shape.as_slice() else {
+            return Err(shape(format!("recording of shape {:?}, expected frames × nodes × 3 (or × 2)", stream.shape)));
+        };
+        if frames == 0 || nodes < 3 {
+            return Err(shape(format!("recording of shape {:?}: need at least 1 frame and 3 nodes", stream.shape)));
+        }
+        // the shape's product was checked by open_npy: it does not overflow
+        if frames * nodes > MAX_CLIP_POSITIONS {
+            return Err(shape(format!(
+                "recording of shape {:?}: {} positions, more than the {MAX_CLIP_POSITIONS} a clip may hold",
+                stream.shape,
+                frames * nodes
+            )));
+        }
+        let (unit, metres) = resolve_unit(path, None, &spec.units, "the NPY file")?;
+        let values = vec![0.0; nodes * dims];
+        let path = path.to_path_buf();
+        Ok(NpyFrames { stream, path, missing: spec.missing, unit, metres, frames, nodes, dims, next: 0, values })
+    }
+
+    /// Frames of the recording.
+    pub fn frames(&self) -> usize {
+        self.frames
+    }
+
+    /// Nodes per frame.
+    pub fn nodes(&self) -> usize {
+        self.nodes
+    }
+
+    /// The unit the positions are read in.
+    pub fn unit(&self) -> LengthUnit {
+        self.unit
+    }
+
+    /// Does the file hold two coordinates per position (a planar recording at z = 0)?
+    pub fn planar(&self) -> bool {
+        self.dims == 2
+    }
+
+    /// The next frame's positions [m] (NaN where untracked, with [`MissingData::Nan`]); `None`
+    /// after the last.
+    pub fn next_frame(&mut self) -> Result<Option<Vec<Vector3<f64>>>, InputError> {
+        if self.next == self.frames {
+            return Ok(None);
+        }
+        self.stream.read(&mut self.values)?;
+        let (f, dims) = (self.next, self.dims);
+        let mut pts = Vec::with_capacity(self.nodes);
+        for (i, c) in self.values.chunks_exact(dims).enumerate() {
+            let p = Vector3::new(c[0], c[1], if dims == 3 { c[2] } else { 0.0 });
+            check_position(&self.path, (f, i), &p, self.missing)?;
+            pts.push(if p.iter().any(|v| v.is_nan()) { Vector3::repeat(f64::NAN) } else { p * self.metres });
+        }
+        self.next += 1;
+        Ok(Some(pts))
+    }
 }
 
 /// What a recording says about itself: its first frame number, its unit and its plane (z = 0
 /// for two coordinates, else an axis along which every position is the same).
 fn recording_info(first_frame: usize, unit: LengthUnit, planar: bool, frames: &[Vec<Vector3<f64>>]) -> RecordingInfo {
-    let plane_normal = if planar { Some(Vector3::z()) } else { constant_axis(frames).map(|k| Vector3::ith(k, 1.0)) };
+    info_of(first_frame, unit, planar, if planar { None } else { constant_axis(frames) })
+}
+
+/// [`recording_info`] with the constant axis of the frames (`crate::clip::recording::ConstantAxes`)
+/// found as they were read.
+pub(crate) fn info_of(first_frame: usize, unit: LengthUnit, planar: bool, axis: Option<usize>) -> RecordingInfo {
+    let plane_normal = if planar { Some(Vector3::z()) } else { axis.map(|k| Vector3::ith(k, 1.0)) };
     RecordingInfo { first_frame, unit, plane_normal }
 }
 

@@ -49,9 +49,16 @@ pub enum ClipFrames<'a> {
     /// `start`: frame 0's initial iterate in its chart (`None`: the data guess)
     Loaded { clip: &'a Clip, truth: Option<&'a GroundTruth>, start: Option<&'a DVector<f64>> },
     /// `total` frames arriving in order on `frames` (each with its ground truth where `truth`),
-    /// e.g. from a generator on another thread: the solve starts with the first frame while
-    /// later ones are made. `header`: the clip without its frames (time step, source).
-    Streamed { header: Clip, total: usize, truth: bool, frames: Receiver<StreamedFrame> },
+    /// e.g. from a generator or a file's reader on another thread: the solve starts with the
+    /// first frame while later ones are made. `header`: the clip without its frames (time step,
+    /// source); `start` as for a loaded clip.
+    Streamed {
+        header: Clip,
+        total: usize,
+        truth: bool,
+        frames: Receiver<StreamedFrame>,
+        start: Option<&'a DVector<f64>>,
+    },
 }
 
 /// The frames of a [`ClipFrames`] at hand: all of a loaded clip; of a streamed one those
@@ -167,8 +174,7 @@ pub fn run_clip_resumed<S: FrameSink>(
     let problem = case.problem();
     // frame 0's initial iterate, for the first run of frames only
     let frame0_start = match &frames {
-        ClipFrames::Loaded { start, .. } => start.cloned(),
-        ClipFrames::Streamed { .. } => None,
+        ClipFrames::Loaded { start, .. } | ClipFrames::Streamed { start, .. } => start.cloned(),
     };
     let mut arrivals = Arrivals { input: frames, frames: Vec::new(), truth: Vec::new(), base: 0 };
     let (header, total, has_truth) = arrivals.header();

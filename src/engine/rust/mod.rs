@@ -51,6 +51,15 @@ pub enum RunError {
     Resume(clip::ResumeError),
     #[error("the clip's frame generator stopped after {received} of {total} frames")]
     Generator { received: usize, total: usize },
+    /// A recording streamed from its file could not be read on (it changed after it was read
+    /// through before the solve).
+    #[error("reading the recording stopped after {received} of {total} frames")]
+    Recording {
+        received: usize,
+        total: usize,
+        #[source]
+        source: crate::io::files::InputError,
+    },
     /// A forward solve diverged: the error, with the largest load of the case named (a load
     /// far beyond the rod's stiffness is the usual cause).
     #[error("rust engine: the solve could not follow the loads, the largest of which is {key} = \"{expr}\" = {value:e} (check its magnitude and units, or raise solver.continuation_steps of a static case)")]

@@ -28,8 +28,9 @@ pub use crate::engine::common::clip_summary::ChosenWeights;
 use crate::solve::fit::noise_level_in;
 use crate::solve::sequence::{solve_sequence, FirstStart, SequenceParams};
 
-/// Frames of the clip's start on which `r(λg)` is measured.
-pub const CALIBRATION_FRAMES: usize = 3;
+/// Frames of the clip's start on which `r(λg)` is measured (a recording streamed from its file
+/// keeps these for the search).
+pub use crate::engine::input::recording_stream::CALIBRATION_FRAMES;
 /// `r` within this factor of `σ̂` ends the search.
 pub const MATCH: f64 = 1.1;
 /// Largest number of calibration solves.
@@ -69,7 +70,13 @@ pub fn recording_noise(frames: &[Vec<Vector3<f64>>]) -> f64 {
 /// [`recording_noise`] of a recording whose noise lies in the plane normal to `plane` (a planar
 /// recording: the two coordinates that carry data, [`noise_level_in`]).
 pub fn recording_noise_in(frames: &[Vec<Vector3<f64>>], plane: Option<&Vector3<f64>>) -> f64 {
-    let mut v: Vec<f64> = frames.iter().map(|f| noise_level_in(f, plane)).filter(|v| v.is_finite()).collect();
+    median_noise(frames.iter().map(|f| noise_level_in(f, plane)))
+}
+
+/// [`recording_noise_in`] of the frames' noise levels [m] (each [`noise_level_in`]), taken as
+/// they come: their median, the non-finite ones left out; 0 where none is finite.
+pub fn median_noise(levels: impl IntoIterator<Item = f64>) -> f64 {
+    let mut v: Vec<f64> = levels.into_iter().filter(|v| v.is_finite()).collect();
     if v.is_empty() {
         return 0.0;
     }
@@ -81,18 +88,31 @@ pub fn recording_noise_in(frames: &[Vec<Vector3<f64>>], plane: Option<&Vector3<f
 /// The case with λg chosen for `frames` when its weights are `"auto"`, the choice, and frame 0's
 /// solution at that λg in its chart (the clip's frame 0 starts there), else `None`.
 pub fn choose_weights(case: &Case, frames: &[Vec<Vector3<f64>>]) -> Option<Auto> {
+    let plane = case.sequence_params()?.plane;
+    let calib = &frames[..CALIBRATION_FRAMES.min(frames.len())];
+    choose_weights_on(case, calib, || recording_noise_in(frames, plane.as_ref()))
+}
+
+/// [`choose_weights`] of a clip known by its first [`CALIBRATION_FRAMES`] frames `calib` (or all
+/// of a shorter clip) and, where the case states no noise level, the recording's
+/// ([`recording_noise_in`], asked for only then): what a clip streamed from its file gives.
+pub fn choose_weights_on(
+    case: &Case,
+    calib: &[Vec<Vector3<f64>>],
+    recording_noise_m: impl FnOnce() -> f64,
+) -> Option<Auto> {
     let rule = case.inverse().map(|s| s.weights_rule)?;
     let sp = case.sequence_params()?;
-    if rule != WeightsRule::Auto || frames.is_empty() {
+    if rule != WeightsRule::Auto || calib.is_empty() {
         return None;
     }
     // the noise the case states, else the recording's (in its plane, for planar data)
-    let sigma = sp.gate.noise_m.unwrap_or_else(|| recording_noise_in(frames, sp.plane.as_ref()));
+    let sigma = sp.gate.noise_m.unwrap_or_else(recording_noise_m);
     let cap = sp.inverse.weights.lambda_g;
     let mut sp = sp;
-    let eps = noise_stabilisation(sigma, frames[0].len(), case.mesh.length_m, sp.inverse.stabilisation);
+    let eps = noise_stabilisation(sigma, calib[0].len(), case.mesh.length_m, sp.inverse.stabilisation);
     sp.inverse.stabilisation = eps;
-    let calib = &frames[..CALIBRATION_FRAMES.min(frames.len())];
+    let calib = &calib[..CALIBRATION_FRAMES.min(calib.len())];
     let mut search = Search { case, sp, calib, states: Vec::new(), solves: 0 };
     let (lambda_g, r) = search_lambda_g(&mut search, sigma, cap);
     let chosen = ChosenWeights {

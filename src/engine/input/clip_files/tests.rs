@@ -3,6 +3,7 @@
 use super::*;
 use crate::clip::tests::{menger_curvature, planar, wave};
 use crate::clip::{kymogram_joints, ClipPlane, Spline, PAPER_NODES, WORM_LENGTH_M};
+use crate::engine::input::resolve::resolve_recording;
 use crate::io::npy::{npy_bytes, write_npy};
 use std::path::PathBuf;
 
@@ -323,7 +324,7 @@ fn from_data_is_resolved_from_the_frames_of_the_recording() {
     let case = recording_case(dir.path(), "rec.csv", 11, Some([1, 4])).with_overrides(&from_data).unwrap();
     let e = load_clip(&case).unwrap_err().to_string();
     assert!(e.starts_with("case `rec`: rod.length_m = \"from_data\" is the body length of the recording"), "{e}");
-    let resolved = resolve_length(&case).unwrap();
+    let resolved = resolve_recording(&case).unwrap();
     let b = resolved.body_length().unwrap();
     assert!((resolved.mesh.length_m / 1.2e-3 - 1.0).abs() < 1e-14, "{b:?}");
     assert_eq!((b.length_m, b.frames), (resolved.mesh.length_m, 3));
@@ -331,12 +332,12 @@ fn from_data_is_resolved_from_the_frames_of_the_recording() {
     assert!((b.min_m / 1.15e-3 - 1.0).abs() < 1e-14 && (b.max_m / 1.25e-3 - 1.0).abs() < 1e-14, "{b:?}");
     assert_eq!(load_clip(&resolved).map(|(c, _)| c.frame_count()).map_err(|e| e.to_string()), Ok(3));
     // resolved once: returned as it is; a sweep point of it keeps the estimate
-    assert_eq!(resolve_length(&resolved).unwrap().rod.length, resolved.rod.length);
+    assert_eq!(resolve_recording(&resolved).unwrap().rod.length, resolved.rod.length);
     let point = resolved.with_values(&[("lambda_d", 2.0.into())]).unwrap();
     assert_eq!(point.body_length(), Some(b));
     // the whole file: frame 0 is 2e-3 m, 1.67× the median of the four (1.225e-3 m)
     let whole = recording_case(dir.path(), "rec.csv", 11, None).with_overrides(&from_data).unwrap();
-    let e = load_clip(&resolve_length(&whole).unwrap()).unwrap_err().to_string();
+    let e = load_clip(&resolve_recording(&whole).unwrap()).unwrap_err().to_string();
     assert!(e.contains("frame 0: the centreline is 2.0000e-3 m long") && e.contains("1.633×"), "{e}");
 }
 
