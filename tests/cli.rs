@@ -217,8 +217,8 @@ fn sweep_writes_one_folder_per_run_a_summary_and_a_convergence_plot() {
 
 #[test]
 fn compare_on_a_clip_checks_consecutive_frames_in_both_engines() {
-    if std::env::var_os("COSSERAT_SKIP_FREEFEM").is_some()
-        || !std::path::Path::new("data/elegansbot/kymogram_omega-turn.npy").is_file()
+    if !common::worm_data_present("compare_on_a_clip_checks_consecutive_frames_in_both_engines")
+        || !common::freefem_required()
     {
         return;
     }
@@ -282,7 +282,7 @@ fn run_refuses_a_clip_in_freefem_before_it_makes_a_folder() {
 /// final line; `--quiet` prints none.
 #[test]
 fn progress_without_a_terminal_is_a_line_every_interval_and_a_final_line() {
-    if !std::path::Path::new("data/elegansbot/kymogram_delta-turn.npy").is_file() {
+    if !common::worm_data_present("progress_without_a_terminal_is_a_line_every_interval_and_a_final_line") {
         return;
     }
     let dir = tempfile::tempdir().expect("tempdir");

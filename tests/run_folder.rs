@@ -374,7 +374,7 @@ fn an_interrupted_sweep_stops_every_point_and_says_what_it_kept() {
 /// status 1: never an abort (status 134).
 #[test]
 fn an_address_space_limit_gives_an_error_not_an_abort() {
-    if !Path::new(env!("CARGO_MANIFEST_DIR")).join("data/elegansbot/kymogram_omega-turn.npy").is_file() {
+    if !common::worm_data_present("an_address_space_limit_gives_an_error_not_an_abort") {
         return;
     }
     let dir = tempfile::tempdir().expect("tempdir");

@@ -14,7 +14,7 @@
 //!   from its own data (`resolved`) and stays flagged while still over it; its solution is the
 //!   one a clip solved from the data on every frame (`start = "data_guess"`) finds.
 //!
-//! Skipped with a notice without the elegansbot kymograms (`scripts/fetch_worm_data.sh`).
+//! Needs the elegansbot kymograms (`scripts/fetch_worm_data.sh`; `common::worm_data_present`).
 mod common;
 
 use std::path::{Path, PathBuf};
@@ -38,11 +38,7 @@ fn percentiles(mut v: Vec<f64>) -> (f64, f64) {
 /// The omega-turn kymogram, `None` (with a notice) when absent.
 fn omega_kymogram() -> Option<PathBuf> {
     let omega = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/elegansbot/kymogram_omega-turn.npy");
-    if !omega.is_file() {
-        println!("SKIPPED: {} is absent (run scripts/fetch_worm_data.sh)", omega.display());
-        return None;
-    }
-    Some(omega)
+    common::worm_data_present("tracker_recording").then_some(omega)
 }
 
 /// `cases/worm_2d_recording.toml` on `recording`, its `[clip]` table given the lines `extra`

@@ -131,13 +131,12 @@ fn a_rotated_3d_clip_gives_the_rotated_answer() {
     assert!(dx < 1e-7 && dd < 1e-7 && dk < 1e-7, "{dx:e} {dd:e} {dk:e}");
 }
 
-/// The default clip from the real omega turn; skipped with a notice when absent.
+/// The default clip from the real omega turn (needs the worm data: `common::worm_data_present`).
 #[test]
 fn default_synthetic_clip_from_the_omega_turn() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/elegansbot");
     let omega_path = dir.join("kymogram_omega-turn.npy");
-    if !omega_path.is_file() {
-        println!("SKIPPED: {} is absent (run scripts/fetch_worm_data.sh)", omega_path.display());
+    if !common::worm_data_present("default_synthetic_clip_from_the_omega_turn") {
         return;
     }
     let to_rows = |p: &Path| kymogram_rows(p).expect("kymogram");

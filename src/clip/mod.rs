@@ -344,6 +344,23 @@ pub fn clip_from_angles(rows: &[Vec<f64>], params: &KymogramParams, source: Stri
 pub(crate) mod tests {
     use super::*;
 
+    /// The elegansbot kymogram `file` of `scripts/fetch_worm_data.sh`, if it is there. A test
+    /// that needs it fails without it, unless `COSSERAT_SKIP_WORM_DATA` is set (local work only;
+    /// CI never sets it: a test that passes without its data would prove nothing), in which case
+    /// it says so and is skipped (`None`). The integration tests' `common::worm_data_present`
+    /// follows the same rule.
+    pub(crate) fn worm_data(file: &str) -> Option<std::path::PathBuf> {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("data/elegansbot").join(file);
+        if path.is_file() {
+            return Some(path);
+        }
+        if std::env::var_os("COSSERAT_SKIP_WORM_DATA").is_none() {
+            panic!("{} is missing: run scripts/fetch_worm_data.sh (or set COSSERAT_SKIP_WORM_DATA=1)", path.display());
+        }
+        eprintln!("SKIPPED (COSSERAT_SKIP_WORM_DATA is set): {} is missing", path.display());
+        None
+    }
+
     /// Discrete (Menger) curvature at the interior nodes [1/m].
     pub(crate) fn menger_curvature(p: &[Vector3<f64>]) -> Vec<f64> {
         p.windows(3)

@@ -147,14 +147,14 @@ fn malformed_recordings_name_file_frame_node_and_row() {
     assert!(e.contains("fortran.npy") && e.contains("Fortran-order"), "{e}");
 }
 
-/// The real clips of `scripts/fetch_worm_data.sh`; skipped with a notice when absent.
+/// The real clips of `scripts/fetch_worm_data.sh` (`crate::clip::tests::worm_data`).
 #[test]
 fn elegansbot_clips_load_when_fetched() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/elegansbot");
-    if !dir.is_dir() {
-        println!("SKIPPED: {} is absent (run scripts/fetch_worm_data.sh)", dir.display());
+    let Some(dir) =
+        crate::clip::tests::worm_data("kymogram_omega-turn.npy").and_then(|p| p.parent().map(Path::to_path_buf))
+    else {
         return;
-    }
+    };
     for (name, frames) in [("kymogram_omega-turn.npy", 600), ("kymogram_delta-turn.npy", 300)] {
         let path = dir.join(name);
         let raw = read_npy(&path).unwrap();
@@ -350,15 +350,11 @@ fn ratio_in(e: &str) -> f64 {
 /// `cosserat synth`'s recordings (1 mm body, 100 frames, seed 11) at every noise level from 0
 /// to 10 µm, at 33 and 128 nodes, pass the length check (the raw polyline at 10 µm is 35 % and
 /// 240 % too long); the same recordings in mm read as m, or on a rod of 0.5× or 1.2× their
-/// length, are refused. Skipped with a notice without the elegansbot data.
+/// length, are refused. Needs the elegansbot data (`crate::clip::tests::worm_data`).
 #[test]
 fn synthetic_recordings_pass_the_length_check_at_any_noise() {
     use crate::engine::input::corpus::{recording_path, write_corpus, CorpusParams};
-    let kymogram = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/elegansbot/kymogram_omega-turn.npy");
-    if !kymogram.is_file() {
-        println!("SKIPPED: {} is absent (run scripts/fetch_worm_data.sh)", kymogram.display());
-        return;
-    }
+    let Some(kymogram) = crate::clip::tests::worm_data("kymogram_omega-turn.npy") else { return };
     let dir = tempfile::tempdir().unwrap();
     for nodes in [33usize, 128] {
         for noise_m in [0.0, 0.3e-6, 1e-6, 3e-6, 10e-6] {
