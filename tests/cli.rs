@@ -402,3 +402,26 @@ fn every_flag_the_readme_names_is_in_the_help() {
     }
     assert!(checked > 30, "only {checked} flags found in the README");
 }
+
+/// `--jobs` is bounded: 0 and more than `MAX_JOBS` are refused before anything runs, with the
+/// range in the message (a batch once started 5,000 threads for `--jobs 100000`).
+#[test]
+fn jobs_outside_one_to_the_maximum_are_refused() {
+    let max = cosserat::jobs::MAX_JOBS;
+    let dir = tempfile::tempdir().expect("tempdir");
+    for given in ["0".to_string(), (max + 1).to_string(), "100000".into(), "many".into()] {
+        for args in [
+            vec!["sweep", "cases/cantilever_dynamic.toml", "--set", "solver.dt_s=[1e-3]", "--jobs", &given],
+            vec!["audit", "--quick", "--jobs", &given],
+            vec!["batch", "cases/batch/roll_recording.toml", "--recordings", "data", "--jobs", &given],
+        ] {
+            let out = dir.path().join("out");
+            let mut c = cosserat();
+            c.args(&args).arg("--out").arg(&out);
+            c.assert().code(2).stderr(predicate::str::contains(format!(
+                "expected a number of parallel runs from 1 to {max}, got `{given}`"
+            )));
+            assert!(!out.exists(), "{args:?}: nothing is written");
+        }
+    }
+}

@@ -351,7 +351,7 @@ pub fn run_audit(
     jobs.sort_by_key(|j| j.case.clip().is_none());
     let total = jobs.len();
     let done = std::sync::atomic::AtomicUsize::new(0);
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(opts.jobs).build().ok();
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(crate::jobs::threads_for(opts.jobs, total)).build().ok();
     let work = || -> Vec<(usize, String, PointResult)> {
         jobs.par_iter()
             .map(|j| {

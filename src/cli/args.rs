@@ -154,8 +154,8 @@ pub struct SweepArgs {
     pub force: bool,
     #[command(flatten)]
     pub limits: Limits,
-    /// Parallel runs [default: number of cores]
-    #[arg(long)]
+    /// Parallel runs, 1 to 256 [default: number of cores; never more than the runs]
+    #[arg(long, value_parser = super::parse_jobs)]
     pub jobs: Option<usize>,
     /// Do not show progress (a bar on a terminal, else a line every 10 s)
     #[arg(long)]
@@ -176,8 +176,8 @@ pub struct AuditArgs {
     /// Replace the output directory even if it holds files but no run.json
     #[arg(long)]
     pub force: bool,
-    /// Parallel runs [default: number of cores]
-    #[arg(long)]
+    /// Parallel runs, 1 to 256 [default: number of cores; never more than the runs]
+    #[arg(long, value_parser = super::parse_jobs)]
     pub jobs: Option<usize>,
     /// Do not show progress (a bar on a terminal, else a line every 10 s)
     #[arg(long)]

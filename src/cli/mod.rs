@@ -20,6 +20,7 @@ use args::OutputFormatArg;
 use cosserat::jobs::batch::{self, gather, list_recordings, run_batch, BatchRow, Plan, SUMMARY};
 use cosserat::jobs::batch_task::run_task;
 use cosserat::jobs::slurm;
+use cosserat::jobs::MAX_JOBS;
 
 use progress::Progress;
 
@@ -35,8 +36,8 @@ pub struct BatchArgs {
     /// Output folder: one folder per recording, summary.csv, batch.json (the plan)
     #[arg(long)]
     out: PathBuf,
-    /// Recordings run at once [default: number of cores]
-    #[arg(long)]
+    /// Recordings run at once, 1 to 256 [default: number of cores; never more than the recordings]
+    #[arg(long, value_parser = parse_jobs)]
     jobs: Option<usize>,
     /// `--slurm` and the options of the Slurm job array
     #[command(flatten)]
@@ -294,6 +295,17 @@ pub enum CountError {
     /// `--frames` of `cosserat compare`
     #[error("expected a number of frames >= 1 or `all`, got `{given}`")]
     Frames { given: String },
+    /// `--jobs` of `batch`, `sweep` and `audit`
+    #[error("expected a number of parallel runs from 1 to {MAX_JOBS}, got `{given}`")]
+    Jobs { given: String },
+}
+
+/// `--jobs`: 1 to [`MAX_JOBS`] (the threads are also never more than the work's items).
+pub fn parse_jobs(s: &str) -> Result<usize, CountError> {
+    match s.parse::<usize>() {
+        Ok(n) if (1..=MAX_JOBS).contains(&n) => Ok(n),
+        _ => Err(CountError::Jobs { given: s.to_string() }),
+    }
 }
 
 /// `--count`: a positive number.

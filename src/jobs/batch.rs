@@ -484,13 +484,16 @@ pub fn unfinished_tasks(plan: &Plan, complete: &[bool]) -> Vec<usize> {
     (0..plan.tasks()).filter(|&t| complete.chunks(plan.per_task).nth(t).is_some_and(|c| c.iter().any(|d| !d))).collect()
 }
 
-/// Run every recording of the plan in `out` on `jobs` threads (0: one per core), then write
+/// Run every recording of the plan in `out` on `jobs` threads (0: one per core; never more than
+/// the recordings, nor [`super::MAX_JOBS`]), then write
 /// `summary.csv`; `tick` after each recording. Rows in the plan's order.
 pub fn run_batch(plan: &Plan, out: &Path, jobs: usize, tick: impl Fn() + Sync) -> Result<Vec<Ran>, BatchError> {
     use rayon::prelude::*;
     let (case, case_file) = plan_case(plan)?;
-    let pool =
-        rayon::ThreadPoolBuilder::new().num_threads(jobs).build().map_err(|e| BatchError::Pool(e.to_string()))?;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(super::threads_for(jobs, plan.recordings.len()))
+        .build()
+        .map_err(|e| BatchError::Pool(e.to_string()))?;
     let ran: Vec<Ran> = pool.install(|| {
         plan.recordings
             .par_iter()

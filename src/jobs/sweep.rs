@@ -153,7 +153,8 @@ fn finish_point(dir: &Path, template: &Manifest, case: &Case, outcome: Solved) -
 }
 
 /// Run every point of a sweep of `case` (`points`: the grid of `case::sweep::product`, swept
-/// `keys`) in parallel on `jobs` threads (0: one per core), each into its folder under `dir`
+/// `keys`) in parallel on `jobs` threads (0: one per core; at most one per point and
+/// [`super::MAX_JOBS`]), each into its folder under `dir`
 /// ([`run_point`]), then write `summary.csv` and `convergence.svg`; `tick` after each point.
 /// Two points with the same folder name are refused (they would write into one folder).
 pub fn sweep_into(
@@ -174,7 +175,8 @@ pub fn sweep_into(
             });
         }
     }
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(jobs).build().map_err(|e| OutputError::Invalid {
+    let threads = super::threads_for(jobs, points.len());
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().map_err(|e| OutputError::Invalid {
         path: dir.to_path_buf(),
         reason: format!("cannot start the thread pool: {e}"),
     })?;
