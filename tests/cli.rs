@@ -425,3 +425,42 @@ fn jobs_outside_one_to_the_maximum_are_refused() {
         }
     }
 }
+
+/// Messages of everyday mistakes: `-` is the standard input; a case given to `audit` or
+/// `noise-study` is named a case; a tiny memory limit keeps its digits; a huge generated
+/// expression gives a line, not the expression.
+#[test]
+fn everyday_mistakes_get_messages_that_say_what_happened() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let case = std::fs::read_to_string("cases/timoshenko_5pct.toml").expect("case");
+    let out = dir.path().join("stdin");
+    cosserat().args(["run", "-", "--quiet", "--out"]).arg(&out).write_stdin(case.clone()).assert().success();
+    assert!(out.join("run.json").is_file(), "`run -` reads the case from the standard input");
+
+    for (command, what) in [("audit", "not an audit spec"), ("noise-study", "not a noise study spec")] {
+        cosserat()
+            .args([command, "cases/timoshenko_5pct.toml", "--out"])
+            .arg(dir.path().join(command))
+            .assert()
+            .failure()
+            .stderr(predicate::str::contains(format!("this is a case file ([rod], [solver]), {what}")));
+    }
+
+    cosserat()
+        .args(["run", "cases/cantilever_dynamic.toml", "--max-memory-gib", "0.001", "--out"])
+        .arg(dir.path().join("mem"))
+        .assert()
+        .failure()
+        .stderr(predicate::str::contains("above the limit of 1.00e-3 GiB"));
+
+    let deep = format!("{}1{}", "(".repeat(100_000), ")".repeat(99_999));
+    let text = case.replacen("[constants]\n", &format!("[constants]\nDEEP = \"{deep}\"\n"), 1);
+    assert_ne!(text, case);
+    let file = dir.path().join("deep.toml");
+    std::fs::write(&file, text).expect("case");
+    let out = cosserat().arg("run").arg(&file).arg("--out").arg(dir.path().join("deep")).output().expect("run");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(stderr.contains("(an expression of 200000 characters)") && stderr.contains("nested more than"), "{stderr}");
+    assert!(stderr.len() < 1000, "a line, not the expression: {} bytes", stderr.len());
+}

@@ -391,8 +391,17 @@ impl Spec {
 /// Read and validate a spec; `quick`: apply the runs' `quick_set` and `quick_grid`.
 pub fn read_spec(path: &Path, quick: bool) -> Result<Spec, SpecError> {
     let text = read_capped_text(path, SPEC_FILE_CAP_BYTES, "audit spec")?;
-    let raw: RawSpec =
-        toml::from_str(&text).map_err(|e| SpecError::Syntax { path: path.to_path_buf(), message: e.to_string() })?;
+    let raw: RawSpec = toml::from_str(&text).map_err(|e| SpecError::Syntax {
+        path: path.to_path_buf(),
+        message: match crate::case::is_case_text(&text) {
+            true => format!(
+                "this is a case file ([rod], [solver]), not an audit spec: `cosserat run {}` runs it; `cosserat \
+                 audit` takes specs of claims and runs (cases/paper/*.toml)",
+                path.display()
+            ),
+            false => e.to_string(),
+        },
+    })?;
     let runs = raw.runs.into_iter().map(|(name, r)| read_run(path, name, r, quick)).collect::<Result<Vec<_>, _>>()?;
     let mut claims: Vec<Claim> = Vec::new();
     for c in raw.claims {

@@ -61,6 +61,15 @@ pub enum CaseError {
 
 /// Largest case file read [bytes]: 1 MiB. The committed cases and audit specs are 1–11 KiB
 /// (the largest, `cases/paper/sec6_worm.toml`, 11 037 bytes), so the cap is ~100× above any
+/// Is `text` a case file (TOML with `[rod]` and `[solver]`)? For the readers of other files (audit
+/// and study specs) to say "this is a case" rather than name the first key they do not know.
+pub fn is_case_text(text: &str) -> bool {
+    text.parse::<toml::Table>().is_ok_and(|t| t.contains_key("rod") && t.contains_key("solver"))
+}
+
+/// The file a case named `-` is read from (`cosserat run - < case.toml`).
+pub const STANDARD_INPUT: &str = "/dev/stdin";
+
 /// real case and stops `cosserat run /dev/zero` at once instead of reading forever.
 pub const CASE_FILE_CAP_BYTES: u64 = 1 << 20;
 
@@ -332,6 +341,8 @@ impl Case {
 
     /// Read and validate a case file (at most [`CASE_FILE_CAP_BYTES`]).
     pub fn from_file(path: &Path) -> Result<Case, CaseError> {
+        // `-`: the standard input, as the shell's convention has it
+        let path = if path == Path::new("-") { Path::new(STANDARD_INPUT) } else { path };
         let text = file::read_case_file(path)?;
         let name = path.file_stem().and_then(|s| s.to_str()).unwrap_or("case").to_string();
         let mut case = Case::from_toml(&text, &name, path)?;

@@ -574,5 +574,20 @@ pub(super) fn syntax_in_words(text: &str, e: &ExprError) -> String {
         }
         _ => "",
     };
-    format!("`{text}`: {e}{hint}")
+    format!("{}: {e}{hint}", quoted(text))
+}
+
+/// Longest expression quoted whole in a message [characters]; a longer one is quoted by its
+/// start and its length (a generated expression can be megabytes: its error stays a line).
+const QUOTE_CHARS: usize = 120;
+
+/// `text` in backquotes for a message: whole up to [`QUOTE_CHARS`] characters, else its first
+/// ones, an ellipsis and its length.
+pub(super) fn quoted(text: &str) -> String {
+    let n = text.chars().count();
+    if n <= QUOTE_CHARS {
+        return format!("`{text}`");
+    }
+    let head: String = text.chars().take(QUOTE_CHARS / 2).collect();
+    format!("`{head}…` (an expression of {n} characters)")
 }

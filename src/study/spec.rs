@@ -94,8 +94,17 @@ impl StudySpec {
     pub fn read(path: &Path) -> Result<Self, SpecError> {
         let text = crate::io::files::read_capped_text(path, 1 << 20, "noise study spec")
             .map_err(|source| SpecError::Read { path: path.into(), source })?;
-        let mut spec: StudySpec =
-            toml::from_str(&text).map_err(|e| SpecError::Parse { path: path.into(), message: e.to_string() })?;
+        let mut spec: StudySpec = toml::from_str(&text).map_err(|e| SpecError::Parse {
+            path: path.into(),
+            message: match crate::case::is_case_text(&text) {
+                true => format!(
+                    "this is a case file ([rod], [solver]), not a noise study spec: `cosserat run {}` runs it; \
+                     `cosserat noise-study` takes a spec such as cases/bench/noise_study.toml",
+                    path.display()
+                ),
+                false => e.to_string(),
+            },
+        })?;
         let dir = path.parent().unwrap_or(Path::new("."));
         spec.kymogram = dir.join(&spec.kymogram);
         spec.meshes.iter_mut().for_each(|m| m.case = dir.join(&m.case));

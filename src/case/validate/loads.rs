@@ -36,7 +36,7 @@ impl Validator<'_> {
         } else {
             ""
         };
-        format!("unknown name `{var}` in `{text}`{why}; allowed names: {}", self.allowed_names(vars))
+        format!("unknown name `{var}` in {}{why}; allowed names: {}", super::quoted(text), self.allowed_names(vars))
     }
 
     /// The names an expression of the variables `vars` may use: `vars`, `pi` and the constants.

@@ -49,7 +49,10 @@ fn limit_text(limit: f64, address_space: bool, key: &str) -> String {
             limit / (1024.0 * 1024.0)
         )
     } else {
-        format!("the limit of {:.1} GiB; reduce {key} or raise the limit with --max-memory-gib", limit / GIB)
+        // a limit below 0.1 GiB with its digits (0.001 GiB printed as "0.0 GiB" read as no limit)
+        let gib = limit / GIB;
+        let gib = if gib >= 0.1 { format!("{gib:.1}") } else { format!("{gib:.2e}") };
+        format!("the limit of {gib} GiB; reduce {key} or raise the limit with --max-memory-gib")
     }
 }
 
