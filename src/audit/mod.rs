@@ -20,6 +20,7 @@ use serde::Deserialize;
 use crate::case::sweep::{product, Point, SweepError};
 use crate::io::compact::OutputFormat;
 use crate::jobs::sweep::{point_manifest, run_clip_point, run_point, SweepOutcome};
+use crate::output::manifest::Status;
 use measures::{derived_metrics, ClipRecorder, ClipSeries};
 use spec::{Claim, RunSpec, Spec};
 
@@ -141,7 +142,9 @@ pub struct ClaimResult {
     pub figure: Option<String>,
 }
 
-/// How far an audit got. Only a complete audit's verdicts are the audit's; an unfinished one
+/// How far an audit got (the audit as a whole; each of its points ends with an
+/// [`crate::solve::Outcome`], and a claim is judged with a [`Verdict`], neither an outcome of
+/// this kind). Only a complete audit's verdicts are the audit's; an unfinished one
 /// judges the claims whose points all finished and marks the others *not judged*.
 #[derive(Clone, Debug, PartialEq)]
 pub enum AuditStatus {
@@ -153,12 +156,18 @@ pub enum AuditStatus {
 }
 
 impl AuditStatus {
-    pub fn as_str(&self) -> &'static str {
+    /// The state of the audit's folder (`run.json`): complete, interrupted or failed.
+    pub fn folder_status(&self) -> Status {
         match self {
-            AuditStatus::Complete => "complete",
-            AuditStatus::Interrupted => "interrupted",
-            AuditStatus::Failed(_) => "failed",
+            AuditStatus::Complete => Status::Complete,
+            AuditStatus::Interrupted => Status::Interrupted,
+            AuditStatus::Failed(_) => Status::Failed,
         }
+    }
+
+    /// The word of the folder's state.
+    pub fn as_str(&self) -> &'static str {
+        self.folder_status().as_str()
     }
 }
 

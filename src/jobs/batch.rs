@@ -14,7 +14,7 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use super::solved::{chain, solve_into, RunStatus};
+use super::solved::{chain, solve_into};
 use crate::case::{Analysis, Case, CaseError, DataSource};
 use crate::engine::clip_metrics::clip_metrics;
 use crate::engine::input::truth_file::{is_truth_sidecar, truth_sidecar};
@@ -25,11 +25,14 @@ use crate::output::clip_run::ClipOptions;
 use crate::output::run_folder::{
     input_file_as, sha256_file, FolderError, InputFile, Manifest, Mode, RunFolder, Status,
 };
+use crate::solve::Outcome;
 
 /// The plan of a batch in its output folder.
 pub const PLAN: &str = "batch.json";
 /// The summary row of a recording in its folder.
 pub const ROW: &str = "batch_row.json";
+/// The `status` of a recording gathered before its task ran (it has no outcome).
+pub const MISSING: &str = "missing";
 /// The summary table in the output folder.
 pub const SUMMARY: &str = "summary.csv";
 
@@ -121,8 +124,9 @@ pub struct Plan {
 pub struct BatchRow {
     pub recording: String,
     pub folder: String,
-    /// `ok`, `failed`, `interrupted`, or `missing` (gathered before its task ran)
-    pub status: String,
+    /// how the recording's run ended; `None`: `missing` in the summary (gathered before its
+    /// task ran; never in a `batch_row.json`)
+    pub status: Option<Outcome>,
     /// converged frames
     pub frames: Option<usize>,
     pub newton_iterations_per_frame: Option<f64>,
@@ -151,11 +155,11 @@ pub struct BatchRow {
 }
 
 impl BatchRow {
-    fn without_result(entry: &PlanEntry, status: &str, reason: String) -> Self {
+    fn without_result(entry: &PlanEntry, status: Option<Outcome>, reason: String) -> Self {
         BatchRow {
             recording: entry.path.display().to_string(),
             folder: entry.folder.clone(),
-            status: status.into(),
+            status,
             frames: None,
             newton_iterations_per_frame: None,
             certificate_max: None,
@@ -170,8 +174,13 @@ impl BatchRow {
         }
     }
 
+    /// The word of the summary's `status` column: the outcome's, or `missing`.
+    pub fn status_word(&self) -> &'static str {
+        self.status.map_or(MISSING, Outcome::as_str)
+    }
+
     pub fn is_ok(&self) -> bool {
-        self.status == RunStatus::Ok.as_str() || self.status == RunStatus::Warnings.as_str()
+        self.status.is_some_and(Outcome::is_complete)
     }
 }
 
@@ -379,7 +388,7 @@ pub fn run_recording(case: &Case, case_file: &InputFile, entry: &PlanEntry, out:
     let failed = |reason: String| Ran {
         row: BatchRow {
             wall_time_s: start.elapsed().as_secs_f64(),
-            ..BatchRow::without_result(entry, RunStatus::Failed.as_str(), reason)
+            ..BatchRow::without_result(entry, Some(Outcome::Failed), reason)
         },
         skipped: false,
     };
@@ -391,7 +400,7 @@ pub fn run_recording(case: &Case, case_file: &InputFile, entry: &PlanEntry, out:
         return Ran { row, skipped: true };
     }
     if crate::interrupt::requested() {
-        let row = BatchRow::without_result(entry, RunStatus::Interrupted.as_str(), NOT_STARTED.into());
+        let row = BatchRow::without_result(entry, Some(Outcome::Interrupted), NOT_STARTED.into());
         return Ran { row, skipped: false };
     }
     let case = match with_recording(case, &entry.path) {
@@ -421,7 +430,7 @@ pub fn run_recording(case: &Case, case_file: &InputFile, entry: &PlanEntry, out:
     let row = BatchRow {
         recording: entry.path.display().to_string(),
         folder: entry.folder.clone(),
-        status: solved.status.as_str().into(),
+        status: Some(solved.status),
         frames: solved.frames.map(|f| f.0),
         newton_iterations_per_frame: get("iterations_mean"),
         certificate_max: get("certificate"),
@@ -442,7 +451,7 @@ pub fn run_recording(case: &Case, case_file: &InputFile, entry: &PlanEntry, out:
         .map_err(|e| OutputError::Invalid { path: folder.dir().join(ROW), reason: e.to_string() })
         .and_then(|bytes| write_atomic(&folder.dir().join(ROW), &bytes));
     let (status, message) = match written {
-        Ok(()) => (solved.status.folder_status(), solved.error),
+        Ok(()) => (solved.status.into(), solved.error),
         Err(e) => (Status::Failed, Some(chain(&e))),
     };
     if let Err(e) = folder.finish(status, message.clone()) {
@@ -519,7 +528,7 @@ pub fn gather(out: &Path) -> Result<Vec<BatchRow>, BatchError> {
                 Some(row) => row,
                 None => BatchRow::without_result(
                     e,
-                    "missing",
+                    None,
                     format!("{} holds no result: its task has not run, or stopped (see slurm/)", path.display()),
                 ),
             }
@@ -539,7 +548,7 @@ pub fn summary_csv(rows: &[BatchRow]) -> Result<String, csv::Error> {
         w.write_record([
             r.recording.clone(),
             r.folder.clone(),
-            r.status.clone(),
+            r.status_word().into(),
             r.frames.map(|f| f.to_string()).unwrap_or_default(),
             num(r.newton_iterations_per_frame),
             num(r.certificate_max),

@@ -5,7 +5,7 @@
 //! of `run` on a clip, its row the metrics of `engine::clip_metrics`).
 use std::path::Path;
 
-pub use super::solved::{case_label, chain, RunStatus, Solved as SweepOutcome};
+pub use super::solved::{case_label, chain, Solved as SweepOutcome};
 use super::solved::{solve_into, Solved};
 use crate::case::sweep::Point;
 use crate::case::Case;
@@ -15,6 +15,7 @@ use crate::engine::{Engine, RunResult};
 use crate::io::files::OutputError;
 use crate::output::clip_run::ClipOptions;
 use crate::output::run_folder::Manifest;
+use crate::solve::Outcome;
 
 /// Columns of the summary table after the swept keys.
 pub const SUMMARY_METRICS: [&str; 12] = [
@@ -39,7 +40,7 @@ pub struct SummaryRow {
     /// the point's folder name
     pub name: String,
     pub point: Point,
-    pub status: RunStatus,
+    pub status: Outcome,
     pub metrics: Option<Metrics>,
     pub error: Option<String>,
 }
@@ -146,7 +147,7 @@ fn finish_point(dir: &Path, template: &Manifest, case: &Case, outcome: Solved) -
     if let Some(c) = &outcome.clip {
         m.frames.frames_done = Some(c.reports.len());
     }
-    match m.finish(dir, outcome.status.folder_status(), outcome.error.clone()) {
+    match m.finish(dir, outcome.status.into(), outcome.error.clone()) {
         Ok(()) => outcome,
         Err(e) => Solved::failed(chain(&e)),
     }
@@ -215,7 +216,7 @@ pub fn sweep_into(
 /// A point that a stop request kept from starting says so (its row, no folder).
 fn not_started(outcome: Solved) -> Solved {
     match outcome.status {
-        RunStatus::Interrupted => Solved { error: Some(NOT_STARTED.into()), ..outcome },
+        Outcome::Interrupted => Solved { error: Some(NOT_STARTED.into()), ..outcome },
         _ => outcome,
     }
 }
@@ -257,21 +258,21 @@ mod tests {
             SummaryRow {
                 name: String::new(),
                 point: vec![("lambda_l".into(), 1e-20.into())],
-                status: RunStatus::Ok,
+                status: Outcome::Converged,
                 metrics: Some(m.clone()),
                 error: None,
             },
             SummaryRow {
                 name: String::new(),
                 point: vec![("lambda_l".into(), 1e3.into())],
-                status: RunStatus::NotConverged,
+                status: Outcome::IterationLimit,
                 metrics: Some(m),
                 error: Some("did not converge,\nat all".into()),
             },
             SummaryRow {
                 name: String::new(),
                 point: vec![("lambda_l".into(), 1.0.into())],
-                status: RunStatus::Failed,
+                status: Outcome::Failed,
                 metrics: None,
                 error: Some("bad".into()),
             },
