@@ -4,6 +4,7 @@
 //! report's text changes only when a result does.
 use super::spec::{Check, Claim, Ref, Selector, Spec};
 use super::{ClaimResult, PointResult, RunResults, Verdict};
+use crate::engine::metrics::Metric;
 use crate::jobs::sweep::NOT_STARTED;
 use crate::solve;
 
@@ -75,9 +76,9 @@ fn failure(p: &PointResult) -> String {
     let e = p.outcome.error.as_deref().unwrap_or("no result");
     match p.outcome.status {
         solve::Outcome::IterationLimit | solve::Outcome::Stalled => {
-            let its = p.metric("iterations").map(|i| format!(" after {}", sig2(i))).unwrap_or_default();
-            let x = p.metric("x_err_rel").map(|x| format!(", x error {}", sig2(x))).unwrap_or_default();
-            let c = p.metric("certificate").map(|c| format!(", certificate {}", sig2(c))).unwrap_or_default();
+            let its = p.value(Metric::Iterations).map(|i| format!(" after {}", sig2(i))).unwrap_or_default();
+            let x = p.value(Metric::XErrRel).map(|x| format!(", x error {}", sig2(x))).unwrap_or_default();
+            let c = p.value(Metric::Certificate).map(|c| format!(", certificate {}", sig2(c))).unwrap_or_default();
             let word = if p.outcome.status == solve::Outcome::Stalled { "stalled" } else { "not converged" };
             format!("{word}{its} iterations{x}{c}")
         }

@@ -101,9 +101,14 @@ impl PointResult {
     pub fn converged(&self) -> bool {
         self.outcome.status.is_complete()
     }
-    /// A metric of the point (its run's metrics with [`measures::derived_metrics`]).
+    /// A metric of the point by the name a spec gives (its run's metrics with
+    /// [`measures::derived_metrics`]).
     pub fn metric(&self, name: &str) -> Option<f64> {
-        self.outcome.metrics.as_ref().and_then(|m| m.get(name)).copied()
+        self.outcome.metrics.as_ref().and_then(|m| m.named(name))
+    }
+    /// A metric of the point's run.
+    pub fn value(&self, key: crate::engine::metrics::Metric) -> Option<f64> {
+        self.outcome.metrics.as_ref().and_then(|m| m.get(key))
     }
     /// Does the point have these grid values?
     pub fn matches(&self, at: &spec::Selector) -> bool {
@@ -519,11 +524,10 @@ fn check_metric_name(spec: &Spec, claim: &Claim, runs: &[RunResults]) -> Result<
         let Some(rr) = runs.iter().find(|r| r.name == run) else { continue };
         let reported: Vec<&crate::engine::metrics::Metrics> =
             rr.points.iter().filter_map(|p| p.outcome.metrics.as_ref()).collect();
-        if reported.is_empty() || reported.iter().any(|m| m.contains_key(metric)) {
+        if reported.is_empty() || reported.iter().any(|m| m.named(metric).is_some()) {
             continue;
         }
-        let known: std::collections::BTreeSet<&str> =
-            reported.iter().flat_map(|m| m.keys().map(String::as_str)).collect();
+        let known: std::collections::BTreeSet<&str> = reported.iter().flat_map(|m| m.names()).collect();
         return Err(AuditError::UnknownMetric {
             path: spec.path.clone(),
             claim: claim.id.clone(),

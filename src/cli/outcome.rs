@@ -4,6 +4,7 @@
 use std::path::Path;
 
 use cosserat::case::Case;
+use cosserat::engine::metrics::Metric;
 use cosserat::engine::Engine;
 use cosserat::output::run_folder::{Manifest, Status};
 use cosserat::solve::Outcome;
@@ -31,7 +32,9 @@ pub fn sweep_interrupted_summary(rows: &[cosserat::jobs::sweep::SummaryRow], tar
         rows.iter().filter(|r| r.status == Outcome::Interrupted && r.error.as_deref() != Some(NOT_STARTED)).collect();
     let frames: Vec<String> = stopped
         .iter()
-        .filter_map(|r| r.metrics.as_ref().and_then(|m| m.get("frames")).map(|f| format!("{} {f} frames", r.name)))
+        .filter_map(|r| {
+            r.metrics.as_ref().and_then(|m| m.get(Metric::Frames)).map(|f| format!("{} {f} frames", r.name))
+        })
         .collect();
     let ok = rows.iter().filter(|r| r.status == Outcome::Converged).count();
     format!(

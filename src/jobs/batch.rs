@@ -18,6 +18,7 @@ use super::solved::{chain, solve_into};
 use crate::case::{Analysis, Case, CaseError, DataSource};
 use crate::engine::clip_metrics::clip_metrics;
 use crate::engine::input::truth_file::{is_truth_sidecar, truth_sidecar};
+use crate::engine::metrics::Metric;
 use crate::engine::Engine;
 use crate::io::compact::OutputFormat;
 use crate::io::files::{write_atomic, OutputError};
@@ -424,7 +425,7 @@ pub fn run_recording(case: &Case, case_file: &InputFile, entry: &PlanEntry, out:
         return failed(format!("{}: {}", crate::io::disk::full_text(&dir), solved.error.unwrap_or_default()));
     }
     let metrics = solved.clip.as_ref().filter(|c| !c.reports.is_empty()).map(|c| clip_metrics(&case, c));
-    let get = |k: &str| metrics.as_ref().and_then(|m| m.get(k)).copied();
+    let get = |k: Metric| metrics.as_ref().and_then(|m| m.get(k));
     let weights = solved.clip.as_ref().and_then(|c| c.weights);
     folder.manifest.weights = weights;
     let row = BatchRow {
@@ -432,10 +433,10 @@ pub fn run_recording(case: &Case, case_file: &InputFile, entry: &PlanEntry, out:
         folder: entry.folder.clone(),
         status: Some(solved.status),
         frames: solved.frames.map(|f| f.0),
-        newton_iterations_per_frame: get("iterations_mean"),
-        certificate_max: get("certificate"),
-        fit_position_rel_length_max: get("fit_position_rel_length_max"),
-        curvature_err_rel_max: get("truth_bending_err_rel_max"),
+        newton_iterations_per_frame: get(Metric::IterationsMean),
+        certificate_max: get(Metric::Certificate),
+        fit_position_rel_length_max: get(Metric::FitPositionRelLengthMax),
+        curvature_err_rel_max: get(Metric::TruthBendingErrRelMax),
         noise_m: weights.map(|w| w.noise_m),
         lambda_g: weights.map(|w| w.lambda_g),
         length_m: Some(case.mesh.length_m),

@@ -9,7 +9,7 @@ use crate::case::Case;
 use crate::clip::missing::MIN_TRACKED;
 use crate::engine::clip::{ClipFrame, ClipRun};
 use crate::engine::clip_metrics::clip_metrics;
-use crate::engine::metrics::{all_metrics, Metrics};
+use crate::engine::metrics::{all_metrics, Metric, Metrics};
 use crate::engine::{run_case, run_inverse_on, stage_data, EngineError};
 use crate::engine::{Engine, RunError, RunResult};
 use crate::output::clip_output::remove_raw;
@@ -44,7 +44,7 @@ impl Solved {
     /// `certificate` metric (a clip's: the largest of its frames) against the case's tolerance.
     pub fn certificate(&self, case: &Case) -> Option<CertificateSummary> {
         let value = match (&self.metrics, &self.single, &self.clip) {
-            (Some(m), _, _) if m.contains_key("certificate") => m["certificate"],
+            (Some(m), _, _) if m.contains(Metric::Certificate) => m.get(Metric::Certificate)?,
             (_, Some(r), _) => r.stats.certificate?,
             (_, _, Some(c)) if !c.reports.is_empty() => c.reports.iter().map(|r| r.certificate).fold(0.0, f64::max),
             _ => return None,
@@ -165,8 +165,8 @@ fn solve_single(case: &Case, engine: Engine, dir: &Path, progress: impl FnMut(us
 /// The warning of a static result that is not stable (D27): the smallest eigenvalue `μ` of its
 /// tangent against the unloaded rod's is not positive.
 fn unstable_message(case: &Case, m: &Metrics) -> Option<String> {
-    let w2 = *m.get("tangent_smallest_eigenvalue_per_s2")?;
-    (m.get("stable") == Some(&0.0)).then(|| {
+    let w2 = m.get(Metric::TangentSmallestEigenvalue)?;
+    (m.get(Metric::Stable) == Some(0.0)).then(|| {
         format!(
             "{}: UNSTABLE: the static state returned is not stable: the rod linearised about it has omega^2 = {w2:.4e} 1/s^2 < 0 (the smallest eigenvalue of its tangent against its mass, D27): the loads exceed a critical load and the rod would leave this state; follow the path with solver.continuation = \"arc_length\" (and an imperfection) for the buckled one",
             case_label(case)
