@@ -37,7 +37,7 @@ pub const MISSING: &str = "missing";
 /// The summary table in the output folder.
 pub const SUMMARY: &str = "summary.csv";
 
-/// Columns of `summary.csv`. `fit_position_rel_length_max` is the worst frame's position
+/// Columns of `summary.csv`, each with its text of a row. `fit_position_rel_length_max` is the worst frame's position
 /// misfit in body lengths, `((1/L) ∫ |x − x_g|²)^½ / L` (`solve::fit`): unlike `‖x − x_g‖/‖x_g‖`
 /// it does not depend on where the recording sits in space. `curvature_err_rel_max` is the
 /// worst frame's relative L² error of the bending `κ1² + κ2²` against the ground truth [–]
@@ -48,22 +48,27 @@ pub const SUMMARY: &str = "summary.csv";
 /// that differs between two runs of the same batch. `noise_m` [m] and `lambda_g` are the noise
 /// level and tracking weight `[inverse] weights = "auto"` chose (empty with fixed weights;
 /// `docs/noise.md`).
-pub const SUMMARY_COLUMNS: [&str; 14] = [
-    "recording",
-    "folder",
-    "status",
-    "frames",
-    "newton_iterations_per_frame",
-    "certificate_max",
-    "fit_position_rel_length_max",
-    "curvature_err_rel_max",
-    "length_m",
-    "length_spread_rel",
-    "noise_m",
-    "lambda_g",
-    "reason",
-    "wall_time_s",
+pub const SUMMARY_COLUMNS: [(&str, fn(&BatchRow) -> String); 14] = [
+    ("recording", |r| r.recording.clone()),
+    ("folder", |r| r.folder.clone()),
+    ("status", |r| r.status_word().into()),
+    ("frames", |r| r.frames.map(|f| f.to_string()).unwrap_or_default()),
+    ("newton_iterations_per_frame", |r| number(r.newton_iterations_per_frame)),
+    ("certificate_max", |r| number(r.certificate_max)),
+    ("fit_position_rel_length_max", |r| number(r.fit_position_rel_length_max)),
+    ("curvature_err_rel_max", |r| number(r.curvature_err_rel_max)),
+    ("length_m", |r| number(r.length_m)),
+    ("length_spread_rel", |r| number(r.length_spread_rel)),
+    ("noise_m", |r| number(r.noise_m)),
+    ("lambda_g", |r| number(r.lambda_g)),
+    ("reason", |r| r.reason.as_deref().unwrap_or("").replace('\n', " ")),
+    ("wall_time_s", |r| format!("{:.3}", r.wall_time_s)),
 ];
+
+/// A number of the summary: 10 significant digits, empty where it does not apply.
+fn number(v: Option<f64>) -> String {
+    v.map(|v| crate::io::number::exp(v, 10)).unwrap_or_default()
+}
 
 /// Errors of a batch as a whole (a recording's own failure is its row's, not one of these).
 #[derive(Debug, thiserror::Error)]
@@ -121,7 +126,7 @@ pub struct Plan {
 }
 
 /// The summary row of one recording.
-#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct BatchRow {
     pub recording: String,
     pub folder: String,
@@ -161,17 +166,8 @@ impl BatchRow {
             recording: entry.path.display().to_string(),
             folder: entry.folder.clone(),
             status,
-            frames: None,
-            newton_iterations_per_frame: None,
-            certificate_max: None,
-            fit_position_rel_length_max: None,
-            curvature_err_rel_max: None,
-            noise_m: None,
-            lambda_g: None,
-            length_m: None,
-            length_spread_rel: None,
             reason: Some(reason),
-            wall_time_s: 0.0,
+            ..BatchRow::default()
         }
     }
 
@@ -543,25 +539,9 @@ pub fn gather(out: &Path) -> Result<Vec<BatchRow>, BatchError> {
 /// where a value does not apply.
 pub fn summary_csv(rows: &[BatchRow]) -> Result<String, csv::Error> {
     let mut w = csv::Writer::from_writer(Vec::new());
-    w.write_record(SUMMARY_COLUMNS)?;
-    let num = |v: Option<f64>| v.map(|v| crate::io::number::exp(v, 10)).unwrap_or_default();
+    w.write_record(SUMMARY_COLUMNS.map(|(name, _)| name))?;
     for r in rows {
-        w.write_record([
-            r.recording.clone(),
-            r.folder.clone(),
-            r.status_word().into(),
-            r.frames.map(|f| f.to_string()).unwrap_or_default(),
-            num(r.newton_iterations_per_frame),
-            num(r.certificate_max),
-            num(r.fit_position_rel_length_max),
-            num(r.curvature_err_rel_max),
-            num(r.length_m),
-            num(r.length_spread_rel),
-            num(r.noise_m),
-            num(r.lambda_g),
-            r.reason.as_deref().unwrap_or("").replace('\n', " "),
-            format!("{:.3}", r.wall_time_s),
-        ])?;
+        w.write_record(SUMMARY_COLUMNS.map(|(_, text)| text(r)))?;
     }
     let bytes = w.into_inner().map_err(|e| csv::Error::from(e.into_error()))?;
     Ok(String::from_utf8_lossy(&bytes).into_owned())
@@ -583,6 +563,17 @@ mod tests {
         let p = |s: &str| PathBuf::from(s);
         let names = folder_names(&[p("/a/w 1.csv"), p("/b/w 1.npy"), p("/a/x.npy"), p("/c/W 1.npy"), p("/d/.npy")]);
         assert_eq!(names, ["w_1", "w_1-2", "x", "W_1-3", "rec.npy"]);
+    }
+
+    #[test]
+    fn summary_columns_and_a_missing_row() {
+        let entry = PlanEntry { path: PathBuf::from("/r/a.npy"), folder: "a".into() };
+        let row = BatchRow::without_result(&entry, None, "no\nresult".into());
+        let text = summary_csv(&[row]).unwrap();
+        assert_eq!(
+            text,
+            "recording,folder,status,frames,newton_iterations_per_frame,certificate_max,fit_position_rel_length_max,curvature_err_rel_max,length_m,length_spread_rel,noise_m,lambda_g,reason,wall_time_s\n/r/a.npy,a,missing,,,,,,,,,,no result,0.000\n"
+        );
     }
 
     #[test]
