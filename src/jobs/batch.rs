@@ -37,6 +37,9 @@ pub const MISSING: &str = "missing";
 /// The summary table in the output folder.
 pub const SUMMARY: &str = "summary.csv";
 
+/// A column of `summary.csv`: its name and its text of a row.
+pub type SummaryColumn = (&'static str, fn(&BatchRow) -> String);
+
 /// Columns of `summary.csv`, each with its text of a row. `fit_position_rel_length_max` is the worst frame's position
 /// misfit in body lengths, `((1/L) ∫ |x − x_g|²)^½ / L` (`solve::fit`): unlike `‖x − x_g‖/‖x_g‖`
 /// it does not depend on where the recording sits in space. `curvature_err_rel_max` is the
@@ -48,7 +51,7 @@ pub const SUMMARY: &str = "summary.csv";
 /// that differs between two runs of the same batch. `noise_m` [m] and `lambda_g` are the noise
 /// level and tracking weight `[inverse] weights = "auto"` chose (empty with fixed weights;
 /// `docs/noise.md`).
-pub const SUMMARY_COLUMNS: [(&str, fn(&BatchRow) -> String); 14] = [
+pub const SUMMARY_COLUMNS: [SummaryColumn; 14] = [
     ("recording", |r| r.recording.clone()),
     ("folder", |r| r.folder.clone()),
     ("status", |r| r.status_word().into()),
