@@ -185,7 +185,9 @@ fn lambda_kappa_one_is_solved() {
     let text = edit(&text, "tolerance = 3e-6", "tolerance = 1e-10");
     let small = edit(&text, "lambda_kappa = [0, 0, 1]", "lambda_kappa = [0, 0, 1e-10]");
     let reference = run_rust(&case_from(&small, "lk10"), |_, _| {}).expect("λκ3 = 1e-10");
-    let k_ref = cosserat::engine::metrics::inverse_metrics(&reference)["kappa_err_rel_inner"];
+    let k_ref = cosserat::engine::metrics::inverse_metrics(&reference)
+        .get(cosserat::engine::metrics::Metric::KappaErrRelInner)
+        .unwrap();
     for (label, t) in [
         ("selective", text.clone()),
         ("gauss2", edit(&text, "analysis = \"inverse\"", "analysis = \"inverse\"\nquadrature = \"gauss2\"")),
@@ -193,7 +195,9 @@ fn lambda_kappa_one_is_solved() {
         let r = run_rust(&case_from(&t, label), |_, _| {})
             .unwrap_or_else(|e| panic!("{label}: {}", common::error_chain(&e)));
         let c = r.stats.certificate.unwrap();
-        let k = cosserat::engine::metrics::inverse_metrics(&r)["kappa_err_rel_inner"];
+        let k = cosserat::engine::metrics::inverse_metrics(&r)
+            .get(cosserat::engine::metrics::Metric::KappaErrRelInner)
+            .unwrap();
         eprintln!(
             "λκ3 = 1, {label}: {} iterations, certificate {c:e}, κ error inner {k:.4} (λκ3 = 1e-10: {k_ref:.4})",
             r.stats.iterations

@@ -178,17 +178,17 @@ fn adjoint_gradient_matches_finite_differences() {
 /// 0.066 / 0.005). Asserted with a margin of about 1.5×.
 #[test]
 fn recovers_eq65_bend_and_twist_from_the_case_file() {
-    use cosserat::engine::metrics::inverse_metrics;
+    use cosserat::engine::metrics::{inverse_metrics, Metric};
     let case = case_from(&case_text("inverse_bend_twist"), "inverse_bend_twist");
     let (r, stop) = common::run_any(&case);
     assert!(matches!(stop, Some(cosserat::solve::SolveError::Stalled(_))), "{stop:?}");
     let m = inverse_metrics(&r);
     eprintln!("eq. 65 inverse: {m:?}");
-    assert!(m["x_err_rel"] < 1.5e-5, "{m:?}");
-    assert!(m["kappa_err_rel"] < 0.2 && m["kappa_err_rel_inner"] < 0.011, "{m:?}");
+    assert!(m[Metric::XErrRel] < 1.5e-5, "{m:?}");
+    assert!(m[Metric::KappaErrRel] < 0.2 && m[Metric::KappaErrRelInner] < 0.011, "{m:?}");
     // 3.7e-5: the λd blend of I13 (ε = 0.034 against 1e-3 before) weighs the within-element
     // variation of ∂s x − d3 more, and the misfit is measured by that blended rule
-    assert!(m["tangent_misfit_m05"] < 5e-5, "{m:?}");
+    assert!(m[Metric::TangentMisfit] < 5e-5, "{m:?}");
     // Each curvature component separately, away from the ends: the twist is recovered as well
     // as the bend. Measured max errors (fraction of max |κ_f|): see the printed line.
     let inv = r.inverse.as_ref().expect("inverse output");

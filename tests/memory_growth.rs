@@ -20,8 +20,9 @@ use cosserat::engine::input::truth_file::truth_sidecar;
 use cosserat::engine::Engine;
 use cosserat::io::compact::{OutputFormat, CURVATURE_COLUMNS, RAW_CURVATURE, RAW_FIELDS};
 use cosserat::io::compact_write::{write_compact, BLOCK_BYTES};
-use cosserat::jobs::solved::{solve_into, RunStatus};
+use cosserat::jobs::solved::solve_into;
 use cosserat::output::clip_run::ClipOptions;
+use cosserat::solve::Outcome;
 
 /// The system allocator, counting the bytes held now and their peak.
 struct Counting;
@@ -84,7 +85,7 @@ fn run(case: &Case, dir: &Path, format: OutputFormat) {
     let out = tempfile::tempdir_in(dir).expect("tempdir");
     let opts = ClipOptions { journal: true, resume: false, format };
     let solved = solve_into(case, Engine::Rust, out.path(), opts, |_| {}, |_, _| {});
-    assert!(matches!(solved.status, RunStatus::Ok | RunStatus::Warnings), "{:?}", solved.error);
+    assert!(matches!(solved.status, Outcome::Converged | Outcome::CompleteWithWarnings), "{:?}", solved.error);
 }
 
 /// The peaks [bytes] of the runs of `case_of(n)` and `case_of(m)` for `(n, m)` = `frames`.

@@ -4,7 +4,9 @@
 //! report's text changes only when a result does.
 use super::spec::{Check, Claim, Ref, Selector, Spec};
 use super::{ClaimResult, PointResult, RunResults, Verdict};
-use crate::jobs::sweep::{RunStatus, NOT_STARTED};
+use crate::engine::metrics::Metric;
+use crate::jobs::sweep::NOT_STARTED;
+use crate::solve;
 
 /// How far a check holds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -73,11 +75,11 @@ fn key_of(points: &[&PointResult]) -> String {
 fn failure(p: &PointResult) -> String {
     let e = p.outcome.error.as_deref().unwrap_or("no result");
     match p.outcome.status {
-        RunStatus::NotConverged | RunStatus::Stalled => {
-            let its = p.metric("iterations").map(|i| format!(" after {}", sig2(i))).unwrap_or_default();
-            let x = p.metric("x_err_rel").map(|x| format!(", x error {}", sig2(x))).unwrap_or_default();
-            let c = p.metric("certificate").map(|c| format!(", certificate {}", sig2(c))).unwrap_or_default();
-            let word = if p.outcome.status == RunStatus::Stalled { "stalled" } else { "not converged" };
+        solve::Outcome::IterationLimit | solve::Outcome::Stalled => {
+            let its = p.value(Metric::Iterations).map(|i| format!(" after {}", sig2(i))).unwrap_or_default();
+            let x = p.value(Metric::XErrRel).map(|x| format!(", x error {}", sig2(x))).unwrap_or_default();
+            let c = p.value(Metric::Certificate).map(|c| format!(", certificate {}", sig2(c))).unwrap_or_default();
+            let word = if p.outcome.status == solve::Outcome::Stalled { "stalled" } else { "not converged" };
             format!("{word}{its} iterations{x}{c}")
         }
         _ => {
@@ -505,7 +507,7 @@ pub fn scheme_deviations(spec: &Spec, check: &Check) -> Vec<String> {
 /// A point that a signal stopped, or kept from starting: its outcome says nothing about the
 /// scheme (its "failed" is not a failure to converge).
 pub fn stopped(p: &PointResult) -> bool {
-    p.outcome.status == RunStatus::Interrupted
+    p.outcome.status == solve::Outcome::Interrupted
         || p.outcome.error.as_deref().is_some_and(|e| e.contains("interrupted by a signal") || e.contains(NOT_STARTED))
 }
 

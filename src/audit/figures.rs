@@ -9,7 +9,7 @@ use super::measures::modal_tip_history;
 use super::spec::{PlotKind, PlotSpec, Selector, Spec};
 use super::{PointResult, RunResults};
 use crate::case::{Case, Reference};
-use crate::engine::metrics::INNER_SKIP_ELEMENTS;
+use crate::engine::metrics::{Metric, INNER_SKIP_ELEMENTS};
 use crate::figures::heatmap::{render_heatmaps_svg, Heatmap};
 use crate::figures::plot::{render_panels_svg, render_svg, Band, Legend, LinePlot, Mark, Series};
 use crate::figures::posture::{render_postures_svg, PosturePanel};
@@ -49,7 +49,7 @@ fn tradeoff_csv(r: &RunResults, metric: &str) -> String {
             "\"{}\",{},{},{}\n",
             label(p),
             p.outcome.status.as_str(),
-            num(p.metric("wall_time_s")),
+            num(p.value(Metric::WallTime)),
             num(p.metric(metric))
         );
     }
@@ -139,7 +139,7 @@ fn tradeoff(title: &str, r: &RunResults, metric: &str) -> Option<Svg> {
         .points
         .iter()
         .filter(|p| p.converged())
-        .filter_map(|p| Some((p.metric("wall_time_s")?, p.metric(metric)?)))
+        .filter_map(|p| Some((p.value(Metric::WallTime)?, p.metric(metric)?)))
         .filter(|(t, e)| *t > 0.0 && *e > 0.0)
         .collect();
     pts.sort_by(|a, b| a.0.total_cmp(&b.0));

@@ -40,7 +40,7 @@ use nalgebra::{DVector, Vector3};
 
 use crate::case::{Analysis, Case, Reference};
 use crate::engine::clip::ClipFrame;
-use crate::engine::metrics::{Metrics, INNER_SKIP_ELEMENTS};
+use crate::engine::metrics::{Metric, Metrics, INNER_SKIP_ELEMENTS};
 use crate::engine::RunResult;
 use crate::model::mesh::Field;
 use crate::reference::timoshenko_deflection;
@@ -110,40 +110,40 @@ pub fn derived_metrics(case: &Case, run: Option<&RunResult>, series: Option<&Cli
                 .zip(&r.nodes.x)
                 .map(|(s, x)| (x[1] - timoshenko_deflection(*s, force_n, l, kga, ei)).abs())
                 .fold(0.0, f64::max);
-            m.insert("eq63_curve_rel_error".into(), worst / tip);
+            m.insert_named("eq63_curve_rel_error", worst / tip);
             if let Some(x) = r.nodes.x.last() {
-                m.insert("tip_deflection_rel_length".into(), x[1].abs() / l);
+                m.insert_named("tip_deflection_rel_length", x[1].abs() / l);
             }
         }
         if let Some((x, a)) = modal_tip_errors(case, r) {
-            m.insert("modal_tip_rel_error".into(), x);
-            m.insert("modal_tip_angle_rel_error".into(), a);
-            m.insert("modal_tip_worst_rel_error".into(), x.max(a));
+            m.insert_named("modal_tip_rel_error", x);
+            m.insert_named("modal_tip_angle_rel_error", a);
+            m.insert_named("modal_tip_worst_rel_error", x.max(a));
         }
         if matches!(case.analysis, Analysis::Dynamic(_)) {
             if let Some(w) = modal_model(&case.problem()).ok().and_then(|m| m.omegas.first().copied()) {
-                m.insert("first_frequency_rad_per_s".into(), w);
+                m.insert_named("first_frequency_rad_per_s", w);
             }
         }
         if r.inverse.is_some() {
             let k = r.nodes.element_curvature();
             let n = k.len();
             let inner = k.iter().skip(INNER_SKIP_ELEMENTS).take(n.saturating_sub(2 * INNER_SKIP_ELEMENTS));
-            m.insert("kappa3_max_abs_per_m".into(), inner.map(|(_, k)| k[2].abs()).fold(0.0, f64::max));
+            m.insert_named("kappa3_max_abs_per_m", inner.map(|(_, k)| k[2].abs()).fold(0.0, f64::max));
             let own = crate::engine::metrics::inverse_metrics(r);
-            let (fc, lc) = (own.get("force_l2_n_per_m05"), own.get("torque_l2_n_m05"));
+            let (fc, lc) = (own.get(Metric::ForceL2), own.get(Metric::TorqueL2));
             if let (Some((f, l)), Some(fc), Some(lc)) = (design_norms(case), fc, lc) {
-                m.insert("force_to_design_l2".into(), fc / f);
-                m.insert("torque_to_design_l2".into(), lc / l);
-                m.insert("force_to_design_orders".into(), (fc / f).log10().abs());
-                m.insert("torque_to_design_orders".into(), (lc / l).log10().abs());
+                m.insert_named("force_to_design_l2", fc / f);
+                m.insert_named("torque_to_design_l2", lc / l);
+                m.insert_named("force_to_design_orders", (fc / f).log10().abs());
+                m.insert_named("torque_to_design_orders", (lc / l).log10().abs());
             }
             m.extend(inner_control_metrics(case, r));
             m.extend(frame_metrics(r));
             if let Some(inv) = r.inverse.as_ref() {
                 let a = inv.ahat.iter().map(|a| a.norm()).fold(0.0, f64::max);
-                m.insert("adjoint_alpha_max_abs".into(), a);
-                m.insert("adjoint_alpha_orders_from_paper".into(), (a / (1e7 * inv.lambda_l)).log10().abs());
+                m.insert_named("adjoint_alpha_max_abs", a);
+                m.insert_named("adjoint_alpha_orders_from_paper", (a / (1e7 * inv.lambda_l)).log10().abs());
             }
         }
     }
@@ -163,7 +163,7 @@ fn frame_metrics(r: &RunResult) -> Metrics {
         ((trace - 1.0) / 2.0).clamp(-1.0, 1.0).acos()
     };
     let worst = r.nodes.directors().iter().zip(inv.data.directors()).map(|(d, f)| angle(d, &f)).fold(0.0, f64::max);
-    m.insert("frame_err_max_rad".into(), worst);
+    m.insert_named("frame_err_max_rad", worst);
     let max = |v: &mut dyn Iterator<Item = f64>| v.fold(0.0, f64::max);
     let disp = max(&mut r.nodes.displacement().iter().map(|d| d.norm()));
     let x1 = max(&mut r.nodes.x.iter().map(|x| x[0].abs()));
@@ -171,7 +171,7 @@ fn frame_metrics(r: &RunResult) -> Metrics {
     let k1 = max(&mut k.iter().map(|(_, k)| k[0].abs()));
     let k23 = max(&mut k.iter().map(|(_, k)| k[1].abs().max(k[2].abs())));
     if disp > 0.0 && k1 > 0.0 {
-        m.insert("other_components_rel".into(), (x1 / disp).max(k23 / k1));
+        m.insert_named("other_components_rel", (x1 / disp).max(k23 / k1));
     }
     m
 }
@@ -188,7 +188,7 @@ fn inner_control_metrics(case: &Case, r: &RunResult) -> Metrics {
     }
     let inner = INNER_SKIP_ELEMENTS..n - INNER_SKIP_ELEMENTS;
     let l_max = inv.ahat[inner.clone()].iter().map(|a| a.norm() / inv.lambda_l).fold(0.0, f64::max);
-    m.insert("torque_max_abs_inner_n_m_per_m".into(), l_max);
+    m.insert_named("torque_max_abs_inner_n_m_per_m", l_max);
     let Some(data) = case.data_case() else { return m };
     let rms = |v: &mut dyn Iterator<Item = f64>| {
         let (sum, count) = v.fold((0.0, 0usize), |(a, c), x| (a + x * x, c + 1));
@@ -199,8 +199,8 @@ fn inner_control_metrics(case: &Case, r: &RunResult) -> Metrics {
     let l = rms(&mut inner.clone().map(|i| inv.ahat[i].norm() / inv.lambda_l));
     let (fd, ld) = (rms(&mut inner.clone().map(|i| design(i).0.norm())), rms(&mut inner.map(|i| design(i).1.norm())));
     if fd > 0.0 && ld > 0.0 {
-        m.insert("force_to_design_orders_inner".into(), (f / fd).log10().abs());
-        m.insert("torque_to_design_orders_inner".into(), (l / ld).log10().abs());
+        m.insert_named("force_to_design_orders_inner", (f / fd).log10().abs());
+        m.insert_named("torque_to_design_orders_inner", (l / ld).log10().abs());
     }
     m
 }
@@ -322,20 +322,20 @@ fn clip_series_metrics(s: &ClipSeries) -> Metrics {
     let rms = |f: &dyn Fn(&Vector3<f64>) -> f64| {
         (s.kappa.iter().flat_map(|k| k[inner.clone()].iter().map(f)).sum::<f64>() / count).sqrt()
     };
-    m.insert("kappa1_rms_per_m".into(), rms(&|k| k[0] * k[0]));
-    m.insert("kappa2_rms_per_m".into(), rms(&|k| k[1] * k[1]));
-    m.insert("kappa3_rms_per_m".into(), rms(&|k| k[2] * k[2]));
-    m.insert("bending_rms_per_m".into(), rms(&|k| k[0] * k[0] + k[1] * k[1]));
-    m.insert("omega_max_rad_per_s".into(), s.omega_max.iter().copied().fold(0.0, f64::max));
+    m.insert_named("kappa1_rms_per_m", rms(&|k| k[0] * k[0]));
+    m.insert_named("kappa2_rms_per_m", rms(&|k| k[1] * k[1]));
+    m.insert_named("kappa3_rms_per_m", rms(&|k| k[2] * k[2]));
+    m.insert_named("bending_rms_per_m", rms(&|k| k[0] * k[0] + k[1] * k[1]));
+    m.insert_named("omega_max_rad_per_s", s.omega_max.iter().copied().fold(0.0, f64::max));
     if let Some((lag, coherence)) = wave_lag(s, &|k| (k[0], k[1]), false) {
-        m.insert("bending_wave_lag_frames".into(), lag as f64);
-        m.insert("bending_wave_coherence".into(), coherence);
+        m.insert_named("bending_wave_lag_frames", lag as f64);
+        m.insert_named("bending_wave_coherence", coherence);
     }
     if let Some((_, coherence)) = wave_lag(s, &|k| (k[2], 0.0), true) {
-        m.insert("twist_wave_coherence".into(), coherence);
+        m.insert_named("twist_wave_coherence", coherence);
     }
     if let Some(j) = x_err_jitter(&s.x_err_rel) {
-        m.insert("x_err_rel_jitter".into(), j);
+        m.insert_named("x_err_rel_jitter", j);
     }
     m
 }

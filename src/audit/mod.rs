@@ -20,6 +20,7 @@ use serde::Deserialize;
 use crate::case::sweep::{product, Point, SweepError};
 use crate::io::compact::OutputFormat;
 use crate::jobs::sweep::{point_manifest, run_clip_point, run_point, SweepOutcome};
+use crate::output::manifest::Status;
 use measures::{derived_metrics, ClipRecorder, ClipSeries};
 use spec::{Claim, RunSpec, Spec};
 
@@ -100,9 +101,14 @@ impl PointResult {
     pub fn converged(&self) -> bool {
         self.outcome.status.is_complete()
     }
-    /// A metric of the point (its run's metrics with [`measures::derived_metrics`]).
+    /// A metric of the point by the name a spec gives (its run's metrics with
+    /// [`measures::derived_metrics`]).
     pub fn metric(&self, name: &str) -> Option<f64> {
-        self.outcome.metrics.as_ref().and_then(|m| m.get(name)).copied()
+        self.outcome.metrics.as_ref().and_then(|m| m.named(name))
+    }
+    /// A metric of the point's run.
+    pub fn value(&self, key: crate::engine::metrics::Metric) -> Option<f64> {
+        self.outcome.metrics.as_ref().and_then(|m| m.get(key))
     }
     /// Does the point have these grid values?
     pub fn matches(&self, at: &spec::Selector) -> bool {
@@ -141,7 +147,9 @@ pub struct ClaimResult {
     pub figure: Option<String>,
 }
 
-/// How far an audit got. Only a complete audit's verdicts are the audit's; an unfinished one
+/// How far an audit got (the audit as a whole; each of its points ends with an
+/// [`crate::solve::Outcome`], and a claim is judged with a [`Verdict`], neither an outcome of
+/// this kind). Only a complete audit's verdicts are the audit's; an unfinished one
 /// judges the claims whose points all finished and marks the others *not judged*.
 #[derive(Clone, Debug, PartialEq)]
 pub enum AuditStatus {
@@ -153,12 +161,18 @@ pub enum AuditStatus {
 }
 
 impl AuditStatus {
-    pub fn as_str(&self) -> &'static str {
+    /// The state of the audit's folder (`run.json`): complete, interrupted or failed.
+    pub fn folder_status(&self) -> Status {
         match self {
-            AuditStatus::Complete => "complete",
-            AuditStatus::Interrupted => "interrupted",
-            AuditStatus::Failed(_) => "failed",
+            AuditStatus::Complete => Status::Complete,
+            AuditStatus::Interrupted => Status::Interrupted,
+            AuditStatus::Failed(_) => Status::Failed,
         }
+    }
+
+    /// The word of the folder's state.
+    pub fn as_str(&self) -> &'static str {
+        self.folder_status().as_str()
     }
 }
 
@@ -510,11 +524,10 @@ fn check_metric_name(spec: &Spec, claim: &Claim, runs: &[RunResults]) -> Result<
         let Some(rr) = runs.iter().find(|r| r.name == run) else { continue };
         let reported: Vec<&crate::engine::metrics::Metrics> =
             rr.points.iter().filter_map(|p| p.outcome.metrics.as_ref()).collect();
-        if reported.is_empty() || reported.iter().any(|m| m.contains_key(metric)) {
+        if reported.is_empty() || reported.iter().any(|m| m.named(metric).is_some()) {
             continue;
         }
-        let known: std::collections::BTreeSet<&str> =
-            reported.iter().flat_map(|m| m.keys().map(String::as_str)).collect();
+        let known: std::collections::BTreeSet<&str> = reported.iter().flat_map(|m| m.names()).collect();
         return Err(AuditError::UnknownMetric {
             path: spec.path.clone(),
             claim: claim.id.clone(),

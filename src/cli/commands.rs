@@ -12,9 +12,9 @@ use cosserat::engine::budget::{self, default_limit_bytes, Footprint, GIB};
 use cosserat::engine::Engine;
 use cosserat::io::compact::OutputFormat;
 use cosserat::jobs::job::{case_label, run_into, run_manifest};
-use cosserat::jobs::sweep::RunStatus;
 use cosserat::output::run_folder::{input_file, Manifest, Mode, RunFolder, Status};
 use cosserat::solve::modes::modal_model;
+use cosserat::solve::Outcome;
 
 /// The case of `path`, its `rod.length_m = "from_data"` resolved from its recording.
 fn load(path: &Path) -> Result<Case> {
@@ -185,9 +185,9 @@ pub fn cmd_sweep(args: SweepArgs) -> Result<ExitCode> {
             anyhow::bail!("{}: sweep: {message}; {} holds run.json saying failed", case_label(&case), target.display());
         }
     };
-    let count = |s: RunStatus| rows.iter().filter(|r| r.status == s).count();
+    let count = |s: Outcome| rows.iter().filter(|r| r.status == s).count();
     let complete = rows.iter().filter(|r| r.status.is_complete()).count();
-    let (interrupted, failed) = (count(RunStatus::Interrupted), rows.len() - complete);
+    let (interrupted, failed) = (count(Outcome::Interrupted), rows.len() - complete);
     let status = if interrupted > 0 {
         Status::Interrupted
     } else if failed > 0 {

@@ -21,6 +21,7 @@ use cosserat::jobs::batch::{self, gather, list_recordings, run_batch, BatchRow, 
 use cosserat::jobs::batch_task::run_task;
 use cosserat::jobs::slurm;
 use cosserat::jobs::MAX_JOBS;
+use cosserat::solve::Outcome;
 
 use progress::Progress;
 
@@ -117,12 +118,12 @@ fn report(out: &Path, rows: &[BatchRow], skipped: usize) -> ExitCode {
         out.join(SUMMARY).display()
     );
     for r in &failed {
-        eprintln!("  {} ({}): {}", r.folder, r.status, r.reason.as_deref().unwrap_or(""));
+        eprintln!("  {} ({}): {}", r.folder, r.status_word(), r.reason.as_deref().unwrap_or(""));
     }
     if failed.is_empty() {
         return ExitCode::SUCCESS;
     }
-    if rows.iter().any(|r| r.status == "interrupted") {
+    if rows.iter().any(|r| r.status == Some(Outcome::Interrupted)) {
         eprintln!("{}", interrupted_summary(out, rows));
         return ExitCode::from(crate::EXIT_INTERRUPTED);
     }
@@ -137,11 +138,11 @@ fn interrupted_summary(out: &Path, rows: &[BatchRow]) -> String {
     let not_started = rows.iter().filter(|r| r.reason.as_deref() == Some(batch::NOT_STARTED)).count();
     let stopped: Vec<String> = rows
         .iter()
-        .filter(|r| r.status == "interrupted" && r.reason.as_deref() != Some(batch::NOT_STARTED))
+        .filter(|r| r.status == Some(Outcome::Interrupted) && r.reason.as_deref() != Some(batch::NOT_STARTED))
         .map(|r| format!("{} ({} frames)", r.folder, r.frames.unwrap_or(0)))
         .collect();
     let ok = rows.iter().filter(|r| r.is_ok()).count();
-    let failed = rows.iter().filter(|r| !r.is_ok() && r.status != "interrupted").count();
+    let failed = rows.iter().filter(|r| !r.is_ok() && r.status != Some(Outcome::Interrupted)).count();
     format!(
         "interrupted: {ok} of {} recordings complete, {} stopped at their next frame{}, {not_started} not started, {failed} failed; {} marks each. Run the same command again to run the others (complete recordings are skipped)",
         rows.len(),
@@ -253,7 +254,7 @@ pub fn cmd_batch_task(a: TaskArgs) -> Result<ExitCode> {
     let ran = run_task(&a.out, a.index, |done, total| pb.set(done, total))?;
     pb.finish();
     for r in &ran {
-        let what = if r.skipped { "already complete".into() } else { r.row.status.clone() };
+        let what = if r.skipped { "already complete" } else { r.row.status_word() };
         eprintln!("{}: {what}{}", r.row.folder, r.row.reason.as_deref().map(|m| format!(": {m}")).unwrap_or_default());
     }
     Ok(if ran.iter().all(|r| r.row.is_ok()) { ExitCode::SUCCESS } else { ExitCode::from(1) })

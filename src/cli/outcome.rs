@@ -4,9 +4,10 @@
 use std::path::Path;
 
 use cosserat::case::Case;
+use cosserat::engine::metrics::Metric;
 use cosserat::engine::Engine;
-use cosserat::jobs::sweep::RunStatus;
 use cosserat::output::run_folder::{Manifest, Status};
+use cosserat::solve::Outcome;
 
 /// What a run stopped by a full disk left, and how to go on.
 pub fn full_disk_note(end: &cosserat::jobs::job::JobEnd, case: &Path, dir: &Path) -> String {
@@ -28,12 +29,14 @@ pub fn sweep_interrupted_summary(rows: &[cosserat::jobs::sweep::SummaryRow], tar
     use cosserat::jobs::sweep::NOT_STARTED;
     let not_started = rows.iter().filter(|r| r.error.as_deref() == Some(NOT_STARTED)).count();
     let stopped: Vec<_> =
-        rows.iter().filter(|r| r.status == RunStatus::Interrupted && r.error.as_deref() != Some(NOT_STARTED)).collect();
+        rows.iter().filter(|r| r.status == Outcome::Interrupted && r.error.as_deref() != Some(NOT_STARTED)).collect();
     let frames: Vec<String> = stopped
         .iter()
-        .filter_map(|r| r.metrics.as_ref().and_then(|m| m.get("frames")).map(|f| format!("{} {f} frames", r.name)))
+        .filter_map(|r| {
+            r.metrics.as_ref().and_then(|m| m.get(Metric::Frames)).map(|f| format!("{} {f} frames", r.name))
+        })
         .collect();
-    let ok = rows.iter().filter(|r| r.status == RunStatus::Ok).count();
+    let ok = rows.iter().filter(|r| r.status == Outcome::Converged).count();
     format!(
         "interrupted: {ok} of {} points complete, {} stopped at their next iteration or frame{}, {not_started} not started; {} marks each (status interrupted), and {} holds run.json saying interrupted",
         rows.len(),

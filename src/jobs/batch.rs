@@ -14,10 +14,11 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use super::solved::{chain, solve_into, RunStatus};
+use super::solved::{chain, solve_into};
 use crate::case::{Analysis, Case, CaseError, DataSource};
 use crate::engine::clip_metrics::clip_metrics;
 use crate::engine::input::truth_file::{is_truth_sidecar, truth_sidecar};
+use crate::engine::metrics::Metric;
 use crate::engine::Engine;
 use crate::io::compact::OutputFormat;
 use crate::io::files::{write_atomic, OutputError};
@@ -25,15 +26,21 @@ use crate::output::clip_run::ClipOptions;
 use crate::output::run_folder::{
     input_file_as, sha256_file, FolderError, InputFile, Manifest, Mode, RunFolder, Status,
 };
+use crate::solve::Outcome;
 
 /// The plan of a batch in its output folder.
 pub const PLAN: &str = "batch.json";
 /// The summary row of a recording in its folder.
 pub const ROW: &str = "batch_row.json";
+/// The `status` of a recording gathered before its task ran (it has no outcome).
+pub const MISSING: &str = "missing";
 /// The summary table in the output folder.
 pub const SUMMARY: &str = "summary.csv";
 
-/// Columns of `summary.csv`. `fit_position_rel_length_max` is the worst frame's position
+/// A column of `summary.csv`: its name and its text of a row.
+pub type SummaryColumn = (&'static str, fn(&BatchRow) -> String);
+
+/// Columns of `summary.csv`, each with its text of a row. `fit_position_rel_length_max` is the worst frame's position
 /// misfit in body lengths, `((1/L) ∫ |x − x_g|²)^½ / L` (`solve::fit`): unlike `‖x − x_g‖/‖x_g‖`
 /// it does not depend on where the recording sits in space. `curvature_err_rel_max` is the
 /// worst frame's relative L² error of the bending `κ1² + κ2²` against the ground truth [–]
@@ -44,22 +51,27 @@ pub const SUMMARY: &str = "summary.csv";
 /// that differs between two runs of the same batch. `noise_m` [m] and `lambda_g` are the noise
 /// level and tracking weight `[inverse] weights = "auto"` chose (empty with fixed weights;
 /// `docs/noise.md`).
-pub const SUMMARY_COLUMNS: [&str; 14] = [
-    "recording",
-    "folder",
-    "status",
-    "frames",
-    "newton_iterations_per_frame",
-    "certificate_max",
-    "fit_position_rel_length_max",
-    "curvature_err_rel_max",
-    "length_m",
-    "length_spread_rel",
-    "noise_m",
-    "lambda_g",
-    "reason",
-    "wall_time_s",
+pub const SUMMARY_COLUMNS: [SummaryColumn; 14] = [
+    ("recording", |r| r.recording.clone()),
+    ("folder", |r| r.folder.clone()),
+    ("status", |r| r.status_word().into()),
+    ("frames", |r| r.frames.map(|f| f.to_string()).unwrap_or_default()),
+    ("newton_iterations_per_frame", |r| number(r.newton_iterations_per_frame)),
+    ("certificate_max", |r| number(r.certificate_max)),
+    ("fit_position_rel_length_max", |r| number(r.fit_position_rel_length_max)),
+    ("curvature_err_rel_max", |r| number(r.curvature_err_rel_max)),
+    ("length_m", |r| number(r.length_m)),
+    ("length_spread_rel", |r| number(r.length_spread_rel)),
+    ("noise_m", |r| number(r.noise_m)),
+    ("lambda_g", |r| number(r.lambda_g)),
+    ("reason", |r| r.reason.as_deref().unwrap_or("").replace('\n', " ")),
+    ("wall_time_s", |r| format!("{:.3}", r.wall_time_s)),
 ];
+
+/// A number of the summary: 10 significant digits, empty where it does not apply.
+fn number(v: Option<f64>) -> String {
+    v.map(|v| crate::io::number::exp(v, 10)).unwrap_or_default()
+}
 
 /// Errors of a batch as a whole (a recording's own failure is its row's, not one of these).
 #[derive(Debug, thiserror::Error)]
@@ -117,12 +129,13 @@ pub struct Plan {
 }
 
 /// The summary row of one recording.
-#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct BatchRow {
     pub recording: String,
     pub folder: String,
-    /// `ok`, `failed`, `interrupted`, or `missing` (gathered before its task ran)
-    pub status: String,
+    /// how the recording's run ended; `None`: `missing` in the summary (gathered before its
+    /// task ran; never in a `batch_row.json`)
+    pub status: Option<Outcome>,
     /// converged frames
     pub frames: Option<usize>,
     pub newton_iterations_per_frame: Option<f64>,
@@ -151,27 +164,23 @@ pub struct BatchRow {
 }
 
 impl BatchRow {
-    fn without_result(entry: &PlanEntry, status: &str, reason: String) -> Self {
+    fn without_result(entry: &PlanEntry, status: Option<Outcome>, reason: String) -> Self {
         BatchRow {
             recording: entry.path.display().to_string(),
             folder: entry.folder.clone(),
-            status: status.into(),
-            frames: None,
-            newton_iterations_per_frame: None,
-            certificate_max: None,
-            fit_position_rel_length_max: None,
-            curvature_err_rel_max: None,
-            noise_m: None,
-            lambda_g: None,
-            length_m: None,
-            length_spread_rel: None,
+            status,
             reason: Some(reason),
-            wall_time_s: 0.0,
+            ..BatchRow::default()
         }
     }
 
+    /// The word of the summary's `status` column: the outcome's, or `missing`.
+    pub fn status_word(&self) -> &'static str {
+        self.status.map_or(MISSING, Outcome::as_str)
+    }
+
     pub fn is_ok(&self) -> bool {
-        self.status == RunStatus::Ok.as_str() || self.status == RunStatus::Warnings.as_str()
+        self.status.is_some_and(Outcome::is_complete)
     }
 }
 
@@ -379,7 +388,7 @@ pub fn run_recording(case: &Case, case_file: &InputFile, entry: &PlanEntry, out:
     let failed = |reason: String| Ran {
         row: BatchRow {
             wall_time_s: start.elapsed().as_secs_f64(),
-            ..BatchRow::without_result(entry, RunStatus::Failed.as_str(), reason)
+            ..BatchRow::without_result(entry, Some(Outcome::Failed), reason)
         },
         skipped: false,
     };
@@ -391,7 +400,7 @@ pub fn run_recording(case: &Case, case_file: &InputFile, entry: &PlanEntry, out:
         return Ran { row, skipped: true };
     }
     if crate::interrupt::requested() {
-        let row = BatchRow::without_result(entry, RunStatus::Interrupted.as_str(), NOT_STARTED.into());
+        let row = BatchRow::without_result(entry, Some(Outcome::Interrupted), NOT_STARTED.into());
         return Ran { row, skipped: false };
     }
     let case = match with_recording(case, &entry.path) {
@@ -415,18 +424,18 @@ pub fn run_recording(case: &Case, case_file: &InputFile, entry: &PlanEntry, out:
         return failed(format!("{}: {}", crate::io::disk::full_text(&dir), solved.error.unwrap_or_default()));
     }
     let metrics = solved.clip.as_ref().filter(|c| !c.reports.is_empty()).map(|c| clip_metrics(&case, c));
-    let get = |k: &str| metrics.as_ref().and_then(|m| m.get(k)).copied();
+    let get = |k: Metric| metrics.as_ref().and_then(|m| m.get(k));
     let weights = solved.clip.as_ref().and_then(|c| c.weights);
     folder.manifest.weights = weights;
     let row = BatchRow {
         recording: entry.path.display().to_string(),
         folder: entry.folder.clone(),
-        status: solved.status.as_str().into(),
+        status: Some(solved.status),
         frames: solved.frames.map(|f| f.0),
-        newton_iterations_per_frame: get("iterations_mean"),
-        certificate_max: get("certificate"),
-        fit_position_rel_length_max: get("fit_position_rel_length_max"),
-        curvature_err_rel_max: get("truth_bending_err_rel_max"),
+        newton_iterations_per_frame: get(Metric::IterationsMean),
+        certificate_max: get(Metric::Certificate),
+        fit_position_rel_length_max: get(Metric::FitPositionRelLengthMax),
+        curvature_err_rel_max: get(Metric::TruthBendingErrRelMax),
         noise_m: weights.map(|w| w.noise_m),
         lambda_g: weights.map(|w| w.lambda_g),
         length_m: Some(case.mesh.length_m),
@@ -442,7 +451,7 @@ pub fn run_recording(case: &Case, case_file: &InputFile, entry: &PlanEntry, out:
         .map_err(|e| OutputError::Invalid { path: folder.dir().join(ROW), reason: e.to_string() })
         .and_then(|bytes| write_atomic(&folder.dir().join(ROW), &bytes));
     let (status, message) = match written {
-        Ok(()) => (solved.status.folder_status(), solved.error),
+        Ok(()) => (solved.status.into(), solved.error),
         Err(e) => (Status::Failed, Some(chain(&e))),
     };
     if let Err(e) = folder.finish(status, message.clone()) {
@@ -522,7 +531,7 @@ pub fn gather(out: &Path) -> Result<Vec<BatchRow>, BatchError> {
                 Some(row) => row,
                 None => BatchRow::without_result(
                     e,
-                    "missing",
+                    None,
                     format!("{} holds no result: its task has not run, or stopped (see slurm/)", path.display()),
                 ),
             }
@@ -536,25 +545,9 @@ pub fn gather(out: &Path) -> Result<Vec<BatchRow>, BatchError> {
 /// where a value does not apply.
 pub fn summary_csv(rows: &[BatchRow]) -> Result<String, csv::Error> {
     let mut w = csv::Writer::from_writer(Vec::new());
-    w.write_record(SUMMARY_COLUMNS)?;
-    let num = |v: Option<f64>| v.map(|v| crate::io::number::exp(v, 10)).unwrap_or_default();
+    w.write_record(SUMMARY_COLUMNS.map(|(name, _)| name))?;
     for r in rows {
-        w.write_record([
-            r.recording.clone(),
-            r.folder.clone(),
-            r.status.clone(),
-            r.frames.map(|f| f.to_string()).unwrap_or_default(),
-            num(r.newton_iterations_per_frame),
-            num(r.certificate_max),
-            num(r.fit_position_rel_length_max),
-            num(r.curvature_err_rel_max),
-            num(r.length_m),
-            num(r.length_spread_rel),
-            num(r.noise_m),
-            num(r.lambda_g),
-            r.reason.as_deref().unwrap_or("").replace('\n', " "),
-            format!("{:.3}", r.wall_time_s),
-        ])?;
+        w.write_record(SUMMARY_COLUMNS.map(|(_, text)| text(r)))?;
     }
     let bytes = w.into_inner().map_err(|e| csv::Error::from(e.into_error()))?;
     Ok(String::from_utf8_lossy(&bytes).into_owned())
@@ -576,6 +569,17 @@ mod tests {
         let p = |s: &str| PathBuf::from(s);
         let names = folder_names(&[p("/a/w 1.csv"), p("/b/w 1.npy"), p("/a/x.npy"), p("/c/W 1.npy"), p("/d/.npy")]);
         assert_eq!(names, ["w_1", "w_1-2", "x", "W_1-3", "rec.npy"]);
+    }
+
+    #[test]
+    fn summary_columns_and_a_missing_row() {
+        let entry = PlanEntry { path: PathBuf::from("/r/a.npy"), folder: "a".into() };
+        let row = BatchRow::without_result(&entry, None, "no\nresult".into());
+        let text = summary_csv(&[row]).unwrap();
+        assert_eq!(
+            text,
+            "recording,folder,status,frames,newton_iterations_per_frame,certificate_max,fit_position_rel_length_max,curvature_err_rel_max,length_m,length_spread_rel,noise_m,lambda_g,reason,wall_time_s\n/r/a.npy,a,missing,,,,,,,,,,no result,0.000\n"
+        );
     }
 
     #[test]

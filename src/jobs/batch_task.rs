@@ -4,8 +4,8 @@
 use std::path::Path;
 
 use super::batch::{plan_case, run_recording, BatchError, BatchRow, Plan, Ran, ROW};
-use super::solved::RunStatus;
 use crate::io::files::{write_atomic, OutputError};
+use crate::solve::Outcome;
 
 /// Run the recordings of Slurm array task `index` of the plan in `out`, one after the other;
 /// `progress(done, total)` after each.
@@ -18,7 +18,7 @@ pub fn run_task(out: &Path, index: usize, mut progress: impl FnMut(usize, usize)
         let r = run_recording(&case, &case_file, e, out, plan.format);
         // a recording that fails before its folder is begun (unreadable, bad values) has its
         // row only here: `gather` reads rows from the folders, so it goes there too
-        if r.row.status == RunStatus::Failed.as_str() {
+        if r.row.status == Some(Outcome::Failed) {
             write_failed_row(&out.join(&e.folder), &r.row)?;
         }
         ran.push(r);

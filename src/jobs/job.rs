@@ -190,7 +190,7 @@ pub fn run_into(
     let solved = solve_into(case, engine, &dir, clip, |_| {}, progress);
     folder.manifest.certificate = solved.certificate(case);
     folder.manifest.recording = solved.recording_notes(case);
-    end.status = solved.status.folder_status();
+    end.status = solved.status.into();
     end.message = solved.error;
     end.single = solved.single;
     end.clip = solved.clip;

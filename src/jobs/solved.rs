@@ -9,7 +9,7 @@ use crate::case::Case;
 use crate::clip::missing::MIN_TRACKED;
 use crate::engine::clip::{ClipFrame, ClipRun};
 use crate::engine::clip_metrics::clip_metrics;
-use crate::engine::metrics::{all_metrics, Metrics};
+use crate::engine::metrics::{all_metrics, Metric, Metrics};
 use crate::engine::{run_case, run_inverse_on, stage_data, EngineError};
 use crate::engine::{Engine, RunError, RunResult};
 use crate::output::clip_output::remove_raw;
@@ -17,60 +17,13 @@ use crate::output::clip_run::{run_clip_to, write_clip_figures, ClipOptions};
 use crate::output::journal::remove_journal;
 use crate::output::manifest::{FrameDataNote, PlanarNote, RecordingNotes};
 use crate::output::run_files::write_run;
-use crate::output::run_folder::{CertificateSummary, Status};
+use crate::output::run_folder::CertificateSummary;
 use crate::solve::sequence::FrameReport;
-use crate::solve::SolveError;
-
-/// How one run ended.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum RunStatus {
-    Ok,
-    /// iteration limit reached; the metrics are those of the last iterate
-    NotConverged,
-    /// the iteration stopped moving but its residual certificate is above the tolerance
-    /// (`solve::Stop::Stalled`); the metrics are those of the last iterate
-    Stalled,
-    /// a clip solved whole, with frames over the fit-quality gate (`solve::fit`): every frame
-    /// is certified, but some do not follow their data; or a static state that is certified but
-    /// not stable (D27)
-    Warnings,
-    Failed,
-    /// stopped by a signal (or not started because of one)
-    Interrupted,
-}
-
-impl RunStatus {
-    /// A result whole: `ok`, or a clip complete with warnings.
-    pub fn is_complete(&self) -> bool {
-        matches!(self, RunStatus::Ok | RunStatus::Warnings)
-    }
-
-    pub fn as_str(&self) -> &'static str {
-        match self {
-            RunStatus::Ok => "ok",
-            RunStatus::NotConverged => "not_converged",
-            RunStatus::Stalled => "stalled",
-            RunStatus::Warnings => "complete_with_warnings",
-            RunStatus::Failed => "failed",
-            RunStatus::Interrupted => "interrupted",
-        }
-    }
-
-    /// The status of the run's folder (`run.json`).
-    pub fn folder_status(&self) -> Status {
-        match self {
-            RunStatus::Ok => Status::Complete,
-            RunStatus::NotConverged | RunStatus::Failed => Status::Failed,
-            RunStatus::Stalled => Status::Stalled,
-            RunStatus::Warnings => Status::CompleteWithWarnings,
-            RunStatus::Interrupted => Status::Interrupted,
-        }
-    }
-}
+use crate::solve::{Outcome, SolveError};
 
 /// What one run left in its folder.
 pub struct Solved {
-    pub status: RunStatus,
+    pub status: Outcome,
     /// why it failed or stopped (the error and its causes, prefixed by the case)
     pub error: Option<String>,
     /// the metrics of a single run (also of the last iterate of one that did not converge) or
@@ -91,7 +44,7 @@ impl Solved {
     /// `certificate` metric (a clip's: the largest of its frames) against the case's tolerance.
     pub fn certificate(&self, case: &Case) -> Option<CertificateSummary> {
         let value = match (&self.metrics, &self.single, &self.clip) {
-            (Some(m), _, _) if m.contains_key("certificate") => m["certificate"],
+            (Some(m), _, _) if m.contains(Metric::Certificate) => m.get(Metric::Certificate)?,
             (_, Some(r), _) => r.stats.certificate?,
             (_, _, Some(c)) if !c.reports.is_empty() => c.reports.iter().map(|r| r.certificate).fold(0.0, f64::max),
             _ => return None,
@@ -121,7 +74,7 @@ impl Solved {
     /// A run that produced nothing, with its error.
     pub fn failed(error: String) -> Self {
         Solved {
-            status: RunStatus::Failed,
+            status: Outcome::Failed,
             error: Some(error),
             metrics: None,
             single: None,
@@ -138,7 +91,7 @@ impl Solved {
 
     /// A run stopped (or not started) by a signal.
     pub fn interrupted() -> Self {
-        Solved { status: RunStatus::Interrupted, ..Solved::failed("interrupted by a signal".into()) }
+        Solved { status: Outcome::Interrupted, ..Solved::failed("interrupted by a signal".into()) }
     }
 }
 
@@ -173,7 +126,7 @@ fn solve_single(case: &Case, engine: Engine, dir: &Path, progress: impl FnMut(us
         match stage_data(case, &path) {
             Ok(()) => run_inverse_on(case, engine, &path, &work, progress),
             Err(e) => {
-                let status = if interrupted(&e) { RunStatus::Interrupted } else { RunStatus::Failed };
+                let status = if interrupted(&e) { Outcome::Interrupted } else { Outcome::Failed };
                 let error = format!("{}: generating the data: {}", case_label(case), chain(&e));
                 return Solved { status, ..Solved::failed_by(error, &e) };
             }
@@ -182,14 +135,14 @@ fn solve_single(case: &Case, engine: Engine, dir: &Path, progress: impl FnMut(us
         run_case(case, engine, &work, progress)
     };
     let (status, r, error) = match result {
-        Ok(r) => (RunStatus::Ok, r, None),
+        Ok(r) => (Outcome::Converged, r, None),
         Err(EngineError::Run(RunError::Incomplete { source, partial })) => (
-            if matches!(source, SolveError::Stalled(_)) { RunStatus::Stalled } else { RunStatus::NotConverged },
+            if matches!(source, SolveError::Stalled(_)) { Outcome::Stalled } else { Outcome::IterationLimit },
             *partial,
             Some(format!("{}: {source}; the files here hold the last iterate", case_label(case))),
         ),
         Err(e) => {
-            let status = if interrupted(&e) { RunStatus::Interrupted } else { RunStatus::Failed };
+            let status = if interrupted(&e) { Outcome::Interrupted } else { Outcome::Failed };
             return Solved { status, ..Solved::failed_by(format!("{}: {}", case_label(case), chain(&e)), &e) };
         }
     };
@@ -198,7 +151,7 @@ fn solve_single(case: &Case, engine: Engine, dir: &Path, progress: impl FnMut(us
         Err(e) => return Solved::failed(format!("{}: {}", case_label(case), chain(&e))),
     };
     let (status, error) = match unstable_message(case, &m) {
-        Some(message) if status == RunStatus::Ok => (RunStatus::Warnings, Some(message)),
+        Some(message) if status == Outcome::Converged => (Outcome::CompleteWithWarnings, Some(message)),
         _ => (status, error),
     };
     match write_run(case, &r, &m, dir) {
@@ -212,8 +165,8 @@ fn solve_single(case: &Case, engine: Engine, dir: &Path, progress: impl FnMut(us
 /// The warning of a static result that is not stable (D27): the smallest eigenvalue `μ` of its
 /// tangent against the unloaded rod's is not positive.
 fn unstable_message(case: &Case, m: &Metrics) -> Option<String> {
-    let w2 = *m.get("tangent_smallest_eigenvalue_per_s2")?;
-    (m.get("stable") == Some(&0.0)).then(|| {
+    let w2 = m.get(Metric::TangentSmallestEigenvalue)?;
+    (m.get(Metric::Stable) == Some(0.0)).then(|| {
         format!(
             "{}: UNSTABLE: the static state returned is not stable: the rod linearised about it has omega^2 = {w2:.4e} 1/s^2 < 0 (the smallest eigenvalue of its tangent against its mass, D27): the loads exceed a critical load and the rod would leave this state; follow the path with solver.continuation = \"arc_length\" (and an imperfection) for the buckled one",
             case_label(case)
@@ -251,11 +204,11 @@ fn solve_clip(
     let flagged: Vec<&FrameReport> = out.run.reports.iter().filter(|r| r.fit.flagged).collect();
     let mut disk_full = out.stopped.as_ref().is_some_and(|e| crate::io::disk::is_full(e));
     let (mut status, mut error) = match &out.stopped {
-        None if !flagged.is_empty() => (RunStatus::Warnings, Some(flag_message(case, &flagged, done))),
-        None => (RunStatus::Ok, None),
-        Some(e) if e.is_interrupted() => (RunStatus::Interrupted, Some(format!("{}: {}", case_label(case), chain(e)))),
+        None if !flagged.is_empty() => (Outcome::CompleteWithWarnings, Some(flag_message(case, &flagged, done))),
+        None => (Outcome::Converged, None),
+        Some(e) if e.is_interrupted() => (Outcome::Interrupted, Some(format!("{}: {}", case_label(case), chain(e)))),
         Some(e) => (
-            RunStatus::Failed,
+            Outcome::Failed,
             Some(format!("{}: {}; the converged frames before it are in this folder", case_label(case), chain(e))),
         ),
     };
@@ -267,7 +220,7 @@ fn solve_clip(
             Some(m) => format!("{m}; then {}", chain(&e)),
             None => format!("{}: {}", case_label(case), chain(&e)),
         });
-        status = RunStatus::Failed;
+        status = Outcome::Failed;
     }
     if status.is_complete() && opts.journal {
         if let Err(e) = remove_journal(dir).and_then(|_| remove_raw(dir)) {

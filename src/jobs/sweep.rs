@@ -5,31 +5,32 @@
 //! of `run` on a clip, its row the metrics of `engine::clip_metrics`).
 use std::path::Path;
 
-pub use super::solved::{case_label, chain, RunStatus, Solved as SweepOutcome};
+pub use super::solved::{case_label, chain, Solved as SweepOutcome};
 use super::solved::{solve_into, Solved};
 use crate::case::sweep::Point;
 use crate::case::Case;
 use crate::engine::clip::ClipFrame;
-use crate::engine::metrics::Metrics;
+use crate::engine::metrics::{Metric, Metrics};
 use crate::engine::{Engine, RunResult};
 use crate::io::files::OutputError;
 use crate::output::clip_run::ClipOptions;
 use crate::output::run_folder::Manifest;
+use crate::solve::Outcome;
 
 /// Columns of the summary table after the swept keys.
-pub const SUMMARY_METRICS: [&str; 12] = [
-    "iterations",
-    "certificate",
-    "x_err_rel",
-    "kappa_err_rel",
-    "kappa_err_rel_inner",
-    "tangent_misfit_m05",
-    "j_tracking",
-    "j_total",
-    "force_l2_n_per_m05",
-    "torque_l2_n_m05",
-    "tip_y_m",
-    "wall_time_s",
+pub const SUMMARY_METRICS: [Metric; 12] = [
+    Metric::Iterations,
+    Metric::Certificate,
+    Metric::XErrRel,
+    Metric::KappaErrRel,
+    Metric::KappaErrRelInner,
+    Metric::TangentMisfit,
+    Metric::JTracking,
+    Metric::JTotal,
+    Metric::ForceL2,
+    Metric::TorqueL2,
+    Metric::TipY,
+    Metric::WallTime,
 ];
 
 /// One row of the summary: the point, its status, its metrics (also those of the last iterate
@@ -39,34 +40,34 @@ pub struct SummaryRow {
     /// the point's folder name
     pub name: String,
     pub point: Point,
-    pub status: RunStatus,
+    pub status: Outcome,
     pub metrics: Option<Metrics>,
     pub error: Option<String>,
 }
 
 /// Columns of the summary table of a clip case after the swept keys (`engine::clip_metrics`).
-pub const CLIP_SUMMARY_METRICS: [&str; 12] = [
-    "frames",
-    "certificate",
-    "iterations_mean",
-    "iterations_max",
-    "x_err_rel_max",
-    "tangent_misfit_rel_max",
-    "max_abs_j_minus_1",
-    "shear_share_median",
-    "j_total_median",
-    "min_abs_cos_beta",
-    "truth_x_err_rel_max",
-    "wall_time_s",
+pub const CLIP_SUMMARY_METRICS: [Metric; 12] = [
+    Metric::Frames,
+    Metric::Certificate,
+    Metric::IterationsMean,
+    Metric::IterationsMax,
+    Metric::XErrRelMax,
+    Metric::TangentMisfitRelMax,
+    Metric::MaxAbsJMinus1,
+    Metric::ShearShareMedian,
+    Metric::JTotalMedian,
+    Metric::MinAbsCosBeta,
+    Metric::TruthXErrRelMax,
+    Metric::WallTime,
 ];
 
 /// CSV text of the summary (header: swept keys, `status` (`ok`, `not_converged`, `failed`),
 /// `columns` ([`SUMMARY_METRICS`], or [`CLIP_SUMMARY_METRICS`] for a clip case), `error`).
-pub fn summary_csv(keys: &[String], columns: &[&str], rows: &[SummaryRow]) -> Result<String, csv::Error> {
+pub fn summary_csv(keys: &[String], columns: &[Metric], rows: &[SummaryRow]) -> Result<String, csv::Error> {
     let mut w = csv::Writer::from_writer(Vec::new());
     let mut header: Vec<String> = keys.to_vec();
     header.push("status".into());
-    header.extend(columns.iter().map(|s| s.to_string()));
+    header.extend(columns.iter().map(|s| s.as_str().to_string()));
     header.push("error".into());
     w.write_record(&header)?;
     for r in rows {
@@ -75,7 +76,7 @@ pub fn summary_csv(keys: &[String], columns: &[&str], rows: &[SummaryRow]) -> Re
         rec.extend(
             columns
                 .iter()
-                .map(|k| r.metrics.as_ref().and_then(|m| m.get(*k)).map(|v| summary_number(k, *v)).unwrap_or_default()),
+                .map(|k| r.metrics.as_ref().and_then(|m| m.get(*k)).map(|v| summary_number(*k, v)).unwrap_or_default()),
         );
         rec.push(r.error.as_deref().unwrap_or("").replace('\n', " "));
         w.write_record(&rec)?;
@@ -85,11 +86,11 @@ pub fn summary_csv(keys: &[String], columns: &[&str], rows: &[SummaryRow]) -> Re
 }
 
 /// The columns of the summary that count (iterations, frames): written as integers.
-pub const SUMMARY_INTEGER_METRICS: [&str; 3] = ["iterations", "frames", "iterations_max"];
+pub const SUMMARY_INTEGER_METRICS: [Metric; 3] = [Metric::Iterations, Metric::Frames, Metric::IterationsMax];
 
 /// A value of the summary: a count of [`SUMMARY_INTEGER_METRICS`] as an integer, any other
 /// number with 10 significant digits.
-fn summary_number(column: &str, v: f64) -> String {
+fn summary_number(column: Metric, v: f64) -> String {
     let mut s = String::new();
     if SUMMARY_INTEGER_METRICS.contains(&column) {
         crate::io::number::push_integer(&mut s, v, 10);
@@ -146,7 +147,7 @@ fn finish_point(dir: &Path, template: &Manifest, case: &Case, outcome: Solved) -
     if let Some(c) = &outcome.clip {
         m.frames.frames_done = Some(c.reports.len());
     }
-    match m.finish(dir, outcome.status.folder_status(), outcome.error.clone()) {
+    match m.finish(dir, outcome.status.into(), outcome.error.clone()) {
         Ok(()) => outcome,
         Err(e) => Solved::failed(chain(&e)),
     }
@@ -202,7 +203,7 @@ pub fn sweep_into(
             error: o.error.clone(),
         })
         .collect();
-    let columns: &[&str] = if case.clip().is_some() { &CLIP_SUMMARY_METRICS } else { &SUMMARY_METRICS };
+    let columns: &[Metric] = if case.clip().is_some() { &CLIP_SUMMARY_METRICS } else { &SUMMARY_METRICS };
     let text = summary_csv(keys, columns, &rows)
         .map_err(|e| OutputError::Invalid { path: dir.join("summary.csv"), reason: e.to_string() })?;
     crate::io::files::write_atomic(&dir.join("summary.csv"), text.as_bytes())?;
@@ -217,7 +218,7 @@ pub fn sweep_into(
 /// A point that a stop request kept from starting says so (its row, no folder).
 fn not_started(outcome: Solved) -> Solved {
     match outcome.status {
-        RunStatus::Interrupted => Solved { error: Some(NOT_STARTED.into()), ..outcome },
+        Outcome::Interrupted => Solved { error: Some(NOT_STARTED.into()), ..outcome },
         _ => outcome,
     }
 }
@@ -254,26 +255,26 @@ mod tests {
     #[test]
     fn summary_has_header_and_failures() {
         let mut m = Metrics::new();
-        m.insert("iterations".into(), 12.0);
+        m.insert(Metric::Iterations, 12.0);
         let rows = vec![
             SummaryRow {
                 name: String::new(),
                 point: vec![("lambda_l".into(), 1e-20.into())],
-                status: RunStatus::Ok,
+                status: Outcome::Converged,
                 metrics: Some(m.clone()),
                 error: None,
             },
             SummaryRow {
                 name: String::new(),
                 point: vec![("lambda_l".into(), 1e3.into())],
-                status: RunStatus::NotConverged,
+                status: Outcome::IterationLimit,
                 metrics: Some(m),
                 error: Some("did not converge,\nat all".into()),
             },
             SummaryRow {
                 name: String::new(),
                 point: vec![("lambda_l".into(), 1.0.into())],
-                status: RunStatus::Failed,
+                status: Outcome::Failed,
                 metrics: None,
                 error: Some("bad".into()),
             },

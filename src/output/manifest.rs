@@ -9,11 +9,16 @@ use sha2::{Digest, Sha256};
 use crate::case::sweep::SweepValue;
 use crate::clip::length::BodyLength;
 use crate::io::files::{is_temporary, write_atomic};
+use crate::solve::Outcome;
 
 /// File name of the manifest in an output folder.
 pub const MANIFEST: &str = "run.json";
 
-/// The state of a run.
+/// The state of an output folder's run in its `run.json`: running, or how it ended. Not the
+/// run's [`Outcome`] (the vocabulary of results, `solve::outcome`): a folder may still be
+/// running, and a run that reached its iteration limit leaves a `failed` folder; its words
+/// are `run.json`'s (`complete` where an outcome is `ok`). `Status::from(outcome)` is the one
+/// mapping.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Status {
@@ -27,6 +32,18 @@ pub enum Status {
     Stalled,
     Failed,
     Interrupted,
+}
+
+impl From<Outcome> for Status {
+    fn from(outcome: Outcome) -> Self {
+        match outcome {
+            Outcome::Converged => Status::Complete,
+            Outcome::IterationLimit | Outcome::Failed => Status::Failed,
+            Outcome::Stalled => Status::Stalled,
+            Outcome::CompleteWithWarnings => Status::CompleteWithWarnings,
+            Outcome::Interrupted => Status::Interrupted,
+        }
+    }
 }
 
 impl Status {

@@ -11,18 +11,21 @@ pub mod dynamics;
 pub mod fit;
 pub mod inverse;
 pub mod modes;
+pub mod outcome;
 pub mod problem;
 pub mod sequence;
 pub mod smoothing;
 pub mod stability;
 pub mod statics;
 
+pub use outcome::Outcome;
 pub use problem::Problem;
 
 use crate::linalg::LinearError;
 use crate::model;
 
-/// Why an iteration stopped with a usable iterate.
+/// Why an iteration stopped with a usable iterate: the part of a run's [`Outcome`] its
+/// solver decides (`Outcome::from`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Stop {
     /// the stopping rule was met and the residual certificate is within its tolerance
@@ -34,17 +37,6 @@ pub enum Stop {
     Stalled,
     /// the iteration limit was reached first; the solution holds the last iterate
     MaxIterations,
-}
-
-impl Stop {
-    /// The status word of outputs (`converged`, `stalled`, `not_converged`).
-    pub fn status(&self) -> &'static str {
-        match self {
-            Stop::Converged => "converged",
-            Stop::Stalled => "stalled",
-            Stop::MaxIterations => "not_converged",
-        }
-    }
 }
 
 /// A fixed point stops on its relative change only when the change has stayed within the

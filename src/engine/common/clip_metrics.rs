@@ -2,7 +2,7 @@
 //! audit): per-frame numbers of [`FrameReport`] reduced over the frames, with SI units in
 //! their names.
 use super::clip_summary::ClipRun;
-use super::metrics::Metrics;
+use super::metric::{Metric, Metrics};
 use crate::case::Case;
 use crate::solve::sequence::FrameReport;
 
@@ -44,48 +44,48 @@ pub fn clip_metrics(case: &Case, run: &ClipRun) -> Metrics {
     let r: &[FrameReport] = &run.reports;
     let mut m = Metrics::new();
     let n = r.len();
-    m.insert("frames".into(), n as f64);
+    m.insert(Metric::Frames, n as f64);
     let its: Vec<f64> = r.iter().map(|f| f.convergence.iterations as f64).collect();
-    m.insert("iterations".into(), its.iter().sum());
-    m.insert("iterations_mean".into(), its.iter().sum::<f64>() / n.max(1) as f64);
-    m.insert("iterations_max".into(), max(its.iter().copied()));
-    m.insert("restarts".into(), r.iter().filter(|f| f.restarted).count() as f64);
-    m.insert("x_err_rel_max".into(), max(r.iter().map(|f| f.misfit.x_err_rel)));
-    m.insert("x_err_rel_median".into(), median(r.iter().map(|f| f.misfit.x_err_rel).collect()));
+    m.insert(Metric::Iterations, its.iter().sum());
+    m.insert(Metric::IterationsMean, its.iter().sum::<f64>() / n.max(1) as f64);
+    m.insert(Metric::IterationsMax, max(its.iter().copied()));
+    m.insert(Metric::Restarts, r.iter().filter(|f| f.restarted).count() as f64);
+    m.insert(Metric::XErrRelMax, max(r.iter().map(|f| f.misfit.x_err_rel)));
+    m.insert(Metric::XErrRelMedian, median(r.iter().map(|f| f.misfit.x_err_rel).collect()));
     let d3_norm = case.mesh.length_m.sqrt();
-    m.insert("tangent_misfit_rel_max".into(), max(r.iter().map(|f| f.misfit.tangent_misfit / d3_norm)));
-    m.insert("max_abs_j_minus_1".into(), max(r.iter().map(|f| f.conditioning.max_stretch_deviation)));
-    m.insert("certificate".into(), max(r.iter().map(|f| f.certificate)));
-    m.insert("flagged_frames".into(), r.iter().filter(|f| f.fit.flagged).count() as f64);
-    m.insert("fit_position_rel_length_max".into(), max(r.iter().map(|f| f.fit.position)));
-    m.insert("fit_tangent_rms_max".into(), max(r.iter().map(|f| f.fit.tangent)));
-    m.insert("data_noise_m_median".into(), median(r.iter().map(|f| f.fit.noise_m).collect()));
-    m.insert("min_abs_cos_beta".into(), r.iter().map(|f| f.conditioning.min_cos_beta).fold(f64::INFINITY, f64::min));
+    m.insert(Metric::TangentMisfitRelMax, max(r.iter().map(|f| f.misfit.tangent_misfit / d3_norm)));
+    m.insert(Metric::MaxAbsJMinus1, max(r.iter().map(|f| f.conditioning.max_stretch_deviation)));
+    m.insert(Metric::Certificate, max(r.iter().map(|f| f.certificate)));
+    m.insert(Metric::FlaggedFrames, r.iter().filter(|f| f.fit.flagged).count() as f64);
+    m.insert(Metric::FitPositionRelLengthMax, max(r.iter().map(|f| f.fit.position)));
+    m.insert(Metric::FitTangentRmsMax, max(r.iter().map(|f| f.fit.tangent)));
+    m.insert(Metric::DataNoiseMedian, median(r.iter().map(|f| f.fit.noise_m).collect()));
+    m.insert(Metric::MinAbsCosBeta, r.iter().map(|f| f.conditioning.min_cos_beta).fold(f64::INFINITY, f64::min));
     let terms = |f: &FrameReport| {
         let o = &f.misfit.objective;
         [o.tracking, o.force, o.torque, o.shear, o.bending, o.angular, o.total()]
     };
-    for (k, name) in crate::solve::inverse::ObjectiveTerms::NAMES.iter().enumerate() {
-        m.insert(format!("{name}_median"), median(r.iter().map(|f| terms(f)[k]).collect()));
+    for (k, key) in Metric::OBJECTIVE_MEDIAN.into_iter().enumerate() {
+        m.insert(key, median(r.iter().map(|f| terms(f)[k]).collect()));
     }
     m.insert(
-        "shear_share_median".into(),
+        Metric::ShearShareMedian,
         median(r.iter().map(|f| f.misfit.objective.shear / f.misfit.objective.total()).collect()),
     );
     let mean = |v: &mut dyn Iterator<Item = f64>| {
         let (s, c) = v.fold((0.0, 0usize), |(s, c), x| (s + x, c + 1));
         s / c.max(1) as f64
     };
-    m.insert("kappa_roughness_mean".into(), mean(&mut run.roughness.iter().map(|r| r.0)));
-    m.insert("data_kappa_roughness_mean".into(), mean(&mut run.roughness.iter().map(|r| r.1)));
+    m.insert(Metric::KappaRoughnessMean, mean(&mut run.roughness.iter().map(|r| r.0)));
+    m.insert(Metric::DataKappaRoughnessMean, mean(&mut run.roughness.iter().map(|r| r.1)));
     if let Some(t) = &run.truth {
         let c = &t.comparisons;
-        m.insert("truth_x_err_rel_max".into(), max(c.iter().map(|c| c.position_rel_l2)));
-        m.insert("truth_bending_err_rel_max".into(), max(c.iter().map(|c| c.bending_rel_l2)));
-        m.insert("truth_tangent_angle_max_rad".into(), max(c.iter().map(|c| c.max_tangent_angle_rad)));
-        m.insert("truth_twist_rms_err_max_per_m".into(), max(c.iter().map(|c| c.twist_rms_error_per_m)));
+        m.insert(Metric::TruthXErrRelMax, max(c.iter().map(|c| c.position_rel_l2)));
+        m.insert(Metric::TruthBendingErrRelMax, max(c.iter().map(|c| c.bending_rel_l2)));
+        m.insert(Metric::TruthTangentAngleMax, max(c.iter().map(|c| c.max_tangent_angle_rad)));
+        m.insert(Metric::TruthTwistRmsErrMax, max(c.iter().map(|c| c.twist_rms_error_per_m)));
     }
-    m.insert("wall_time_s".into(), run.wall_time_s);
+    m.insert(Metric::WallTime, run.wall_time_s);
     m
 }
 

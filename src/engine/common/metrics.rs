@@ -1,7 +1,5 @@
 //! Metrics of a run (one function for both engines), the errors against the independent
 //! theory of a case's `[reference]`, and the Rust–FreeFEM comparison (D8).
-use std::collections::BTreeMap;
-
 use nalgebra::{DVector, Vector3};
 
 use super::result::InverseOutput;
@@ -9,29 +7,27 @@ use super::result::{NodalState, PathOutput, RunResult};
 use crate::case::{Case, Reference};
 use crate::model::mesh::Mesh;
 use crate::reference::{timoshenko_tip_deflection, tip_loaded_cantilever, PlanarRod, ReferenceError};
-use crate::solve::inverse::ObjectiveTerms;
 
-/// Flat map metric name → value (`metrics.json`). Names carry SI units.
-pub type Metrics = BTreeMap<String, f64>;
+pub use super::metric::{Metric, Metrics};
 
 /// Physical metrics compared between engines.
 pub fn physical_metrics(r: &RunResult) -> Metrics {
     let mut m = Metrics::new();
     let last = r.nodes.x.len() - 1;
     let (x, a) = (r.nodes.x[last], r.nodes.alpha[last]);
-    for (k, name) in ["x", "y", "z"].iter().enumerate() {
-        m.insert(format!("tip_{name}_m"), x[k]);
+    for (k, key) in Metric::TIP_POSITION.into_iter().enumerate() {
+        m.insert(key, x[k]);
     }
-    for (k, name) in ["alpha", "beta", "gamma"].iter().enumerate() {
-        m.insert(format!("tip_{name}_rad"), a[k]);
+    for (k, key) in Metric::TIP_ANGLES.into_iter().enumerate() {
+        m.insert(key, a[k]);
     }
     if !r.tip.is_empty() {
         let max_abs = |k: usize| r.tip.iter().fold(0.0_f64, |acc, t| acc.max(t.position_m[k].abs()));
-        m.insert("tip_max_abs_x_m".into(), max_abs(0));
-        m.insert("tip_max_abs_y_m".into(), max_abs(1));
+        m.insert(Metric::TipMaxAbsX, max_abs(0));
+        m.insert(Metric::TipMaxAbsY, max_abs(1));
         let max_abs_a = |k: usize| r.tip.iter().fold(0.0_f64, |acc, t| acc.max(t.angles_rad[k].abs()));
-        m.insert("tip_max_abs_beta_rad".into(), max_abs_a(1));
-        m.insert("tip_max_abs_gamma_rad".into(), max_abs_a(2));
+        m.insert(Metric::TipMaxAbsBeta, max_abs_a(1));
+        m.insert(Metric::TipMaxAbsGamma, max_abs_a(2));
     }
     if let Some(p) = &r.path {
         path_metrics(p, &mut m);
@@ -39,8 +35,8 @@ pub fn physical_metrics(r: &RunResult) -> Metrics {
     if let Some(st) = &r.stability {
         stability_metrics(st, &mut m);
     }
-    for (k, c) in centroid(&r.nodes.s, &r.nodes.x).iter().enumerate() {
-        m.insert(format!("centroid_{}_m", ["x", "y", "z"][k]), *c);
+    for (key, c) in Metric::CENTROID.into_iter().zip(centroid(&r.nodes.s, &r.nodes.x).iter()) {
+        m.insert(key, *c);
     }
     m
 }
@@ -60,13 +56,13 @@ pub fn centroid(s: &[f64], x: &[Vector3<f64>]) -> Vector3<f64> {
 /// when it is positive, else 0), `buckling_{k}_load_factor` (k = 1, 2, …, ascending).
 fn stability_metrics(st: &super::result::StabilityOutput, m: &mut Metrics) {
     if let Some(mu) = st.smallest_eigenvalue_per_s2 {
-        m.insert("tangent_smallest_eigenvalue_per_s2".into(), mu);
+        m.insert(Metric::TangentSmallestEigenvalue, mu);
         if st.conservative {
-            m.insert("stable".into(), if mu > 0.0 { 1.0 } else { 0.0 });
+            m.insert(Metric::Stable, if mu > 0.0 { 1.0 } else { 0.0 });
         }
     }
     for (k, mode) in st.modes.iter().enumerate() {
-        m.insert(format!("buckling_{}_load_factor", k + 1), mode.load_factor);
+        m.insert_named(format!("buckling_{}_load_factor", k + 1), mode.load_factor);
     }
 }
 
@@ -75,14 +71,14 @@ fn stability_metrics(st: &super::result::StabilityOutput, m: &mut Metrics) {
 fn path_metrics(p: &PathOutput, m: &mut Metrics) {
     use crate::solve::arclength::Critical;
     if let Some(last) = p.points.last() {
-        m.insert("final_load_factor".into(), last.load_factor);
+        m.insert(Metric::FinalLoadFactor, last.load_factor);
     }
-    m.insert("path_points".into(), p.points.len() as f64);
+    m.insert(Metric::PathPoints, p.points.len() as f64);
     if let Some(c) = p.critical.iter().find(|c| matches!(c, Critical::Limit { .. })) {
-        m.insert("limit_load_factor".into(), c.load_factor());
+        m.insert(Metric::LimitLoadFactor, c.load_factor());
     }
     if let Some(c) = p.critical.iter().find(|c| matches!(c, Critical::Bifurcation { .. })) {
-        m.insert("bifurcation_load_factor".into(), c.load_factor());
+        m.insert(Metric::BifurcationLoadFactor, c.load_factor());
     }
 }
 
@@ -103,19 +99,19 @@ pub fn inverse_metrics(r: &RunResult) -> Metrics {
     let mut m = Metrics::new();
     let Some(inv) = &r.inverse else { return m };
     let Some(last) = inv.history.last() else { return m };
-    m.insert("x_err_rel".into(), last.x_err_rel);
-    m.insert("tangent_misfit_m05".into(), last.tangent_misfit);
+    m.insert(Metric::XErrRel, last.x_err_rel);
+    m.insert(Metric::TangentMisfit, last.tangent_misfit);
     if inv.angles_known {
         let k: Vec<_> = r.nodes.element_curvature().into_iter().map(|(_, k)| k).collect();
         let kf: Vec<_> = inv.data.element_curvature().into_iter().map(|(_, k)| k).collect();
-        m.insert("kappa_err_rel".into(), relative_error(&k, &kf, 0));
-        m.insert("kappa_err_rel_inner".into(), relative_error(&k, &kf, INNER_SKIP_ELEMENTS));
+        m.insert(Metric::KappaErrRel, relative_error(&k, &kf, 0));
+        m.insert(Metric::KappaErrRelInner, relative_error(&k, &kf, INNER_SKIP_ELEMENTS));
     }
-    for (name, v) in ObjectiveTerms::NAMES.iter().zip(last.objective.values()) {
-        m.insert(name.to_string(), v);
+    for (key, v) in Metric::OBJECTIVE.into_iter().zip(last.objective.values()) {
+        m.insert(key, v);
     }
-    m.insert("force_l2_n_per_m05".into(), (2.0 * last.objective.force / inv.lambda_f).sqrt());
-    m.insert("torque_l2_n_m05".into(), (2.0 * last.objective.torque / inv.lambda_l).sqrt());
+    m.insert(Metric::ForceL2, (2.0 * last.objective.force / inv.lambda_f).sqrt());
+    m.insert(Metric::TorqueL2, (2.0 * last.objective.torque / inv.lambda_l).sqrt());
     m
 }
 
@@ -164,9 +160,13 @@ pub fn reference_metrics(case: &Case, r: &RunResult, m: &mut Metrics) -> Result<
     };
     let elastica = tip_loaded_cantilever(&rod(false), force_n)?.tip_y_m;
     let reissner = tip_loaded_cantilever(&rod(true), force_n)?.tip_y_m;
-    for (name, value) in [("eq63", eq63), ("elastica", elastica), ("reissner", reissner)] {
-        m.insert(format!("{name}_tip_y_m"), value);
-        m.insert(format!("{name}_rel_error"), tip_y / value - 1.0);
+    for (tip, error, value) in [
+        (Metric::Eq63TipY, Metric::Eq63RelError, eq63),
+        (Metric::ElasticaTipY, Metric::ElasticaRelError, elastica),
+        (Metric::ReissnerTipY, Metric::ReissnerRelError, reissner),
+    ] {
+        m.insert(tip, value);
+        m.insert(error, tip_y / value - 1.0);
     }
     Ok(())
 }
@@ -178,20 +178,20 @@ pub fn all_metrics(case: &Case, r: &RunResult) -> Result<Metrics, ReferenceError
     let mut m = physical_metrics(r);
     m.extend(inverse_metrics(r));
     reference_metrics(case, r, &mut m)?;
-    m.insert("iterations".into(), r.stats.iterations as f64);
+    m.insert(Metric::Iterations, r.stats.iterations as f64);
     if let Some(v) = r.stats.last_change {
-        m.insert("last_change".into(), v);
+        m.insert(Metric::LastChange, v);
     }
     if let Some(v) = r.stats.residual {
-        m.insert("relative_residual".into(), v);
+        m.insert(Metric::RelativeResidual, v);
     }
     if let Some(v) = r.stats.max_newton_iterations {
-        m.insert("max_newton_iterations".into(), v as f64);
+        m.insert(Metric::MaxNewtonIterations, v as f64);
     }
     if let Some(v) = r.stats.certificate {
-        m.insert("certificate".into(), v);
+        m.insert(Metric::Certificate, v);
     }
-    m.insert("wall_time_s".into(), r.stats.wall_time_s);
+    m.insert(Metric::WallTime, r.stats.wall_time_s);
     let published = super::published::evaluate(case, r, &m);
     m.extend(super::published::metric_entries(&published));
     Ok(m)
@@ -236,7 +236,7 @@ pub struct Difference {
 
 /// Metrics the FreeFEM engine does not compute (the mass-matrix eigen-analysis of a static
 /// state, D27): compared only when both runs have them.
-pub const RUST_ONLY_METRICS: [&str; 2] = ["tangent_smallest_eigenvalue_per_s2", "stable"];
+pub const RUST_ONLY_METRICS: [Metric; 2] = [Metric::TangentSmallestEigenvalue, Metric::Stable];
 
 /// The quantities two runs of the same case are compared on: node-wise displacement, angles
 /// and (inverse) adjoints, the tip history of a dynamic run, the physical metrics, the recovery
@@ -262,8 +262,8 @@ pub fn differences(a: &RunResult, b: &RunResult, iterations: bool) -> Vec<Differ
         rows.push(Difference::field("node_count", Group::Displacement, f64::INFINITY));
     }
     let (ma, mb) = (physical_metrics(a), physical_metrics(b));
-    for (name, &x) in &ma {
-        if RUST_ONLY_METRICS.contains(&name.as_str()) && !mb.contains_key(name) {
+    for (name, x) in ma.iter() {
+        if RUST_ONLY_METRICS.iter().any(|k| k.as_str() == name) && mb.named(name).is_none() {
             continue;
         }
         let bound = if name.ends_with("_rad") {
@@ -271,14 +271,14 @@ pub fn differences(a: &RunResult, b: &RunResult, iterations: bool) -> Vec<Differ
         } else if name.ends_with("load_factor") {
             // a load factor on the path moves with the state it balances, R(u, λ) = 0: relatively
             Some((Group::Displacement, x.abs()))
-        } else if name == "path_points" || name == "stable" {
+        } else if name == Metric::PathPoints.as_str() || name == Metric::Stable.as_str() {
             None // a count or a verdict: equal, or the runs differ
-        } else if name == "tangent_smallest_eigenvalue_per_s2" {
+        } else if name == Metric::TangentSmallestEigenvalue.as_str() {
             Some((Group::Displacement, x.abs()))
         } else {
             Some((Group::Displacement, disp_scale))
         };
-        rows.push(Difference::scalar(name, Group::Metric, Some(x), mb.get(name).copied(), bound));
+        rows.push(Difference::scalar(name, Group::Metric, Some(x), mb.named(name), bound));
     }
     if let (Some(p), Some(q)) = (&a.path, &b.path) {
         rows.extend(path_differences(p, q));
@@ -355,13 +355,14 @@ fn recovery_differences(a: &RunResult, b: &RunResult, x: &InverseOutput, angle_s
     let kf: Vec<f64> = x.data.element_curvature().iter().map(|(_, k)| k.norm_squared()).collect();
     let k_rms = (kf.iter().sum::<f64>() / kf.len().max(1) as f64).sqrt();
     let h = a.nodes.s.get(1).copied().unwrap_or(1.0) - a.nodes.s.first().copied().unwrap_or(0.0);
-    for name in ["x_err_rel", "kappa_err_rel", "kappa_err_rel_inner"].into_iter().filter(|n| ma.contains_key(*n)) {
-        let bound = if name == "x_err_rel" {
+    for key in [Metric::XErrRel, Metric::KappaErrRel, Metric::KappaErrRelInner].into_iter().filter(|k| ma.contains(*k))
+    {
+        let bound = if key == Metric::XErrRel {
             (Group::Displacement, 1.0)
         } else {
             (Group::Angles, 2.0 * angle_scale / (h * k_rms))
         };
-        rows.push(Difference::scalar(name, Group::Metric, ma.get(name).copied(), mb.get(name).copied(), Some(bound)));
+        rows.push(Difference::scalar(key.as_str(), Group::Metric, ma.get(key), mb.get(key), Some(bound)));
     }
     rows
 }

@@ -7,6 +7,7 @@ pub mod clip_frame;
 pub mod clip_metrics;
 pub mod clip_summary;
 pub mod frames;
+pub mod metric;
 pub mod metrics;
 pub mod published;
 pub mod result;

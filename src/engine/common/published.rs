@@ -3,18 +3,14 @@
 //! number, its error and whether it is within the tolerance. `run` writes the rows to
 //! `reference.csv` and `metrics.json` ([`metric_entries`]); [`unavailable`] refuses, before any
 //! run, a quantity the case's analysis does not compute.
-use std::collections::BTreeMap;
 
 use nalgebra::Vector3;
 
 use super::result::{NodalState, RunResult};
 use crate::case::published::{NodeField, PublishedValue, Quantity};
 use crate::case::{Analysis, Case, Reference};
-use crate::solve::inverse::ObjectiveTerms;
 
-/// Metric name → value, as `metrics.json` (`super::metrics::Metrics`, named here so that the
-/// metrics may use this module).
-type Metrics = BTreeMap<String, f64>;
+use super::metric::{Metric, Metrics};
 
 /// One published value against one run.
 #[derive(Clone, Debug, PartialEq)]
@@ -92,7 +88,7 @@ pub fn value(q: &Quantity, r: &RunResult, m: &Metrics) -> Result<f64, String> {
             Ok(nodal(&r.nodes, *field, last))
         }
         Quantity::Node { s_m, field } => at_arc_length(&r.nodes, *field, *s_m),
-        Quantity::Metric(key) => m.get(key).copied().ok_or_else(|| format!("{key} is not in this run's metrics.json")),
+        Quantity::Metric(key) => m.named(key).ok_or_else(|| format!("{key} is not in this run's metrics.json")),
     }
 }
 
@@ -130,16 +126,16 @@ pub fn metric_entries(rows: &[PublishedRow]) -> Metrics {
     }
     for r in rows {
         let key = |what: &str| format!("reference.{}.{what}", r.quantity);
-        m.insert(key("published"), r.published);
+        m.insert_named(key("published"), r.published);
         if let Ok(c) = r.computed {
-            m.insert(key("computed"), c);
-            m.insert(key("error"), r.error);
+            m.insert_named(key("computed"), c);
+            m.insert_named(key("error"), r.error);
         }
-        m.insert(key("tolerance"), r.tolerance);
-        m.insert(key("pass"), f64::from(u8::from(r.pass)));
+        m.insert_named(key("tolerance"), r.tolerance);
+        m.insert_named(key("pass"), f64::from(u8::from(r.pass)));
     }
-    m.insert("reference.rows".into(), rows.len() as f64);
-    m.insert("reference.missed".into(), rows.iter().filter(|r| !r.pass).count() as f64);
+    m.insert_named("reference.rows", rows.len() as f64);
+    m.insert_named("reference.missed", rows.iter().filter(|r| !r.pass).count() as f64);
     m
 }
 
@@ -148,39 +144,37 @@ pub fn metric_entries(rows: &[PublishedRow]) -> Metrics {
 /// recovery errors and objective, the `[reference]` theory's errors, and solver statistics
 /// (some of which one engine or analysis leaves out: such a row is then not computed).
 pub fn metric_keys(case: &Case) -> Vec<String> {
-    let mut keys: Vec<String> = ["x", "y", "z"].iter().map(|c| format!("tip_{c}_m")).collect();
-    keys.extend(["alpha", "beta", "gamma"].iter().map(|a| format!("tip_{a}_rad")));
-    keys.extend(["x", "y", "z"].iter().map(|c| format!("centroid_{c}_m")));
+    use Metric as M;
+    let mut keys: Vec<Metric> = [Metric::TIP_POSITION, Metric::TIP_ANGLES, Metric::CENTROID].concat();
     match &case.analysis {
-        Analysis::Static(crate::solve::statics::StaticParams { path: Some(_), .. }) => keys.extend(
-            ["final_load_factor", "path_points", "limit_load_factor", "bifurcation_load_factor"].map(String::from),
-        ),
-        Analysis::Dynamic(_) => keys.extend(
-            ["tip_max_abs_x_m", "tip_max_abs_y_m", "tip_max_abs_beta_rad", "tip_max_abs_gamma_rad"].map(String::from),
-        ),
+        Analysis::Static(crate::solve::statics::StaticParams { path: Some(_), .. }) => {
+            keys.extend([M::FinalLoadFactor, M::PathPoints, M::LimitLoadFactor, M::BifurcationLoadFactor])
+        }
+        Analysis::Dynamic(_) => keys.extend([M::TipMaxAbsX, M::TipMaxAbsY, M::TipMaxAbsBeta, M::TipMaxAbsGamma]),
         Analysis::Inverse(_) => {
-            keys.extend(["x_err_rel", "tangent_misfit_m05", "kappa_err_rel", "kappa_err_rel_inner"].map(String::from));
-            keys.extend(ObjectiveTerms::NAMES.iter().map(|n| n.to_string()));
-            keys.extend(["force_l2_n_per_m05", "torque_l2_n_m05"].map(String::from));
+            keys.extend([M::XErrRel, M::TangentMisfit, M::KappaErrRel, M::KappaErrRelInner]);
+            keys.extend(Metric::OBJECTIVE);
+            keys.extend([M::ForceL2, M::TorqueL2]);
         }
         Analysis::Static(_) => {}
     }
+    let mut names = Vec::new();
     if let Analysis::Static(p) = &case.analysis {
         if super::dense_analyses_fit(case) {
             // `stable`: conservative loads only (D27)
-            keys.extend(["tangent_smallest_eigenvalue_per_s2", "stable"].map(String::from));
+            keys.extend([M::TangentSmallestEigenvalue, M::Stable]);
         }
-        keys.extend((1..=p.buckling_modes).map(|k| format!("buckling_{k}_load_factor")));
+        names.extend((1..=p.buckling_modes).map(|k| format!("buckling_{k}_load_factor")));
     }
+    let mut after = Vec::new();
     if let Some(Reference::TipLoadedCantilever { .. }) = case.checks.reference {
-        for name in ["eq63", "elastica", "reissner"] {
-            keys.extend([format!("{name}_tip_y_m"), format!("{name}_rel_error")]);
-        }
+        after.extend([M::Eq63TipY, M::Eq63RelError, M::ElasticaTipY, M::ElasticaRelError]);
+        after.extend([M::ReissnerTipY, M::ReissnerRelError]);
     }
-    let stats =
-        ["iterations", "last_change", "relative_residual", "max_newton_iterations", "certificate", "wall_time_s"];
-    keys.extend(stats.map(String::from));
-    keys
+    after.extend([M::Iterations, M::LastChange, M::RelativeResidual, M::MaxNewtonIterations]);
+    after.extend([M::Certificate, M::WallTime]);
+    let text = |k: &[Metric]| k.iter().map(|k| k.as_str().to_string()).collect::<Vec<_>>();
+    [text(&keys), names, text(&after)].concat()
 }
 
 /// Why `case` cannot check its published values, if it cannot: a `metric.KEY` that its run

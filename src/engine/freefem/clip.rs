@@ -13,7 +13,7 @@ use crate::case::Case;
 use crate::engine::common::frames::{frame_result, FrameSolution, SolvedFrame};
 use crate::engine::common::result::{Engine, NodalState};
 use crate::engine::freefem::{
-    execute, info_certificate, io, read_info, read_table, ClipInclude, FreeFemError, RunOptions,
+    execute, info_certificate, io, read_info, read_table, ClipInclude, FreeFemError, RunOptions, FAILED_STATUS,
 };
 use crate::model::chart::Chart;
 use crate::solve::certificate::Certificate;
@@ -87,7 +87,7 @@ pub fn run_clip(
     };
     let outputs = ["ff_clip_nodes.csv", "ff_clip_frames.csv", "ff_info.csv"];
     match execute(case, workdir, "clip.edp", &outputs, &opts) {
-        Ok(()) | Err(FreeFemError::Failed { status: 2, .. }) => read_clip_run(case, frames, workdir),
+        Ok(()) | Err(FreeFemError::Failed { status: FAILED_STATUS, .. }) => read_clip_run(case, frames, workdir),
         Err(e) => Err(e),
     }
 }
@@ -103,9 +103,8 @@ pub fn read_clip_run(case: &Case, frames: &[Vec<Vector3<f64>>], workdir: &Path) 
     // the driver's `FAILED: frame K: …` line (its output, `execute`'s log)
     let output = std::fs::read_to_string(workdir.join("freefem_output.txt")).unwrap_or_default();
     let error = output.lines().find(|l| l.starts_with("FAILED")).map(str::to_string);
-    // solveFrame's code 4: the frame stalled (freefem/inverse_core.idp)
     let stalled = match get("failed_frame") {
-        Some(frame) if get("failed_status") == Some(4.0) => {
+        Some(frame) if get("failed_status").and_then(FrameCode::from_info) == Some(FrameCode::Stalled) => {
             let c = info
                 .as_ref()
                 .and_then(info_certificate)
@@ -124,6 +123,31 @@ pub fn read_clip_run(case: &Case, frames: &[Vec<Vector3<f64>>], workdir: &Path) 
     };
     let wall_time_s = get("wall_time_s").unwrap_or_else(|| frames_out.iter().map(|f| f.result.stats.wall_time_s).sum());
     Ok(FreeFemFrames { frames: frames_out, error, stalled, wall_time_s })
+}
+
+/// The return code of `solveFrame` (`freefem/inverse_core.idp`) that stopped a clip, its
+/// `failed_status` in `ff_info.csv` (`freefem/clip.edp`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum FrameCode {
+    Converged = 0,
+    IterationLimit = 1,
+    /// the message in `failMsg`
+    Diverged = 2,
+    NonFiniteSolve = 3,
+    /// the stopping rule met, the certificate above its tolerance ([`crate::solve::Stop::Stalled`])
+    Stalled = 4,
+    /// the angle chart's guard (`min_cos_beta`)
+    ChartGuard = 5,
+}
+
+impl FrameCode {
+    /// The code of a `failed_status` value, if it is one.
+    fn from_info(value: f64) -> Option<FrameCode> {
+        use FrameCode::*;
+        [Converged, IterationLimit, Diverged, NonFiniteSolve, Stalled, ChartGuard]
+            .into_iter()
+            .find(|c| *c as i32 as f64 == value)
+    }
 }
 
 /// Columns of `ff_clip_frames.csv` (the contract of `freefem/clip.edp`).

@@ -31,7 +31,7 @@ use crate::solve::certificate::Certificate;
 use crate::solve::dynamics::TipRecord;
 use crate::solve::inverse::{InverseRecord, ObjectiveTerms};
 use crate::solve::statics::{IterationRecord, Method};
-use crate::solve::{SolveError, Step};
+use crate::solve::{SolveError, Step, Stop};
 
 /// Environment variable pointing at the `freefem/` script directory (default: the crate's).
 pub const SCRIPT_DIR_ENV: &str = "COSSERAT_FREEFEM_DIR";
@@ -79,6 +79,9 @@ pub const STALLED_STATUS: i32 = 3;
 /// Exit status of a static or single-frame inverse FreeFEM run that reached its iteration limit
 /// (`FAILED: …`); its outputs hold the last iterate.
 pub const ITERATION_LIMIT_STATUS: i32 = 4;
+/// Exit status of a FreeFEM script that failed after writing what it had (`FAILED: …`; the
+/// clip script: the frames before its failed frame, and that frame's code in `ff_info.csv`).
+pub const FAILED_STATUS: i32 = 2;
 
 /// The keys of `ff_info.csv` holding the certificate's blocks, in the order of
 /// [`Certificate::blocks`] (the forward scripts write the first two).
@@ -97,30 +100,20 @@ fn optional_certificate(v: f64) -> Option<f64> {
     (v >= 0.0).then_some(v)
 }
 
-/// How a FreeFEM run with a result ended.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum End {
-    /// its stopping rule met and its result certified
-    Converged,
-    /// exit status [`STALLED_STATUS`]
-    Stalled,
-    /// exit status [`ITERATION_LIMIT_STATUS`]
-    IterationLimit,
-}
-
 /// Run `script`: how it ended when its outputs hold a result (the last iterate when not
-/// converged), else the error.
+/// converged), as the Rust engine's solvers say it ([`Stop`]: exit status 0 converged,
+/// [`STALLED_STATUS`] stalled, [`ITERATION_LIMIT_STATUS`] the iteration limit), else the error.
 fn execute_to_end(
     case: &Case,
     workdir: &Path,
     script: &str,
     outputs: &[&str],
     opts: &RunOptions,
-) -> Result<End, FreeFemError> {
+) -> Result<Stop, FreeFemError> {
     match execute(case, workdir, script, outputs, opts) {
-        Ok(()) => Ok(End::Converged),
-        Err(FreeFemError::Failed { status: STALLED_STATUS, .. }) => Ok(End::Stalled),
-        Err(FreeFemError::Failed { status: ITERATION_LIMIT_STATUS, .. }) => Ok(End::IterationLimit),
+        Ok(()) => Ok(Stop::Converged),
+        Err(FreeFemError::Failed { status: STALLED_STATUS, .. }) => Ok(Stop::Stalled),
+        Err(FreeFemError::Failed { status: ITERATION_LIMIT_STATUS, .. }) => Ok(Stop::MaxIterations),
         Err(e) => Err(e),
     }
 }
@@ -282,7 +275,7 @@ fn read_inverse_info(workdir: &Path) -> Result<(SolverStats, Option<Certificate>
 /// (`InverseSolution::converged`), from how `inverse.edp` ended and its history; `None`:
 /// converged and certified.
 fn inverse_stop(
-    end: End,
+    end: Stop,
     history: &[InverseRecord],
     certificate: Option<Certificate>,
     tolerance: f64,
@@ -293,8 +286,8 @@ fn inverse_stop(
     let newton = history.iter().any(|r| r.residual.is_some());
     let c = certificate.unwrap_or(Certificate { value: f64::NAN, blocks: [f64::NAN; 4] });
     match (end, last.and_then(|r| r.residual)) {
-        (End::Converged, _) => None,
-        (End::Stalled, _) => Some(SolveError::Stalled(Box::new(crate::solve::Stall {
+        (Stop::Converged, _) => None,
+        (Stop::Stalled, _) => Some(SolveError::Stalled(Box::new(crate::solve::Stall {
             solver: format!("inverse {} of frame 0", if newton { "Newton" } else { "fixed point" }),
             iterations,
             rel_change,
@@ -302,16 +295,16 @@ fn inverse_stop(
             tolerance,
             block: c.worst_block(true),
         }))),
-        (End::IterationLimit, Some(residual)) => {
+        (Stop::MaxIterations, Some(residual)) => {
             Some(SolveError::InverseNewtonNotConverged { frame: 0, iterations, residual, certificate: c.value })
         }
-        (End::IterationLimit, None) if newton => Some(SolveError::InverseNewtonNotConverged {
+        (Stop::MaxIterations, None) if newton => Some(SolveError::InverseNewtonNotConverged {
             frame: 0,
             iterations,
             residual: f64::NAN,
             certificate: c.value,
         }),
-        (End::IterationLimit, None) => Some(SolveError::InverseNotConverged { frame: 0, iterations, rel_change }),
+        (Stop::MaxIterations, None) => Some(SolveError::InverseNotConverged { frame: 0, iterations, rel_change }),
     }
 }
 
@@ -330,8 +323,8 @@ pub fn run(case: &Case, workdir: &Path) -> Result<RunResult, FreeFemError> {
         last.map(|r| (r.step, r.iteration, r.change)).unwrap_or((1, result.stats.iterations, f64::NAN));
     let c = certificate.unwrap_or(Certificate { value: f64::NAN, blocks: [f64::NAN; 4] });
     let source = match (end, newton) {
-        (End::Converged, _) => return Ok(result),
-        (End::Stalled, _) => SolveError::Stalled(Box::new(crate::solve::Stall {
+        (Stop::Converged, _) => return Ok(result),
+        (Stop::Stalled, _) => SolveError::Stalled(Box::new(crate::solve::Stall {
             solver: if newton { "static Newton" } else { "static fixed point" }.to_string(),
             iterations: result.stats.iterations,
             rel_change: change,
@@ -339,8 +332,8 @@ pub fn run(case: &Case, workdir: &Path) -> Result<RunResult, FreeFemError> {
             tolerance: case.certificate_tolerance(),
             block: c.worst_block(false),
         })),
-        (End::IterationLimit, false) => SolveError::FixedPointNotConverged { step, iterations, rel_change: change },
-        (End::IterationLimit, true) => {
+        (Stop::MaxIterations, false) => SolveError::FixedPointNotConverged { step, iterations, rel_change: change },
+        (Stop::MaxIterations, true) => {
             SolveError::NewtonNotConverged { step: Some(Step::Continuation(step)), iterations, increment: change }
         }
     };

@@ -7,7 +7,7 @@ use nalgebra::Vector3;
 use super::{run_forward, run_inverse, RunError};
 use crate::case::published::{Axis, NodeField, PublishedValue, Quantity, Tolerance};
 use crate::case::{Analysis, Case};
-use crate::engine::common::metrics::{all_metrics, Metrics};
+use crate::engine::common::metrics::{all_metrics, Metric, Metrics};
 use crate::engine::common::published::*;
 use crate::engine::common::result::{Engine, SolverStats};
 use crate::engine::common::result::{NodalState, RunResult};
@@ -76,8 +76,8 @@ fn rows_pass_within_their_tolerance_only() {
     let (n, [a, b, ..]) = linear_state();
     let r = result(n);
     let mut m = Metrics::new();
-    m.insert("iterations".into(), 7.0);
-    m.insert("odd".into(), f64::NAN);
+    m.insert(Metric::Iterations, 7.0);
+    m.insert_named("odd", f64::NAN);
     let tip_y = a[1] + b[1];
     let cases = [
         (published("tip.y_m", tip_y + 0.9e-3, Tolerance::Absolute(1e-3)), true),
@@ -98,9 +98,9 @@ fn rows_pass_within_their_tolerance_only() {
     let rows: Vec<PublishedRow> =
         cases[..2].iter().map(|(v, _)| PublishedRow::new(v, value(&v.quantity, &r, &m))).collect();
     let e = metric_entries(&rows);
-    assert_eq!(e["reference.tip.y_m.pass"], 0.0, "the last row of a quantity is the one kept: {e:?}");
-    assert_eq!((e["reference.rows"], e["reference.missed"]), (2.0, 1.0));
-    assert!((e["reference.tip.y_m.error"] + 1.1e-3).abs() < 1e-12, "computed − published");
+    assert_eq!(e.named("reference.tip.y_m.pass").unwrap(), 0.0, "the last row of a quantity is the one kept: {e:?}");
+    assert_eq!((e.named("reference.rows").unwrap(), e.named("reference.missed").unwrap()), (2.0, 1.0));
+    assert!((e.named("reference.tip.y_m.error").unwrap() + 1.1e-3).abs() < 1e-12, "computed − published");
     assert!(metric_entries(&[]).is_empty());
 }
 
@@ -131,7 +131,7 @@ fn metric_keys_cover_what_runs_write() {
     ] {
         let keys = metric_keys(c);
         let written = all_metrics(c, &r).expect("metrics");
-        let unlisted: Vec<&String> = written.keys().filter(|k| !keys.contains(k)).collect();
+        let unlisted: Vec<&str> = written.names().filter(|k| !keys.iter().any(|n| n == k)).collect();
         assert!(unlisted.is_empty(), "{}: metrics.json keys missing from metric_keys: {unlisted:?}", c.name);
         assert!(written.len() >= keys.len() - 3, "{}: {written:?} against {keys:?}", c.name);
     }
