@@ -144,6 +144,19 @@ fn an_interrupted_batch_stops_at_the_next_frame_and_says_what_it_kept() {
         assert!(start.elapsed().as_secs() < 60 && child.try_wait().expect("try_wait").is_none(), "no progress");
         std::thread::sleep(std::time::Duration::from_millis(5));
     }
+    // while it runs, no second batch nor a gather writes into its folder, by any of its names
+    let link = tmp.path().join("out-link");
+    std::os::unix::fs::symlink(&out, &link).expect("symlink");
+    let held = format!("being written by another cosserat process (pid {})", child.id());
+    for name in [&out, &link] {
+        let second = batch_command(&recs, name, &[]).output().expect("second batch");
+        let e = String::from_utf8_lossy(&second.stderr);
+        assert!(!second.status.success() && e.contains(&held) && e.contains("before this batch"), "{e}");
+        let gather = cosserat().arg("gather").arg(name).output().expect("gather");
+        let e = String::from_utf8_lossy(&gather.stderr);
+        assert!(!gather.status.success() && e.contains(&held) && e.contains("before this gather"), "{e}");
+    }
+    assert!(std::fs::symlink_metadata(&link).expect("link").file_type().is_symlink(), "the link is kept");
     let _ = std::process::Command::new("kill").args(["-INT", &child.id().to_string()]).status();
     let o = child.wait_with_output().expect("wait");
     let stderr = String::from_utf8_lossy(&o.stderr);

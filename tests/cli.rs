@@ -464,3 +464,19 @@ fn everyday_mistakes_get_messages_that_say_what_happened() {
     assert!(stderr.contains("(an expression of 200000 characters)") && stderr.contains("nested more than"), "{stderr}");
     assert!(stderr.len() < 1000, "a line, not the expression: {} bytes", stderr.len());
 }
+
+/// `--out` given as a symbolic link is written through it (the link is kept, the folder it
+/// names holds the run), and a run into the folder by its real name finds the link's run.
+#[test]
+fn an_output_folder_given_as_a_symlink_is_written_through_it() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let (real, link) = (dir.path().join("real"), dir.path().join("link"));
+    std::fs::create_dir(&real).expect("folder");
+    std::os::unix::fs::symlink(&real, &link).expect("symlink");
+    cosserat().args(["run", "cases/timoshenko_5pct.toml", "--quiet", "--out"]).arg(&link).assert().success();
+    assert!(std::fs::symlink_metadata(&link).expect("link").file_type().is_symlink(), "the link is kept");
+    assert!(real.join("run.json").is_file(), "the run is in the folder the link names");
+    // the same folder by its other name: a run of its own, replaced as any earlier run is
+    cosserat().args(["run", "cases/timoshenko_5pct.toml", "--quiet", "--out"]).arg(&real).assert().success();
+    assert!(link.join("run.json").is_file());
+}

@@ -159,9 +159,9 @@ pub fn cmd_batch(a: BatchArgs) -> Result<ExitCode> {
     plan.format = a.output_format.into();
     // the case is read (and refused if it is not a clip case) before anything is written
     let (case, _) = batch::plan_case(&plan).with_context(|| format!("batch of {}", a.case.display()))?;
-    let _lock = lock_batch(&a.out)?;
-    plan.begin(&a.out)?;
-    let out = std::fs::canonicalize(&a.out).with_context(|| format!("output folder {}", a.out.display()))?;
+    let (_lock, real) = lock_batch(&a.out, "batch")?;
+    plan.begin(&real)?;
+    let out = std::fs::canonicalize(&real).with_context(|| format!("output folder {}", a.out.display()))?;
     if a.slurm.submit {
         return submit_batch(&a.slurm, a.quiet, &plan, &out, &case.name);
     }
@@ -174,20 +174,29 @@ pub fn cmd_batch(a: BatchArgs) -> Result<ExitCode> {
 }
 
 /// The lock of a batch's output folder while this process writes its plan and runs or submits
-/// it: a second `cosserat batch` into the same folder is refused at once.
-fn lock_batch(out: &Path) -> Result<cosserat::output::folder_lock::FolderLock> {
-    use cosserat::output::folder_lock::{FolderLock, LockError};
-    let name = out.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "batch".into());
-    let parent = out.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+/// it (`doing`: "batch"), or gathers its rows ("gather"): a second `cosserat batch` or a
+/// `gather` into the same folder is refused at once, by any of its names (a symbolic link is
+/// resolved: the folder it names is locked and written through it). The lock and the folder.
+fn lock_batch(out: &Path, doing: &str) -> Result<(cosserat::output::folder_lock::FolderLock, PathBuf)> {
+    use cosserat::output::folder_lock::{real_folder, FolderLock, LockError};
+    let io = |path: PathBuf, source| anyhow::Error::new(source).context(format!("cannot lock {}", path.display()));
+    let real = real_folder(out).map_err(|e| match e {
+        LockError::Io { path, source } => io(path, source),
+        LockError::Held { .. } => anyhow::anyhow!("cannot lock {}", out.display()),
+    })?;
+    let name = real.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "batch".into());
+    let parent = real.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
     std::fs::create_dir_all(parent).with_context(|| format!("cannot create {}", parent.display()))?;
-    FolderLock::acquire(parent, &name).map_err(|e| match e {
+    let lock = FolderLock::acquire(parent, &name).map_err(|e| match e {
         LockError::Held { pid } => anyhow::anyhow!(
-            "{} is being written by another cosserat batch ({}): wait for it to end, or choose another --out",
+            "{} is being written by another cosserat process ({}): wait for it to end before this {doing}, or choose \
+             another folder",
             out.display(),
             pid.map_or("its pid not yet known".to_string(), |p| format!("pid {p}"))
         ),
-        LockError::Io { path, source } => anyhow::Error::new(source).context(format!("cannot lock {}", path.display())),
-    })
+        LockError::Io { path, source } => io(path, source),
+    })?;
+    Ok((lock, real))
 }
 
 /// `batch --slurm`: the job script of the array tasks that have a recording to run (a
@@ -261,7 +270,9 @@ pub fn cmd_batch_task(a: TaskArgs) -> Result<ExitCode> {
 }
 
 pub fn cmd_gather(out: &Path) -> Result<ExitCode> {
-    let rows = gather(out).with_context(|| format!("gather {}", out.display()))?;
+    // not while a batch runs into it (its rows are being written)
+    let (_lock, real) = lock_batch(out, "gather")?;
+    let rows = gather(&real).with_context(|| format!("gather {}", out.display()))?;
     Ok(report(out, &rows, 0))
 }
 

@@ -37,6 +37,19 @@ pub struct FolderLock {
     file: File,
 }
 
+/// The output folder `target` as its lock knows it: a symbolic link (its last component)
+/// resolved to the folder it names, so that two names of one folder take one lock and the
+/// folder is written through the link, never replacing it; any other path as given (a link
+/// among its parents names the same lock file already).
+pub fn real_folder(target: &Path) -> Result<PathBuf, LockError> {
+    match std::fs::symlink_metadata(target) {
+        Ok(m) if m.file_type().is_symlink() => {
+            std::fs::canonicalize(target).map_err(|source| LockError::Io { path: target.to_path_buf(), source })
+        }
+        _ => Ok(target.to_path_buf()),
+    }
+}
+
 /// The lock file of the output folder `name` in `parent`.
 pub fn lock_path(parent: &Path, name: &str) -> PathBuf {
     parent.join(format!(".{name}.lock"))

@@ -13,7 +13,7 @@
 //! replaced unless `--force`.
 use std::path::{Path, PathBuf};
 
-use super::folder_lock::{FolderLock, LockError};
+use super::folder_lock::{real_folder, FolderLock, LockError};
 use super::manifest::io_err;
 pub use super::manifest::{
     input_file, input_file_as, list_files, sha256_file, CertificateSummary, FolderError, InputFile, Manifest, Status,
@@ -60,6 +60,12 @@ impl RunFolder {
     /// run being continued (a killed run's staging folder taken over, or a copy of the output
     /// folder, which stays in place until this run ends).
     pub fn begin(target: &Path, mut manifest: Manifest, mode: Mode) -> Result<RunFolder, FolderError> {
+        // a symbolic link is written through, and locked as the folder it names
+        let real = real_folder(target).map_err(|e| match e {
+            LockError::Io { path, source } => FolderError::Io { path, source },
+            LockError::Held { pid } => FolderError::Busy { path: target.to_path_buf(), pid },
+        })?;
+        let target = real.as_path();
         let name = target
             .file_name()
             .filter(|n| !n.is_empty() && *n != "..")
