@@ -1,6 +1,8 @@
 //! The errors of the bindings and the Python exception each becomes, with the message the CLI
 //! prints for it (the error and its causes, `: `-separated).
-use pyo3::exceptions::{PyFileNotFoundError, PyKeyboardInterrupt, PyOSError, PyRuntimeError, PyValueError};
+use pyo3::exceptions::{
+    PyFileNotFoundError, PyKeyboardInterrupt, PyOSError, PyRuntimeError, PyTypeError, PyValueError,
+};
 use pyo3::PyErr;
 
 use cosserat::case::sweep::SweepError;
@@ -13,19 +15,19 @@ use cosserat::engine::EngineError;
 pub enum BindError {
     /// the case file or text (syntax, an invalid key, an unreadable file)
     #[error(transparent)]
-    Case(#[from] CaseError),
+    Case(Box<CaseError>),
     /// an override (`key = value`) the case does not take
     #[error(transparent)]
-    Override(#[from] SweepError),
+    Override(Box<SweepError>),
     /// the clip of the case (a missing file, a recording that does not fit the case)
     #[error(transparent)]
-    Clip(#[from] ClipFileError),
+    Clip(Box<ClipFileError>),
     /// the engine could not start or stopped (a frame's failure is a status, not this)
     #[error("{label}: {source}")]
     Engine {
         label: String,
         #[source]
-        source: EngineError,
+        source: Box<EngineError>,
     },
     /// a request the engine does not serve (a clip in FreeFEM, an unknown engine)
     #[error("{0}")]
@@ -39,6 +41,24 @@ pub enum BindError {
     /// a stop was requested (`cosserat::interrupt`), e.g. by Ctrl-C in another thread
     #[error("{0}")]
     Interrupted(String),
+}
+
+impl From<CaseError> for BindError {
+    fn from(e: CaseError) -> Self {
+        BindError::Case(Box::new(e))
+    }
+}
+
+impl From<SweepError> for BindError {
+    fn from(e: SweepError) -> Self {
+        BindError::Override(Box::new(e))
+    }
+}
+
+impl From<ClipFileError> for BindError {
+    fn from(e: ClipFileError) -> Self {
+        BindError::Clip(Box::new(e))
+    }
 }
 
 /// An error and its causes, `: `-separated (as the CLI prints them).
@@ -55,22 +75,26 @@ pub fn chain(e: &dyn std::error::Error) -> String {
 impl From<BindError> for PyErr {
     fn from(e: BindError) -> PyErr {
         let message = chain(&e);
+        let not_found = |io: &std::io::Error| io.kind() == std::io::ErrorKind::NotFound;
+        let clip = |c: &ClipFileError| match c {
+            ClipFileError::Missing { .. } => PyFileNotFoundError::new_err(message.clone()),
+            _ => PyValueError::new_err(message.clone()),
+        };
         match &e {
-            BindError::Case(CaseError::Io { source, .. }) if source.kind() == std::io::ErrorKind::NotFound => {
-                PyFileNotFoundError::new_err(message)
-            }
-            BindError::Case(CaseError::Io { .. }) | BindError::Io(_) => PyOSError::new_err(message),
-            BindError::Clip(ClipFileError::Missing { .. }) => PyFileNotFoundError::new_err(message),
-            BindError::Case(_) | BindError::Override(_) | BindError::Clip(_) | BindError::Unsupported(_) => {
-                PyValueError::new_err(message)
-            }
-            BindError::Engine { source: EngineError::Clip(ClipFileError::Missing { .. }), .. } => {
-                PyFileNotFoundError::new_err(message)
-            }
-            BindError::Engine { source: EngineError::Clip(_), .. } => PyValueError::new_err(message),
-            BindError::Type(_) => pyo3::exceptions::PyTypeError::new_err(message),
+            BindError::Case(c) => match &**c {
+                CaseError::Io { source, .. } if not_found(source) => PyFileNotFoundError::new_err(message),
+                CaseError::Io { .. } => PyOSError::new_err(message),
+                _ => PyValueError::new_err(message),
+            },
+            BindError::Io(_) => PyOSError::new_err(message),
+            BindError::Clip(c) => clip(c),
+            BindError::Engine { source, .. } => match &**source {
+                EngineError::Clip(c) => clip(c),
+                _ => PyRuntimeError::new_err(message),
+            },
+            BindError::Override(_) | BindError::Unsupported(_) => PyValueError::new_err(message),
+            BindError::Type(_) => PyTypeError::new_err(message),
             BindError::Interrupted(_) => PyKeyboardInterrupt::new_err(message),
-            BindError::Engine { .. } => PyRuntimeError::new_err(message),
         }
     }
 }

@@ -113,7 +113,8 @@ fn run_clip<'py>(
         .into());
     }
     let solved = watch::run_watched(py, progress.as_ref(), |tx| solve_clip(&case, tx))?;
-    let (out, frames) = solved.map_err(|source| BindError::Engine { label: case_label(&case), source })?;
+    let (out, frames) =
+        solved.map_err(|source| BindError::Engine { label: case_label(&case), source: Box::new(source) })?;
     let (status, error) = clip_status(&case, &out)?;
     let d = PyDict::new(py);
     d.set_item("status", status)?;
@@ -123,8 +124,7 @@ fn run_clip<'py>(
     d.set_item("case", case.name.clone())?;
     d.set_item("body_length_m", case.mesh.length_m)?;
     d.set_item("frame_interval_s", case.inverse().map(|i| i.params.frame_interval_s))?;
-    let weights =
-        out.run.weights.map(|w| serde_json::to_value(w)).transpose().map_err(|e| BindError::Type(e.to_string()))?;
+    let weights = out.run.weights.map(serde_json::to_value).transpose().map_err(|e| BindError::Type(e.to_string()))?;
     d.set_item("weights", weights.map(|w| json_to_py(py, &w)).transpose()?)?;
     let metrics = (status != "failed").then(|| clip_metrics::clip_metrics(&case, &out.run));
     d.set_item("metrics", metrics.map(|m| m.into_iter().collect::<Vec<_>>().into_py_dict(py)).transpose()?)?;
@@ -213,7 +213,7 @@ fn run_case<'py>(
         Err(e) if interrupted(&e) => {
             return Err(BindError::Interrupted(format!("{}: {}", case_label(&case), chain(&e))).into())
         }
-        Err(source) => return Err(BindError::Engine { label: case_label(&case), source }.into()),
+        Err(source) => return Err(BindError::Engine { label: case_label(&case), source: Box::new(source) }.into()),
     };
     d.set_item("status", status)?;
     d.set_item("error", error)?;

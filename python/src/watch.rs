@@ -14,10 +14,12 @@ const TICK_S: f64 = 0.02;
 
 /// Progress messages of the worker: (done, total).
 pub type Progress = Sender<(usize, usize)>;
+/// Where the calling thread receives them.
+type Reports = Receiver<(usize, usize)>;
 
 /// The newest message waiting on `rx` after at most one tick, and whether the worker may send
 /// more (false: it has ended). Takes and gives back `rx`, so that it can run without the GIL.
-fn wait(rx: Receiver<(usize, usize)>) -> (Receiver<(usize, usize)>, Option<(usize, usize)>, bool) {
+fn wait(rx: Reports) -> (Reports, Option<(usize, usize)>, bool) {
     match rx.recv_timeout(Duration::from_secs_f64(TICK_S)) {
         Ok(first) => {
             let latest = rx.try_iter().last().unwrap_or(first);
