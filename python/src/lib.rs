@@ -47,9 +47,9 @@ fn json_to_py<'py>(py: Python<'py>, v: &serde_json::Value) -> PyResult<Bound<'py
 }
 
 /// A [`FrameSink`] into a [`Collected`] the caller keeps.
-struct Into<'a>(&'a mut Collected);
+struct Collecting<'a>(&'a mut Collected);
 
-impl FrameSink for Into<'_> {
+impl FrameSink for Collecting<'_> {
     type Error = std::convert::Infallible;
     fn frame(&mut self, f: &cosserat::engine::clip::ClipFrame) -> Result<(), Self::Error> {
         self.0.frame(f)
@@ -64,7 +64,7 @@ fn solve_clip(case: &Case, progress: watch::Progress) -> Result<(ClipOutcome, Co
     let input = ClipInput::of(case)?;
     let mut frames = Collected::default();
     let mut none = std::iter::empty::<Result<FrameRecord, JournalError>>();
-    let out = run_clip_into(case, input, &mut none, Into(&mut frames), |done, total| {
+    let out = run_clip_into(case, input, &mut none, Collecting(&mut frames), |done, total| {
         let _ = progress.send((done, total));
     })?;
     Ok((out, frames))
