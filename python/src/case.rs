@@ -8,7 +8,7 @@ use pyo3::types::{PyBool, PyFloat, PyInt, PyList, PyString, PyTuple};
 
 use crate::errors::BindError;
 use cosserat::case::Case;
-use cosserat::engine::input::clip_files::resolve_recording;
+use cosserat::engine::input::resolve::resolve_recording;
 
 /// A Python value as a TOML value: bool, int, float, str, or a list/tuple of them.
 pub fn to_toml(key: &str, v: &Bound<'_, PyAny>) -> Result<toml::Value, BindError> {
