@@ -131,7 +131,9 @@ fn an_interrupted_batch_stops_at_the_next_frame_and_says_what_it_kept() {
         .arg(&recs)
         .arg("--out")
         .arg(&out)
-        .args(["--quiet", "--jobs", "2"])
+        .args(["--jobs", "2"])
+        // progress without a terminal: only the final line within the test's time
+        .env("COSSERAT_PROGRESS_INTERVAL_S", "1000")
         .stdout(std::process::Stdio::null())
         .stderr(std::process::Stdio::piped())
         .spawn()
@@ -163,6 +165,8 @@ fn an_interrupted_batch_stops_at_the_next_frame_and_says_what_it_kept() {
     assert_eq!(o.status.code(), Some(130), "{stderr}");
     assert!(stderr.contains("interrupted: 0 of 4 recordings complete, 2 stopped at their next frame"), "{stderr}");
     assert!(stderr.contains("2 not started"), "{stderr}");
+    // the final progress line counts what was done, not what was stopped
+    assert!(stderr.contains("roll_recording batch: 0/4 recordings in"), "{stderr}");
     let rows = summary_without_time(&out);
     let not_started = "not started: a stop was requested before its turn";
     let (waiting, stopped): (Vec<_>, Vec<_>) = rows[1..].iter().partition(|r| r[12] == not_started);

@@ -370,7 +370,10 @@ pub fn run_audit(
         jobs.par_iter()
             .map(|j| {
                 let r = run_job(j);
-                progress(done.fetch_add(1, std::sync::atomic::Ordering::SeqCst) + 1, total);
+                // a point stopped by a stop request is not done
+                if r.outcome.status != crate::solve::Outcome::Interrupted {
+                    progress(done.fetch_add(1, std::sync::atomic::Ordering::SeqCst) + 1, total);
+                }
                 (j.spec, j.run.name.clone(), r)
             })
             .collect()

@@ -495,7 +495,8 @@ pub fn unfinished_tasks(plan: &Plan, complete: &[bool]) -> Vec<usize> {
 
 /// Run every recording of the plan in `out` on `jobs` threads (0: one per core; never more than
 /// the recordings, nor [`super::MAX_JOBS`]), then write
-/// `summary.csv`; `tick` after each recording. Rows in the plan's order.
+/// `summary.csv`; `tick` after each recording that ran to its end (not after one a stop request
+/// stopped or kept from starting). Rows in the plan's order.
 pub fn run_batch(plan: &Plan, out: &Path, jobs: usize, tick: impl Fn() + Sync) -> Result<Vec<Ran>, BatchError> {
     use rayon::prelude::*;
     let (case, case_file) = plan_case(plan)?;
@@ -508,7 +509,10 @@ pub fn run_batch(plan: &Plan, out: &Path, jobs: usize, tick: impl Fn() + Sync) -
             .par_iter()
             .map(|entry| {
                 let r = run_recording(&case, &case_file, entry, out, plan.format);
-                tick();
+                // a recording stopped (or never started) by a stop request is not done
+                if r.row.status != Some(crate::solve::Outcome::Interrupted) {
+                    tick();
+                }
                 r
             })
             .collect()
