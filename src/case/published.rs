@@ -168,6 +168,28 @@ pub const VOCABULARY: &[Form] = &[
     },
 ];
 
+/// Why the text of a quantity is not one ([`Quantity::parse`]); each message ends with the
+/// vocabulary.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum QuantityError {
+    #[error("`{text}`: unknown field `{field}` (fields: {fields}); a quantity is one of: {}", vocabulary_in_words())]
+    UnknownField { text: String, field: String, fields: String },
+    #[error("`{text}`: write node(s=S).FIELD, S in metres; a quantity is one of: {}", vocabulary_in_words())]
+    NodeSyntax { text: String },
+    #[error(
+        "`{text}`: the arc length `{s}` is not a number in metres; a quantity is one of: {}",
+        vocabulary_in_words()
+    )]
+    ArcLength { text: String, s: String },
+    #[error(
+        "`{text}`: `{key}` is not a key of metrics.json (letters, digits, _); a quantity is one of: {}",
+        vocabulary_in_words()
+    )]
+    MetricKey { text: String, key: String },
+    #[error("`{text}` is not a quantity; a quantity is one of: {}", vocabulary_in_words())]
+    NotAQuantity { text: String },
+}
+
 /// The vocabulary in one line, for error messages.
 pub fn vocabulary_in_words() -> String {
     VOCABULARY.iter().map(|f| f.pattern).collect::<Vec<_>>().join("; ")
@@ -176,14 +198,14 @@ pub fn vocabulary_in_words() -> String {
 impl Quantity {
     /// Parse a quantity as written in a case file; `Err` says what is wrong and lists the
     /// vocabulary.
-    pub fn parse(text: &str) -> Result<Quantity, String> {
+    pub fn parse(text: &str) -> Result<Quantity, QuantityError> {
         let t = text.trim();
         let family_end = t.find(['.', '(']).unwrap_or(t.len());
-        let unknown = |what: String| format!("{what}; a quantity is one of: {}", vocabulary_in_words());
+        let text = || t.to_string();
         let field = |f: &str| {
             NodeField::parse(f).ok_or_else(|| {
                 let all: Vec<String> = NodeField::all().map(NodeField::name).collect();
-                unknown(format!("`{t}`: unknown field `{f}` (fields: {})", all.join(", ")))
+                QuantityError::UnknownField { text: text(), field: f.to_string(), fields: all.join(", ") }
             })
         };
         match &t[..family_end] {
@@ -191,23 +213,23 @@ impl Quantity {
             "node" => {
                 let rest = &t[family_end..];
                 let inner = rest.strip_prefix("(s=").and_then(|r| r.split_once(")."));
-                let (s, f) = inner.ok_or_else(|| unknown(format!("`{t}`: write node(s=S).FIELD, S in metres")))?;
+                let (s, f) = inner.ok_or_else(|| QuantityError::NodeSyntax { text: text() })?;
                 let s_m = s
                     .trim()
                     .parse::<f64>()
                     .ok()
                     .filter(|v| v.is_finite())
-                    .ok_or_else(|| unknown(format!("`{t}`: the arc length `{s}` is not a number in metres")))?;
+                    .ok_or_else(|| QuantityError::ArcLength { text: text(), s: s.to_string() })?;
                 Ok(Quantity::Node { s_m, field: field(f)? })
             }
             "metric" if t[family_end..].starts_with('.') => {
                 let key = &t[family_end + 1..];
                 if key.is_empty() || !key.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
-                    return Err(unknown(format!("`{t}`: `{key}` is not a key of metrics.json (letters, digits, _)")));
+                    return Err(QuantityError::MetricKey { text: text(), key: key.to_string() });
                 }
                 Ok(Quantity::Metric(key.to_string()))
             }
-            _ => Err(unknown(format!("`{t}` is not a quantity"))),
+            _ => Err(QuantityError::NotAQuantity { text: text() }),
         }
     }
 
@@ -277,7 +299,7 @@ mod tests {
             ("tip", &["is not a quantity"]),
             ("", &["is not a quantity"]),
         ] {
-            let e = Quantity::parse(text).unwrap_err();
+            let e = Quantity::parse(text).unwrap_err().to_string();
             for w in words {
                 assert!(e.contains(w), "{text}: `{e}` lacks `{w}`");
             }

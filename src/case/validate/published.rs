@@ -48,7 +48,8 @@ impl Validator<'_> {
 
     /// One `[[reference.values]]` row (`key`: `reference.values[i]`).
     fn published_value(&self, key: &str, raw: &RawPublished, mesh: &Mesh) -> Result<PublishedValue, CaseError> {
-        let quantity = Quantity::parse(&raw.quantity).map_err(|e| self.err(&format!("{key}.quantity"), e))?;
+        let quantity =
+            Quantity::parse(&raw.quantity).map_err(|e| self.err(&format!("{key}.quantity"), e.to_string()))?;
         if let Quantity::Node { s_m, .. } = quantity {
             if !(0.0..=mesh.length_m).contains(&s_m) {
                 return Err(self.err(

@@ -20,7 +20,7 @@ pub struct PublishedRow {
     pub unit: &'static str,
     pub published: f64,
     /// the run's value, or why it has none
-    pub computed: Result<f64, String>,
+    pub computed: Result<f64, ValueError>,
     /// `computed − published` (NaN without a computed value)
     pub error: f64,
     /// the largest |error| allowed, in the quantity's unit
@@ -30,7 +30,7 @@ pub struct PublishedRow {
 }
 
 impl PublishedRow {
-    pub(crate) fn new(v: &PublishedValue, computed: Result<f64, String>) -> Self {
+    pub(crate) fn new(v: &PublishedValue, computed: Result<f64, ValueError>) -> Self {
         let tolerance = v.tolerance.bound(v.value);
         let error = computed.as_ref().map_or(f64::NAN, |c| c - v.value);
         // NaN fails: a value that is not a number is no agreement
@@ -80,15 +80,27 @@ pub fn evaluate(case: &Case, r: &RunResult, m: &Metrics) -> Vec<PublishedRow> {
     case.checks.published.values.iter().map(|v| PublishedRow::new(v, value(&v.quantity, r, m))).collect()
 }
 
+/// Why a run has no value of a published quantity.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum ValueError {
+    #[error("the result has no nodes")]
+    NoNodes,
+    /// `node(s=S)` outside the rod's nodes `[first, last]` [m]
+    #[error("s = {s_m} m lies outside the rod's nodes, [{first_m}, {last_m}] m")]
+    OutsideRod { s_m: f64, first_m: f64, last_m: f64 },
+    #[error("{key} is not in this run's metrics.json")]
+    NotInMetrics { key: String },
+}
+
 /// The value of a quantity on a run: the evaluator of every family of the vocabulary.
-pub fn value(q: &Quantity, r: &RunResult, m: &Metrics) -> Result<f64, String> {
+pub fn value(q: &Quantity, r: &RunResult, m: &Metrics) -> Result<f64, ValueError> {
     match q {
         Quantity::Tip(field) => {
-            let last = r.nodes.s.len().checked_sub(1).ok_or("the result has no nodes")?;
+            let last = r.nodes.s.len().checked_sub(1).ok_or(ValueError::NoNodes)?;
             Ok(nodal(&r.nodes, *field, last))
         }
         Quantity::Node { s_m, field } => at_arc_length(&r.nodes, *field, *s_m),
-        Quantity::Metric(key) => m.named(key).ok_or_else(|| format!("{key} is not in this run's metrics.json")),
+        Quantity::Metric(key) => m.named(key).ok_or_else(|| ValueError::NotInMetrics { key: key.clone() }),
     }
 }
 
@@ -104,10 +116,10 @@ fn nodal(n: &NodalState, field: NodeField, i: usize) -> f64 {
 
 /// A field at reference arc length `s` [m], linear between the two nodes around it (P1, as the
 /// discrete solution is).
-pub fn at_arc_length(n: &NodalState, field: NodeField, s: f64) -> Result<f64, String> {
+pub fn at_arc_length(n: &NodalState, field: NodeField, s: f64) -> Result<f64, ValueError> {
     let (first, last) = (n.s.first().copied().unwrap_or(f64::NAN), n.s.last().copied().unwrap_or(f64::NAN));
     if !(first..=last).contains(&s) {
-        return Err(format!("s = {s} m lies outside the rod's nodes, [{first}, {last}] m"));
+        return Err(ValueError::OutsideRod { s_m: s, first_m: first, last_m: last });
     }
     // the element [s_j, s_j+1] holding s (the last one for s = L)
     let j = n.s.partition_point(|&t| t <= s).clamp(1, n.s.len() - 1) - 1;

@@ -221,11 +221,11 @@ fn check_gap(
 }
 
 /// A cell of a position column: a number, or NaN for an empty cell or `nan` (any case).
-fn parse_coordinate(text: &str) -> Result<f64, String> {
+fn parse_coordinate(text: &str) -> Result<f64, std::num::ParseFloatError> {
     if text.is_empty() || text.eq_ignore_ascii_case("nan") {
         return Ok(f64::NAN);
     }
-    text.parse::<f64>().map_err(|e| e.to_string())
+    text.parse::<f64>()
 }
 
 /// A position's coordinates must be finite; with [`MissingData::Nan`] a NaN (an empty cell)

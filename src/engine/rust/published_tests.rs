@@ -61,7 +61,7 @@ fn node_interpolation_is_exact_on_a_linear_field() {
     let r = result(n.clone());
     let tip = value(&Quantity::Tip(NodeField::Angle(2)), &r, &Metrics::new()).unwrap();
     assert!((tip - (c[2] + d[2])).abs() < 1e-15);
-    let e = at_arc_length(&n, NodeField::Position(Axis::X), 1.5).unwrap_err();
+    let e = at_arc_length(&n, NodeField::Position(Axis::X), 1.5).unwrap_err().to_string();
     assert!(e.contains("outside the rod's nodes"), "{e}");
     assert!(at_arc_length(&n, NodeField::Position(Axis::X), -1e-9).is_err());
 }
