@@ -53,6 +53,26 @@ fn dangerous(path: &Path) -> bool {
     abs.parent().is_none() || cwd.is_some_and(|c| c.starts_with(&abs))
 }
 
+/// The output folder `target` as it is written: a symbolic link resolved to the folder it names
+/// (written through, and locked as that folder), its parent and its name.
+fn locate(target: &Path) -> Result<(PathBuf, PathBuf, String), FolderError> {
+    let real = real_folder(target).map_err(|e| match e {
+        LockError::Io { path, source } => FolderError::Io { path, source },
+        LockError::Held { pid } => FolderError::Busy { path: target.to_path_buf(), pid },
+    })?;
+    let name = real
+        .file_name()
+        .filter(|n| !n.is_empty() && *n != "..")
+        .ok_or_else(|| FolderError::Dangerous { path: real.clone() })?
+        .to_string_lossy()
+        .into_owned();
+    let parent = match real.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    Ok((real, parent, name))
+}
+
 impl RunFolder {
     /// Start a run whose results go to `target`, described by `manifest` (status running):
     /// take the folder's lock (refused at once if another run holds it), clear what runs that
@@ -60,22 +80,8 @@ impl RunFolder {
     /// run being continued (a killed run's staging folder taken over, or a copy of the output
     /// folder, which stays in place until this run ends).
     pub fn begin(target: &Path, mut manifest: Manifest, mode: Mode) -> Result<RunFolder, FolderError> {
-        // a symbolic link is written through, and locked as the folder it names
-        let real = real_folder(target).map_err(|e| match e {
-            LockError::Io { path, source } => FolderError::Io { path, source },
-            LockError::Held { pid } => FolderError::Busy { path: target.to_path_buf(), pid },
-        })?;
+        let (real, parent, name) = locate(target)?;
         let target = real.as_path();
-        let name = target
-            .file_name()
-            .filter(|n| !n.is_empty() && *n != "..")
-            .ok_or_else(|| FolderError::Dangerous { path: target.to_path_buf() })?
-            .to_string_lossy()
-            .into_owned();
-        let parent = match target.parent() {
-            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-            _ => PathBuf::from("."),
-        };
         // the folder, or the first of its parents that exists, must be a folder
         if let Some(existing) = target.ancestors().find(|a| !a.as_os_str().is_empty() && a.exists()) {
             if !existing.is_dir() {
