@@ -9,6 +9,7 @@ use cosserat::case::sweep::SweepError;
 use cosserat::case::CaseError;
 use cosserat::engine::input::clip_files::ClipFileError;
 use cosserat::engine::EngineError;
+pub use cosserat::jobs::solved::chain;
 
 /// Why a call could not give a result.
 #[derive(Debug, thiserror::Error)]
@@ -59,17 +60,6 @@ impl From<ClipFileError> for BindError {
     fn from(e: ClipFileError) -> Self {
         BindError::Clip(Box::new(e))
     }
-}
-
-/// An error and its causes, `: `-separated (as the CLI prints them).
-pub fn chain(e: &dyn std::error::Error) -> String {
-    let mut s = e.to_string();
-    let mut src = e.source();
-    while let Some(c) = src {
-        s += &format!(": {c}");
-        src = c.source();
-    }
-    s
 }
 
 impl From<BindError> for PyErr {

@@ -8,10 +8,8 @@ use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use cosserat::clip::missing::MIN_TRACKED;
 use cosserat::engine::clip::{ClipFrame, FrameSink};
-use cosserat::output::clip_output::{CLIP_FRAME_COLUMNS, CLIP_FRAME_INTEGER_COLUMNS};
-use cosserat::solve::sequence::FrameReport;
+use cosserat::output::clip_output::{report_row, CLIP_FRAME_COLUMNS, CLIP_FRAME_INTEGER_COLUMNS};
 
 /// The flags of `frames.csv`: booleans in Python.
 const FLAG_COLUMNS: [&str; 5] = ["restarted", "flagged", "lost", "filled", "resolved"];
@@ -77,38 +75,6 @@ impl FrameSink for Collected {
     fn finish(&mut self) -> Result<(), Infallible> {
         Ok(())
     }
-}
-
-/// The row of `frames.csv` of a frame (as `cosserat::output::clip_output` writes it): its report,
-/// time [s], roughness and largest |ω| [rad/s].
-fn report_row(r: &FrameReport, time_s: f64, roughness: (f64, f64), omega: &[Vector3<f64>], nodes: usize) -> Vec<f64> {
-    let mut row = vec![
-        r.frame as f64,
-        time_s,
-        r.convergence.iterations as f64,
-        r.convergence.last_change,
-        r.misfit.x_err_rel,
-        r.misfit.tangent_misfit,
-    ];
-    row.extend(r.misfit.objective.values());
-    row.extend([
-        r.conditioning.min_cos_beta,
-        r.conditioning.min_cos_beta_node as f64,
-        r.conditioning.max_stretch_deviation,
-        roughness.0,
-        roughness.1,
-        f64::from(u8::from(r.restarted)),
-    ]);
-    row.extend(r.chart_axis.iter());
-    row.push(omega.iter().map(|w| w.norm()).fold(0.0, f64::max));
-    row.push(r.certificate);
-    row.extend([r.fit.noise_m, r.fit.position, r.fit.tangent, f64::from(u8::from(r.fit.flagged))]);
-    row.push(r.nodes_tracked as f64);
-    let lost = r.nodes_tracked < MIN_TRACKED;
-    let filled = !lost && r.nodes_tracked < nodes;
-    row.extend([lost, filled, r.fit.resolved].map(|b| f64::from(u8::from(b))));
-    row.push(r.fit.curvature_max_per_m);
-    row
 }
 
 impl Collected {

@@ -471,8 +471,15 @@ fn push_csv(s: &mut String, values: &[f64]) {
     }
 }
 
-/// The row of `frames.csv` of a frame: its report, time [s], roughness and largest |ω| [rad/s].
-fn report_row(r: &FrameReport, time_s: f64, roughness: (f64, f64), omega: &[Vector3<f64>], nodes: usize) -> Vec<f64> {
+/// The row of `frames.csv` of a frame: its report, time [s], roughness and largest |ω| [rad/s]
+/// (also the Python package's per-frame table).
+pub fn report_row(
+    r: &FrameReport,
+    time_s: f64,
+    roughness: (f64, f64),
+    omega: &[Vector3<f64>],
+    nodes: usize,
+) -> Vec<f64> {
     let mut row = vec![
         r.frame as f64,
         time_s,
