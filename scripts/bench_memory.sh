@@ -68,6 +68,6 @@ for n in $FRAMES; do
 done
 echo "128-node recording (cases/batch/roll_recording.toml, 127 elements) on $(nproc) cores, $(lscpu | awk -F': +' '/Model name/ {print $2}') ($(date -u +%Y-%m-%d))"
 echo
-echo "| binary, command | frames | peak memory [MB] | output [MB] | output per frame [kB] | wall time |"
+echo "| binary, command | frames | peak memory [MiB] | output [MB] | output per frame [kB] | wall time |"
 echo "|---|---|---|---|---|---|"
 printf '%s\n' "${rows[@]}"
