@@ -297,6 +297,7 @@ fn write_corpus<'py>(
         length_m,
         dt_s: frame_interval_s,
         noise_m,
+        shape_noise_m: 0.0,
         seed,
         max_roll_rad,
         max_twist_per_m,

@@ -9,7 +9,7 @@ use anyhow::{Context, Result};
 
 use cosserat::figures::plot::{render_panels_svg, LinePlot, Series};
 use cosserat::io::write_atomic;
-use cosserat::study::{recovered_name, run_study, StudyRow, StudySpec, SPLINE};
+use cosserat::study::{centreline_name, recovered_name, run_study, StudyRow, StudySpec, SPLINE};
 
 use super::progress::Progress;
 
@@ -69,10 +69,16 @@ fn range(v: impl Iterator<Item = f64>) -> (f64, f64) {
     v.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| if x.is_finite() { (a.min(x), b.max(x)) } else { (a, b) })
 }
 
-fn cells(rows: &[StudyRow]) -> BTreeMap<(usize, String, u64), Cell> {
-    let mut groups: BTreeMap<(usize, String, u64), Vec<&StudyRow>> = BTreeMap::new();
+/// A cell's key: the mesh (nodes, shape changes' RMS as bits), the method, σ as bits.
+type CellKey = ((usize, u64), String, u64);
+
+fn cells(rows: &[StudyRow]) -> BTreeMap<CellKey, Cell> {
+    let mut groups: BTreeMap<CellKey, Vec<&StudyRow>> = BTreeMap::new();
     for r in rows {
-        groups.entry((r.nodes, r.method.clone(), r.noise_m.to_bits())).or_default().push(r);
+        groups
+            .entry(((r.nodes, r.shape_noise_m.to_bits()), r.method.clone(), r.noise_m.to_bits()))
+            .or_default()
+            .push(r);
     }
     let opt = |r: (f64, f64)| if r.0.is_finite() { Some(r) } else { None };
     groups
@@ -98,9 +104,20 @@ fn methods(spec: &StudySpec) -> Vec<(String, String)> {
         if v.recovered {
             m.push((recovered_name(&v.name), format!("{}, nodal recovery", v.label)));
         }
+        if v.centreline {
+            m.push((centreline_name(&v.name), format!("{}, its centreline's curvature", v.label)));
+        }
     }
     m.push((SPLINE.into(), "smoothing spline (GCV)".into()));
     m
+}
+
+/// A mesh as the table names it: `33` or `33, shape changes 5 µm`.
+fn mesh_name(nodes: usize, shape_noise_m: f64) -> String {
+    match shape_noise_m > 0.0 {
+        true => format!("{nodes}, shape changes {} µm", shape_noise_m * 1e6),
+        false => nodes.to_string(),
+    }
 }
 
 /// The markdown table of the study (docs/results.md).
@@ -109,12 +126,13 @@ fn table(spec: &StudySpec, rows: &[StudyRow]) -> String {
     let span = |(a, b): (f64, f64)| if a.is_finite() { format!("{a:.3}–{b:.3}") } else { "–".into() };
     let span_e = |r: Option<(f64, f64)>| r.map_or("".into(), |(a, b)| format!("{a:.2e}–{b:.2e}"));
     let mut s = String::from("| nodes | σ [µm] | method | frames reconstructed | bending error, median | worst frame | σ estimated [µm] | λg chosen |\n|---|---|---|---|---|---|---|---|\n");
-    for ((nodes, method, bits), c) in &cells {
+    for (((nodes, shape), method, bits), c) in &cells {
+        let nodes = mesh_name(*nodes, f64::from_bits(*shape));
         let label = methods(spec).into_iter().find(|m| &m.0 == method).map_or(method.clone(), |m| m.1);
         let est = c.noise_estimate.map(|(a, b)| (a * 1e6, b * 1e6));
         s += &format!(
             "| {nodes} | {} | {label} | {} / {} | {} | {} | {} | {} |\n",
-            f64::from_bits(*bits) * 1e6,
+            (f64::from_bits(*bits) * 1e12).round() / 1e6,
             c.reconstructed,
             c.frames,
             span(c.median),
@@ -137,7 +155,10 @@ fn figure(spec: &StudySpec, rows: &[StudyRow]) -> Result<String> {
     let mut panels = Vec::new();
     for mesh in &spec.meshes {
         let panel = |what: &str, y_label: &str, log_y: bool| LinePlot {
-            title: format!("{} nodes: {what}", mesh.nodes),
+            title: match mesh.shape_noise_m > 0.0 {
+                true => format!("{} nodes, shape changes {} µm: {what}", mesh.nodes, mesh.shape_noise_m * 1e6),
+                false => format!("{} nodes: {what}", mesh.nodes),
+            },
             x_label: "noise σ per coordinate [µm] (σ = 0: see the table)".into(),
             y_label: y_label.into(),
             log_x: true,
@@ -150,7 +171,7 @@ fn figure(spec: &StudySpec, rows: &[StudyRow]) -> Result<String> {
         for (name, label) in &shown {
             let pts: Vec<(f64, &Cell)> = cells
                 .iter()
-                .filter(|((n, m, _), _)| *n == mesh.nodes && m == name)
+                .filter(|((n, m, _), _)| *n == (mesh.nodes, mesh.shape_noise_m.to_bits()) && m == name)
                 .map(|((_, _, b), c)| (f64::from_bits(*b) * 1e6, c))
                 .filter(|(s, _)| *s > 0.0)
                 .collect();

@@ -59,6 +59,10 @@ pub struct TrackerArgs {
     /// was built in; with --tracker also kymogram_delta-turn.npy]
     #[arg(long)]
     kymogram: Vec<PathBuf>,
+    /// RMS of a smooth change of shape added to every frame independently (3D recordings): the
+    /// first three sine and cosine modes along the body, per coordinate [m] [default: 0]
+    #[arg(long, conflicts_with = "tracker")]
+    shape_noise_m: Option<f64>,
     /// Write the recordings as a single-camera tracker does: 2D midlines (CSV frame,node,x_um,y_um
     /// in micrometres, frames numbered from 1) with lost frames and lost tail points, each with
     /// its truth (worm_KKK.csv, worm_KKK.truth.npy)
@@ -119,6 +123,7 @@ pub fn cmd_synth(a: SynthArgs) -> Result<ExitCode> {
         length_m: a.length_m.first().copied().unwrap_or(d.length_m),
         dt_s: a.frame_interval_s.unwrap_or(d.dt_s),
         noise_m: a.noise_m.unwrap_or(d.noise_m),
+        shape_noise_m: a.shape.shape_noise_m.unwrap_or(d.shape_noise_m),
         seed: a.seed.unwrap_or(d.seed),
         ..d
     };
@@ -134,6 +139,7 @@ pub fn cmd_synth(a: SynthArgs) -> Result<ExitCode> {
         ("length_m", params.length_m),
         ("seed", params.seed as f64),
         ("noise_m", params.noise_m),
+        ("shape_noise_m", params.shape_noise_m),
         ("frame_interval_s", params.dt_s),
     ];
     let written =

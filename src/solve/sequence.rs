@@ -311,6 +311,29 @@ fn continued(
     Ok(sol)
 }
 
+/// Decades of λg above the case's at which [`continued_down`] starts.
+pub const DOWN_DECADES: i32 = 2;
+
+/// Continuation in λg from above of a frame that [`continued`] could not bring to `lambda_g`
+/// either (`docs/noise.md`, N7): solved from `guess` at `λg·10^DOWN_DECADES`, where the frame
+/// follows its data closely, then down by half a decade at a time to `lambda_g`. A frame
+/// whose data a rod cannot follow exactly (smooth changes of shape that stretch the body by a
+/// few per cent) has its twist held by the weak load terms only; in a band of λg the twist
+/// changes branch there, the moment rows of Newton's matrix are near singular and Newton
+/// stalls when it comes from below. From above it lands on the branch of the closely
+/// followed data.
+fn continued_down(
+    solve: &mut impl FnMut(&DVector<f64>, Start, f64) -> Result<InverseSolution, SolveError>,
+    guess: &DVector<f64>,
+    lambda_g: f64,
+) -> Result<InverseSolution, SolveError> {
+    let mut sol = solve(guess, Start::Guess, lambda_g * 10f64.powi(DOWN_DECADES))?;
+    for half in (0..2 * DOWN_DECADES).rev() {
+        sol = solve(&sol.u, Start::Near, lambda_g * 10f64.powf(0.5 * half as f64))?;
+    }
+    Ok(sol)
+}
+
 /// The initial iterate of a clip's first frame, in the chart of that frame.
 #[derive(Clone, Copy, Debug)]
 pub enum FirstStart<'a> {
@@ -507,7 +530,10 @@ fn with_restarts(
                 Ok(sol) => Ok((sol, true)),
                 Err(e) if recoverable(&e) => {
                     let smooth = smooth().unwrap_or_else(guess);
-                    Ok((continued(solve, &smooth, lambda_g).map_err(|_| e)?, true))
+                    match continued(solve, &smooth, lambda_g) {
+                        Ok(sol) => Ok((sol, true)),
+                        Err(_) => Ok((continued_down(solve, &smooth, lambda_g).map_err(|_| e)?, true)),
+                    }
                 }
                 Err(e) => Err(e),
             }

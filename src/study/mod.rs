@@ -24,8 +24,8 @@ use crate::engine::input::truth_file::{read_truth, truth_sidecar};
 use crate::io::{write_atomic, InputError, OutputError};
 use crate::jobs::batch::{run_batch, Plan};
 use score::{
-    bending_error, median_and_worst, read_curvature, recovered_nodal, spline_bending, truth_bending,
-    truth_bending_nodal, ScoreError,
+    bending_error, centreline_bending, median_and_worst, read_curvature, read_positions, recovered_nodal,
+    spline_bending, truth_bending, truth_bending_nodal, ScoreError,
 };
 
 /// Errors of the study.
@@ -56,6 +56,8 @@ pub const SPLINE: &str = "spline";
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct StudyRow {
     pub nodes: usize,
+    /// the RMS of the smooth changes of shape added to every frame (`Mesh::shape_noise_m`) [m]
+    pub shape_noise_m: f64,
     /// the standard deviation of the added noise [m]
     pub noise_m: f64,
     /// a variant's name, or `spline`
@@ -82,7 +84,11 @@ pub fn run_study(spec: &StudySpec, out: &Path, quick: bool, tick: impl Fn(&str))
     let mut rows = Vec::new();
     for mesh in &spec.meshes {
         for &noise_m in &plan.noise_m {
-            let kind = if mesh.planar { "_planar" } else { "" };
+            let kind = match (mesh.planar, mesh.shape_noise_m > 0.0) {
+                (true, _) => "_planar".to_string(),
+                (false, true) => format!("_shape{}", crate::case::sweep::fmt_value(mesh.shape_noise_m)),
+                (false, false) => String::new(),
+            };
             let tag = format!("n{}{kind}_s{}", mesh.nodes, crate::case::sweep::fmt_value(noise_m));
             let corpus = out.join("corpora").join(&tag);
             let params = CorpusParams {
@@ -90,6 +96,7 @@ pub fn run_study(spec: &StudySpec, out: &Path, quick: bool, tick: impl Fn(&str))
                 frames: plan.frames,
                 nodes: mesh.nodes,
                 noise_m,
+                shape_noise_m: mesh.shape_noise_m,
                 seed: spec.seed,
                 ..CorpusParams::default()
             };
@@ -111,7 +118,7 @@ pub fn run_study(spec: &StudySpec, out: &Path, quick: bool, tick: impl Fn(&str))
                 let entries = write_corpus(&corpus, &spec.kymogram, &params)?;
                 entries.iter().map(|e| recording_path(&corpus, &e.name)).collect()
             };
-            rows.extend(spline_rows(mesh.nodes, noise_m, params.length_m, &recordings, spec.skip_elements)?);
+            rows.extend(spline_rows(mesh, noise_m, params.length_m, &recordings, spec.skip_elements)?);
             for variant in &spec.variants {
                 let case = spec.variant_case(mesh, variant, &out.join("cases"))?;
                 let runs = out.join("runs").join(&tag).join(&variant.name);
@@ -120,7 +127,7 @@ pub fn run_study(spec: &StudySpec, out: &Path, quick: bool, tick: impl Fn(&str))
                 let ran = run_batch(&plan, &runs, 0, || {})?;
                 for (r, recording) in ran.iter().zip(&recordings) {
                     let dir = runs.join(&r.row.folder);
-                    let scored = score_run(mesh.nodes, noise_m, variant, recording, &dir, spec.skip_elements)?;
+                    let scored = score_run(mesh, noise_m, variant, recording, &dir, spec.skip_elements)?;
                     for mut row in scored {
                         row.frames_per_s = row.frames_reconstructed as f64 / r.row.wall_time_s.max(1e-9);
                         rows.push(row);
@@ -147,7 +154,7 @@ fn recording_and_truth(recording: &Path) -> Result<Recorded, StudyError> {
 }
 
 fn spline_rows(
-    nodes: usize,
+    mesh: &Mesh,
     noise_m: f64,
     length_m: f64,
     recordings: &[PathBuf],
@@ -162,17 +169,18 @@ fn spline_rows(
             .zip(&truth.frames)
             .map(|(f, t)| bending_error(&spline_bending(f, length_m), &truth_bending(t), skip))
             .collect();
-        let mut r = row(nodes, noise_m, SPLINE, recording, &errors);
+        let mut r = row(mesh, noise_m, SPLINE, recording, &errors);
         r.frames_per_s = r.frames_reconstructed as f64 / started.elapsed().as_secs_f64().max(1e-9);
         rows.push(r);
     }
     Ok(rows)
 }
 
-fn row(nodes: usize, noise_m: f64, method: &str, recording: &Path, errors: &[f64]) -> StudyRow {
+fn row(mesh: &Mesh, noise_m: f64, method: &str, recording: &Path, errors: &[f64]) -> StudyRow {
     let (median, worst) = median_and_worst(errors);
     StudyRow {
-        nodes,
+        nodes: mesh.nodes,
+        shape_noise_m: mesh.shape_noise_m,
         noise_m,
         method: method.into(),
         recording: recording.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default(),
@@ -186,6 +194,12 @@ fn row(nodes: usize, noise_m: f64, method: &str, recording: &Path, errors: &[f64
     }
 }
 
+/// The name of a variant's row scored on its reconstructed centreline
+/// ([`score::centreline_bending`]).
+pub fn centreline_name(variant: &str) -> String {
+    format!("{variant}+centreline")
+}
+
 /// The name of a variant's row scored with the nodal recovery ([`score::recovered_nodal`]).
 pub fn recovered_name(variant: &str) -> String {
     format!("{variant}+nodal")
@@ -194,7 +208,7 @@ pub fn recovered_name(variant: &str) -> String {
 /// Score one recording's run folder (its `curvature.csv`; the weights from `run.json`): the
 /// variant's row, and with `recovered` its nodal recovery's.
 fn score_run(
-    nodes: usize,
+    mesh: &Mesh,
     noise_m: f64,
     variant: &Variant,
     recording: &Path,
@@ -216,9 +230,22 @@ fn score_run(
             .collect()
     };
     let weights = crate::output::manifest::Manifest::read(dir).ok().flatten().and_then(|m| m.weights);
-    let mut rows = vec![row(nodes, noise_m, &variant.name, recording, &score(false))];
+    let mut rows = vec![row(mesh, noise_m, &variant.name, recording, &score(false))];
     if variant.recovered {
-        rows.push(row(nodes, noise_m, &recovered_name(&variant.name), recording, &score(true)));
+        rows.push(row(mesh, noise_m, &recovered_name(&variant.name), recording, &score(true)));
+    }
+    if variant.centreline {
+        let fields = dir.join("fields.csv");
+        let x = if fields.is_file() { read_positions(&fields)? } else { Vec::new() };
+        let errors: Vec<f64> = (0..frames.len())
+            .map(|k| match x.get(k) {
+                Some(x) if !x.is_empty() => {
+                    bending_error(&centreline_bending(x), &truth_bending(&truth.frames[k]), skip)
+                }
+                _ => f64::NAN,
+            })
+            .collect();
+        rows.push(row(mesh, noise_m, &centreline_name(&variant.name), recording, &errors));
     }
     for r in &mut rows {
         r.noise_estimate_m = weights.map(|w| w.noise_m);

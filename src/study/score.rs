@@ -94,6 +94,47 @@ pub fn recovered_nodal(b: &[f64]) -> Vec<f64> {
         .collect()
 }
 
+/// The bending curvature per element of a reconstructed centreline `x` (the rod's nodes [m]),
+/// not of its frame: the Menger curvature `2|a × b| / (|a| |b| |a + b|)` of each interior node's
+/// two chords (exact on a circle), an end node taking its neighbour's, each element the mean of
+/// its two nodes [1/m]. Beside the frame's `√(κ1² + κ2²)` it shows how far the frame's
+/// curvature is from its centreline's (`docs/noise.md` N13).
+pub fn centreline_bending(x: &[Vector3<f64>]) -> Vec<f64> {
+    if x.len() < 3 {
+        return vec![f64::NAN; x.len().saturating_sub(1)];
+    }
+    let mut nodal: Vec<f64> = x
+        .windows(3)
+        .map(|w| {
+            let (a, b) = (w[1] - w[0], w[2] - w[1]);
+            2.0 * a.cross(&b).norm() / (a.norm() * b.norm() * (a + b).norm())
+        })
+        .collect();
+    nodal.insert(0, nodal[0]);
+    nodal.push(nodal[nodal.len() - 1]);
+    nodal.windows(2).map(|w| 0.5 * (w[0] + w[1])).collect()
+}
+
+/// The reconstructed node positions per frame [m] from a run's `fields.csv` (columns `frame`,
+/// `node`, `s_m`, `x_m`, `y_m`, `z_m`, …); frames that were not written are absent.
+pub fn read_positions(path: &Path) -> Result<Vec<Vec<Vector3<f64>>>, ScoreError> {
+    let bad = |reason: String| ScoreError::Curvature { path: path.display().to_string(), reason };
+    let mut reader = csv::Reader::from_path(path).map_err(|e| bad(e.to_string()))?;
+    let mut frames: Vec<Vec<Vector3<f64>>> = Vec::new();
+    for record in reader.records() {
+        let r = record.map_err(|e| bad(e.to_string()))?;
+        let num = |i: usize| -> Result<f64, ScoreError> {
+            r.get(i).and_then(|v| v.parse::<f64>().ok()).ok_or_else(|| bad(format!("column {i} of {r:?}")))
+        };
+        let frame = num(0)? as usize;
+        while frames.len() <= frame {
+            frames.push(Vec::new());
+        }
+        frames[frame].push(Vector3::new(num(3)?, num(4)?, num(5)?));
+    }
+    Ok(frames)
+}
+
 /// The truth's bending curvature at the nodes [1/m].
 pub fn truth_bending_nodal(truth: &FrameTruth) -> Vec<f64> {
     truth.kappa.iter().map(|k| k.x.hypot(k.y)).collect()
@@ -137,6 +178,21 @@ mod tests {
         assert_eq!(r.len(), 9);
         for (i, v) in r.iter().enumerate().take(8).skip(1) {
             assert!((v - (2.0 + 3.0 * i as f64 * h)).abs() < 1e-14, "node {i}: {v}");
+        }
+    }
+
+    /// Nodes on a circle of radius 2 mm, unevenly spaced: every element has curvature 1/R.
+    #[test]
+    fn centreline_bending_is_exact_on_a_circle() {
+        let r = 2e-3;
+        let x: Vec<Vector3<f64>> = [0.0, 0.1, 0.25, 0.3, 0.5, 0.55, 0.8]
+            .iter()
+            .map(|t: &f64| Vector3::new(r * t.cos(), r * t.sin(), 0.0))
+            .collect();
+        let b = centreline_bending(&x);
+        assert_eq!(b.len(), 6);
+        for v in b {
+            assert!((v * r - 1.0).abs() < 1e-12, "{v}");
         }
     }
 

@@ -28,6 +28,11 @@ pub struct Mesh {
     /// µm, noise in x and y only; no frame or point lost) instead of 3D `roll_3d` clips
     #[serde(default)]
     pub planar: bool,
+    /// RMS of smooth, frame-independent changes of shape added to the 3D recordings
+    /// (`engine::input::corpus::shape_change`: the first three sine and cosine modes along the
+    /// body) [m]; the truth stays the clean clip's
+    #[serde(default)]
+    pub shape_noise_m: f64,
 }
 
 /// A way of reconstructing: keys of the case set to values (`"inverse.weights" = "auto"`).
@@ -43,6 +48,10 @@ pub struct Variant {
     /// method `NAME+nodal`
     #[serde(default)]
     pub recovered: bool,
+    /// also score the curvature of the reconstructed centreline (its nodes' Menger curvature,
+    /// `score::centreline_bending`) instead of the frame's, as the method `NAME+centreline`
+    #[serde(default)]
+    pub centreline: bool,
     /// drawn in noise_study.svg (every variant is in the table)
     #[serde(default = "yes")]
     pub plot: bool,
@@ -114,6 +123,15 @@ impl StudySpec {
         }
         if spec.recordings == 0 || spec.quick.recordings == 0 || spec.frames < 2 || spec.quick.frames < 2 {
             return invalid("recordings must be >= 1 and frames >= 2 (also in [quick])".into());
+        }
+        if let Some(m) = spec.meshes.iter().find(|m| !(m.shape_noise_m.is_finite() && m.shape_noise_m >= 0.0)) {
+            return invalid(format!("shape_noise_m = {} m is not finite and >= 0", m.shape_noise_m));
+        }
+        if let Some(m) = spec.meshes.iter().find(|m| m.planar && m.shape_noise_m > 0.0) {
+            return invalid(format!(
+                "the planar mesh of {} nodes has shape_noise_m = {} m: shape changes are added to 3D recordings only",
+                m.nodes, m.shape_noise_m
+            ));
         }
         if let Some(m) = spec.meshes.iter().find(|m| m.nodes < 2 * spec.skip_elements + 3) {
             return invalid(format!(
