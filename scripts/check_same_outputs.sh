@@ -6,7 +6,7 @@
 # byte, except run.json, whose wall times, pid, host and dates differ between any two runs: there
 # only the lines without those keys are compared. Also compares `--help` of every command.
 #
-#   scripts/check_same_outputs.sh BEFORE_BINARY AFTER_BINARY [CASE.toml …]
+#   [ENGINE=freefem] scripts/check_same_outputs.sh BEFORE_BINARY AFTER_BINARY [CASE.toml …]
 #
 # Prints one line per case (same / DIFFERENT and the files that differ) and exits 1 if any case
 # differs. Not a test (it needs two builds); takes about 10 min on 2 cores for every case.
@@ -25,9 +25,9 @@ differ=0
 for c in "${cases[@]}"; do
   name=$(echo "$c" | tr '/' '_'); a="$tmp/a_$name"; b="$tmp/b_$name"
   ra=0; rb=0; out="$tmp/out"  # one folder name for both: messages name it
-  "$before" run "$c" --quiet --out "$out" >/dev/null 2>"$a.err" || ra=$?
+  "$before" run "$c" --engine "${ENGINE:-rust}" --quiet --out "$out" >/dev/null 2>"$a.err" || ra=$?
   [ ! -e "$out" ] || mv "$out" "$a"
-  "$after" run "$c" --quiet --out "$out" >/dev/null 2>"$b.err" || rb=$?
+  "$after" run "$c" --engine "${ENGINE:-rust}" --quiet --out "$out" >/dev/null 2>"$b.err" || rb=$?
   [ ! -e "$out" ] || mv "$out" "$b"
   bad=()
   [ "$ra" = "$rb" ] || bad+=("exit $ra vs $rb")

@@ -12,9 +12,8 @@ use nalgebra::Vector3;
 use crate::case::Case;
 use crate::engine::common::frames::{frame_result, FrameSolution, SolvedFrame};
 use crate::engine::common::result::{Engine, NodalState};
-use crate::engine::freefem::{
-    execute, info_certificate, io, read_info, read_table, ClipInclude, FreeFemError, RunOptions, FAILED_STATUS,
-};
+use crate::engine::freefem::info::FfInfo;
+use crate::engine::freefem::{execute, io, read_table, ClipInclude, FreeFemError, RunOptions, FAILED_STATUS};
 use crate::model::chart::Chart;
 use crate::solve::certificate::Certificate;
 use crate::solve::inverse::{InverseRecord, ObjectiveTerms};
@@ -98,22 +97,18 @@ pub fn read_clip_run(case: &Case, frames: &[Vec<Vector3<f64>>], workdir: &Path) 
     let sp = case.sequence_params().ok_or_else(|| FreeFemError::NotInverse(case.name.clone()))?;
     let charts = clip_charts(&sp, frames, case.mesh.length_m);
     let frames_out = read_frames(case, sp.frame_offset, frames, &charts, workdir)?;
-    let info = read_info(&workdir.join("ff_info.csv")).ok();
-    let get = |k: &str| info.as_ref().and_then(|i| i.get(k).copied());
+    let info = FfInfo::read(&workdir.join("ff_info.csv")).ok().unwrap_or_default();
     // the driver's `FAILED: frame K: …` line (its output, `execute`'s log)
     let output = std::fs::read_to_string(workdir.join("freefem_output.txt")).unwrap_or_default();
     let error = output.lines().find(|l| l.starts_with("FAILED")).map(str::to_string);
-    let stalled = match get("failed_frame") {
-        Some(frame) if get("failed_status").and_then(FrameCode::from_info) == Some(FrameCode::Stalled) => {
-            let c = info
-                .as_ref()
-                .and_then(info_certificate)
-                .unwrap_or(Certificate { value: f64::NAN, blocks: [f64::NAN; 4] });
-            let solver = if get("failed_newton") == Some(1.0) { "Newton" } else { "fixed point" };
+    let stalled = match info.failed.frame {
+        Some(frame) if info.failed.status.and_then(FrameCode::from_info) == Some(FrameCode::Stalled) => {
+            let c = info.certificate().unwrap_or(Certificate { value: f64::NAN, blocks: [f64::NAN; 4] });
+            let solver = if info.failed.newton == Some(1.0) { "Newton" } else { "fixed point" };
             Some(SolveError::Stalled(Box::new(crate::solve::Stall {
                 solver: format!("inverse {solver} of frame {}", frame as usize),
-                iterations: get("failed_iterations").unwrap_or(0.0) as usize,
-                rel_change: get("failed_rel_change").unwrap_or(f64::NAN),
+                iterations: info.failed.iterations.unwrap_or(0.0) as usize,
+                rel_change: info.failed.rel_change.unwrap_or(f64::NAN),
                 certificate: c.value,
                 tolerance: case.certificate_tolerance(),
                 block: c.worst_block(true),
@@ -121,7 +116,7 @@ pub fn read_clip_run(case: &Case, frames: &[Vec<Vector3<f64>>], workdir: &Path) 
         }
         _ => None,
     };
-    let wall_time_s = get("wall_time_s").unwrap_or_else(|| frames_out.iter().map(|f| f.result.stats.wall_time_s).sum());
+    let wall_time_s = info.wall_time_s.unwrap_or_else(|| frames_out.iter().map(|f| f.result.stats.wall_time_s).sum());
     Ok(FreeFemFrames { frames: frames_out, error, stalled, wall_time_s })
 }
 

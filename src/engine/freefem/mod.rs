@@ -10,17 +10,18 @@
 //! (`crate::engine` turns it into `RunError::Incomplete`).
 pub mod clip;
 pub mod include;
+pub mod info;
 pub mod path;
 pub mod progress;
 pub mod stability;
 
-use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use nalgebra::Vector3;
 
 pub use self::include::{include_file, ClipInclude, RunOptions};
+use self::info::FfInfo;
 use self::progress::Watch;
 use crate::case::{Analysis, Case};
 use crate::engine::common::angles_known;
@@ -82,18 +83,6 @@ pub const ITERATION_LIMIT_STATUS: i32 = 4;
 /// Exit status of a FreeFEM script that failed after writing what it had (`FAILED: …`; the
 /// clip script: the frames before its failed frame, and that frame's code in `ff_info.csv`).
 pub const FAILED_STATUS: i32 = 2;
-
-/// The keys of `ff_info.csv` holding the certificate's blocks, in the order of
-/// [`Certificate::blocks`] (the forward scripts write the first two).
-const CERTIFICATE_BLOCK_KEYS: [&str; 4] =
-    ["certificate_x_rows", "certificate_alpha_rows", "certificate_xhat_rows", "certificate_ahat_rows"];
-
-/// The certificate of the result in `ff_info.csv`, with its blocks.
-pub(super) fn info_certificate(info: &BTreeMap<String, f64>) -> Option<Certificate> {
-    let value = *info.get("certificate")?;
-    let blocks = CERTIFICATE_BLOCK_KEYS.map(|k| info.get(k).copied().unwrap_or(0.0));
-    Some(Certificate { value, blocks })
-}
 
 /// A certificate column of FreeFEM's inverse histories: −1 marks a record without one.
 fn optional_certificate(v: f64) -> Option<f64> {
@@ -258,15 +247,15 @@ fn read_inverse_history(workdir: &Path) -> Result<Vec<InverseRecord>, FreeFemErr
 
 /// The solver statistics and the certificate of an inverse run from `ff_info.csv` of `workdir`.
 fn read_inverse_info(workdir: &Path) -> Result<(SolverStats, Option<Certificate>), FreeFemError> {
-    let info = read_info(&workdir.join("ff_info.csv"))?;
-    let certificate = info_certificate(&info);
+    let info = FfInfo::read(&workdir.join("ff_info.csv"))?;
+    let certificate = info.certificate();
     let stats = SolverStats {
-        iterations: info.get("iterations").copied().unwrap_or(0.0) as usize,
-        last_change: info.get("rel_change").copied(),
+        iterations: info.iterations(),
+        last_change: info.solve.rel_change,
         residual: None,
         max_newton_iterations: None,
         certificate: certificate.map(|c| c.value),
-        wall_time_s: info.get("wall_time_s").copied().unwrap_or(f64::NAN),
+        wall_time_s: info.wall_time_s(),
     };
     Ok((stats, certificate))
 }
@@ -410,19 +399,6 @@ impl FreeFemError {
     }
 }
 
-pub(super) fn read_info(info_path: &Path) -> Result<BTreeMap<String, f64>, FreeFemError> {
-    let csv_err = |source| InputError::Csv { path: info_path.to_path_buf(), source };
-    let mut info = BTreeMap::new();
-    let mut rdr = csv::ReaderBuilder::new().trim(csv::Trim::All).from_path(info_path).map_err(csv_err)?;
-    for rec in rdr.records() {
-        let rec = rec.map_err(csv_err)?;
-        if let (Some(k), Some(v)) = (rec.get(0), rec.get(1).and_then(|v| v.parse::<f64>().ok())) {
-            info.insert(k.to_string(), v);
-        }
-    }
-    Ok(info)
-}
-
 pub(super) fn read_table(path: &Path, expected: &[&str]) -> Result<Vec<Vec<f64>>, FreeFemError> {
     let bad = |reason: String| FreeFemError::BadOutput { path: path.to_path_buf(), reason };
     let mut rdr = csv_reader(path, expected)?;
@@ -456,16 +432,15 @@ fn read_outputs(case: &Case, dir: &Path) -> Result<(RunResult, Option<Certificat
         chart: case.rod.general.as_ref().map(|g| g.rest.chart).unwrap_or_default(),
         reference_x: case.rod.general.as_ref().map(|g| g.rest.positions.clone()),
     };
-    let info = read_info(&dir.join("ff_info.csv"))?;
-    let get = |k: &str| info.get(k).copied();
-    let certificate = info_certificate(&info);
+    let info = FfInfo::read(&dir.join("ff_info.csv"))?;
+    let certificate = info.certificate();
     let stats = SolverStats {
-        iterations: get("iterations").unwrap_or(0.0) as usize,
-        last_change: get("rel_change"),
-        residual: get("residual"),
-        max_newton_iterations: get("max_newton_iterations").map(|v| v as usize),
+        iterations: info.iterations(),
+        last_change: info.solve.rel_change,
+        residual: info.solve.residual,
+        max_newton_iterations: info.solve.max_newton_iterations.map(|v| v as usize),
         certificate: certificate.map(|c| c.value),
-        wall_time_s: get("wall_time_s").unwrap_or(f64::NAN),
+        wall_time_s: info.wall_time_s(),
     };
     let mut history = Vec::new();
     let mut tip = Vec::new();

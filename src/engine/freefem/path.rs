@@ -2,11 +2,12 @@
 //! point: step, λ, arc length, the determinant's sign, iterations, certificate, the displacement
 //! at each recorded node) and `ff_critical.csv` read into the [`PathOutput`] the Rust engine
 //! gives, so that both engines write the same `path.csv` and are compared on it.
-use std::collections::BTreeMap;
+
 use std::path::Path;
 
 use nalgebra::Vector3;
 
+use super::info::FfInfo;
 use super::{read_table, FreeFemError};
 use crate::case::Case;
 use crate::engine::common::path_record_points;
@@ -17,7 +18,7 @@ use crate::solve::arclength::Critical;
 pub const PATH_OUTPUTS: [&str; 2] = ["ff_path.csv", "ff_critical.csv"];
 
 /// The path in `dir` of a case followed by arc length; `info` its `ff_info.csv`.
-pub(super) fn read_path(case: &Case, dir: &Path, info: &BTreeMap<String, f64>) -> Result<PathOutput, FreeFemError> {
+pub(super) fn read_path(case: &Case, dir: &Path, info: &FfInfo) -> Result<PathOutput, FreeFemError> {
     let record_s_m = path_record_points(case);
     let mut header: Vec<String> =
         ["step", "load_factor", "arc_length", "determinant_sign", "iterations", "certificate"].map(String::from).into();
@@ -49,5 +50,5 @@ pub(super) fn read_path(case: &Case, dir: &Path, info: &BTreeMap<String, f64>) -
         k => Err(FreeFemError::BadOutput { path: critical_path.clone(), reason: format!("critical point kind {k}") }),
     })
     .collect::<Result<_, _>>()?;
-    Ok(PathOutput { record_s_m, points, critical, reached_end: info.get("reached_end") == Some(&1.0) })
+    Ok(PathOutput { record_s_m, points, critical, reached_end: info.path.reached_end == Some(1.0) })
 }
