@@ -80,16 +80,9 @@ pub(crate) fn run(
         if let Some(c) = cert {
             certificate = c;
         }
-        let previous = frame.previous.unwrap_or(&s.no_previous);
         let rec = InverseRecord {
             certificate: cert.map(|c| c.value),
-            ..record(
-                FrameProblem { problem: s.problem, params, frame, alpha_prev: previous },
-                (k, rel_change),
-                &u,
-                &adjoint,
-                None,
-            )
+            ..record(FrameProblem::of(s.problem, params, frame, &s.no_previous), (k, rel_change), &u, &adjoint, None)
         };
         rec.divergence(frame.index, &u, &adjoint)?;
         let stop_requested = observer(&rec, &u, &adjoint).is_break();

@@ -178,6 +178,19 @@ pub struct FrameProblem<'a> {
     pub alpha_prev: &'a [Vector3<f64>],
 }
 
+impl<'a> FrameProblem<'a> {
+    /// The problem of `frame`: its previous angles, or `no_previous` (zeros, one per node) on a
+    /// first frame. Every kernel's caller builds it here.
+    pub fn of(
+        problem: &'a Problem<'a>,
+        params: &'a InverseParams,
+        frame: &'a Frame<'a>,
+        no_previous: &'a [Vector3<f64>],
+    ) -> Self {
+        FrameProblem { problem, params, frame, alpha_prev: frame.previous.unwrap_or(no_previous) }
+    }
+}
+
 /// Where a frame's solve starts from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Start {
@@ -527,8 +540,7 @@ impl<'p> FrameSolver<'p> {
     /// [`FrameSolver::certify`] of a KKT vector.
     pub(crate) fn certify_kkt(&mut self, frame: &Frame, big: &DVector<f64>) -> Certificate {
         self.work.cert_values.resize(self.pattern.nnz(), 0.0);
-        let alpha_prev = frame.previous.unwrap_or(&self.no_previous);
-        let fp = FrameProblem { problem: self.problem, params: &self.params, frame, alpha_prev };
+        let fp = FrameProblem::of(self.problem, &self.params, frame, &self.no_previous);
         kkt::certificate(fp, big, &self.pattern, &mut self.work.cert_values)
     }
 
@@ -549,8 +561,7 @@ impl<'p> FrameSolver<'p> {
         u: &DVector<f64>,
         rescale: bool,
     ) -> Result<DVector<f64>, SolveError> {
-        let alpha_prev = frame.previous.unwrap_or(&self.no_previous);
-        let fp = FrameProblem { problem: self.problem, params, frame, alpha_prev };
+        let fp = FrameProblem::of(self.problem, params, frame, &self.no_previous);
         let mut rhs = kkt::assemble_system(fp, &self.pattern, &mut self.work.values, u);
         for &(d, v) in &self.dirichlet.fixed {
             rhs[d] = v;

@@ -344,8 +344,7 @@ impl Newton<'_, '_, '_> {
     /// values if `jacobian`.
     fn residual(&mut self, big: &DVector<f64>, jacobian: bool) -> DVector<f64> {
         let s = &mut *self.s;
-        let alpha_prev = self.frame.previous.unwrap_or(s.no_previous.as_slice());
-        let fp = FrameProblem { problem: s.problem, params: self.params, frame: self.frame, alpha_prev };
+        let fp = FrameProblem::of(s.problem, self.params, self.frame, &s.no_previous);
         let jacobian = jacobian.then_some((&s.pattern, s.work.values.as_mut_slice(), s.dirichlet.rows.as_slice()));
         assemble_residual(fp, big, &s.dirichlet.fixed, jacobian)
     }
@@ -353,8 +352,7 @@ impl Newton<'_, '_, '_> {
     /// The residual certificate of `big` (`kkt::certificate`).
     fn certify(&mut self, big: &DVector<f64>) -> Certificate {
         let s = &mut *self.s;
-        let alpha_prev = self.frame.previous.unwrap_or(s.no_previous.as_slice());
-        let fp = FrameProblem { problem: s.problem, params: self.params, frame: self.frame, alpha_prev };
+        let fp = FrameProblem::of(s.problem, self.params, self.frame, &s.no_previous);
         super::kkt::certificate(fp, big, &s.pattern, &mut s.work.cert_values)
     }
 
@@ -367,8 +365,7 @@ impl Newton<'_, '_, '_> {
         adjoint: &DVector<f64>,
         residual: Option<f64>,
     ) -> InverseRecord {
-        let alpha_prev = self.frame.previous.unwrap_or(self.s.no_previous.as_slice());
-        let fp = FrameProblem { problem: self.s.problem, params: self.params, frame: self.frame, alpha_prev };
+        let fp = FrameProblem::of(self.s.problem, self.params, self.frame, &self.s.no_previous);
         record(fp, (k, change), u, adjoint, residual)
     }
 
