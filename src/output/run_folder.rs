@@ -10,7 +10,9 @@
 //! removed, or resumed, by the next run. `--resume` continues in a staging folder of its own (a
 //! copy of the output folder, or the staging folder of a killed run), so the previous folder
 //! stays in place until the resumed run ends. A folder holding files but no `run.json` is not
-//! replaced unless `--force`.
+//! replaced unless `--force`. A run that fails or is interrupted is not put in place of a
+//! folder holding a complete run: that folder stays, and the run stays beside it in its
+//! staging folder ([`Placed::Beside`]), unless `--force`.
 use std::path::{Path, PathBuf};
 
 use super::folder_lock::{real_folder, FolderLock, LockError};
