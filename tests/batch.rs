@@ -225,3 +225,134 @@ fn synth_refuses_a_folder_that_is_not_empty_and_finds_its_kymogram_anywhere() {
     let m = std::fs::read_to_string(tmp.path().join("corpus/run.json")).expect("run.json");
     assert!(m.contains("\"command\": \"synth\"") && m.contains("kymogram_omega-turn.npy"), "{m}");
 }
+
+/// The names in `dir`, sorted.
+fn names(dir: &std::path::Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .expect("dir")
+        .map(|e| e.expect("e").file_name().to_string_lossy().into_owned())
+        .collect();
+    v.sort();
+    v
+}
+
+/// A pid that is no longer alive: a child that has ended (and been reaped).
+fn dead_pid() -> u32 {
+    let mut child = std::process::Command::new("true").spawn().expect("true");
+    let pid = child.id();
+    child.wait().expect("wait");
+    pid
+}
+
+/// What killed runs left in OUT goes at the end of the next batch, for recordings it skips
+/// too: a lock file whose holder is dead, the staging folder that held a recording's previous
+/// folder after the exchange (the kill "just after a recording's folder is swapped in"), the
+/// staging folder of a folder no longer in the batch, a temporary summary. A lock held by a
+/// live process (this test) keeps that recording's files until it is released.
+#[test]
+fn a_batch_removes_what_killed_runs_left_and_nothing_of_a_live_one() {
+    if !common::worm_data_present("batch") {
+        return;
+    }
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let (recs, out) = (tmp.path().join("recordings"), tmp.path().join("out"));
+    corpus(&recs);
+    let run = || batch_command(&recs, &out, &["--jobs", "2", "--output-format", "csv"]).output().expect("batch");
+    assert_eq!(run().status.code(), Some(1), "the bad recording fails");
+    let clean = names(&out);
+    let dead = dead_pid();
+    // a killed batch's leftovers: roll_000's previous folder after the swap, its lock, a
+    // folder of an earlier plan's recording, a temporary summary
+    let swapped = out.join(format!(".roll_000.staging-{dead}"));
+    std::fs::create_dir(&swapped).expect("mkdir");
+    std::fs::copy(out.join("roll_000/run.json"), swapped.join("run.json")).expect("copy");
+    std::fs::write(out.join(".roll_000.lock"), dead.to_string()).expect("lock");
+    std::fs::create_dir(out.join(format!(".gone.staging-{dead}"))).expect("mkdir");
+    std::fs::write(out.join(format!(".summary.csv.{dead}.0.tmp")), "recording,folder\n").expect("tmp");
+    // a live process writing roll_001 (this one): its lock and staging folder stay
+    let live = cosserat::output::folder_lock::FolderLock::acquire(&out, "roll_001").expect("lock");
+    let live_stage = out.join(format!(".roll_001.staging-{}", std::process::id()));
+    std::fs::create_dir(&live_stage).expect("mkdir");
+
+    let second = run();
+    assert!(String::from_utf8_lossy(&second.stdout).contains("4 already complete, skipped"));
+    let mut expected = clean.clone();
+    expected.extend([".roll_001.lock".to_string(), live_stage.file_name().unwrap().to_string_lossy().into_owned()]);
+    expected.sort();
+    assert_eq!(names(&out), expected, "only the live run's files are left");
+    drop(live);
+    std::fs::remove_dir(&live_stage).expect("rmdir"); // what its run would do at its end
+    run();
+    assert_eq!(names(&out), clean);
+}
+
+/// summary.csv never describes folders of another run: a batch of a changed case killed
+/// after it started leaves no summary (the earlier one, of the other case, is gone) beside
+/// the new plan. Then a batch of a case whose recordings now fail (one iteration per frame)
+/// keeps each complete folder, its row saying where its own work is; --force replaces them.
+#[test]
+fn a_batch_never_leaves_a_stale_summary_nor_replaces_complete_recordings() {
+    if !common::worm_data_present("batch") {
+        return;
+    }
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let (recs, out) = (tmp.path().join("recordings"), tmp.path().join("out"));
+    corpus(&recs);
+    std::fs::remove_file(recs.join("bad.csv")).expect("rm");
+    let args = ["--jobs", "2", "--output-format", "csv"];
+    assert_eq!(batch_command(&recs, &out, &args).output().expect("batch").status.code(), Some(0));
+    let before: Vec<_> =
+        (0..4).map(|k| std::fs::read(out.join(format!("roll_00{k}/fields.csv"))).expect("f")).collect();
+    // the case, its clip file (replaced by each recording) absolute so that it runs from here
+    let text = std::fs::read_to_string(batch_common::case()).expect("case").replacen(
+        "../../data/corpus/roll_000.npy",
+        &recs.join("roll_000.npy").display().to_string(),
+        1,
+    );
+    let changed = tmp.path().join("changed.toml");
+    let edited = text.replacen("max_iterations = 300", "max_iterations = 299", 1);
+    assert_ne!(edited, text);
+    std::fs::write(&changed, &edited).expect("case");
+    let batch = |case: &std::path::Path, extra: &[&str]| {
+        let mut c = std::process::Command::new(env!("CARGO_BIN_EXE_cosserat"));
+        c.current_dir(batch_common::root()).arg("batch").arg(case).arg("--recordings").arg(&recs);
+        c.arg("--out").arg(&out).arg("--quiet").args(args).args(extra);
+        c
+    };
+    let mut child = batch(&changed, &[]).stderr(std::process::Stdio::null()).spawn().expect("batch");
+    let stage = out.join(format!(".roll_000.staging-{}", child.id()));
+    let start = std::time::Instant::now();
+    while !stage.join("run.json").exists() {
+        assert!(start.elapsed().as_secs() < 60 && child.try_wait().expect("try_wait").is_none(), "no progress");
+        std::thread::sleep(std::time::Duration::from_millis(2));
+    }
+    child.kill().expect("kill");
+    child.wait().expect("wait");
+    let plan = std::fs::read_to_string(out.join("batch.json")).expect("plan");
+    assert!(plan.contains("changed.toml"), "the new plan");
+    assert!(!out.join("summary.csv").exists(), "no summary of the earlier case beside it");
+
+    let failing = tmp.path().join("failing.toml");
+    std::fs::write(&failing, text.replacen("max_iterations = 300", "max_iterations = 1", 1)).expect("case");
+    let o = batch(&failing, &[]).output().expect("batch");
+    assert_eq!(o.status.code(), Some(1), "{}", String::from_utf8_lossy(&o.stderr));
+    let rows = summary_without_time(&out);
+    for (k, r) in rows[1..].iter().enumerate() {
+        assert_eq!(r[2], "failed", "{r:?}");
+        let folder = out.join(&r[1]);
+        assert!(r[12].contains(&format!("{} keeps its complete run", folder.display())), "{r:?}");
+        assert!(
+            r[12]
+                .contains(&format!("this run's work is kept in {}", out.join(format!(".{}.staging-", r[1])).display())),
+            "{r:?}"
+        );
+        assert_eq!(std::fs::read(folder.join("fields.csv")).expect("fields"), before[k], "{} as it was", r[1]);
+    }
+    let o = batch(&failing, &["--force"]).output().expect("batch");
+    assert_eq!(o.status.code(), Some(1));
+    for k in 0..4 {
+        let m = std::fs::read_to_string(out.join(format!("roll_00{k}/run.json"))).expect("run.json");
+        assert!(m.contains("\"status\": \"failed\""), "--force replaces: {m}");
+    }
+    assert!(names(&out).iter().all(|n| !n.starts_with('.')), "{:?}", names(&out));
+}

@@ -130,6 +130,21 @@ fn a_full_disk_keeps_the_previous_folder_and_the_clip_resumes_once_there_is_spac
     assert!(lines(&kept[0].join("frames.csv")) > done, "frames.csv holds at least the kept frames");
     assert!(err.contains(&format!("The {done} converged frames are kept in {}", kept[0].display())), "{err}");
 
+    // --resume on the disk still full (not a byte free): it says the space and that the
+    // frames already written are kept, and where; it changes nothing.
+    let filler = disk.dir.join("filler");
+    let (free, _) = cosserat::io::disk::free_bytes(&disk.dir).expect("statvfs");
+    let _ = std::fs::write(&filler, vec![1u8; free as usize + (64 << 10)]); // ENOSPC at the end
+    let journal = std::fs::read(kept[0].join("resume.jsonl")).expect("journal");
+    let (code, err) = cosserat(&case, &out, &["--resume"]);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(err.contains(&format!("the disk holding {} is full (", out.display())), "{err}");
+    assert!(err.contains(" free of 2 MiB)"), "{err}");
+    assert!(err.contains(&format!("the {done} frames already written are kept in {}", kept[0].display())), "{err}");
+    assert_eq!(stagings(&out), kept, "the frames stay where they were");
+    assert_eq!(std::fs::read(kept[0].join("resume.jsonl")).expect("journal"), journal);
+    std::fs::remove_file(&filler).expect("rm filler");
+
     // Space freed: --resume completes the clip, byte for byte the uninterrupted run's files.
     disk.resize("64m");
     let (code, err) = cosserat(&case, &out, &["--resume"]);
@@ -143,10 +158,61 @@ fn a_full_disk_keeps_the_previous_folder_and_the_clip_resumes_once_there_is_spac
     // A run with nothing to keep (a forward case) on a full disk: its staging folder goes.
     let (free, _) = cosserat::io::disk::free_bytes(&disk.dir).expect("statvfs");
     // all but 12 KiB: room for the lock, the staging folder and its run.json, not the results
-    std::fs::write(disk.dir.join("filler"), vec![1u8; free as usize - (12 << 10)]).expect("filler");
+    std::fs::write(&filler, vec![1u8; free as usize - (12 << 10)]).expect("filler");
     let single = disk.dir.join("s");
     let (code, err) = cosserat(&forward, &single, &[]);
     assert_eq!(code, Some(1), "{err}");
     assert!(err.contains("is full") && err.contains("nothing of this run was kept"), "{err}");
     assert!(!single.exists() && stagings(&single).is_empty(), "nothing left behind");
+}
+
+/// A batch recording stopped by a full disk: its row says where its converged frames are (its
+/// staging folder, which is there), and once there is space the next batch continues them.
+#[test]
+fn a_batch_on_a_full_disk_says_where_the_frames_are_and_continues_them() {
+    if !common::worm_data_present("disk_full") {
+        return;
+    }
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let recs = tmp.path().join("recordings");
+    let root = env!("CARGO_MANIFEST_DIR");
+    let synth = Command::new(env!("CARGO_BIN_EXE_cosserat"))
+        .current_dir(root)
+        .args(["synth", "--count", "1", "--frames", "200", "--seed", "3", "--out"])
+        .arg(&recs)
+        .output()
+        .expect("synth");
+    assert!(synth.status.success(), "{}", String::from_utf8_lossy(&synth.stderr));
+    let disk = match Tmpfs::mount(&tmp.path().join("disk"), "2m") {
+        Ok(d) => d,
+        Err(reason) => return unavailable(&reason),
+    };
+    let out = disk.dir.join("b");
+    let batch = || {
+        Command::new(env!("CARGO_BIN_EXE_cosserat"))
+            .current_dir(root)
+            .args(["batch", "cases/batch/roll_recording.toml", "--quiet", "--output-format", "csv", "--recordings"])
+            .arg(&recs)
+            .arg("--out")
+            .arg(&out)
+            .output()
+            .expect("batch")
+    };
+    assert_eq!(batch().status.code(), Some(1));
+    let summary = std::fs::read_to_string(out.join("summary.csv")).expect("summary");
+    let kept: Vec<PathBuf> = stagings(&out.join("roll_000"));
+    assert_eq!(kept.len(), 1, "{summary}");
+    let done = json(&kept[0].join("run.json"))["frames_done"].as_u64().expect("frames_done");
+    assert!(done > 0 && done as usize == lines(&kept[0].join("resume.jsonl")), "{done}");
+    assert!(summary.contains(" free of 2 MiB)"), "{summary}");
+    let said = format!("the {done} converged frames are kept in {}: the next batch continues", kept[0].display());
+    assert!(summary.contains(&said), "{summary}");
+    assert!(!summary.contains("in this folder"), "{summary}");
+    disk.resize("64m");
+    let o = batch();
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(json(&out.join("roll_000/run.json"))["frames_done"], 200);
+    let frames = std::fs::read_to_string(out.join("roll_000/frames.csv")).expect("frames");
+    assert_eq!(frames.lines().count(), 1 + 200, "the kept frames and the rest, once each");
+    assert!(stagings(&out.join("roll_000")).is_empty());
 }

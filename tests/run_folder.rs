@@ -188,24 +188,6 @@ fn a_folder_never_mixes_two_runs() {
 }
 
 #[test]
-fn a_failed_run_replaces_the_results_it_would_otherwise_leave_looking_valid() {
-    let dir = tempfile::tempdir().expect("tempdir");
-    let out = dir.path().join("r");
-    cosserat().args(["run", "cases/inverse_bend_twist_newton.toml", "--quiet", "--out"]).arg(&out).assert().success();
-    let text = common::edit(&common::case_text("inverse_bend_twist"), "max_iterations = 1000", "max_iterations = 3");
-    let case = dir.path().join("short.toml");
-    std::fs::write(&case, text).expect("write case");
-    cosserat().args(["run", "--quiet", "--out"]).arg(&out).arg(&case).assert().code(1).stderr(
-        predicate::str::contains("did not converge after 3 iterations").and(predicate::str::contains("failed")),
-    );
-    let m = manifest(&out);
-    assert_eq!(m["status"], "failed");
-    assert!(m["message"].as_str().unwrap_or_default().contains("last iterate"), "{m}");
-    let history = std::fs::read_to_string(out.join("inverse_history.csv")).expect("the last iterate's history");
-    assert_eq!(history.lines().count(), 4, "3 iterations of the failed run, not the earlier run's");
-}
-
-#[test]
 fn a_folder_not_written_by_cosserat_is_refused_unless_forced() {
     let dir = tempfile::tempdir().expect("tempdir");
     let out = dir.path().join("mine");
@@ -340,7 +322,7 @@ fn an_interrupted_sweep_stops_every_point_and_says_what_it_kept() {
     let o = child.wait_with_output().expect("wait");
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(130), "{stderr}");
-    assert!(stderr.contains("interrupted: 0 of 3 points complete, "), "{stderr}");
+    assert!(stderr.contains("interrupted: of 3 points 0 complete, 0 stalled, 0 failed or not converged, "), "{stderr}");
     let summary = std::fs::read_to_string(out.join("summary.csv")).expect("summary");
     let rows: Vec<Vec<&str>> = summary.lines().skip(1).map(|l| l.split(',').collect()).collect();
     let not_started = "not started: a stop was requested before its turn";
@@ -395,4 +377,22 @@ fn an_address_space_limit_gives_an_error_not_an_abort() {
         assert_eq!(o.status.code(), Some(1), "ulimit -v {kib}: {stderr}");
         assert!(stderr.contains(words) && stderr.contains("ulimit -v"), "ulimit -v {kib}: {stderr}");
     }
+}
+
+/// An interrupted sweep counts every point once, whatever its end: one failed at its first
+/// frame (one iteration allowed), one stopped at its next frame.
+#[test]
+fn an_interrupted_sweep_counts_a_failed_point() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = dir.path().join("two");
+    let mut child = spawn(&["sweep", CLIP, "--quiet", "--jobs", "2", "--set", "max_iterations=1,300"], &out);
+    wait_for_lines(&mut child, &out, "max_iterations=300/frames.csv", 1 + 20);
+    wait_for_lines(&mut child, &out, "max_iterations=1/run.json", 2);
+    signal(&child, "-INT");
+    let o = child.wait_with_output().expect("wait");
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(130), "{stderr}");
+    let said = "interrupted: of 2 points 0 complete, 0 stalled, 1 failed or not converged, 1 stopped at their next iteration or frame (kept: max_iterations=300 ";
+    assert!(stderr.contains(said), "{stderr}");
+    assert!(stderr.contains("frames), 0 not started"), "{stderr}");
 }

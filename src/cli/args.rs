@@ -51,7 +51,8 @@ pub enum Command {
         /// `[compare] frames`, 10]
         #[arg(long, value_parser = super::parse_frames)]
         frames: Option<usize>,
-        /// Replace the output directory even if it holds files but no run.json
+        /// Replace the output directory even if it holds files but no run.json, or a complete
+        /// run with one that fails or is interrupted
         #[arg(long)]
         force: bool,
         #[command(flatten)]
@@ -149,7 +150,8 @@ pub struct SweepArgs {
     /// Output directory [default: out/<case name>/sweep]
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// Replace the output directory even if it holds files but no run.json
+    /// Replace the output directory even if it holds files but no run.json, or a complete run
+    /// with one that fails or is interrupted (which otherwise is kept beside it)
     #[arg(long)]
     pub force: bool,
     #[command(flatten)]
@@ -173,7 +175,8 @@ pub struct AuditArgs {
     /// Output directory [default: out/audit, out/audit-quick with --quick]; replaced whole
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// Replace the output directory even if it holds files but no run.json
+    /// Replace the output directory even if it holds files but no run.json, or a complete run
+    /// with one that fails or is interrupted (which otherwise is kept beside it)
     #[arg(long)]
     pub force: bool,
     /// Parallel runs, 1 to 256 [default: number of cores; never more than the runs]
@@ -205,7 +208,8 @@ pub struct RunArgs {
     /// folder beside it that replaces it whole at the end; run.json says what it holds
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// Replace the output directory even if it holds files but no run.json
+    /// Replace the output directory even if it holds files but no run.json, or a complete run
+    /// with one that fails or is interrupted (which otherwise is kept beside it)
     #[arg(long)]
     pub force: bool,
     /// Continue the interrupted, failed or killed clip of the output directory from its

@@ -12,7 +12,7 @@ use cosserat::engine::budget::{self, default_limit_bytes, Footprint, GIB};
 use cosserat::engine::Engine;
 use cosserat::io::compact::OutputFormat;
 use cosserat::jobs::job::{case_label, run_into, run_manifest};
-use cosserat::output::run_folder::{input_file, Manifest, Mode, RunFolder, Status};
+use cosserat::output::run_folder::{input_file, Manifest, Mode, Placed, RunFolder, Status};
 use cosserat::solve::modes::modal_model;
 use cosserat::solve::Outcome;
 
@@ -95,13 +95,14 @@ pub fn cmd_compare(
         Err(_) if cosserat::interrupt::requested() => (Status::Interrupted, Some("interrupted by a signal".into())),
         Err(e) => (Status::Failed, Some(format!("{e:#}"))),
     };
-    folder.finish(status, message)?;
+    let placed = folder.finish(status, message)?;
+    let then = "until the next compare into it";
     match (status, result) {
         (Status::Interrupted, _) => {
-            eprintln!("{}: interrupted; {} holds run.json saying interrupted", case.name, target.display());
+            eprintln!("{}: interrupted; {}", case.name, held(&placed, "interrupted", then));
             Ok(ExitCode::from(crate::EXIT_INTERRUPTED))
         }
-        (_, Err(e)) => Err(e.context(format!("{} holds run.json saying failed", target.display()))),
+        (_, Err(e)) => Err(e.context(held(&placed, "failed", then))),
         (_, Ok(code)) => Ok(code),
     }
 }
@@ -181,8 +182,8 @@ pub fn cmd_sweep(args: SweepArgs) -> Result<ExitCode> {
         }
         Err(e) => {
             let message = cosserat::jobs::sweep::chain(&e);
-            folder.finish(Status::Failed, Some(message.clone()))?;
-            anyhow::bail!("{}: sweep: {message}; {} holds run.json saying failed", case_label(&case), target.display());
+            let placed = folder.finish(Status::Failed, Some(message.clone()))?;
+            anyhow::bail!("{}: sweep: {message}; {}", case_label(&case), held(&placed, "failed", SWEEP_THEN));
         }
     };
     let count = |s: Outcome| rows.iter().filter(|r| r.status == s).count();
@@ -198,22 +199,27 @@ pub fn cmd_sweep(args: SweepArgs) -> Result<ExitCode> {
     let message = (failed > 0).then(|| {
         format!("{failed} of {} points failed, did not converge or were interrupted (summary.csv)", rows.len())
     });
-    folder.finish(status, message)?;
+    let placed = folder.finish(status, message)?;
+    // where the summary and the points' folders are: the output folder, or beside it
+    let written = if let Placed::Beside { kept: Some(k), .. } = &placed { k.clone() } else { target.clone() };
     println!(
         "{}: {} runs, {} failed or not converged, {interrupted} interrupted; wrote {} and one folder per run to {}",
         case.name,
         rows.len(),
         failed - interrupted,
-        target.join("summary.csv").display(),
-        target.display()
+        written.join("summary.csv").display(),
+        written.display()
     );
+    if let Placed::Beside { .. } = placed {
+        eprintln!("{}: sweep {}", case.name, held(&placed, "", SWEEP_THEN));
+    }
     for r in rows.iter().filter(|r| r.error.as_deref() != Some(cosserat::jobs::sweep::NOT_STARTED)) {
         if let Some(e) = &r.error {
             eprintln!("  {}: {}: {e}", r.name, r.status.as_str());
         }
     }
     if interrupted > 0 {
-        eprintln!("{}", super::outcome::sweep_interrupted_summary(&rows, &target));
+        eprintln!("{}", super::outcome::sweep_interrupted_summary(&rows, &written));
     }
     Ok(if interrupted > 0 {
         ExitCode::from(crate::EXIT_INTERRUPTED)
@@ -222,6 +228,20 @@ pub fn cmd_sweep(args: SweepArgs) -> Result<ExitCode> {
     } else {
         ExitCode::from(1)
     })
+}
+
+/// What continues a sweep's or an audit's run kept beside a complete one ([`held`]).
+const SWEEP_THEN: &str = "until the next sweep into it";
+const AUDIT_THEN: &str = "(`cosserat audit --resume` with the same specs continues it)";
+
+/// Where a run that ended `word` ("failed", "interrupted") is, for a message: its output folder
+/// holding `run.json` saying so, or (a complete run was there) beside it, `then` saying what
+/// continues it.
+fn held(placed: &Placed, word: &str, then: &str) -> String {
+    match placed {
+        Placed::InPlace(t) => format!("{} holds run.json saying {word}", t.display()),
+        beside => beside.kept_text(then).trim_start_matches("; ").to_string(),
+    }
 }
 
 pub fn cmd_audit(args: AuditArgs) -> Result<ExitCode> {
@@ -254,8 +274,8 @@ pub fn cmd_audit(args: AuditArgs) -> Result<ExitCode> {
         Ok(r) => r,
         Err(e) => {
             let message = format!("{:#}", anyhow::Error::from(e));
-            folder.finish(Status::Failed, Some(message.clone()))?;
-            anyhow::bail!("audit: {message}; {} holds run.json saying failed", out.display());
+            let placed = folder.finish(Status::Failed, Some(message.clone()))?;
+            anyhow::bail!("audit: {message}; {}", held(&placed, "failed", AUDIT_THEN));
         }
     };
     let judged = format!("{} of {} claims judged", report.claims.len() - report.unjudged(), report.claims.len());
@@ -266,19 +286,20 @@ pub fn cmd_audit(args: AuditArgs) -> Result<ExitCode> {
         AuditStatus::Interrupted => {
             let kept =
                 super::outcome::audit_points_kept(folder.dir(), points.load(std::sync::atomic::Ordering::SeqCst));
-            folder.finish(Status::Interrupted, Some(format!("interrupted by a signal: {kept}; {judged}")))?;
+            let placed =
+                folder.finish(Status::Interrupted, Some(format!("interrupted by a signal: {kept}; {judged}")))?;
             eprintln!(
-                "audit interrupted: {kept}; {judged}; REPORT.md is headed interrupted and marks the others not judged; {} holds run.json saying interrupted",
-                out.display()
+                "audit interrupted: {kept}; {judged}; REPORT.md is headed interrupted and marks the others not judged; {}",
+                held(&placed, "interrupted", AUDIT_THEN)
             );
             return Ok(ExitCode::from(crate::EXIT_INTERRUPTED));
         }
         AuditStatus::Failed(errors) => {
             let message = format!("{judged}: {}", errors.join("; "));
-            folder.finish(Status::Failed, Some(message.clone()))?;
+            let placed = folder.finish(Status::Failed, Some(message.clone()))?;
             anyhow::bail!(
-                "audit failed: {message}; REPORT.md is headed failed; {} holds run.json saying failed",
-                out.display()
+                "audit failed: {message}; REPORT.md is headed failed; {}",
+                held(&placed, "failed", AUDIT_THEN)
             );
         }
     }

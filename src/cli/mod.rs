@@ -52,6 +52,10 @@ pub struct BatchArgs {
     /// Do not show progress (a bar on a terminal, else a line every 10 s)
     #[arg(long)]
     quiet: bool,
+    /// A recording's run replaces its folder even when it fails or is interrupted and the
+    /// folder holds a complete run (without it, that run stays and this one is kept beside it)
+    #[arg(long)]
+    force: bool,
 }
 
 /// `cosserat batch --slurm`: whether to submit a job array, and its options (each but `--slurm`
@@ -166,7 +170,7 @@ pub fn cmd_batch(a: BatchArgs) -> Result<ExitCode> {
         return submit_batch(&a.slurm, a.quiet, &plan, &out, &case.name);
     }
     let pb = Progress::new(&format!("{} batch", case.name), "recordings", plan.recordings.len(), a.quiet);
-    let ran = run_batch(&plan, &out, a.jobs.unwrap_or(0), || pb.inc())?;
+    let ran = run_batch(&plan, &out, (a.jobs.unwrap_or(0), a.force), || pb.inc())?;
     pb.finish();
     let skipped = ran.iter().filter(|r| r.skipped).count();
     let rows: Vec<BatchRow> = ran.into_iter().map(|r| r.row).collect();

@@ -23,8 +23,9 @@ pub fn full_disk_note(end: &cosserat::jobs::job::JobEnd, case: &Path, dir: &Path
     }
 }
 
-/// What an interrupted sweep kept: points complete, stopped (their folders, a clip's converged
-/// frames) and not started.
+/// What an interrupted sweep kept: every point counted once by how it ended (complete, stalled,
+/// failed or not converged, stopped at its next iteration or frame with a clip's converged
+/// frames, not started).
 pub fn sweep_interrupted_summary(rows: &[cosserat::jobs::sweep::SummaryRow], target: &Path) -> String {
     use cosserat::jobs::sweep::NOT_STARTED;
     let not_started = rows.iter().filter(|r| r.error.as_deref() == Some(NOT_STARTED)).count();
@@ -36,9 +37,12 @@ pub fn sweep_interrupted_summary(rows: &[cosserat::jobs::sweep::SummaryRow], tar
             r.metrics.as_ref().and_then(|m| m.get(Metric::Frames)).map(|f| format!("{} {f} frames", r.name))
         })
         .collect();
-    let ok = rows.iter().filter(|r| r.status == Outcome::Converged).count();
+    let count = |f: fn(Outcome) -> bool| rows.iter().filter(|r| f(r.status)).count();
+    let complete = count(Outcome::is_complete);
+    let stalled = count(|s| s == Outcome::Stalled);
+    let failed = count(|s| matches!(s, Outcome::Failed | Outcome::IterationLimit));
     format!(
-        "interrupted: {ok} of {} points complete, {} stopped at their next iteration or frame{}, {not_started} not started; {} marks each (status interrupted), and {} holds run.json saying interrupted",
+        "interrupted: of {} points {complete} complete, {stalled} stalled, {failed} failed or not converged, {} stopped at their next iteration or frame{}, {not_started} not started; {} marks each, and {} holds run.json saying interrupted",
         rows.len(),
         stopped.len(),
         if frames.is_empty() { String::new() } else { format!(" (kept: {})", frames.join(", ")) },
@@ -126,16 +130,30 @@ pub fn run_end(
             }
         }
         Status::Interrupted => {
-            let kept = match end.frames {
-                Some((n, _)) => format!(
+            let resume = format!("(`cosserat run {} --out {} --resume` continues it)", path.display(), dir.display());
+            let kept = match (&end.beside, end.frames) {
+                (Some(beside), _) => {
+                    eprintln!("{}: interrupted{}", case.name, beside.kept_text(&resume));
+                    return Ok(std::process::ExitCode::from(crate::EXIT_INTERRUPTED));
+                }
+                (None, Some((n, _))) => format!(
                     "kept {n} converged frames (the folder's files and figures cover exactly them); continue with `cosserat run {} --out {} --resume`",
                     path.display(),
                     dir.display()
                 ),
-                None => "a single run keeps no partial result".into(),
+                (None, None) => "a single run keeps no partial result".into(),
             };
             eprintln!("{}: interrupted; {kept}; run.json in {} says interrupted", case.name, dir.display());
             return Ok(std::process::ExitCode::from(crate::EXIT_INTERRUPTED));
+        }
+        Status::Stalled | Status::Failed if end.beside.is_some() => {
+            let resume = format!(
+                "(after a fix that does not change the case, `cosserat run {} --out {} --resume` continues it)",
+                path.display(),
+                dir.display()
+            );
+            let beside = end.beside.as_ref().map(|b| b.kept_text(&resume)).unwrap_or_default();
+            anyhow::bail!("{}{beside}", end.message.unwrap_or_default())
         }
         Status::Stalled => anyhow::bail!(
             "{}\n{} holds the last iterate, with its certificate (run.json says stalled; docs/certificate.md)",

@@ -51,7 +51,7 @@ pub fn full_text(folder: &Path) -> String {
 }
 
 /// A size for people: `2 MiB`, `1.5 MiB`, `48 KiB`, `700 bytes`.
-fn bytes_text(n: u64) -> String {
+pub fn bytes_text(n: u64) -> String {
     match [(30, "GiB"), (20, "MiB"), (10, "KiB")].into_iter().find(|(shift, _)| n >= 1 << shift) {
         Some((shift, unit)) if n.is_multiple_of(1 << shift) => format!("{} {unit}", n >> shift),
         Some((shift, unit)) => format!("{:.1} {unit}", n as f64 / (1u64 << shift) as f64),

@@ -24,54 +24,16 @@ use crate::io::compact::OutputFormat;
 use crate::io::files::{write_atomic, OutputError};
 use crate::output::clip_run::ClipOptions;
 use crate::output::run_folder::{
-    input_file_as, sha256_file, FolderError, InputFile, Manifest, Mode, RunFolder, Status,
+    input_file_as, resumable_beside, sha256_file, FolderError, InputFile, Manifest, Mode, Placed, RunFolder, Status,
 };
 use crate::solve::Outcome;
+
+pub use super::batch_summary::{summary_csv, BatchRow, SummaryColumn, MISSING, SUMMARY, SUMMARY_COLUMNS};
 
 /// The plan of a batch in its output folder.
 pub const PLAN: &str = "batch.json";
 /// The summary row of a recording in its folder.
 pub const ROW: &str = "batch_row.json";
-/// The `status` of a recording gathered before its task ran (it has no outcome).
-pub const MISSING: &str = "missing";
-/// The summary table in the output folder.
-pub const SUMMARY: &str = "summary.csv";
-
-/// A column of `summary.csv`: its name and its text of a row.
-pub type SummaryColumn = (&'static str, fn(&BatchRow) -> String);
-
-/// Columns of `summary.csv`, each with its text of a row. `fit_position_rel_length_max` is the worst frame's position
-/// misfit in body lengths, `((1/L) ∫ |x − x_g|²)^½ / L` (`solve::fit`): unlike `‖x − x_g‖/‖x_g‖`
-/// it does not depend on where the recording sits in space. `curvature_err_rel_max` is the
-/// worst frame's relative L² error of the bending `κ1² + κ2²` against the ground truth [–]
-/// (empty without a truth sidecar). `length_m` is the rod length the recording was solved with
-/// [m], and `length_spread_rel` the spread of its frames' corrected lengths about it (`1.4826`
-/// median absolute deviation over the median, `clip::length`), where `rod.length_m =
-/// "from_data"` estimated it (empty otherwise). `wall_time_s` comes last: it is the only column
-/// that differs between two runs of the same batch. `noise_m` [m] and `lambda_g` are the noise
-/// level and tracking weight `[inverse] weights = "auto"` chose (empty with fixed weights;
-/// `docs/noise.md`).
-pub const SUMMARY_COLUMNS: [SummaryColumn; 14] = [
-    ("recording", |r| r.recording.clone()),
-    ("folder", |r| r.folder.clone()),
-    ("status", |r| r.status_word().into()),
-    ("frames", |r| r.frames.map(|f| f.to_string()).unwrap_or_default()),
-    ("newton_iterations_per_frame", |r| number(r.newton_iterations_per_frame)),
-    ("certificate_max", |r| number(r.certificate_max)),
-    ("fit_position_rel_length_max", |r| number(r.fit_position_rel_length_max)),
-    ("curvature_err_rel_max", |r| number(r.curvature_err_rel_max)),
-    ("length_m", |r| number(r.length_m)),
-    ("length_spread_rel", |r| number(r.length_spread_rel)),
-    ("noise_m", |r| number(r.noise_m)),
-    ("lambda_g", |r| number(r.lambda_g)),
-    ("reason", |r| r.reason.as_deref().unwrap_or("").replace('\n', " ")),
-    ("wall_time_s", |r| format!("{:.3}", r.wall_time_s)),
-];
-
-/// A number of the summary: 10 significant digits, empty where it does not apply.
-fn number(v: Option<f64>) -> String {
-    v.map(|v| crate::io::number::exp(v, 10)).unwrap_or_default()
-}
 
 /// Errors of a batch as a whole (a recording's own failure is its row's, not one of these).
 #[derive(Debug, thiserror::Error)]
@@ -128,41 +90,6 @@ pub struct Plan {
     pub format: OutputFormat,
 }
 
-/// The summary row of one recording.
-#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct BatchRow {
-    pub recording: String,
-    pub folder: String,
-    /// how the recording's run ended; `None`: `missing` in the summary (gathered before its
-    /// task ran; never in a `batch_row.json`)
-    pub status: Option<Outcome>,
-    /// converged frames
-    pub frames: Option<usize>,
-    pub newton_iterations_per_frame: Option<f64>,
-    /// the largest residual certificate of the frames (`docs/certificate.md`)
-    #[serde(default)]
-    pub certificate_max: Option<f64>,
-    /// the worst frame's position misfit in body lengths (`solve::fit`)
-    #[serde(default)]
-    pub fit_position_rel_length_max: Option<f64>,
-    pub curvature_err_rel_max: Option<f64>,
-    /// `weights = "auto"`: the recording's noise level per coordinate [m] and the λg chosen
-    #[serde(default)]
-    pub noise_m: Option<f64>,
-    #[serde(default)]
-    pub lambda_g: Option<f64>,
-    /// the rod length solved with [m]
-    #[serde(default)]
-    pub length_m: Option<f64>,
-    /// `rod.length_m = "from_data"`: the spread of the frames' lengths (`clip::length`)
-    #[serde(default)]
-    pub length_spread_rel: Option<f64>,
-    /// why it failed (the error and its causes)
-    pub reason: Option<String>,
-    /// this recording's wall time [s]
-    pub wall_time_s: f64,
-}
-
 impl BatchRow {
     fn without_result(entry: &PlanEntry, status: Option<Outcome>, reason: String) -> Self {
         BatchRow {
@@ -172,15 +99,6 @@ impl BatchRow {
             reason: Some(reason),
             ..BatchRow::default()
         }
-    }
-
-    /// The word of the summary's `status` column: the outcome's, or `missing`.
-    pub fn status_word(&self) -> &'static str {
-        self.status.map_or(MISSING, Outcome::as_str)
-    }
-
-    pub fn is_ok(&self) -> bool {
-        self.status.is_some_and(Outcome::is_complete)
     }
 }
 
@@ -294,7 +212,8 @@ impl Plan {
     }
 
     /// Claim `out` for this plan: a new or empty folder, or the folder of a batch (its plan is
-    /// replaced; its recordings' folders stay, for the skip of complete ones).
+    /// replaced and its `summary.csv` removed; its recordings' folders stay, for the skip of
+    /// complete ones).
     pub fn begin(&self, out: &Path) -> Result<(), BatchError> {
         if out.exists() && !out.join(PLAN).is_file() {
             let mut names: Vec<String> = std::fs::read_dir(out)
@@ -308,6 +227,15 @@ impl Plan {
             }
         }
         std::fs::create_dir_all(out).map_err(|source| OutputError::Io { path: out.to_path_buf(), source })?;
+        // the summary of an earlier batch goes before this one's plan is written: it would
+        // describe folders this batch may replace (it is written again, last, from the rows)
+        let summary = out.join(SUMMARY);
+        match std::fs::remove_file(&summary) {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                return Err(OutputError::Io { path: summary, source: e }.into());
+            }
+            _ => {}
+        }
         let path = out.join(PLAN);
         let text = serde_json::to_string_pretty(self)
             .map_err(|e| BatchError::Plan { path: path.clone(), reason: e.to_string() })?;
@@ -382,7 +310,7 @@ pub struct Ran {
 /// Run `case` (its file hashed in `case_file`) on the recording of `entry` into
 /// `out/entry.folder`, or read its row back when that folder holds a complete run of the same
 /// case and recording. Never fails as a whole: a failure is the row's.
-pub fn run_recording(case: &Case, case_file: &InputFile, entry: &PlanEntry, out: &Path, format: OutputFormat) -> Ran {
+pub fn run_recording(case: &Case, case_file: &InputFile, entry: &PlanEntry, out: &Path, opts: RecordingOptions) -> Ran {
     let start = Instant::now();
     let dir = out.join(&entry.folder);
     let failed = |reason: String| Ran {
@@ -392,7 +320,7 @@ pub fn run_recording(case: &Case, case_file: &InputFile, entry: &PlanEntry, out:
         },
         skipped: false,
     };
-    let manifest = match recording_manifest(case, case_file, &entry.path, format) {
+    let manifest = match recording_manifest(case, case_file, &entry.path, opts.format) {
         Ok(m) => m,
         Err(e) => return failed(chain(&e)),
     };
@@ -412,22 +340,106 @@ pub fn run_recording(case: &Case, case_file: &InputFile, entry: &PlanEntry, out:
         Ok(c) => c,
         Err(e) => return failed(chain(&e)),
     };
-    let mut folder = match RunFolder::begin(&dir, manifest, Mode::Fresh { force: false }) {
+    let (mut folder, resume) = match begin_recording(&dir, manifest, opts.force) {
         Ok(f) => f,
         Err(e) => return failed(chain(&e)),
     };
-    let clip = ClipOptions { journal: true, resume: false, format };
+    let clip = ClipOptions { journal: true, resume, format: opts.format };
     let solved = solve_into(&case, Engine::Rust, folder.dir(), clip, |_| {}, |_, _| {});
+    folder.manifest.frames.frames_done = solved.frames.map(|f| f.0);
+    folder.manifest.frames.frames_total = solved.frames.map(|f| f.1);
     if solved.disk_full {
-        // the recording's previous folder stays; its staging folder goes, freeing its space
-        folder.abandon();
-        return failed(format!("{}: {}", crate::io::disk::full_text(&dir), solved.error.unwrap_or_default()));
+        return failed(stopped_by_full_disk(folder, &dir, solved.frames, solved.error));
     }
-    let metrics = solved.clip.as_ref().filter(|c| !c.reports.is_empty()).map(|c| clip_metrics(&case, c));
+    let mut row = result_row(&case, entry, &solved, start);
+    folder.manifest.weights = solved.clip.as_ref().and_then(|c| c.weights);
+    folder.manifest.certificate = solved.certificate(&case);
+    folder.manifest.recording = solved.recording_notes(&case);
+    let written = serde_json::to_vec_pretty(&row)
+        .map_err(|e| OutputError::Invalid { path: folder.dir().join(ROW), reason: e.to_string() })
+        .and_then(|bytes| write_atomic(&folder.dir().join(ROW), &bytes));
+    let (status, message) = match written {
+        Ok(()) => (solved.status.into(), solved.error),
+        Err(e) => (Status::Failed, Some(chain(&e))),
+    };
+    match folder.finish(status, message.clone()) {
+        Err(e) => return failed(chain(&e)),
+        Ok(placed @ Placed::Beside { .. }) => {
+            row.reason = Some(format!("{}{}", row.reason.unwrap_or_default(), placed.kept_text(NEXT_BATCH)));
+        }
+        Ok(Placed::InPlace(_)) if status == Status::Failed && row.frames.is_some_and(|n| n > 0) => {
+            let n = row.frames.unwrap_or(0);
+            let kept = format!("; the {n} converged frames before it are in {}", dir.display());
+            row.reason = Some(format!("{}{kept}", row.reason.unwrap_or_default()));
+        }
+        Ok(Placed::InPlace(_)) => {}
+    }
+    match status {
+        Status::Failed if row.is_ok() => failed(message.unwrap_or_default()),
+        _ => Ran { row, skipped: false },
+    }
+}
+
+/// What continues a recording's run kept beside its folder.
+const NEXT_BATCH: &str = "(the next batch of this case continues it; `--force` lets a batch replace a complete run)";
+
+/// How [`run_recording`] runs a recording.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct RecordingOptions {
+    /// how its per-node fields are written
+    pub format: OutputFormat,
+    /// `--force`: its run replaces a complete run of its folder even if it fails or is
+    /// interrupted (`RunFolder::finish`)
+    pub force: bool,
+}
+
+/// Claim the folder `dir` of a recording: continuing the run of the same case and recording
+/// kept beside it (killed, stopped by a full disk, or stopped beside a complete run), if there
+/// is one (`true`), else fresh.
+fn begin_recording(dir: &Path, manifest: Manifest, force: bool) -> Result<(RunFolder, bool), FolderError> {
+    // --force: a fresh run, which replaces the folder whatever its end
+    if !force && resumable_beside(dir, &manifest) {
+        match RunFolder::begin(dir, manifest.clone(), Mode::Resume) {
+            Ok(f) => return Ok((f, true)),
+            Err(FolderError::CannotResume { .. }) => {}
+            Err(e) => return Err(e),
+        }
+    }
+    Ok((RunFolder::begin(dir, manifest, Mode::Fresh { force })?, false))
+}
+
+/// A recording's run stopped by a full disk: its folder `dir` is left as it was; its converged
+/// frames (`frames`) stay in its staging folder, which the next batch continues, or, without
+/// any, that folder goes (freeing its space). The reason of its row.
+fn stopped_by_full_disk(
+    folder: RunFolder,
+    dir: &Path,
+    frames: Option<(usize, usize)>,
+    error: Option<String>,
+) -> String {
+    let full = format!("{}: {}", crate::io::disk::full_text(dir), error.unwrap_or_default());
+    let kept = match frames {
+        Some((n, _)) if n > 0 => {
+            let staging = folder.keep_staging(Status::Failed, Some(full.clone()));
+            format!(
+                "the {n} converged frames are kept in {}: the next batch continues from them once there is space (or remove that folder to free its space)",
+                staging.display()
+            )
+        }
+        _ => {
+            folder.abandon();
+            "nothing of this run was kept (its staging folder is removed)".into()
+        }
+    };
+    format!("{full}; {} is left as it was; {kept}", dir.display())
+}
+
+/// The summary row of a recording's run (`solved`), begun at `start`.
+fn result_row(case: &Case, entry: &PlanEntry, solved: &super::solved::Solved, start: Instant) -> BatchRow {
+    let metrics = solved.clip.as_ref().filter(|c| !c.reports.is_empty()).map(|c| clip_metrics(case, c));
     let get = |k: Metric| metrics.as_ref().and_then(|m| m.get(k));
     let weights = solved.clip.as_ref().and_then(|c| c.weights);
-    folder.manifest.weights = weights;
-    let row = BatchRow {
+    BatchRow {
         recording: entry.path.display().to_string(),
         folder: entry.folder.clone(),
         status: Some(solved.status),
@@ -442,24 +454,6 @@ pub fn run_recording(case: &Case, case_file: &InputFile, entry: &PlanEntry, out:
         length_spread_rel: case.body_length().map(|b| b.spread_rel),
         reason: solved.error.clone(),
         wall_time_s: start.elapsed().as_secs_f64(),
-    };
-    folder.manifest.frames.frames_done = solved.frames.map(|f| f.0);
-    folder.manifest.frames.frames_total = solved.frames.map(|f| f.1);
-    folder.manifest.certificate = solved.certificate(&case);
-    folder.manifest.recording = solved.recording_notes(&case);
-    let written = serde_json::to_vec_pretty(&row)
-        .map_err(|e| OutputError::Invalid { path: folder.dir().join(ROW), reason: e.to_string() })
-        .and_then(|bytes| write_atomic(&folder.dir().join(ROW), &bytes));
-    let (status, message) = match written {
-        Ok(()) => (solved.status.into(), solved.error),
-        Err(e) => (Status::Failed, Some(chain(&e))),
-    };
-    if let Err(e) = folder.finish(status, message.clone()) {
-        return failed(chain(&e));
-    }
-    match status {
-        Status::Failed if row.is_ok() => failed(message.unwrap_or_default()),
-        _ => Ran { row, skipped: false },
     }
 }
 
@@ -497,7 +491,12 @@ pub fn unfinished_tasks(plan: &Plan, complete: &[bool]) -> Vec<usize> {
 /// the recordings, nor [`super::MAX_JOBS`]), then write
 /// `summary.csv`; `tick` after each recording that ran to its end (not after one a stop request
 /// stopped or kept from starting). Rows in the plan's order.
-pub fn run_batch(plan: &Plan, out: &Path, jobs: usize, tick: impl Fn() + Sync) -> Result<Vec<Ran>, BatchError> {
+pub fn run_batch(
+    plan: &Plan,
+    out: &Path,
+    (jobs, force): (usize, bool),
+    tick: impl Fn() + Sync,
+) -> Result<Vec<Ran>, BatchError> {
     use rayon::prelude::*;
     let (case, case_file) = plan_case(plan)?;
     let pool = rayon::ThreadPoolBuilder::new()
@@ -508,7 +507,7 @@ pub fn run_batch(plan: &Plan, out: &Path, jobs: usize, tick: impl Fn() + Sync) -
         plan.recordings
             .par_iter()
             .map(|entry| {
-                let r = run_recording(&case, &case_file, entry, out, plan.format);
+                let r = run_recording(&case, &case_file, entry, out, RecordingOptions { format: plan.format, force });
                 // a recording stopped (or never started) by a stop request is not done
                 if r.row.status != Some(crate::solve::Outcome::Interrupted) {
                     tick();
@@ -518,6 +517,10 @@ pub fn run_batch(plan: &Plan, out: &Path, jobs: usize, tick: impl Fn() + Sync) -
             .collect()
     });
     let rows: Vec<BatchRow> = ran.iter().map(|r| r.row.clone()).collect();
+    // what killed runs left (their locks, staging folders, temporary files); the work of a
+    // recording not complete stays for the next batch to continue
+    let unfinished = |name: &str| rows.iter().any(|r| r.folder == name && !r.is_ok());
+    crate::output::tidy::clear_ended(out, unfinished)?;
     write_summary(out, &rows)?;
     Ok(ran)
 }
@@ -543,18 +546,6 @@ pub fn gather(out: &Path) -> Result<Vec<BatchRow>, BatchError> {
         .collect();
     write_summary(out, &rows)?;
     Ok(rows)
-}
-
-/// CSV text of the summary ([`SUMMARY_COLUMNS`]); numbers with 10 significant digits, empty
-/// where a value does not apply.
-pub fn summary_csv(rows: &[BatchRow]) -> Result<String, csv::Error> {
-    let mut w = csv::Writer::from_writer(Vec::new());
-    w.write_record(SUMMARY_COLUMNS.map(|(name, _)| name))?;
-    for r in rows {
-        w.write_record(SUMMARY_COLUMNS.map(|(_, text)| text(r)))?;
-    }
-    let bytes = w.into_inner().map_err(|e| csv::Error::from(e.into_error()))?;
-    Ok(String::from_utf8_lossy(&bytes).into_owned())
 }
 
 /// Write `out/summary.csv` (atomically).

@@ -3,7 +3,7 @@
 //! each row left in its recording's folder for [`super::batch::gather`].
 use std::path::Path;
 
-use super::batch::{plan_case, run_recording, BatchError, BatchRow, Plan, Ran, ROW};
+use super::batch::{plan_case, run_recording, BatchError, BatchRow, Plan, Ran, RecordingOptions, ROW};
 use crate::io::files::{write_atomic, OutputError};
 use crate::solve::Outcome;
 
@@ -15,7 +15,7 @@ pub fn run_task(out: &Path, index: usize, mut progress: impl FnMut(usize, usize)
     let (case, case_file) = plan_case(&plan)?;
     let mut ran = Vec::with_capacity(entries.len());
     for e in entries {
-        let r = run_recording(&case, &case_file, e, out, plan.format);
+        let r = run_recording(&case, &case_file, e, out, RecordingOptions { format: plan.format, force: false });
         // a recording that fails before its folder is begun (unreadable, bad values) has its
         // row only here: `gather` reads rows from the folders, so it goes there too
         if r.row.status == Some(Outcome::Failed) {

@@ -14,7 +14,7 @@ use crate::engine::clip::ClipRun;
 use crate::engine::{Engine, RunResult};
 use crate::io::compact::OutputFormat;
 use crate::output::clip_run::ClipOptions;
-use crate::output::run_folder::{input_file_as, FolderError, InputFile, Manifest, Mode, RunFolder, Status};
+use crate::output::run_folder::{input_file_as, FolderError, InputFile, Manifest, Mode, Placed, RunFolder, Status};
 
 /// How a run ended.
 #[derive(Debug)]
@@ -37,6 +37,9 @@ pub struct JobEnd {
     /// a run stopped by a full disk: the output folder is the previous one, and this staging
     /// folder keeps the converged frames of a clip for `--resume` (`None`: nothing was kept)
     pub disk_full: Option<Option<PathBuf>>,
+    /// a run that failed or was interrupted into a folder holding a complete run: that folder
+    /// is left as it was, and this run is kept beside it (or removed) as this says
+    pub beside: Option<Placed>,
 }
 
 impl JobEnd {
@@ -178,6 +181,7 @@ pub fn run_into(
         files: 0,
         notes: std::mem::take(&mut folder.notes),
         disk_full: None,
+        beside: None,
     };
     if case.clip().is_some_and(|c| c.recording.data_plane.is_some()) {
         end.notes.push(format!(
@@ -201,8 +205,14 @@ pub fn run_into(
     if solved.disk_full {
         return Ok(stopped_by_full_disk(folder, end, out));
     }
-    let target = folder.finish(end.status, end.message.clone())?;
-    // the manifest lists every file but itself
-    end.files = Manifest::read(&target)?.map(|m| m.files.len() + 1).unwrap_or(0);
+    // a clip keeps its converged frames for --resume; a single run's run.json alone is nothing
+    let keep = end.frames.is_some_and(|(n, _)| n > 0);
+    match folder.finish_keeping(end.status, end.message.clone(), keep)? {
+        Placed::InPlace(target) => {
+            // the manifest lists every file but itself
+            end.files = Manifest::read(&target)?.map(|m| m.files.len() + 1).unwrap_or(0);
+        }
+        beside => end.beside = Some(beside),
+    }
     Ok(end)
 }

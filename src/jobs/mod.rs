@@ -4,6 +4,7 @@
 //! [`compare_published`]), a batch of recordings
 //! ([`batch`], on Slurm: [`slurm`], a task of it: [`batch_task`]).
 pub mod batch;
+pub mod batch_summary;
 pub mod batch_task;
 pub mod compare;
 pub mod compare_published;

@@ -207,10 +207,9 @@ fn solve_clip(
         None if !flagged.is_empty() => (Outcome::CompleteWithWarnings, Some(flag_message(case, &flagged, done))),
         None => (Outcome::Converged, None),
         Some(e) if e.is_interrupted() => (Outcome::Interrupted, Some(format!("{}: {}", case_label(case), chain(e)))),
-        Some(e) => (
-            Outcome::Failed,
-            Some(format!("{}: {}; the converged frames before it are in this folder", case_label(case), chain(e))),
-        ),
+        // where its converged frames are (the output folder, a staging folder beside it, or
+        // nowhere) is the caller's to say: it decides which
+        Some(e) => (Outcome::Failed, Some(format!("{}: {}", case_label(case), chain(e)))),
     };
     // A clip whose figures cannot be written keeps its frames (and says so).
     let figures = if done > 0 { write_clip_figures(case, &out.run, dir) } else { Ok(()) };

@@ -227,6 +227,22 @@ pub enum FolderError {
     },
     #[error("{path}: {reason}")]
     Manifest { path: PathBuf, reason: String },
+    #[error(
+        "{space}: `--resume` cannot continue the run of {path}: the {frames} frames already written are kept in {}{need}; free some space and run --resume again",
+        kept.display()
+    )]
+    ResumeDiskFull {
+        path: PathBuf,
+        /// the disk and its free space ("the disk holding … is full (… free of …)")
+        space: String,
+        frames: usize,
+        /// the folder that holds them
+        kept: PathBuf,
+        /// what the resume needs, where known ("; the copy … needs 3 MiB")
+        need: String,
+        #[source]
+        source: Box<FolderError>,
+    },
     #[error(transparent)]
     Input(#[from] crate::io::files::InputError),
 }
@@ -304,9 +320,13 @@ impl Manifest {
         let path = dir.join(MANIFEST);
         let text = serde_json::to_string_pretty(self)
             .map_err(|e| FolderError::Manifest { path: path.clone(), reason: e.to_string() })?;
-        write_atomic(&path, format!("{text}\n").as_bytes()).map_err(|e| {
-            let cause = std::error::Error::source(&e).map(|c| format!(": {c}")).unwrap_or_default();
-            FolderError::Manifest { path, reason: format!("{e}{cause}") }
+        write_atomic(&path, format!("{text}\n").as_bytes()).map_err(|e| match e {
+            // an I/O error keeps its cause (a full disk is recognised by it)
+            crate::io::files::OutputError::Io { path, source } => FolderError::Io { path, source },
+            e => {
+                let cause = std::error::Error::source(&e).map(|c| format!(": {c}")).unwrap_or_default();
+                FolderError::Manifest { path, reason: format!("{e}{cause}") }
+            }
         })
     }
 
@@ -370,12 +390,16 @@ pub enum ResumeRefusal {
 }
 
 /// Can the run of `previous` be continued by the run described by `new`? The same command
-/// (`run`) on the same case file and inputs, a clip, not complete; or an audit (`audit
+/// (`run`, or a batch's recording) on the same case file and inputs, a clip, not complete; or an audit (`audit
 /// --resume`, `crate::audit::resume`) on the same specs, not complete.
 pub(super) fn check_resumable(previous: &Manifest, new: &Manifest) -> Result<(), ResumeRefusal> {
     let clip = previous.writer.command == "run" && previous.frames.frames_done.is_some();
     let audit = previous.writer.command == "audit" && new.writer.command == "audit";
-    if !(clip || audit) {
+    // a batch's recording (its command names its format: the same one)
+    let batch = previous.writer.command.starts_with("batch")
+        && previous.writer.command == new.writer.command
+        && previous.frames.frames_done.is_some();
+    if !(clip || audit || batch) {
         return Err(ResumeRefusal::NotClip { command: previous.writer.command.clone() });
     }
     if previous.status.is_complete() {

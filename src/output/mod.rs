@@ -2,7 +2,7 @@
 //! plot, the published values of [`reference_file`]), a clip's files streamed frame by frame ([`clip_output`], its figures
 //! [`clip_figures`], the resume [`journal`]) and a clip case run into its folder
 //! ([`clip_run`]); the folder itself ([`run_folder`]: its lock [`folder_lock`], what runs leave
-//! beside it, `staging`) and its record `run.json` ([`manifest`]).
+//! beside it, `staging`, and what runs that ended left in a folder of them, [`tidy`]) and its record `run.json` ([`manifest`]).
 pub mod clip_figures;
 pub mod clip_output;
 pub mod clip_run;
@@ -14,3 +14,4 @@ pub mod reference_file;
 pub mod run_files;
 pub mod run_folder;
 mod staging;
+pub mod tidy;

@@ -10,7 +10,9 @@
 //! removed, or resumed, by the next run. `--resume` continues in a staging folder of its own (a
 //! copy of the output folder, or the staging folder of a killed run), so the previous folder
 //! stays in place until the resumed run ends. A folder holding files but no `run.json` is not
-//! replaced unless `--force`.
+//! replaced unless `--force`. A run that fails or is interrupted is not put in place of a
+//! folder holding a complete run: that folder stays, and the run stays beside it in its
+//! staging folder ([`Placed::Beside`]), unless `--force`.
 use std::path::{Path, PathBuf};
 
 use super::folder_lock::{real_folder, FolderLock, LockError};
@@ -19,12 +21,15 @@ pub use super::manifest::{
     input_file, input_file_as, list_files, sha256_file, CertificateSummary, FolderError, InputFile, Manifest, Status,
     MANIFEST,
 };
-use super::staging::{copy_run, leftovers, put_in_place, remove_temporaries, resume_source, Leftover, ResumeSource};
+use super::staging::{
+    copy_run, journal_frames, leftovers, put_in_place, remove_temporaries, resume_source, Leftover, ResumeSource,
+};
 
 /// How a run treats its output folder.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Mode {
-    /// a new run; `force`: also replace a folder that holds files but no `run.json`
+    /// a new run; `force`: also replace a folder that holds files but no `run.json`, and a
+    /// complete run with one that failed or was interrupted ([`RunFolder::finish`])
     Fresh { force: bool },
     /// continue the interrupted or failed run of the folder (same case and inputs)
     Resume,
@@ -42,6 +47,8 @@ pub struct RunFolder {
     pub resumed: Option<Manifest>,
     /// what was done to the folder's surroundings (stale staging folders removed), for the user
     pub notes: Vec<String>,
+    /// `--force`: the run replaces a complete run even if it ends worse
+    force: bool,
     /// one writer per folder
     _lock: FolderLock,
 }
@@ -118,24 +125,7 @@ impl RunFolder {
                 None
             }
             Mode::Resume => {
-                let (source, previous) = resume_source(target, old.as_ref(), &left, &manifest)?;
-                match source {
-                    ResumeSource::Leftover(i) => {
-                        let dir = left.remove(i).dir;
-                        if dir != staging {
-                            std::fs::rename(&dir, &staging).map_err(io_err(&dir))?;
-                        }
-                        notes.push(format!("resuming the run that was stopped while writing {}", dir.display()));
-                    }
-                    ResumeSource::Target => {
-                        if let Some(i) = left.iter().position(|l| l.dir == staging) {
-                            let dir = left.remove(i).dir;
-                            std::fs::remove_dir_all(&dir).map_err(io_err(&dir))?;
-                        }
-                        copy_run(target, &staging)?;
-                    }
-                }
-                remove_temporaries(&staging)?;
+                let previous = adopt(target, old.as_ref(), &mut left, &manifest, &staging, &mut notes)?;
                 manifest.process.started_unix_s = previous.process.started_unix_s;
                 Some(previous)
             }
@@ -148,8 +138,14 @@ impl RunFolder {
             std::fs::create_dir_all(&staging).map_err(io_err(&staging))?;
         }
         manifest.status = Status::Running;
-        manifest.write(&staging)?;
-        Ok(RunFolder { target: target.to_path_buf(), staging, manifest, resumed, notes, _lock: lock })
+        if let Err(e) = manifest.write(&staging) {
+            if resumed.is_none() {
+                let _ = std::fs::remove_dir_all(&staging);
+            }
+            return Err(e);
+        }
+        let force = mode == Mode::Fresh { force: true };
+        Ok(RunFolder { target: target.to_path_buf(), staging, manifest, resumed, notes, force, _lock: lock })
     }
 
     /// Where the run writes (the staging folder).
@@ -179,12 +175,163 @@ impl RunFolder {
 
     /// End the run as `status`: `run.json` written with the files, then the staging folder put
     /// in place of the output folder in one step ([`put_in_place`]), the previous one removed
-    /// after. Returns the output folder.
-    pub fn finish(mut self, status: Status, message: Option<String>) -> Result<PathBuf, FolderError> {
+    /// after; or, where the run did not complete and the output folder holds a complete run
+    /// (and not `--force`), that folder left as it was and this run's kept beside it
+    /// ([`Placed::Beside`]), where `--resume` finds it.
+    pub fn finish(self, status: Status, message: Option<String>) -> Result<Placed, FolderError> {
+        self.finish_keeping(status, message, true)
+    }
+
+    /// [`RunFolder::finish`]; `keep`: whether a run that is not put in place (it would have
+    /// replaced a complete run) is kept beside it, or removed (it holds nothing to continue:
+    /// a single run's `run.json` alone).
+    pub fn finish_keeping(
+        mut self,
+        status: Status,
+        message: Option<String>,
+        keep: bool,
+    ) -> Result<Placed, FolderError> {
+        let previous = Manifest::read(&self.target).ok().flatten().map(|m| m.status);
+        if !status.is_complete() && !self.force && previous.is_some_and(Status::is_complete) {
+            if !keep {
+                std::fs::remove_dir_all(&self.staging).map_err(io_err(&self.staging))?;
+                return Ok(Placed::Beside { target: self.target.clone(), kept: None });
+            }
+            self.manifest.finish(&self.staging, status, message)?;
+            return Ok(Placed::Beside { target: self.target.clone(), kept: Some(self.staging.clone()) });
+        }
         self.manifest.finish(&self.staging, status, message)?;
         put_in_place(&self.staging, &self.target)?;
-        Ok(self.target.clone())
+        Ok(Placed::InPlace(self.target.clone()))
     }
+}
+
+/// Where [`RunFolder::finish`] left a run.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Placed {
+    /// in the output folder
+    InPlace(PathBuf),
+    /// not in the output folder `target`, which keeps the complete run it held: this run (it
+    /// failed or was interrupted) is kept beside it in its staging folder `kept`, to be
+    /// continued by `--resume` (or by the next batch) or replaced by the next run (`None`:
+    /// removed, it held nothing to continue)
+    Beside { target: PathBuf, kept: Option<PathBuf> },
+}
+
+impl Placed {
+    /// The output folder.
+    pub fn target(&self) -> &Path {
+        match self {
+            Placed::InPlace(t) | Placed::Beside { target: t, .. } => t,
+        }
+    }
+
+    /// The words that say where the run is when it was not put in place ("" when it was):
+    /// "; OUT keeps its complete run (…); this run's work is kept in STAGING {then}".
+    pub fn kept_text(&self, then: &str) -> String {
+        match self {
+            Placed::InPlace(_) => String::new(),
+            Placed::Beside { target, kept } => {
+                let this = match kept {
+                    Some(k) => format!("this run's work is kept in {} {then}", k.display()),
+                    None => "nothing of this run was kept (it had no partial result)".into(),
+                };
+                format!(
+                    "; {} keeps its complete run, which a run that failed or was interrupted does not replace \
+                     (--force does); {this}",
+                    target.display()
+                )
+            }
+        }
+    }
+}
+
+/// Is there beside the output folder `target` a staging folder that a run described by
+/// `manifest` can continue ([`Mode::Resume`]): a run that was killed, stopped by a full disk,
+/// or failed or was interrupted beside a complete run ([`Placed::Beside`])? Read without the
+/// folder's lock; [`RunFolder::begin`] decides again under it.
+pub fn resumable_beside(target: &Path, manifest: &Manifest) -> bool {
+    let Ok((_, parent, name)) = locate(target) else { return false };
+    let Ok((left, _)) = leftovers(&parent, &name) else { return false };
+    left.iter()
+        .filter(|l| l.in_progress())
+        .any(|l| l.manifest.as_ref().is_some_and(|m| super::manifest::check_resumable(m, manifest).is_ok()))
+}
+
+/// `--resume`: make the staging folder `staging` the run to continue ([`resume_source`]): a
+/// left staging folder taken over (renamed), or a copy of the output folder. Returns the
+/// manifest of the run continued. A full disk on the way leaves the run's frames where they
+/// were (a taken-over folder gets its name back) and says so ([`FolderError::ResumeDiskFull`]).
+fn adopt(
+    target: &Path,
+    old: Option<&Manifest>,
+    left: &mut Vec<Leftover>,
+    manifest: &Manifest,
+    staging: &Path,
+    notes: &mut Vec<String>,
+) -> Result<Manifest, FolderError> {
+    let (source, previous) = resume_source(target, old, left, manifest)?;
+    // the folder that holds the frames, and whether it is a copy (what it needs on disk)
+    let (from, copied) = match source {
+        ResumeSource::Leftover(i) => {
+            let dir = left.remove(i).dir;
+            if dir != staging {
+                std::fs::rename(&dir, staging).map_err(io_err(&dir))?;
+            }
+            notes.push(format!("resuming the run that was stopped while writing {}", dir.display()));
+            (dir, false)
+        }
+        ResumeSource::Target => {
+            if let Some(i) = left.iter().position(|l| l.dir == staging) {
+                let dir = left.remove(i).dir;
+                std::fs::remove_dir_all(&dir).map_err(io_err(&dir))?;
+            }
+            (target.to_path_buf(), true)
+        }
+    };
+    let prepared = if copied { copy_run(target, staging) } else { Ok(()) };
+    let prepared = prepared.and_then(|()| remove_temporaries(staging)).and_then(|()| {
+        // run.json says running from here on: written now, so a full disk is found before
+        // the run starts (and the taken-over folder keeps its own until then)
+        let mut running = manifest.clone();
+        running.status = Status::Running;
+        running.write(staging)
+    });
+    match prepared {
+        Ok(()) => Ok(previous),
+        Err(e) if crate::io::disk::is_full(&e) => {
+            if !copied && from != staging {
+                let _ = std::fs::rename(staging, &from);
+            }
+            let need = if copied {
+                format!("; the copy that --resume works in needs {}", crate::io::disk::bytes_text(folder_bytes(target)))
+            } else {
+                String::new()
+            };
+            Err(FolderError::ResumeDiskFull {
+                space: crate::io::disk::full_text(target),
+                path: target.to_path_buf(),
+                frames: journal_frames(&from),
+                kept: from,
+                need,
+                source: Box::new(e),
+            })
+        }
+        Err(e) => Err(e),
+    }
+}
+
+/// The bytes of the files under `dir`.
+fn folder_bytes(dir: &Path) -> u64 {
+    std::fs::read_dir(dir)
+        .into_iter()
+        .flatten()
+        .flatten()
+        .map(|e| match e.file_type() {
+            Ok(t) if t.is_dir() => folder_bytes(&e.path()),
+            _ => e.metadata().map(|m| m.len()).unwrap_or(0),
+        })
+        .sum()
 }
 
 /// The names in a folder.

@@ -124,7 +124,7 @@ pub fn run_study(spec: &StudySpec, out: &Path, quick: bool, tick: impl Fn(&str))
                 let runs = out.join("runs").join(&tag).join(&variant.name);
                 let plan = Plan::new(&case, &recordings, 1);
                 plan.begin(&runs)?;
-                let ran = run_batch(&plan, &runs, 0, || {})?;
+                let ran = run_batch(&plan, &runs, (0, false), || {})?;
                 for (r, recording) in ran.iter().zip(&recordings) {
                     let dir = runs.join(&r.row.folder);
                     let scored = score_run(mesh, noise_m, variant, recording, &dir, spec.skip_elements)?;
