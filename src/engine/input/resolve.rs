@@ -90,9 +90,10 @@ fn resolve_as(
     Ok(resolved)
 }
 
-/// What [`resolve_recording`] finds in a recording read whole (`clip`, as read and filled): what the file says about itself,
-/// its frames, and its body length where `rod.length_m = "from_data"` (over the frames of the
-/// range; with missing data, the frames tracked whole, else every frame as filled).
+/// What [`resolve_recording`] finds in a recording read whole (`clip`, as read and filled):
+/// what the file says about itself, its frames, and its body length where `rod.length_m =
+/// "from_data"` (over the frames of the range; with missing data, the frames tracked whole,
+/// else every frame as filled).
 fn whole_body_length(
     case: &Case,
     src: &crate::case::ClipSource,
