@@ -5,13 +5,20 @@ The Rust engine of the ``cosserat`` command-line tool behind numpy arrays:
 - :func:`reconstruct` a recording held in memory (frames × nodes × 3 positions [m], NaN for
   untracked nodes): per-frame positions, directors, curvature, controls, certificates, fit
   measures and flags, and the chosen noise level and tracking weight;
-- :func:`run_case` a case file or TOML text (with overrides of its keys) in either engine;
+- :func:`run_case` a case file or TOML text (with overrides of its keys) in either engine,
+  optionally into an output folder (``out=``) exactly as ``cosserat run --out`` writes it;
+- :func:`compare` a case in both engines (Rust and FreeFEM) as ``cosserat compare`` does: the
+  rows of its ``compare.csv`` as records;
 - :func:`synth` synthetic 3D recordings with their ground truth;
 - :func:`recording_case` the case file :func:`reconstruct` runs (to run it with the CLI);
 - :func:`read_compact` a clip's ``fields.npz`` as the CLI writes it.
 
-Every solve runs with the GIL released; Ctrl-C stops it within a frame and raises
-``KeyboardInterrupt``. A bad case or recording raises ``ValueError`` with the CLI's message.
+Every solve runs with the GIL released and has its own stop request. Ctrl-C (which Python
+delivers to the main thread) stops the call running in the main thread within an iteration and
+raises ``KeyboardInterrupt`` there; calls in other threads run on. To stop a call in any thread,
+pass it a :class:`Cancel` (``cancel=``) and call ``Cancel.set()`` from elsewhere: the call stops
+at its next check and raises :class:`Cancelled`. A bad case or recording raises ``ValueError``
+with the CLI's message.
 """
 from __future__ import annotations
 
@@ -24,6 +31,7 @@ from typing import Any, Callable, Dict, Mapping, Optional, Sequence, Tuple, Unio
 import numpy as np
 
 from . import _native
+from ._native import Cancel, Cancelled
 
 __version__ = _native.__version__
 
@@ -31,6 +39,9 @@ __all__ = [
     "reconstruct",
     "recording_case",
     "run_case",
+    "compare",
+    "Cancel",
+    "Cancelled",
     "synth",
     "read_compact",
     "DEFAULT_KYMOGRAM",
@@ -225,9 +236,14 @@ def reconstruct(
     weights: Union[str, Mapping[str, Any]] = "auto",
     noise_m: Optional[float] = None,
     progress: Optional[Progress] = None,
+    cancel: Optional[Cancel] = None,
 ) -> Dict[str, Any]:
     """Reconstruct a recording held in memory, frame by frame (the inverse problem of Wang et
     al. 2023 on each frame, warm-started from the previous one).
+
+    The engine reads the array where it is (no file is written): each position checked, NaN
+    nodes and frames filled, exactly as ``cosserat run`` reads the same array saved as ``.npy``
+    with the case :func:`recording_case` writes, and the numbers are the same to the last bit.
 
     Parameters
     ----------
@@ -239,6 +255,8 @@ def reconstruct(
     weights: ``"auto"``, ``"fixed"`` or a dict of weights (see :func:`recording_case`).
     noise_m: tracking noise per coordinate [m] if known.
     progress: called as ``progress(frames_done, frames_total)`` on the calling thread.
+    cancel: a :class:`Cancel`; its ``set()`` (from any thread) stops this call, which then
+        raises :class:`Cancelled`.
 
     Returns
     -------
@@ -256,21 +274,20 @@ def reconstruct(
     ------
     ValueError: a recording the case cannot take (its message is the CLI's).
     TypeError: positions of a dtype that does not convert exactly to float64.
-    KeyboardInterrupt: Ctrl-C during the solve (it stops within a frame).
+    KeyboardInterrupt: Ctrl-C during the solve, in the main thread (it stops within a frame).
+    Cancelled: ``cancel.set()`` was called.
     """
     a = _as_positions(positions_m)
-    with tempfile.TemporaryDirectory(prefix="cosserat-") as tmp:
-        file = os.path.join(tmp, "recording.npy")
-        np.save(file, a, allow_pickle=False)
-        text = recording_case(
-            nodes=a.shape[1],
-            frame_interval_s=frame_interval_s,
-            file=file,
-            body_length_m=body_length_m,
-            weights=weights,
-            noise_m=noise_m,
-        )
-        result = _native.run_clip(text, os.path.join(tmp, "recording.toml"), [], progress)
+    text = recording_case(
+        nodes=a.shape[1],
+        frame_interval_s=frame_interval_s,
+        file="positions_m",  # names the array in messages; nothing is read from it
+        body_length_m=body_length_m,
+        weights=weights,
+        noise_m=noise_m,
+    )
+    case_path = os.path.join(os.getcwd(), "recording.toml")
+    result = _native.run_recording(text, case_path, a, progress, cancel)
     lambda_g = dict(weights).get("lambda_g", _DEFAULT_WEIGHTS["lambda_g"]) if not isinstance(weights, str) else 1e9
     return _add_weights(result, lambda_g, noise_m)
 
@@ -290,9 +307,12 @@ def run_case(
     overrides: Overrides = None,
     engine: str = "rust",
     progress: Optional[Progress] = None,
+    cancel: Optional[Cancel] = None,
+    out: Union[str, os.PathLike, None] = None,
+    force: bool = False,
+    output_format: str = "csv",
 ) -> Dict[str, Any]:
-    """Run a case (a ``.toml`` path or TOML text) as ``cosserat run`` does, without an output
-    folder.
+    """Run a case (a ``.toml`` path or TOML text) as ``cosserat run`` does.
 
     Parameters
     ----------
@@ -302,27 +322,90 @@ def run_case(
         (``{"inverse.lambda_g": 1e8, "clip.frames": [0, 20], "solver.method": "fixed_point"}``).
     engine: ``"rust"`` or ``"freefem"`` (needs ``FreeFem++``; clips run in Rust only).
     progress: called as ``progress(done, total)`` on the calling thread.
+    cancel: a :class:`Cancel`; its ``set()`` (from any thread) stops this call, which then
+        raises :class:`Cancelled`.
+    out: an output folder: written as ``cosserat run CASE --out OUT`` writes it (the same files,
+        byte for byte but for times and the process in ``run.json``; written in a staging
+        folder beside it under the folder's lock and put in place at the end, with ``run.json``
+        saying how the run ended), and the result is returned as well. ``None``: nothing is
+        written.
+    force: with ``out``, replace a folder that holds files but no ``run.json`` (``--force``;
+        the folder of an earlier run is replaced without it).
+    output_format: with ``out``, a clip's per-node fields as ``"csv"`` or ``"compact"``
+        (``fields.npz``, ``--output-format``).
 
     Returns
     -------
     A clip case: as :func:`reconstruct`. Otherwise a dict: ``status`` (``"ok"``,
-    ``"not_converged"``, ``"stalled"``: the last iterate is returned), ``error``, ``case``,
+    ``"not_converged"``, ``"stalled"``: the last iterate is returned; with ``out`` also
+    ``"warnings"``: an unstable static state, as run.json says), ``error``, ``case``,
     ``engine``, ``metrics`` (metrics.json), per node ``s_m``, ``x_m``, ``angles_rad``, ``d1``,
     ``d2``, ``d3`` (and for an inverse case ``f_n_per_m``, ``l_nm_per_m``, ``data_m``), per
-    element ``s_mid_m``, ``kappa_per_m``.
+    element ``s_mid_m``, ``kappa_per_m``. With ``out``: also ``out``, the folder.
 
     Raises
     ------
     ValueError: a bad case or override (the message names the key), an unknown engine.
     FileNotFoundError: a missing case or clip file.
-    RuntimeError: the engine failed (e.g. FreeFEM missing).
-    KeyboardInterrupt: Ctrl-C during the solve.
+    OSError: ``out`` cannot be written (a folder of other files without ``force``, another
+        process writing it).
+    RuntimeError: the engine failed (e.g. FreeFEM missing); with ``out`` the folder's
+        run.json says failed.
+    KeyboardInterrupt: Ctrl-C during the solve, in the main thread.
+    Cancelled: ``cancel.set()`` was called.
     """
     text, path = _case_source(case)
-    result = _native.run_case(text, path, _overrides(overrides), engine, progress)
+    folder = None if out is None else os.fspath(out)
+    result = _native.run_case(
+        text, path, _overrides(overrides), engine, progress, cancel, folder, bool(force), output_format
+    )
     if "frames" in result:
         _add_weights(result, None, None)
     return result
+
+
+def compare(
+    case: Union[str, os.PathLike],
+    *,
+    overrides: Overrides = None,
+    short: bool = False,
+    frames: Union[int, str, None] = None,
+    cancel: Optional[Cancel] = None,
+) -> list:
+    """Run a case in both engines (Rust and FreeFEM) and compare them, as ``cosserat compare``
+    does: the Rust engine twice (as given, and with its input perturbed by 1e-13 to measure the
+    case's conditioning, from which each tolerance is derived), then FreeFEM (``FreeFem++``, in
+    a temporary folder removed afterwards). Nothing else is written.
+
+    Parameters
+    ----------
+    case, overrides: as :func:`run_case`.
+    short: the short horizon (``--short``): 200 time steps, 40 fixed-point iterations, 3 frames.
+    frames: a clip's frames to compare (``--frames``): a count, ``"all"``, or ``None`` for the
+        case's ``[compare] frames``.
+    cancel: a :class:`Cancel`; its ``set()`` stops the call (FreeFEM is killed).
+
+    Returns
+    -------
+    The rows of ``compare.csv``, one dict per compared quantity with its columns:
+    ``quantity``, ``rust`` and ``freefem`` (floats; ``None`` for a row that compares whole
+    fields), ``difference``, ``tolerance`` (floats), ``result`` (``"pass"`` or ``"FAIL"``) and
+    ``basis`` (how the tolerance was found).
+
+    Raises
+    ------
+    ValueError: a bad case or override; a case whose published values cannot be computed.
+    RuntimeError: an engine failed (e.g. FreeFEM missing or its script failed).
+    KeyboardInterrupt: Ctrl-C, in the main thread. Cancelled: ``cancel.set()`` was called.
+    """
+    if frames == "all":
+        frames = 2**64 - 1  # usize::MAX: every frame of the clip (`--frames all`)
+    elif frames is not None:
+        frames = int(frames)
+        if frames < 1:
+            raise ValueError(f"frames = {frames}: at least 1 frame (or \"all\")")
+    text, path = _case_source(case)
+    return _native.compare(text, path, _overrides(overrides), bool(short), frames, cancel)
 
 
 def synth(

@@ -9,6 +9,15 @@ __version__: str
 DEFAULT_KYMOGRAM: str
 
 Progress = Callable[[int, int], Any]
+
+class Cancel:
+    """A stop request for the calls it is passed to (``cancel=``); ``set()`` from any thread."""
+    def __init__(self) -> None: ...
+    def set(self) -> None: ...
+    def is_set(self) -> bool: ...
+
+class Cancelled(Exception):
+    """A call stopped by its :class:`Cancel`."""
 Overrides = Union[Mapping[str, Any], Sequence[Tuple[str, Any]], None]
 
 def recording_case(
@@ -29,6 +38,7 @@ def reconstruct(
     weights: Union[str, Mapping[str, Any]] = ...,
     noise_m: Optional[float] = ...,
     progress: Optional[Progress] = ...,
+    cancel: Optional[Cancel] = ...,
 ) -> Dict[str, Any]: ...
 def run_case(
     case: Union[str, os.PathLike[str]],
@@ -36,7 +46,19 @@ def run_case(
     overrides: Overrides = ...,
     engine: str = ...,
     progress: Optional[Progress] = ...,
+    cancel: Optional[Cancel] = ...,
+    out: Union[str, os.PathLike[str], None] = ...,
+    force: bool = ...,
+    output_format: str = ...,
 ) -> Dict[str, Any]: ...
+def compare(
+    case: Union[str, os.PathLike[str]],
+    *,
+    overrides: Overrides = ...,
+    short: bool = ...,
+    frames: Union[int, str, None] = ...,
+    cancel: Optional[Cancel] = ...,
+) -> List[Dict[str, Any]]: ...
 def synth(
     *,
     count: int = ...,

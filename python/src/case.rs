@@ -43,16 +43,20 @@ pub fn to_toml(key: &str, v: &Bound<'_, PyAny>) -> Result<toml::Value, BindError
 /// The case of the file `path`, or of `text` (then `path` names it in messages and resolves its
 /// relative clip file), with `overrides` applied and resolved against its recording.
 pub fn load_case(text: Option<&str>, path: &str, overrides: &[(String, toml::Value)]) -> Result<Case, BindError> {
-    let p = Path::new(path);
     let case = match text {
-        Some(t) => {
-            let name = p.file_stem().and_then(|s| s.to_str()).unwrap_or("case");
-            Case::from_toml(t, name, p)?
-        }
-        None => Case::from_file(p)?,
+        Some(t) => parse_case(t, path)?,
+        None => Case::from_file(Path::new(path))?,
     };
     let case = if overrides.is_empty() { case } else { case.with_overrides(overrides)? };
     Ok(resolve_recording(&case)?)
+}
+
+/// The case of the TOML text `text`, named by `path` (its stem is the case's name, its folder
+/// resolves a relative clip file), not resolved against its recording.
+pub fn parse_case(text: &str, path: &str) -> Result<Case, BindError> {
+    let p = Path::new(path);
+    let name = p.file_stem().and_then(|s| s.to_str()).unwrap_or("case");
+    Ok(Case::from_toml(text, name, p)?)
 }
 
 /// The overrides of a Python call as TOML values.

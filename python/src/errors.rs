@@ -1,8 +1,6 @@
 //! The errors of the bindings and the Python exception each becomes, with the message the CLI
 //! prints for it (the error and its causes, `: `-separated).
-use pyo3::exceptions::{
-    PyFileNotFoundError, PyKeyboardInterrupt, PyOSError, PyRuntimeError, PyTypeError, PyValueError,
-};
+use pyo3::exceptions::{PyFileNotFoundError, PyOSError, PyRuntimeError, PyTypeError, PyValueError};
 use pyo3::PyErr;
 
 use cosserat::case::sweep::SweepError;
@@ -30,6 +28,23 @@ pub enum BindError {
         #[source]
         source: Box<EngineError>,
     },
+    /// a comparison of the engines that could not be made (FreeFEM missing or failed, …)
+    #[error("{label}: {source}")]
+    Compare {
+        label: String,
+        #[source]
+        source: Box<cosserat::jobs::compare::CompareError>,
+    },
+    /// an output folder that could not be claimed or finished (`cosserat::output::run_folder`)
+    #[error("output folder {path}")]
+    Folder {
+        path: String,
+        #[source]
+        source: Box<cosserat::output::run_folder::FolderError>,
+    },
+    /// a run into an output folder that ended without a result; the folder's `run.json` says so
+    #[error("{0}")]
+    RunFailed(String),
     /// a request the engine does not serve (a clip in FreeFEM, an unknown engine)
     #[error("{0}")]
     Unsupported(String),
@@ -39,10 +54,17 @@ pub enum BindError {
     /// a temporary folder for the engine's files
     #[error("a temporary folder for the engine: {0}")]
     Io(#[from] std::io::Error),
-    /// a stop was requested (`cosserat::interrupt`), e.g. by Ctrl-C in another thread
+    /// the call's stop was requested (`cosserat.Cancel.set()`; `cosserat::interrupt`)
     #[error("{0}")]
     Interrupted(String),
 }
+
+pyo3::create_exception!(
+    cosserat,
+    Cancelled,
+    pyo3::exceptions::PyException,
+    "A call stopped by its `cosserat.Cancel` (set from another thread)."
+);
 
 impl From<CaseError> for BindError {
     fn from(e: CaseError) -> Self {
@@ -84,7 +106,9 @@ impl From<BindError> for PyErr {
             },
             BindError::Override(_) | BindError::Unsupported(_) => PyValueError::new_err(message),
             BindError::Type(_) => PyTypeError::new_err(message),
-            BindError::Interrupted(_) => PyKeyboardInterrupt::new_err(message),
+            BindError::Compare { .. } | BindError::RunFailed(_) => PyRuntimeError::new_err(message),
+            BindError::Folder { .. } => PyOSError::new_err(message),
+            BindError::Interrupted(_) => Cancelled::new_err(message),
         }
     }
 }

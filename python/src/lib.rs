@@ -1,10 +1,16 @@
 //! `cosserat._native`: the Rust engine behind the Python package `cosserat`
 //! (`cosserat/__init__.py` is its documented face). A case is read as `cosserat run` reads it,
 //! solved on a worker thread with the GIL released ([`watch`]), and its result handed back as
-//! numpy arrays and dicts; nothing is written unless the engine needs a working folder (a
-//! temporary one, removed afterwards).
+//! numpy arrays and dicts; nothing is written unless the caller asks for an output folder
+//! (`out=`, [`folder`]: what `cosserat run --out` writes) or the engine needs a working folder
+//! (a temporary one, removed afterwards). A recording held in numpy memory is read from there
+//! ([`clip::run_recording`]); a comparison of the engines gives the rows of `compare.csv`
+//! ([`compare`]). Each call has its own stop token ([`watch`]).
 mod case;
+mod clip;
+mod compare;
 mod errors;
+mod folder;
 mod sink;
 mod watch;
 
@@ -15,15 +21,13 @@ use pyo3::types::{IntoPyDict, PyDict, PyList};
 
 use crate::case::{case_label, load_case};
 use crate::errors::{chain, BindError};
-use crate::sink::Collected;
+use crate::watch::Cancel;
 use cosserat::case::Case;
-use cosserat::engine::clip::{ClipOutcome, FrameRecord, FrameSink};
-use cosserat::engine::{clip_metrics, metrics, run_case as engine_run_case, run_clip_into, ClipInput};
+use cosserat::engine::{metrics, run_case as engine_run_case};
 use cosserat::engine::{Engine, EngineError, RunError, RunResult};
-use cosserat::io::files::JournalError;
 
 /// A JSON value as a Python object (numbers, strings, bools, null, arrays, objects).
-fn json_to_py<'py>(py: Python<'py>, v: &serde_json::Value) -> PyResult<Bound<'py, PyAny>> {
+pub(crate) fn json_to_py<'py>(py: Python<'py>, v: &serde_json::Value) -> PyResult<Bound<'py, PyAny>> {
     use serde_json::Value;
     Ok(match v {
         Value::Null => py.None().into_bound(py),
@@ -46,93 +50,6 @@ fn json_to_py<'py>(py: Python<'py>, v: &serde_json::Value) -> PyResult<Bound<'py
     })
 }
 
-/// A [`FrameSink`] into a [`Collected`] the caller keeps.
-struct Collecting<'a>(&'a mut Collected);
-
-impl FrameSink for Collecting<'_> {
-    type Error = std::convert::Infallible;
-    fn frame(&mut self, f: &cosserat::engine::clip::ClipFrame) -> Result<(), Self::Error> {
-        self.0.frame(f)
-    }
-    fn finish(&mut self) -> Result<(), Self::Error> {
-        self.0.finish()
-    }
-}
-
-/// The clip of `case` in the Rust engine, every converged frame collected.
-fn solve_clip(case: &Case, progress: watch::Progress) -> Result<(ClipOutcome, Collected), EngineError> {
-    let input = ClipInput::of(case)?;
-    let mut frames = Collected::default();
-    let mut none = std::iter::empty::<Result<FrameRecord, JournalError>>();
-    let out = run_clip_into(case, input, &mut none, Collecting(&mut frames), |done, total| {
-        let _ = progress.send((done, total));
-    })?;
-    Ok((out, frames))
-}
-
-/// Status and message of a clip run that started, as the CLI's `run.json` says them.
-fn clip_status(case: &Case, out: &ClipOutcome) -> Result<(&'static str, Option<String>), BindError> {
-    let flagged = out.run.reports.iter().filter(|r| r.fit.flagged).count();
-    Ok(match &out.stopped {
-        None if flagged > 0 => (
-            "warnings",
-            Some(format!(
-                "{}: {flagged} of {} frames are over the fit-quality gate (`flagged` in frames): each is certified, but \
-                 does not follow its data",
-                case_label(case),
-                out.run.reports.len()
-            )),
-        ),
-        None => ("ok", None),
-        Some(e) if e.is_interrupted() => return Err(BindError::Interrupted(format!("{}: {}", case_label(case), chain(e)))),
-        Some(e) => (
-            "failed",
-            Some(format!("{}: {}; the converged frames before it are in the result", case_label(case), chain(e))),
-        ),
-    })
-}
-
-/// Run the clip case of the file `case_path` (or of `case_text`, named by `case_path`) with
-/// `overrides` in the Rust engine; see `cosserat.run_clip`.
-#[pyfunction]
-#[pyo3(signature = (case_text, case_path, overrides, progress=None))]
-fn run_clip<'py>(
-    py: Python<'py>,
-    case_text: Option<&str>,
-    case_path: &str,
-    overrides: Vec<(String, Bound<'py, PyAny>)>,
-    progress: Option<Bound<'py, PyAny>>,
-) -> PyResult<Bound<'py, PyDict>> {
-    let o = case::overrides(&overrides)?;
-    let case = py.detach(|| load_case(case_text, case_path, &o))?;
-    if case.clip().is_none() {
-        return Err(BindError::Unsupported(format!(
-            "{}: not a clip case (it has no [clip]); use run_case",
-            case_label(&case)
-        ))
-        .into());
-    }
-    let solved = watch::run_watched(py, progress.as_ref(), |tx| solve_clip(&case, tx))?;
-    let (out, frames) =
-        solved.map_err(|source| BindError::Engine { label: case_label(&case), source: Box::new(source) })?;
-    let (status, error) = clip_status(&case, &out)?;
-    let d = PyDict::new(py);
-    d.set_item("status", status)?;
-    d.set_item("error", error)?;
-    d.set_item("frames_done", frames.len())?;
-    d.set_item("frames_total", out.total)?;
-    d.set_item("case", case.name.clone())?;
-    d.set_item("body_length_m", case.mesh.length_m)?;
-    d.set_item("frame_interval_s", case.inverse().map(|i| i.params.frame_interval_s))?;
-    let weights = out.run.weights.map(serde_json::to_value).transpose().map_err(|e| BindError::Type(e.to_string()))?;
-    d.set_item("weights", weights.map(|w| json_to_py(py, &w)).transpose()?)?;
-    let metrics = (status != "failed").then(|| clip_metrics::clip_metrics(&case, &out.run));
-    d.set_item("metrics", metrics.map(|m| m.into_iter().collect::<Vec<_>>().into_py_dict(py)).transpose()?)?;
-    d.set_item("wall_time_s", out.run.wall_time_s)?;
-    frames.into_dict(&d)?;
-    Ok(d)
-}
-
 /// Three components per node as a `nodes × 3` array.
 fn vectors<'py>(py: Python<'py>, v: &[Vector3<f64>]) -> PyResult<Bound<'py, PyAny>> {
     let flat: Vec<f64> = v.iter().flat_map(|x| x.iter().copied()).collect();
@@ -140,7 +57,7 @@ fn vectors<'py>(py: Python<'py>, v: &[Vector3<f64>]) -> PyResult<Bound<'py, PyAn
 }
 
 /// The arrays and metrics of a single-frame result.
-fn result_dict<'py>(py: Python<'py>, case: &Case, r: &RunResult, d: &Bound<'py, PyDict>) -> PyResult<()> {
+pub(crate) fn result_dict<'py>(py: Python<'py>, case: &Case, r: &RunResult, d: &Bound<'py, PyDict>) -> PyResult<()> {
     let n = &r.nodes;
     d.set_item("s_m", PyArray1::from_vec(py, n.s.clone()))?;
     d.set_item("x_m", vectors(py, &n.x)?)?;
@@ -163,9 +80,11 @@ fn result_dict<'py>(py: Python<'py>, case: &Case, r: &RunResult, d: &Bound<'py, 
 }
 
 /// Run the case of the file `case_path` (or of `case_text`) with `overrides` in `engine`
-/// (`"rust"` or `"freefem"`); see `cosserat.run_case`. A clip case runs as [`run_clip`].
+/// (`"rust"` or `"freefem"`); see `cosserat.run_case`. A clip case runs as [`clip::run_clip`];
+/// with `out`, into that folder ([`folder::run_into_folder`]).
 #[pyfunction]
-#[pyo3(signature = (case_text, case_path, overrides, engine="rust", progress=None))]
+#[pyo3(signature = (case_text, case_path, overrides, engine="rust", progress=None, cancel=None, out=None, force=false, output_format="csv"))]
+#[allow(clippy::too_many_arguments)]
 fn run_case<'py>(
     py: Python<'py>,
     case_text: Option<&str>,
@@ -173,6 +92,10 @@ fn run_case<'py>(
     overrides: Vec<(String, Bound<'py, PyAny>)>,
     engine: &str,
     progress: Option<Bound<'py, PyAny>>,
+    cancel: Option<Bound<'py, Cancel>>,
+    out: Option<&str>,
+    force: bool,
+    output_format: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
     let engine = match engine {
         "rust" => Engine::Rust,
@@ -183,20 +106,19 @@ fn run_case<'py>(
     };
     let o = case::overrides(&overrides)?;
     let case = py.detach(|| load_case(case_text, case_path, &o))?;
-    if case.clip().is_some() {
-        if engine == Engine::Freefem {
-            let why = cosserat::jobs::solved::unsupported(&case, engine)
-                .unwrap_or_else(|| "a clip runs in the Rust engine".into());
-            return Err(BindError::Unsupported(why).into());
-        }
-        return run_clip(py, case_text, case_path, overrides, progress);
-    }
     if let Some(why) = cosserat::jobs::solved::unsupported(&case, engine) {
         return Err(BindError::Unsupported(why).into());
     }
+    if let Some(out) = out {
+        let opts = folder::FolderOptions { out, force, format: output_format };
+        return folder::run_into_folder(py, &case, engine, opts, progress, cancel.as_ref());
+    }
+    if case.clip().is_some() {
+        return clip::run_clip(py, case_text, case_path, overrides, progress, cancel);
+    }
     let work = tempfile_dir()?;
     let path = work.clone();
-    let solved = watch::run_watched(py, progress.as_ref(), |tx| {
+    let solved = watch::run_watched(py, progress.as_ref(), watch::token_of(cancel.as_ref()), |tx| {
         engine_run_case(&case, engine, &path, |done, total| {
             let _ = tx.send((done, total));
         })
@@ -233,7 +155,7 @@ fn interrupted(e: &EngineError) -> bool {
 }
 
 /// A fresh private folder for the engine's files (an inverse case's `data.csv`, FreeFEM's).
-fn tempfile_dir() -> Result<std::path::PathBuf, BindError> {
+pub(crate) fn tempfile_dir() -> Result<std::path::PathBuf, BindError> {
     let base = std::env::temp_dir();
     for k in 0..1000u32 {
         let p = base.join(format!("cosserat-py-{}-{k}", std::process::id()));
@@ -263,8 +185,12 @@ fn read_compact<'py>(py: Python<'py>, path: &str) -> PyResult<Bound<'py, PyDict>
 
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    m.add_function(wrap_pyfunction!(run_clip, m)?)?;
+    m.add_function(wrap_pyfunction!(clip::run_clip, m)?)?;
+    m.add_function(wrap_pyfunction!(clip::run_recording, m)?)?;
     m.add_function(wrap_pyfunction!(run_case, m)?)?;
+    m.add_function(wrap_pyfunction!(compare::compare, m)?)?;
+    m.add_class::<Cancel>()?;
+    m.add("Cancelled", m.py().get_type::<errors::Cancelled>())?;
     m.add_function(wrap_pyfunction!(read_compact, m)?)?;
     m.add_function(wrap_pyfunction!(write_corpus, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;

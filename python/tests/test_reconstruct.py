@@ -132,3 +132,20 @@ def test_progress_is_reported_and_its_exception_stops_the_solve(recording):
     # the stop request is cleared: the next call runs whole
     r = cosserat.reconstruct(recording["positions_m"][:3], frame_interval_s=0.04)
     assert r["frames_done"] == 3
+
+
+def test_the_recording_is_read_in_memory_and_checked_as_a_file_is(recording, reconstructed, monkeypatch):
+    """No file is written for the engine: saving or a temporary folder would fail here."""
+    def refuse(*args, **kwargs):
+        raise AssertionError("reconstruct wrote a file")
+
+    monkeypatch.setattr(np, "save", refuse)
+    monkeypatch.setattr(cosserat.tempfile, "TemporaryDirectory", refuse)
+    monkeypatch.setattr(cosserat.tempfile, "mkstemp", refuse)
+    r = cosserat.reconstruct(recording["positions_m"], frame_interval_s=0.04)
+    assert np.array_equal(r["x_m"], reconstructed["x_m"])
+    # a position the file reader refuses is refused alike, naming the array, frame and node
+    x = recording["positions_m"][:3].copy()
+    x[1, 4, 2] = np.inf
+    with pytest.raises(ValueError, match=r"positions_m.*frame 1.*node 4"):
+        cosserat.reconstruct(x, frame_interval_s=0.04)

@@ -179,6 +179,25 @@ impl ClipInput {
         Ok(ClipInput::Loaded { clip, truth, chosen })
     }
 
+    /// The frames of `case`'s recording held in memory instead of in its file (`values`:
+    /// `(frames, nodes, dims)` coordinates frame-major, read as an NPY file of that array is,
+    /// `input::recording::memory_recorded`; `clip.file` only names it): the case resolved
+    /// against them as `input::resolve::resolve_recording` resolves it against a file (body
+    /// length, plane), and its clip, filled and fitted as [`load_clip`] does a file's.
+    pub fn in_memory(case: &Case, values: &[f64], shape: (usize, usize, usize)) -> Result<(Case, Self), EngineError> {
+        use self::input::{clip_files, recording::memory_recorded, resolve::resolve_recorded};
+        let src = case
+            .clip()
+            .filter(|c| c.kind == crate::case::ClipKind::Recording)
+            .ok_or_else(|| ClipFileError::NotAClip(case.name.clone()))?;
+        let spec = clip_files::read_spec(case, src);
+        let recorded = memory_recorded(&src.file, values, shape, &spec).map_err(ClipFileError::from)?;
+        let resolved = resolve_recorded(case, clip_files::recording_clip(&src.file, recorded.clone(), &spec)?)?;
+        let clip = clip_files::load_recorded(&resolved, recorded)?;
+        let chosen = choose_weights(&resolved, &clip.frames).map(Box::new);
+        Ok((resolved, ClipInput::Loaded { clip, truth: None, chosen }))
+    }
+
     /// Does the clip come with its ground truth (a synthetic clip, or a recording with a truth
     /// file)?
     pub fn has_truth(&self) -> bool {

@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 pub use super::solved::case_label;
 use super::solved::solve_into;
 use crate::case::Case;
-use crate::engine::clip::ClipRun;
+use crate::engine::clip::{ClipFrame, ClipRun};
 use crate::engine::{Engine, RunResult};
 use crate::io::compact::OutputFormat;
 use crate::output::clip_run::ClipOptions;
@@ -166,7 +166,20 @@ pub fn run_into(
     case: &Case,
     engine: Engine,
     out: &Path,
+    mode: (Mode, OutputFormat),
+    progress: impl FnMut(usize, usize),
+) -> Result<JobEnd, FolderError> {
+    run_into_observed(case, engine, out, mode, |_| {}, progress)
+}
+
+/// [`run_into`], with each frame of a clip shown to `observer` once it is written (what a
+/// caller that keeps the frames in memory as well, the Python package, collects).
+pub fn run_into_observed(
+    case: &Case,
+    engine: Engine,
+    out: &Path,
     (mode, format): (Mode, OutputFormat),
+    observer: impl FnMut(&ClipFrame) + Send,
     progress: impl FnMut(usize, usize),
 ) -> Result<JobEnd, FolderError> {
     let mut folder = RunFolder::begin(out, run_manifest(case, engine)?, mode)?;
@@ -191,7 +204,7 @@ pub fn run_into(
         ));
     }
     let clip = ClipOptions { journal: true, resume: mode == Mode::Resume, format };
-    let solved = solve_into(case, engine, &dir, clip, |_| {}, progress);
+    let solved = solve_into(case, engine, &dir, clip, observer, progress);
     folder.manifest.certificate = solved.certificate(case);
     folder.manifest.recording = solved.recording_notes(case);
     end.status = solved.status.into();

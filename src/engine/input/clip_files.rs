@@ -173,7 +173,7 @@ pub fn load_clip(case: &Case) -> Result<(Clip, Option<GroundTruth>), ClipFileErr
         return Err(ClipFileError::LengthNotResolved { case: case.name.clone() });
     }
     let src = clip_source(case)?;
-    let (mut clip, mut truth) = match &src.kind {
+    let (clip, truth) = match &src.kind {
         ClipKind::Kymogram => {
             let params = case.kymogram_params().ok_or_else(|| ClipFileError::NotAClip(case.name.clone()))?;
             let rows = kymogram_rows(&src.file)?;
@@ -199,6 +199,33 @@ pub fn load_clip(case: &Case) -> Result<(Clip, Option<GroundTruth>), ClipFileErr
             (clip, Some(truth))
         }
     };
+    fit_to_case(case, src, clip, truth)
+}
+
+/// The clip of a `kind = "recording"` case from a recording already read (`recorded`, e.g. held
+/// in memory by the caller, [`super::recording::memory_recorded`]) instead of its file: filled
+/// as the case's `clip.missing` says ([`recording_clip`]) and fitted to the case as
+/// [`load_clip`] fits a recording's file, check for check; `clip.file` only names it.
+pub fn load_recorded(case: &Case, recorded: Recorded) -> Result<Clip, ClipFileError> {
+    if case.rod.length == RodLength::FromData(None) {
+        return Err(ClipFileError::LengthNotResolved { case: case.name.clone() });
+    }
+    let src = case
+        .clip()
+        .filter(|c| c.kind == ClipKind::Recording)
+        .ok_or_else(|| ClipFileError::NotAClip(case.name.clone()))?;
+    let clip = recording_clip(&src.file, recorded, &read_spec(case, src))?;
+    Ok(fit_to_case(case, src, clip, None)?.0)
+}
+
+/// A clip as read fitted to its case: the mesh's node count, the frame range of the case, a
+/// recording's lengths checked against the rod's, the case's orientation (of the truth too).
+fn fit_to_case(
+    case: &Case,
+    src: &crate::case::ClipSource,
+    mut clip: Clip,
+    mut truth: Option<GroundTruth>,
+) -> Result<(Clip, Option<GroundTruth>), ClipFileError> {
     if clip.node_count() != case.mesh.nodes() {
         return Err(ClipFileError::NodeCount {
             path: src.file.clone(),
@@ -367,7 +394,13 @@ pub fn read_recording(path: &Path, dt_s: f64) -> Result<Clip, InputError> {
 /// [`MissingData::Nan`], untracked nodes and lost frames are filled and recorded in
 /// [`Clip::tracked`] ([`fill_missing`]).
 pub fn read_recording_as(path: &Path, spec: &ReadSpec) -> Result<Clip, ClipFileError> {
-    let recorded = read_positions(path, spec)?;
+    recording_clip(path, read_positions(path, spec)?, spec)
+}
+
+/// The clip of the recording `recorded` (read from `path`, or held in memory under that name)
+/// as `spec` says: with [`MissingData::Nan`], untracked nodes and lost frames filled and
+/// recorded in [`Clip::tracked`] ([`fill_missing`]).
+pub fn recording_clip(path: &Path, recorded: Recorded, spec: &ReadSpec) -> Result<Clip, ClipFileError> {
     let mut clip = clip_of(path, recorded, spec.dt_s, spec.missing)?;
     if spec.missing == MissingData::Nan {
         let tracked = fill_missing(&mut clip.frames, clip.recording.first_frame)?;

@@ -409,16 +409,66 @@ impl NpyFrames {
             return Ok(None);
         }
         self.stream.read(&mut self.values)?;
-        let (f, dims) = (self.next, self.dims);
-        let mut pts = Vec::with_capacity(self.nodes);
-        for (i, c) in self.values.chunks_exact(dims).enumerate() {
-            let p = Vector3::new(c[0], c[1], if dims == 3 { c[2] } else { 0.0 });
-            check_position(&self.path, (f, i), &p, self.missing)?;
-            pts.push(if p.iter().any(|v| v.is_nan()) { Vector3::repeat(f64::NAN) } else { p * self.metres });
-        }
+        let pts = frame_positions(&self.path, self.next, (&self.values, self.dims), self.missing, self.metres)?;
         self.next += 1;
         Ok(Some(pts))
     }
+}
+
+/// Frame `frame` of a recording from its coordinates `values`, `dims` (2 or 3) per node, each
+/// position checked and converted to metres (`metres` per unit): a 2D position placed at
+/// z = 0, a node untracked (NaN) in one coordinate untracked in all. `path` names the source.
+pub(crate) fn frame_positions(
+    path: &Path,
+    frame: usize,
+    (values, dims): (&[f64], usize),
+    missing: MissingData,
+    metres: f64,
+) -> Result<Vec<Vector3<f64>>, InputError> {
+    let mut pts = Vec::with_capacity(values.len() / dims);
+    for (i, c) in values.chunks_exact(dims).enumerate() {
+        let p = Vector3::new(c[0], c[1], if dims == 3 { c[2] } else { 0.0 });
+        check_position(path, (frame, i), &p, missing)?;
+        pts.push(if p.iter().any(|v| v.is_nan()) { Vector3::repeat(f64::NAN) } else { p * metres });
+    }
+    Ok(pts)
+}
+
+/// A recording held in memory (frames × nodes × `dims` coordinates, frame-major, numbered from
+/// 0), read as an NPY file of the same array is ([`NpyFrames`]): the same shape limits, checks,
+/// unit (`spec`: the case's `clip.unit`, metres by default) and missing-data rule. `name` stands
+/// for the file in messages.
+pub fn memory_recorded(
+    name: &Path,
+    values: &[f64],
+    (frames, nodes, dims): (usize, usize, usize),
+    spec: &ReadSpec,
+) -> Result<Recorded, InputError> {
+    let shape = |reason: String| InputError::Shape { path: name.to_path_buf(), reason };
+    let shape_text = format!("[{frames}, {nodes}, {dims}]");
+    if !(dims == 2 || dims == 3) || frames.checked_mul(nodes).and_then(|p| p.checked_mul(dims)) != Some(values.len()) {
+        return Err(shape(format!(
+            "recording of shape {shape_text} with {} values, expected frames × nodes × 3 (or × 2)",
+            values.len()
+        )));
+    }
+    if frames == 0 || nodes < 3 {
+        return Err(shape(format!("recording of shape {shape_text}: need at least 1 frame and 3 nodes")));
+    }
+    if frames * nodes > MAX_CLIP_POSITIONS {
+        return Err(shape(format!(
+            "recording of shape {shape_text}: {} positions, more than the {MAX_CLIP_POSITIONS} a clip may hold",
+            frames * nodes
+        )));
+    }
+    let (unit, metres) = resolve_unit(name, None, &spec.units, "the recording in memory")?;
+    let out = values
+        .chunks_exact(nodes * dims)
+        .enumerate()
+        .map(|(f, v)| frame_positions(name, f, (v, dims), spec.missing, metres))
+        .collect::<Result<Vec<_>, _>>()?;
+    let info = recording_info(0, unit, dims == 2, &out);
+    Ok(Recorded { frames: out, info })
 }
 
 /// What a recording says about itself: its first frame number, its unit and its plane (z = 0

@@ -9,6 +9,7 @@ use super::recording_stream::streamed_body_length;
 use crate::case::{Case, ClipKind, RodLength};
 use crate::clip::length::BodyLength;
 use crate::clip::recording::RecordingInfo;
+use crate::clip::Clip;
 
 /// The case resolved against its recording (`kind = "recording"`; any other case is returned
 /// as it is), written into the case file's tables and validated again, so that everything
@@ -28,10 +29,32 @@ pub fn resolve_recording(case: &Case) -> Result<Case, ClipFileError> {
     let Some(src) = case.clip().filter(|c| c.kind == ClipKind::Recording) else { return Ok(case.clone()) };
     let src = clip_source(case).map(|_| src)?;
     // an NPY recording read a frame at a time, else the whole clip
-    let (info, frames, body) = match streamed_body_length(case)? {
+    let found = match streamed_body_length(case)? {
         Some((info, body)) => (info, None, body),
-        None => whole_body_length(case, src)?,
+        None => whole_body_length(case, src, read_recording_as(&src.file, &read_spec(case, src))?)?,
     };
+    // the clip file as an absolute path (a batch's recording replaces the file's)
+    let file = std::path::absolute(&src.file).unwrap_or_else(|_| src.file.clone());
+    resolve_as(case, src, found, Some(&file))
+}
+
+/// [`resolve_recording`] on the clip `clip` of a `kind = "recording"` case, read by the caller
+/// (a recording held in memory, `super::recording::memory_recorded` and
+/// `super::clip_files::recording_clip`) instead of from `clip.file`, which stays as it is.
+pub fn resolve_recorded(case: &Case, clip: Clip) -> Result<Case, ClipFileError> {
+    let Some(src) = case.clip().filter(|c| c.kind == ClipKind::Recording) else { return Ok(case.clone()) };
+    let found = whole_body_length(case, src, clip)?;
+    resolve_as(case, src, found, None)
+}
+
+/// The case with what was found in its recording (`info`, its frames where counted, its body
+/// length where asked for) written into its tables, and its clip file replaced by `file`.
+fn resolve_as(
+    case: &Case,
+    src: &crate::case::ClipSource,
+    (info, frames, body): (RecordingInfo, Option<usize>, Option<BodyLength>),
+    file: Option<&std::path::Path>,
+) -> Result<Case, ClipFileError> {
     let mut overrides: Vec<(String, toml::Value)> = Vec::new();
     let array = |v: &Vector3<f64>| toml::Value::Array(v.iter().map(|c| toml::Value::Float(*c)).collect());
     if let (Some(n), None) = (&info.plane_normal, &src.recording.data_plane) {
@@ -52,8 +75,9 @@ pub fn resolve_recording(case: &Case) -> Result<Case, ClipFileError> {
     if overrides.is_empty() {
         return Ok(case.clone());
     }
-    let file = std::path::absolute(&src.file).unwrap_or_else(|_| src.file.clone());
-    overrides.push(("clip.file".into(), toml::Value::String(file.display().to_string())));
+    if let Some(file) = file {
+        overrides.push(("clip.file".into(), toml::Value::String(file.display().to_string())));
+    }
     let mut resolved = case.with_overrides(&overrides).map_err(|source| ClipFileError::FromData {
         path: src.file.clone(),
         length_m: body.map_or(case.mesh.length_m, |b| b.length_m),
@@ -66,14 +90,15 @@ pub fn resolve_recording(case: &Case) -> Result<Case, ClipFileError> {
     Ok(resolved)
 }
 
-/// What [`resolve_recording`] finds in a recording read whole: what the file says about itself,
-/// its frames, and its body length where `rod.length_m = "from_data"` (over the frames of the
-/// range; with missing data, the frames tracked whole, else every frame as filled).
+/// What [`resolve_recording`] finds in a recording read whole (`clip`, as read and filled):
+/// what the file says about itself, its frames, and its body length where `rod.length_m =
+/// "from_data"` (over the frames of the range; with missing data, the frames tracked whole,
+/// else every frame as filled).
 fn whole_body_length(
     case: &Case,
     src: &crate::case::ClipSource,
+    mut clip: Clip,
 ) -> Result<(RecordingInfo, Option<usize>, Option<BodyLength>), ClipFileError> {
-    let mut clip = read_recording_as(&src.file, &read_spec(case, src))?;
     let (info, frames) = (clip.recording.clone(), clip.frame_count());
     if case.rod.length != RodLength::FromData(None) {
         return Ok((info, Some(frames), None));

@@ -146,3 +146,29 @@ fn wcon_records_of_one_worm_become_frames_of_its_times() {
     let e = read_positions(&p, &off).unwrap_err().to_string();
     assert!(e.contains("t = 0.08 s is 2.667 frame intervals"), "{e}");
 }
+
+/// A recording held in memory is read as the NPY file of the same array: the same positions
+/// (units, planar placement, NaN nodes) and what it says of itself; the same refusals.
+#[test]
+fn a_recording_in_memory_reads_as_its_npy_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let name = dir.path().join("memory.npy");
+    let mut data: Vec<f64> =
+        (0..3).flat_map(|f| (0..4).flat_map(move |i| [point(f, i).0, 7.0 + f as f64, point(f, i).1])).collect();
+    data[12 + 4] = f64::NAN; // frame 1, node 1: y untracked
+    write_npy(&name, &[3, 4, 3], &data).unwrap();
+    let s =
+        ReadSpec { units: UnitSpec { unit: Some(LengthUnit::Micrometre), m_per_px: None }, ..spec(MissingData::Nan) };
+    let from_file = read_positions(&name, &s).unwrap();
+    let in_memory = memory_recorded(&name, &data, (3, 4, 3), &s).unwrap();
+    assert_eq!(in_memory.info, from_file.info);
+    assert!(in_memory.frames[1][1].iter().all(|v| v.is_nan()));
+    let bits = |r: &Recorded| r.frames.iter().flatten().flat_map(|p| p.iter().map(|v| v.to_bits())).collect::<Vec<_>>();
+    assert_eq!(bits(&in_memory), bits(&from_file));
+    // a NaN without clip.missing = "nan", an infinity, a shape that does not hold the values
+    let refused = |r: Result<Recorded, InputError>| r.unwrap_err().to_string();
+    assert!(refused(memory_recorded(&name, &data, (3, 4, 3), &spec(MissingData::Error))).contains("frame 1, node 1"));
+    data[2] = f64::INFINITY;
+    assert!(refused(memory_recorded(&name, &data, (3, 4, 3), &s)).contains("frame 0, node 0: z = inf"));
+    assert!(refused(memory_recorded(&name, &data, (3, 4, 2), &s)).contains("expected frames × nodes × 3"));
+}
