@@ -284,6 +284,13 @@ fn a_batch_removes_what_killed_runs_left_and_nothing_of_a_live_one() {
     std::fs::remove_dir(&live_stage).expect("rmdir"); // what its run would do at its end
     run();
     assert_eq!(names(&out), clean);
+    // `gather` (the end of a Slurm batch, whose tasks clear nothing) clears the same
+    std::fs::write(out.join(".roll_002.lock"), dead.to_string()).expect("lock");
+    std::fs::create_dir(out.join(format!(".roll_002.staging-{dead}"))).expect("mkdir");
+    std::fs::write(out.join(format!(".summary.csv.{dead}.1.tmp")), "recording,folder\n").expect("tmp");
+    let gathered = cosserat().arg("gather").arg(&out).output().expect("gather");
+    assert_eq!(gathered.status.code(), Some(1), "the bad recording's row: {gathered:?}");
+    assert_eq!(names(&out), clean, "gather leaves only the batch's own files");
 }
 
 /// summary.csv never describes folders of another run: a batch of a changed case killed

@@ -526,7 +526,8 @@ pub fn run_batch(
 }
 
 /// The rows of the plan in `out` from its recordings' folders (`missing` where a folder holds
-/// no row), and `summary.csv` written from them.
+/// no row), and `summary.csv` written from them, after clearing what ended runs left
+/// (`output::tidy`; a live task's files stay).
 pub fn gather(out: &Path) -> Result<Vec<BatchRow>, BatchError> {
     let plan = Plan::read(out)?;
     let rows: Vec<BatchRow> = plan
@@ -544,6 +545,10 @@ pub fn gather(out: &Path) -> Result<Vec<BatchRow>, BatchError> {
             }
         })
         .collect();
+    // as at a batch's end: what ended runs left (a Slurm batch's tasks, a killed batch), the
+    // work of a recording not complete kept for the next batch
+    let unfinished = |name: &str| rows.iter().any(|r| r.folder == name && !r.is_ok());
+    crate::output::tidy::clear_ended(out, unfinished)?;
     write_summary(out, &rows)?;
     Ok(rows)
 }
