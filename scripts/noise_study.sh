@@ -19,6 +19,3 @@ cp "$tmp/np/noise_study.csv" docs/noise_study_planar.csv
 # smooth changes of shape (docs/noise.md N13)
 target/release/cosserat noise-study cases/bench/noise_study_shapes.toml --out "$tmp/nh" --quiet "$@"
 cp "$tmp/nh/noise_study.csv" docs/noise_study_shapes.csv
-# the λd term's stabilisation at 0.1 on every recording against the automatic rule (N13)
-target/release/cosserat noise-study cases/bench/noise_study_stabilisation.toml --out "$tmp/ne" --quiet "$@"
-cp "$tmp/ne/noise_study.csv" docs/noise_study_stabilisation.csv

@@ -126,6 +126,12 @@ fn automatic_weights_on_a_clean_recording_stay_within_the_element_floor() {
 /// farther from the data than the noise, the discrepancy principle's choice is the cap (a
 /// stalled calibration solve at 1e8 was read as a fit that follows the noise: recording 6
 /// then got λg = 9.96e7 and a twist of −35,000 rad/m on every frame).
+///
+/// The frame's curvature against the smoothing spline's, recording by recording: without
+/// added noise the worst frame at or below the spline's and the median within 1.25× of it (the
+/// issue's target; the stabilisation ε = 0.1 of automatic weights gives 0.85–0.98× and
+/// 0.81–1.04×, where the earlier ε = 1e-3 gave up to 2.12× and 1.48×); at 1 µm of noise both
+/// within 1.5× (0.68–1.17× and 0.73–1.25× measured; 4.42× and 1.93× with ε = 1e-3).
 #[test]
 fn recordings_with_smooth_changes_of_shape_reconstruct_every_frame() {
     let levels = [0.0, 1e-6];
@@ -135,6 +141,13 @@ fn recordings_with_smooth_changes_of_shape_reconstruct_every_frame() {
     assert_eq!(auto.len(), 16);
     for r in &auto {
         assert_eq!(r.frames_reconstructed, r.frames, "{r:?}");
+        let spline = rows
+            .iter()
+            .find(|s| s.method == SPLINE && s.noise_m == r.noise_m && s.recording == r.recording)
+            .expect("the spline's row");
+        let (median, worst) = if r.noise_m == 0.0 { (1.25, 1.0) } else { (1.5, 1.5) };
+        assert!(r.bending_err_median <= median * spline.bending_err_median, "{r:?} against {spline:?}");
+        assert!(r.bending_err_worst <= worst * spline.bending_err_worst, "{r:?} against {spline:?}");
         if r.noise_m == 0.0 {
             assert_eq!(r.lambda_g, Some(1e9), "{r:?}");
         }

@@ -147,8 +147,8 @@ pub struct ChosenWeights {
     pub calibration_frames: usize,
     /// calibration solves
     pub solves: usize,
-    /// the stabilisation ε of the λd term's rule (I11) the noise asked for
-    /// (`crate::engine::weights::noise_stabilisation`)
+    /// the stabilisation ε of the λd term's rule (I11) the run used
+    /// (`crate::engine::weights::auto_stabilisation`)
     #[serde(default)]
     pub stabilisation: f64,
 }
