@@ -27,7 +27,7 @@ use cosserat::clip::missing::MissingData;
 use cosserat::engine::input::clip_files::read_recording_as;
 use cosserat::engine::input::recording::ReadSpec;
 use cosserat::engine::input::truth_file::{read_truth, truth_sidecar};
-use cosserat::solve::smoothing::SmoothingSpline;
+use cosserat::recorded::smoothing::SmoothingSpline;
 use cosserat::study::score::{bending_error, spline_bending, truth_bending};
 use nalgebra::Vector3;
 

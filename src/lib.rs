@@ -74,6 +74,7 @@ pub mod jobs;
 pub mod linalg;
 pub mod model;
 pub mod output;
+pub mod recorded;
 pub mod reference;
 pub mod solve;
 pub mod study;

@@ -17,6 +17,7 @@ const LAYERS: &[&[&str]] = &[
     &["figures"],
     &["io"],
     &["model"],
+    &["recorded"],
     &["assemble"],
     &["solve"],
     &["clip"],

@@ -12,8 +12,8 @@ use assert_cmd::Command;
 use common::{short_roll_case, worm_data_present};
 use cosserat::engine::clip::nodal_curvature;
 use cosserat::io::compact::{read_compact, CompactClip, OutputFormat, COMPACT_FILE, CURVATURE_COLUMNS, RAW_FIELDS};
+use cosserat::jobs::clip_run::{run_clip_to, ClipOptions};
 use cosserat::output::clip_output::CLIP_FIELD_COLUMNS;
-use cosserat::output::clip_run::{run_clip_to, ClipOptions};
 use cosserat::output::journal::JOURNAL;
 use nalgebra::Vector3;
 

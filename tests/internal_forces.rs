@@ -238,7 +238,7 @@ fn clip_frames_balance_their_controls_in_space_coordinates() {
         assert!(force < 1e-10 && moment < 1e-10, "frame {}: force {force:e}, moment {moment:e}", fr.report.frame);
     }
     let out_dir = dir.path().join("out");
-    cosserat::output::clip_run::run_clip_case(&case, &out_dir, |_, _| {}).expect("clip to files");
+    cosserat::jobs::clip_run::run_clip_case(&case, &out_dir, |_, _| {}).expect("clip to files");
     let text = std::fs::read_to_string(out_dir.join("curvature.csv")).expect("curvature.csv");
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().expect("header").split(',').collect();

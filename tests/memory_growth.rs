@@ -20,8 +20,8 @@ use cosserat::engine::input::truth_file::truth_sidecar;
 use cosserat::engine::Engine;
 use cosserat::io::compact::{OutputFormat, CURVATURE_COLUMNS, RAW_CURVATURE, RAW_FIELDS};
 use cosserat::io::compact_write::{write_compact, BLOCK_BYTES};
+use cosserat::jobs::clip_run::ClipOptions;
 use cosserat::jobs::solved::solve_into;
-use cosserat::output::clip_run::ClipOptions;
 use cosserat::solve::Outcome;
 
 /// The system allocator, counting the bytes held now and their peak.

@@ -12,7 +12,7 @@ use cosserat::engine::run_case;
 use cosserat::engine::Engine;
 use cosserat::engine::EngineError;
 use cosserat::engine::RunError;
-use cosserat::output::clip_run::run_clip_case;
+use cosserat::jobs::clip_run::run_clip_case;
 use cosserat::solve::sequence::SequenceError;
 use nalgebra::{Matrix3, Rotation3, Vector3};
 use std::path::Path;

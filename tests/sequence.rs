@@ -4,8 +4,8 @@ mod common;
 
 use common::{case_from, case_text, edit, with_weights};
 use cosserat::model::mesh::{DofMap, Field};
+use cosserat::recorded::fit::FitGate;
 use cosserat::solve::certificate::DEFAULT_CERTIFICATE_TOLERANCE;
-use cosserat::solve::fit::FitGate;
 use cosserat::solve::inverse::{InverseMethod, InverseParams, Records, Weights, DEFAULT_STABILISATION};
 use cosserat::solve::sequence::{
     solve_sequence, FirstStart, FrameStart, RotationTreatment, SequenceError, SequenceParams,

@@ -24,7 +24,7 @@ use cosserat::clip::missing::MIN_TRACKED;
 use cosserat::engine::input::clip_files::load_clip;
 use cosserat::engine::input::resolve::resolve_recording;
 use cosserat::engine::input::tracker::{write_tracker_corpus, Losses, TrackerParams};
-use cosserat::output::clip_run::run_clip_case;
+use cosserat::jobs::clip_run::run_clip_case;
 use cosserat::study::score::{bending_error, spline_bending, truth_bending};
 use nalgebra::Vector3;
 

@@ -6,8 +6,8 @@ mod common;
 use common::{case_file, worm_data_present};
 use cosserat::case::{Analysis, Case, DataSource};
 use cosserat::engine::clip::ClipRun;
+use cosserat::jobs::clip_run::run_clip_case;
 use cosserat::jobs::sweep::chain;
-use cosserat::output::clip_run::run_clip_case;
 use cosserat::solve::inverse::InverseMethod;
 
 fn run(case: &Case) -> ClipRun {

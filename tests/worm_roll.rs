@@ -11,7 +11,7 @@ use cosserat::engine::clip::ClipRun;
 use cosserat::engine::input::clip_files::kymogram_rows;
 use cosserat::engine::EngineError;
 use cosserat::engine::RunError;
-use cosserat::output::clip_run::run_clip_case;
+use cosserat::jobs::clip_run::run_clip_case;
 use cosserat::solve::sequence::SequenceError;
 use nalgebra::{Rotation3, Vector3};
 use std::path::Path;

@@ -22,7 +22,7 @@
 //! expectations, so that adjacent chords share a node does not change it.
 //!
 //! ## The correction
-//! Per frame, with the noise level `σ̂` of its nodes ([`crate::solve::fit::noise_level`], from
+//! Per frame, with the noise level `σ̂` of its nodes ([`crate::recorded::fit::noise_level`], from
 //! the data) and `s = √2 σ̂`:
 //!
 //! 1. **Chords long against the noise.** At `σ/h` near or above 1 (10 µm of noise at 128 nodes
@@ -67,7 +67,7 @@
 use nalgebra::Vector3;
 
 use super::polyline_length;
-use crate::solve::fit::{noise_level, noise_level_in};
+use crate::recorded::fit::{noise_level, noise_level_in};
 
 /// `√(2/π)`.
 const SQRT_2_OVER_PI: f64 = 0.797_884_560_802_865_4;

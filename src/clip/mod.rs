@@ -41,7 +41,6 @@
 use nalgebra::{Matrix3, Vector2, Vector3};
 
 pub mod length;
-pub use crate::solve::smoothing;
 pub mod missing;
 pub mod recording;
 mod spline;

@@ -7,7 +7,7 @@
 //! NPY `frames × nodes × 2`: placed at z = 0), or three of which one is the same number in every
 //! frame and node (a tracker that writes z = 0). Such data say nothing about the rotation of the
 //! cross-section about the centreline: the twist κ3 and the roll of (d1, d2) about d3 are not
-//! observable, and the position noise has two components, not three (`crate::solve::fit`).
+//! observable, and the position noise has two components, not three (`crate::recorded::fit`).
 use nalgebra::Vector3;
 
 /// Unit of a recording's positions (`clip.unit`, or the suffix of a CSV header `x_um`).
@@ -115,7 +115,7 @@ impl ConstantAxes {
     }
 }
 
-pub use crate::solve::fit::plane_basis;
+pub use crate::recorded::fit::plane_basis;
 
 #[cfg(test)]
 mod tests {

@@ -3,7 +3,7 @@
 //! (`crate::engine::rust`) or the FreeFEM engine ([`self::freefem`]) on it. What `cosserat run` and
 //! `cosserat compare` do for a single-frame case; and a clip case's frames ([`ClipInput`]) in the
 //! Rust engine, each converged frame handed to any [`FrameSink`] ([`run_clip_into`]; the output
-//! folder's writer is `crate::output::clip_run`'s).
+//! folder's writer is `crate::jobs::clip_run`'s).
 pub mod common;
 pub mod freefem;
 pub mod input;
@@ -170,7 +170,7 @@ impl ClipInput {
             return Ok(ClipInput::Streamed(stream));
         }
         if let Some(stream) = recording_stream(case)? {
-            let noise = || weights::median_noise(stream.noise_levels().iter().copied());
+            let noise = || crate::recorded::noise::median_noise(stream.noise_levels().iter().copied());
             let chosen = choose_weights_on(case, stream.calibration(), noise).map(Box::new);
             return Ok(ClipInput::Recorded { stream, chosen });
         }

@@ -22,7 +22,7 @@ use crate::engine::metrics::Metric;
 use crate::engine::Engine;
 use crate::io::compact::OutputFormat;
 use crate::io::files::{write_atomic, OutputError};
-use crate::output::clip_run::ClipOptions;
+use crate::jobs::clip_run::ClipOptions;
 use crate::output::run_folder::{
     input_file_as, resumable_beside, sha256_file, FolderError, InputFile, Manifest, Mode, Placed, RunFolder, Status,
 };

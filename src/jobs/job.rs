@@ -13,7 +13,7 @@ use crate::case::Case;
 use crate::engine::clip::{ClipFrame, ClipRun};
 use crate::engine::{Engine, RunResult};
 use crate::io::compact::OutputFormat;
-use crate::output::clip_run::ClipOptions;
+use crate::jobs::clip_run::ClipOptions;
 use crate::output::run_folder::{input_file_as, FolderError, InputFile, Manifest, Mode, Placed, RunFolder, Status};
 
 /// How a run ended.

@@ -6,6 +6,7 @@
 pub mod batch;
 pub mod batch_summary;
 pub mod batch_task;
+pub mod clip_run;
 pub mod compare;
 pub mod compare_published;
 pub mod job;

@@ -13,7 +13,7 @@ use crate::engine::clip::ClipFrame;
 use crate::engine::metrics::{Metric, Metrics};
 use crate::engine::{Engine, RunResult};
 use crate::io::files::OutputError;
-use crate::output::clip_run::ClipOptions;
+use crate::jobs::clip_run::ClipOptions;
 use crate::output::run_folder::Manifest;
 use crate::solve::Outcome;
 

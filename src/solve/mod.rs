@@ -8,13 +8,11 @@ pub mod arclength;
 pub mod certificate;
 pub mod continuation;
 pub mod dynamics;
-pub mod fit;
 pub mod inverse;
 pub mod modes;
 pub mod outcome;
 pub mod problem;
 pub mod sequence;
-pub mod smoothing;
 pub mod stability;
 pub mod statics;
 

@@ -9,7 +9,7 @@
 //! the paper's chart. Either way every frame is guarded: a frame whose recovered β comes within
 //! `min_cos_beta` of ±π/2 at any node stops the clip with an error naming frame and node (the
 //! failure is otherwise silent: the fit stays good while α and κ3 explode, PAPER-NOTES).
-pub use super::smoothing::{frame_geometry, NOISY_GEOMETRY};
+pub use crate::recorded::smoothing::{frame_geometry, NOISY_GEOMETRY};
 use std::f64::consts::PI;
 
 use nalgebra::{DVector, Matrix3, Vector3};
@@ -26,10 +26,10 @@ use crate::model::chart::{frame_axis, Chart};
 use crate::model::mesh::{DofMap, Field};
 use crate::model::rotation::{angles_from_rotation, skew, Angles};
 
-use super::fit::FitGate;
 use super::inverse::tracking::tracking_weights;
 use super::inverse::{Frame, FrameSolver, InverseParams, InverseRecord, InverseSolution, Records, Start};
 use super::{Problem, SolveError};
+use crate::recorded::fit::FitGate;
 
 /// Settings of a clip solve.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -55,7 +55,7 @@ pub struct SequenceParams {
     /// the unit normal of the plane a planar recording lies in (`clip::recording`), in space
     /// coordinates; `None`: 3D data. Planar data do not hold the roll of the frame about the
     /// centreline, so every frame, not only the first, has the gauge `α(0) = α0` (R7), and the
-    /// noise is estimated in the plane ([`super::fit::noise_level_in`])
+    /// noise is estimated in the plane ([`crate::recorded::fit::noise_level_in`])
     pub plane: Option<Vector3<f64>>,
 }
 
@@ -292,7 +292,7 @@ fn recoverable(e: &SolveError) -> bool {
 /// (`solve::smoothing`, nodes equally spaced over `length_m`): on noisy data the plain guess's
 /// tangents carry the noise. `None` where no spline can be fitted.
 pub fn smoothed_guess(x_g: &[Vector3<f64>], length_m: f64) -> Option<DVector<f64>> {
-    let s = super::smoothing::SmoothingSpline::fit_uniform(x_g, length_m)?;
+    let s = crate::recorded::smoothing::SmoothingSpline::fit_uniform(x_g, length_m)?;
     Some(data_frame_guess(s.knot_values()))
 }
 

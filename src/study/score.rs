@@ -12,9 +12,9 @@ use std::path::Path;
 
 use nalgebra::Vector3;
 
-use crate::clip::smoothing::SmoothingSpline;
 use crate::clip::synthetic::FrameTruth;
 use crate::io::{InputError, OutputError};
+use crate::recorded::smoothing::SmoothingSpline;
 
 /// Errors of scoring a run.
 #[derive(Debug, thiserror::Error)]

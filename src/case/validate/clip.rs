@@ -12,7 +12,7 @@ use crate::clip::recording::{LengthUnit, UnitSpec};
 use crate::clip::synthetic::RollClipParams;
 use crate::clip::{ClipPlane, CLIP_SKIP_ELEMENTS, MAX_CLIP_POSITIONS, MIN_CLIP_ELEMENTS};
 use crate::model::mesh::Mesh;
-use crate::solve::fit::FitGate;
+use crate::recorded::fit::FitGate;
 use crate::solve::sequence::{FrameStart, RotationTreatment};
 
 impl Validator<'_> {

@@ -253,7 +253,7 @@ mod tests {
             count += frame.len();
             let x: Vec<nalgebra::Vector3<f64>> =
                 frame.chunks_exact(3).map(|c| nalgebra::Vector3::new(c[0], c[1], c[2])).collect();
-            seen.push(crate::solve::fit::noise_level(&x));
+            seen.push(crate::recorded::fit::noise_level(&x));
         }
         let measured = (sum2 / count as f64).sqrt();
         assert!((measured / rms - 1.0).abs() < 0.05, "RMS {measured:e}");

@@ -25,7 +25,7 @@ use crate::clip::length::{BodyLength, FrameLength};
 use crate::clip::recording::{ConstantAxes, RecordingInfo};
 use crate::clip::{check_frame_range, polyline_length, rotate_frame, Clip, MAX_LENGTH_DEVIATION};
 use crate::io::files::InputError;
-use crate::solve::fit::noise_level_in;
+use crate::recorded::fit::noise_level_in;
 
 /// Frames of a clip the automatic weights calibrate λg on (`crate::engine::weights`, N2).
 pub const CALIBRATION_FRAMES: usize = 3;

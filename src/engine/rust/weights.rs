@@ -25,7 +25,7 @@ use nalgebra::{DVector, Vector3};
 
 use crate::case::{Analysis, Case, WeightsRule};
 pub use crate::engine::common::clip_summary::ChosenWeights;
-use crate::solve::fit::noise_level_in;
+use crate::recorded::noise::recording_noise_in;
 use crate::solve::sequence::{solve_sequence, FirstStart, SequenceParams};
 
 /// Frames of the clip's start on which `r(λg)` is measured (a recording streamed from its file
@@ -61,29 +61,6 @@ pub const AUTO_STABILISATION: f64 = 0.1;
 /// earlier rule, `max(case_eps, min(σ̂/h, 0.1))`, left clean recordings at the case's ε.
 pub fn auto_stabilisation(case_eps: f64) -> f64 {
     case_eps.max(AUTO_STABILISATION)
-}
-
-/// The noise level σ̂ of a recording [m]: the median of the frames' [`crate::solve::fit::noise_level`].
-pub fn recording_noise(frames: &[Vec<Vector3<f64>>]) -> f64 {
-    recording_noise_in(frames, None)
-}
-
-/// [`recording_noise`] of a recording whose noise lies in the plane normal to `plane` (a planar
-/// recording: the two coordinates that carry data, [`noise_level_in`]).
-pub fn recording_noise_in(frames: &[Vec<Vector3<f64>>], plane: Option<&Vector3<f64>>) -> f64 {
-    median_noise(frames.iter().map(|f| noise_level_in(f, plane)))
-}
-
-/// [`recording_noise_in`] of the frames' noise levels [m] (each [`noise_level_in`]), taken as
-/// they come: their median, the non-finite ones left out; 0 where none is finite.
-pub fn median_noise(levels: impl IntoIterator<Item = f64>) -> f64 {
-    let mut v: Vec<f64> = levels.into_iter().filter(|v| v.is_finite()).collect();
-    if v.is_empty() {
-        return 0.0;
-    }
-    let mid = v.len() / 2;
-    let (_, m, _) = v.select_nth_unstable_by(mid, f64::total_cmp);
-    *m
 }
 
 /// The case with λg chosen for `frames` when its weights are `"auto"`, the choice, and frame 0's

@@ -7,7 +7,7 @@ use super::SequenceParams;
 use crate::model::chart::Chart;
 use crate::model::element::midpoint_curvatures;
 use crate::model::mesh::Field;
-use crate::solve::fit::{noise_level_in, position_misfit, FrameFit};
+use crate::recorded::fit::{noise_level_in, position_misfit, FrameFit};
 use crate::solve::inverse::tracking::MIN_TRACKED;
 use crate::solve::inverse::InverseSolution;
 use crate::solve::Problem;

@@ -5,7 +5,7 @@
 //! `crate::output::journal`), its keys in the order of the fields here, as before the grouping.
 use nalgebra::Vector3;
 
-use crate::solve::fit::FrameFit;
+use crate::recorded::fit::FrameFit;
 use crate::solve::inverse::{InverseRecord, ObjectiveTerms};
 
 /// Per-frame report.

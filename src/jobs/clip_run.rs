@@ -1,21 +1,22 @@
 //! A clip case run into its output folder: the Rust engine ([`crate::engine::run_clip_into`])
 //! streams every converged frame to a [`ClipWriter`] (rows, fields, VTK file, the resume
-//! journal), fresh or resumed after the journal's frames; then the clip's summary figures.
+//! journal), fresh or resumed after the journal's frames. The one place where a clip's engine
+//! meets its files: `output/` writes them and runs no engine; the summary figures are
+//! [`crate::output::clip_figures::write_clip_figures`].
 use std::path::Path;
 
-use super::clip_output::{
-    write_clip_kymographs, write_clip_plot, write_omega_kymographs, write_truth_plot, ClipWriter,
-};
-use super::journal::{journal_records, scan_journal, JournalScan};
 use crate::case::Case;
 use crate::engine::clip::{ClipFrame, ClipOutcome, ClipRun, FrameSink};
 use crate::engine::{run_clip_into, ClipInput, EngineError};
 use crate::io::compact::OutputFormat;
 use crate::io::files::{JournalError, OutputError};
+use crate::output::clip_output::ClipWriter;
+use crate::output::journal::{journal_records, scan_journal, JournalScan};
 
 /// Solve the clip of a clip case frame by frame in the Rust engine, streaming every converged
 /// frame into `dir` ([`ClipWriter`]); on failure the converged frames stay there and the error
-/// names the frame. The summary figures are the caller's ([`write_clip_figures`]).
+/// names the frame. The summary figures are the caller's
+/// ([`crate::output::clip_figures::write_clip_figures`]).
 pub fn run_clip_case(case: &Case, dir: &Path, progress: impl FnMut(usize, usize)) -> Result<ClipRun, EngineError> {
     run_clip_case_observed(case, dir, |_| {}, progress)
 }
@@ -94,19 +95,4 @@ impl<F: FnMut(&ClipFrame) + Send> FrameSink for Observed<F> {
     fn finish(&mut self) -> Result<(), OutputError> {
         self.sink.finish()
     }
-}
-
-/// The summary figures of a clip run in `dir`: `plot.svg` (per frame: iterations, fit, chart,
-/// objective, roughness), `kymograph.svg` and, for synthetic clips, `truth.svg`.
-/// The angular-velocity kymographs (the largest figure: three heatmaps) are drawn on a second
-/// thread while this one draws the others (worm_roll_3d: 21 ms against 24 ms).
-pub fn write_clip_figures(case: &Case, run: &ClipRun, dir: &Path) -> Result<(), OutputError> {
-    std::thread::scope(|s| {
-        let omega = s.spawn(|| write_omega_kymographs(case, run, &dir.join("omega.svg")));
-        let others = write_clip_kymographs(case, run, &dir.join("kymograph.svg"))
-            .and_then(|()| write_clip_plot(case, &run.reports, &run.roughness, &dir.join("plot.svg")))
-            .and_then(|()| write_truth_plot(case, run, &dir.join("truth.svg")));
-        let omega = omega.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic));
-        others.and(omega)
-    })
 }

@@ -241,7 +241,7 @@ pub const NOISY_GEOMETRY: f64 = 0.1;
 
 /// The centreline a frame's chart axis (`sequence::frame_chart`) and data guess (`sequence::data_frame_guess`)
 /// are taken from (`docs/noise.md` N8): the data `x`, or, where their noise level
-/// ([`crate::solve::fit::noise_level`]) exceeds [`NOISY_GEOMETRY`] times the node spacing of a
+/// ([`crate::recorded::fit::noise_level`]) exceeds [`NOISY_GEOMETRY`] times the node spacing of a
 /// rod of `length_m`, the knot values of their GCV smoothing spline (`solve::smoothing`). A
 /// noisy chord's direction is noise: at σ = 10 µm on 128 nodes of 1 mm (h = 7.9 µm) the raw
 /// tangents point anywhere, no chart axis keeps away from all of them, and the guess's angles
