@@ -75,11 +75,7 @@ pub fn cmd_compare(
     let mut manifest = run_manifest(&case, Engine::Rust)?;
     manifest.writer.command = "compare".into();
     manifest.input.engine = Some("rust and freefem".into());
-    let folder = RunFolder::begin(&target, manifest, Mode::Fresh { force })
-        .with_context(|| format!("{}: output folder {}", case_label(&case), target.display()))?;
-    for n in &folder.notes {
-        eprintln!("note: {n}");
-    }
+    let folder = CommandFolder::begin(&target, manifest, Mode::Fresh { force }, &case_label(&case), COMPARE_THEN)?;
     // FreeFEM's frames (a clip) or time steps (a dynamic case) as it runs: a bar on a terminal,
     // elsewhere a line every 10 s and a final line. Other cases: without a terminal, a line
     // every 10 s says the comparison is still running.
@@ -96,13 +92,12 @@ pub fn cmd_compare(
         Err(e) => (Status::Failed, Some(format!("{e:#}"))),
     };
     let placed = folder.finish(status, message)?;
-    let then = "until the next compare into it";
     match (status, result) {
         (Status::Interrupted, _) => {
-            eprintln!("{}: interrupted; {}", case.name, held(&placed, "interrupted", then));
+            eprintln!("{}: interrupted; {}", case.name, held(&placed, "interrupted", COMPARE_THEN));
             Ok(ExitCode::from(crate::EXIT_INTERRUPTED))
         }
-        (_, Err(e)) => Err(e.context(held(&placed, "failed", then))),
+        (_, Err(e)) => Err(e.context(held(&placed, "failed", COMPARE_THEN))),
         (_, Ok(code)) => Ok(code),
     }
 }
@@ -165,11 +160,7 @@ pub fn cmd_sweep(args: SweepArgs) -> Result<ExitCode> {
     let target = out.unwrap_or_else(|| PathBuf::from("out").join(&case.name).join("sweep"));
     let mut manifest = run_manifest(&case, Engine::Rust)?;
     manifest.writer.command = "sweep".into();
-    let folder = RunFolder::begin(&target, manifest, Mode::Fresh { force })
-        .with_context(|| format!("{}: output folder {}", case_label(&case), target.display()))?;
-    for n in &folder.notes {
-        eprintln!("note: {n}");
-    }
+    let folder = CommandFolder::begin(&target, manifest, Mode::Fresh { force }, &case_label(&case), SWEEP_THEN)?;
     let pb = Progress::new(&format!("{} sweep", case.name), "points", points.len(), quiet);
     let keys: Vec<String> = params.iter().map(|p| p.key.clone()).collect();
     let result = sweep_into(&case, &keys, &points, folder.dir(), jobs.unwrap_or(0), || pb.inc());
@@ -177,25 +168,15 @@ pub fn cmd_sweep(args: SweepArgs) -> Result<ExitCode> {
     let rows = match result {
         Ok(rows) => rows,
         Err(e) if cosserat::io::disk::is_full(&e) => {
-            folder.abandon();
+            folder.folder.abandon();
             anyhow::bail!("{}: sweep: {}", case_label(&case), super::outcome::disk_full_text(&e, &target, "sweep"));
         }
-        Err(e) => {
-            let message = cosserat::jobs::sweep::chain(&e);
-            let placed = folder.finish(Status::Failed, Some(message.clone()))?;
-            anyhow::bail!("{}: sweep: {message}; {}", case_label(&case), held(&placed, "failed", SWEEP_THEN));
-        }
+        Err(e) => return Err(folder.failed(&format!("{}: sweep", case_label(&case)), cosserat::jobs::sweep::chain(&e))),
     };
     let count = |s: Outcome| rows.iter().filter(|r| r.status == s).count();
     let complete = rows.iter().filter(|r| r.status.is_complete()).count();
     let (interrupted, failed) = (count(Outcome::Interrupted), rows.len() - complete);
-    let status = if interrupted > 0 {
-        Status::Interrupted
-    } else if failed > 0 {
-        Status::Failed
-    } else {
-        Status::Complete
-    };
+    let status = ended(interrupted > 0, failed > 0);
     let message = (failed > 0).then(|| {
         format!("{failed} of {} points failed, did not converge or were interrupted (summary.csv)", rows.len())
     });
@@ -221,18 +202,72 @@ pub fn cmd_sweep(args: SweepArgs) -> Result<ExitCode> {
     if interrupted > 0 {
         eprintln!("{}", super::outcome::sweep_interrupted_summary(&rows, &written));
     }
-    Ok(if interrupted > 0 {
-        ExitCode::from(crate::EXIT_INTERRUPTED)
-    } else if failed == 0 {
-        ExitCode::SUCCESS
-    } else {
-        ExitCode::from(1)
-    })
+    Ok(exit_code(status))
 }
 
-/// What continues a sweep's or an audit's run kept beside a complete one ([`held`]).
+/// What continues a compare's, a sweep's or an audit's run kept beside a complete one ([`held`]).
+const COMPARE_THEN: &str = "until the next compare into it";
 const SWEEP_THEN: &str = "until the next sweep into it";
 const AUDIT_THEN: &str = "(`cosserat audit --resume` with the same specs continues it)";
+
+/// The output folder of a command that writes one (`compare`, `sweep`, `audit`; `run`'s is
+/// `jobs::job::run_into`'s): begun with its notes shown, then finished with the status its
+/// work ended in ([`ended`], [`exit_code`]); `then` says what continues a run kept beside a
+/// complete one.
+struct CommandFolder {
+    folder: RunFolder,
+    then: &'static str,
+}
+
+impl CommandFolder {
+    /// Begin `target` for `manifest` in `mode`; `what` names the run in an error.
+    fn begin(target: &Path, manifest: Manifest, mode: Mode, what: &str, then: &'static str) -> Result<Self> {
+        let folder = RunFolder::begin(target, manifest, mode)
+            .with_context(|| format!("{what}: output folder {}", target.display()))?;
+        for n in &folder.notes {
+            eprintln!("note: {n}");
+        }
+        Ok(CommandFolder { folder, then })
+    }
+
+    /// Where the work writes (the staging folder).
+    fn dir(&self) -> &Path {
+        self.folder.dir()
+    }
+
+    /// Finish the folder with `status` and `message`: where the run is now.
+    fn finish(self, status: Status, message: Option<String>) -> Result<Placed> {
+        Ok(self.folder.finish(status, message)?)
+    }
+
+    /// The work failed with `message`: the folder finished failed, and the error `what: message;`
+    /// followed by where the run is.
+    fn failed(self, what: &str, message: String) -> anyhow::Error {
+        let then = self.then;
+        match self.finish(Status::Failed, Some(message.clone())) {
+            Ok(placed) => anyhow::anyhow!("{what}: {message}; {}", held(&placed, "failed", then)),
+            Err(e) => e.context(format!("{what}: {message}")),
+        }
+    }
+}
+
+/// The status of work that was `interrupted` or had parts that `failed` (complete otherwise).
+fn ended(interrupted: bool, failed: bool) -> Status {
+    match (interrupted, failed) {
+        (true, _) => Status::Interrupted,
+        (false, true) => Status::Failed,
+        (false, false) => Status::Complete,
+    }
+}
+
+/// The exit code of a command whose work ended `status`: 0 complete, 1 failed, 130 interrupted.
+fn exit_code(status: Status) -> ExitCode {
+    match status {
+        Status::Interrupted => ExitCode::from(crate::EXIT_INTERRUPTED),
+        Status::Failed | Status::Stalled => ExitCode::from(1),
+        Status::Complete | Status::CompleteWithWarnings | Status::Running => ExitCode::SUCCESS,
+    }
+}
 
 /// Where a run that ended `word` ("failed", "interrupted") is, for a message: its output folder
 /// holding `run.json` saying so, or (a complete run was there) beside it, `then` saying what
@@ -260,8 +295,7 @@ pub fn cmd_audit(args: AuditArgs) -> Result<ExitCode> {
     manifest.input.inputs = files.iter().map(|f| input_file(f)).collect::<Result<_, _>>()?;
     manifest.input.settings.insert("quick".into(), f64::from(u8::from(quick)).into());
     let resume = force.is_none();
-    let folder =
-        RunFolder::begin(&out, manifest, mode).with_context(|| format!("audit: output folder {}", out.display()))?;
+    let folder = CommandFolder::begin(&out, manifest, mode, "audit", AUDIT_THEN)?;
     let pb = Progress::new(if quick { "audit (quick)" } else { "audit" }, "points", 0, quiet);
     let opts = AuditOptions { out: folder.dir().to_path_buf(), jobs: jobs.unwrap_or(0), fields, resume };
     let points = std::sync::atomic::AtomicUsize::new(0);
@@ -272,11 +306,7 @@ pub fn cmd_audit(args: AuditArgs) -> Result<ExitCode> {
     pb.finish();
     let report = match report {
         Ok(r) => r,
-        Err(e) => {
-            let message = format!("{:#}", anyhow::Error::from(e));
-            let placed = folder.finish(Status::Failed, Some(message.clone()))?;
-            anyhow::bail!("audit: {message}; {}", held(&placed, "failed", AUDIT_THEN));
-        }
+        Err(e) => return Err(folder.failed("audit", format!("{:#}", anyhow::Error::from(e)))),
     };
     let judged = format!("{} of {} claims judged", report.claims.len() - report.unjudged(), report.claims.len());
     match &report.status {
