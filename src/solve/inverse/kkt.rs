@@ -27,40 +27,46 @@ pub(crate) const AL: [usize; 2] = [LOCAL.local(0, Field::Alpha, 0), LOCAL.local(
 const XH: [usize; 2] = [LOCAL.local(0, Field::XHat, 0), LOCAL.local(1, Field::XHat, 0)];
 const ALH: [usize; 2] = [LOCAL.local(0, Field::AlphaHat, 0), LOCAL.local(1, Field::AlphaHat, 0)];
 
-/// The KKT element index of forward element index `i` (`[x_a, α_a, x_b, α_b]`); `hat` selects
-/// the adjoint copy (x → x̂, α → α̂).
+/// Which half of the KKT unknowns (eq. 61): the state `(x, α)` or its adjoint `(x̂, α̂)`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Part {
+    State,
+    Adjoint,
+}
+
+/// The KKT element index of forward element index `i` (`[x_a, α_a, x_b, α_b]`) in `part`
+/// (the adjoint's copy: x → x̂, α → α̂).
 #[inline]
-pub(crate) fn kkt(i: usize, hat: bool) -> usize {
-    if hat {
-        KKT_HAT[i]
-    } else {
-        KKT_STATE[i]
+pub(crate) fn kkt(i: usize, part: Part) -> usize {
+    match part {
+        Part::State => KKT_STATE[i],
+        Part::Adjoint => KKT_HAT[i],
     }
 }
 
-const fn kkt_index(i: usize, hat: bool) -> usize {
+const fn kkt_index(i: usize, part: Part) -> usize {
     let position = i % FORWARD.block() < 3;
-    let field = match (position, hat) {
-        (true, false) => Field::X,
-        (true, true) => Field::XHat,
-        (false, false) => Field::Alpha,
-        (false, true) => Field::AlphaHat,
+    let field = match (position, part) {
+        (true, Part::State) => Field::X,
+        (true, Part::Adjoint) => Field::XHat,
+        (false, Part::State) => Field::Alpha,
+        (false, Part::Adjoint) => Field::AlphaHat,
     };
     LOCAL.local(i / FORWARD.block(), field, i % 3)
 }
 
-const fn kkt_table(hat: bool) -> [usize; 12] {
+const fn kkt_table(part: Part) -> [usize; 12] {
     let mut t = [0; 12];
     let mut i = 0;
     while i < 12 {
-        t[i] = kkt_index(i, hat);
+        t[i] = kkt_index(i, part);
         i += 1;
     }
     t
 }
 
-const KKT_STATE: [usize; 12] = kkt_table(false);
-const KKT_HAT: [usize; 12] = kkt_table(true);
+const KKT_STATE: [usize; 12] = kkt_table(Part::State);
+const KKT_HAT: [usize; 12] = kkt_table(Part::Adjoint);
 // `add_operator_blocks` relies on this layout: forward unknown i of node a at 12 a + i % 6,
 // its adjoint 6 further
 const _: () = {
@@ -71,10 +77,9 @@ const _: () = {
     }
 };
 
-/// The state part (`hat = false`) or the adjoint part of a KKT element vector, in the forward
-/// element layout.
-pub(crate) fn element_part(ue: &KktVec, hat: bool) -> LocalVec {
-    LocalVec::from_fn(|i, _| ue[kkt(i, hat)])
+/// The state or the adjoint `part` of a KKT element vector, in the forward element layout.
+pub(crate) fn element_part(ue: &KktVec, part: Part) -> LocalVec {
+    LocalVec::from_fn(|i, _| ue[kkt(i, part)])
 }
 
 /// Points `(ξ, w)` of the λd term's rule (I11): `(1 − ε)` times the stretch–shear rule of the
@@ -120,18 +125,28 @@ pub(crate) fn d3_jacobian(alpha: &Vector3<f64>) -> Matrix3<f64> {
     Matrix3::from_columns(&[dq[0].row(2).transpose(), dq[1].row(2).transpose(), dq[2].row(2).transpose()])
 }
 
+/// Where [`add_operator_blocks`] adds a forward-layout element matrix.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Blocks {
+    /// the adjoint rows × state columns only (a Jacobian's linearised operator)
+    AdjointRows,
+    /// those and the transpose into the state rows × adjoint columns (the symmetric KKT matrix)
+    WithTranspose,
+}
+
 /// Add a forward-layout element matrix `l` (12 × 12) into the adjoint rows × state columns of a
-/// KKT element matrix, `m[kkt(i, true), kkt(j, false)] += l[i, j]`, and, if `transpose`, its
-/// transpose into the state rows × adjoint columns: 6 × 6 blocks per pair of nodes (a node's
-/// forward unknowns `[x, α]` are the first six of its KKT block, the adjoint's the last six).
-pub(crate) fn add_operator_blocks(m: &mut KktMat, l: &LocalMat, transpose: bool) {
+/// KKT element matrix, `m[kkt(i, Adjoint), kkt(j, State)] += l[i, j]`, and, with
+/// [`Blocks::WithTranspose`], its transpose into the state rows × adjoint columns: 6 × 6 blocks
+/// per pair of nodes (a node's forward unknowns `[x, α]` are the first six of its KKT block, the
+/// adjoint's the last six).
+pub(crate) fn add_operator_blocks(m: &mut KktMat, l: &LocalMat, blocks: Blocks) {
     const B: usize = 6;
     for a in 0..2 {
         for c in 0..2 {
             let blk = l.fixed_view::<B, B>(B * a, B * c);
             let mut adj_rows = m.fixed_view_mut::<B, B>(2 * B * a + B, 2 * B * c);
             adj_rows += blk;
-            if transpose {
+            if blocks == Blocks::WithTranspose {
                 let mut state_rows = m.fixed_view_mut::<B, B>(2 * B * c, 2 * B * a + B);
                 state_rows += blk.transpose();
             }
@@ -177,9 +192,9 @@ pub(crate) fn element_system(
     // (the inverse problem keeps the straight reference, D20)
     let (l, b) = frozen_operator(&problem.props, problem.scheme, h, uk, &ElementRest::ZERO);
     for i in 0..12 {
-        r[kkt(i, true)] += b[i];
+        r[kkt(i, Part::Adjoint)] += b[i];
     }
-    add_operator_blocks(m, &l, true);
+    add_operator_blocks(m, &l, Blocks::WithTranspose);
     let nodal = NodalData { xg, wg, alpha_prev };
     objective_terms(problem, p, first_frame, uk, &nodal, m, &mut r);
     lambda_d_term(problem, p, uk, m, &mut r);

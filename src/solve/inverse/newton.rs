@@ -31,7 +31,9 @@ use std::ops::ControlFlow;
 
 use nalgebra::{DVector, Matrix3, Vector3};
 
-use super::kkt::{add_node_pairs, add_operator_blocks, element_part, element_system, KktMat, KktVec, PointRule, AL, X};
+use super::kkt::{
+    add_node_pairs, add_operator_blocks, element_part, element_system, Blocks, KktMat, KktVec, Part, PointRule, AL, X,
+};
 use super::measures::{position_error, record};
 use super::{
     early_divergence, Frame, FrameProblem, FrameSolver, InverseParams, InverseRecord, InverseSolution, Records,
@@ -91,11 +93,11 @@ fn coefficient_derivative(
     let h = problem.mesh.h();
     let props = &problem.props;
     let w8 = &p.weights;
-    let (state, adj) = (element_part(ue, false), element_part(ue, true));
+    let (state, adj) = (element_part(ue, Part::State), element_part(ue, Part::Adjoint));
     // Primal rows: ∂G/∂u − L(u).
     let mut t = LocalMat::zeros();
     internal_force(props, problem.scheme, h, &state, &ElementRest::ZERO, Some(&mut t));
-    add_operator_blocks(e, &(t - l), false);
+    add_operator_blocks(e, &(t - l), Blocks::AdjointRows);
     let K = Matrix3::from_diagonal(&props.shear_stretch_n);
     let Jm = Matrix3::from_diagonal(&props.bend_twist_nm2);
     // Stretch–shear rule: L(u)ᵀ û on the x rows, and the λd term.
@@ -182,7 +184,7 @@ pub fn assemble_residual(
     let mut scratch = KktMat::zeros();
     let kernel = |e: usize, t: Option<&mut KktMat>| {
         let ue: KktVec = dofs.gather(big, e);
-        let uk = element_part(&ue, false);
+        let uk = element_part(&ue, Part::State);
         let ap = [alpha_prev[e], alpha_prev[e + 1]];
         let jacobian = t.is_some();
         let m = t.unwrap_or_else(|| {
