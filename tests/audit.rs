@@ -67,6 +67,10 @@ fn quick_audit_verdicts_are_the_recorded_ones() {
     let doc = std::fs::read_to_string(root.join("docs/audit.md")).expect("docs/audit.md");
     check_docs_numbers(&report, &doc, &spec_inputs(&dir));
     check_causes_have_no_measured_numbers(&report, &spec_inputs(&dir));
+    check_causes_only_for_failed_checks(&report, &md);
+    check_digits_and_whole_messages(&report);
+    let results = std::fs::read_to_string(root.join("docs/results.md")).expect("docs/results.md");
+    check_docs_counts(&report, &results);
 
     let table: Vec<String> = report
         .claims
@@ -316,6 +320,71 @@ fn check_causes_have_no_measured_numbers(report: &cosserat::audit::AuditReport, 
         }
     }
     assert!(problems.is_empty(), "numbers in the causes of the specs that are not inputs:\n{}", problems.join("\n"));
+}
+
+/// The row of claim `id` in REPORT.md.
+fn report_row<'a>(md: &'a str, id: &str) -> &'a str {
+    md.lines().find(|l| l.starts_with(&format!("| {id} |"))).unwrap_or_else(|| panic!("no row {id} in REPORT.md"))
+}
+
+/// A cause explains a failed check: a row whose check holds (reproduced, not computable here)
+/// shows none of its spec's cause text; the causes that name where a grid starts to fail
+/// name the points of this run (eq64-2: the histories part after λl = 1e-6 of the quick grid,
+/// eq65-4: 1e-8 is the first point that does not stall).
+fn check_causes_only_for_failed_checks(report: &cosserat::audit::AuditReport, md: &str) {
+    for c in &report.claims {
+        let Some(text) = &c.claim.caveats.cause else { continue };
+        let held = matches!(c.verdict, Some(Verdict::Reproduced | Verdict::NotComputable));
+        if held {
+            assert_eq!(c.cause, None, "{}: a check that holds has no cause", c.claim.id);
+            let start: String = text.chars().take(40).collect();
+            assert!(!report_row(md, &c.claim.id).contains(&start), "{} shows its cause: {start}", c.claim.id);
+        }
+    }
+    for id in ["fig5", "t1-minimal", "ld-dominated", "ld-oscillation", "omega3-needed"] {
+        let c = report.claims.iter().find(|c| c.claim.id == id).expect(id);
+        assert_eq!(c.cause, None, "{id}: {}", c.ours);
+    }
+    let cause = |id: &str| report.claims.iter().find(|c| c.claim.id == id).and_then(|c| c.cause.clone()).expect(id);
+    let eq64_2 = cause("eq64-2");
+    assert!(eq64_2.starts_with("identical up to lambda_l = 1e-6; from lambda_l = 1e3 on"), "{eq64_2}");
+    let eq65_4 = cause("eq65-4");
+    assert!(eq65_4.starts_with("from lambda_kappa3 = 1e-8 on"), "{eq65_4}");
+    assert!(report_row(md, "eq65-4").contains(&eq65_4), "REPORT.md shows the judged cause");
+}
+
+/// A value compared with a reference shows their difference (the first natural frequency
+/// 206.78 rad/s against the paper's 207.0236, not 210 against 210), counts are exact, and no
+/// message is cut short.
+fn check_digits_and_whole_messages(report: &cosserat::audit::AuditReport) {
+    let ours = |id: &str| report.claims.iter().find(|c| c.claim.id == id).map(|c| c.ours.clone()).expect(id);
+    let omega0 = ours("fig5-omega0");
+    assert!(omega0.starts_with("first_frequency_rad_per_s 206.7"), "{omega0}");
+    assert!(omega0.contains("of 207.0236)"), "{omega0}");
+    assert!(ours("eq64-2").contains("(148 iterations)"), "{}", ours("eq64-2"));
+    for c in &report.claims {
+        assert!(!c.ours.contains('…'), "{}: a message cut short: {}", c.claim.id, c.ours);
+    }
+}
+
+/// The counts docs/results.md states of the audit ("judged N claims of the paper", the
+/// verdicts, the figures) are this run's: the quick and the full audit give the same verdicts.
+fn check_docs_counts(report: &cosserat::audit::AuditReport, results: &str) {
+    let section = results.split("## The audit of the paper").nth(1).expect("the audit's section");
+    let section = section.split("\n## ").next().unwrap_or_default().replace('\n', " ");
+    let [rep, dif, refu, nc] = report.counts();
+    let ours = report.claims.iter().filter(|c| c.claim.ours).count();
+    let figures = report.figures.len();
+    for stated in [
+        format!("judged {} claims of the paper and {ours} checks of ours", report.claims.len() - ours),
+        format!("{rep} reproduced, {dif} differ, {refu} refuted and {nc} not computable here"),
+        format!("drew {figures} figures"),
+    ] {
+        assert!(
+            section.contains(&stated),
+            "docs/results.md, the audit of the paper, does not say \"{stated}\":\n{section}"
+        );
+    }
 }
 
 #[test]

@@ -1,7 +1,9 @@
 //! Judging a claim: the check of its spec on the runs' points gives an [`Outcome`] (holds,
 //! holds in part, fails) and our numbers as text; the verdict follows from the outcome and the
-//! claim's declared fallbacks. Numbers are printed with two significant digits, so that the
-//! report's text changes only when a result does.
+//! claim's declared fallbacks. Numbers are written as `numbers` says: two significant digits,
+//! counts exactly, a value beside its reference with the digits that show their difference.
+use super::cause::{fill, PointState};
+use super::numbers::{against, input, round_numbers, sig2};
 use super::spec::{Check, Claim, Ref, Selector, Spec};
 use super::{ClaimResult, PointResult, RunResults, Verdict};
 use crate::engine::metrics::Metric;
@@ -17,36 +19,13 @@ pub enum Outcome {
     Fails,
 }
 
-/// `x` with two significant digits: plain for 0.01 ≤ |x| < 1e4, else scientific (`8.2e-5`).
-pub fn sig2(x: f64) -> String {
-    if !x.is_finite() {
-        return format!("{x}");
-    }
-    if x == 0.0 {
-        return "0".into();
-    }
-    let a = x.abs();
-    if (0.01..1e4).contains(&a) {
-        let digits = (1 - a.log10().floor() as i32).max(0) as usize;
-        let r = format!("{x:.digits$}");
-        // 2 significant digits of an integer ≥ 100: round the rest away (361 → 360)
-        if a >= 100.0 {
-            let p = 10f64.powi(a.log10().floor() as i32 - 1);
-            return format!("{}", (x / p).round() * p);
-        }
-        r
-    } else {
-        let s = format!("{x:.1e}");
-        s.replace("e-0", "e-")
-    }
-}
-
-/// `metric` at each point, `label: value` joined by commas (no label for a single point).
-fn metric_list(pts: &[&PointResult], metric: &str) -> String {
+/// `metric` at each point, `label: value` joined by commas (no label for a single point),
+/// each value with the digits that show its difference from `reference`.
+fn metric_list(pts: &[&PointResult], metric: &str, reference: f64) -> String {
     pts.iter()
         .map(|p| {
             let label = if pts.len() == 1 { String::new() } else { format!("{}: ", point_label(p)) };
-            format!("{label}{}", metric_text(p, metric))
+            format!("{label}{}", p.metric(metric).map_or_else(|| "–".into(), |v| against(v, reference)))
         })
         .collect::<Vec<_>>()
         .join(", ")
@@ -76,7 +55,7 @@ fn failure(p: &PointResult) -> String {
     let e = p.outcome.error.as_deref().unwrap_or("no result");
     match p.outcome.status {
         solve::Outcome::IterationLimit | solve::Outcome::Stalled => {
-            let its = p.value(Metric::Iterations).map(|i| format!(" after {}", sig2(i))).unwrap_or_default();
+            let its = p.value(Metric::Iterations).map(|i| format!(" after {i}")).unwrap_or_default();
             let x = p.value(Metric::XErrRel).map(|x| format!(", x error {}", sig2(x))).unwrap_or_default();
             let c = p.value(Metric::Certificate).map(|c| format!(", certificate {}", sig2(c))).unwrap_or_default();
             let word = if p.outcome.status == solve::Outcome::Stalled { "stalled" } else { "not converged" };
@@ -85,34 +64,10 @@ fn failure(p: &PointResult) -> String {
         _ => {
             // the innermost cause: after the last ": " of the error chain
             let short = e.rsplit(": ").take(2).collect::<Vec<_>>().into_iter().rev().collect::<Vec<_>>().join(": ");
-            let mut short = round_numbers(&short.replace('\n', " "));
-            if short.len() > 140 {
-                let cut = (0..=140).rev().find(|&i| short.is_char_boundary(i)).unwrap_or(0);
-                short.truncate(cut);
-                short.push('…');
-            }
-            format!("failed: {short}")
+            // whole: the report wraps it, and a cut message hides its end
+            format!("failed: {}", round_numbers(&short.replace('\n', " ")))
         }
     }
-}
-
-/// `text` with every number of more than two significant digits written as [`sig2`] (an
-/// error's `9.378712387458614e-8` is `9.4e-8`), so that the report's text changes only when a
-/// result does.
-fn round_numbers(text: &str) -> String {
-    text.split(' ')
-        .map(|word| {
-            let end = word.trim_end_matches([',', ';', ')', ':']);
-            let start = end.trim_start_matches('(');
-            match start.parse::<f64>() {
-                Ok(x) if start.contains('.') && start.len() > 6 => {
-                    format!("{}{}{}", &end[..end.len() - start.len()], sig2(x), &word[end.len()..])
-                }
-                _ => word.to_string(),
-            }
-        })
-        .collect::<Vec<_>>()
-        .join(" ")
 }
 
 fn metric_text(p: &PointResult, metric: &str) -> String {
@@ -189,9 +144,8 @@ fn iterations_range(pts: &[&PointResult], metric: &str) -> String {
         return String::new();
     }
     let (lo, hi) = v.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| (a.min(*x), b.max(*x)));
-    // frames are counted exactly; iterations to two digits (they may move by one between
-    // machines)
-    let f = |x: f64| if metric == "frames" { format!("{x}") } else { sig2(x) };
+    // frames and iterations are counted exactly
+    let f = |x: f64| format!("{x}");
     if lo == hi {
         format!(" ({} {metric})", f(lo))
     } else {
@@ -287,16 +241,16 @@ fn threshold(
     below: bool,
 ) -> Result<(Outcome, String), CheckError> {
     let mut pts = select(runs, run, at)?;
-    let mut list = metric_list(&pts, metric);
+    let mut list = metric_list(&pts, metric, limit);
     for w in with {
         let more = select(runs, w, &Selector::new())?;
-        list.push_str(&format!("; {w}: {}", metric_list(&more, metric)));
+        list.push_str(&format!("; {w}: {}", metric_list(&more, metric, limit)));
         pts.extend(more);
     }
     let pass = |p: &PointResult| p.metric(metric).is_some_and(|v| if below { v <= limit } else { v >= limit });
     let (ok, _) = split_by(&pts, pass);
     let rel = if below { "≤" } else { "≥" };
-    Ok((outcome(ok.len(), pts.len()), format!("{metric} {list} (claim: {rel} {})", sig2(limit))))
+    Ok((outcome(ok.len(), pts.len()), format!("{metric} {list} (claim: {rel} {})", input(limit))))
 }
 
 /// `increasing`: `metric` rises along the run's single grid key.
@@ -340,9 +294,9 @@ fn ratio(
         sig2(vb),
         denominator.run,
         point_label(b),
-        sig2(ratio),
+        against(ratio, limit),
         if above { "≥" } else { "≤" },
-        sig2(limit)
+        input(limit)
     );
     Ok((if pass { Outcome::Holds } else { Outcome::Fails }, text))
 }
@@ -381,8 +335,8 @@ fn within_factor(
     let text = format!(
         "{metric} at {at}: {} (max/min of the magnitudes 1 + {}; claim: ≤ 1 + {})",
         pts.iter().map(|p| metric_text(p, metric)).collect::<Vec<_>>().join(", "),
-        if hi == 0.0 { "0".to_string() } else { sig2(hi / lo - 1.0) },
-        sig2(factor - 1.0)
+        if hi == 0.0 { "0".to_string() } else { against(hi / lo - 1.0, factor - 1.0) },
+        input(factor - 1.0)
     );
     // every value 0 (a term whose weight is 0): the same everywhere
     let o = if hi <= lo * factor || hi == 0.0 {
@@ -407,9 +361,43 @@ fn magnitude(
     let pts = select(runs, run, at)?;
     let apart = |p: &PointResult| p.metric(metric).map(|v| (v.abs() / value).log10().abs());
     let (ok, _) = split_by(&pts, |p| apart(p).is_some_and(|o| o <= orders));
-    let list = metric_list(&pts, metric);
-    let text = format!("{metric} {list} (claim: within {} orders of magnitude of {})", sig2(orders), sig2(value));
+    let list = metric_list(&pts, metric, value);
+    let text = format!("{metric} {list} (claim: within {} orders of magnitude of {})", input(orders), input(value));
     Ok((outcome(ok.len(), pts.len()), text))
+}
+
+/// Spread and length of each point's history
+type Spreads<'a> = Vec<(&'a PointResult, Option<(f64, usize)>)>;
+
+/// The reference point of `same_histories`, its history, and for each other point of `run`
+/// the largest relative spread of its history from the reference's over their common
+/// iterations, with its length.
+fn history_spreads<'a>(
+    runs: &'a [RunResults],
+    run: &str,
+    history: &str,
+    reference: &Selector,
+) -> Result<(&'a PointResult, Vec<f64>, Spreads<'a>), CheckError> {
+    let pts = select(runs, run, &Selector::new())?;
+    let base = one(runs, &Ref { run: run.to_string(), at: reference.clone() })?;
+    let hb = history_of(base, history).ok_or_else(|| CheckError::NoHistory { history: history.to_string() })?;
+    let spreads = pts
+        .into_iter()
+        .filter(|p| !std::ptr::eq(*p, base))
+        .map(|p| {
+            let s = history_of(p, history).map(|hp| {
+                let n = hp.len().min(hb.len());
+                ((0..n).map(|i| (hp[i] - hb[i]).abs() / hb[i].abs()).fold(0.0, f64::max), hp.len())
+            });
+            (p, s)
+        })
+        .collect();
+    Ok((base, hb, spreads))
+}
+
+/// The same curve also stops at the same iteration (±1 %, at least one).
+fn same_length(n: usize, reference: usize) -> bool {
+    n.abs_diff(reference) as f64 <= (0.01 * reference as f64).max(1.0)
 }
 
 /// `same_histories`: the `history` of every point of `run` against the `reference` point's,
@@ -421,21 +409,8 @@ fn same_histories(
     reference: &Selector,
     limit: f64,
 ) -> Result<(Outcome, String), CheckError> {
-    let pts = select(runs, run, &Selector::new())?;
-    let base = one(runs, &Ref { run: run.to_string(), at: reference.clone() })?;
-    let h = |p: &PointResult| -> Option<Vec<f64>> { history_of(p, history) };
-    let hb = h(base).ok_or_else(|| CheckError::NoHistory { history: history.to_string() })?;
-    // (spread over the common iterations, iterations) per point; the same curve also
-    // stops at the same iteration (±1 %)
-    let mut spreads = Vec::new();
-    for p in pts.iter().filter(|p| !std::ptr::eq(**p, base)) {
-        let s = h(p).map(|hp| {
-            let n = hp.len().min(hb.len());
-            ((0..n).map(|i| (hp[i] - hb[i]).abs() / hb[i].abs()).fold(0.0, f64::max), hp.len())
-        });
-        spreads.push((p, s));
-    }
-    let same_length = |n: usize| n.abs_diff(hb.len()) as f64 <= (0.01 * hb.len() as f64).max(1.0);
+    let (base, hb, spreads) = history_spreads(runs, run, history, reference)?;
+    let same_length = |n: usize| same_length(n, hb.len());
     let good = spreads.iter().filter(|(_, s)| s.is_some_and(|(s, n)| s <= limit && same_length(n))).count();
     let text = format!(
         "max relative spread of the {history} history against {} ({} iterations): {} (claim: ≤ {} and the \
@@ -447,11 +422,11 @@ fn same_histories(
             .map(|(p, s)| format!(
                 "{}: {}",
                 p.point.first().map(|x| x.1.to_string()).unwrap_or_default(),
-                s.map(|(s, n)| format!("{} ({n} its)", sig2(s))).unwrap_or_else(|| "–".into())
+                s.map(|(s, n)| format!("{} ({n} its)", against(s, limit))).unwrap_or_else(|| "–".into())
             ))
             .collect::<Vec<_>>()
             .join(", "),
-        sig2(limit)
+        input(limit)
     );
     Ok((outcome(good, spreads.len()), text))
 }
@@ -528,17 +503,23 @@ fn unjudgeable(check: &Check, runs: &[RunResults]) -> Option<String> {
 /// Judge `claim` of `spec` on its runs; not judged (verdict `None`) when a point it reads was
 /// stopped by a signal.
 pub fn judge(spec: &Spec, claim: &Claim, runs: &[RunResults]) -> ClaimResult {
-    let result = |verdict, ours| ClaimResult {
+    let result = |verdict, ours, cause| ClaimResult {
         spec: spec.name.clone(),
         claim: claim.clone(),
         verdict,
         ours,
+        cause,
         figure: claim.figure.clone(),
     };
     if let Some(why) = unjudgeable(&claim.check, runs) {
-        return result(None, why);
+        return result(None, why, None);
     }
     let (o, mut ours) = evaluate(&claim.check, runs);
+    // the cause explains a failure: none for a check that holds
+    let cause = match (o, &claim.caveats.cause) {
+        (Outcome::Holds, _) | (_, None) => None,
+        (_, Some(text)) => Some(fill(text, &point_states(&claim.check, runs))),
+    };
     if let Some(s) = &claim.caveats.substitute {
         ours = format!("{ours} [on {s}]");
     }
@@ -562,31 +543,33 @@ pub fn judge(spec: &Spec, claim: &Claim, runs: &[RunResults]) -> ClaimResult {
         (Verdict::Reproduced | Verdict::NotComputable, Some(_)) => Verdict::Differs,
         (v, _) => v,
     };
-    result(Some(verdict), ours)
+    result(Some(verdict), ours, cause)
 }
 
-#[cfg(test)]
-mod tests {
-    use super::{round_numbers, sig2};
-
-    #[test]
-    fn two_significant_digits() {
-        assert_eq!(sig2(8.19499e-5), "8.2e-5");
-        assert_eq!(sig2(0.0860337), "0.086");
-        assert_eq!(sig2(361.0), "360");
-        assert_eq!(sig2(1.0), "1.0");
-        assert_eq!(sig2(12.4), "12");
-        assert_eq!(sig2(2.5e6), "2.5e6");
-        assert_eq!(sig2(-0.0025), "-2.5e-3");
-    }
-
-    #[test]
-    fn long_numbers_of_an_error_are_rounded() {
-        assert_eq!(
-            round_numbers(
-                "change (x, α) is 9.378712387458614e-8, but 1e-10 (after 3000 iterations: 1.0245671838684249e-1)"
-            ),
-            "change (x, α) is 9.4e-8, but 1e-10 (after 3000 iterations: 0.10)"
-        );
+/// The points of a `converges` or `same_histories` check in the order of the grid, each
+/// holding or not, for the placeholders of its cause (`super::cause`); none for other checks.
+fn point_states(check: &Check, runs: &[RunResults]) -> Vec<PointState> {
+    let state = |p: &PointResult, holds: bool| PointState {
+        value: p.point.first().map_or_else(|| point_label(p), |x| x.1.to_string()),
+        holds,
+        stalled: p.outcome.status == solve::Outcome::Stalled,
+    };
+    match check {
+        Check::Converges { run } => select(runs, run, &Selector::new())
+            .map(|pts| pts.iter().map(|p| state(p, p.converged())).collect())
+            .unwrap_or_default(),
+        Check::SameHistories { run, history, reference, limit } => {
+            let Ok((base, hb, spreads)) = history_spreads(runs, run, history, reference) else { return Vec::new() };
+            let holds = |p: &PointResult| {
+                std::ptr::eq(p, base)
+                    || spreads.iter().any(|(q, s)| {
+                        std::ptr::eq(*q, p) && s.is_some_and(|(s, n)| s <= *limit && same_length(n, hb.len()))
+                    })
+            };
+            select(runs, run, &Selector::new())
+                .map(|pts| pts.iter().map(|p| state(p, holds(p))).collect())
+                .unwrap_or_default()
+        }
+        _ => Vec::new(),
     }
 }

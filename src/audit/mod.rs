@@ -4,10 +4,12 @@
 //! through the same path as `cosserat sweep` (`jobs::sweep::run_point`), one folder per point;
 //! [`measures`] adds the numbers a claim needs beyond a run's metrics, [`figures`] draws the
 //! paper's panels and [`report`] writes `REPORT.md` and `report.csv`.
+pub mod cause;
 pub mod check;
 pub mod figures;
 pub mod inventory;
 pub mod measures;
+pub mod numbers;
 pub mod report;
 pub mod resume;
 pub mod spec;
@@ -141,8 +143,11 @@ pub struct ClaimResult {
     pub claim: Claim,
     /// the verdict; `None`: not judged (an interrupted or failed audit), `ours` says why
     pub verdict: Option<Verdict>,
-    /// our numbers, two significant digits (not judged: why)
+    /// our numbers, two significant digits or those a verdict needs (not judged: why)
     pub ours: String,
+    /// why the check did not hold: the spec's cause with its points filled in from the
+    /// runs (`cause`); `None` when it held, was not judged or the spec gives no cause
+    pub cause: Option<String>,
     /// the figure illustrating the claim, relative to the audit folder
     pub figure: Option<String>,
 }

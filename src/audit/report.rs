@@ -33,11 +33,18 @@ fn verdict_text(c: &ClaimResult) -> &'static str {
 /// The verdict column of a claim that an unfinished audit could not judge.
 pub const NOT_JUDGED: &str = "not judged";
 
+/// Why a row is not *reproduced*: what of the paper is not available here, and the cause of a
+/// failed check (judged from the same numbers as the verdict, so a check that holds has none);
+/// a partial check that holds says so.
 fn cause(c: &ClaimResult) -> String {
-    match (&c.claim.caveats.not_computable, &c.claim.caveats.cause) {
+    let caveats = &c.claim.caveats;
+    match (&caveats.not_computable, &c.cause) {
         (Some(n), Some(k)) => format!("{n}. {k}"),
         (Some(n), None) => n.clone(),
         (None, Some(k)) => k.clone(),
+        (None, None) if caveats.partial.is_some() => {
+            "the check holds, but it tests less than the paper's words (partial check, in ours)".into()
+        }
         (None, None) => "(no cause recorded)".into(),
     }
 }

@@ -25,6 +25,8 @@ struct Stored {
     id: String,
     verdict: Verdict,
     ours: String,
+    /// the cause of a failed check, as judged
+    cause: Option<String>,
 }
 
 /// Record `spec`'s claims (every one judged) and the figures written, relative to the audit
@@ -39,7 +41,14 @@ pub fn store(
     let claims = claims
         .iter()
         .filter(|c| c.spec == spec.name)
-        .map(|c| c.verdict.map(|verdict| Stored { id: c.claim.id.clone(), verdict, ours: c.ours.clone() }))
+        .map(|c| {
+            c.verdict.map(|verdict| Stored {
+                id: c.claim.id.clone(),
+                verdict,
+                ours: c.ours.clone(),
+                cause: c.cause.clone(),
+            })
+        })
         .collect::<Option<Vec<_>>>();
     let Some(claims) = claims else { return Ok(()) };
     let prefix = format!("{}/", spec.name);
@@ -68,6 +77,7 @@ pub fn load(spec: &Spec, quick: bool, out: &Path) -> Option<(Vec<ClaimResult>, V
                 claim: claim.clone(),
                 verdict: Some(s.verdict),
                 ours: s.ours.clone(),
+                cause: s.cause.clone(),
                 figure: claim.figure.clone(),
             })
         })

@@ -21,7 +21,7 @@
 //! paper = "converges for λd = 1e-10 … 1e1"
 //! check = { kind = "converges", run = "ld" }
 //! expect = "reproduced"
-//! cause = "…"                                 # shown with any other verdict
+//! cause = "…"                                 # shown when the check fails (`{first_failing}` …: audit::cause)
 //!
 //! [[figures]]
 //! file = "fig10.svg"
@@ -355,7 +355,8 @@ pub struct FallbackVerdicts {
 /// The reservations of a claim's verdict, each reported with it.
 #[derive(Clone, Debug)]
 pub struct Caveats {
-    /// why our number differs (reported with any verdict but reproduced)
+    /// why the check fails, reported only when it does; its placeholders (`{first_failing}`,
+    /// `super::cause`) are filled in from the measured points
     pub cause: Option<String>,
     /// what of the paper is not available here (its data, its code): the check runs on the
     /// `substitute` and the verdict is "not computable here" when it holds there
@@ -492,6 +493,10 @@ fn read_claim(path: &Path, c: RawClaim, earlier: &[Claim], runs: &[RunSpec]) -> 
     }
     if !matches!(c.expect, Verdict::Reproduced | Verdict::NotComputable) && c.cause.is_none() {
         return Err(invalid(path, format!("claim `{}`", c.id), "a verdict other than reproduced needs a cause".into()));
+    }
+    if let Some(word) = c.cause.as_deref().and_then(super::cause::unknown_placeholder) {
+        let known = super::cause::PLACEHOLDERS.join(", ");
+        return Err(invalid(path, format!("claim `{}`", c.id), format!("the cause's `{word}` is none of {known}")));
     }
     if c.expect == Verdict::NotComputable && (c.not_computable.is_none() || c.substitute.is_none()) {
         return Err(invalid(
