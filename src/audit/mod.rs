@@ -273,18 +273,7 @@ const BULKY: [&str; 5] = ["fields.npz", "kymograph.svg", "omega.svg", "truth.svg
 pub const FULL_AUDIT_BUDGET_BYTES: u64 = 200_000_000;
 
 /// Bytes of the files under `dir` (the audit folder's size, printed in REPORT.md).
-pub fn folder_bytes(dir: &Path) -> u64 {
-    std::fs::read_dir(dir)
-        .into_iter()
-        .flatten()
-        .flatten()
-        .map(|e| match e.file_type() {
-            Ok(t) if t.is_dir() => folder_bytes(&e.path()),
-            Ok(_) => e.metadata().map(|m| m.len()).unwrap_or(0),
-            Err(_) => 0,
-        })
-        .sum()
-}
+pub use crate::io::files::folder_bytes;
 
 /// The spec files of a folder (`*.toml`, sorted).
 pub fn spec_files(dir: &Path) -> Result<Vec<PathBuf>, AuditError> {

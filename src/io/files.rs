@@ -314,6 +314,21 @@ pub fn read_capped_text(path: &Path, cap: u64, what: &'static str) -> Result<Str
 
 static TMP_COUNTER: AtomicU64 = AtomicU64::new(0);
 
+/// Bytes of the files under `dir` [bytes], its sub-folders included; what cannot be read counts 0
+/// (an output folder's size: the audit's REPORT.md, the copy `--resume` needs).
+pub fn folder_bytes(dir: &Path) -> u64 {
+    std::fs::read_dir(dir)
+        .into_iter()
+        .flatten()
+        .flatten()
+        .map(|e| match e.file_type() {
+            Ok(t) if t.is_dir() => folder_bytes(&e.path()),
+            Ok(_) => e.metadata().map(|m| m.len()).unwrap_or(0),
+            Err(_) => 0,
+        })
+        .sum()
+}
+
 /// Is `name` the temporary file of an atomic write ([`write_atomic`])? A run killed while it
 /// wrote one leaves it behind.
 pub fn is_temporary(name: &str) -> bool {

@@ -304,7 +304,10 @@ fn adopt(
                 let _ = std::fs::rename(staging, &from);
             }
             let need = if copied {
-                format!("; the copy that --resume works in needs {}", crate::io::disk::bytes_text(folder_bytes(target)))
+                format!(
+                    "; the copy that --resume works in needs {}",
+                    crate::io::disk::bytes_text(crate::io::files::folder_bytes(target))
+                )
             } else {
                 String::new()
             };
@@ -319,19 +322,6 @@ fn adopt(
         }
         Err(e) => Err(e),
     }
-}
-
-/// The bytes of the files under `dir`.
-fn folder_bytes(dir: &Path) -> u64 {
-    std::fs::read_dir(dir)
-        .into_iter()
-        .flatten()
-        .flatten()
-        .map(|e| match e.file_type() {
-            Ok(t) if t.is_dir() => folder_bytes(&e.path()),
-            _ => e.metadata().map(|m| m.len()).unwrap_or(0),
-        })
-        .sum()
 }
 
 /// The names in a folder.

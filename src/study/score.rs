@@ -62,9 +62,19 @@ pub fn spline_bending(frame: &[Vector3<f64>], length_m: f64) -> Vec<f64> {
 /// (columns `frame, s_mid_m, kappa1_per_m, kappa2_per_m, kappa3_per_m`); frames that were not
 /// written (the run stopped) are absent.
 pub fn read_curvature(path: &Path) -> Result<Vec<Vec<f64>>, ScoreError> {
+    read_frames(path, |num| Ok(num(2)?.hypot(num(3)?)))
+}
+
+/// One value per row of the CSV file `path` whose first column is the frame, gathered per frame
+/// in row order: `value` reads a row through its number of column `i`. Frames without rows are
+/// empty.
+fn read_frames<T>(
+    path: &Path,
+    value: impl Fn(&dyn Fn(usize) -> Result<f64, ScoreError>) -> Result<T, ScoreError>,
+) -> Result<Vec<Vec<T>>, ScoreError> {
     let bad = |reason: String| ScoreError::Curvature { path: path.display().to_string(), reason };
     let mut reader = csv::Reader::from_path(path).map_err(|e| bad(e.to_string()))?;
-    let mut frames: Vec<Vec<f64>> = Vec::new();
+    let mut frames: Vec<Vec<T>> = Vec::new();
     for record in reader.records() {
         let r = record.map_err(|e| bad(e.to_string()))?;
         let num = |i: usize| -> Result<f64, ScoreError> {
@@ -74,7 +84,7 @@ pub fn read_curvature(path: &Path) -> Result<Vec<Vec<f64>>, ScoreError> {
         while frames.len() <= frame {
             frames.push(Vec::new());
         }
-        frames[frame].push(num(2)?.hypot(num(3)?));
+        frames[frame].push(value(&num)?);
     }
     Ok(frames)
 }
@@ -118,21 +128,7 @@ pub fn centreline_bending(x: &[Vector3<f64>]) -> Vec<f64> {
 /// The reconstructed node positions per frame [m] from a run's `fields.csv` (columns `frame`,
 /// `node`, `s_m`, `x_m`, `y_m`, `z_m`, …); frames that were not written are absent.
 pub fn read_positions(path: &Path) -> Result<Vec<Vec<Vector3<f64>>>, ScoreError> {
-    let bad = |reason: String| ScoreError::Curvature { path: path.display().to_string(), reason };
-    let mut reader = csv::Reader::from_path(path).map_err(|e| bad(e.to_string()))?;
-    let mut frames: Vec<Vec<Vector3<f64>>> = Vec::new();
-    for record in reader.records() {
-        let r = record.map_err(|e| bad(e.to_string()))?;
-        let num = |i: usize| -> Result<f64, ScoreError> {
-            r.get(i).and_then(|v| v.parse::<f64>().ok()).ok_or_else(|| bad(format!("column {i} of {r:?}")))
-        };
-        let frame = num(0)? as usize;
-        while frames.len() <= frame {
-            frames.push(Vec::new());
-        }
-        frames[frame].push(Vector3::new(num(3)?, num(4)?, num(5)?));
-    }
-    Ok(frames)
+    read_frames(path, |num| Ok(Vector3::new(num(3)?, num(4)?, num(5)?)))
 }
 
 /// The truth's bending curvature at the nodes [1/m].
