@@ -74,6 +74,7 @@ pub fn write_run(case: &Case, r: &RunResult, metrics: &Metrics, dir: &Path) -> R
             )
             .into_bytes(),
         )?;
+        put("balance.csv", balance_csv(&r.tip).into_bytes())?;
     }
     if let Some(inv) = &r.inverse {
         write_inverse(r, inv, &mut put)?;
@@ -390,3 +391,33 @@ pub fn write_convergence_plot(runs: &[(&String, &RunResult)], path: &Path) -> Re
     }
     write_plot(path, render_panels_svg(&panels, 2))
 }
+
+/// `balance.csv` of a dynamic run: the rod's energy and momenta per time step
+/// (`model::balance`; momenta in space coordinates, angular momentum about the origin) and
+/// whether the step is loaded (a load acts or an end moves: 1) or free (0).
+fn balance_csv(tip: &[crate::solve::dynamics::TipRecord]) -> String {
+    let rows = tip.iter().map(|t| {
+        let (b, p, h) = (&t.balance, t.balance.momentum_n_s, t.balance.angular_momentum_n_m_s);
+        let loaded = if t.loaded { 1.0 } else { 0.0 };
+        [t.time_s, b.kinetic_j, b.elastic_j, b.energy_j(), p[0], p[1], p[2], h[0], h[1], h[2], loaded]
+            .into_iter()
+            .map(Some)
+            .collect()
+    });
+    csv_text_int(&BALANCE_COLUMNS, &["loaded"], rows)
+}
+
+/// The columns of `balance.csv`.
+const BALANCE_COLUMNS: [&str; 11] = [
+    "time_s",
+    "kinetic_energy_j",
+    "elastic_energy_j",
+    "energy_j",
+    "momentum_x_n_s",
+    "momentum_y_n_s",
+    "momentum_z_n_s",
+    "angular_momentum_x_n_m_s",
+    "angular_momentum_y_n_m_s",
+    "angular_momentum_z_n_m_s",
+    "loaded",
+];

@@ -17,6 +17,7 @@ use super::statics::frozen_system;
 use super::{divergence, Problem, SolveError, Step, CHORD_CONTRACTION};
 use crate::assemble::Tangent;
 use crate::linalg::{LinearSolver, Pattern};
+use crate::model::balance::Balance;
 use crate::model::ends::MotionAt;
 use crate::model::loads::LoadFrame;
 use crate::model::mesh::Field;
@@ -42,6 +43,12 @@ pub struct TipRecord {
     /// the residual certificate of the step's equations (68) at the state ([`step_certificate`];
     /// 0 at t = 0, the initial state is given)
     pub certificate: f64,
+    /// the rod's energy and momenta at the state `(u_n, u̇_n)` (momenta in space coordinates)
+    pub balance: Balance,
+    /// loads act in the step (its `F(t_n)` or `F(t_{n−1})` is not zero) or an end moves: the
+    /// step may change the energy (and, with a held end, the momenta); false at t = 0 when
+    /// `F(0)` is zero
+    pub loaded: bool,
 }
 
 /// Result of a time integration.
@@ -66,16 +73,16 @@ pub fn solve(
     let pattern = dofs.pattern();
     let dt = params.end_time_s / params.steps as f64;
     let last = problem.mesh.nodes() - 1;
-    let u0 = problem.reference_state();
-    let v0 = DVector::zeros(u0.len());
+    let (u0, v0) = (problem.reference_state(), DVector::zeros(dofs.len()));
     let mut prev = StepState { p: problem.momentum(&u0, &v0, None), f: problem.loads_at(&u0, 0.0, None), u: u0, v: v0 };
-    let record = |t: f64, u: &DVector<f64>, it: usize, certificate: f64| {
-        let (x, a) = (dofs.get(u, last, Field::X), dofs.get(u, last, Field::Alpha));
-        TipRecord { time_s: t, position_m: x, angles_rad: a, newton_iterations: it, certificate }
+    let moving = problem.ends().moving();
+    let record = |t: f64, s: &StepState, (it, certificate): (usize, f64), loaded: bool| {
+        let (x, a) = (dofs.get(&s.u, last, Field::X), dofs.get(&s.u, last, Field::Alpha));
+        let balance = problem.balance(&s.u, &s.v);
+        TipRecord { time_s: t, position_m: x, angles_rad: a, newton_iterations: it, certificate, balance, loaded }
     };
-    let mut tip = vec![record(0.0, &prev.u, 0, 0.0)];
-    let mut cert_values = vec![0.0; pattern.nnz()];
-    let mut max_certificate: f64 = 0.0;
+    let mut tip = vec![record(0.0, &prev, (0, 0.0), moving || loaded(&prev.f))];
+    let (mut cert_values, mut max_certificate) = (vec![0.0; pattern.nnz()], 0.0_f64);
     let (mut total, mut max_it) = (0, 0);
     // Global-frame (or no distributed) loads do not depend on the state: F(t_n) once per step
     // instead of once per Newton iteration and again after it (the same numbers).
@@ -124,8 +131,9 @@ pub fn solve(
             });
         }
         max_certificate = max_certificate.max(certificate.value);
-        tip.push(record(t, &u, it, certificate.value));
+        let step_loaded = moving || loaded(&f_n) || loaded(&prev.f);
         prev = StepState { u, v, p: p_n, f: f_n };
+        tip.push(record(t, &prev, (it, certificate.value), step_loaded));
         progress(n, params.steps);
     }
     Ok(DynamicSolution {
@@ -135,6 +143,11 @@ pub fn solve(
         max_newton_iterations: max_it,
         max_certificate,
     })
+}
+
+/// Does the load vector `F` hold a load (an entry that is not zero)?
+fn loaded(f: &DVector<f64>) -> bool {
+    f.iter().any(|v| *v != 0.0)
 }
 
 /// The state of a time step: `u_n`, `u̇_n`, the momentum `P(u_n, u̇_n)` and the loads `F(t_n)`.

@@ -4,6 +4,7 @@
 use nalgebra::DVector;
 
 use crate::assemble::{assemble_new, Tangent};
+use crate::model::balance::{element_balance, Balance};
 use crate::model::chart::Chart;
 use crate::model::element::{
     distributed_load, follower_load, internal_force, momentum, point_shape, ElementRest, LocalMat,
@@ -363,6 +364,24 @@ impl<'a> Problem<'a> {
                 None => momentum(&self.props, self.scheme, h, &ue, &ve, None, None),
             }
         })
+    }
+
+    /// The energy and the momenta of the state `u` with rates `udot` (both in the problem's
+    /// chart), the momenta in space coordinates (D21; [`crate::model::balance`]).
+    pub fn balance(&self, u: &DVector<f64>, udot: &DVector<f64>) -> Balance {
+        let h = self.mesh.h();
+        let dofs = self.dofs();
+        let mut sum = Balance::default();
+        for e in 0..self.mesh.elements {
+            let (ue, ve) = (dofs.gather(u, e), dofs.gather(udot, e));
+            sum += element_balance(&self.props, self.scheme, h, (&ue, &ve), self.rest(e));
+        }
+        let chart = self.chart();
+        if chart.is_identity() {
+            sum
+        } else {
+            sum.rotated(&chart.base.transpose())
+        }
     }
 
     /// Infinity norm over the unknowns that are not held.

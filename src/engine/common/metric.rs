@@ -45,6 +45,27 @@ metric_keys! {
     CentroidX => "centroid_x_m",
     CentroidY => "centroid_y_m",
     CentroidZ => "centroid_z_m",
+    // a dynamic run's energy and momenta (`metrics::balance_metrics`): at the end time, and their
+    // largest change over the trailing steps in which no load acts and no end moves
+    /// [J]
+    KineticEnergy => "kinetic_energy_j",
+    /// [J]
+    ElasticEnergy => "elastic_energy_j",
+    MomentumX => "momentum_x_n_s",
+    MomentumY => "momentum_y_n_s",
+    MomentumZ => "momentum_z_n_s",
+    /// about the origin
+    AngularMomentumX => "angular_momentum_x_n_m_s",
+    AngularMomentumY => "angular_momentum_y_n_m_s",
+    AngularMomentumZ => "angular_momentum_z_n_m_s",
+    /// the start of the trailing unloaded steps [s]
+    UnloadedFrom => "unloaded_from_s",
+    /// `max |E(t) − E(t₀)| / E(t₀)` over them, `E = T + V`
+    UnloadedEnergyChangeRel => "unloaded_energy_change_rel",
+    /// `max |p(t) − p(t₀)|` over them [N s] (conserved where no end is held)
+    UnloadedMomentumChange => "unloaded_momentum_change_n_s",
+    /// `max |h(t) − h(t₀)|` over them [N m s] (conserved where no end is held)
+    UnloadedAngularMomentumChange => "unloaded_angular_momentum_change_n_m_s",
     // a static state's stability and an arc-length path (D25, D27)
     /// `min Re ω²` of the tangent against the mass [1/s²]
     TangentSmallestEigenvalue => "tangent_smallest_eigenvalue_per_s2",
@@ -121,6 +142,11 @@ impl Metric {
     pub const TIP_ANGLES: [Metric; 3] = [Metric::TipAlpha, Metric::TipBeta, Metric::TipGamma];
     /// The centreline's mean position x, y, z [m].
     pub const CENTROID: [Metric; 3] = [Metric::CentroidX, Metric::CentroidY, Metric::CentroidZ];
+    /// The linear momentum [N s] at the end time.
+    pub const MOMENTUM: [Metric; 3] = [Metric::MomentumX, Metric::MomentumY, Metric::MomentumZ];
+    /// The angular momentum about the origin [N m s] at the end time.
+    pub const ANGULAR_MOMENTUM: [Metric; 3] =
+        [Metric::AngularMomentumX, Metric::AngularMomentumY, Metric::AngularMomentumZ];
     /// The objective's terms, in the order of `ObjectiveTerms::NAMES`.
     pub const OBJECTIVE: [Metric; 7] = [
         Metric::JTracking,

@@ -7,6 +7,7 @@ use super::result::{NodalState, PathOutput, RunResult};
 use crate::case::{Case, Reference};
 use crate::model::mesh::Mesh;
 use crate::reference::{timoshenko_tip_deflection, tip_loaded_cantilever, PlanarRod, ReferenceError};
+use crate::solve::dynamics::TipRecord;
 
 pub use super::metric::{Metric, Metrics};
 
@@ -29,6 +30,9 @@ pub fn physical_metrics(r: &RunResult) -> Metrics {
         m.insert(Metric::TipMaxAbsBeta, max_abs_a(1));
         m.insert(Metric::TipMaxAbsGamma, max_abs_a(2));
     }
+    if r.tip.len() > 1 {
+        balance_metrics(&r.tip, &mut m);
+    }
     if let Some(p) = &r.path {
         path_metrics(p, &mut m);
     }
@@ -39,6 +43,35 @@ pub fn physical_metrics(r: &RunResult) -> Metrics {
         m.insert(key, *c);
     }
     m
+}
+
+/// A dynamic run's energy and momenta at its end time, and their largest change over its
+/// trailing unloaded steps (no load, no moving end: the energy is conserved by the continuous
+/// problem, and the momenta too where no end is held; `model::balance`).
+fn balance_metrics(tip: &[TipRecord], m: &mut Metrics) {
+    let end = &tip[tip.len() - 1].balance;
+    m.insert(Metric::KineticEnergy, end.kinetic_j);
+    m.insert(Metric::ElasticEnergy, end.elastic_j);
+    for k in 0..3 {
+        m.insert(Metric::MOMENTUM[k], end.momentum_n_s[k]);
+        m.insert(Metric::ANGULAR_MOMENTUM[k], end.angular_momentum_n_m_s[k]);
+    }
+    // the trailing records whose steps are unloaded, and the state before the first of them
+    let loaded = tip.iter().rposition(|t| t.loaded).map_or(0, |i| i + 1);
+    let first = loaded.saturating_sub(1).min(tip.len() - 1);
+    if tip.len() - first < 2 {
+        return;
+    }
+    let (start, window) = (&tip[first], &tip[first..]);
+    let e0 = start.balance.energy_j();
+    let change = |f: &dyn Fn(&TipRecord) -> f64| window.iter().map(f).fold(0.0_f64, f64::max);
+    m.insert(Metric::UnloadedFrom, start.time_s);
+    if e0 > 0.0 {
+        m.insert(Metric::UnloadedEnergyChangeRel, change(&|t| (t.balance.energy_j() - e0).abs() / e0));
+    }
+    let (p0, h0) = (start.balance.momentum_n_s, start.balance.angular_momentum_n_m_s);
+    m.insert(Metric::UnloadedMomentumChange, change(&|t| (t.balance.momentum_n_s - p0).norm()));
+    m.insert(Metric::UnloadedAngularMomentumChange, change(&|t| (t.balance.angular_momentum_n_m_s - h0).norm()));
 }
 
 /// The centreline's mean position `∫ x ds / L` [m] of the P1 interpolant (exact: the

@@ -162,7 +162,16 @@ pub fn metric_keys(case: &Case) -> Vec<String> {
         Analysis::Static(crate::solve::statics::StaticParams { path: Some(_), .. }) => {
             keys.extend([M::FinalLoadFactor, M::PathPoints, M::LimitLoadFactor, M::BifurcationLoadFactor])
         }
-        Analysis::Dynamic(_) => keys.extend([M::TipMaxAbsX, M::TipMaxAbsY, M::TipMaxAbsBeta, M::TipMaxAbsGamma]),
+        Analysis::Dynamic(_) => {
+            keys.extend([M::TipMaxAbsX, M::TipMaxAbsY, M::TipMaxAbsBeta, M::TipMaxAbsGamma]);
+            // the balance at the end time, and its change over the trailing unloaded steps (a
+            // run whose last step is loaded has none: such a row is then not computed)
+            keys.extend([M::KineticEnergy, M::ElasticEnergy]);
+            keys.extend(Metric::MOMENTUM);
+            keys.extend(Metric::ANGULAR_MOMENTUM);
+            keys.extend([M::UnloadedFrom, M::UnloadedEnergyChangeRel, M::UnloadedMomentumChange]);
+            keys.push(M::UnloadedAngularMomentumChange);
+        }
         Analysis::Inverse(_) => {
             keys.extend([M::XErrRel, M::TangentMisfit, M::KappaErrRel, M::KappaErrRelInner]);
             keys.extend(Metric::OBJECTIVE);

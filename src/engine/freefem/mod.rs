@@ -27,6 +27,7 @@ use crate::case::{Analysis, Case};
 use crate::engine::common::angles_known;
 use crate::engine::common::result::{Engine, InverseOutput, NodalState, RunResult, SolverStats};
 use crate::io::files::{csv_reader, InputError};
+use crate::model::balance::Balance;
 use crate::model::chart::Chart;
 use crate::solve::certificate::Certificate;
 use crate::solve::dynamics::TipRecord;
@@ -216,6 +217,28 @@ fn read_inverse_nodes(case: &Case, workdir: &Path) -> Result<InverseNodes, FreeF
     };
     Ok(InverseNodes { state, xhat: v3(7), ahat: v3(10) })
 }
+
+/// The columns of `ff_tip.csv` (a dynamic run: the tip and the balance per time step, forward.edp).
+const TIP_COLUMNS: [&str; 18] = [
+    "time_s",
+    "x_m",
+    "y_m",
+    "z_m",
+    "alpha_rad",
+    "beta_rad",
+    "gamma_rad",
+    "newton_iterations",
+    "certificate",
+    "kinetic_j",
+    "elastic_j",
+    "px",
+    "py",
+    "pz",
+    "hx",
+    "hy",
+    "hz",
+    "loaded",
+];
 
 /// Read the iteration history `ff_inverse_history.csv` of `workdir`.
 fn read_inverse_history(workdir: &Path) -> Result<Vec<InverseRecord>, FreeFemError> {
@@ -445,16 +468,20 @@ fn read_outputs(case: &Case, dir: &Path) -> Result<(RunResult, Option<Certificat
     let mut history = Vec::new();
     let mut tip = Vec::new();
     if case.is_dynamic() {
-        for r in read_table(
-            &dir.join("ff_tip.csv"),
-            &["time_s", "x_m", "y_m", "z_m", "alpha_rad", "beta_rad", "gamma_rad", "newton_iterations", "certificate"],
-        )? {
+        for r in read_table(&dir.join("ff_tip.csv"), &TIP_COLUMNS)? {
             tip.push(TipRecord {
                 time_s: r[0],
                 position_m: Vector3::new(r[1], r[2], r[3]),
                 angles_rad: Vector3::new(r[4], r[5], r[6]),
                 newton_iterations: r[7] as usize,
                 certificate: r[8],
+                balance: Balance {
+                    kinetic_j: r[9],
+                    elastic_j: r[10],
+                    momentum_n_s: Vector3::new(r[11], r[12], r[13]),
+                    angular_momentum_n_m_s: Vector3::new(r[14], r[15], r[16]),
+                },
+                loaded: r[17] != 0.0,
             });
         }
     } else {
