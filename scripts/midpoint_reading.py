@@ -3,8 +3,8 @@
 the regularisations of eq. 41 and Remark 10) on P1 elements, each term on a rule of its own.
 
 Written from the paper (Wang et al., Comput. Mech. 71, 2023) and the errata of PAPER-NOTES
-(the sign of the lambda_d term, the d_s of the Lambda_kappa test, A^T Lambda_kappa A), not
-from the Rust or FreeFEM code. numpy only, a block-tridiagonal LU after Ruiz equilibration. It reads a
+(the sign of the lambda_d term, the d_s of the Lambda_kappa test, A^T Lambda_kappa A), with
+its own assembly, solver and measures. numpy only, a block-tridiagonal LU after Ruiz equilibration. It reads a
 `data.csv` written by `cosserat run` (columns s_m, x_m, y_m, z_m, alpha_rad, beta_rad,
 gamma_rad) and reports the iterations to a relative change, the position error and the
 curvature error, the measures of docs/inverse.md.
