@@ -69,6 +69,7 @@ fn quick_audit_verdicts_are_the_recorded_ones() {
     check_causes_have_no_measured_numbers(&report, &spec_inputs(&dir));
     check_causes_only_for_failed_checks(&report, &md);
     check_digits_and_whole_messages(&report);
+    check_figures(&opts.out);
     let results = std::fs::read_to_string(root.join("docs/results.md")).expect("docs/results.md");
     check_docs_counts(&report, &results);
 
@@ -364,6 +365,47 @@ fn check_digits_and_whole_messages(report: &cosserat::audit::AuditReport) {
     assert!(ours("eq64-2").contains("(148 iterations)"), "{}", ours("eq64-2"));
     for c in &report.claims {
         assert!(!c.ours.contains('…'), "{}: a message cut short: {}", c.claim.id, c.ours);
+    }
+}
+
+/// What the figures say agrees with the runs they draw:
+/// - Fig. 9: the λl runs that meet the paper's stopping rule (eq64-2: 148 iterations) are not
+///   labelled "not converged"; λl = 1e3 stops at the iteration limit (3000) and is; the rule's
+///   threshold (the spec's `solver.tolerance`, 3e-6) is drawn;
+/// - Fig. 16: one colour scale for every frame (one colour bar);
+/// - Fig. 19: the caption's pair, Table 1 against λf = 1e-20, λl = 1e-10, and nothing else;
+/// - Fig. 20: every axis of the objective's terms has a unit;
+/// - every figure title has a strip of its own (not in a panel's title).
+fn check_figures(out: &Path) {
+    let svg = |f: &str| std::fs::read_to_string(out.join(f)).unwrap_or_else(|e| panic!("{f}: {e}"));
+    let texts = |s: &str| -> Vec<String> {
+        let text = |t: &str| Some(t.split_once('>')?.1.split("</text>").next()?.trim().replace("&apos;", "'"));
+        s.split("<text").skip(1).filter_map(text).collect()
+    };
+    let fig9 = texts(&svg("sec52_eq64/fig09_lambda_l.svg"));
+    for converged in ["λl = 1e-20", "λl = 1e-6"] {
+        assert!(fig9.iter().any(|t| t == converged), "{converged} is labelled otherwise: {fig9:?}");
+    }
+    assert!(fig9.iter().any(|t| t.starts_with("λl = 1e3 (not converged")), "{fig9:?}");
+    assert!(fig9.iter().any(|t| t == "stopping rule: 3e-6"), "{fig9:?}");
+    let fig16 = svg("sec6_worm/fig16_postures.svg");
+    assert_eq!(fig16.matches("|κ| [1/mm]").count(), 1, "one colour bar in fig16");
+    let fig19 = texts(&svg("sec6_worm/fig19_objectives.svg"));
+    let legend: std::collections::BTreeSet<&String> = fig19.iter().filter(|t| t.starts_with("λf = ")).collect();
+    let pair = ["λf = 1e-20, λl = 1e-10", "λf = 1e-3, λl = 1e-6"];
+    assert_eq!(legend.into_iter().map(|s| s.as_str()).collect::<Vec<_>>(), pair, "fig19's curves");
+    let fig20 = texts(&svg("sec6_worm/fig20_objectives.svg"));
+    for axis in ["λf/2 ∫|f|² ds [–]", "λd/2 ∫|∂s x − d3|² ds [–]", "J [–]"] {
+        assert!(fig20.iter().any(|t| t == axis), "fig20 has no axis {axis}: {fig20:?}");
+    }
+    for (f, title) in [
+        (
+            "fig05_cantilever/fig05_tip_history.svg",
+            "Fig. 5: the cantilever's tip, Cosserat rod against the modal solution",
+        ),
+        ("sec6_worm/fig17_kymograph.svg", "Fig. 17: κ1, κ2, κ3 over time and body, Table 1"),
+    ] {
+        assert!(texts(&svg(f)).iter().any(|t| t == title), "{f}: the title is not a text of its own");
     }
 }
 

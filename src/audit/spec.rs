@@ -263,8 +263,13 @@ pub enum PlotKind {
         #[serde(default)]
         at: Selector,
     },
-    /// the objective's terms per frame, one curve per point of each run (Figs. 18–20)
-    Objectives { runs: Vec<String> },
+    /// the objective's terms per frame, one curve per point of each run (Figs. 18–20); `at`
+    /// keeps, of a run it names, the points of its selector (`at = { ll = { lambda_l = 1e-10 } }`)
+    Objectives {
+        runs: Vec<String>,
+        #[serde(default)]
+        at: BTreeMap<String, Selector>,
+    },
     /// the angular velocity ω per frame, max over the body, one curve per point of each run
     /// (Fig. 24)
     Omega { runs: Vec<String> },
@@ -292,9 +297,8 @@ impl PlotKind {
             | PlotKind::Kymograph { run, .. }
             | PlotKind::Tradeoff { run, .. }
             | PlotKind::Postures { run, .. } => vec![run],
-            PlotKind::Deflection { runs } | PlotKind::Objectives { runs } | PlotKind::Omega { runs } => {
-                runs.iter().map(|s| s.as_str()).collect()
-            }
+            PlotKind::Deflection { runs } | PlotKind::Omega { runs } => runs.iter().map(|s| s.as_str()).collect(),
+            PlotKind::Objectives { runs, at } => runs.iter().chain(at.keys()).map(|s| s.as_str()).collect(),
         }
     }
 }

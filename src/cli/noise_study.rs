@@ -7,7 +7,8 @@ use std::process::ExitCode;
 
 use anyhow::{Context, Result};
 
-use cosserat::figures::plot::{render_panels_svg, LinePlot, Series};
+use cosserat::figures::panels::render_panels_svg;
+use cosserat::figures::plot::{LinePlot, Series};
 use cosserat::io::write_atomic;
 use cosserat::study::{centreline_name, recovered_name, run_study, StudyRow, StudySpec, SPLINE};
 

@@ -7,6 +7,7 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 use std::ops::Range;
 
+use super::panels::FIGURE_TITLE_STRIP;
 use super::plot::{
     axis_tick, draw_err, fit_font, font, nice_ticks, render, text_style, title_strip, PlotError, CHAR_WIDTH, DESC_PX,
     LEGEND_PX, TICK_PX, TITLE_PX, TITLE_STRIP,
@@ -335,11 +336,27 @@ pub fn render_heatmaps_svg(maps: &[Heatmap]) -> Result<String, PlotError> {
 /// [`render_heatmaps_svg`] with the columns of `marks` marked on every map (maps of one time
 /// axis), and its legend under each title.
 pub fn render_marked_heatmaps_svg(maps: &[Heatmap], marks: &ColumnMarks) -> Result<String, PlotError> {
+    render_maps(None, maps, marks)
+}
+
+/// [`render_heatmaps_svg`] under `title`, in a strip of its own above the maps (as
+/// [`super::panels::render_figure_svg`]); each map keeps its own title.
+pub fn render_figure_heatmaps_svg(title: &str, maps: &[Heatmap]) -> Result<String, PlotError> {
+    render_maps(Some(title), maps, &ColumnMarks::default())
+}
+
+/// The maps from top to bottom, under the figure title `title` if given.
+fn render_maps(title: Option<&str>, maps: &[Heatmap], marks: &ColumnMarks) -> Result<String, PlotError> {
     validate_maps(maps)?;
-    let size = (HEATMAP_SIZE.0, HEATMAP_SIZE.1 * maps.len() as u32);
-    let title = maps[0].title.clone();
-    render(size, &title, |root| {
-        for (m, area) in maps.iter().zip(root.split_evenly((maps.len(), 1))) {
+    let strip = if title.is_some() { FIGURE_TITLE_STRIP } else { 0 };
+    let size = (HEATMAP_SIZE.0, HEATMAP_SIZE.1 * maps.len() as u32 + strip);
+    let name = title.map_or_else(|| maps[0].title.clone(), str::to_string);
+    render(size, &name, |root| {
+        let body = match title {
+            Some(t) => title_strip(root, t, FIGURE_TITLE_STRIP, TITLE_PX + 3)?,
+            None => root.clone(),
+        };
+        for (m, area) in maps.iter().zip(body.split_evenly((maps.len(), 1))) {
             draw_heatmap(&area, m, marks)?;
         }
         Ok(())
@@ -362,6 +379,23 @@ mod tests {
             assert!(svg.contains(text), "missing {text}");
         }
         assert!(smallest_text(&svg) >= 12.0);
+    }
+
+    /// Under a figure title, each map keeps its own title and no text runs into another.
+    #[test]
+    fn a_figure_title_has_a_strip_of_its_own() {
+        let x: Vec<f64> = (0..40).map(|i| i as f64 * 1.2).collect();
+        let y: Vec<f64> = (0..20).map(|j| j as f64 * 0.05).collect();
+        let map = |c: usize| {
+            let v = vec![vec![0.5; y.len()]; x.len()];
+            Heatmap::kymograph(format!("κ{c}"), x.clone(), y.clone(), v, 1.0, format!("κ{c} [1/mm]"))
+        };
+        let title = "Fig. 25: κ with Λκ = diag(0, 0, 1e-20), Λω = diag(0, 0, 1e-10), the caption's set";
+        let svg = render_figure_heatmaps_svg(title, &[map(1), map(2), map(3)]).unwrap();
+        assert!(svg.contains(&format!("height=\"{}\"", 3 * HEATMAP_SIZE.1 + FIGURE_TITLE_STRIP)));
+        let texts = crate::figures::svg_text::texts(&svg);
+        assert!(texts.iter().any(|t| t.text == title) && texts.iter().any(|t| t.text == "κ1"));
+        assert_eq!(crate::figures::svg_text::overlaps(&svg), Vec::<(String, String)>::new());
     }
 
     /// Marked columns are hatched or barred on every map, with a legend under each title;

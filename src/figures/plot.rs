@@ -133,6 +133,9 @@ pub struct LinePlot {
     pub legend: Legend,
     /// Shaded x intervals.
     pub bands: Vec<Band>,
+    /// The y values drawn, if not all: points outside `(lo, hi)` are left out like
+    /// non-finite ones (a line breaks there), and the axis spans the points kept.
+    pub y_window: Option<(f64, f64)>,
 }
 
 /// The legend of a plot: in a strip right of the data, or none.
@@ -160,7 +163,7 @@ pub enum PlotError {
     /// Every point is non-finite (or non-positive on a log axis).
     #[error("plot '{title}' has no plottable point (log_x = {log_x}, log_y = {log_y}; non-finite and, on log axes, non-positive values are dropped)")]
     NoPlottablePoints { title: String, log_x: bool, log_y: bool },
-    /// [`render_panels_svg`] called with no panels or zero columns.
+    /// A grid of panels (`super::panels`) with no panels or zero columns.
     #[error("invalid panel grid: {panels} panel(s) in {cols} column(s)")]
     InvalidGrid { panels: usize, cols: usize },
     /// Drawing failed inside plotters.
@@ -176,8 +179,14 @@ fn keep(v: f64, log: bool) -> bool {
     v.is_finite() && (!log || v > 0.0)
 }
 
+/// Whether the point (x, y) of `plot` is drawn: finite, positive on a log axis, y inside the
+/// plot's window.
+fn kept(plot: &LinePlot, x: f64, y: f64) -> bool {
+    keep(x, plot.log_x) && keep(y, plot.log_y) && plot.y_window.is_none_or(|(lo, hi)| lo <= y && y <= hi)
+}
+
 /// Validates `plot` and returns the padded (x, y) ranges.
-fn ranges(plot: &LinePlot) -> Result<(Range<f64>, Range<f64>), PlotError> {
+pub(crate) fn ranges(plot: &LinePlot) -> Result<(Range<f64>, Range<f64>), PlotError> {
     if plot.series.is_empty() {
         return Err(PlotError::NoSeries { title: plot.title.clone() });
     }
@@ -195,7 +204,7 @@ fn ranges(plot: &LinePlot) -> Result<(Range<f64>, Range<f64>), PlotError> {
             return Err(PlotError::EmptySeries { title: plot.title.clone(), series: s.label.clone() });
         }
         for (&x, &y) in s.x.iter().zip(&s.y) {
-            if keep(x, plot.log_x) && keep(y, plot.log_y) {
+            if kept(plot, x, y) {
                 (x0, x1, y0, y1) = (x0.min(x), x1.max(x), y0.min(y), y1.max(y));
             }
         }
@@ -305,6 +314,7 @@ where
     let (chart_area, legend_area) = body.split_horizontally(w - lw);
     let mut chart = ChartBuilder::on(&chart_area)
         .margin(10)
+        .margin_right(right_margin(plot, ax, lw))
         .x_label_area_size(58)
         .y_label_area_size(96)
         .build_cartesian_2d(xs, ys)
@@ -356,6 +366,18 @@ where
     Ok(())
 }
 
+/// The margin right of the chart [px]: 10, or, without a legend strip (`legend_width` 0) to
+/// take it, room for half the widest tick label of the x axis's ends, which is centred on the
+/// chart's right edge and was cut off at the figure's edge.
+fn right_margin(plot: &LinePlot, ax: Axis, legend_width: u32) -> u32 {
+    if legend_width > 0 {
+        return 10;
+    }
+    let Ok((xr, _)) = ranges(plot) else { return 10 };
+    let chars = [xr.start, xr.end].iter().map(|v| ax.label(ax.to(*v)).chars().count()).max().unwrap_or(0);
+    10 + (chars as f64 * CHAR_WIDTH * TICK_PX as f64 / 2.0).ceil() as u32
+}
+
 /// The order the series of `plot` are drawn in: markers first, so that the lines of the
 /// solution lie on the data.
 fn drawing_order(plot: &LinePlot) -> Vec<usize> {
@@ -368,7 +390,7 @@ fn drawing_order(plot: &LinePlot) -> Vec<usize> {
 fn plottable_runs(plot: &LinePlot, s: &Series, (ax, ay): (Axis, Axis)) -> Vec<Vec<(f64, f64)>> {
     let mut runs: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
     for (&x, &y) in s.x.iter().zip(&s.y) {
-        if keep(x, plot.log_x) && keep(y, plot.log_y) {
+        if kept(plot, x, y) {
             if let Some(r) = runs.last_mut() {
                 r.push((ax.to(x), ay.to(y)));
             }
@@ -408,7 +430,7 @@ impl Axis {
     }
 }
 
-fn draw_plot<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, plot: &LinePlot) -> Result<(), PlotError> {
+pub(crate) fn draw_plot<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, plot: &LinePlot) -> Result<(), PlotError> {
     let (xr, yr) = ranges(plot)?;
     let ((ax, xr), (ay, yr)) = (Axis::new(xr, plot.log_x), Axis::new(yr, plot.log_y));
     match (plot.log_x, plot.log_y) {
@@ -440,37 +462,6 @@ pub(crate) fn render(
 pub fn render_svg(plot: &LinePlot) -> Result<String, PlotError> {
     ranges(plot)?; // validate before rendering
     render(PLOT_SIZE, &plot.title, |root| draw_plot(root, plot))
-}
-
-/// `panels` as a grid with `cols` columns (rows as needed) in one SVG; each panel is 900×600
-/// (text keeps its size in px). Errors if any panel is invalid, `panels` is empty or `cols`
-/// is 0.
-pub fn render_panels_svg(panels: &[LinePlot], cols: usize) -> Result<String, PlotError> {
-    if panels.is_empty() || cols == 0 {
-        return Err(PlotError::InvalidGrid { panels: panels.len(), cols });
-    }
-    for p in panels {
-        ranges(p)?;
-    }
-    let cols = cols.min(panels.len());
-    let rows = panels.len().div_ceil(cols);
-    let (pw, ph) = PLOT_SIZE;
-    let size = (pw * cols as u32, ph * rows as u32);
-    let title = panels.first().map_or("", |p| p.title.as_str());
-    render(size, title, |root| draw_panels(root, panels, cols))
-}
-
-/// `panels` in a grid of `cols` columns filling `area`.
-pub(crate) fn draw_panels<DB: DrawingBackend>(
-    area: &DrawingArea<DB, Shift>,
-    panels: &[LinePlot],
-    cols: usize,
-) -> Result<(), PlotError> {
-    let rows = panels.len().div_ceil(cols);
-    for (a, plot) in area.split_evenly((rows, cols)).iter().zip(panels) {
-        draw_plot(a, plot)?;
-    }
-    Ok(())
 }
 
 /// The smallest `font-size` of an SVG [px] (tests of the figures).
@@ -532,8 +523,21 @@ mod tests {
         assert!(matches!(render_svg(&plot(vec![])), Err(PlotError::NoSeries { .. })));
         let mismatch = plot(vec![Series::new("m", vec![1.0, 2.0], vec![1.0])]);
         assert!(matches!(render_svg(&mismatch), Err(PlotError::LengthMismatch { x_len: 2, y_len: 1, .. })));
-        assert!(matches!(render_panels_svg(&[], 2), Err(PlotError::InvalidGrid { .. })));
-        assert!(matches!(render_panels_svg(&[plot(vec![series("a", |x| x)])], 0), Err(PlotError::InvalidGrid { .. })));
+    }
+
+    /// A y window leaves out the points outside it (the line breaks there) and the axis spans
+    /// the points kept: a spike of 100 on a curve within ±1 leaves the axis at ±1.
+    #[test]
+    fn a_y_window_leaves_out_the_points_outside_it() {
+        let mut s = series("wave", |x| (x * 2.0).sin());
+        s.y[3] = 100.0;
+        let mut p = plot(vec![s]);
+        assert!(ranges(&p).unwrap().1.end > 100.0);
+        p.y_window = Some((-1.0, 1.0));
+        let (_, y) = ranges(&p).unwrap();
+        assert!(y.end <= 1.0 + 2.0 * RANGE_MARGIN && y.start >= -1.0 - 2.0 * RANGE_MARGIN, "{y:?}");
+        let runs = plottable_runs(&p, &p.series[0], (Axis::new(0.0..1.0, false).0, Axis::new(0.0..1.0, false).0));
+        assert_eq!(runs.iter().map(Vec::len).collect::<Vec<_>>(), [3, 46], "broken at the spike");
     }
 
     #[test]
@@ -543,27 +547,6 @@ mod tests {
         assert_eq!(format_tick(0.25), "0.25");
         assert_eq!(format_tick(0.0), "0");
         assert_eq!(format_tick(3.0), "3");
-    }
-
-    #[test]
-    fn panels_grid() {
-        let names = ["position", "kappa_1", "kappa_2", "kappa_3"];
-        let panels: Vec<LinePlot> = names
-            .iter()
-            .enumerate()
-            .map(|(i, n)| LinePlot {
-                title: n.to_string(),
-                x_label: "s [m]".into(),
-                y_label: format!("{n} [1/m]"),
-                series: vec![series(&format!("rust {n}"), move |x| (x * i as f64).cos()), series("freefem", |x| x)],
-                ..Default::default()
-            })
-            .collect();
-        let svg = render_panels_svg(&panels, 2).unwrap();
-        for n in names {
-            assert!(svg.contains(n) && svg.contains(&format!("rust {n}")), "{n}");
-        }
-        assert!(svg.contains("width=\"1800\"") && svg.contains("height=\"1200\""));
     }
 
     #[test]

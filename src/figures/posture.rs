@@ -8,7 +8,8 @@
 //! to make a detachment of the frame from the centreline visible, as in Fig. 21.
 
 use super::heatmap::{draw_colour_bar, COLOUR_BAR_STRIP};
-use super::plot::{draw_err, draw_panels, font, title_strip, LinePlot, PlotError, PLOT_SIZE};
+use super::panels::draw_panels;
+use super::plot::{draw_err, font, title_strip, LinePlot, PlotError, PLOT_SIZE};
 use nalgebra::Vector3;
 use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
@@ -129,68 +130,113 @@ fn validate(p: &PosturePanel) -> Result<(), PlotError> {
     Ok(())
 }
 
-/// Finite-difference unit tangent `∂s x / |∂s x|` per node (central inside, one-sided at the
-/// ends); `None` where neighbouring nodes coincide.
-pub(crate) fn tangents(x: &[Vector3<f64>]) -> Vec<Option<Vector3<f64>>> {
-    let n = x.len();
-    (0..n)
+/// The angle [deg] between d3 and the centreline of each element: the element's `∂s x` (its
+/// chord `x_{i+1} − x_i`, P1) against the mean of its two nodes' d3, the pair the λd term of
+/// eq. (41) compares at the element's midpoint. `None` for an element whose chord or mean d3
+/// has no direction.
+pub fn element_angles_deg(x: &[Vector3<f64>], d3: &[Vector3<f64>]) -> Vec<Option<f64>> {
+    (0..x.len().min(d3.len()).saturating_sub(1))
         .map(|i| {
-            let (a, b) = (i.saturating_sub(1), (i + 1).min(n - 1));
-            let d = x[b] - x[a];
-            let l = d.norm();
-            (l > 0.0 && l.is_finite()).then(|| d / l)
+            let (c, m) = (x[i + 1] - x[i], d3[i] + d3[i + 1]);
+            let norms = c.norm() * m.norm();
+            (norms > 0.0 && norms.is_finite()).then(|| (c.dot(&m) / norms).clamp(-1.0, 1.0).acos().to_degrees())
         })
         .collect()
 }
 
-/// A panel prepared for drawing: positions in mm, glyph length, colour range.
-struct Prepared<'a> {
-    panel: &'a PosturePanel,
-    /// Node positions [mm].
-    x_mm: Vec<Vector3<f64>>,
-    tangent: Vec<Option<Vector3<f64>>>,
-    /// Glyph length [mm].
-    glyph: f64,
-    /// Colour range (lo, hi).
-    range: (f64, f64),
-    /// Nodes carrying frame glyphs.
-    samples: Vec<usize>,
-    /// Largest angle between d3 and the tangent over all nodes [deg].
-    max_angle_deg: f64,
+/// The glyphs of one sampled element, at its midpoint [mm]: the unit directions of its chord
+/// (`∂s x`) and of the mean of its nodes' d3 and d1.
+struct Glyph {
+    mid: Vector3<f64>,
+    chord: Option<Vector3<f64>>,
+    d3: Vector3<f64>,
+    d1: Vector3<f64>,
 }
 
-impl<'a> Prepared<'a> {
-    fn new(panel: &'a PosturePanel) -> Self {
-        let x_mm: Vec<Vector3<f64>> = panel.x.iter().map(|p| p * 1e3).collect();
-        let extent = (0..3)
-            .map(|k| {
-                let (lo, hi) =
-                    x_mm.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), p| (l.min(p[k]), h.max(p[k])));
-                hi - lo
-            })
-            .fold(0.0, f64::max);
+/// `v` of unit length, or zero.
+fn unit(v: Vector3<f64>) -> Vector3<f64> {
+    let n = v.norm();
+    if n > 0.0 && n.is_finite() {
+        v / n
+    } else {
+        Vector3::zeros()
+    }
+}
+
+/// What every row of a posture figure shares, so that the rows compare: positions in the lab
+/// frame on the same axes (per projection one centre and half-width over all rows), one glyph
+/// length and one colour range.
+struct Shared {
+    /// Per projection of [`PROJECTIONS`]: the centre (a, b) and the half-width [mm].
+    boxes: [((f64, f64), f64); 3],
+    /// Glyph length [mm].
+    glyph: f64,
+    /// Colour range (lo, hi) over every row.
+    range: (f64, f64),
+}
+
+impl Shared {
+    fn new(panels: &[PosturePanel]) -> Self {
+        let nodes = || panels.iter().flat_map(|p| p.x.iter().map(|q| q * 1e3));
+        let bounds =
+            |k: usize| nodes().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), q| (l.min(q[k]), h.max(q[k])));
+        let b = [bounds(0), bounds(1), bounds(2)];
+        let extent = b.iter().map(|(lo, hi)| hi - lo).fold(0.0, f64::max);
         let glyph = GLYPH_FRACTION * if extent > 0.0 { extent } else { 1.0 };
-        let range = panel.colour.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &c| (l.min(c), h.max(c)));
-        let tangent = tangents(&x_mm);
-        let max_angle_deg = tangent
-            .iter()
-            .zip(&panel.d3)
-            .filter_map(|(t, d)| t.map(|t| (t, d)))
-            .filter(|(_, d)| d.norm() > 0.0)
-            .map(|(t, d)| (t.dot(d) / d.norm()).clamp(-1.0, 1.0).acos().to_degrees())
-            .fold(0.0, f64::max);
-        let samples = (0..x_mm.len()).step_by(sample_step(x_mm.len())).collect();
-        Prepared { panel, x_mm, tangent, glyph, range, samples, max_angle_deg }
+        let boxes = PROJECTIONS.map(|(i, j, _, _)| {
+            let half = 0.5 * (b[i].1 - b[i].0).max(b[j].1 - b[j].0) * 1.05 + 1.5 * glyph;
+            ((0.5 * (b[i].0 + b[i].1), 0.5 * (b[j].0 + b[j].1)), if half > 0.0 { half } else { 1.0 })
+        });
+        let range = colour_range(panels);
+        Shared { boxes, glyph, range }
     }
 
     fn colour_of(&self, v: f64) -> RGBColor {
         let (lo, hi) = self.range;
         viridis(if hi > lo { (v - lo) / (hi - lo) } else { 0.5 })
     }
+}
+
+/// The one colour range (lo, hi) of a posture figure: the smallest and largest colour value
+/// of all its rows.
+pub(crate) fn colour_range(panels: &[PosturePanel]) -> (f64, f64) {
+    panels.iter().flat_map(|p| &p.colour).fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &c| (l.min(c), h.max(c)))
+}
+
+/// A panel prepared for drawing: positions in mm, the glyphs of its sampled elements.
+struct Prepared<'a> {
+    panel: &'a PosturePanel,
+    /// Node positions [mm].
+    x_mm: Vec<Vector3<f64>>,
+    /// The sampled elements' glyphs.
+    glyphs: Vec<Glyph>,
+    /// Largest angle between d3 and ∂s x over all elements [deg] ([`element_angles_deg`]).
+    max_angle_deg: f64,
+}
+
+impl<'a> Prepared<'a> {
+    fn new(panel: &'a PosturePanel) -> Self {
+        let x_mm: Vec<Vector3<f64>> = panel.x.iter().map(|p| p * 1e3).collect();
+        let elements = x_mm.len() - 1;
+        let glyphs = (0..elements)
+            .step_by(sample_step(elements))
+            .map(|i| {
+                let c = x_mm[i + 1] - x_mm[i];
+                Glyph {
+                    mid: 0.5 * (x_mm[i] + x_mm[i + 1]),
+                    chord: (c.norm() > 0.0).then(|| unit(c)),
+                    d3: unit(panel.d3[i] + panel.d3[i + 1]),
+                    d1: unit(panel.d1[i] + panel.d1[i + 1]),
+                }
+            })
+            .collect();
+        let max_angle_deg = element_angles_deg(&panel.x, &panel.d3).into_iter().flatten().fold(0.0, f64::max);
+        Prepared { panel, x_mm, glyphs, max_angle_deg }
+    }
 
     fn caption(&self) -> String {
         format!(
-            "{} — ● head (s = 0); black arrows d3, grey ticks d1, red: tangent ∂s x — max ∠(d3, ∂s x) = {}°",
+            "{} — ● head (s = 0); per element: black arrow d3, grey tick d1, red ∂s x — max ∠(d3, ∂s x) = {}°",
             self.panel.label,
             fmt_num(sig2(self.max_angle_deg))
         )
@@ -199,38 +245,37 @@ impl<'a> Prepared<'a> {
 
 type Chart<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
 
-/// Draws one projection (coordinates `a`, `b`) of `p` into `area` with equal-aspect axes.
+/// Draws projection `k` of [`PROJECTIONS`] of `p` into `area` with equal-aspect axes, on the
+/// figure's shared box.
 fn draw_projection<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     p: &Prepared,
-    (a, b, name_a, name_b): (usize, usize, &str, &str),
+    shared: &Shared,
+    k: usize,
 ) -> Result<(), PlotError> {
-    let mut chart = projection_chart(area, p, (a, b, name_a, name_b))?;
-    draw_rod(&mut chart, p, |v: &Vector3<f64>| (v[a], v[b]))
+    let (a, b, _, _) = PROJECTIONS[k];
+    let mut chart = projection_chart(area, p, shared, k)?;
+    draw_rod(&mut chart, p, shared, |v: &Vector3<f64>| (v[a], v[b]))
 }
 
-/// The square chart of one projection (axes `a`, `b` of the positions, named `name_a`,
-/// `name_b`) with its mesh drawn: the data's bounds in both coordinates with a common half-width
-/// (and room for the glyphs), the surplus pixels spread over the margins.
+/// The square chart of projection `k` with its mesh drawn: the figure's box of that projection
+/// (the same for every row: positions in the lab frame), the surplus pixels spread over the
+/// margins.
 fn projection_chart<'a, DB: DrawingBackend>(
     area: &'a DrawingArea<DB, Shift>,
     p: &Prepared,
-    (a, b, name_a, name_b): (usize, usize, &str, &str),
+    shared: &Shared,
+    k: usize,
 ) -> Result<Chart<'a, DB>, PlotError> {
     let t = p.panel.label.as_str();
+    let (_, _, name_a, name_b) = PROJECTIONS[k];
     // Square plotting area: spread the surplus pixels over the margins.
     let (w, h) = area.dim_in_pixel();
     let pw = w.saturating_sub(2 * MARGIN + Y_LABEL_AREA);
     let ph = h.saturating_sub(2 * MARGIN + X_LABEL_AREA);
     let side = pw.min(ph);
     let (ex, ey) = (pw - side, ph - side);
-    // Common half-width from the data bounds in both projected coordinates (+ room for glyphs).
-    let bounds =
-        |k: usize| p.x_mm.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, hi), q| (l.min(q[k]), hi.max(q[k])));
-    let ((a0, a1), (b0, b1)) = (bounds(a), bounds(b));
-    let half = 0.5 * (a1 - a0).max(b1 - b0) * 1.05 + 1.5 * p.glyph;
-    let half = if half > 0.0 { half } else { 1.0 };
-    let (ca, cb) = (0.5 * (a0 + a1), 0.5 * (b0 + b1));
+    let ((ca, cb), half) = shared.boxes[k];
     let mut chart: Chart<DB> = ChartBuilder::on(area)
         .margin_left(MARGIN + ex / 2)
         .margin_right(MARGIN + ex - ex / 2)
@@ -258,37 +303,41 @@ fn projection_chart<'a, DB: DrawingBackend>(
     Ok(chart)
 }
 
-/// The rod in `chart`, projected by `proj` [mm]: the coloured centreline, the d1 ribbon ticks,
-/// the d3 arrows, the finite-difference tangents and the head.
+/// The rod in `chart`, projected by `proj` [mm]: the coloured centreline, and at the sampled
+/// elements' midpoints the d1 ticks, the d3 arrows and `∂s x` (the chord); the head.
 fn draw_rod<DB: DrawingBackend>(
     chart: &mut Chart<'_, DB>,
     p: &Prepared,
+    shared: &Shared,
     proj: impl Fn(&Vector3<f64>) -> (f64, f64),
 ) -> Result<(), PlotError> {
     let t = p.panel.label.as_str();
     let n = p.x_mm.len();
     // Centreline, segment by segment, coloured by the mean of its end values.
     let segments = (0..n - 1).map(|i| {
-        let c = p.colour_of(0.5 * (p.panel.colour[i] + p.panel.colour[i + 1]));
+        let c = shared.colour_of(0.5 * (p.panel.colour[i] + p.panel.colour[i + 1]));
         PathElement::new(vec![proj(&p.x_mm[i]), proj(&p.x_mm[i + 1])], c.stroke_width(3))
     });
     chart.draw_series(segments).map_err(|e| draw_err(t, e))?;
-    let g = p.glyph;
-    // d1 ribbon ticks: a segment through the node along ±d1 (total length g).
-    let ribbons = p.samples.iter().map(|&i| {
-        let (x, d1) = (p.x_mm[i], p.panel.d1[i]);
-        PathElement::new(vec![proj(&(x - 0.5 * g * d1)), proj(&(x + 0.5 * g * d1))], RIBBON_COLOUR.stroke_width(2))
+    let g = shared.glyph;
+    // d1 ribbon ticks: a segment through the midpoint along ±d1 (total length g).
+    let ribbons = p.glyphs.iter().map(|q| {
+        PathElement::new(
+            vec![proj(&(q.mid - 0.5 * g * q.d1)), proj(&(q.mid + 0.5 * g * q.d1))],
+            RIBBON_COLOUR.stroke_width(2),
+        )
     });
     chart.draw_series(ribbons).map_err(|e| draw_err(t, e))?;
-    let d3 = d3_arrows(p, &proj);
+    let d3 = d3_arrows(p, g, &proj);
     chart.draw_series(d3.arrows).map_err(|e| draw_err(t, e))?;
     chart.draw_series(d3.rings).map_err(|e| draw_err(t, e))?;
-    // Finite-difference tangent (unit, same length as the d3 arrows), on top of the arrows.
-    let tangents = p.samples.iter().filter_map(|&i| p.tangent[i].map(|tv| (i, tv))).map(|(i, tv)| {
-        let x = p.x_mm[i];
-        PathElement::new(vec![proj(&x), proj(&(x + g * tv))], TANGENT_COLOUR.stroke_width(1))
-    });
-    chart.draw_series(tangents).map_err(|e| draw_err(t, e))?;
+    // ∂s x of the element (unit, same length as the d3 arrows), on top of the arrows.
+    let chords = p
+        .glyphs
+        .iter()
+        .filter_map(|q| q.chord.map(|c| (q.mid, c)))
+        .map(|(m, c)| PathElement::new(vec![proj(&m), proj(&(m + g * c))], TANGENT_COLOUR.stroke_width(1)));
+    chart.draw_series(chords).map_err(|e| draw_err(t, e))?;
     // Head (node 0).
     let head = Circle::new(proj(&p.x_mm[0]), 5, BLACK.filled());
     chart.draw_series(std::iter::once(head)).map_err(|e| draw_err(t, e))?;
@@ -297,23 +346,22 @@ fn draw_rod<DB: DrawingBackend>(
 
 /// The d3 arrows of a projection.
 struct D3Arrows {
-    /// one polyline per sampled node: shaft and head
+    /// one polyline per sampled element: shaft and head
     arrows: Vec<PathElement<(f64, f64)>>,
-    /// a ring at each node whose d3 is out of the plane (projected shorter than a quarter glyph)
+    /// a ring at each element whose d3 is out of the plane (projected shorter than a quarter
+    /// glyph)
     rings: Vec<Circle<(f64, f64), i32>>,
 }
 
-/// The d3 arrows at the sampled nodes, projected by `proj`.
-fn d3_arrows(p: &Prepared, proj: &impl Fn(&Vector3<f64>) -> (f64, f64)) -> D3Arrows {
-    let g = p.glyph;
+/// The d3 arrows (length `g` [mm]) at the sampled elements' midpoints, projected by `proj`.
+fn d3_arrows(p: &Prepared, g: f64, proj: &impl Fn(&Vector3<f64>) -> (f64, f64)) -> D3Arrows {
     let mut rings = Vec::new();
     let arrows = p
-        .samples
+        .glyphs
         .iter()
-        .map(|&i| {
-            let (x, d3) = (p.x_mm[i], p.panel.d3[i]);
-            let (x0, y0) = proj(&x);
-            let (x1, y1) = proj(&(x + g * d3));
+        .map(|q| {
+            let (x0, y0) = proj(&q.mid);
+            let (x1, y1) = proj(&(q.mid + g * q.d3));
             let (dx, dy) = (x1 - x0, y1 - y0);
             let len = dx.hypot(dy);
             let mut pts = vec![(x0, y0), (x1, y1)];
@@ -339,24 +387,34 @@ fn draw_caption<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, p: &Prepared)
     area.draw_text(&p.caption(), &style, (12, h as i32 / 2)).map_err(|e| draw_err(&p.panel.label, e))
 }
 
-/// The colour bar of one row, in the strip right of its projections, as tall as a projection.
-fn draw_row_colour_bar<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, p: &Prepared) -> Result<(), PlotError> {
+/// The figure's one colour bar, in the strip right of the rows, from the first row's
+/// projections to the last row's.
+fn draw_figure_colour_bar<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    shared: &Shared,
+    label: &str,
+) -> Result<(), PlotError> {
     let (_, h) = area.dim_in_pixel();
-    let rows = (MARGIN + 20) as i32..(h - MARGIN - X_LABEL_AREA - 20) as i32;
-    let (lo, hi) = p.range;
+    let rows = (CAPTION_H + MARGIN + 20) as i32..(h - MARGIN - X_LABEL_AREA - 20) as i32;
+    let (lo, hi) = shared.range;
     let colour = |t: f64| viridis(t);
-    draw_colour_bar(area, 10, rows, &colour, (lo, hi.max(lo)), &p.panel.colour_label)
+    draw_colour_bar(area, 10, rows, &colour, (lo, hi.max(lo)), label)
 }
 
 /// Render panels (one row per panel, three orthogonal projections per row: x–y, x–z, y–z,
 /// each with equal aspect ratio axes in mm) to SVG text.
 ///
-/// Per projection: the centreline coloured segment by segment by `colour` (one scale per panel,
-/// its colour bar right of the row), at about 16 sampled nodes a black `d3` arrow, a grey `d1` tick
-/// through the node and a thin red finite-difference tangent (all ≈ 4 % of the rod's extent;
-/// `d3` off the tangent is what the `Λ`/`λ_d` term of eq. 41 penalises), and a filled circle at
-/// the head (node 0). A `d3` nearly normal to the projection plane is marked by a ring.
-/// `extra`, if given, is drawn beneath the rows (900 × 600 px high, the full width).
+/// Every row is drawn on the same axes (per projection, one box around the nodes of all rows:
+/// positions stay in the lab frame, so that a rod's motion between the frames shows) and with
+/// one colour scale (the smallest to the largest `colour` of all rows, one colour bar right of
+/// the rows, labelled with the first panel's `colour_label`). Per projection: the centreline
+/// coloured segment by segment by `colour`, and at about 16 sampled elements' midpoints a black
+/// `d3` arrow and a grey `d1` tick (the means of the element's two nodes) with a thin red `∂s x`
+/// of the element (its chord; all ≈ 4 % of the rods' extent; `d3` off `∂s x` is what the λd
+/// term of eq. 41 penalises, and each row's caption gives its largest angle,
+/// [`element_angles_deg`]), and a filled circle at the head (node 0). A `d3` nearly normal to
+/// the projection plane is marked by a ring. `extra`, if given, is drawn beneath the rows
+/// (900 × 600 px high, the full width).
 ///
 /// Errors: no panels ([`PlotError::InvalidGrid`]), a panel without nodes
 /// ([`PlotError::EmptySeries`]), `d1`/`d3`/`colour` lengths differing from `x`
@@ -374,6 +432,7 @@ pub fn render_postures_svg(
         validate(p)?;
     }
     let prepared: Vec<Prepared> = panels.iter().map(Prepared::new).collect();
+    let shared = Shared::new(panels);
     let rows = panels.len() as u32;
     let width = CELL * PROJECTIONS.len() as u32 + COLOUR_BAR_STRIP;
     let extra_h = if extra.is_some() { PLOT_SIZE.1 } else { 0 };
@@ -384,15 +443,15 @@ pub fn render_postures_svg(
         root.fill(&WHITE).map_err(|e| draw_err(title, e))?;
         let body = title_strip(&root, title, TITLE_H, 20)?;
         let (postures, below) = body.split_vertically(rows * (CAPTION_H + CELL));
+        let (postures, bar) = postures.split_horizontally(CELL * PROJECTIONS.len() as u32);
         for (row, p) in postures.split_evenly((panels.len(), 1)).iter().zip(&prepared) {
             let (cap, cells) = row.split_vertically(CAPTION_H);
             draw_caption(&cap, p)?;
-            let (cells, bar) = cells.split_horizontally(CELL * PROJECTIONS.len() as u32);
-            for (cell, pr) in cells.split_evenly((1, PROJECTIONS.len())).iter().zip(PROJECTIONS) {
-                draw_projection(cell, p, pr)?;
+            for (k, cell) in cells.split_evenly((1, PROJECTIONS.len())).iter().enumerate() {
+                draw_projection(cell, p, &shared, k)?;
             }
-            draw_row_colour_bar(&bar, p)?;
         }
+        draw_figure_colour_bar(&bar, &shared, &panels[0].colour_label)?;
         if let Some(plot) = extra {
             draw_panels(&below, std::slice::from_ref(plot), 1)?;
         }
@@ -427,14 +486,71 @@ mod tests {
         let n = 33;
         let svg = render_postures_svg("Straight rod", &[straight(n)], None).expect("renders");
         assert!(svg.contains("Straight rod") && svg.contains("frame 7") && svg.contains("|kappa| [1/m]"));
-        let samples = (0..n).step_by(sample_step(n)).count();
-        assert_eq!(samples, 17);
+        let samples = (0..n - 1).step_by(sample_step(n - 1)).count();
+        assert_eq!(samples, 16);
         assert_eq!(polylines(&svg, ARROW_COLOUR), 3 * samples);
         assert_eq!(polylines(&svg, RIBBON_COLOUR), 3 * samples);
         assert_eq!(polylines(&svg, TANGENT_COLOUR), 3 * samples);
         // d3 = e1 is normal to the y–z plane: one ring per sample there.
         assert_eq!(svg.split('<').filter(|t| t.starts_with("circle") && t.contains("#141414")).count(), samples);
         assert!(svg.contains("max ∠(d3, ∂s x) = 0°"));
+    }
+
+    /// An arc of a circle (radius 1 mm, a quarter turn, 21 nodes) with d3 turned by `tilt`
+    /// [rad] from the exact tangent about the arc's normal e3, at every node.
+    fn arc(tilt: f64) -> PosturePanel {
+        let n = 21;
+        let phi = |i: usize| std::f64::consts::FRAC_PI_2 * i as f64 / (n - 1) as f64;
+        let x = (0..n).map(|i| 1e-3 * Vector3::new(phi(i).cos(), phi(i).sin(), 0.0)).collect();
+        let d3 = (0..n).map(|i| Vector3::new(-(phi(i) + tilt).sin(), (phi(i) + tilt).cos(), 0.0)).collect();
+        PosturePanel {
+            label: "arc".into(),
+            x,
+            d1: vec![Vector3::z(); n],
+            d3,
+            colour: vec![1.0; n],
+            colour_label: "|κ| [1/mm]".into(),
+        }
+    }
+
+    /// The caption's angle is the largest of the per-element angles (the λd term's pair, the
+    /// data the audit's profile draws): 0 for an arc whose d3 is its tangent (by symmetry the
+    /// mean of the end tangents of an element lies along its chord; a one-sided difference at
+    /// the ends would give half the angle an element subtends, 2.25°), and the tilt when d3 is
+    /// turned off the tangent.
+    #[test]
+    fn the_caption_angle_is_the_largest_element_angle() {
+        let straight_d3 = arc(0.0);
+        let angles: Vec<f64> = element_angles_deg(&straight_d3.x, &straight_d3.d3).into_iter().flatten().collect();
+        assert_eq!(angles.len(), 20);
+        assert!(angles.iter().all(|a| *a < 1e-5), "{angles:?}");
+        let tilted = arc(2f64.to_radians());
+        let angles: Vec<f64> = element_angles_deg(&tilted.x, &tilted.d3).into_iter().flatten().collect();
+        assert!(angles.iter().all(|a| (a - 2.0).abs() < 1e-9), "{angles:?}");
+        assert_eq!(Prepared::new(&tilted).max_angle_deg, angles.iter().copied().fold(0.0, f64::max));
+        let svg = render_postures_svg("arcs", &[tilted], None).unwrap();
+        assert!(svg.contains("max ∠(d3, ∂s x) = 2°"), "caption");
+    }
+
+    /// Every row is drawn on the same lab-frame axes and colour scale: a rod moved by 2 mm
+    /// along x and coloured 3× stronger in the second row widens the box and the range of
+    /// both rows, and the figure has one colour bar.
+    #[test]
+    fn rows_share_the_lab_frame_and_one_colour_range() {
+        let first = straight(33);
+        let mut second = straight(33);
+        second.x.iter_mut().for_each(|q| q.x += 2e-3);
+        second.colour.iter_mut().for_each(|c| *c *= 3.0);
+        let panels = [first, second];
+        assert_eq!(colour_range(&panels), (0.0, 96.0));
+        let shared = Shared::new(&panels);
+        // x from 0 to 3 mm, y = z = 0: centre 1.5 mm, half-width 1.5 × 1.05 + 1.5 glyphs
+        let ((ca, cb), half) = shared.boxes[0];
+        assert!((ca - 1.5).abs() < 1e-12 && cb == 0.0, "{ca} {cb}");
+        assert!((half - (1.575 + 1.5 * GLYPH_FRACTION * 3.0)).abs() < 1e-12, "{half}");
+        let svg = render_postures_svg("two rows", &panels, None).unwrap();
+        assert_eq!(svg.matches("|kappa| [1/m]").count(), 1, "one colour bar");
+        assert_eq!(crate::figures::svg_text::overlaps(&svg), Vec::<(String, String)>::new());
     }
 
     #[test]

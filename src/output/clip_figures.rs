@@ -6,7 +6,8 @@ use crate::case::Case;
 use crate::engine::clip::{ClipRun, KymographColumn};
 use crate::figures::decimate::{min_max, MAX_LINE_POINTS};
 use crate::figures::heatmap::{render_marked_heatmaps_svg, ColourScale, ColumnMarks, Heatmap};
-use crate::figures::plot::{render_panels_svg, LinePlot, Series};
+use crate::figures::panels::render_panels_svg;
+use crate::figures::plot::{LinePlot, Series};
 use crate::io::files::{write_plot, OutputError};
 use crate::solve::sequence::FrameReport;
 
