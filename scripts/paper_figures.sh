@@ -13,7 +13,8 @@ if grep -q -- '--quick' "$audit/REPORT.md"; then
     exit 1
 fi
 mkdir -p docs/figures
-rm -f docs/figures/*.png
+# the audit's figures only (fig*.png): the other PNGs there (deep_arch_path.png) are drawn elsewhere
+rm -f docs/figures/fig*.png
 for svg in "$audit"/*/fig*.svg; do
     png="docs/figures/$(basename "${svg%.svg}").png"
     rsvg-convert "$svg" -o "$png"
