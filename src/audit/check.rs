@@ -10,6 +10,9 @@ use crate::engine::metrics::Metric;
 use crate::jobs::sweep::NOT_STARTED;
 use crate::solve;
 
+mod compound;
+mod truth_rows;
+
 /// How far a check holds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Outcome {
@@ -195,6 +198,11 @@ fn evaluate_inner(check: &Check, runs: &[RunResults]) -> Result<(Outcome, String
         Check::Magnitude { run, metric, value, orders, at } => magnitude(runs, run, metric, *value, *orders, at),
         Check::SameHistories { run, history, reference, limit } => {
             same_histories(runs, run, history, reference, *limit)
+        }
+        Check::All { checks } => Ok(compound::all(checks, runs)),
+        Check::Varies { run, with, metrics, factor } => compound::varies(runs, run, with, metrics, *factor),
+        Check::WithTruth { check, runs: names, bending_below, twist_below } => {
+            truth_rows::with_truth(check, runs, names, (*bending_below, *twist_below))
         }
     }
 }
@@ -570,6 +578,7 @@ fn point_states(check: &Check, runs: &[RunResults]) -> Vec<PointState> {
                 .map(|pts| pts.iter().map(|p| state(p, holds(p))).collect())
                 .unwrap_or_default()
         }
+        Check::WithTruth { check, .. } => point_states(check, runs),
         _ => Vec::new(),
     }
 }

@@ -31,11 +31,34 @@
 //!   max(|κ2|, |κ3|) over max |κ1|, the larger (eq. 64: "all the other components of the
 //!   position vector and generalised curvature are zero");
 //! - clip runs ([`ClipSeries`]): RMS of the recovered κ1, κ2, κ3 and of the bending
-//!   `√(κ1² + κ2²)` over frames and inner elements [1/m] (Figs. 17, 23, 25), and the lag in
-//!   frames of the bending wave between s = L/4 and 3L/4 (> 0: from s = 0 towards s = L), with
-//!   the coherence of the bending and of the twist at their best lag (`bending_wave_coherence`,
-//!   `twist_wave_coherence`: a wave that keeps its shape, 1, none, 0), and `x_err_rel_jitter`:
-//!   the largest frame-to-frame oscillation of ‖x − x_g‖/‖x_g‖ over its median (Fig. 20 (i)).
+//!   `√(κ1² + κ2²)` over frames and inner elements [1/m] (Figs. 17, 23, 25);
+//!   `kappa_rate_rms_per_m_per_s`: the RMS of `(κ(t) − κ(t − Δt))/Δt` over frames, inner
+//!   elements and components (§6: "the curvature along the worm's body does not change
+//!   significantly in time"); and `x_err_rel_jitter`: the largest frame-to-frame oscillation of
+//!   ‖x − x_g‖/‖x_g‖ over its median (Fig. 20 (i));
+//! - the curvature waves of a clip run (`super::wave`, in time windows): of the bending
+//!   `√(κ1² + κ2²)` (`bending_wave_head_to_tail_share`, `bending_wave_tail_to_head_share`, their
+//!   `bending_wave_speed_body_per_s` and `bending_wave_clarity`), of the components κ1 and κ2
+//!   as Figs. 17 and 23 draw them (`kappa12_wave_clarity`, the mean of the two clarities) and of
+//!   the twist κ3 (`twist_wave_clarity`);
+//! - `kappa3_head_peak_frame`, `kappa3_head_peak_ratio_elsewhere`, `kappa3_head_peak_ratio_other_frames`
+//!   (§6, Fig. 22: "κ3 is much larger near the worm's head at frame 700 than elsewhere or any
+//!   other frames"): the frame where the largest |κ3| over the head's elements ([`HEAD_FRACTION`]
+//!   of the body after the end elements) peaks, that peak over the largest |κ3| of the other
+//!   inner elements at that frame, and over the largest |κ3| of the inner elements at the frames
+//!   more than [`PEAK_FRAMES_APART`] away;
+//! - synthetic clips, against their ground truth: `super::truth`;
+//! - synthetic inverse runs, the data the test makes (§5.2): `data_rotation_max_rad`, the
+//!   largest rotation of the forward frames from the straight reference, `acos((Σᵢ dᵢ·eᵢ − 1)/2)`
+//!   (eq. 2); `data_kappa1_extent`, the share of the inner elements where the forward |κ1| is at
+//!   least a tenth of its largest (eq. 64: "a curvature κ1 ... is also generated along the
+//!   rod"); `data_torsion_to_bending_rms`, the RMS of the forward centreline's torsion over
+//!   that of its curvature over the inner elements (eq. 65: "both curvature and torsion",
+//!   [`torsion_to_bending`]);
+//! - `force_distribution_diff`, `torque_distribution_diff` (synthetic inverse runs, Fig. 15:
+//!   "the distribution is different"): `‖ |f|/‖f‖ − |f_d|/‖f_d‖ ‖` over the inner nodes, the
+//!   magnitudes along the rod of the control and of the design each scaled to norm 1 (0: the
+//!   same distribution, √2: disjoint), frame-free as [`inner_control_metrics`].
 use nalgebra::{DVector, Vector3};
 
 use crate::case::{Analysis, Case, Reference};
@@ -45,6 +68,9 @@ use crate::engine::RunResult;
 use crate::model::mesh::Field;
 use crate::reference::timoshenko_deflection;
 use crate::solve::modes::modal_model;
+
+use super::truth::{truth_metrics, TruthSeries};
+use super::wave::{propagation, Direction};
 
 /// Per-frame series of a clip run kept for the audit's measures and figures.
 #[derive(Clone, Debug, Default)]
@@ -63,6 +89,8 @@ pub struct ClipSeries {
     pub kept: Vec<ClipFrame>,
     /// the last frame solved
     pub last: Option<ClipFrame>,
+    /// synthetic clips: the frames against their ground truth
+    pub truth: Option<TruthSeries>,
 }
 
 /// Collects a [`ClipSeries`] frame by frame (the observer of a clip run).
@@ -85,6 +113,13 @@ impl ClipRecorder {
             .omega_max
             .push(frame.omega.as_ref().map_or(0.0, |w| w.iter().map(|v| v.norm()).fold(0.0, f64::max)));
         self.series.x_err_rel.push(frame.report.misfit.x_err_rel);
+        if let Some(t) = &frame.truth {
+            let ts = self.series.truth.get_or_insert_with(TruthSeries::default);
+            ts.bending_true.push(t.bending_true.clone());
+            ts.bending_recovered.push(t.bending_recovered.clone());
+            ts.comparisons.push(t.comparison);
+            ts.twist_per_m.push(t.twist_per_m);
+        }
         if self.keep.contains(&frame.report.frame) {
             self.series.kept.push(frame.clone());
         }
@@ -140,6 +175,7 @@ pub fn derived_metrics(case: &Case, run: Option<&RunResult>, series: Option<&Cli
             }
             m.extend(inner_control_metrics(case, r));
             m.extend(frame_metrics(r));
+            m.extend(data_metrics(r));
             if let Some(inv) = r.inverse.as_ref() {
                 let a = inv.ahat.iter().map(|a| a.norm()).fold(0.0, f64::max);
                 m.insert_named("adjoint_alpha_max_abs", a);
@@ -148,7 +184,12 @@ pub fn derived_metrics(case: &Case, run: Option<&RunResult>, series: Option<&Cli
         }
     }
     if let Some(s) = series {
-        m.extend(clip_series_metrics(s));
+        // the time between frames [s]; a clip case always has one
+        let dt_s = case.inverse().map_or(1.0, |i| i.params.frame_interval_s);
+        m.extend(clip_series_metrics(s, dt_s));
+        if let Some(t) = &s.truth {
+            m.extend(truth_metrics(t, dt_s));
+        }
     }
     m
 }
@@ -176,6 +217,56 @@ fn frame_metrics(r: &RunResult) -> Metrics {
     m
 }
 
+/// The data a synthetic inverse test makes (see the module documentation); none for a
+/// recording.
+fn data_metrics(r: &RunResult) -> Metrics {
+    let mut m = Metrics::new();
+    let Some(inv) = r.inverse.as_ref().filter(|i| i.angles_known) else { return m };
+    let angle = |d: &[Vector3<f64>; 3]| {
+        let trace: f64 = (0..3).map(|i| d[i][i]).sum();
+        ((trace - 1.0) / 2.0).clamp(-1.0, 1.0).acos()
+    };
+    m.insert_named("data_rotation_max_rad", inv.data.directors().iter().map(angle).fold(0.0, f64::max));
+    let k = inv.data.element_curvature();
+    let n = k.len();
+    if n <= 2 * INNER_SKIP_ELEMENTS {
+        return m;
+    }
+    let inner: Vec<Vector3<f64>> = k[INNER_SKIP_ELEMENTS..n - INNER_SKIP_ELEMENTS].iter().map(|(_, k)| *k).collect();
+    let k1_max = inner.iter().map(|k| k[0].abs()).fold(0.0, f64::max);
+    if k1_max > 0.0 {
+        let extent = inner.iter().filter(|k| k[0].abs() >= 0.1 * k1_max).count();
+        m.insert_named("data_kappa1_extent", extent as f64 / inner.len() as f64);
+    }
+    if let Some(r) = torsion_to_bending(&k[INNER_SKIP_ELEMENTS..n - INNER_SKIP_ELEMENTS]) {
+        m.insert_named("data_torsion_to_bending_rms", r);
+    }
+    m
+}
+
+/// The RMS of the torsion of the centreline, `τ = κ3 + ∂sφ` with `φ = atan2(κ2, κ1)` the
+/// direction of the bending about d3 (between neighbouring elements, where both bend by at
+/// least 5 % of the largest bending: elsewhere φ has no direction), over the RMS of the
+/// curvature `√(κ1² + κ2²)` there; `kappa`: `(s [m], κ [1/m])` per element.
+fn torsion_to_bending(kappa: &[(f64, Vector3<f64>)]) -> Option<f64> {
+    let bend = |k: &Vector3<f64>| (k[0] * k[0] + k[1] * k[1]).sqrt();
+    let most = kappa.iter().map(|(_, k)| bend(k)).fold(0.0, f64::max);
+    let (mut tau2, mut bend2) = (0.0, 0.0);
+    for w in kappa.windows(2) {
+        let ((s0, k0), (s1, k1)) = (w[0], w[1]);
+        if bend(&k0) < 0.05 * most || bend(&k1) < 0.05 * most || s1 <= s0 {
+            continue;
+        }
+        let turn = k1[1].atan2(k1[0]) - k0[1].atan2(k0[0]);
+        // wrapped into (−π, π]
+        let turn = turn - 2.0 * std::f64::consts::PI * (turn / (2.0 * std::f64::consts::PI)).round();
+        let tau = 0.5 * (k0[2] + k1[2]) + turn / (s1 - s0);
+        tau2 += tau * tau;
+        bend2 += (0.5 * (bend(&k0) + bend(&k1))).powi(2);
+    }
+    (bend2 > 0.0).then(|| (tau2 / bend2).sqrt())
+}
+
 /// The controls f = x̂/λf, l = α̂/λl of an inverse run at the nodes without
 /// [`INNER_SKIP_ELEMENTS`] at each end (eq. 61): max |l|, and against the design loads of a
 /// synthetic case's `[data]` solve the orders of magnitude of the RMS ratios (Fig. 15).
@@ -197,10 +288,22 @@ fn inner_control_metrics(case: &Case, r: &RunResult) -> Metrics {
     let design = |i: usize| data.loads.distributed(r.nodes.s[i], 0.0);
     let f = rms(&mut inner.clone().map(|i| inv.xhat[i].norm() / inv.lambda_f));
     let l = rms(&mut inner.clone().map(|i| inv.ahat[i].norm() / inv.lambda_l));
-    let (fd, ld) = (rms(&mut inner.clone().map(|i| design(i).0.norm())), rms(&mut inner.map(|i| design(i).1.norm())));
+    let (fd, ld) =
+        (rms(&mut inner.clone().map(|i| design(i).0.norm())), rms(&mut inner.clone().map(|i| design(i).1.norm())));
     if fd > 0.0 && ld > 0.0 {
         m.insert_named("force_to_design_orders_inner", (f / fd).log10().abs());
         m.insert_named("torque_to_design_orders_inner", (l / ld).log10().abs());
+    }
+    let shape = |ours: &dyn Fn(usize) -> f64, design: &dyn Fn(usize) -> f64| {
+        let norm = |g: &dyn Fn(usize) -> f64| inner.clone().map(|i| g(i) * g(i)).sum::<f64>().sqrt();
+        let (a, b) = (norm(ours), norm(design));
+        (a > 0.0 && b > 0.0).then(|| inner.clone().map(|i| (ours(i) / a - design(i) / b).powi(2)).sum::<f64>().sqrt())
+    };
+    if let Some(d) = shape(&|i| inv.xhat[i].norm(), &|i| design(i).0.norm()) {
+        m.insert_named("force_distribution_diff", d);
+    }
+    if let Some(d) = shape(&|i| inv.ahat[i].norm(), &|i| design(i).1.norm()) {
+        m.insert_named("torque_distribution_diff", d);
     }
     m
 }
@@ -309,9 +412,10 @@ pub fn modal_tip_history(case: &Case, r: &RunResult) -> Option<Vec<ModalTip>> {
     Some(out)
 }
 
-/// RMS of the recovered curvature components over the frames and the inner elements, and the
-/// lag of the bending wave (see the module documentation).
-fn clip_series_metrics(s: &ClipSeries) -> Metrics {
+/// RMS of the recovered curvature components over the frames and the inner elements, their
+/// rate, the curvature waves and the head's twist peak (see the module documentation); `dt_s`
+/// the time between frames [s].
+fn clip_series_metrics(s: &ClipSeries, dt_s: f64) -> Metrics {
     let mut m = Metrics::new();
     let ne = s.s_mid.len();
     if s.kappa.is_empty() || ne <= 2 * INNER_SKIP_ELEMENTS {
@@ -327,16 +431,71 @@ fn clip_series_metrics(s: &ClipSeries) -> Metrics {
     m.insert_named("kappa3_rms_per_m", rms(&|k| k[2] * k[2]));
     m.insert_named("bending_rms_per_m", rms(&|k| k[0] * k[0] + k[1] * k[1]));
     m.insert_named("omega_max_rad_per_s", s.omega_max.iter().copied().fold(0.0, f64::max));
-    if let Some((lag, coherence)) = wave_lag(s, &|k| (k[0], k[1]), false) {
-        m.insert_named("bending_wave_lag_frames", lag as f64);
-        m.insert_named("bending_wave_coherence", coherence);
+    if s.kappa.len() > 1 {
+        let steps = ((s.kappa.len() - 1) * inner.len()) as f64;
+        let sum: f64 =
+            s.kappa.windows(2).flat_map(|w| inner.clone().map(move |e| (w[1][e] - w[0][e]).norm_squared())).sum();
+        m.insert_named("kappa_rate_rms_per_m_per_s", (sum / steps).sqrt() / dt_s);
     }
-    if let Some((_, coherence)) = wave_lag(s, &|k| (k[2], 0.0), true) {
-        m.insert_named("twist_wave_coherence", coherence);
-    }
+    m.extend(wave_metrics(s, dt_s));
+    m.extend(head_twist_metrics(s));
     if let Some(j) = x_err_jitter(&s.x_err_rel) {
         m.insert_named("x_err_rel_jitter", j);
     }
+    m
+}
+
+/// The curvature waves of a clip run (`super::wave`): the bending, κ1 and κ2, the twist.
+fn wave_metrics(s: &ClipSeries, dt_s: f64) -> Metrics {
+    let mut m = Metrics::new();
+    let length = s.s_mid.last().copied().unwrap_or(0.0) + s.s_mid.first().copied().unwrap_or(0.0);
+    if length <= 0.0 {
+        return m;
+    }
+    let pos: Vec<f64> = s.s_mid.iter().map(|x| x / length).collect();
+    let kymo = |f: &dyn Fn(&Vector3<f64>) -> f64| -> Vec<Vec<f64>> {
+        s.kappa.iter().map(|row| row.iter().map(f).collect()).collect()
+    };
+    let bending = propagation(&kymo(&|k| (k[0] * k[0] + k[1] * k[1]).sqrt()), &pos);
+    if bending.windows.is_empty() {
+        return m;
+    }
+    m.insert_named("bending_wave_head_to_tail_share", bending.share(Direction::HeadToTail));
+    m.insert_named("bending_wave_tail_to_head_share", bending.share(Direction::TailToHead));
+    m.insert_named("bending_wave_clarity", bending.clarity());
+    if let Some(v) = bending.median_speed_body_per_frame() {
+        m.insert_named("bending_wave_speed_body_per_s", v / dt_s);
+    }
+    let (k1, k2) = (propagation(&kymo(&|k| k[0]), &pos), propagation(&kymo(&|k| k[1]), &pos));
+    m.insert_named("kappa12_wave_clarity", 0.5 * (k1.clarity() + k2.clarity()));
+    m.insert_named("twist_wave_clarity", propagation(&kymo(&|k| k[2]), &pos).clarity());
+    m
+}
+
+/// Share of the inner elements, after the end elements, that is the head's (§6, Fig. 22).
+pub const HEAD_FRACTION: f64 = 0.1;
+/// Frames from the head's twist peak beyond which a frame is "another frame" (Fig. 22).
+pub const PEAK_FRAMES_APART: usize = 20;
+
+/// Where and how far the head's |κ3| peaks (see the module documentation); none without frames
+/// more than [`PEAK_FRAMES_APART`] from the peak.
+fn head_twist_metrics(s: &ClipSeries) -> Metrics {
+    let mut m = Metrics::new();
+    let ne = s.s_mid.len();
+    let inner = INNER_SKIP_ELEMENTS..ne - INNER_SKIP_ELEMENTS;
+    let head = INNER_SKIP_ELEMENTS..INNER_SKIP_ELEMENTS + ((HEAD_FRACTION * inner.len() as f64).ceil() as usize).max(1);
+    let max3 = |row: &[Vector3<f64>], r: std::ops::Range<usize>| row[r].iter().map(|k| k[2].abs()).fold(0.0, f64::max);
+    let heads: Vec<f64> = s.kappa.iter().map(|row| max3(row, head.clone())).collect();
+    let Some((at, peak)) = heads.iter().copied().enumerate().max_by(|a, b| a.1.total_cmp(&b.1)) else { return m };
+    let rest = max3(&s.kappa[at], head.end..inner.end);
+    let others = (0..s.kappa.len()).filter(|&f| f.abs_diff(at) > PEAK_FRAMES_APART);
+    let other = others.map(|f| max3(&s.kappa[f], inner.clone())).fold(f64::NAN, f64::max);
+    if other.is_nan() || rest <= 0.0 || other <= 0.0 {
+        return m;
+    }
+    m.insert_named("kappa3_head_peak_frame", s.frames[at] as f64);
+    m.insert_named("kappa3_head_peak_ratio_elsewhere", peak / rest);
+    m.insert_named("kappa3_head_peak_ratio_other_frames", peak / other);
     m
 }
 
@@ -351,86 +510,4 @@ fn x_err_jitter(e: &[f64]) -> Option<f64> {
     let median = sorted[sorted.len() / 2];
     let worst = e.windows(3).map(|w| (w[1] - 0.5 * (w[0] + w[2])).abs()).fold(0.0, f64::max);
     (median > 0.0).then_some(worst / median)
-}
-
-/// The lag τ (frames) maximising `|Σ_t z_a(t) conj(z_b(t + τ))|` with `z` a complex signal of
-/// κ (`κ1 + i κ2` for the bending, `κ3` for the twist) at the elements nearest s = L/4 (a)
-/// and 3L/4 (b), |τ| ≤ a quarter of the clip: positive when the wave travels from s = 0
-/// towards s = L. A roll of the material frame multiplies both bending signals by the same
-/// phase and does not change the magnitude. With it, the coherence at that lag,
-/// `|Σ z_a conj(z_b)| / √(Σ|z_a|² Σ|z_b|²)` over the overlap, in [0, 1]: 1 for a wave that
-/// keeps its shape between the probes, near 0 when there is no such wave. `centred`: each
-/// probe's mean over the frames is taken out first (the twist: a steady κ3 is no wave).
-fn wave_lag(s: &ClipSeries, signal: &dyn Fn(&Vector3<f64>) -> (f64, f64), centred: bool) -> Option<(i64, f64)> {
-    let nf = s.kappa.len();
-    if nf < 8 {
-        return None;
-    }
-    let ne = s.s_mid.len();
-    let (a, b) = (ne / 4, 3 * ne / 4);
-    let mean = |e: usize| {
-        let sum = (0..nf).map(|f| signal(&s.kappa[f][e])).fold((0.0, 0.0), |m, v| (m.0 + v.0, m.1 + v.1));
-        if centred {
-            (sum.0 / nf as f64, sum.1 / nf as f64)
-        } else {
-            (0.0, 0.0)
-        }
-    };
-    let (ma, mb) = (mean(a), mean(b));
-    let z = |f: usize, e: usize| {
-        let (v, m) = (signal(&s.kappa[f][e]), if e == a { ma } else { mb });
-        (v.0 - m.0, v.1 - m.1)
-    };
-    let max_lag = (nf / 4) as i64;
-    let mut best = (0i64, -1.0f64, 0.0f64);
-    for tau in -max_lag..=max_lag {
-        let (mut re, mut im, mut pa, mut pb) = (0.0, 0.0, 0.0, 0.0);
-        for t in 0..nf as i64 {
-            let u = t + tau;
-            if u < 0 || u >= nf as i64 {
-                continue;
-            }
-            let (x, y) = (z(t as usize, a), z(u as usize, b));
-            // x · conj(y)
-            re += x.0 * y.0 + x.1 * y.1;
-            im += x.1 * y.0 - x.0 * y.1;
-            pa += x.0 * x.0 + x.1 * x.1;
-            pb += y.0 * y.0 + y.1 * y.1;
-        }
-        let cross = (re * re + im * im).sqrt();
-        let mag = cross / (nf as i64 - tau.abs()) as f64;
-        if mag > best.1 {
-            let coherence = if pa > 0.0 && pb > 0.0 { cross / (pa * pb).sqrt() } else { 0.0 };
-            best = (tau, mag, coherence);
-        }
-    }
-    Some((best.0, best.2))
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// A pulse of bending travels towards s = L at 0.01 body lengths per frame: the probes at
-    /// L/4 and 3L/4 see it 50 frames apart; played backwards, −50.
-    #[test]
-    fn wave_lag_sign_and_size() {
-        let (ne, nf) = (100, 400);
-        let s_mid: Vec<f64> = (0..ne).map(|e| (e as f64 + 0.5) / ne as f64).collect();
-        let kappa: Vec<Vec<Vector3<f64>>> = (0..nf)
-            .map(|t| {
-                s_mid
-                    .iter()
-                    .map(|s| {
-                        let u = (s - 0.01 * t as f64 + 1.0) / 0.1;
-                        Vector3::new((-u * u).exp(), 0.5 * (-u * u).exp(), 3.0)
-                    })
-                    .collect()
-            })
-            .collect();
-        let series = ClipSeries { frames: (0..nf).collect(), s_mid, kappa, ..Default::default() };
-        assert_eq!(wave_lag(&series, &|k| (k[0], k[1]), false).map(|w| w.0), Some(50));
-        let back = ClipSeries { kappa: series.kappa.iter().rev().cloned().collect(), ..series.clone() };
-        assert_eq!(wave_lag(&back, &|k| (k[0], k[1]), false).map(|w| w.0), Some(-50));
-    }
 }

@@ -13,6 +13,8 @@ pub mod numbers;
 pub mod report;
 pub mod resume;
 pub mod spec;
+pub mod truth;
+pub mod wave;
 
 use std::path::{Path, PathBuf};
 

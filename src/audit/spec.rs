@@ -190,6 +190,28 @@ pub enum Check {
     /// the histories of `history` (an inverse run's per-iteration record) agree with the
     /// reference point's to a relative spread ≤ `limit` over their common iterations
     SameHistories { run: String, history: String, reference: Selector, limit: f64 },
+    /// every check of `checks` holds (partly: some do): a sentence with several parts
+    All { checks: Vec<Check> },
+    /// some metric of `metrics` changes by more than `factor` (max/min) over the points of `run`
+    /// and of the runs `with` (the converse of `within_factor`)
+    Varies {
+        run: String,
+        #[serde(default)]
+        with: Vec<String>,
+        metrics: Vec<String>,
+        factor: f64,
+    },
+    /// `check`, with every point of the runs `runs` (clips with a ground truth) measured against
+    /// the truth (`audit::truth`); with `bending_below`, `twist_below` the check holds only where
+    /// those errors are within them (the sentence is about recovering the worm's state)
+    WithTruth {
+        check: Box<Check>,
+        runs: Vec<String>,
+        #[serde(default)]
+        bending_below: Option<f64>,
+        #[serde(default)]
+        twist_below: Option<f64>,
+    },
 }
 
 impl Check {
@@ -203,7 +225,12 @@ impl Check {
             | Check::RatioBelow { metric, .. }
             | Check::WithinFactor { metric, .. }
             | Check::Magnitude { metric, .. } => Some(metric),
-            Check::Converges { .. } | Check::DoesNotConverge { .. } | Check::SameHistories { .. } => None,
+            Check::WithTruth { check, .. } => check.metric(),
+            Check::Converges { .. }
+            | Check::DoesNotConverge { .. }
+            | Check::SameHistories { .. }
+            | Check::All { .. }
+            | Check::Varies { .. } => None,
         }
     }
 
@@ -221,6 +248,10 @@ impl Check {
             Check::RatioAbove { numerator, denominator, .. } | Check::RatioBelow { numerator, denominator, .. } => {
                 vec![&numerator.run, &denominator.run]
             }
+            Check::All { checks } => checks.iter().flat_map(|c| c.runs()).collect(),
+            Check::Varies { run, with, .. } => std::iter::once(run).chain(with).map(|s| s.as_str()).collect(),
+            // the truth's runs give numbers only: the scheme and the stopped points are the check's
+            Check::WithTruth { check, .. } => check.runs(),
         }
     }
 }
