@@ -165,6 +165,18 @@ impl Pattern {
         }
     }
 
+    /// The product `A x` of the matrix with these values and a vector.
+    pub fn multiply(&self, values: &[f64], x: &nalgebra::DVector<f64>) -> nalgebra::DVector<f64> {
+        let mut y = nalgebra::DVector::zeros(self.ndofs);
+        for j in 0..self.ndofs {
+            let xj = x[j];
+            for k in self.col_ptr[j]..self.col_ptr[j + 1] {
+                y[self.row_idx[k]] += values[k] * xj;
+            }
+        }
+        y
+    }
+
     /// Dense copy (for eigenvalue problems of modest size).
     pub fn to_dense(&self, values: &[f64]) -> nalgebra::DMatrix<f64> {
         let mut m = nalgebra::DMatrix::zeros(self.ndofs, self.ndofs);
