@@ -85,7 +85,7 @@ fn the_critical_load_converges_to_euler_at_second_order() {
     }
 }
 
-/// The banded shift-invert Arnoldi (D31) finds the dense eigen-solve's critical load factors,
+/// The banded shift-invert Arnoldi (D28) finds the dense eigen-solve's critical load factors,
 /// double ones included, to 1e-9, and the same modes (up to the sign fixed by the scaling, and
 /// for a double factor up to a turn within its plane pair: compared by their lateral size).
 #[test]

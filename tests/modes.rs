@@ -1,8 +1,8 @@
 //! The lowest natural frequencies by shift-invert block Lanczos (`solve::modes::lowest_modes`,
-//! D31) against the dense eigen-solve of the same pencil (`modal_model`), and against the
+//! D28) against the dense eigen-solve of the same pencil (`modal_model`), and against the
 //! Euler–Bernoulli cantilever's frequencies (R. D. Blevins, Formulas for Natural Frequency and
-//! Mode Shape, 1979, Table 8-1) with their mesh-convergence order; the case is the benchmark
-//! `cases/benchmarks/cantilever_frequencies.toml` (a steel wire, L/r = 1000, round section).
+//! Mode Shape, 1979, Table 8-1) with their mesh-convergence order; the case is
+//! `tests/modes/cantilever_frequencies.toml` (a steel wire, L/r = 1000, round section).
 mod common;
 
 use common::{case_from, case_text, edit};
@@ -13,7 +13,7 @@ use cosserat::solve::modes::{lowest_modes, modal_model};
 const BETA_L: [f64; 4] = [1.87510407, 4.69409113, 7.85475744, 10.99554073];
 
 fn benchmark_path() -> std::path::PathBuf {
-    common::cases_dir().join("benchmarks/cantilever_frequencies.toml")
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/modes/cantilever_frequencies.toml")
 }
 
 fn benchmark(elements: usize) -> Case {

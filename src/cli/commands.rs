@@ -426,7 +426,7 @@ pub fn cmd_buckling(path: &Path, count: usize) -> Result<ExitCode> {
 }
 
 /// `cosserat modes`: the lowest `count` natural frequencies of the rod clamped at s = 0,
-/// linearised about its rest state (shift-invert block Lanczos, D31).
+/// linearised about its rest state (shift-invert block Lanczos, D28).
 pub fn cmd_modes(path: &Path, count: usize, limits: Limits) -> Result<ExitCode> {
     let case = load(path)?;
     if !case.density_given() {

@@ -1,6 +1,6 @@
 //! Block Krylov subspaces with full reorthogonalisation, for the few extreme eigenpairs of an
 //! operator given only by its action: the shift-invert operators of the modal and buckling
-//! analyses (`docs/decisions.md`, D27, D31), each application one solve with a banded LU
+//! analyses (`docs/decisions.md`, D27, D28), each application one solve with a banded LU
 //! factored once.
 //!
 //! ```text
@@ -24,10 +24,15 @@ use nalgebra::{DMatrix, DVector};
 
 use super::LinearError;
 
+/// The operator `Op` of a [`Krylov`] basis: one application (a solve with factors).
+type Operator<'a> = Box<dyn FnMut(&DVector<f64>) -> Result<DVector<f64>, LinearError> + 'a>;
+/// The matrix `B` of a [`Krylov`] basis's inner product `uᵀ B v`, applied to a vector.
+type InnerProduct<'a> = Box<dyn Fn(&DVector<f64>) -> DVector<f64> + 'a>;
+
 /// A block Krylov basis being built: the vectors, their `B`-images and the coefficients `H̃`.
 pub struct Krylov<'a> {
-    op: Box<dyn FnMut(&DVector<f64>) -> Result<DVector<f64>, LinearError> + 'a>,
-    inner: Box<dyn Fn(&DVector<f64>) -> DVector<f64> + 'a>,
+    op: Operator<'a>,
+    inner: InnerProduct<'a>,
     /// `v_1 … v_{m+p}` (`B`-orthonormal)
     vectors: Vec<DVector<f64>>,
     /// `B v_i`
@@ -102,7 +107,7 @@ impl<'a> Krylov<'a> {
     /// in the span (norm below 1e-10 of its start) is replaced by a fresh random direction,
     /// with a zero coefficient: the Krylov space is invariant and any new direction continues it.
     /// When no direction is left (the random one is in the span too), nothing is appended.
-    fn append(&mut self, mut w: DVector<f64>, mut coefficients: Option<&mut Vec<f64>>) {
+    fn append(&mut self, mut w: DVector<f64>, coefficients: Option<&mut Vec<f64>>) {
         let n = w.len();
         let start = (self.inner)(&w).dot(&w).max(0.0).sqrt();
         let mut h = vec![0.0; self.vectors.len()];
@@ -116,17 +121,18 @@ impl<'a> Krylov<'a> {
         let mut bw = (self.inner)(&w);
         let mut norm = bw.dot(&w).max(0.0).sqrt();
         let mut fresh = false;
-        if !(norm > 1e-10 * start) {
+        // (a NaN norm counts as none: the fresh direction replaces it)
+        if norm.is_nan() || norm <= 1e-10 * start {
             let r = DVector::from_fn(n, |_, _| next_uniform(&mut self.seed));
             let r = (self.op)(&r).unwrap_or(r);
             let before = (self.inner)(&r).dot(&r).max(0.0).sqrt();
             self.append_direction(r, &mut bw, &mut norm, &mut w);
             fresh = true;
-            if !(norm > 1e-10 * before) {
+            if norm.is_nan() || norm <= 1e-10 * before {
                 self.exhausted = true;
             }
         }
-        if let Some(c) = coefficients.as_deref_mut() {
+        if let Some(c) = coefficients {
             c.extend_from_slice(&h);
             c.push(if fresh { 0.0 } else { norm });
         }

@@ -10,7 +10,7 @@
 //! - [`modal_model`]: every mode, dense (Cholesky reduction `L⁻¹ K_s L⁻ᵀ`, `M_s = L Lᵀ`, and
 //!   the symmetric QR iteration): for the modal superposition of a whole response, a few
 //!   hundred elements at most (O(n²) memory, O(n³) time);
-//! - [`lowest_modes`]: the lowest `k` modes by shift-invert block Lanczos (D31): the operator
+//! - [`lowest_modes`]: the lowest `k` modes by shift-invert block Lanczos (D28): the operator
 //!   `(K − σM)⁻¹M = (K_s − σM_s)⁻¹M_s` (the same for the paper's rows and the symmetrised ones,
 //!   `T = blockdiag(I, A(0)ᵀ)` being invertible), one banded LU of `K` (σ = 0: the clamped rod
 //!   has no rigid motion) and one solve per Lanczos vector, the vectors `M_s`-orthonormal, so
@@ -119,7 +119,7 @@ pub const LANCZOS_BLOCK: usize = 3;
 pub const RITZ_TOLERANCE: f64 = 1e-10;
 
 /// The lowest `count` modes of the rod clamped at s = 0, linearised about its rest state
-/// (module doc): the same pencil as [`modal_model`], by shift-invert block Lanczos (D31).
+/// (module doc): the same pencil as [`modal_model`], by shift-invert block Lanczos (D28).
 /// `count` is capped at half the free unknowns.
 pub fn lowest_modes(problem: &Problem, count: usize) -> Result<LowestModes, ModesError> {
     let pattern = problem.dofs().pattern();

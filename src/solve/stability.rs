@@ -31,7 +31,7 @@
 //!
 //! Dense: up to [`DENSE_LIMIT`] unknowns (300 elements); above it the stability is not computed
 //! (`None`) and buckling takes the banded matrices, `K₀` factored once and the lowest factors
-//! by shift-invert block Arnoldi ([`buckling_sparse`], D31; the same factors to 1e-9, tests/buckling.rs).
+//! by shift-invert block Arnoldi ([`buckling_sparse`], D28; the same factors to 1e-9, tests/buckling.rs).
 use nalgebra::{DMatrix, DVector};
 
 use super::arclength::{load_rate, newton_system, wnorm2};
@@ -164,7 +164,7 @@ fn dense_mass(problem: &Problem, u: &DVector<f64>) -> DMatrix<f64> {
 
 /// The lowest `count` positive critical load factors of the case's loads about the reference,
 /// with their modes (D27), ascending: dense up to [`DENSE_LIMIT`] unknowns, above it by
-/// shift-invert Arnoldi on the banded matrices ([`buckling_sparse`], D31).
+/// shift-invert Arnoldi on the banded matrices ([`buckling_sparse`], D28).
 pub fn buckling(problem: &Problem, count: usize) -> Result<Vec<BucklingMode>, StabilityError> {
     if problem.dofs().len() > DENSE_LIMIT {
         return buckling_sparse(problem, count);
@@ -229,7 +229,7 @@ pub const ARNOLDI_BLOCK: usize = 3;
 /// largest `|ν|`.
 pub const ARNOLDI_TOLERANCE: f64 = 1e-10;
 
-/// [`buckling`] on the banded matrices (D31): `K₀` factored once (the crate's banded LU with
+/// [`buckling`] on the banded matrices (D28): `K₀` factored once (the crate's banded LU with
 /// Ruiz equilibration), `K_σ` by the same central difference, and the largest positive real
 /// eigenvalues `ν` of `−K₀⁻¹ K_σ` by block Arnoldi with full reorthogonalisation
 /// ([`crate::linalg::largest_real_positive`]); `λ_cr = 1/ν`, each mode the Ritz vector scaled

@@ -18,7 +18,7 @@ pub const GIB: f64 = 1024.0 * 1024.0 * 1024.0;
 pub enum Footprint {
     /// `run`, `sweep` points, `compare`: the case's solver
     Run,
-    /// `modes`: the lowest `count` modes by shift-invert block Lanczos (D31)
+    /// `modes`: the lowest `count` modes by shift-invert block Lanczos (D28)
     Modes { count: usize },
 }
 
