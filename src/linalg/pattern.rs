@@ -193,6 +193,15 @@ impl Pattern {
 mod tests {
     use super::*;
 
+    /// `multiply` is the dense product of `to_dense` (integer-valued entries: exact).
+    #[test]
+    fn multiply_is_the_dense_product() {
+        let p = Pattern::block_tridiagonal(5, 3);
+        let values: Vec<f64> = (0..p.nnz()).map(|k| ((7 * k) % 11) as f64 - 5.0).collect();
+        let x = nalgebra::DVector::from_fn(p.ndofs(), |i, _| (i % 4) as f64 - 1.5);
+        assert_eq!(p.multiply(&values, &x), p.to_dense(&values) * &x);
+    }
+
     /// A pass of `scatter_first` over every element, in order, on values holding garbage gives
     /// bit for bit what zeroing them and adding with `scatter` gives (signed zeros included).
     #[test]
