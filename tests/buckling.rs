@@ -9,7 +9,7 @@ mod common;
 use assert_cmd::Command;
 use common::case_from;
 use cosserat::case::Case;
-use cosserat::solve::stability::{buckling, stability};
+use cosserat::solve::stability::{buckling, buckling_sparse, stability, DENSE_LIMIT};
 use cosserat::solve::statics;
 use nalgebra::{Matrix3, Rotation3, Vector3};
 use std::f64::consts::PI;
@@ -83,6 +83,62 @@ fn the_critical_load_converges_to_euler_at_second_order() {
         }
         assert!(errors[2].abs() < if pinned { 1.2e-3 } else { 3e-4 }, "pinned {pinned}: {errors:?}");
     }
+}
+
+/// The banded shift-invert Arnoldi (D28) finds the dense eigen-solve's critical load factors,
+/// double ones included, to 1e-9, and the same modes (up to the sign fixed by the scaling, and
+/// for a double factor up to a turn within its plane pair: compared by their lateral size).
+#[test]
+fn sparse_buckling_matches_the_dense_eigen_solve() {
+    for pinned in [false, true] {
+        let p = if pinned { 5e-6 } else { 1.0 };
+        let case = column(pinned, 20, p, &Matrix3::identity());
+        let problem = case.problem();
+        let dense = buckling(&problem, 4).expect("dense");
+        let sparse = buckling_sparse(&problem, 4).expect("sparse");
+        assert_eq!(sparse.len(), 4, "pinned {pinned}");
+        for (d, s) in dense.iter().zip(&sparse) {
+            let e = (s.load_factor / d.load_factor - 1.0).abs();
+            assert!(e <= 1e-9, "pinned {pinned}: {} vs {} ({e:.1e})", s.load_factor, d.load_factor);
+        }
+        let dofs = problem.dofs();
+        let lateral = |m: &cosserat::solve::stability::BucklingMode, i: usize| {
+            let x = dofs.get(&m.shape, i, cosserat::model::mesh::Field::X);
+            (x[0] * x[0] + x[1] * x[1]).sqrt()
+        };
+        for i in 0..dofs.nodes() {
+            let (a, b) = (lateral(&dense[0], i), lateral(&sparse[0], i));
+            assert!(
+                (a - b).abs() <= 1e-6 * lateral(&dense[0], dofs.nodes() / 2).max(1e-300),
+                "pinned {pinned}, node {i}"
+            );
+        }
+    }
+}
+
+/// Above the dense limit (300 elements) the sparse path takes over: the factors at 100 (dense),
+/// 200 (sparse, called directly) and 400 elements (sparse, past the limit) converge at second
+/// order (their differences), and their Richardson limit meets Euler–Engesser's load to within
+/// twice the pre-buckling shortening's P_cr/EA = 2.5e-6, which the formula leaves out.
+#[test]
+fn buckling_above_the_dense_limit_converges_to_euler() {
+    let exact = euler_factor(false, 1.0);
+    let c400 = column(false, 400, 1.0, &Matrix3::identity());
+    assert!(c400.problem().dofs().len() > DENSE_LIMIT);
+    let c200 = column(false, 200, 1.0, &Matrix3::identity());
+    let l = [
+        lowest(&column(false, 100, 1.0, &Matrix3::identity())),
+        buckling_sparse(&c200.problem(), 1).expect("sparse")[0].load_factor,
+        lowest(&c400),
+    ];
+    let order = ((l[0] - l[1]) / (l[1] - l[2])).log2();
+    let limit = l[2] + (l[2] - l[1]) / 3.0;
+    let error = limit / exact - 1.0;
+    eprintln!(
+        "clamped-free: factors {l:?}, order {order:.3}, Richardson limit {limit:.9} ({error:.2e} from Euler-Engesser)"
+    );
+    assert!((1.95..2.05).contains(&order), "order {order}");
+    assert!(error.abs() < 2.0 * (PI * PI / 4.0) / 1e6, "{error}");
 }
 
 #[test]

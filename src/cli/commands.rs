@@ -13,7 +13,7 @@ use cosserat::engine::Engine;
 use cosserat::io::compact::OutputFormat;
 use cosserat::jobs::job::{case_label, run_into, run_manifest};
 use cosserat::output::run_folder::{input_file, Manifest, Mode, Placed, RunFolder, Status};
-use cosserat::solve::modes::modal_model;
+use cosserat::solve::modes::lowest_modes;
 use cosserat::solve::Outcome;
 
 /// The case of `path`, its `rod.length_m = "from_data"` resolved from its recording.
@@ -425,6 +425,8 @@ pub fn cmd_buckling(path: &Path, count: usize) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
+/// `cosserat modes`: the lowest `count` natural frequencies of the rod clamped at s = 0,
+/// linearised about its rest state (shift-invert block Lanczos, D28).
 pub fn cmd_modes(path: &Path, count: usize, limits: Limits) -> Result<ExitCode> {
     let case = load(path)?;
     if !case.density_given() {
@@ -433,8 +435,8 @@ pub fn cmd_modes(path: &Path, count: usize, limits: Limits) -> Result<ExitCode> 
             path.display()
         );
     }
-    check_memory(&case, Footprint::Modes, limits)?;
-    let model = modal_model(&case.problem())?;
+    check_memory(&case, Footprint::Modes { count }, limits)?;
+    let model = lowest_modes(&case.problem(), count)?;
     println!(
         "{}: natural frequencies of the linearised rod (clamped at s = 0, {} elements)",
         case.name, case.mesh.elements

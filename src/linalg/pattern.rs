@@ -165,6 +165,18 @@ impl Pattern {
         }
     }
 
+    /// The product `A x` of the matrix with these values and a vector.
+    pub fn multiply(&self, values: &[f64], x: &nalgebra::DVector<f64>) -> nalgebra::DVector<f64> {
+        let mut y = nalgebra::DVector::zeros(self.ndofs);
+        for j in 0..self.ndofs {
+            let xj = x[j];
+            for k in self.col_ptr[j]..self.col_ptr[j + 1] {
+                y[self.row_idx[k]] += values[k] * xj;
+            }
+        }
+        y
+    }
+
     /// Dense copy (for eigenvalue problems of modest size).
     pub fn to_dense(&self, values: &[f64]) -> nalgebra::DMatrix<f64> {
         let mut m = nalgebra::DMatrix::zeros(self.ndofs, self.ndofs);
@@ -180,6 +192,15 @@ impl Pattern {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `multiply` is the dense product of `to_dense` (integer-valued entries: exact).
+    #[test]
+    fn multiply_is_the_dense_product() {
+        let p = Pattern::block_tridiagonal(5, 3);
+        let values: Vec<f64> = (0..p.nnz()).map(|k| ((7 * k) % 11) as f64 - 5.0).collect();
+        let x = nalgebra::DVector::from_fn(p.ndofs(), |i, _| (i % 4) as f64 - 1.5);
+        assert_eq!(p.multiply(&values, &x), p.to_dense(&values) * &x);
+    }
 
     /// A pass of `scatter_first` over every element, in order, on values holding garbage gives
     /// bit for bit what zeroing them and adding with `scatter` gives (signed zeros included).

@@ -4,11 +4,23 @@
 //! tests the moment balance with `δα` rather than with the virtual rotation `δθ = Qᵀ A δα`
 //! (eqs. 27, 30), so the α rows are not symmetric. Left-multiplying them by `A(0)ᵀ` (the
 //! virtual-work form at rest) gives symmetric `K_s`, `M_s` with `M_s` positive definite; we
-//! solve `K_s φ = ω² M_s φ` by Cholesky reduction. The symmetry is checked, not assumed.
-use nalgebra::{DMatrix, DVector, SymmetricEigen};
+//! solve `K_s φ = ω² M_s φ`. The symmetry is checked, not assumed.
+//!
+//! Two solvers of the same pencil:
+//! - [`modal_model`]: every mode, dense (Cholesky reduction `L⁻¹ K_s L⁻ᵀ`, `M_s = L Lᵀ`, and
+//!   the symmetric QR iteration): for the modal superposition of a whole response, a few
+//!   hundred elements at most (O(n²) memory, O(n³) time);
+//! - [`lowest_modes`]: the lowest `k` modes by shift-invert block Lanczos (D28): the operator
+//!   `(K − σM)⁻¹M = (K_s − σM_s)⁻¹M_s` (the same for the paper's rows and the symmetrised ones,
+//!   `T = blockdiag(I, A(0)ᵀ)` being invertible), one banded LU of `K` (σ = 0: the clamped rod
+//!   has no rigid motion) and one solve per Lanczos vector, the vectors `M_s`-orthonormal, so
+//!   that `V_mᵀ M_s (K_s − σM_s)⁻¹ M_s V_m` is symmetric and its largest eigenvalues
+//!   `θ = 1/(ω² − σ)` give the lowest `ω²`: O(n k) memory, O(n (k + bandwidth²)) time.
+use nalgebra::{DMatrix, DVector, Matrix3, SymmetricEigen};
 
 use super::{Problem, SolveError};
 use crate::assemble::Tangent;
+use crate::linalg::{largest_symmetric, Krylov, LinearSolver, Pattern};
 use crate::model::mesh::{DofMap, Field};
 use crate::model::rotation::a_matrix;
 
@@ -84,6 +96,109 @@ pub fn modal_model(problem: &Problem) -> Result<ModalModel, ModesError> {
     let y = DMatrix::from_fn(n, n, |r, c| eig.eigenvectors[(r, order[c])]);
     let shapes = l.transpose().solve_upper_triangular(&y).ok_or(ModesError::MassNotDefinite)?;
     Ok(ModalModel { omegas, shapes, row_transform: t, asymmetry, first_free: free.start })
+}
+
+/// The lowest modes of the rod linearised about its rest state ([`lowest_modes`]).
+#[derive(Clone, Debug)]
+pub struct LowestModes {
+    /// circular frequencies ω_i [rad/s], ascending
+    pub omegas: Vec<f64>,
+    /// the modes in the problem's layout (zero on the clamped node 0), `φᵀ M_s φ = 1`
+    pub shapes: Vec<DVector<f64>>,
+    /// largest relative asymmetry found in `K_s` and `M_s`
+    pub asymmetry: f64,
+}
+
+/// Block size of the Lanczos method: at least the multiplicity of the wanted frequencies (a
+/// section with EI1 = EI2 bends alike in two planes: every bending frequency is double).
+pub const LANCZOS_BLOCK: usize = 3;
+
+/// A Ritz pair is converged when its residual is at most this times the largest `θ`
+/// (`‖(K_s − σM_s)⁻¹M_s x − θ x‖_{M_s}`; the error of `θ` is of the order of its square over
+/// the gap to the next one, Saad 2011, Th. 4.8 of [`crate::linalg::Krylov`]'s references).
+pub const RITZ_TOLERANCE: f64 = 1e-10;
+
+/// The lowest `count` modes of the rod clamped at s = 0, linearised about its rest state
+/// (module doc): the same pencil as [`modal_model`], by shift-invert block Lanczos (D28).
+/// `count` is capped at half the free unknowns.
+pub fn lowest_modes(problem: &Problem, count: usize) -> Result<LowestModes, ModesError> {
+    let pattern = problem.dofs().pattern();
+    let u0 = problem.reference_state();
+    let zero = DVector::zeros(u0.len());
+    let mut kv = vec![0.0; pattern.nnz()];
+    problem.internal_force(&u0, Some(Tangent::new(&pattern, &mut kv, 1.0)));
+    let mut mv = vec![0.0; pattern.nnz()];
+    problem.momentum(&u0, &zero, Some((Tangent::new(&pattern, &mut mv, 0.0), 1.0)));
+    let (free, free_dofs) = free_dofs(problem);
+    let a0t = a_matrix(&nalgebra::Vector3::zeros()).transpose();
+    let alpha = problem.dofs().index(0, Field::Alpha, 0);
+    let asymmetry = symmetrised_asymmetry(&pattern, &kv, &a0t, alpha, free.start)
+        .max(symmetrised_asymmetry(&pattern, &mv, &a0t, alpha, free.start));
+    if asymmetry > 1e-10 {
+        return Err(ModesError::NotSymmetric(asymmetry));
+    }
+    // node 0 clamped: identity rows in K, zero rows in M (the vectors vanish there)
+    let clamped: Vec<usize> = (0..free.start).collect();
+    pattern.set_identity_rows(&mut kv, &clamped);
+    pattern.set_identity_rows(&mut mv, &clamped);
+    for &d in &clamped {
+        mv[pattern.position(d, d).expect("diagonal")] = 0.0;
+    }
+    let mut solver = LinearSolver::new(&pattern);
+    let mut factored = false;
+    let op = |v: &DVector<f64>| {
+        let b = pattern.multiply(&mv, v);
+        if factored {
+            solver.solve_factored(&b)
+        } else {
+            factored = true;
+            solver.solve_equilibrated(&kv, &b)
+        }
+    };
+    let block = pattern.block();
+    let inner = |v: &DVector<f64>| transform_rows(pattern.multiply(&mv, v), &a0t, block, alpha);
+    let count = count.min(free_dofs.len() / 2);
+    let mut krylov = Krylov::new(u0.len(), LANCZOS_BLOCK, op, inner).map_err(SolveError::from)?;
+    let pairs = largest_symmetric(&mut krylov, count, RITZ_TOLERANCE).map_err(SolveError::from)?;
+    let (omegas, shapes) = pairs.into_iter().map(|(theta, x)| ((1.0 / theta).max(0.0).sqrt(), x)).unzip();
+    Ok(LowestModes { omegas, shapes, asymmetry })
+}
+
+/// `T v`: `A(0)ᵀ` applied to every node's angle triple (at `alpha` within its block).
+fn transform_rows(mut v: DVector<f64>, a0t: &Matrix3<f64>, block: usize, alpha: usize) -> DVector<f64> {
+    for node in 0..v.len() / block {
+        let o = node * block + alpha;
+        let t = a0t * v.fixed_rows::<3>(o);
+        v.fixed_rows_mut::<3>(o).copy_from(&t);
+    }
+    v
+}
+
+/// The largest `|(T A)_ij − (T A)_ji|` over the unknowns from `first` on, relative to the
+/// largest `|(T A)_ij|` there (`T` as in [`transform_rows`]; a column's rows are whole blocks).
+fn symmetrised_asymmetry(pattern: &Pattern, values: &[f64], a0t: &Matrix3<f64>, alpha: usize, first: usize) -> f64 {
+    let (n, block) = (pattern.ndofs(), pattern.block());
+    let mut ta = values.to_vec();
+    let (col_ptr, row_idx) = (pattern.col_ptr(), pattern.row_idx());
+    for j in 0..n {
+        for k in (col_ptr[j]..col_ptr[j + 1]).step_by(block) {
+            let o = k + alpha - (row_idx[k] % block);
+            let t = a0t * nalgebra::Vector3::new(values[o], values[o + 1], values[o + 2]);
+            ta[o..o + 3].copy_from_slice(t.as_slice());
+        }
+    }
+    let (mut diff, mut big) = (0.0_f64, 0.0_f64);
+    for j in first..n {
+        for k in col_ptr[j]..col_ptr[j + 1] {
+            let i = row_idx[k];
+            if i >= first {
+                let back = pattern.position(j, i).map_or(0.0, |p| ta[p]);
+                diff = diff.max((ta[k] - back).abs());
+                big = big.max(ta[k].abs());
+            }
+        }
+    }
+    diff / big
 }
 
 impl ModalModel {

@@ -30,13 +30,15 @@
 //! load.
 //!
 //! Dense: up to [`DENSE_LIMIT`] unknowns (300 elements); above it the stability is not computed
-//! (`None`) and buckling is refused.
+//! (`None`) and buckling takes the banded matrices, `K₀` factored once and the lowest factors
+//! by shift-invert block Arnoldi ([`buckling_sparse`], D28; the same factors to 1e-9, tests/buckling.rs).
 use nalgebra::{DMatrix, DVector};
 
 use super::arclength::{load_rate, newton_system, wnorm2};
 use super::problem::{FrameAt, HeldRows};
 use super::{Problem, SolveError};
 use crate::assemble::Tangent;
+use crate::linalg::{largest_real_positive, Krylov, LinearSolver};
 use crate::model::mesh::Field;
 
 /// The largest rotation of the sections in the linear pre-buckling response, relative to its
@@ -161,33 +163,21 @@ fn dense_mass(problem: &Problem, u: &DVector<f64>) -> DMatrix<f64> {
 }
 
 /// The lowest `count` positive critical load factors of the case's loads about the reference,
-/// with their modes (D27), ascending.
+/// with their modes (D27), ascending: dense up to [`DENSE_LIMIT`] unknowns, above it by
+/// shift-invert Arnoldi on the banded matrices ([`buckling_sparse`], D28).
 pub fn buckling(problem: &Problem, count: usize) -> Result<Vec<BucklingMode>, StabilityError> {
-    check_size(problem)?;
+    if problem.dofs().len() > DENSE_LIMIT {
+        return buckling_sparse(problem, count);
+    }
     let pattern = problem.dofs().pattern();
     let u0 = problem.reference_state();
     let k0 = dense_tangent(problem, &u0, 0.0);
     let q = load_rate(problem, &u0, 0.0, &pattern);
     let lu = k0.clone().lu();
     let u1 = lu.solve(&q).ok_or(StabilityError::SingularReference)?;
-    let size = wnorm2(problem, &u1, &u1).sqrt();
-    if size == 0.0 || !size.is_finite() {
+    let Some(eps) = prebuckling_step(problem, &u1)? else {
         return Ok(Vec::new()); // no load: nothing buckles
-    }
-    // the linear pre-buckling response must keep the sections' orientation (module doc)
-    let dofs = problem.dofs();
-    let (mut turn, mut shift) = (0.0_f64, 0.0_f64);
-    for (i, v) in u1.iter().enumerate() {
-        if dofs.field_of(i) == Field::X {
-            shift = shift.max(v.abs() / problem.mesh.length_m);
-        } else {
-            turn = turn.max(v.abs());
-        }
-    }
-    if turn > PREBUCKLING_TURN * shift {
-        return Err(StabilityError::TurningPrebuckling { turn_rad: turn, shift });
-    }
-    let eps = 1e-5 / size;
+    };
     let kp = dense_tangent(problem, &(&u0 + &u1 * eps), eps);
     let km = dense_tangent(problem, &(&u0 - &u1 * eps), -eps);
     let k_sigma = (kp - km) / (2.0 * eps);
@@ -208,12 +198,78 @@ pub fn buckling(problem: &Problem, count: usize) -> Result<Vec<BucklingMode>, St
         .collect())
 }
 
+/// The step `ε` (`‖ε u₁‖_w = 10⁻⁵`) of the central difference of `K_σ` along the linear
+/// pre-buckling response `u₁` (`None`: no load), after checking that `u₁` turns no section
+/// (module doc).
+fn prebuckling_step(problem: &Problem, u1: &DVector<f64>) -> Result<Option<f64>, StabilityError> {
+    let size = wnorm2(problem, u1, u1).sqrt();
+    if size == 0.0 || !size.is_finite() {
+        return Ok(None);
+    }
+    let dofs = problem.dofs();
+    let (mut turn, mut shift) = (0.0_f64, 0.0_f64);
+    for (i, v) in u1.iter().enumerate() {
+        if dofs.field_of(i) == Field::X {
+            shift = shift.max(v.abs() / problem.mesh.length_m);
+        } else {
+            turn = turn.max(v.abs());
+        }
+    }
+    if turn > PREBUCKLING_TURN * shift {
+        return Err(StabilityError::TurningPrebuckling { turn_rad: turn, shift });
+    }
+    Ok(Some(1e-5 / size))
+}
+
+/// Block size of the Arnoldi method of [`buckling_sparse`]: at least the multiplicity of the
+/// wanted factors (a round column buckles alike in two planes).
+pub const ARNOLDI_BLOCK: usize = 3;
+
+/// A Ritz pair of [`buckling_sparse`] is converged when its residual is at most this times the
+/// largest `|ν|`.
+pub const ARNOLDI_TOLERANCE: f64 = 1e-10;
+
+/// [`buckling`] on the banded matrices (D28): `K₀` factored once (the crate's banded LU with
+/// Ruiz equilibration), `K_σ` by the same central difference, and the largest positive real
+/// eigenvalues `ν` of `−K₀⁻¹ K_σ` by block Arnoldi with full reorthogonalisation
+/// ([`crate::linalg::largest_real_positive`]); `λ_cr = 1/ν`, each mode the Ritz vector scaled
+/// as [`mode_shape`] scales the dense null vector.
+pub fn buckling_sparse(problem: &Problem, count: usize) -> Result<Vec<BucklingMode>, StabilityError> {
+    let pattern = problem.dofs().pattern();
+    let u0 = problem.reference_state();
+    let mut k0 = vec![0.0; pattern.nnz()];
+    newton_system(problem, &u0, 0.0, &pattern, &mut k0);
+    let q = load_rate(problem, &u0, 0.0, &pattern);
+    let mut solver = LinearSolver::new(&pattern);
+    let u1 = solver.solve_equilibrated(&k0, &q).map_err(|_| StabilityError::SingularReference)?;
+    let Some(eps) = prebuckling_step(problem, &u1)? else {
+        return Ok(Vec::new());
+    };
+    let (mut kp, mut km) = (vec![0.0; pattern.nnz()], vec![0.0; pattern.nnz()]);
+    newton_system(problem, &(&u0 + &u1 * eps), eps, &pattern, &mut kp);
+    newton_system(problem, &(&u0 - &u1 * eps), -eps, &pattern, &mut km);
+    let k_sigma: Vec<f64> = kp.iter().zip(&km).map(|(p, m)| (p - m) / (2.0 * eps)).collect();
+    let op = |v: &DVector<f64>| solver.solve_factored(&-pattern.multiply(&k_sigma, v));
+    let n = u0.len();
+    let mut krylov = Krylov::new(n, ARNOLDI_BLOCK, op, |v: &DVector<f64>| v.clone()).map_err(SolveError::from)?;
+    let pairs = largest_real_positive(&mut krylov, count, ARNOLDI_TOLERANCE).map_err(SolveError::from)?;
+    Ok(pairs
+        .into_iter()
+        .map(|(nu, phi)| BucklingMode { load_factor: 1.0 / nu, shape: normalised(problem, phi) })
+        .collect())
+}
+
 /// The null vector of `K₀ + λ K_σ`, scaled to `‖φ‖_w = 1` with its largest entry positive.
 fn mode_shape(problem: &Problem, k0: &DMatrix<f64>, k_sigma: &DMatrix<f64>, lambda: f64) -> DVector<f64> {
     let svd = (k0 + k_sigma * lambda).svd(false, true);
     let vt = svd.v_t.expect("requested");
     let (k, _) = svd.singular_values.argmin();
-    let mut phi: DVector<f64> = vt.row(k).transpose();
+    normalised(problem, vt.row(k).transpose())
+}
+
+/// A mode scaled to `‖φ‖_w = 1` with its largest entry (positions over L) positive, zero on
+/// the held unknowns.
+fn normalised(problem: &Problem, mut phi: DVector<f64>) -> DVector<f64> {
     // a held unknown does not move (its row of K₀ + λ K_σ is the identity's); the SVD leaves ~1e-8
     for d in problem.clamped_dofs() {
         phi[d] = 0.0;

@@ -18,8 +18,8 @@ pub const GIB: f64 = 1024.0 * 1024.0 * 1024.0;
 pub enum Footprint {
     /// `run`, `sweep` points, `compare`: the case's solver
     Run,
-    /// `modes`: the dense modal model
-    Modes,
+    /// `modes`: the lowest `count` modes by shift-invert block Lanczos (D28)
+    Modes { count: usize },
 }
 
 /// A run refused before it started.
@@ -133,11 +133,16 @@ pub fn estimate(case: &Case, what: Footprint) -> (f64, String, &'static str) {
     let n_forward = 6.0 * (e + 1.0);
     let basis = format!("rod.elements = {elements}");
     match what {
-        Footprint::Modes => (
-            FIXED_BYTES + 12.0 * n_forward * n_forward * 8.0,
-            format!("{basis}: a dense modal model of {n_forward} unknowns"),
-            "rod.elements",
-        ),
+        Footprint::Modes { count } => {
+            // the banded LU of K and the Lanczos basis (each vector and its M-image), grown
+            // twice by 4 (count + block) vectors (`linalg::largest_symmetric`)
+            let vectors = 2.0 * 8.0 * (count + crate::solve::modes::LANCZOS_BLOCK) as f64;
+            (
+                FIXED_BYTES + e * banded_bytes_per_element(6.0) + 2.0 * vectors * n_forward * 8.0,
+                format!("{basis}: {n_forward} unknowns, a Lanczos basis of {vectors} vectors"),
+                "rod.elements",
+            )
+        }
         Footprint::Run => match &case.analysis {
             Analysis::Static(_) => (FIXED_BYTES + e * banded_bytes_per_element(6.0), basis, "rod.elements"),
             Analysis::Dynamic(p) => (
@@ -170,7 +175,7 @@ pub fn check(case: &Case, what: Footprint, limit_bytes: f64) -> Result<(), Budge
     if bytes > limit_bytes {
         let what = match what {
             Footprint::Run => "the run",
-            Footprint::Modes => "the modal model",
+            Footprint::Modes { .. } => "the modal analysis",
         };
         let case = case.origin.source.as_ref().map(|p| p.display().to_string()).unwrap_or_else(|| case.name.clone());
         return Err(BudgetError { case, what, bytes, limit: limit_bytes, basis, key, address_space });
