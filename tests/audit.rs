@@ -39,8 +39,9 @@ fn quick_audit_verdicts_are_the_recorded_ones() {
         })
         .collect();
     assert!(wrong.is_empty(), "verdicts that changed:\n{}", wrong.join("\n"));
-    // Every verdict class a spec may ask for occurs: the audit can tell them apart ("refuted"
-    // needs FreeFEM too, which the audit does not run: no spec may ask for it).
+    // Every verdict class occurs: the audit can tell them apart ("refuted" needs the reruns in
+    // FreeFEM and the other reading, `--engines`, which the quick audit does not run; the
+    // synthetic test of tests/audit_convergence.rs gives it).
     for v in [Verdict::Reproduced, Verdict::Differs, Verdict::NotComputable] {
         assert!(report.claims.iter().any(|c| c.verdict == Some(v)), "no claim is {}", v.as_str());
     }
