@@ -14,7 +14,13 @@ fn quick_audit_verdicts_are_the_recorded_ones() {
     let specs: Vec<_> = spec_files(&dir).expect("specs").iter().map(|f| read_spec(f, true).expect("spec")).collect();
     assert!(specs.len() >= 5, "the audit covers §5.1, §5.2 (three specs) and §6");
     let out = tempfile::tempdir().expect("tempdir");
-    let opts = AuditOptions { out: out.path().join("audit"), jobs: 0, fields: Default::default(), resume: false };
+    let opts = AuditOptions {
+        out: out.path().join("audit"),
+        jobs: 0,
+        fields: Default::default(),
+        resume: false,
+        engines: false,
+    };
     let report = run_audit(&specs, true, &opts, |_, _| {}).expect("audit");
 
     let wrong: Vec<String> = report
@@ -33,8 +39,9 @@ fn quick_audit_verdicts_are_the_recorded_ones() {
         })
         .collect();
     assert!(wrong.is_empty(), "verdicts that changed:\n{}", wrong.join("\n"));
-    // Every verdict class a spec may ask for occurs: the audit can tell them apart ("refuted"
-    // needs FreeFEM too, which the audit does not run: no spec may ask for it).
+    // Every verdict class occurs: the audit can tell them apart ("refuted" needs the reruns in
+    // FreeFEM and the other reading, `--engines`, which the quick audit does not run; the
+    // synthetic test of tests/audit_convergence.rs gives it).
     for v in [Verdict::Reproduced, Verdict::Differs, Verdict::NotComputable] {
         assert!(report.claims.iter().any(|c| c.verdict == Some(v)), "no claim is {}", v.as_str());
     }
@@ -88,7 +95,8 @@ fn audit_folder_is_replaced_whole_or_refused() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/paper");
     let spec = read_spec(&dir.join("fig07_timoshenko.toml"), true).expect("spec");
     let out = tempfile::tempdir().expect("tempdir");
-    let opts = AuditOptions { out: out.path().join("a"), jobs: 1, fields: Default::default(), resume: false };
+    let opts =
+        AuditOptions { out: out.path().join("a"), jobs: 1, fields: Default::default(), resume: false, engines: false };
     run_audit(std::slice::from_ref(&spec), true, &opts, |_, _| {}).expect("first audit");
     let stale = opts.out.join("fig07_timoshenko/stale.txt");
     std::fs::write(&stale, "from an older audit").expect("write");
@@ -101,7 +109,7 @@ fn audit_folder_is_replaced_whole_or_refused() {
     let err = run_audit(
         &[spec],
         true,
-        &AuditOptions { out: foreign.clone(), jobs: 1, fields: Default::default(), resume: false },
+        &AuditOptions { out: foreign.clone(), jobs: 1, fields: Default::default(), resume: false, engines: false },
         |_, _| {},
     )
     .err()
@@ -118,7 +126,13 @@ fn tradeoff_figure_lists_every_point_with_its_time_and_error() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/bench/accuracy_per_second.toml");
     let spec = read_spec(&path, true).expect("spec");
     let out = tempfile::tempdir().expect("tempdir");
-    let opts = AuditOptions { out: out.path().join("aps"), jobs: 1, fields: Default::default(), resume: false };
+    let opts = AuditOptions {
+        out: out.path().join("aps"),
+        jobs: 1,
+        fields: Default::default(),
+        resume: false,
+        engines: false,
+    };
     let report = run_audit(std::slice::from_ref(&spec), true, &opts, |_, _| {}).expect("audit");
     assert!(report.claims.iter().all(|c| c.verdict == Some(Verdict::Reproduced)), "{:?}", report.claims[0].ours);
     let csv = std::fs::read_to_string(opts.out.join("accuracy_per_second/accuracy_per_second.csv")).expect("csv");
@@ -167,7 +181,13 @@ expect = "reproduced"
     let path = tmp.path().join("failed.toml");
     std::fs::write(&path, spec).expect("spec");
     let spec = read_spec(&path, true).expect("spec");
-    let opts = AuditOptions { out: tmp.path().join("out"), jobs: 1, fields: Default::default(), resume: false };
+    let opts = AuditOptions {
+        out: tmp.path().join("out"),
+        jobs: 1,
+        fields: Default::default(),
+        resume: false,
+        engines: false,
+    };
     let report = run_audit(&[spec], true, &opts, |_, _| {}).expect("report written");
     assert!(matches!(&report.status, AuditStatus::Failed(e) if e.len() == 1 && e[0].contains("eq63_curve_rel_eror")));
     assert_eq!((report.unjudged(), report.counts()), (1, [1, 0, 0, 0]));
@@ -264,8 +284,11 @@ fn check_docs_numbers(report: &cosserat::audit::AuditReport, doc: &str, specs_te
                     problems.push(format!("{n}: no claim `{id}` in the quick audit"));
                     continue;
                 };
-                if !numbers(&c.ours).iter().any(|(_, o)| same_within_rounding(&n, o)) {
-                    problems.push(format!("{n} (claim {id}): the quick audit gives {}", c.ours));
+                // the row's numbers: ours, our standard and the other engine's
+                let row = [Some(&c.ours), c.standard.as_ref(), c.engines.as_ref()].into_iter().flatten();
+                let row = row.cloned().collect::<Vec<_>>().join("; ");
+                if !numbers(&row).iter().any(|(_, o)| same_within_rounding(&n, o)) {
+                    problems.push(format!("{n} (claim {id}): the quick audit gives {row}"));
                 }
             }
             None => {
@@ -493,7 +516,13 @@ ours = true
     let err = read(spec("refuted", "agrees very well", "")).expect_err("refused");
     assert!(err.to_string().contains("both engines"), "{err}");
     let spec = read(spec("differs", "agrees very well", "")).expect("spec");
-    let opts = AuditOptions { out: tmp.path().join("out"), jobs: 1, fields: Default::default(), resume: false };
+    let opts = AuditOptions {
+        out: tmp.path().join("out"),
+        jobs: 1,
+        fields: Default::default(),
+        resume: false,
+        engines: false,
+    };
     let report = run_audit(&[spec], true, &opts, |_, _| {}).expect("audit");
     // the same check, which holds (fig7-5pct): partial → differs; ours → reproduced, apart
     assert_eq!(report.claims[0].verdict, Some(Verdict::Differs), "{}", report.claims[0].ours);

@@ -3,24 +3,17 @@
 //! claim's declared fallbacks. Numbers are written as `numbers` says: two significant digits,
 //! counts exactly, a value beside its reference with the digits that show their difference.
 use super::cause::{fill, PointState};
-use super::numbers::{against, input, round_numbers, sig2};
+use super::convergence::{converges, met_rule};
+use super::numbers::{against, input, sig2};
+use super::points::{key_of, outcome, point_label, select, values};
+pub use super::points::{CheckError, Outcome};
 use super::spec::{Check, Claim, Ref, Selector, Spec};
 use super::{ClaimResult, PointResult, RunResults, Verdict};
-use crate::engine::metrics::Metric;
 use crate::jobs::sweep::NOT_STARTED;
 use crate::solve;
 
 mod compound;
 mod truth_rows;
-
-/// How far a check holds.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Outcome {
-    Holds,
-    /// holds on some points of the grid only
-    Partly,
-    Fails,
-}
 
 /// `metric` at each point, `label: value` joined by commas (no label for a single point),
 /// each value with the digits that show its difference from `reference`.
@@ -34,78 +27,8 @@ fn metric_list(pts: &[&PointResult], metric: &str, reference: f64) -> String {
         .join(", ")
 }
 
-/// A point's label for the report: `λd = 1e-2` style from its grid values (`key=value`).
-fn point_label(p: &PointResult) -> String {
-    if p.point.is_empty() {
-        return "the run".into();
-    }
-    p.point.iter().map(|(k, v)| format!("{k} = {v}")).collect::<Vec<_>>().join(", ")
-}
-
-/// Values of the points, `1e-20, 1e-10, 1` (single grid key) or full labels.
-fn values(points: &[&PointResult]) -> String {
-    let single = points.iter().all(|p| p.point.len() == 1);
-    points.iter().map(|p| if single { p.point[0].1.to_string() } else { point_label(p) }).collect::<Vec<_>>().join(", ")
-}
-
-/// The grid key of a run with one key (for "λd = …" phrasing).
-fn key_of(points: &[&PointResult]) -> String {
-    points.first().and_then(|p| (p.point.len() == 1).then(|| p.point[0].0.clone())).unwrap_or_default()
-}
-
-/// Why a point did not converge, shortly: `not converged after N iterations` or the error.
-fn failure(p: &PointResult) -> String {
-    let e = p.outcome.error.as_deref().unwrap_or("no result");
-    match p.outcome.status {
-        solve::Outcome::IterationLimit | solve::Outcome::Stalled => {
-            let its = p.value(Metric::Iterations).map(|i| format!(" after {i}")).unwrap_or_default();
-            let x = p.value(Metric::XErrRel).map(|x| format!(", x error {}", sig2(x))).unwrap_or_default();
-            let c = p.value(Metric::Certificate).map(|c| format!(", certificate {}", sig2(c))).unwrap_or_default();
-            let word = if p.outcome.status == solve::Outcome::Stalled { "stalled" } else { "not converged" };
-            format!("{word}{its} iterations{x}{c}")
-        }
-        _ => {
-            // the innermost cause: after the last ": " of the error chain
-            let short = e.rsplit(": ").take(2).collect::<Vec<_>>().into_iter().rev().collect::<Vec<_>>().join(": ");
-            // whole: the report wraps it, and a cut message hides its end
-            format!("failed: {}", round_numbers(&short.replace('\n', " ")))
-        }
-    }
-}
-
 fn metric_text(p: &PointResult, metric: &str) -> String {
     p.metric(metric).map(sig2).unwrap_or_else(|| "–".into())
-}
-
-/// Why a check could not be evaluated on the runs' points (a spec that names a run, point,
-/// metric or history the runs do not have); the report says "not evaluated: …".
-#[derive(Clone, Debug, PartialEq, thiserror::Error)]
-pub enum CheckError {
-    #[error("no run `{run}`")]
-    NoRun { run: String },
-    #[error("run `{run}` has no point {at:?}")]
-    NoPoint { run: String, at: Selector },
-    #[error("run `{run}` at {at:?} selects {count} points, not one")]
-    NotOnePoint { run: String, at: Selector, count: usize },
-    /// `point`: the point's label (`lambda_d = 1e-2`, `the run`)
-    #[error("`{metric}` missing at {point}")]
-    MissingMetric { metric: String, point: String },
-    #[error("`within_factor` needs two points or more (run `{run}` and `with`)")]
-    TooFewPoints { run: String },
-    #[error("`{metric}` missing at some points of `{run}`")]
-    MissingAtSomePoints { metric: String, run: String },
-    #[error("no `{history}` history at the reference point")]
-    NoHistory { history: String },
-}
-
-/// The points of `run` selected by `at`.
-fn select<'a>(runs: &'a [RunResults], run: &str, at: &Selector) -> Result<Vec<&'a PointResult>, CheckError> {
-    let r = runs.iter().find(|r| r.name == run).ok_or_else(|| CheckError::NoRun { run: run.to_string() })?;
-    let pts: Vec<&PointResult> = r.select(at).collect();
-    if pts.is_empty() {
-        return Err(CheckError::NoPoint { run: run.to_string(), at: at.clone() });
-    }
-    Ok(pts)
 }
 
 fn one<'a>(runs: &'a [RunResults], r: &Ref) -> Result<&'a PointResult, CheckError> {
@@ -129,31 +52,6 @@ fn split_by<'a>(
     ok: impl Fn(&PointResult) -> bool,
 ) -> (Vec<&'a PointResult>, Vec<&'a PointResult>) {
     pts.iter().partition(|p| ok(p))
-}
-
-fn outcome(good: usize, total: usize) -> Outcome {
-    if good == total {
-        Outcome::Holds
-    } else if good > 0 {
-        Outcome::Partly
-    } else {
-        Outcome::Fails
-    }
-}
-
-fn iterations_range(pts: &[&PointResult], metric: &str) -> String {
-    let v: Vec<f64> = pts.iter().filter_map(|p| p.metric(metric)).collect();
-    if v.is_empty() {
-        return String::new();
-    }
-    let (lo, hi) = v.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| (a.min(*x), b.max(*x)));
-    // frames and iterations are counted exactly
-    let f = |x: f64| format!("{x}");
-    if lo == hi {
-        format!(" ({} {metric})", f(lo))
-    } else {
-        format!(" ({}–{} {metric})", f(lo), f(hi))
-    }
 }
 
 /// The outcome and text of `check`, one stage per kind of check.
@@ -204,37 +102,6 @@ fn evaluate_inner(check: &Check, runs: &[RunResults]) -> Result<(Outcome, String
         Check::WithTruth { check, runs: names, bending_below, twist_below } => {
             truth_rows::with_truth(check, runs, names, (*bending_below, *twist_below))
         }
-    }
-}
-
-/// `converges` (or, with `fails`, `does_not_converge`): the points that converge, with their
-/// iteration (or frame) range, and why each other did not.
-fn converges(runs: &[RunResults], run: &str, fails: bool) -> Result<(Outcome, String), CheckError> {
-    let pts = select(runs, run, &Selector::new())?;
-    let (ok, bad) = split_by(&pts, |p| p.converged());
-    let count = if pts.iter().any(|p| p.outcome.clip.is_some()) { "frames" } else { "iterations" };
-    let mut text = String::new();
-    let key = key_of(&pts);
-    let named = |v: &[&PointResult]| {
-        if key.is_empty() {
-            values(v)
-        } else {
-            format!("{key} = {}", values(v))
-        }
-    };
-    if !ok.is_empty() {
-        text.push_str(&format!("converges for {}{}", named(&ok), iterations_range(&ok, count)));
-    }
-    for p in &bad {
-        if !text.is_empty() {
-            text.push_str("; ");
-        }
-        text.push_str(&format!("{}: {}", named(&[p]), failure(p)));
-    }
-    if fails {
-        Ok((outcome(bad.len(), pts.len()), text))
-    } else {
-        Ok((outcome(ok.len(), pts.len()), text))
     }
 }
 
@@ -516,8 +383,10 @@ pub fn judge(spec: &Spec, claim: &Claim, runs: &[RunResults]) -> ClaimResult {
         claim: claim.clone(),
         verdict,
         ours,
+        standard: super::convergence::standard(&claim.check, runs),
         cause,
         figure: claim.figure.clone(),
+        engines: None,
     };
     if let Some(why) = unjudgeable(&claim.check, runs) {
         return result(None, why, None);
@@ -564,7 +433,7 @@ fn point_states(check: &Check, runs: &[RunResults]) -> Vec<PointState> {
     };
     match check {
         Check::Converges { run } => select(runs, run, &Selector::new())
-            .map(|pts| pts.iter().map(|p| state(p, p.converged())).collect())
+            .map(|pts| pts.iter().map(|p| state(p, met_rule(p))).collect())
             .unwrap_or_default(),
         Check::SameHistories { run, history, reference, limit } => {
             let Ok((base, hb, spreads)) = history_spreads(runs, run, history, reference) else { return Vec::new() };

@@ -6,10 +6,14 @@
 //! paper's panels and [`report`] writes `REPORT.md` and `report.csv`.
 pub mod cause;
 pub mod check;
+pub mod convergence;
+pub mod engines;
 pub mod figures;
 pub mod inventory;
 pub mod measures;
+pub mod newton_distance;
 pub mod numbers;
+pub mod points;
 pub mod report;
 pub mod resume;
 pub mod spec;
@@ -147,11 +151,16 @@ pub struct ClaimResult {
     pub verdict: Option<Verdict>,
     /// our numbers, two significant digits or those a verdict needs (not judged: why)
     pub ours: String,
+    /// a convergence claim: our standard of a solution, the certificate against 1e-10 with
+    /// its margin and the distance to Newton's solution (`convergence::standard`)
+    pub standard: Option<String>,
     /// why the check did not hold: the spec's cause with its points filled in from the
     /// runs (`cause`); `None` when it held, was not judged or the spec gives no cause
     pub cause: Option<String>,
     /// the figure illustrating the claim, relative to the audit folder
     pub figure: Option<String>,
+    /// the check in the other engine and one-rule readings (`engines`), where it was rerun
+    pub engines: Option<String>,
 }
 
 /// How far an audit got (the audit as a whole; each of its points ends with an
@@ -230,6 +239,9 @@ pub struct AuditOptions {
     /// continue the audit of `out`: specs it judged whole ([`resume::JUDGED`]) are taken
     /// from it, the others run again
     pub resume: bool,
+    /// rerun the failing rows of the printed scheme in the other engine and reading
+    /// ([`engines`]), so that a row can be refuted
+    pub engines: bool,
 }
 
 /// What a clip point of the audit keeps in its folder. Its claims and the audit's figures
@@ -379,8 +391,18 @@ pub fn run_audit(
         None => work(),
     };
     let results = regroup(specs, finished);
+    // the failing rows of the printed scheme in the other engine and reading (`engines`)
+    let reruns = if opts.engines { engines::plan(specs, &results, &opts.out) } else { Vec::new() };
+    let reruns = if crate::interrupt::requested() {
+        specs.iter().map(|_| Vec::new()).collect()
+    } else {
+        match &pool {
+            Some(p) => p.install(|| engines::run(specs, &reruns)),
+            None => engines::run(specs, &reruns),
+        }
+    };
     let interrupted = crate::interrupt::requested();
-    let (claims, figures, failures) = judge_all(specs, &results, &opts.out, reused, quick);
+    let (claims, figures, failures) = judge_all(specs, (&results, &reruns), &opts.out, reused, quick);
     let status = if interrupted {
         AuditStatus::Interrupted
     } else if failures.is_empty() {
@@ -455,16 +477,17 @@ fn coverage(specs: &[Spec], claims: &[ClaimResult]) -> Option<Result<inventory::
 /// all finished (none stopped by a signal); a spec taken from the audit being resumed
 /// (`reused`) keeps its claims and figures. A claim whose metric no point reports, or that
 /// reads a point a signal stopped, is not judged; the failures (metric typos, figures not
-/// written) are returned as text. A spec judged whole is recorded for `--resume`.
+/// written) are returned as text. A spec judged whole is recorded for `--resume`. A claim
+/// rerun in the other engine and reading (`reruns`, [`engines`]) shows it, and may be refuted.
 fn judge_all(
     specs: &[Spec],
-    results: &[Vec<RunResults>],
+    (results, reruns): (&[Vec<RunResults>], &engines::Reruns),
     out: &Path,
     reused: Vec<Option<(Vec<ClaimResult>, Vec<String>)>>,
     quick: bool,
 ) -> (Vec<ClaimResult>, Vec<String>, Vec<String>) {
     let (mut claims, mut figures, mut failures) = (Vec::new(), Vec::new(), Vec::new());
-    for ((spec, runs), old) in specs.iter().zip(results).zip(reused) {
+    for (((spec, runs), old), reruns) in specs.iter().zip(results).zip(reused).zip(reruns) {
         if let Some((c, f)) = old {
             claims.extend(c);
             figures.extend(f);
@@ -480,6 +503,7 @@ fn judge_all(
         let first = claims.len();
         for claim in &spec.claims {
             let mut c = check::judge(spec, claim, runs);
+            engines::apply(spec, claim, &mut c, reruns);
             if let Err(e) = check_metric_name(spec, claim, runs) {
                 c.ours = format!("not judged: {e}");
                 c.verdict = None;
@@ -558,6 +582,7 @@ fn run_job(j: &Job) -> PointResult {
     };
     if let Some(m) = outcome.metrics.as_mut() {
         m.extend(derived_metrics(&j.case, outcome.single.as_ref(), series.as_ref()));
+        m.extend(newton_distance::newton_metrics(&j.case, outcome.single.as_ref()));
     }
     PointResult { point: j.point.clone(), label, outcome, series }
 }

@@ -7,10 +7,22 @@ use super::{AuditError, AuditReport, AuditStatus, ClaimResult, Verdict};
 use crate::io::write_atomic;
 
 /// Columns of `report.csv`.
-pub const REPORT_COLUMNS: [&str; 10] =
-    ["spec", "id", "where", "statement", "paper", "ours", "verdict", "expected", "cause", "figure"];
+pub const REPORT_COLUMNS: [&str; 12] = [
+    "spec",
+    "id",
+    "where",
+    "statement",
+    "paper",
+    "ours",
+    "standard",
+    "engines",
+    "verdict",
+    "expected",
+    "cause",
+    "figure",
+];
 
-fn cells(c: &ClaimResult) -> [String; 10] {
+fn cells(c: &ClaimResult) -> [String; 12] {
     [
         c.spec.clone(),
         c.claim.id.clone(),
@@ -18,6 +30,8 @@ fn cells(c: &ClaimResult) -> [String; 10] {
         c.claim.cited.statement.clone(),
         c.claim.cited.paper.clone(),
         c.ours.clone(),
+        c.standard.clone().unwrap_or_default(),
+        c.engines.clone().unwrap_or_default(),
         verdict_text(c).into(),
         c.claim.expect.as_str().into(),
         if matches!(c.verdict, Some(Verdict::Reproduced) | None) { String::new() } else { cause(c) },
@@ -203,8 +217,8 @@ fn coverage_section(o: &mut String, r: &AuditReport) {
 }
 
 fn table_head(o: &mut String) {
-    let _ = writeln!(o, "| claim | where | the paper | ours | verdict | figure |");
-    let _ = writeln!(o, "|---|---|---|---|---|---|");
+    let _ = writeln!(o, "| claim | where | the paper | ours | our standard of a solution | verdict | figure |");
+    let _ = writeln!(o, "|---|---|---|---|---|---|---|");
 }
 
 /// One row: the paper's words in quotes, our paraphrase of its number outside them.
@@ -215,14 +229,20 @@ fn row(o: &mut String, c: &ClaimResult) {
         None => format!("*{NOT_JUDGED}*"),
     };
     let fig = c.figure.as_ref().map(|f| format!("[{f}]({}/{f})", c.spec)).unwrap_or_default();
+    // the check rerun in the other engine and reading (`super::engines`) follows ours
+    let ours = match &c.engines {
+        Some(e) => format!("{}; {e}", c.ours),
+        None => c.ours.clone(),
+    };
     let _ = writeln!(
         o,
-        "| {} | {} | “{}” (read as: {}) | {} | {} | {} |",
+        "| {} | {} | “{}” (read as: {}) | {} | {} | {} | {} |",
         c.claim.id,
         md(&c.claim.cited.location),
         md(&c.claim.cited.statement),
         md(&c.claim.cited.paper),
-        md(&c.ours),
+        md(&ours),
+        md(c.standard.as_deref().unwrap_or("")),
         verdict,
         fig
     );

@@ -25,8 +25,14 @@ struct Stored {
     id: String,
     verdict: Verdict,
     ours: String,
+    /// a convergence claim's column of our standard
+    #[serde(default)]
+    standard: Option<String>,
     /// the cause of a failed check, as judged
     cause: Option<String>,
+    /// the check in the other engine and readings, where it was rerun
+    #[serde(default)]
+    engines: Option<String>,
 }
 
 /// Record `spec`'s claims (every one judged) and the figures written, relative to the audit
@@ -46,7 +52,9 @@ pub fn store(
                 id: c.claim.id.clone(),
                 verdict,
                 ours: c.ours.clone(),
+                standard: c.standard.clone(),
                 cause: c.cause.clone(),
+                engines: c.engines.clone(),
             })
         })
         .collect::<Option<Vec<_>>>();
@@ -77,8 +85,10 @@ pub fn load(spec: &Spec, quick: bool, out: &Path) -> Option<(Vec<ClaimResult>, V
                 claim: claim.clone(),
                 verdict: Some(s.verdict),
                 ours: s.ours.clone(),
+                standard: s.standard.clone(),
                 cause: s.cause.clone(),
                 figure: claim.figure.clone(),
+                engines: s.engines.clone(),
             })
         })
         .collect::<Option<Vec<_>>>()?;

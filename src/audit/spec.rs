@@ -383,7 +383,8 @@ pub struct FallbackVerdicts {
     /// the verdict when the check fails outright (default: differs)
     pub if_fails: Verdict,
     /// the verdict when the check holds on some points of the paper's range only (default:
-    /// differs; "refuted" is refused when a spec is read: the audit runs the Rust engine only)
+    /// differs; "refuted" is not a fallback: the audit gives it from its reruns in both
+    /// engines and readings, `super::engines`)
     pub if_partly: Verdict,
 }
 
@@ -549,12 +550,14 @@ fn read_claim(path: &Path, c: RawClaim, earlier: &[Claim], runs: &[RunSpec]) -> 
         ));
     }
     // "refuted" needs the failure in the paper's scheme under both one-rule readings and in
-    // both engines (docs/audit.md); the audit runs the Rust engine only, so no spec may ask for it.
-    if [Some(c.expect), c.if_fails, c.if_partly].contains(&Some(Verdict::Refuted)) {
+    // both engines (docs/audit.md): the audit decides it from its reruns (`super::engines`), a
+    // spec may expect it but not declare it as a fallback.
+    let rerun = !c.ours && c.partial.is_none() && c.substitute.is_none();
+    if [c.if_fails, c.if_partly].contains(&Some(Verdict::Refuted)) || (c.expect == Verdict::Refuted && !rerun) {
         return Err(invalid(
             path,
             format!("claim `{}`", c.id),
-            "\"refuted\" needs the failure under both one-rule readings and in both engines (Rust and FreeFEM); the audit runs the Rust engine only: use \"differs\" and say so in the cause".into(),
+            "\"refuted\" is not a fallback, nor for a check of ours, a partial one or one on a substitute: the audit gives it when the check of the paper's claim fails under both one-rule readings and in both engines (Rust and FreeFEM, docs/audit.md)".into(),
         ));
     }
     if let Some(q) = ["(here", "(ours", "(our "].iter().find(|q| c.statement.contains(*q)) {

@@ -194,6 +194,10 @@ pub struct AuditArgs {
     /// Continue the unfinished audit of --out: keep the specs it judged whole, rerun the rest
     #[arg(long, conflicts_with = "force")]
     pub resume: bool,
+    /// Rerun the failing rows of the printed scheme in FreeFEM and the other one-rule reading,
+    /// so that a row can be judged refuted (docs/audit.md; long: FreeFEM's fixed point)
+    #[arg(long)]
+    pub engines: bool,
 }
 
 /// The options of `cosserat run` (its help is the `Run` command's).

@@ -281,7 +281,7 @@ fn held(placed: &Placed, word: &str, then: &str) -> String {
 
 pub fn cmd_audit(args: AuditArgs) -> Result<ExitCode> {
     use cosserat::audit::{run_audit, spec::read_spec, AuditOptions, AuditStatus, PointFields};
-    let AuditArgs { specs: paths, quick, out, force, jobs, quiet, fields, vtk, resume } = args;
+    let AuditArgs { specs: paths, quick, out, force, jobs, quiet, fields, vtk, resume, engines } = args;
     let (paths, fields) = (paths.as_slice(), PointFields::from_flags(fields, vtk));
     // --resume keeps what the folder holds: no replacing it (`None`)
     let force = (!resume).then_some(force);
@@ -297,7 +297,7 @@ pub fn cmd_audit(args: AuditArgs) -> Result<ExitCode> {
     let resume = force.is_none();
     let folder = CommandFolder::begin(&out, manifest, mode, "audit", AUDIT_THEN)?;
     let pb = Progress::new(if quick { "audit (quick)" } else { "audit" }, "points", 0, quiet);
-    let opts = AuditOptions { out: folder.dir().to_path_buf(), jobs: jobs.unwrap_or(0), fields, resume };
+    let opts = AuditOptions { out: folder.dir().to_path_buf(), jobs: jobs.unwrap_or(0), fields, resume, engines };
     let points = std::sync::atomic::AtomicUsize::new(0);
     let report = run_audit(&specs, quick, &opts, |done, total| {
         points.store(total, std::sync::atomic::Ordering::SeqCst);

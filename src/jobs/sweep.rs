@@ -106,7 +106,14 @@ fn summary_number(column: Metric, v: f64) -> String {
 /// its whole clip ([`run_clip_point`]). A point reached after a stop was requested
 /// (`crate::interrupt`) is not started and writes nothing.
 pub fn run_point(case: &Case, dir: &Path, template: &Manifest) -> SweepOutcome {
-    finish_point(dir, template, case, solve_into(case, Engine::Rust, dir, ClipOptions::default(), |_| {}, |_, _| {}))
+    run_point_in(case, Engine::Rust, dir, template)
+}
+
+/// [`run_point`] in `engine` (the audit's reruns in FreeFEM, `audit::engines`).
+pub fn run_point_in(case: &Case, engine: Engine, dir: &Path, template: &Manifest) -> SweepOutcome {
+    let mut m = template.clone();
+    m.input.engine = Some(engine.to_string());
+    finish_point(dir, &m, case, solve_into(case, engine, dir, ClipOptions::default(), |_| {}, |_, _| {}))
 }
 
 /// The whole clip of a clip case in the Rust engine as a point of a sweep or audit, frames
