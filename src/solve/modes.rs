@@ -55,8 +55,9 @@ fn free_dofs(problem: &Problem) -> (std::ops::Range<usize>, DofMap) {
     (dofs.block()..dofs.len(), DofMap::forward(dofs.nodes() - 1))
 }
 
-/// Build the modal model (dense; intended for a few hundred unknowns).
-pub fn modal_model(problem: &Problem) -> Result<ModalModel, ModesError> {
+/// `K = ∂G/∂u` and `M = ∂P/∂u̇` at the reference configuration (D3, D6), on the full
+/// pattern: its values `(pattern, K, M)`.
+fn rest_operators(problem: &Problem) -> (Pattern, Vec<f64>, Vec<f64>) {
     let pattern = problem.dofs().pattern();
     let u0 = problem.reference_state();
     let zero = DVector::zeros(u0.len());
@@ -64,6 +65,12 @@ pub fn modal_model(problem: &Problem) -> Result<ModalModel, ModesError> {
     problem.internal_force(&u0, Some(Tangent::new(&pattern, &mut kv, 1.0)));
     let mut mv = vec![0.0; pattern.nnz()];
     problem.momentum(&u0, &zero, Some((Tangent::new(&pattern, &mut mv, 0.0), 1.0)));
+    (pattern, kv, mv)
+}
+
+/// Build the modal model (dense; intended for a few hundred unknowns).
+pub fn modal_model(problem: &Problem) -> Result<ModalModel, ModesError> {
+    let (pattern, kv, mv) = rest_operators(problem);
     let (free, free_dofs) = free_dofs(problem);
     let n = free.len();
     let kd = pattern.to_dense(&kv).view((free.start, free.start), (n, n)).into_owned();
@@ -122,13 +129,7 @@ pub const RITZ_TOLERANCE: f64 = 1e-10;
 /// (module doc): the same pencil as [`modal_model`], by shift-invert block Lanczos (D28).
 /// `count` is capped at half the free unknowns.
 pub fn lowest_modes(problem: &Problem, count: usize) -> Result<LowestModes, ModesError> {
-    let pattern = problem.dofs().pattern();
-    let u0 = problem.reference_state();
-    let zero = DVector::zeros(u0.len());
-    let mut kv = vec![0.0; pattern.nnz()];
-    problem.internal_force(&u0, Some(Tangent::new(&pattern, &mut kv, 1.0)));
-    let mut mv = vec![0.0; pattern.nnz()];
-    problem.momentum(&u0, &zero, Some((Tangent::new(&pattern, &mut mv, 0.0), 1.0)));
+    let (pattern, mut kv, mut mv) = rest_operators(problem);
     let (free, free_dofs) = free_dofs(problem);
     let a0t = a_matrix(&nalgebra::Vector3::zeros()).transpose();
     let alpha = problem.dofs().index(0, Field::Alpha, 0);
@@ -158,7 +159,7 @@ pub fn lowest_modes(problem: &Problem, count: usize) -> Result<LowestModes, Mode
     let block = pattern.block();
     let inner = |v: &DVector<f64>| transform_rows(pattern.multiply(&mv, v), &a0t, block, alpha);
     let count = count.min(free_dofs.len() / 2);
-    let mut krylov = Krylov::new(u0.len(), LANCZOS_BLOCK, op, inner).map_err(SolveError::from)?;
+    let mut krylov = Krylov::new(problem.dofs().len(), LANCZOS_BLOCK, op, inner).map_err(SolveError::from)?;
     let pairs = largest_symmetric(&mut krylov, count, RITZ_TOLERANCE).map_err(SolveError::from)?;
     let (omegas, shapes) = pairs.into_iter().map(|(theta, x)| ((1.0 / theta).max(0.0).sqrt(), x)).unzip();
     Ok(LowestModes { omegas, shapes, asymmetry })
