@@ -222,6 +222,78 @@ fn postbuckled_elastica_published_digits_are_the_elliptic_solution() {
     assert!((published(Axis::Z) - x).abs() <= 5e-5, "x/L: {} against {x}", published(Axis::Z));
 }
 
+// ------------------------------------------------------ the localised helix of a twisted rod
+
+/// The end conditions of the localised helix (Neukirch, van der Heijden & Thompson 2002, J.
+/// Mech. Phys. Solids 50, Eqs. 14–15) in m = M L/B, τ = T L²/B: the shortening
+/// `D/L = √(16/τ (1 − m²/(4τ)))` and the end rotation `R = m/γ + 4 acos(m/(2√τ))`, γ = C/B.
+fn helix_end_conditions(m: f64, tau: f64, gamma: f64) -> (f64, f64) {
+    ((16.0 / tau * (1.0 - m * m / (4.0 * tau))).sqrt(), m / gamma + 4.0 * (m / (2.0 * tau.sqrt())).acos())
+}
+
+/// (m, τ) with the given slack ratio D/L and end rotation R [rad], by Newton from (R γ, R²γ²/3)
+/// (the pure twist's moment and a tension a little above the straight rod's limit m²/4);
+/// the Jacobian by central differences.
+fn helix_loads(d_over_l: f64, rotation: f64, gamma: f64) -> (f64, f64) {
+    let (mut m, mut tau) = (rotation * gamma, (rotation * gamma).powi(2) / 3.0);
+    for _ in 0..60 {
+        let (f0, f1) = helix_end_conditions(m, tau, gamma);
+        let (r0, r1) = (f0 - d_over_l, f1 - rotation);
+        let (hm, ht) = (1e-6 * m, 1e-6 * tau);
+        let (mp, mm) = (helix_end_conditions(m + hm, tau, gamma), helix_end_conditions(m - hm, tau, gamma));
+        let (tp, tm) = (helix_end_conditions(m, tau + ht, gamma), helix_end_conditions(m, tau - ht, gamma));
+        let (j00, j10) = ((mp.0 - mm.0) / (2.0 * hm), (mp.1 - mm.1) / (2.0 * hm));
+        let (j01, j11) = ((tp.0 - tm.0) / (2.0 * ht), (tp.1 - tm.1) / (2.0 * ht));
+        let det = j00 * j11 - j01 * j10;
+        m -= (r0 * j11 - r1 * j01) / det;
+        tau -= (j00 * r1 - j10 * r0) / det;
+    }
+    (m, tau)
+}
+
+/// The helical-buckling benchmark's constants m, τ solve its end conditions (to 1e-12
+/// relative), the envelope's largest distance from the axis a/k is half the slack, and its
+/// published rows are the localised helix of van der Heijden et al. (2003), Eqs. 27, 52:
+/// `1 − cos θ = a sech²(kσ)` integrated to `x + iy = (a/k) sech(kσ) e^{iωσ}`,
+/// `z = σ − (a/k) tanh(kσ)`, plus the imperfection's tent `F/(2T) (L/2 − |σ|)` along x.
+#[test]
+fn helical_buckling_published_values_are_the_localised_helix() {
+    let case = Case::from_file(&benchmarks_dir().join("helical_buckling.toml")).unwrap_or_else(|e| panic!("{e}"));
+    let c = &case.origin.constants;
+    let (l, b, cc, d, r, f) = (c["L"], c["B"], c["C"], c["D"], c["R"], c["F"]);
+    assert!((r - 27.0 * std::f64::consts::TAU).abs() < 1e-12, "27 turns");
+    let (m, tau) = helix_loads(d / l, r, cc / b);
+    let (fd, fr) = helix_end_conditions(m, tau, cc / b);
+    assert!((fd - d / l).abs() < 1e-13 && (fr - r).abs() < 1e-10, "Newton: {fd} {fr}");
+    assert!((c["m"] - m).abs() <= 1e-12 * m && (c["tau"] - tau).abs() <= 1e-12 * tau, "m {m}, tau {tau}");
+    let (moment, tension) = (m * b / l, tau * b / (l * l));
+    let k = (4.0 * b * tension - moment * moment).sqrt() / (2.0 * b);
+    let a = 2.0 - moment * moment / (2.0 * b * tension);
+    let omega = moment / (2.0 * b);
+    assert!((a / k - d / 2.0).abs() < 1e-12, "a/k = {} against D/2", a / k);
+    // the integrated centreline is a unit-speed curve whose tangent makes 1 − cos θ = a sech²
+    let position = |sigma: f64| {
+        let rho = a / k / (k * sigma).cosh();
+        [rho * (omega * sigma).cos(), rho * (omega * sigma).sin(), sigma - a / k * (k * sigma).tanh()]
+    };
+    for sigma in [-7.0, -1.0, 0.3, 2.0, 9.0] {
+        let h = 1e-5;
+        let (p, q) = (position(sigma + h), position(sigma - h));
+        let t: Vec<f64> = (0..3).map(|i| (p[i] - q[i]) / (2.0 * h)).collect();
+        let speed = t.iter().map(|v| v * v).sum::<f64>().sqrt();
+        assert!((speed - 1.0).abs() < 1e-9, "sigma {sigma}: |x'| = {speed}");
+        assert!((1.0 - t[2] - a / (k * sigma).cosh().powi(2)).abs() < 1e-9, "sigma {sigma}: 1 - cos theta");
+    }
+    let published = |q: &Quantity| {
+        case.checks.published.values.iter().find(|v| &v.quantity == q).map(|v| v.value).expect("published value")
+    };
+    let node = |sigma: f64, axis: Axis| Quantity::Node { s_m: l / 2.0 + sigma, field: NodeField::Position(axis) };
+    let tent = |sigma: f64| f / (2.0 * tension) * (l / 2.0 - sigma.abs());
+    assert!((published(&node(0.0, Axis::X)) - (position(0.0)[0] + tent(0.0))).abs() < 1e-12);
+    assert!((published(&node(1.0 / k, Axis::Y)) - position(1.0 / k)[1]).abs() < 1e-12);
+    assert!((published(&node(1.0 / k, Axis::Z)) - position(1.0 / k)[2]).abs() < 1e-12);
+}
+
 // ------------------------------------------------------------------------------ the command line
 
 /// The benchmark written to `dir` with `edits` (each pattern once) and its data-free paths.
