@@ -28,6 +28,7 @@ fn static_tip(case: &Case, method: Method, tol: f64) -> (f64, f64, usize) {
             certificate_tolerance: DEFAULT_CERTIFICATE_TOLERANCE,
             path: None,
             buckling_modes: 0,
+            vibration_modes: 0,
         },
         |_| {},
     )
@@ -255,6 +256,7 @@ fn follower_load_eq64_large_bend() {
             certificate_tolerance: DEFAULT_CERTIFICATE_TOLERANCE,
             path: None,
             buckling_modes: 0,
+            vibration_modes: 0,
         },
         |_| {},
     )
@@ -270,6 +272,7 @@ fn follower_load_eq64_large_bend() {
             certificate_tolerance: DEFAULT_CERTIFICATE_TOLERANCE,
             path: None,
             buckling_modes: 0,
+            vibration_modes: 0,
         },
         |_| {},
     )
@@ -306,6 +309,7 @@ fn follower_load_eq65_needs_newton() {
             certificate_tolerance: DEFAULT_CERTIFICATE_TOLERANCE,
             path: None,
             buckling_modes: 0,
+            vibration_modes: 0,
         },
         |_| {},
     )
@@ -330,6 +334,7 @@ fn follower_load_eq65_needs_newton() {
             certificate_tolerance: DEFAULT_CERTIFICATE_TOLERANCE,
             path: None,
             buckling_modes: 0,
+            vibration_modes: 0,
         },
         |_| {},
     )

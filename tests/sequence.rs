@@ -49,6 +49,7 @@ fn forward(p: &Problem, steps: usize) -> DVector<f64> {
         certificate_tolerance: DEFAULT_CERTIFICATE_TOLERANCE,
         path: None,
         buckling_modes: 0,
+        vibration_modes: 0,
     };
     statics::solve(p, &params, |_| {}).and_then(|s| s.converged()).expect("forward").u
 }

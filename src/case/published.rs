@@ -242,10 +242,16 @@ impl Quantity {
     }
 }
 
-/// The unit a metric's name carries (`_m`, `_rad`, `_s`; a count or ratio has none).
+/// The unit a metric's name carries (`_m`, `_rad`, `_s`, `_rad_per_s`; a count or ratio has none).
 fn metric_unit(key: &str) -> &'static str {
-    const SUFFIXES: [(&str, &str); 5] =
-        [("_m", "m"), ("_rad", "rad"), ("_s", "s"), ("_m05", "m^0.5"), ("_n_per_m05", "N/m^0.5")];
+    const SUFFIXES: [(&str, &str); 6] = [
+        ("_m", "m"),
+        ("_rad", "rad"),
+        ("_s", "s"),
+        ("_m05", "m^0.5"),
+        ("_n_per_m05", "N/m^0.5"),
+        ("_rad_per_s", "rad/s"),
+    ];
     SUFFIXES.iter().rev().find(|(suffix, _)| key.ends_with(suffix)).map_or("1", |(_, unit)| unit)
 }
 
@@ -316,6 +322,7 @@ mod tests {
         assert_eq!(unit("metric.iterations"), "1");
         assert_eq!(unit("metric.tangent_misfit_m05"), "m^0.5");
         assert_eq!(unit("metric.force_l2_n_per_m05"), "N/m^0.5");
+        assert_eq!(unit("metric.omega_1_rad_per_s"), "rad/s");
     }
 
     #[test]

@@ -374,6 +374,8 @@ pub(super) struct RawSolver {
     pub(super) certificate_tolerance: Option<f64>,
     /// static: the lowest critical load factors to compute with their modes (D27)
     pub(super) buckling_modes: Option<usize>,
+    /// static: the lowest natural frequencies of the rod about its rest state (D28)
+    pub(super) vibration_modes: Option<usize>,
 }
 pub(super) fn one() -> usize {
     1

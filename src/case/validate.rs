@@ -24,6 +24,7 @@ use crate::solve::statics::{Method, StaticParams};
 mod clip;
 mod general;
 mod loads;
+mod modes;
 mod published;
 mod rod;
 
@@ -142,10 +143,12 @@ impl<'a> Validator<'a> {
                 "\"midpoint\" integrates the mass matrix with one point, which is singular for P1 elements: a dynamic case needs \"selective\", \"full\", \"reduced\" or \"gauss2\"",
             ));
         }
+        let vibration_modes = self.vibration_modes(&raw, &mesh, density_given, general.is_some())?;
         let analysis = match kind {
             RawAnalysis::Static => Analysis::Static(StaticParams {
                 path: self.path(&raw)?,
                 buckling_modes: self.buckling_modes(raw.solver.buckling_modes, &mesh)?,
+                vibration_modes,
                 ..self.static_solve("solver", &raw.solver)?
             }),
             RawAnalysis::Dynamic => Analysis::Dynamic(self.dynamic(&raw.solver, raw.time.as_ref())?),
@@ -293,6 +296,7 @@ impl<'a> Validator<'a> {
                 .certificate_tolerance(&format!("{table}.certificate_tolerance"), s.certificate_tolerance)?,
             path: None,
             buckling_modes: 0,
+            vibration_modes: 0,
         })
     }
 
@@ -482,6 +486,7 @@ impl<'a> Validator<'a> {
             certificate_tolerance: self.certificate_tolerance("data.certificate_tolerance", d.certificate_tolerance)?,
             path: None,
             buckling_modes: 0,
+            vibration_modes: 0,
         })
     }
 

@@ -84,14 +84,30 @@ pub fn write_run(case: &Case, r: &RunResult, metrics: &Metrics, dir: &Path) -> R
         put("path.csv", super::path_files::path_csv(p).into_bytes())?;
         put("critical_points.csv", super::path_files::critical_csv(p).into_bytes())?;
     }
-    if let Some(st) = r.stability.as_ref().filter(|st| !st.modes.is_empty()) {
-        put("buckling.csv", super::path_files::buckling_csv(st, &r.nodes.s).into_bytes())?;
+    if let Some(st) = &r.stability {
+        write_eigen(r, st, &mut put)?;
     }
     write_metrics(case, r, metrics, &mut put)?;
     let plot_path = dir.join("plot.svg");
     write_plot(&plot_path, render_panels_svg(&headline_panels(case, r), 2))?;
     written.push(plot_path);
     Ok(written)
+}
+
+/// A static result's eigen-analyses: `buckling.csv` with buckling modes (D27), `modes.csv` with
+/// natural frequencies (D28).
+fn write_eigen(
+    r: &RunResult,
+    st: &crate::engine::StabilityOutput,
+    put: &mut impl FnMut(&str, Vec<u8>) -> Result<(), OutputError>,
+) -> Result<(), OutputError> {
+    if !st.modes.is_empty() {
+        put("buckling.csv", super::path_files::buckling_csv(st, &r.nodes.s).into_bytes())?;
+    }
+    if !st.omegas_rad_per_s.is_empty() {
+        put("modes.csv", super::modes_file::modes_csv(st).into_bytes())?;
+    }
+    Ok(())
 }
 
 /// `metrics.json` and, for a case with published values, `reference.csv`.

@@ -41,6 +41,9 @@ pub struct StaticParams {
     /// the lowest critical load factors of the case's loads about the reference to compute with
     /// their modes (`solver.buckling_modes`, D27); 0: none
     pub buckling_modes: usize,
+    /// the lowest natural frequencies of the rod about its rest state to compute
+    /// (`solver.vibration_modes`, D28, `solve::modes::lowest_modes`); 0: none
+    pub vibration_modes: usize,
 }
 
 impl StaticParams {
@@ -54,6 +57,7 @@ impl StaticParams {
             certificate_tolerance: DEFAULT_CERTIFICATE_TOLERANCE,
             path: None,
             buckling_modes: 0,
+            vibration_modes: 0,
         }
     }
 }

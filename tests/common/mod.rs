@@ -122,6 +122,7 @@ pub fn forward_data(case: &Case, steps: usize) -> (nalgebra::DVector<f64>, Vec<n
             certificate_tolerance: DEFAULT_CERTIFICATE_TOLERANCE,
             path: None,
             buckling_modes: 0,
+            vibration_modes: 0,
         },
         |_| {},
     )

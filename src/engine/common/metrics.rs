@@ -86,7 +86,8 @@ pub fn centroid(s: &[f64], x: &[Vector3<f64>]) -> Vector3<f64> {
 
 /// A static result's stability and its buckling load factors (D27):
 /// `tangent_smallest_eigenvalue_per_s2` (`min Re ω²`), `stable` (conservative loads only: 1
-/// when it is positive, else 0), `buckling_{k}_load_factor` (k = 1, 2, …, ascending).
+/// when it is positive, else 0), `buckling_{k}_load_factor` (k = 1, 2, …, ascending), and the
+/// natural frequencies about the rest state `omega_{k}_rad_per_s` (D28, k = 1, 2, …).
 fn stability_metrics(st: &super::result::StabilityOutput, m: &mut Metrics) {
     if let Some(mu) = st.smallest_eigenvalue_per_s2 {
         m.insert(Metric::TangentSmallestEigenvalue, mu);
@@ -96,6 +97,9 @@ fn stability_metrics(st: &super::result::StabilityOutput, m: &mut Metrics) {
     }
     for (k, mode) in st.modes.iter().enumerate() {
         m.insert_named(format!("buckling_{}_load_factor", k + 1), mode.load_factor);
+    }
+    for (k, w) in st.omegas_rad_per_s.iter().enumerate() {
+        m.insert_named(format!("omega_{}_rad_per_s", k + 1), *w);
     }
 }
 
@@ -301,8 +305,9 @@ pub fn differences(a: &RunResult, b: &RunResult, iterations: bool) -> Vec<Differ
         }
         let bound = if name.ends_with("_rad") {
             Some((Group::Angles, angle_scale))
-        } else if name.ends_with("load_factor") {
-            // a load factor on the path moves with the state it balances, R(u, λ) = 0: relatively
+        } else if name.ends_with("load_factor") || name.ends_with("_rad_per_s") {
+            // a load factor on the path moves with the state it balances, R(u, λ) = 0: relatively;
+            // a natural frequency (D28) is a relative quantity of the same matrices
             Some((Group::Displacement, x.abs()))
         } else if name == Metric::PathPoints.as_str() || name == Metric::Stable.as_str() {
             None // a count or a verdict: equal, or the runs differ

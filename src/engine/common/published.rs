@@ -186,6 +186,7 @@ pub fn metric_keys(case: &Case) -> Vec<String> {
             keys.extend([M::TangentSmallestEigenvalue, M::Stable]);
         }
         names.extend((1..=p.buckling_modes).map(|k| format!("buckling_{k}_load_factor")));
+        names.extend((1..=p.vibration_modes).map(|k| format!("omega_{k}_rad_per_s")));
     }
     let mut after = Vec::new();
     if let Some(Reference::TipLoadedCantilever { .. }) = case.checks.reference {

@@ -154,8 +154,8 @@ pub struct RunResult {
     pub stability: Option<StabilityOutput>,
 }
 
-/// The stability of a static result and the case's linearised buckling (D27), the same for
-/// both engines.
+/// The stability of a static result, the case's linearised buckling (D27) and the rod's
+/// natural frequencies about its rest state (D28), the same for both engines.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct StabilityOutput {
     /// `min Re ω²` of the rod linearised about the result [1/s²] (≤ 0 unstable; unit inertias
@@ -168,6 +168,9 @@ pub struct StabilityOutput {
     pub conservative: bool,
     /// the lowest critical load factors about the reference (`solver.buckling_modes`), ascending
     pub modes: Vec<BucklingRecord>,
+    /// the lowest natural frequencies ω [rad/s] of the rod about its rest state
+    /// (`solver.vibration_modes`, D28), ascending, each multiple one repeated
+    pub omegas_rad_per_s: Vec<f64>,
 }
 
 /// One buckling mode: its critical load factor and its shape at the nodes.

@@ -344,11 +344,13 @@ fn write_solver(o: &mut String, case: &Case, s: &SolverSettings) {
 }
 
 /// `freefem/stability.idp`'s keys (D27): the buckling modes asked for (`solver.buckling_modes`, 0
-/// for other analyses) and the dense limit of `solve::stability`.
+/// for other analyses) and the dense limit of `solve::stability`; `freefem/modes.idp`'s (D28):
+/// the natural frequencies asked for (`solver.vibration_modes`) and the Lanczos tolerance of
+/// `solve::modes` (ARPACK's `tol`), written only when asked for.
 fn write_stability(o: &mut String, case: &Case) {
-    let modes = match &case.analysis {
-        Analysis::Static(p) => p.buckling_modes,
-        _ => 0,
+    let (modes, vibration) = match &case.analysis {
+        Analysis::Static(p) => (p.buckling_modes, p.vibration_modes),
+        _ => (0, 0),
     };
     let _ = writeln!(
         o,
@@ -357,6 +359,17 @@ int buckModes = {modes};
 int denseLimit = {};",
         crate::solve::stability::DENSE_LIMIT
     );
+    if vibration > 0 {
+        // assigned, not declared: forward.edp declares them (none) before it includes case.idp,
+        // so that the other cases' case.idp stay as they were
+        let _ = writeln!(
+            o,
+            "// the natural frequencies about the rest state (D28, freefem/modes.idp)
+vibModes = {vibration};
+vibTol = {};",
+            num(crate::solve::modes::RITZ_TOLERANCE)
+        );
+    }
 }
 
 /// `pathOn` and, for a static case followed by arc length (D25), `freefem/arclength.idp`'s keys:

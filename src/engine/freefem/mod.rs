@@ -11,6 +11,7 @@
 pub mod clip;
 pub mod include;
 pub mod info;
+pub mod modes;
 pub mod path;
 pub mod progress;
 pub mod stability;

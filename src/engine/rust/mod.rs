@@ -45,6 +45,8 @@ pub enum RunError {
     Chart { case: String, axis: [f64; 3] },
     #[error("rust engine: the eigen-analysis of the static result (D27)")]
     Stability(#[from] crate::solve::stability::StabilityError),
+    #[error("rust engine: the natural frequencies about the rest state (solver.vibration_modes, D28)")]
+    Modes(#[from] crate::solve::modes::ModesError),
     #[error("writing the clip")]
     Sink(#[source] Box<dyn std::error::Error + Send + Sync>),
     #[error("resuming the clip: {0}")]
