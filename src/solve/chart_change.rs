@@ -40,7 +40,7 @@ use crate::model::rotation::a_matrix;
 /// the nodes is below this: the margin ½ of R4 (`|d3·n| > √3/2`), the level at which D21
 /// stops keeping the paper's chart for a reference. A step that starts above it turns no
 /// director by more than the 30° left to the singular set at the step sizes of the cases
-/// (the three-dimensional flying spaghetti turns its end by at most 0.04 rad per step of
+/// (the three-dimensional flying spaghetti turns its tip frame by at most 0.081 rad in a step of
 /// 0.025 s); the new axis gives a margin of at least ½ except for a rod whose directors come
 /// near every direction (the R4 fallback then maximises it).
 pub const CHANGE_BELOW: f64 = 0.5;

@@ -324,7 +324,7 @@ fn inverse_stop(
 /// A static run that ends stalled or at its iteration limit is [`FreeFemError::Incomplete`] with
 /// the Rust engine's error (`StaticSolution::converged`) and the last iterate.
 pub fn run(case: &Case, workdir: &Path) -> Result<RunResult, FreeFemError> {
-    let mut outputs = vec!["ff_nodes.csv", "ff_info.csv", "ff_history.csv", "ff_tip.csv"];
+    let mut outputs = vec!["ff_nodes.csv", "ff_info.csv", "ff_history.csv", "ff_tip.csv", "ff_charts.csv"];
     outputs.extend(path::PATH_OUTPUTS);
     outputs.push(stability::BUCKLING_OUTPUT);
     let end = execute_to_end(case, workdir, "forward.edp", &outputs, &RunOptions::default())?;
