@@ -117,6 +117,32 @@ impl RestShape {
     pub fn new(mesh: &Mesh, spec: &RestSpec, chart: Option<Chart>) -> Self {
         let (positions, frames) = integrate(mesh, spec);
         let chart = chart.unwrap_or_else(|| default_chart(&positions, &frames));
+        Self::from_frames(mesh, positions, frames, chart, spec.curvature.clone())
+    }
+
+    /// The same reference posed in another chart (D32: a dynamic run that changes its chart):
+    /// the nodal state and the reference strains recomputed from the space positions and frames,
+    /// so that the reference is exactly stress free in the new chart's interpolation too.
+    pub fn in_chart(&self, mesh: &Mesh, chart: Chart) -> Self {
+        Self::from_frames(mesh, self.positions.clone(), self.frames.clone(), chart, self.curvature.clone())
+    }
+
+    /// The paper's straight rod along e3 from the origin (`x0 = (0, 0, s)`, `Q0 = I`, D1) posed in
+    /// `chart`.
+    pub fn straight(mesh: &Mesh, chart: Chart) -> Self {
+        let positions = (0..mesh.nodes()).map(|i| Vector3::new(0.0, 0.0, mesh.node_s(i))).collect();
+        let frames = vec![Matrix3::identity(); mesh.nodes()];
+        Self::from_frames(mesh, positions, frames, chart, VectorExpr::zero())
+    }
+
+    /// The discrete reference of nodal positions and frames (space coordinates) in `chart`.
+    fn from_frames(
+        mesh: &Mesh,
+        positions: Vec<Vector3<f64>>,
+        frames: Vec<Matrix3<f64>>,
+        chart: Chart,
+        curvature: VectorExpr,
+    ) -> Self {
         let dofs = mesh.dofs();
         let mut state = dofs.zeros();
         let mut prev: Option<Vector3<f64>> = None;
@@ -130,7 +156,7 @@ impl RestShape {
         }
         let h = mesh.h();
         let strains = (0..mesh.elements).map(|e| ElementRest::of(&dofs.gather::<12>(&state, e), h)).collect();
-        RestShape { chart, state, strains, positions, frames, curvature: spec.curvature.clone() }
+        RestShape { chart, state, strains, positions, frames, curvature }
     }
 
     /// The reference of the node `i` (an end).

@@ -31,10 +31,7 @@ pub fn write_run(case: &Case, r: &RunResult, metrics: &Metrics, dir: &Path) -> R
         csv_text(&["s_m", "x_m", "y_m", "z_m", "ux_m", "uy_m", "uz_m", "alpha_rad", "beta_rad", "gamma_rad"], rows)
             .into_bytes(),
     )?;
-    let kappa = r.nodes.element_curvature();
-    let rest = case.rod.general.as_ref().map(|g| g.rest.strains.as_slice());
-    let loads = r.nodes.resultants(&case.props, case.quadrature, rest);
-    put("curvature.csv", csv_text(&CURVATURE_COLUMNS, kappa.iter().zip(&loads).map(element_row)).into_bytes())?;
+    put("curvature.csv", curvature_csv(case, r).into_bytes())?;
     if !r.history.is_empty() {
         put(
             "history.csv",
@@ -76,6 +73,9 @@ pub fn write_run(case: &Case, r: &RunResult, metrics: &Metrics, dir: &Path) -> R
             .into_bytes(),
         )?;
         put("balance.csv", balance_csv(&r.tip).into_bytes())?;
+        if let Some(text) = charts_csv(&r.tip) {
+            put("charts.csv", text.into_bytes())?;
+        }
     }
     if let Some(inv) = &r.inverse {
         write_inverse(r, inv, &mut put)?;
@@ -438,3 +438,39 @@ const BALANCE_COLUMNS: [&str; 11] = [
     "angular_momentum_z_n_m_s",
     "loaded",
 ];
+
+/// `curvature.csv`: the element curvatures and resultants of the state, with the reference strains
+/// posed in the state's chart (a dynamic run may have changed it, D32).
+fn curvature_csv(case: &Case, r: &RunResult) -> String {
+    let kappa = r.nodes.element_curvature();
+    let rechart = case.rod.general.as_ref().filter(|g| g.rest.chart != r.nodes.chart);
+    let rest_in_chart = rechart.map(|g| g.rest.in_chart(&case.mesh, r.nodes.chart));
+    let rest = match &rest_in_chart {
+        Some(rest) => Some(rest.strains.as_slice()),
+        None => case.rod.general.as_ref().map(|g| g.rest.strains.as_slice()),
+    };
+    let loads = r.nodes.resultants(&case.props, case.quadrature, rest);
+    csv_text(&CURVATURE_COLUMNS, kappa.iter().zip(&loads).map(element_row))
+}
+
+/// `charts.csv` of a dynamic run that changed its chart (D32): the chart at t = 0 and at every
+/// step that starts in a new one (`step`: the first record in it, `time_s`: when the change was
+/// made, the time of the record before), `B` row by row (`x̃ = B x`; the frame of the angles α of
+/// that record and the later ones is `Q = Q_E(α) B`). `None` for a run in one chart.
+fn charts_csv(tip: &[crate::solve::dynamics::TipRecord]) -> Option<String> {
+    let first = tip.first()?.chart;
+    if tip.iter().all(|t| t.chart == first) {
+        return None;
+    }
+    let mut columns = vec!["step".to_string(), "time_s".to_string()];
+    columns.extend((0..9).map(|k| format!("b{}{}", k / 3 + 1, k % 3 + 1)));
+    let columns: Vec<&str> = columns.iter().map(String::as_str).collect();
+    let rows = tip.iter().enumerate().filter(|(i, t)| *i == 0 || tip[i - 1].chart != t.chart).map(|(i, t)| {
+        // the change is made at the start of step i, at the time of the record before it
+        let made_at = if i == 0 { 0.0 } else { tip[i - 1].time_s };
+        let mut row = vec![Some(i as f64), Some(made_at)];
+        row.extend((0..9).map(|k| Some(t.chart.base[(k / 3, k % 3)])));
+        row
+    });
+    Some(csv_text_int(&columns, &["step"], rows))
+}

@@ -12,12 +12,14 @@
 use nalgebra::{DVector, Vector3};
 
 use super::certificate::{system_terms, Certificate};
+use super::chart_change::{self, ChartRule};
 use super::problem::{FrameAt, Held, HeldRows};
 use super::statics::frozen_system;
 use super::{divergence, Problem, SolveError, Step, CHORD_CONTRACTION};
 use crate::assemble::Tangent;
 use crate::linalg::{LinearSolver, Pattern};
 use crate::model::balance::Balance;
+use crate::model::chart::Chart;
 use crate::model::ends::MotionAt;
 use crate::model::loads::LoadFrame;
 use crate::model::mesh::Field;
@@ -49,13 +51,18 @@ pub struct TipRecord {
     /// step may change the energy (and, with a held end, the momenta); false at t = 0 when
     /// `F(0)` is zero
     pub loaded: bool,
+    /// the chart the state is in (D21, D32): the tip's angles are its angles, and the position
+    /// is in its coordinates until the engine rotates it to space
+    pub chart: Chart,
 }
 
 /// Result of a time integration.
 #[derive(Clone, Debug)]
 pub struct DynamicSolution {
-    /// final state
+    /// final state, in the chart [`DynamicSolution::chart`]
     pub u: DVector<f64>,
+    /// the chart of the final state: the case's, or the last one the run changed to (D32)
+    pub chart: Chart,
     pub tip: Vec<TipRecord>,
     pub total_newton_iterations: usize,
     pub max_newton_iterations: usize,
@@ -63,86 +70,177 @@ pub struct DynamicSolution {
     pub max_certificate: f64,
 }
 
-/// Integrate from the reference configuration at rest.
+/// Integrate from the reference configuration at rest, changing the chart by the default
+/// rule of D32 ([`ChartRule::default`]).
 pub fn solve(
     problem: &Problem,
     params: &DynamicParams,
+    progress: impl FnMut(usize, usize),
+) -> Result<DynamicSolution, SolveError> {
+    solve_charted(problem, params, &ChartRule::default(), progress)
+}
+
+/// Integrate from the reference configuration at rest, changing the chart when `rule` says so
+/// (D32, [`super::chart_change`]): the run is a sequence of segments, each in one chart, the
+/// state re-expressed between them.
+pub fn solve_charted(
+    problem: &Problem,
+    params: &DynamicParams,
+    rule: &ChartRule,
     mut progress: impl FnMut(usize, usize),
 ) -> Result<DynamicSolution, SolveError> {
-    let dofs = problem.dofs();
-    let pattern = dofs.pattern();
-    let dt = params.end_time_s / params.steps as f64;
-    let last = problem.mesh.nodes() - 1;
-    let (u0, v0) = (problem.reference_state(), DVector::zeros(dofs.len()));
-    let mut prev = StepState { p: problem.momentum(&u0, &v0, None), f: problem.loads_at(&u0, 0.0, None), u: u0, v: v0 };
-    let moving = problem.ends().moving();
-    let record = |t: f64, s: &StepState, (it, certificate): (usize, f64), loaded: bool| {
-        let (x, a) = (dofs.get(&s.u, last, Field::X), dofs.get(&s.u, last, Field::Alpha));
-        let balance = problem.balance(&s.u, &s.v);
-        TipRecord { time_s: t, position_m: x, angles_rad: a, newton_iterations: it, certificate, balance, loaded }
-    };
-    let mut tip = vec![record(0.0, &prev, (0, 0.0), moving || loaded(&prev.f))];
-    let (mut cert_values, mut max_certificate) = (vec![0.0; pattern.nnz()], 0.0_f64);
-    let (mut total, mut max_it) = (0, 0);
-    // Global-frame (or no distributed) loads do not depend on the state: F(t_n) once per step
-    // instead of once per Newton iteration and again after it (the same numbers).
-    let state_free_loads = !(problem.loads.has_distributed() && matches!(problem.loads.frame, LoadFrame::Local));
-    let mut stepper = Stepper {
-        problem,
-        params,
-        solver: LinearSolver::new(&pattern),
-        values: vec![0.0; pattern.nnz()],
-        pattern,
-        dt,
-        factored: false,
-        refactor: true,
-    };
-    for n in 1..=params.steps {
-        if crate::interrupt::requested() {
-            return Err(SolveError::Interrupted { what: "time steps", done: n - 1, total: params.steps });
+    let mut run = Run::start(problem);
+    let mut rod = None;
+    let mut n = 1;
+    loop {
+        let current = match &rod {
+            Some(r) => problem.on_rod(Some(r)),
+            None => *problem,
+        };
+        let Some((at, chart)) = run.segment(&current, params, (n, rule), &mut progress)? else { break };
+        let new_rod = chart_change::rod_in_chart(&current, chart);
+        let next = current.on_rod(Some(&new_rod));
+        let changed = run.rechart(&current, &next, (at - 1) as f64 * params.end_time_s / params.steps as f64);
+        n = at;
+        if changed {
+            rod = Some(new_rod);
         }
-        let t = n as f64 * dt;
-        let held = problem.held(MotionAt::Dynamic { t_prev: t - dt, t }, Some(&prev.u));
-        let mut u = &prev.u + &prev.v * dt;
-        if problem.ends().moving() {
-            // a moving end's held unknowns start at their targets; fixed ones keep the
-            // predictor's (their Newton rows are identities with zero residual)
-            held.impose(&mut u);
-        }
-        let f_step = if state_free_loads { Some(problem.loads_at(&u, t, None)) } else { None };
-        let at = StepAt { n, t, held: &held, f_step: f_step.as_ref() };
-        let (u, it, increment) = stepper.newton(at, u, &prev)?;
-        total += it;
-        max_it = max_it.max(it);
-        let v = (&u - &prev.u) * (2.0 / dt) - &prev.v;
-        let p_n = problem.momentum(&u, &v, None);
-        let f_n = f_step.unwrap_or_else(|| problem.loads_at(&u, t, None));
-        let terms =
-            StepTerms { u: &u, u_prev: &prev.u, p: &p_n, p_prev: &prev.p, f: &f_n, f_prev: &prev.f, dt, held: &held };
-        let certificate = step_certificate(problem, terms, &stepper.pattern, &mut cert_values);
-        if !certificate.within(params.certificate_tolerance) {
-            return Err(SolveError::StepNotCertified {
-                step: n,
-                iterations: it,
-                increment,
-                certificate: certificate.value,
-                tolerance: params.certificate_tolerance,
-                block: certificate.worst_block(false),
-            });
-        }
-        max_certificate = max_certificate.max(certificate.value);
-        let step_loaded = moving || loaded(&f_n) || loaded(&prev.f);
-        prev = StepState { u, v, p: p_n, f: f_n };
-        tip.push(record(t, &prev, (it, certificate.value), step_loaded));
-        progress(n, params.steps);
     }
     Ok(DynamicSolution {
-        u: prev.u,
-        tip,
-        total_newton_iterations: total,
-        max_newton_iterations: max_it,
-        max_certificate,
+        u: run.prev.u,
+        chart: run.tip.last().map(|t| t.chart).unwrap_or_default(),
+        tip: run.tip,
+        total_newton_iterations: run.total,
+        max_newton_iterations: run.max_it,
+        max_certificate: run.max_certificate,
     })
+}
+
+/// The time stepping's state across its segments: the last step's state, the tip records
+/// and the counts.
+struct Run {
+    prev: StepState,
+    tip: Vec<TipRecord>,
+    total: usize,
+    max_it: usize,
+    max_certificate: f64,
+    /// the step at which the last segment started in a new chart (a rule that names a step
+    /// changes once there)
+    changed_at: usize,
+}
+
+/// The tip record of the state `s` at `t` [s] in `problem`'s chart.
+fn record(problem: &Problem, t: f64, s: &StepState, (it, certificate): (usize, f64), loaded: bool) -> TipRecord {
+    let (dofs, last) = (problem.dofs(), problem.mesh.nodes() - 1);
+    let (x, a) = (dofs.get(&s.u, last, Field::X), dofs.get(&s.u, last, Field::Alpha));
+    let balance = problem.balance(&s.u, &s.v);
+    let chart = problem.chart();
+    TipRecord { time_s: t, position_m: x, angles_rad: a, newton_iterations: it, certificate, balance, loaded, chart }
+}
+
+impl Run {
+    /// The reference configuration at rest, recorded at t = 0.
+    fn start(problem: &Problem) -> Self {
+        let dofs = problem.dofs();
+        let (u0, v0) = (problem.reference_state(), DVector::zeros(dofs.len()));
+        let prev = StepState { p: problem.momentum(&u0, &v0, None), f: problem.loads_at(&u0, 0.0, None), u: u0, v: v0 };
+        let tip = vec![record(problem, 0.0, &prev, (0, 0.0), problem.ends().moving() || loaded(&prev.f))];
+        Run { prev, tip, total: 0, max_it: 0, max_certificate: 0.0, changed_at: 0 }
+    }
+
+    /// Re-express the last step's state from `from`'s chart in `to`'s (`t_prev` [s]: its time):
+    /// false (nothing changed) where some node is on the new chart's singular set.
+    fn rechart(&mut self, from: &Problem, to: &Problem, t_prev: f64) -> bool {
+        let Some((u, v)) =
+            chart_change::reexpress_state(&from.dofs(), &from.chart(), &to.chart(), &self.prev.u, &self.prev.v)
+        else {
+            return false;
+        };
+        self.prev = StepState { p: to.momentum(&u, &v, None), f: to.loads_at(&u, t_prev, None), u, v };
+        true
+    }
+
+    /// Steps `n..` in `problem`'s chart until the last one, or until `rule` changes the chart at
+    /// the start of a step: that step and the new chart.
+    fn segment(
+        &mut self,
+        problem: &Problem,
+        params: &DynamicParams,
+        (first, rule): (usize, &ChartRule),
+        progress: &mut impl FnMut(usize, usize),
+    ) -> Result<Option<(usize, Chart)>, SolveError> {
+        let pattern = problem.dofs().pattern();
+        let dt = params.end_time_s / params.steps as f64;
+        let moving = problem.ends().moving();
+        let mut cert_values = vec![0.0; pattern.nnz()];
+        // Global-frame (or no distributed) loads do not depend on the state: F(t_n) once per step
+        // instead of once per Newton iteration and again after it (the same numbers).
+        let state_free_loads = !(problem.loads.has_distributed() && matches!(problem.loads.frame, LoadFrame::Local));
+        let mut stepper = Stepper {
+            problem,
+            params,
+            solver: LinearSolver::new(&pattern),
+            values: vec![0.0; pattern.nnz()],
+            pattern,
+            dt,
+            factored: false,
+            refactor: true,
+        };
+        for n in first..=params.steps {
+            if n != self.changed_at {
+                if let Some(chart) = rule.decide(problem, n, &self.prev.u, &problem.chart()) {
+                    self.changed_at = n;
+                    return Ok(Some((n, chart)));
+                }
+            }
+            if crate::interrupt::requested() {
+                return Err(SolveError::Interrupted { what: "time steps", done: n - 1, total: params.steps });
+            }
+            let t = n as f64 * dt;
+            let held = problem.held(MotionAt::Dynamic { t_prev: t - dt, t }, Some(&self.prev.u));
+            let mut u = &self.prev.u + &self.prev.v * dt;
+            if moving {
+                // a moving end's held unknowns start at their targets; fixed ones keep the
+                // predictor's (their Newton rows are identities with zero residual)
+                held.impose(&mut u);
+            }
+            let f_step = if state_free_loads { Some(problem.loads_at(&u, t, None)) } else { None };
+            let at = StepAt { n, t, held: &held, f_step: f_step.as_ref() };
+            let (u, it, increment) = stepper.newton(at, u, &self.prev)?;
+            let v = (&u - &self.prev.u) * (2.0 / dt) - &self.prev.v;
+            let p_n = problem.momentum(&u, &v, None);
+            let f_n = f_step.unwrap_or_else(|| problem.loads_at(&u, t, None));
+            let prev = &self.prev;
+            let terms = StepTerms {
+                u: &u,
+                u_prev: &prev.u,
+                p: &p_n,
+                p_prev: &prev.p,
+                f: &f_n,
+                f_prev: &prev.f,
+                dt,
+                held: &held,
+            };
+            let certificate = step_certificate(problem, terms, &stepper.pattern, &mut cert_values);
+            if !certificate.within(params.certificate_tolerance) {
+                return Err(SolveError::StepNotCertified {
+                    step: n,
+                    iterations: it,
+                    increment,
+                    certificate: certificate.value,
+                    tolerance: params.certificate_tolerance,
+                    block: certificate.worst_block(false),
+                });
+            }
+            (self.total, self.max_it) = (self.total + it, self.max_it.max(it));
+            self.max_certificate = self.max_certificate.max(certificate.value);
+            let step_loaded = moving || loaded(&f_n) || loaded(&self.prev.f);
+            self.prev = StepState { u, v, p: p_n, f: f_n };
+            self.tip.push(record(problem, t, &self.prev, (it, certificate.value), step_loaded));
+            progress(n, params.steps);
+        }
+        Ok(None)
+    }
 }
 
 /// Does the load vector `F` hold a load (an entry that is not zero)?

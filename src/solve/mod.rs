@@ -6,6 +6,7 @@
 //! numbers. All of them assemble through the one element loop of [`crate::assemble`].
 pub mod arclength;
 pub mod certificate;
+pub mod chart_change;
 pub mod continuation;
 pub mod dynamics;
 pub mod inverse;

@@ -71,6 +71,18 @@ impl NodalState {
         }
         n
     }
+    /// [`NodalState::of_forward`] for a state in `chart`, which may differ from the case's
+    /// (a dynamic run that changed its chart, D32): positions in space, angles in `chart`.
+    pub fn of_forward_in(case: &crate::case::Case, u: &DVector<f64>, chart: Chart) -> Self {
+        let mut n = NodalState::of_forward(case, u);
+        let case_chart = case.rod.general.as_ref().map(|g| g.rest.chart).unwrap_or_default();
+        if chart != case_chart {
+            let from_case = chart.base.transpose() * case_chart.base;
+            n.x.iter_mut().for_each(|x| *x = from_case * *x);
+            n.chart = chart;
+        }
+        n
+    }
     /// Element-midpoint curvature `κˡ = A(α) ∂s α` [1/m] with the midpoint arc length [m]
     /// (eq. 28, [`midpoint_curvatures`]).
     pub fn element_curvature(&self) -> Vec<(f64, Vector3<f64>)> {

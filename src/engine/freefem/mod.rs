@@ -325,7 +325,7 @@ fn inverse_stop(
 /// A static run that ends stalled or at its iteration limit is [`FreeFemError::Incomplete`] with
 /// the Rust engine's error (`StaticSolution::converged`) and the last iterate.
 pub fn run(case: &Case, workdir: &Path) -> Result<RunResult, FreeFemError> {
-    let mut outputs = vec!["ff_nodes.csv", "ff_info.csv", "ff_history.csv", "ff_tip.csv"];
+    let mut outputs = vec!["ff_nodes.csv", "ff_info.csv", "ff_history.csv", "ff_tip.csv", "ff_charts.csv"];
     outputs.extend(path::PATH_OUTPUTS);
     outputs.push(stability::BUCKLING_OUTPUT);
     let end = execute_to_end(case, workdir, "forward.edp", &outputs, &RunOptions::default())?;
@@ -439,6 +439,17 @@ pub(super) fn read_table(path: &Path, expected: &[&str]) -> Result<Vec<Vec<f64>>
     Ok(rows)
 }
 
+/// The charts of a dynamic run (`ff_charts.csv`, D32): the first step in each and its base `B`;
+/// only `initial` where the script wrote none.
+fn read_charts(path: &Path, initial: Chart) -> Result<Vec<(usize, Chart)>, FreeFemError> {
+    if !path.exists() {
+        return Ok(vec![(0, initial)]);
+    }
+    let columns = ["step", "time_s", "b11", "b12", "b13", "b21", "b22", "b23", "b31", "b32", "b33"];
+    let rows = read_table(path, &columns)?;
+    Ok(rows.iter().map(|r| (r[0] as usize, Chart { base: nalgebra::Matrix3::from_row_slice(&r[2..11]) })).collect())
+}
+
 /// The result of `forward.edp` in `dir`, and its certificate with the blocks.
 fn read_outputs(case: &Case, dir: &Path) -> Result<(RunResult, Option<Certificate>), FreeFemError> {
     let nodes_path = dir.join("ff_nodes.csv");
@@ -468,7 +479,13 @@ fn read_outputs(case: &Case, dir: &Path) -> Result<(RunResult, Option<Certificat
     };
     let mut history = Vec::new();
     let mut tip = Vec::new();
+    let mut nodes = nodes;
     if case.is_dynamic() {
+        // the charts of the run (D32): each record's, and the final state's
+        let initial = nodes.chart;
+        let charts = read_charts(&dir.join("ff_charts.csv"), initial)?;
+        let chart_at = |k: usize| charts.iter().rev().find(|(step, _)| *step <= k).map(|c| c.1).unwrap_or(initial);
+        nodes.chart = charts.last().map(|c| c.1).unwrap_or(initial);
         for r in read_table(&dir.join("ff_tip.csv"), &TIP_COLUMNS)? {
             tip.push(TipRecord {
                 time_s: r[0],
@@ -483,6 +500,7 @@ fn read_outputs(case: &Case, dir: &Path) -> Result<(RunResult, Option<Certificat
                     angular_momentum_n_m_s: Vector3::new(r[14], r[15], r[16]),
                 },
                 loaded: r[17] != 0.0,
+                chart: chart_at(tip.len()),
             });
         }
     } else {

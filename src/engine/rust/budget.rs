@@ -120,10 +120,10 @@ fn clip_bytes(case: &Case) -> Option<(f64, String)> {
     Some((held * nodes * CLIP_BYTES_PER_NODE_FRAME + frames * SUMMARY_BYTES_PER_FRAME, basis))
 }
 
-/// Bytes per time step of a dynamic run's records (`solve::dynamics::TipRecord`, about 140 with
-/// its balance) and their rows in `tip_history.csv` and `balance.csv` (9 and 11 numbers of about
-/// 24 characters, written from memory).
-const TIP_RECORD_BYTES: f64 = 640.0;
+/// Bytes per time step of a dynamic run's records (`solve::dynamics::TipRecord`, about 210 with
+/// its balance and chart) and their rows in `tip_history.csv` and `balance.csv` (9 and 11 numbers
+/// of about 24 characters, written from memory).
+const TIP_RECORD_BYTES: f64 = 720.0;
 
 /// Estimated peak memory [bytes] of `what` on `case`, with what it was estimated from and the
 /// keys that scale it.

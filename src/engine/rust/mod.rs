@@ -161,13 +161,14 @@ fn run_forward_solve(case: &Case, mut progress: impl FnMut(usize, usize)) -> Res
         }
         Analysis::Dynamic(params) => {
             let mut sol = dynamics::solve(&problem, params, &mut progress)?;
-            let chart = problem.chart();
-            if !chart.is_identity() {
-                sol.tip.iter_mut().for_each(|t| t.position_m = chart.to_space(&t.position_m));
-            }
+            // each record in its own chart (D32)
+            sol.tip
+                .iter_mut()
+                .filter(|t| !t.chart.is_identity())
+                .for_each(|t| t.position_m = t.chart.to_space(&t.position_m));
             Ok(RunResult {
                 engine: Engine::Rust,
-                nodes: NodalState::of_forward(case, &sol.u),
+                nodes: NodalState::of_forward_in(case, &sol.u, sol.chart),
                 history: Vec::new(),
                 tip: sol.tip,
                 stats: SolverStats {
