@@ -182,13 +182,13 @@ impl BandLu {
             // rank-1 update of the columns j + 1..=ju, rows j + 1..=j + km; for the usual
             // block sizes (6 and 12 unknowns per node: km from 6 to 11 and from 12 to 23) with
             // a fixed, unrolled length
-            let span = ju - j;
+            let at = Sweep { col, kv, ld, span: ju - j };
             macro_rules! fixed {
                 ($($k:literal)*) => {
                     match (km, wide) {
-                        $(($k, Some(cpu)) => simd::update::<$k>(cpu, head, tail, col, kv, ld, span),)*
-                        $(($k, None) => update::<$k>(head, tail, col, kv, ld, span),)*
-                        _ => update_any(head, tail, col, kv, ld, span, km),
+                        $(($k, Some(cpu)) => simd::update::<$k>(cpu, head, tail, at),)*
+                        $(($k, None) => update::<$k>(head, tail, at),)*
+                        _ => update_any(head, tail, at, km),
                     }
                 };
             }
@@ -317,8 +317,21 @@ fn pivot(v: &[f64]) -> (usize, f64) {
     (p, best)
 }
 
+/// Where a rank-1 update of [`BandLu::factor`] works in the band storage (`ld` values per
+/// column, the diagonal at offset `kv`): the pivot column's diagonal at `col` of the `head`
+/// slice, and the `span` columns after it at the start of the `tail` slice. Small and `Copy`, so
+/// that the kernels take it in registers as they took its four numbers.
+#[derive(Clone, Copy, Debug)]
+struct Sweep {
+    col: usize,
+    kv: usize,
+    ld: usize,
+    span: usize,
+}
+
 /// [`update`] for any number `km` of rows below the pivot.
-fn update_any(head: &[f64], tail: &mut [f64], col: usize, kv: usize, ld: usize, span: usize, km: usize) {
+fn update_any(head: &[f64], tail: &mut [f64], at: Sweep, km: usize) {
+    let Sweep { col, kv, ld, span } = at;
     let l = &head[col + 1..col + 1 + km];
     for (t, column) in tail.chunks_exact_mut(ld).take(span).enumerate() {
         let base = kv - 1 - t;
@@ -335,7 +348,8 @@ fn update_any(head: &[f64], tail: &mut [f64], col: usize, kv: usize, ld: usize, 
 /// (`head` ends with it, its multipliers at `col + 1..`; `tail` holds the next columns), the `KL`
 /// rows below the pivot row that can hold non-zeros.
 #[inline]
-fn update<const KL: usize>(head: &[f64], tail: &mut [f64], col: usize, kv: usize, ld: usize, span: usize) {
+fn update<const KL: usize>(head: &[f64], tail: &mut [f64], at: Sweep) {
+    let Sweep { col, kv, ld, span } = at;
     let l: &[f64; KL] = head[col + 1..col + 1 + KL].try_into().expect("KL multipliers");
     for (t, column) in tail.chunks_exact_mut(ld).take(span).enumerate() {
         // column c = j + 1 + t: row j at kv + j − c
@@ -381,14 +395,20 @@ mod tests {
         m
     }
 
-    /// Random block-tridiagonal matrix (blocks `b`, `nb` blocks), optionally made diagonally
-    /// dominant.
-    fn block_tridiagonal(nb: usize, b: usize, seed: u64, dominant: bool) -> DMatrix<f64> {
+    /// The diagonal of a random test matrix: as random as the rest, or made dominant.
+    #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+    enum Diagonal {
+        Random,
+        Dominant,
+    }
+
+    /// Random block-tridiagonal matrix (blocks `b`, `nb` blocks), its diagonal as `diagonal` says.
+    fn block_tridiagonal(nb: usize, b: usize, seed: u64, diagonal: Diagonal) -> DMatrix<f64> {
         let mut r = rng(seed);
         let n = nb * b;
         DMatrix::from_fn(n, n, |i, j| {
             if (i / b).abs_diff(j / b) <= 1 {
-                r() + if dominant && i == j { 4.0 * b as f64 } else { 0.0 }
+                r() + if diagonal == Diagonal::Dominant && i == j { 4.0 * b as f64 } else { 0.0 }
             } else {
                 0.0
             }
@@ -398,7 +418,7 @@ mod tests {
     #[test]
     fn determinant_sign_is_the_dense_determinant_s() {
         for seed in 0..20 {
-            let a = block_tridiagonal(5, 3, 100 + seed, false);
+            let a = block_tridiagonal(5, 3, 100 + seed, Diagonal::Random);
             let mut lu = band_from_dense(&a, 5, 5);
             lu.factor().expect("factor");
             let det = a.clone().determinant();
@@ -446,9 +466,9 @@ mod tests {
     #[test]
     fn random_block_tridiagonal_systems_match_dense_lu() {
         for (nb, b, seed) in [(1, 6, 1), (2, 6, 2), (17, 6, 3), (9, 12, 4), (40, 12, 5), (3, 1, 6), (50, 2, 7)] {
-            check_blocks(&block_tridiagonal(nb, b, seed, true), b, seed + 100);
+            check_blocks(&block_tridiagonal(nb, b, seed, Diagonal::Dominant), b, seed + 100);
             // Not diagonally dominant: pivoting is exercised.
-            check_blocks(&block_tridiagonal(nb, b, seed + 50, false), b, seed + 200);
+            check_blocks(&block_tridiagonal(nb, b, seed + 50, Diagonal::Random), b, seed + 200);
         }
     }
 
@@ -458,8 +478,8 @@ mod tests {
     #[test]
     fn wide_and_portable_factors_agree_bit_for_bit() {
         for (nb, b, seed) in [(17, 6, 31), (40, 12, 32), (9, 12, 33), (50, 2, 34)] {
-            for dominant in [true, false] {
-                let a = block_tridiagonal(nb, b, seed, dominant);
+            for diagonal in [Diagonal::Dominant, Diagonal::Random] {
+                let a = block_tridiagonal(nb, b, seed, diagonal);
                 let mut wide = BandLu::block_tridiagonal(nb, b);
                 for j in 0..a.ncols() {
                     for i in 0..a.nrows() {
@@ -475,7 +495,7 @@ mod tests {
                 portable.factor_with(None).expect("portable factor");
                 general.factor().expect("factor");
                 general_portable.factor_with(None).expect("portable factor");
-                assert_eq!((&wide.ab, &wide.piv), (&portable.ab, &portable.piv), "{nb}×{b}, dominant {dominant}");
+                assert_eq!((&wide.ab, &wide.piv), (&portable.ab, &portable.piv), "{nb}×{b}, {diagonal:?}");
                 assert_eq!((&general.ab, &general.piv), (&general_portable.ab, &general_portable.piv));
                 let mut r = rng(seed + 7);
                 let rhs: Vec<f64> = (0..a.nrows()).map(|_| r()).collect();
@@ -524,7 +544,7 @@ mod tests {
     #[test]
     fn zero_leading_diagonal_needs_pivoting() {
         // [[0, 1], [1, 0]] ⊕ ...: elimination without interchanges fails at the first pivot.
-        let mut a = block_tridiagonal(8, 3, 9, false);
+        let mut a = block_tridiagonal(8, 3, 9, Diagonal::Random);
         a[(0, 0)] = 0.0;
         a[(4, 4)] = 0.0;
         check_blocks(&a, 3, 11);

@@ -17,6 +17,15 @@ pub struct Pattern {
     diag: Vec<usize>,
 }
 
+/// How an element's matrix goes into the values: added to what they hold
+/// ([`Pattern::scatter`]), or in a pass over every element in order that writes the entries no
+/// earlier element touched ([`Pattern::scatter_first`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Pass {
+    Adding,
+    First,
+}
+
 impl Pattern {
     /// Pattern of `nodes` blocks of `block` unknowns each (`nodes ≥ 2`).
     pub fn block_tridiagonal(nodes: usize, block: usize) -> Self {
@@ -79,7 +88,7 @@ impl Pattern {
 
     /// Add a local `(2 block)²` matrix of element `e` into the values.
     pub fn scatter<const N: usize>(&self, values: &mut [f64], e: usize, local: &SMatrix<f64, N, N>) {
-        self.scatter_with(values, e, local, false);
+        self.scatter_with(values, e, local, Pass::Adding);
     }
 
     /// [`Pattern::scatter`] of an assembly pass that starts from whatever `values` holds, with
@@ -89,11 +98,12 @@ impl Pattern {
     /// every entry of the pattern belongs to some element, so the pass leaves no old value and
     /// the values need no zeroing before it.
     pub fn scatter_first<const N: usize>(&self, values: &mut [f64], e: usize, local: &SMatrix<f64, N, N>) {
-        self.scatter_with(values, e, local, true);
+        self.scatter_with(values, e, local, Pass::First);
     }
 
     #[inline]
-    fn scatter_with<const N: usize>(&self, values: &mut [f64], e: usize, local: &SMatrix<f64, N, N>, first: bool) {
+    fn scatter_with<const N: usize>(&self, values: &mut [f64], e: usize, local: &SMatrix<f64, N, N>, pass: Pass) {
+        let first = pass == Pass::First;
         assert_eq!(N, 2 * self.block, "local matrix size must be twice the block size");
         // rows [0, shared) of the columns [0, block) were touched by element e − 1 (first pass)
         let shared = match (first, e) {
@@ -224,38 +234,39 @@ mod tests {
                     })
                 })
                 .collect();
-            let run = |first: bool| {
-                let mut values: Vec<f64> =
-                    if first { (0..p.nnz()).map(|k| 1e300 * (k as f64 + 1.0)).collect() } else { vec![0.0; p.nnz()] };
-                for (e, l) in locals.iter().enumerate() {
-                    // the top-left (2 block)² corner of the 24 × 24 sample
-                    let local =
-                        SMatrix::<f64, 24, 24>::from_fn(
-                            |i, j| {
-                                if i < 2 * block && j < 2 * block {
-                                    l[(i, j)]
-                                } else {
-                                    0.0
-                                }
-                            },
-                        );
-                    match block {
-                        12 if first => p.scatter_first(&mut values, e, &local),
-                        12 => p.scatter(&mut values, e, &local),
-                        6 => scatter_n::<12>(&p, &mut values, e, &local, first),
-                        _ => scatter_n::<6>(&p, &mut values, e, &local, first),
+            let run =
+                |pass: Pass| {
+                    let mut values: Vec<f64> = if pass == Pass::First {
+                        (0..p.nnz()).map(|k| 1e300 * (k as f64 + 1.0)).collect()
+                    } else {
+                        vec![0.0; p.nnz()]
+                    };
+                    for (e, l) in locals.iter().enumerate() {
+                        // the top-left (2 block)² corner of the 24 × 24 sample
+                        let local = SMatrix::<f64, 24, 24>::from_fn(|i, j| {
+                            if i < 2 * block && j < 2 * block {
+                                l[(i, j)]
+                            } else {
+                                0.0
+                            }
+                        });
+                        match block {
+                            12 if pass == Pass::First => p.scatter_first(&mut values, e, &local),
+                            12 => p.scatter(&mut values, e, &local),
+                            6 => scatter_n::<12>(&p, &mut values, e, &local, pass),
+                            _ => scatter_n::<6>(&p, &mut values, e, &local, pass),
+                        }
                     }
-                }
-                values.iter().map(|v| v.to_bits()).collect::<Vec<_>>()
-            };
-            assert_eq!(run(true), run(false), "{nodes} nodes, block {block}");
+                    values.iter().map(|v| v.to_bits()).collect::<Vec<_>>()
+                };
+            assert_eq!(run(Pass::First), run(Pass::Adding), "{nodes} nodes, block {block}");
         }
     }
 
     /// The `N × N` corner of `local`, scattered by `scatter_first` or `scatter`.
-    fn scatter_n<const N: usize>(p: &Pattern, values: &mut [f64], e: usize, local: &SMatrix<f64, 24, 24>, first: bool) {
+    fn scatter_n<const N: usize>(p: &Pattern, values: &mut [f64], e: usize, local: &SMatrix<f64, 24, 24>, pass: Pass) {
         let m = SMatrix::<f64, N, N>::from_fn(|i, j| local[(i, j)]);
-        if first {
+        if pass == Pass::First {
             p.scatter_first(values, e, &m)
         } else {
             p.scatter(values, e, &m)

@@ -13,6 +13,31 @@ use super::{BandLu, LinearError, Pattern};
 /// Passes of Ruiz equilibration.
 const RUIZ_PASSES: usize = 5;
 
+/// How the values are copied into the band ([`LinearSolver::load`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Load {
+    /// as given
+    Plain,
+    /// times `dr_i dc_j`, the factors of the last equilibration
+    Scaled,
+    /// as given, with Ruiz's first row and column maxima taken from each column just copied
+    WithMaxima,
+}
+
+/// Whether a column of a Ruiz pass also takes the maxima of the scaled values (every pass but
+/// the last, whose maxima no pass needs).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Maxima {
+    Take,
+    Skip,
+}
+
+/// The accumulated row and column factors `D_r`, `D_c` of a Ruiz equilibration.
+struct Factors<'a> {
+    rows: &'a mut [f64],
+    columns: &'a mut [f64],
+}
+
 /// Where column `j` of the pattern lives: its first row, its length and where its first entry
 /// sits in the CSC value array and in the band storage.
 #[derive(Clone, Debug)]
@@ -77,15 +102,8 @@ impl LinearSolver {
         // the copy into the band also takes Ruiz's first row and column maxima (each column
         // while it is in cache), so `ruiz` starts with its first scaling
         self.load_with_maxima(values);
-        ruiz(
-            &self.cols,
-            self.lu.band_mut(),
-            &mut self.dr,
-            &mut self.dc,
-            &mut self.rmax,
-            &mut self.cmax,
-            &mut self.rnext,
-        );
+        let factors = Factors { rows: &mut self.dr, columns: &mut self.dc };
+        ruiz(&self.cols, self.lu.band_mut(), factors, &mut self.rmax, &mut self.cmax, &mut self.rnext);
         let solved = self.factor_and_solve_scaled(b);
         self.unscaled_if_zero_pivot(solved, values, b)
     }
@@ -113,7 +131,7 @@ impl LinearSolver {
     /// Jacobians of one Newton solve). Any positive diagonal scaling leaves the solution
     /// unchanged up to round-off; these keep the pivots as well-scaled as the equilibrated ones.
     pub fn solve_rescaled(&mut self, values: &[f64], b: &DVector<f64>) -> Result<DVector<f64>, LinearError> {
-        self.load(values, true);
+        self.load(values, Load::Scaled);
         let solved = self.factor_and_solve_scaled(b);
         self.unscaled_if_zero_pivot(solved, values, b)
     }
@@ -132,13 +150,13 @@ impl LinearSolver {
         let (mut r, mut c, mut r_next) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
         let csc = Columns { band: self.cols.csc.clone(), ..self.cols.clone() };
         column_maxima(&csc, &a, &mut r, &mut c);
-        ruiz(&csc, &mut a, &mut dr, &mut dc, &mut r, &mut c, &mut r_next);
+        ruiz(&csc, &mut a, Factors { rows: &mut dr, columns: &mut dc }, &mut r, &mut c, &mut r_next);
         (a, dr, dc)
     }
 
     /// Solve `M x = b` for the matrix with the pattern's structure and the given values.
     pub fn solve(&mut self, values: &[f64], b: &DVector<f64>) -> Result<DVector<f64>, LinearError> {
-        self.load(values, false);
+        self.load(values, Load::Plain);
         self.scaled = false;
         self.lu.factor_cleared()?;
         self.solve_factored(b)
@@ -167,22 +185,18 @@ impl LinearSolver {
         Ok(x)
     }
 
-    /// Copy `values` (CSC, the pattern's order) into the band, column by column: the pattern's
-    /// rows (times `dr_i dc_j` if `scaled`) and zeros in the rest of the column, the fill rows
-    /// of the interchanges included (ready for [`BandLu::factor_cleared`]).
-    fn load(&mut self, values: &[f64], scaled: bool) {
-        self.load_columns(values, scaled, false);
-    }
-
-    /// [`LinearSolver::load`] unscaled, with the row maxima `|a_ij|` into `rmax` and the column
-    /// maxima into `cmax` taken from each column just copied (the first sweep of [`ruiz`]: the
-    /// same numbers in the same order, without a second pass over the band).
+    /// [`LinearSolver::load`] with the row maxima `|a_ij|` into `rmax` and the column maxima into
+    /// `cmax` taken from each column just copied (the first sweep of [`ruiz`]: the same numbers
+    /// in the same order, without a second pass over the band).
     fn load_with_maxima(&mut self, values: &[f64]) {
         self.rmax.iter_mut().for_each(|v| *v = 0.0);
-        self.load_columns(values, false, true);
+        self.load(values, Load::WithMaxima);
     }
 
-    fn load_columns(&mut self, values: &[f64], scaled: bool, maxima: bool) {
+    /// Copy `values` (CSC, the pattern's order) into the band, column by column: the pattern's
+    /// rows (times `dr_i dc_j` if [`Load::Scaled`]) and zeros in the rest of the column, the
+    /// fill rows of the interchanges included (ready for [`BandLu::factor_cleared`]).
+    fn load(&mut self, values: &[f64], how: Load) {
         let c = &self.cols;
         let ld = self.lu.ld();
         for (j, col) in self.lu.band_mut().chunks_exact_mut(ld).enumerate() {
@@ -190,7 +204,7 @@ impl LinearSolver {
             col[..s].fill(0.0);
             let dst = &mut col[s..s + len];
             let src = &values[k0..k0 + len];
-            if scaled {
+            if how == Load::Scaled {
                 let (dr, dcj) = (&self.dr[c.first[j]..c.first[j] + len], self.dc[j]);
                 for ((d, v), r) in dst.iter_mut().zip(src).zip(dr) {
                     *d = v * (r * dcj);
@@ -198,7 +212,7 @@ impl LinearSolver {
             } else {
                 dst.copy_from_slice(src);
             }
-            if maxima {
+            if how == Load::WithMaxima {
                 self.cmax[j] = row_col_max(&mut self.rmax[c.first[j]..c.first[j] + len], dst);
             }
             col[s + len..].fill(0.0);
@@ -263,20 +277,19 @@ fn inv_sqrt_all(v: &mut [f64]) {
     body(v)
 }
 
-/// One column of a Ruiz pass with `L` rows: `a_i ← a_i (r_i c)`, then (if `maxima`) the
-/// maxima of the scaled column into `next` (row-wise) and the returned column maximum, as
+/// One column of a Ruiz pass with `L` rows: `a_i ← a_i (r_i c)`, then (with [`Maxima::Take`])
+/// the maxima of the scaled column into `next` (row-wise) and the returned column maximum, as
 /// [`row_col_max`] takes them.
 #[inline(always)]
-fn scale_column<const L: usize>(a: &mut [f64], r: &[f64], c: f64, next: &mut [f64], maxima: bool) -> f64 {
+fn scale_column<const L: usize>(a: &mut [f64], r: &[f64], c: f64, next: &mut [f64], maxima: Maxima) -> f64 {
     let a: &mut [f64; L] = a.try_into().expect("L rows");
     let r: &[f64; L] = r.try_into().expect("L rows");
     for i in 0..L {
         a[i] *= r[i] * c;
     }
-    if maxima {
-        row_col_max(next, a)
-    } else {
-        0.0
+    match maxima {
+        Maxima::Take => row_col_max(next, a),
+        Maxima::Skip => 0.0,
     }
 }
 
@@ -334,71 +347,70 @@ fn column_maxima(cols: &Columns, a: &[f64], r: &mut [f64], c: &mut [f64]) {
 
 /// Five passes of Ruiz row/column max-norm scaling of the values in `a` (column `j` of the
 /// pattern at `a[cols.band[j]..][..cols.len[j]]`, rows from `cols.first[j]`), in place, with the
-/// accumulated row and column factors in `dr`, `dc`, from the row and column maxima of `a` in
+/// accumulated row and column factors in `factors`, from the row and column maxima of `a` in
 /// `r`, `c` ([`column_maxima`], or taken while the values were copied into the band; `r_next`:
-/// scratch). Each pass scales `a_ij ← a_ij (1/√r_i)(1/√c_j)` and takes the maxima of the next
-/// in the same sweep over the values. (The slices are arguments of their own: gathered in a
-/// struct they lose the compiler's no-alias knowledge, 9.5 % more instructions here.)
-fn ruiz(
-    cols: &Columns,
-    a: &mut [f64],
-    dr: &mut [f64],
-    dc: &mut [f64],
-    r: &mut [f64],
-    c: &mut [f64],
-    r_next: &mut [f64],
-) {
-    let n = cols.len.len();
-    #[cfg(target_arch = "x86_64")]
-    let wide = Avx2::detect();
+/// scratch). Each pass scales `a_ij ← a_ij (1/√r_i)(1/√c_j)` ([`ruiz_pass`]) and takes the
+/// maxima of the next in the same sweep over the values.
+fn ruiz(cols: &Columns, a: &mut [f64], factors: Factors<'_>, r: &mut [f64], c: &mut [f64], r_next: &mut [f64]) {
+    let Factors { rows: dr, columns: dc } = factors;
     dr.iter_mut().for_each(|v| *v = 1.0);
     dc.iter_mut().for_each(|v| *v = 1.0);
-    // the rows of a column are contiguous (block-tridiagonal pattern): slices, no gathers
-    let column = |j: usize| (cols.band[j], cols.band[j] + cols.len[j], cols.first[j]);
     for pass in 0..RUIZ_PASSES {
         // the factors of this pass, 1/√r and 1/√c, once per row and column
         inv_sqrt_all(r);
         inv_sqrt_all(c);
-        let last = pass + 1 == RUIZ_PASSES;
-        r_next.iter_mut().for_each(|v| *v = 0.0);
-        for j in 0..n {
-            let (k0, k1, first) = column(j);
-            let cj = c[j];
-            dc[j] *= cj;
-            let (a, rows, next) = (&mut a[k0..k1], &r[first..first + (k1 - k0)], &mut r_next[first..first + (k1 - k0)]);
-            // the maxima of the next pass come from the freshly scaled column; the columns of
-            // a block-tridiagonal pattern hold 2 or 3 blocks of rows (block 6 or 12): those
-            // lengths have loops of fixed length
-            #[cfg(target_arch = "x86_64")]
-            if let (false, Some(_cpu)) = (last, wide) {
-                // SAFETY: the `Avx2` token `_cpu` exists, so the CPU has AVX2.
-                c[j] = unsafe { scale_and_measure_avx2(a, rows, cj, next) };
-                continue;
-            }
-            let m = match a.len() {
-                36 => scale_column::<36>(a, rows, cj, next, !last),
-                24 => scale_column::<24>(a, rows, cj, next, !last),
-                18 => scale_column::<18>(a, rows, cj, next, !last),
-                12 => scale_column::<12>(a, rows, cj, next, !last),
-                _ => {
-                    for (av, rv) in a.iter_mut().zip(rows) {
-                        *av *= rv * cj;
-                    }
-                    if last {
-                        0.0
-                    } else {
-                        row_col_max(next, a)
-                    }
-                }
-            };
-            if !last {
-                c[j] = m;
-            }
+        for (d, cj) in dc.iter_mut().zip(c.iter()) {
+            *d *= cj;
         }
-        for i in 0..n {
-            dr[i] *= r[i];
+        let maxima = if pass + 1 == RUIZ_PASSES { Maxima::Skip } else { Maxima::Take };
+        r_next.iter_mut().for_each(|v| *v = 0.0);
+        ruiz_pass(cols, a, r, c, r_next, maxima);
+        for (d, ri) in dr.iter_mut().zip(r.iter()) {
+            *d *= ri;
         }
         r.copy_from_slice(r_next);
+    }
+}
+
+/// One pass of [`ruiz`] over the columns: `a_ij ← a_ij r_i c_j` with this pass's factors `r`,
+/// `c`, and (with [`Maxima::Take`]) the maxima of the scaled values into `r_next` (row-wise)
+/// and `c` (column-wise) for the next pass. (The slices are arguments of their own: gathered in
+/// a struct they lose the compiler's no-alias knowledge, 9.5 % more instructions here.)
+fn ruiz_pass(cols: &Columns, a: &mut [f64], r: &[f64], c: &mut [f64], r_next: &mut [f64], maxima: Maxima) {
+    #[cfg(target_arch = "x86_64")]
+    let wide = Avx2::detect();
+    for j in 0..cols.len.len() {
+        // the rows of a column are contiguous (block-tridiagonal pattern): slices, no gathers
+        let (k0, k1, first) = (cols.band[j], cols.band[j] + cols.len[j], cols.first[j]);
+        let cj = c[j];
+        let (a, rows, next) = (&mut a[k0..k1], &r[first..first + (k1 - k0)], &mut r_next[first..first + (k1 - k0)]);
+        // the maxima of the next pass come from the freshly scaled column; the columns of
+        // a block-tridiagonal pattern hold 2 or 3 blocks of rows (block 6 or 12): those
+        // lengths have loops of fixed length
+        #[cfg(target_arch = "x86_64")]
+        if let (Maxima::Take, Some(_cpu)) = (maxima, wide) {
+            // SAFETY: the `Avx2` token `_cpu` exists, so the CPU has AVX2.
+            c[j] = unsafe { scale_and_measure_avx2(a, rows, cj, next) };
+            continue;
+        }
+        let m = match a.len() {
+            36 => scale_column::<36>(a, rows, cj, next, maxima),
+            24 => scale_column::<24>(a, rows, cj, next, maxima),
+            18 => scale_column::<18>(a, rows, cj, next, maxima),
+            12 => scale_column::<12>(a, rows, cj, next, maxima),
+            _ => {
+                for (av, rv) in a.iter_mut().zip(rows) {
+                    *av *= rv * cj;
+                }
+                match maxima {
+                    Maxima::Take => row_col_max(next, a),
+                    Maxima::Skip => 0.0,
+                }
+            }
+        };
+        if maxima == Maxima::Take {
+            c[j] = m;
+        }
     }
 }
 

@@ -18,7 +18,7 @@ use nalgebra::{Matrix3, Vector3};
 use super::element::{for_each_point, interpolate, ElementRest, LocalVec};
 use super::material::RodProperties;
 use super::mesh::QuadratureScheme;
-use super::rotation::PointFrame;
+use super::rotation::{Derivatives, PointFrame};
 
 /// Energy [J] and momenta of a rod, or of one of its elements.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -77,7 +77,7 @@ pub fn element_balance(
     let rule = scheme.loads();
     for (xi, w) in rule.points.iter().zip(rule.weights) {
         let (p, v) = (interpolate(u, h, *xi), interpolate(udot, h, *xi));
-        let f = PointFrame::new(&p.alpha, false);
+        let f = PointFrame::new(&p.alpha, Derivatives::Without);
         let omega = f.a * v.alpha;
         let spin = I * omega;
         let wh = w * h;
@@ -86,12 +86,12 @@ pub fn element_balance(
         b.angular_momentum_n_m_s += (p.x.cross(&v.x) * rho_a + f.q.transpose() * spin) * wh;
     }
     for_each_point(&scheme.stretch_shear(), h, u, |p, wh, slot| {
-        let f = PointFrame::new(&p.alpha, false);
+        let f = PointFrame::new(&p.alpha, Derivatives::Without);
         let e = f.q * p.dx - Vector3::z() - rest.stretch_shear[slot];
         b.elastic_j += 0.5 * wh * e.dot(&(K * e));
     });
     for_each_point(&scheme.bending(), h, u, |p, wh, slot| {
-        let f = PointFrame::new(&p.alpha, false);
+        let f = PointFrame::new(&p.alpha, Derivatives::Without);
         let kappa = f.a * p.dalpha - rest.curvature[slot];
         b.elastic_j += 0.5 * wh * kappa.dot(&(J * kappa));
     });
@@ -102,7 +102,7 @@ pub fn element_balance(
 mod tests {
     use super::*;
     use crate::model::element::tests::{props, state};
-    use crate::model::element::{momentum, X};
+    use crate::model::element::{momentum, MomentumDerivatives, X};
 
     /// The linear momentum is the sum of the momentum functional's position rows (the same
     /// rule): `P` is `δx · ρA ẋ + δα · Qᵀ I A α̇` and `Σ_a N_a = 1`.
@@ -111,7 +111,7 @@ mod tests {
         let (p, h) = (props(), 0.1);
         let u = state();
         let udot = LocalVec::from_fn(|i, _| 0.3 * (i as f64 + 1.0).sin());
-        let pv = momentum(&p, QuadratureScheme::Selective, h, &u, &udot, None, None);
+        let pv = momentum(&p, QuadratureScheme::Selective, h, &u, &udot, MomentumDerivatives::default());
         let b = element_balance(&p, QuadratureScheme::Selective, h, (&u, &udot), &ElementRest::ZERO);
         let rows = |off: usize| Vector3::new(pv[off], pv[off + 1], pv[off + 2]);
         let sum_x = rows(X[0]) + rows(X[1]);

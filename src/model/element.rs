@@ -18,7 +18,7 @@ use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 
 use super::material::RodProperties;
 use super::mesh::{DofMap, Field, QuadratureScheme, Rule};
-use super::rotation::{curvature, rotation, rotation_derivatives, skew, PointFrame};
+use super::rotation::{curvature, rotation, rotation_derivatives, skew, Derivatives, PointFrame};
 
 /// Local element vector (12 entries).
 pub type LocalVec = SVector<f64, 12>;
@@ -49,7 +49,7 @@ impl ElementRest {
         let mut rest = ElementRest::ZERO;
         for (k, xi) in super::mesh::POINT_SLOTS.iter().enumerate() {
             let p = interpolate(u0, h, *xi);
-            let f = PointFrame::new(&p.alpha, false);
+            let f = PointFrame::new(&p.alpha, Derivatives::Without);
             rest.stretch_shear[k] = f.q * p.dx - Vector3::z();
             rest.curvature[k] = f.a * p.dalpha;
         }
@@ -122,9 +122,9 @@ pub fn internal_force(
     let K = Matrix3::from_diagonal(&props.shear_stretch_n);
     let J = Matrix3::from_diagonal(&props.bend_twist_nm2);
     let mut r = LocalVec::zeros();
-    let with_tangent = tangent.is_some();
+    let derivatives = Derivatives::for_tangent(&tangent);
     for_each_point(&scheme.stretch_shear(), h, u, |p, wh, slot| {
-        let f = PointFrame::new(&p.alpha, with_tangent);
+        let f = PointFrame::new(&p.alpha, derivatives);
         let Q = f.q;
         let e = Q * p.dx - Vector3::z() - rest.stretch_shear[slot];
         let n = Q.transpose() * (K * e);
@@ -151,7 +151,7 @@ pub fn internal_force(
         }
     });
     for_each_point(&scheme.bending(), h, u, |p, wh, slot| {
-        let f = PointFrame::new(&p.alpha, with_tangent);
+        let f = PointFrame::new(&p.alpha, derivatives);
         let (Q, A) = (f.q, f.a);
         let kappa = A * p.dalpha - rest.curvature[slot];
         let m = Q.transpose() * (J * kappa);
@@ -214,7 +214,7 @@ pub fn frozen_operator(
         }
     });
     for_each_point(&scheme.bending(), h, uk, |p, wh, slot| {
-        let f = PointFrame::new(&p.alpha, false);
+        let f = PointFrame::new(&p.alpha, Derivatives::Without);
         let (Q, A) = (f.q, f.a);
         let C = Q.transpose() * J * A;
         // the reference curvature on the right-hand side: ∂sδα · Qᵀ J κ̄ (D20)
@@ -234,8 +234,17 @@ pub fn frozen_operator(
     (l, b)
 }
 
-/// Momentum functional `P(u, u̇)` of one element (D6, 2-point Gauss) and optionally its
-/// derivatives with respect to `u` and `u̇`.
+/// The derivatives of an element's momentum functional `P(u, u̇)` ([`momentum`]) a caller asks
+/// for: `∂P/∂u` into `d_u` and `∂P/∂u̇` into `d_udot`, each where a matrix is given (added into
+/// it). `Default`: neither.
+#[derive(Debug, Default)]
+pub struct MomentumDerivatives<'a> {
+    pub d_u: Option<&'a mut LocalMat>,
+    pub d_udot: Option<&'a mut LocalMat>,
+}
+
+/// Momentum functional `P(u, u̇)` of one element (D6, 2-point Gauss; eqs. (7), (27), (40)) and
+/// the derivatives `derivatives` asks for.
 #[allow(non_snake_case)] // paper symbols K, J, Q, A, S, C, Bk, H, I
 pub fn momentum(
     props: &RodProperties,
@@ -243,9 +252,9 @@ pub fn momentum(
     h: f64,
     u: &LocalVec,
     udot: &LocalVec,
-    mut d_u: Option<&mut LocalMat>,
-    mut d_udot: Option<&mut LocalMat>,
+    derivatives: MomentumDerivatives<'_>,
 ) -> LocalVec {
+    let MomentumDerivatives { mut d_u, mut d_udot } = derivatives;
     let I = Matrix3::from_diagonal(&props.rotary_inertia_kg_m);
     let rho_a = props.mass_per_length_kg_m;
     let mut r = LocalVec::zeros();
@@ -254,7 +263,7 @@ pub fn momentum(
         let p = interpolate(u, h, *xi);
         let v = interpolate(udot, h, *xi);
         let wh = w * h;
-        let f = PointFrame::new(&p.alpha, d_u.is_some());
+        let f = PointFrame::new(&p.alpha, Derivatives::for_tangent(&d_u));
         let (Q, A) = (f.q, f.a);
         let H = Q.transpose() * I * A;
         let px = v.x * rho_a;
@@ -461,9 +470,11 @@ pub(crate) mod tests {
         let udot = LocalVec::from_fn(|i, _| 0.1 * (i as f64 + 1.0).sin());
         let mut du = LocalMat::zeros();
         let mut dv = LocalMat::zeros();
-        momentum(&p, QuadratureScheme::Selective, 0.1, &u, &udot, Some(&mut du), Some(&mut dv));
-        fd_check(&|v| momentum(&p, QuadratureScheme::Selective, 0.1, v, &udot, None, None), &du, &u);
-        fd_check(&|w| momentum(&p, QuadratureScheme::Selective, 0.1, &u, w, None, None), &dv, &udot);
+        let both = MomentumDerivatives { d_u: Some(&mut du), d_udot: Some(&mut dv) };
+        momentum(&p, QuadratureScheme::Selective, 0.1, &u, &udot, both);
+        let none = MomentumDerivatives::default;
+        fd_check(&|v| momentum(&p, QuadratureScheme::Selective, 0.1, v, &udot, none()), &du, &u);
+        fd_check(&|w| momentum(&p, QuadratureScheme::Selective, 0.1, &u, w, none()), &dv, &udot);
     }
 
     #[test]

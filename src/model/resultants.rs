@@ -5,7 +5,7 @@ use nalgebra::{Matrix3, Vector3};
 use super::element::{for_each_point, ElementRest, LocalVec, ALPHA, X};
 use super::material::RodProperties;
 use super::mesh::QuadratureScheme;
-use super::rotation::{rotation, PointFrame};
+use super::rotation::{rotation, Derivatives, PointFrame};
 
 /// The stress resultants of one element: the internal force `n` [N] and moment `m` [N m], as
 /// the element's discrete equations see them.
@@ -46,7 +46,7 @@ pub fn resultants(
         r.n += Q.transpose() * nl * (wh / h);
     });
     for_each_point(&scheme.bending(), h, u, |p, wh, slot| {
-        let f = PointFrame::new(&p.alpha, false);
+        let f = PointFrame::new(&p.alpha, Derivatives::Without);
         let ml = J * (f.a * p.dalpha - rest.curvature[slot]);
         r.m_local += ml * (wh / h);
         r.m += f.q.transpose() * ml * (wh / h);

@@ -161,13 +161,30 @@ pub struct PointFrame {
     pub da: [Matrix3<f64>; 3],
 }
 
+/// Whether a [`PointFrame`] also holds the derivatives `∂Q/∂α_j`, `∂A/∂α_j` (a kernel that
+/// assembles a tangent needs them, a residual alone does not).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Derivatives {
+    Without,
+    With,
+}
+
+impl Derivatives {
+    /// [`Derivatives::With`] where a tangent is assembled (`tangent` is `Some`).
+    pub fn for_tangent<T>(tangent: &Option<T>) -> Self {
+        match tangent {
+            Some(_) => Derivatives::With,
+            None => Derivatives::Without,
+        }
+    }
+}
+
 impl PointFrame {
-    pub fn new(a: &Angles, derivatives: bool) -> Self {
+    pub fn new(a: &Angles, derivatives: Derivatives) -> Self {
         let t = Trig::new(a);
-        let (dq, da) = if derivatives {
-            (rotation_derivatives_t(&t), a_matrix_derivatives_t(&t))
-        } else {
-            ([Matrix3::zeros(); 3], [Matrix3::zeros(); 3])
+        let (dq, da) = match derivatives {
+            Derivatives::With => (rotation_derivatives_t(&t), a_matrix_derivatives_t(&t)),
+            Derivatives::Without => ([Matrix3::zeros(); 3], [Matrix3::zeros(); 3]),
         };
         PointFrame { q: rotation_t(&t), a: a_matrix_t(&t), dq, da }
     }
@@ -326,7 +343,7 @@ mod tests {
     fn point_frame_is_the_separate_functions() {
         for k in 0..10 {
             let a = field(0.7 * k as f64) * 2.0;
-            let f = PointFrame::new(&a, true);
+            let f = PointFrame::new(&a, Derivatives::With);
             assert_eq!(f.q, rotation(&a));
             assert_eq!(f.a, a_matrix(&a));
             assert_eq!(f.dq, rotation_derivatives(&a));

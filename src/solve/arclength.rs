@@ -218,12 +218,10 @@ pub fn follow(
         }
         let last = path.points.last().expect("the reference").clone();
         let mut cuts = 0;
-        let (u, lambda, iterations) = loop {
-            match corrected_step(problem, &mut sys, &last, direction.as_ref(), dl, (tolerance, max_iterations), step) {
-                Ok((u, lambda, its, records)) => {
-                    path.history.extend(records);
-                    break (u, lambda, its);
-                }
+        let Corrected { u, lambda, iterations, records } = loop {
+            let from = StepFrom { step, last: &last, direction: direction.as_ref(), dl };
+            match corrected_step(problem, &mut sys, from, Stopping { tolerance, max_iterations }) {
+                Ok(c) => break c,
                 Err(e) if cuts < MAX_CUTS && !matches!(e, SolveError::Interrupted { .. }) => {
                     cuts += 1;
                     dl *= 0.5;
@@ -234,6 +232,7 @@ pub fn follow(
                 Err(e) => return Err(e),
             }
         };
+        path.history.extend(records);
         // crossing the end load: solve at exactly λ = max by load control from the last point
         let (u, lambda, end) = if lambda >= params.max_load_factor && last.load_factor < params.max_load_factor {
             let f = (params.max_load_factor - last.load_factor) / (lambda - last.load_factor);
@@ -269,18 +268,39 @@ pub fn follow(
     Ok(path)
 }
 
-/// One arc-length step from `last` with arc length `dl`: the converged `(u, λ)`, its
-/// iterations and their records.
-#[allow(clippy::type_complexity)]
+/// An arc-length step to take: path step `step` from the point `last` with arc length `dl`,
+/// oriented by the direction of the step before (`None` at the first step).
+#[derive(Clone, Copy)]
+struct StepFrom<'a> {
+    step: usize,
+    last: &'a PathPoint,
+    direction: Option<&'a DVector<f64>>,
+    dl: f64,
+}
+
+/// Newton's stopping rule in a step: the tolerance of the increment (D5) and the iteration limit.
+#[derive(Clone, Copy)]
+struct Stopping {
+    tolerance: f64,
+    max_iterations: usize,
+}
+
+/// A converged arc-length step: the state `u`, its load factor λ, the iterations and their records.
+struct Corrected {
+    u: DVector<f64>,
+    lambda: f64,
+    iterations: usize,
+    records: Vec<IterationRecord>,
+}
+
+/// One arc-length step (`from`): the converged `(u, λ)`, its iterations and their records.
 fn corrected_step(
     problem: &Problem,
     sys: &mut System,
-    last: &PathPoint,
-    direction: Option<&DVector<f64>>,
-    dl: f64,
-    (tolerance, max_iterations): (f64, usize),
-    step: usize,
-) -> Result<(DVector<f64>, f64, usize, Vec<IterationRecord>), SolveError> {
+    from: StepFrom<'_>,
+    stopping: Stopping,
+) -> Result<Corrected, SolveError> {
+    let (StepFrom { step, last, direction, dl }, Stopping { tolerance, max_iterations }) = (from, stopping);
     // predictor along the tangent
     sys.residual(problem, &last.u, last.load_factor)?;
     let q = load_rate(problem, &last.u, last.load_factor, &sys.pattern);
@@ -326,7 +346,7 @@ fn corrected_step(
         let cert = certificate(&Problem { load_factor: lambda, ..*problem }, &u).value;
         records.push(IterationRecord { step, iteration: it, change: increment, certificate: cert });
         if increment <= tolerance && cert <= step_certificate_bound(tolerance) {
-            return Ok((u, lambda, it, records));
+            return Ok(Corrected { u, lambda, iterations: it, records });
         }
     }
     Err(SolveError::NewtonNotConverged {

@@ -39,6 +39,15 @@ pub struct Certificate {
     pub blocks: [f64; 4],
 }
 
+/// The system a certificate is of, which names its four blocks of rows: a forward problem's
+/// (force and moment balance, two blocks) or the inverse problem's KKT system (eq. 61: the
+/// adjoint's and the primal's rows, four blocks).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum System {
+    Forward,
+    Kkt,
+}
+
 impl Certificate {
     /// The certificate of a residual `r` and the term magnitudes `scale` (`|K||U| + |r|` per row),
     /// both in the layout `dofs`. A block whose terms are all zero has `η_b = 0` if its residual
@@ -67,11 +76,10 @@ impl Certificate {
     }
 
     /// The block with the largest `η_b`, named by the balance its rows express.
-    pub fn worst_block(&self, kkt: bool) -> &'static str {
-        let names: [&'static str; 4] = if kkt {
-            ["adjoint δx rows", "adjoint δα rows", "primal force rows (δx̂)", "primal moment rows (δα̂)"]
-        } else {
-            ["force balance", "moment balance", "", ""]
+    pub fn worst_block(&self, system: System) -> &'static str {
+        let names: [&'static str; 4] = match system {
+            System::Kkt => ["adjoint δx rows", "adjoint δα rows", "primal force rows (δx̂)", "primal moment rows (δα̂)"],
+            System::Forward => ["force balance", "moment balance", "", ""],
         };
         let worst = (0..4).max_by(|&a, &b| self.blocks[a].total_cmp(&self.blocks[b])).unwrap_or(0);
         names[worst]
@@ -124,7 +132,7 @@ mod tests {
         assert_eq!(c.blocks[Field::X as usize], 1e-4);
         assert_eq!(c.blocks[Field::Alpha as usize], 0.0);
         assert_eq!(c.value, 1e-4);
-        assert_eq!(c.worst_block(false), "force balance");
+        assert_eq!(c.worst_block(System::Forward), "force balance");
         // a residual where every term vanishes cannot be certified, nor can a NaN
         r[3] = 1e-30;
         s[3] = 0.0;

@@ -11,7 +11,7 @@
 //! used (errata: (Δt²/2) F_n and M_{n−2}; see PAPER-NOTES and `docs/decisions.md`).
 use nalgebra::{DVector, Vector3};
 
-use super::certificate::{system_terms, Certificate};
+use super::certificate::{system_terms, Certificate, System};
 use super::chart_change::{self, ChartRule};
 use super::problem::{FrameAt, Held, HeldRows};
 use super::statics::frozen_system;
@@ -229,7 +229,7 @@ impl Run {
                     increment,
                     certificate: certificate.value,
                     tolerance: params.certificate_tolerance,
-                    block: certificate.worst_block(false),
+                    block: certificate.worst_block(System::Forward),
                 });
             }
             (self.total, self.max_it) = (self.total + it, self.max_it.max(it));
@@ -294,21 +294,22 @@ impl Stepper<'_, '_> {
             let v = (&u - &prev.u) * (2.0 / dt) - &prev.v;
             let u_mid = (&u + &prev.u) * 0.5;
             let newton = self.refactor || !self.factored;
+            let jacobian = if newton { Jacobian::Assembled } else { Jacobian::Frozen };
             if newton {
                 self.values.iter_mut().for_each(|x| *x = 0.0);
             }
             let p = problem.momentum(
                 &u,
                 &v,
-                tangent(newton, &self.pattern, &mut self.values, 1.0 / dt).map(|t| (t, 2.0 / (dt * dt))),
+                tangent(jacobian, &self.pattern, &mut self.values, 1.0 / dt).map(|t| (t, 2.0 / (dt * dt))),
             );
-            let g = problem.internal_force(&u_mid, tangent(newton, &self.pattern, &mut self.values, 0.5));
+            let g = problem.internal_force(&u_mid, tangent(jacobian, &self.pattern, &mut self.values, 0.5));
             // ½[F(t_n, u_n) + F(t_{n−1}, u_{n−1})]: only the first half depends on u_n.
             let f_state;
             let f_n = match f_step {
                 Some(f) => f,
                 None => {
-                    f_state = problem.loads_at(&u, t, tangent(newton, &self.pattern, &mut self.values, -0.5));
+                    f_state = problem.loads_at(&u, t, tangent(jacobian, &self.pattern, &mut self.values, -0.5));
                     &f_state
                 }
             };
@@ -359,9 +360,17 @@ struct StepAt<'a> {
     f_step: Option<&'a DVector<f64>>,
 }
 
+/// What an iteration of a step's Newton does with the Jacobian: assembles it (a Newton step)
+/// or keeps the last factorisation (a chord step).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Jacobian {
+    Assembled,
+    Frozen,
+}
+
 /// The assembly target of one term of the Jacobian, if one is assembled.
-fn tangent<'a>(on: bool, pattern: &'a Pattern, values: &'a mut [f64], scale: f64) -> Option<Tangent<'a>> {
-    on.then(|| Tangent::new(pattern, values, scale))
+fn tangent<'a>(jacobian: Jacobian, pattern: &'a Pattern, values: &'a mut [f64], scale: f64) -> Option<Tangent<'a>> {
+    (jacobian == Jacobian::Assembled).then(|| Tangent::new(pattern, values, scale))
 }
 
 /// What the certificate of a time step is made of: the step's state and the previous one, their

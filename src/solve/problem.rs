@@ -7,7 +7,7 @@ use crate::assemble::{assemble_new, Tangent};
 use crate::model::balance::{element_balance, Balance};
 use crate::model::chart::Chart;
 use crate::model::element::{
-    distributed_load, follower_load, internal_force, momentum, point_shape, ElementRest, LocalMat,
+    distributed_load, follower_load, internal_force, momentum, point_shape, ElementRest, LocalMat, MomentumDerivatives,
 };
 use crate::model::ends::{EndKind, Ends, MotionAt};
 use crate::model::geometry::Rod;
@@ -357,11 +357,12 @@ impl<'a> Problem<'a> {
             match t {
                 Some(du) => {
                     dv.as_mut_slice().fill(0.0);
-                    let r = momentum(&self.props, self.scheme, h, &ue, &ve, Some(du), Some(&mut dv));
+                    let both = MomentumDerivatives { d_u: Some(&mut *du), d_udot: Some(&mut dv) };
+                    let r = momentum(&self.props, self.scheme, h, &ue, &ve, both);
                     *du = *du * su + dv * sv;
                     r
                 }
-                None => momentum(&self.props, self.scheme, h, &ue, &ve, None, None),
+                None => momentum(&self.props, self.scheme, h, &ue, &ve, MomentumDerivatives::default()),
             }
         })
     }

@@ -17,7 +17,7 @@ use nalgebra::{DVector, Matrix3, Vector3};
 mod accept;
 mod carry;
 mod report;
-use accept::{accepted, frame_fit};
+use accept::{accepted, frame_fit, StartedFrom};
 pub use carry::vector_to_space;
 use carry::{carry_converted, carry_state, to_space};
 pub use report::{DataMisfit, FrameConditioning, FrameConvergence, FrameReport};
@@ -360,7 +360,15 @@ pub fn solve_sequence<'a>(
     on_iteration: impl FnMut(usize, &InverseRecord),
     on_frame: impl FnMut(&FrameReport, &FrameSolution) -> Result<(), FrameStop>,
 ) -> Result<Vec<FrameReport>, SequenceError> {
-    solve_sequence_from(problem, sp, frames, first, None, on_iteration, on_frame)
+    solve_sequence_from(problem, sp, frames, SequenceStart { first, resume: None }, on_iteration, on_frame)
+}
+
+/// Where a clip's solve starts: the initial iterate of its first frame and, when it resumes,
+/// the frames already solved ([`ResumeFrom`]).
+#[derive(Clone, Debug)]
+pub struct SequenceStart<'a> {
+    pub first: FirstStart<'a>,
+    pub resume: Option<ResumeFrom>,
 }
 
 /// Where a clip solve resumes: the number of frames already solved (≥ 1) and the states of
@@ -375,8 +383,8 @@ pub struct ResumeFrom {
     pub prev2: Option<(Chart, DVector<f64>)>,
 }
 
-/// [`solve_sequence`] (the first frame from `start0`), optionally resumed after the frames of
-/// `resume`; the reports returned
+/// [`solve_sequence`] from `start` (the first frame from `start.first`), optionally resumed
+/// after the frames of `start.resume`; the reports returned
 /// are those of the frames solved here. Before each frame it checks for a requested stop
 /// (`crate::interrupt`): the clip then ends with [`SolveError::Interrupted`], every frame before
 /// it handed to `on_frame`.
@@ -384,12 +392,11 @@ pub fn solve_sequence_from<'a>(
     problem: &Problem,
     sp: &SequenceParams,
     data: impl Into<ClipData<'a>>,
-    start0: FirstStart<'_>,
-    resume: Option<ResumeFrom>,
+    start: SequenceStart<'_>,
     mut on_iteration: impl FnMut(usize, &InverseRecord),
     mut on_frame: impl FnMut(&FrameReport, &FrameSolution) -> Result<(), FrameStop>,
 ) -> Result<Vec<FrameReport>, SequenceError> {
-    let data = data.into();
+    let (data, SequenceStart { first: start0, resume }) = (data.into(), start);
     let frames = data.positions;
     let dofs = problem.dofs();
     let h = problem.mesh.h();
@@ -419,13 +426,13 @@ pub fn solve_sequence_from<'a>(
             solver.solve(&frame, u0, start, |r, _, _| on_iteration(k, r))?.converged(k)
         };
         // restarts from the data guess (D13) and continuation in λg: [`with_restarts`]
-        let from_previous = i > 0 && sp.start == FrameStart::PreviousFrame;
-        let near = from_previous || (carried.is_none() && matches!(start0, FirstStart::Near(_)));
+        let from = StartedFrom::frame(i, sp.start);
+        let near = from == StartedFrom::PreviousFrame || (carried.is_none() && matches!(start0, FirstStart::Near(_)));
         let smooth = || smoothed_guess(&x_g, problem.mesh.length_m);
-        let first = with_restarts(&mut solve, &first_start, near, &guess, &smooth, lambda_g)?;
+        let kind = if near { Start::Near } else { Start::Guess };
+        let first = with_restarts(&mut solve, &first_start, kind, &guess, &smooth, lambda_g)?;
         let check = |sol: &InverseSolution| frame_fit(sp, problem, sol, (&x_g[..], tracked), &chart);
-        let (sol, restarted, fit) =
-            accepted(first, from_previous, &check, || solve(&guess(), Start::Guess, lambda_g).ok());
+        let (sol, restarted, fit) = accepted(first, from, &check, || solve(&guess(), Start::Guess, lambda_g).ok());
         let (cos_beta, node) = min_cos_beta(&dofs, &sol.u);
         chart_guard(sp, &reports, k, &chart, (cos_beta, node))?;
         let last = sol.history.last().copied().ok_or(SequenceError::NoIteration { frame: k })?;
@@ -509,23 +516,23 @@ fn prepare(
     FramePrep { chart, x_g, first_start, alpha_prev, carried }
 }
 
-/// A frame solved from `first_start` (`near`: a start near its solution); one that does not
+/// A frame solved from `first_start` as `first_kind` says ([`Start::Near`]: a start near its
+/// solution, [`Start::Guess`]: a guess, from which the restart below is not tried); one that does not
 /// converge from there is solved again from the data `guess` (D13), and one that does not
 /// converge from there either is continued in λg from the `smooth`ed data ([`continued`]).
 /// Whether it was restarted.
 fn with_restarts(
     solve: &mut impl FnMut(&DVector<f64>, Start, f64) -> Result<InverseSolution, SolveError>,
     first_start: &DVector<f64>,
-    near: bool,
+    first_kind: Start,
     guess: &dyn Fn() -> DVector<f64>,
     smooth: &dyn Fn() -> Option<DVector<f64>>,
     lambda_g: f64,
 ) -> Result<(InverseSolution, bool), SolveError> {
-    let first_kind = if near { Start::Near } else { Start::Guess };
     match solve(first_start, first_kind, lambda_g) {
         Ok(sol) => Ok((sol, false)),
         Err(e) if recoverable(&e) => {
-            let again = if near { solve(&guess(), Start::Guess, lambda_g) } else { Err(e) };
+            let again = if first_kind == Start::Near { solve(&guess(), Start::Guess, lambda_g) } else { Err(e) };
             match again {
                 Ok(sol) => Ok((sol, true)),
                 Err(e) if recoverable(&e) => {

@@ -17,7 +17,7 @@
 //! 1. Wang et al., Comput. Mech. 71 (2023), §4, eqs. (52), (61), Remark 10.
 use nalgebra::DVector;
 
-use super::certificate::{of_system, Certificate, DEFAULT_CERTIFICATE_TOLERANCE};
+use super::certificate::{of_system, Certificate, System, DEFAULT_CERTIFICATE_TOLERANCE};
 use super::problem::{FrameAt, Held, HeldRows};
 use super::{divergence, Problem, SolveError, Stall, Step, Stop, PLATEAU_ITERATIONS};
 use crate::assemble::{assemble, Tangent};
@@ -125,7 +125,7 @@ impl StaticSolution {
                 rel_change: change,
                 certificate: self.certificate.value,
                 tolerance: self.certificate_tolerance,
-                block: self.certificate.worst_block(false),
+                block: self.certificate.worst_block(System::Forward),
             })),
             (_, Method::FixedPoint { .. }) => {
                 SolveError::FixedPointNotConverged { step, iterations, rel_change: change }

@@ -15,7 +15,7 @@ use crate::engine::common::result::{Engine, NodalState};
 use crate::engine::freefem::info::FfInfo;
 use crate::engine::freefem::{execute, io, read_table, ClipInclude, FreeFemError, RunOptions, FAILED_STATUS};
 use crate::model::chart::Chart;
-use crate::solve::certificate::Certificate;
+use crate::solve::certificate::{Certificate, System};
 use crate::solve::inverse::{InverseRecord, ObjectiveTerms};
 use crate::solve::sequence::{clip_charts, ClipData, FrameStart};
 use crate::solve::SolveError;
@@ -111,7 +111,7 @@ pub fn read_clip_run(case: &Case, frames: &[Vec<Vector3<f64>>], workdir: &Path) 
                 rel_change: info.failed.rel_change.unwrap_or(f64::NAN),
                 certificate: c.value,
                 tolerance: case.certificate_tolerance(),
-                block: c.worst_block(true),
+                block: c.worst_block(System::Kkt),
             })))
         }
         _ => None,

@@ -30,7 +30,7 @@ use crate::engine::common::result::{Engine, InverseOutput, NodalState, RunResult
 use crate::io::files::{csv_reader, InputError};
 use crate::model::balance::Balance;
 use crate::model::chart::Chart;
-use crate::solve::certificate::Certificate;
+use crate::solve::certificate::{Certificate, System};
 use crate::solve::dynamics::TipRecord;
 use crate::solve::inverse::{InverseRecord, ObjectiveTerms};
 use crate::solve::statics::{IterationRecord, Method};
@@ -306,7 +306,7 @@ fn inverse_stop(
             rel_change,
             certificate: c.value,
             tolerance,
-            block: c.worst_block(true),
+            block: c.worst_block(System::Kkt),
         }))),
         (Stop::MaxIterations, Some(residual)) => {
             Some(SolveError::InverseNewtonNotConverged { frame: 0, iterations, residual, certificate: c.value })
@@ -343,7 +343,7 @@ pub fn run(case: &Case, workdir: &Path) -> Result<RunResult, FreeFemError> {
             rel_change: change,
             certificate: c.value,
             tolerance: case.certificate_tolerance(),
-            block: c.worst_block(false),
+            block: c.worst_block(System::Forward),
         })),
         (Stop::MaxIterations, false) => SolveError::FixedPointNotConverged { step, iterations, rel_change: change },
         (Stop::MaxIterations, true) => {

@@ -18,9 +18,11 @@ use crate::engine::common::clip_summary::{ClipRun, Summary};
 use crate::io::files::JournalError;
 use crate::model::chart::Chart;
 use crate::model::rotation::Angles;
+use crate::solve::inverse::kkt::Part;
 use crate::solve::inverse::Records;
 use crate::solve::sequence::{
     solve_sequence_from, vector_to_space, ClipData, FirstStart, FrameReport, ResumeFrom, SequenceError, SequenceParams,
+    SequenceStart,
 };
 use crate::solve::{Problem, SolveError};
 
@@ -248,7 +250,7 @@ fn resume_summary(
             frame_data(first_frame + arrivals.base(), &r.report, arrivals.frames()).map_err(frame_error)?;
         let c = Converged {
             report: r.report,
-            u: vector_to_space(&deriver.dofs, &r.chart, &r.state, false),
+            u: vector_to_space(&deriver.dofs, &r.chart, &r.state, Part::State),
             adjoint: r.adjoint.clone(),
             chart: r.chart,
             previous: r.previous.clone(),
@@ -327,8 +329,10 @@ impl Runs<'_, '_> {
                 self.problem,
                 &sp,
                 data,
-                frame0_start.take().as_ref().map_or(FirstStart::DataGuess, FirstStart::Near),
-                from,
+                SequenceStart {
+                    first: frame0_start.take().as_ref().map_or(FirstStart::DataGuess, FirstStart::Near),
+                    resume: from,
+                },
                 |_, _| {},
                 |rep, frame| {
                     last2 = last.replace((frame.chart, frame.state.clone()));

@@ -1,5 +1,6 @@
 //! The rank-1 update of [`super::BandLu::factor`] with AVX2 (or AVX-512) vectors where the CPU
 //! has them.
+use super::Sweep;
 use crate::linalg::cpu::Avx2;
 #[cfg(target_arch = "x86_64")]
 use crate::linalg::cpu::Avx512;
@@ -19,29 +20,21 @@ const _: () = assert!(REGS_AVX2 * 4 == MAX_ROWS && REGS_AVX512 * 8 == MAX_ROWS, 
 /// registers for all `span` columns, and each row is `d − l · u` with one rounding per
 /// operation, as there. `KL ≤ MAX_ROWS`, checked at compile time.
 #[inline]
-pub fn update<const KL: usize>(
-    cpu: Avx2,
-    head: &[f64],
-    tail: &mut [f64],
-    col: usize,
-    kv: usize,
-    ld: usize,
-    span: usize,
-) {
+pub fn update<const KL: usize>(cpu: Avx2, head: &[f64], tail: &mut [f64], at: Sweep) {
     const { assert!(KL <= MAX_ROWS, "more rows below the pivot than the kernels hold in registers") };
     #[cfg(target_arch = "x86_64")]
     if Avx512::detect().is_some() {
         // SAFETY: an `Avx512` token was just made, so the CPU has AVX-512F; KL ≤ MAX_ROWS above.
-        unsafe { kernel512::<KL>(head, tail, col, kv, ld, span) }
+        unsafe { kernel512::<KL>(head, tail, at) }
     } else {
         let _: Avx2 = cpu;
         // SAFETY: the `Avx2` token `cpu` exists, so the CPU has AVX2; KL ≤ MAX_ROWS above.
-        unsafe { kernel::<KL>(head, tail, col, kv, ld, span) }
+        unsafe { kernel::<KL>(head, tail, at) }
     }
     #[cfg(not(target_arch = "x86_64"))]
     {
         let _: Avx2 = cpu;
-        super::update::<KL>(head, tail, col, kv, ld, span)
+        super::update::<KL>(head, tail, at)
     }
 }
 
@@ -52,7 +45,8 @@ pub fn update<const KL: usize>(
 /// by [`update`]; beyond it rows would be left out). The slice bounds are checked.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f")]
-unsafe fn kernel512<const KL: usize>(head: &[f64], tail: &mut [f64], col: usize, kv: usize, ld: usize, span: usize) {
+unsafe fn kernel512<const KL: usize>(head: &[f64], tail: &mut [f64], at: Sweep) {
+    let Sweep { col, kv, ld, span } = at;
     use std::arch::x86_64::{
         _mm512_loadu_pd, _mm512_mask_storeu_pd, _mm512_maskz_loadu_pd, _mm512_mul_pd, _mm512_set1_pd, _mm512_storeu_pd,
         _mm512_sub_pd,
@@ -91,7 +85,8 @@ unsafe fn kernel512<const KL: usize>(head: &[f64], tail: &mut [f64], col: usize,
 /// [`update`]; beyond it rows would be left out). The slice bounds are checked.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-unsafe fn kernel<const KL: usize>(head: &[f64], tail: &mut [f64], col: usize, kv: usize, ld: usize, span: usize) {
+unsafe fn kernel<const KL: usize>(head: &[f64], tail: &mut [f64], at: Sweep) {
+    let Sweep { col, kv, ld, span } = at;
     use std::arch::x86_64::{_mm256_loadu_pd, _mm256_mul_pd, _mm256_set1_pd, _mm256_storeu_pd, _mm256_sub_pd};
     let l: &[f64; KL] = head[col + 1..col + 1 + KL].try_into().expect("KL multipliers");
     let full = KL / 4;

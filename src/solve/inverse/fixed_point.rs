@@ -16,7 +16,7 @@ use std::ops::ControlFlow;
 use nalgebra::DVector;
 
 use super::measures::record;
-use super::{Frame, FrameProblem, FrameSolver, InverseParams, InverseRecord, InverseSolution, Records};
+use super::{Frame, FrameProblem, FrameSolver, InverseParams, InverseRecord, InverseSolution, Records, Scaling};
 use crate::solve::certificate::Certificate;
 use crate::solve::statics::relative_change;
 use crate::solve::{SolveError, Stop, PLATEAU_ITERATIONS};
@@ -67,7 +67,8 @@ pub(crate) fn run(
     let mut certificate = Certificate::default();
     for k in 1..=params.max_iterations {
         // Ruiz (I6) on the first iteration's matrix; its factors scale the later ones
-        let big = s.solve_linearised(params, frame, &u, k > 1)?;
+        let scaling = if k == 1 { Scaling::Equilibrated } else { Scaling::Rescaled };
+        let big = s.solve_linearised(params, frame, &u, scaling)?;
         let u_new = s.dofs.kkt_state(&big);
         adjoint = s.dofs.kkt_adjoint(&big);
         let u_next = &u_new * params.relaxation + &u * (1.0 - params.relaxation);

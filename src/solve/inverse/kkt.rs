@@ -29,7 +29,7 @@ const ALH: [usize; 2] = [LOCAL.local(0, Field::AlphaHat, 0), LOCAL.local(1, Fiel
 
 /// Which half of the KKT unknowns (eq. 61): the state `(x, α)` or its adjoint `(x̂, α̂)`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum Part {
+pub enum Part {
     State,
     Adjoint,
 }
@@ -170,22 +170,16 @@ fn add_diagonal3(m: &mut KktMat, ro: usize, co: usize, s: f64) {
 }
 
 /// Local KKT matrix (added into `m`, which the caller zeroes) and right-hand side (returned)
-/// of one element of eq. (61) (`docs/inverse.md`, I4), coefficients frozen at the element's
-/// state `uk`; `xg`, `alpha_prev`: the data and the previous frame's angles at its nodes
-/// (`first_frame`: no Λω term), `wg` the nodal weights of the tracking term (I14:
-/// `λg ∫ w δx·(x − x_g)`, w P1). Also returns the frozen operator `L(u)` of the element
+/// of element `e` of eq. (61) (`docs/inverse.md`, I4) in the frame's problem `fp`,
+/// coefficients frozen at the element's state `uk`; from `fp` at the element's nodes: the data
+/// `x_g`, the previous frame's angles (no Λω term on a first frame) and the nodal weights of
+/// the tracking term (I14: `λg ∫ w δx·(x − x_g)`, w P1). Also returns the frozen operator `L(u)` of the element
 /// (`element::frozen_operator`), which the Newton Jacobian needs again. The terms are added in
 /// this order: the frozen operator, the objective rule's terms ([`objective_terms`]), the λd
 /// term ([`lambda_d_term`], I11), the Λκ term ([`lambda_kappa_term`], I12).
-pub(crate) fn element_system(
-    problem: &Problem,
-    p: &InverseParams,
-    first_frame: bool,
-    uk: &LocalVec,
-    (xg, wg): ([Vector3<f64>; 2], [f64; 2]),
-    alpha_prev: [Vector3<f64>; 2],
-    m: &mut KktMat,
-) -> (KktVec, LocalMat) {
+pub(crate) fn element_system(fp: &FrameProblem<'_>, e: usize, uk: &LocalVec, m: &mut KktMat) -> (KktVec, LocalMat) {
+    let FrameProblem { problem, params: p, frame, alpha_prev } = *fp;
+    let (xg, wg) = frame.tracking().element(e);
     let h = problem.mesh.h();
     let mut r = KktVec::zeros();
     // Frozen operator: primal rows (hat test) × state columns, and its transpose.
@@ -195,8 +189,8 @@ pub(crate) fn element_system(
         r[kkt(i, Part::Adjoint)] += b[i];
     }
     add_operator_blocks(m, &l, Blocks::WithTranspose);
-    let nodal = NodalData { xg, wg, alpha_prev };
-    objective_terms(problem, p, first_frame, uk, &nodal, m, &mut r);
+    let nodal = NodalData { xg, wg, alpha_prev: [alpha_prev[e], alpha_prev[e + 1]] };
+    objective_terms(fp, uk, &nodal, m, &mut r);
     lambda_d_term(problem, p, uk, m, &mut r);
     lambda_kappa_term(problem, p, uk, m);
     (r, l)
@@ -214,17 +208,11 @@ struct NodalData {
 
 /// Mass-type terms of eq. (61) on the objective rule: the tracking term
 /// `λg ∫ w δx·(x − x_g)` (I14), the control costs `−∫ δx̂·x̂ / λf` and `−∫ δα̂·α̂ / λl`, and the
-/// Λω term `∫ δα·AᵀΛωA (α − α_{n−1}) / Δt²` (none on the first frame).
+/// Λω term `∫ δα·AᵀΛωA (α − α_{n−1}) / Δt²` (none on the first frame of `fp`).
 #[allow(non_snake_case)] // paper symbols W, A
-fn objective_terms(
-    problem: &Problem,
-    p: &InverseParams,
-    first_frame: bool,
-    uk: &LocalVec,
-    nodal: &NodalData,
-    m: &mut KktMat,
-    r: &mut KktVec,
-) {
+fn objective_terms(fp: &FrameProblem<'_>, uk: &LocalVec, nodal: &NodalData, m: &mut KktMat, r: &mut KktVec) {
+    let FrameProblem { problem, params: p, frame, .. } = *fp;
+    let first_frame = frame.is_first();
     let h = problem.mesh.h();
     let w8 = &p.weights;
     let NodalData { xg, wg, alpha_prev } = nodal;
@@ -359,8 +347,7 @@ pub(crate) fn dirichlet_into(dofs: &DofMap, alpha0: f64, frame: &Frame, fixed: &
 /// Assemble the KKT matrix (replacing `values`) and right-hand side of I4 with the
 /// coefficients frozen at the state `u` (forward layout); boundary conditions not applied.
 pub fn assemble_system(fp: FrameProblem<'_>, pattern: &Pattern, values: &mut [f64], u: &DVector<f64>) -> DVector<f64> {
-    let FrameProblem { problem, params: p, frame, alpha_prev } = fp;
-    let (first_frame, data) = (frame.is_first(), frame.tracking());
+    let problem = fp.problem;
     let fwd = problem.dofs();
     let kkt_dofs = problem.mesh.kkt_dofs();
 
@@ -369,7 +356,7 @@ pub fn assemble_system(fp: FrameProblem<'_>, pattern: &Pattern, values: &mut [f6
     assemble(&kkt_dofs, &mut rhs, Some(Tangent::overwriting(pattern, values, 1.0)), |e, t| {
         let uk: LocalVec = fwd.gather(u, e);
         let m = t.unwrap_or(&mut scratch);
-        element_system(problem, p, first_frame, &uk, data.element(e), [alpha_prev[e], alpha_prev[e + 1]], m).0
+        element_system(&fp, e, &uk, m).0
     });
     rhs
 }

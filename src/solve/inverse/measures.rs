@@ -4,7 +4,7 @@ use nalgebra::{DVector, Vector3};
 
 use super::kkt::PointRule;
 use super::tracking::weight_at;
-use super::{FrameProblem, InverseParams, InverseRecord, ObjectiveTerms, Tracking};
+use super::{FrameProblem, InverseRecord, ObjectiveTerms, Tracking};
 use crate::assemble::integrate;
 use crate::model::element::{interpolate, LocalVec, PointState};
 use crate::model::rotation::{a_matrix, curvature, d3, Angles};
@@ -30,20 +30,14 @@ pub struct Measures {
     pub objective: ObjectiveTerms,
 }
 
-/// [`Measures`] at the state `u` with the adjoint `adjoint` (forward layout each);
-/// `alpha_prev`: the previous frame's angles (the Λω term is off on the first frame). Three
+/// [`Measures`] of the frame's problem `fp` (its data, tracking weights and previous frame's
+/// angles; the Λω term is off on a first frame) at the state `u` with the adjoint `adjoint`
+/// (forward layout each). Three
 /// passes of [`integrate`], one per rule: the 2-point Gauss rule (fit, tracking, controls, Λω),
 /// the λd term's rule (misfit and shear term from the same `|∂s x − d3|²`) and the Λκ rule.
-pub fn measures<'a>(
-    problem: &Problem,
-    p: &InverseParams,
-    first_frame: bool,
-    u: &DVector<f64>,
-    adjoint: &DVector<f64>,
-    data: impl Into<Tracking<'a>>,
-    alpha_prev: &[Vector3<f64>],
-) -> Measures {
-    let data = data.into();
+pub fn measures(fp: &FrameProblem<'_>, u: &DVector<f64>, adjoint: &DVector<f64>) -> Measures {
+    let FrameProblem { problem, params: p, frame, alpha_prev } = *fp;
+    let (first_frame, data) = (frame.is_first(), frame.tracking());
     let (mesh, dofs) = (&problem.mesh, problem.dofs());
     let h = mesh.h();
     let w8 = &p.weights;
@@ -114,8 +108,7 @@ pub(crate) fn record(
     adjoint: &DVector<f64>,
     residual: Option<f64>,
 ) -> InverseRecord {
-    let FrameProblem { problem, params: p, frame, alpha_prev } = fp;
-    let m = measures(problem, p, frame.is_first(), u, adjoint, frame.tracking(), alpha_prev);
+    let m = measures(&fp, u, adjoint);
     let (x_err_rel, tangent_misfit, objective) = (m.x_err_rel, m.tangent_misfit, m.objective);
     InverseRecord { iteration, rel_change, x_err_rel, tangent_misfit, objective, residual, certificate: None }
 }

@@ -36,7 +36,7 @@ use std::ops::ControlFlow;
 
 use nalgebra::{DVector, Vector3};
 
-use super::certificate::Certificate;
+use super::certificate::{Certificate, System};
 use super::{Problem, SolveError, Stall, Stop};
 use crate::linalg::{LinearError, LinearSolver, Pattern};
 use crate::model::mesh::DofMap;
@@ -347,7 +347,7 @@ impl InverseSolution {
                 rel_change,
                 certificate: self.certificate.value,
                 tolerance: self.certificate_tolerance,
-                block: self.certificate.worst_block(true),
+                block: self.certificate.worst_block(System::Kkt),
             })),
             (_, Some(residual)) => SolveError::InverseNewtonNotConverged {
                 frame,
@@ -396,6 +396,16 @@ pub struct FrameSolver<'p> {
     /// polled after every recorded iteration: `true` stops the solve there with
     /// [`SolveError::Interrupted`] ([`FrameSolver::stopped_by`])
     pub(crate) stop: Option<fn() -> bool>,
+}
+
+/// How a frame's linear solve scales its matrix (I6).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Scaling {
+    /// by a Ruiz equilibration of this matrix ([`LinearSolver::solve_equilibrated`])
+    Equilibrated,
+    /// by the factors of the frame's last equilibration, for a matrix of the same frame
+    /// ([`LinearSolver::solve_rescaled`])
+    Rescaled,
 }
 
 /// The Dirichlet conditions of I5 of a frame, refilled per frame: the positions depend only
@@ -552,14 +562,13 @@ impl<'p> FrameSolver<'p> {
     }
 
     /// Solve `K(u) U = r(u)` of I4 with the boundary conditions of I5 (equilibrated, I6); `U`
-    /// has the KKT layout. `rescale`: scale by the factors of the last equilibration instead of
-    /// computing new ones (a matrix of the same frame; [`LinearSolver::solve_rescaled`]).
+    /// has the KKT layout, the matrix scaled as `scaling` says.
     pub(crate) fn solve_linearised(
         &mut self,
         params: &InverseParams,
         frame: &Frame,
         u: &DVector<f64>,
-        rescale: bool,
+        scaling: Scaling,
     ) -> Result<DVector<f64>, SolveError> {
         let fp = FrameProblem::of(self.problem, params, frame, &self.no_previous);
         let mut rhs = kkt::assemble_system(fp, &self.pattern, &mut self.work.values, u);
@@ -567,10 +576,9 @@ impl<'p> FrameSolver<'p> {
             rhs[d] = v;
         }
         self.pattern.set_identity_rows(&mut self.work.values, &self.dirichlet.rows);
-        Ok(if rescale {
-            self.solver.solve_rescaled(&self.work.values, &rhs)?
-        } else {
-            self.solver.solve_equilibrated(&self.work.values, &rhs)?
+        Ok(match scaling {
+            Scaling::Rescaled => self.solver.solve_rescaled(&self.work.values, &rhs)?,
+            Scaling::Equilibrated => self.solver.solve_equilibrated(&self.work.values, &rhs)?,
         })
     }
 }

@@ -36,18 +36,19 @@ use super::kkt::{
 };
 use super::measures::{position_error, record};
 use super::{
-    early_divergence, Frame, FrameProblem, FrameSolver, InverseParams, InverseRecord, InverseSolution, Records,
+    early_divergence, Frame, FrameProblem, FrameSolver, InverseParams, InverseRecord, InverseSolution, Records, Scaling,
 };
 use crate::assemble::{assemble, Tangent};
 use crate::linalg::Pattern;
 use crate::model::element::{internal_force, interpolate, ElementRest, LocalMat};
 use crate::model::mesh::DofMap;
 use crate::model::rotation::{
-    a_matrix, a_matrix_derivatives, d3, d3_second_derivatives, rotation, rotation_derivatives, skew, PointFrame,
+    a_matrix, a_matrix_derivatives, d3, d3_second_derivatives, rotation, rotation_derivatives, skew, Derivatives,
+    PointFrame,
 };
 use crate::solve::certificate::Certificate;
 use crate::solve::statics::relative_change;
-use crate::solve::{Problem, SolveError, Stop, CHORD_CONTRACTION};
+use crate::solve::{SolveError, Stop, CHORD_CONTRACTION};
 
 /// Smallest step fraction of the backtracking line search (2⁻¹⁰).
 const MIN_STEP: f64 = 1.0 / 1024.0;
@@ -67,8 +68,9 @@ pub const STALL_DECREASE: f64 = 0.1;
 /// Iterations over which [`STALL_DECREASE`] is measured.
 pub const STALL_WINDOW: usize = 20;
 
-/// `∂/∂u [K_e(u) V − r_e(u)]` at `V = U_e` for one element (24 × 24, KKT numbering; only the
-/// state columns are non-zero), added into `e`: the derivative of the frozen coefficients of I4;
+/// `∂/∂u [K_e(u) V − r_e(u)]` at `V = U_e` for element `element` of the frame's problem `fp`
+/// (24 × 24, KKT numbering; only the state columns are non-zero), added into `e`: the
+/// derivative of the frozen coefficients of I4;
 /// `l`: the element's frozen operator `L(u)` (`element::frozen_operator`, as `element_system`
 /// returns it).
 ///
@@ -81,15 +83,9 @@ pub const STALL_WINDOW: usize = 20;
 ///                  Λω:  ∫ δα · ∂_α(AᵀΛωA) (α − α_{n−1}) / Δt²                      (objective rule)
 /// ```
 #[allow(non_snake_case)] // paper symbols K, J, Q, A, S, H2, Lk, Lw
-fn coefficient_derivative(
-    problem: &Problem,
-    p: &InverseParams,
-    first_frame: bool,
-    ue: &KktVec,
-    l: &LocalMat,
-    alpha_prev: [Vector3<f64>; 2],
-    e: &mut KktMat,
-) {
+fn coefficient_derivative(fp: &FrameProblem<'_>, element: usize, ue: &KktVec, l: &LocalMat, e: &mut KktMat) {
+    let FrameProblem { problem, params: p, frame, alpha_prev } = *fp;
+    let alpha_prev = [alpha_prev[element], alpha_prev[element + 1]];
     let h = problem.mesh.h();
     let props = &problem.props;
     let w8 = &p.weights;
@@ -125,7 +121,7 @@ fn coefficient_derivative(
     // Bending rule: L(u)ᵀ û on the α rows.
     for (xi, w) in problem.scheme.bending().iter() {
         let (q, qa) = (interpolate(&state, h, xi), interpolate(&adj, h, xi));
-        let f = PointFrame::new(&q.alpha, true);
+        let f = PointFrame::new(&q.alpha, Derivatives::With);
         // (dQ_jᵀ J A + Qᵀ J dA_j)ᵀ w = dA_jᵀ J (Q w) + Aᵀ J (dQ_j w), w = ∂s α̂
         let blk = product_rule((&f.a, &f.da), &Jm, (&f.q, &f.dq), &qa.dalpha);
         add_node_pairs(e, (AL, AL), &blk, w * h, (&q.dn, &q.n));
@@ -141,7 +137,7 @@ fn coefficient_derivative(
         }
     }
     // Load rule: the Λω term (as in `element_system`).
-    if !first_frame && w8.lambda_omega.amax() > 0.0 {
+    if !frame.is_first() && w8.lambda_omega.amax() > 0.0 {
         let dt = p.frame_interval_s;
         let Lw = Matrix3::from_diagonal(&w8.lambda_omega) / (dt * dt);
         for (xi, w) in problem.scheme.objective().iter() {
@@ -177,26 +173,22 @@ pub fn assemble_residual(
     fixed: &[(usize, f64)],
     jacobian: Option<(&Pattern, &mut [f64], &[usize])>,
 ) -> DVector<f64> {
-    let FrameProblem { problem, params: p, frame, alpha_prev } = fp;
-    let dofs = problem.mesh.kkt_dofs();
-    let first = frame.is_first();
-    let data = frame.tracking();
+    let dofs = fp.problem.mesh.kkt_dofs();
     let mut scratch = KktMat::zeros();
     let kernel = |e: usize, t: Option<&mut KktMat>| {
         let ue: KktVec = dofs.gather(big, e);
         let uk = element_part(&ue, Part::State);
-        let ap = [alpha_prev[e], alpha_prev[e + 1]];
         let jacobian = t.is_some();
         let m = t.unwrap_or_else(|| {
             scratch.as_mut_slice().fill(0.0);
             &mut scratch
         });
-        let (rhs, l) = element_system(problem, p, first, &uk, data.element(e), ap, m);
+        let (rhs, l) = element_system(&fp, e, &uk, m);
         // by reference: `*m * ue` would copy the 24 × 24 matrix first
         #[allow(clippy::op_ref)]
         let r = &*m * ue - rhs;
         if jacobian {
-            coefficient_derivative(problem, p, first, &ue, &l, ap, m);
+            coefficient_derivative(&fp, e, &ue, &l, m);
         }
         r
     };
@@ -233,11 +225,11 @@ pub(crate) fn solve(
     u0: &DVector<f64>,
     observer: &mut impl FnMut(&InverseRecord, &DVector<f64>, &DVector<f64>) -> ControlFlow<()>,
 ) -> Result<InverseSolution, SolveError> {
-    solve_from(s, params, frame, u0, false, observer)
+    solve_from(s, params, frame, u0, Scaling::Equilibrated, observer)
 }
 
-/// [`solve`]; `rescale`: the frame's Ruiz factors exist already (the warm start's fixed point
-/// computed them), so the consistent start is scaled by them instead of equilibrating again.
+/// [`solve`], the consistent start scaled as `scaling` says: [`Scaling::Rescaled`] where the
+/// frame's Ruiz factors exist already (the warm start's fixed point computed them).
 /// Each iteration is one [`Newton::attempt`], or two when a chord step is rejected and the
 /// iteration is redone as Newton's ([`Mode`]).
 fn solve_from(
@@ -245,11 +237,11 @@ fn solve_from(
     params: &InverseParams,
     frame: &Frame,
     u0: &DVector<f64>,
-    rescale: bool,
+    scaling: Scaling,
     observer: &mut impl FnMut(&InverseRecord, &DVector<f64>, &DVector<f64>) -> ControlFlow<()>,
 ) -> Result<InverseSolution, SolveError> {
     // Consistent start: one linear solve of the fixed point at u0.
-    let big = s.solve_linearised(params, frame, u0, rescale)?;
+    let big = s.solve_linearised(params, frame, u0, scaling)?;
     let fwd = s.problem.dofs();
     s.work.cert_values.resize(s.pattern.nnz(), 0.0);
     let lean = s.records == Records::Last;
@@ -291,6 +283,24 @@ enum Mode {
     Newton,
     /// with the last factorisation (a chord step)
     Chord,
+}
+
+/// What an assembly of [`Newton::residual`] gives: the residual alone, or with the Jacobian.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Eval {
+    Residual,
+    WithJacobian,
+}
+
+/// An iteration's step as [`Newton::attempt`] judges it before the line search.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum StepKind {
+    /// its relative change is within the tolerance: taken whole, without the line search
+    WithinTolerance,
+    /// searched; the next iteration is predicted to be a chord step ([`CHORD_RATE`])
+    ChordNext,
+    /// searched; the next iteration is Newton's
+    NewtonNext,
 }
 
 /// What became of an attempt at an iteration.
@@ -343,11 +353,15 @@ impl Newton<'_, '_, '_> {
     }
 
     /// The residual at `big` ([`assemble_residual`]), with the Jacobian into the solver's
-    /// values if `jacobian`.
-    fn residual(&mut self, big: &DVector<f64>, jacobian: bool) -> DVector<f64> {
+    /// values for [`Eval::WithJacobian`].
+    fn residual(&mut self, big: &DVector<f64>, eval: Eval) -> DVector<f64> {
         let s = &mut *self.s;
         let fp = FrameProblem::of(s.problem, self.params, self.frame, &s.no_previous);
-        let jacobian = jacobian.then_some((&s.pattern, s.work.values.as_mut_slice(), s.dirichlet.rows.as_slice()));
+        let jacobian = (eval == Eval::WithJacobian).then_some((
+            &s.pattern,
+            s.work.values.as_mut_slice(),
+            s.dirichlet.rows.as_slice(),
+        ));
         assemble_residual(fp, big, &s.dirichlet.fixed, jacobian)
     }
 
@@ -393,7 +407,7 @@ impl Newton<'_, '_, '_> {
         let chord = it.mode == Mode::Chord;
         let r = match it.next.take() {
             Some(r) => r,
-            None => self.residual(&it.big, !chord),
+            None => self.residual(&it.big, if chord { Eval::Residual } else { Eval::WithJacobian }),
         };
         let delta = if chord {
             self.s.solver.solve_factored(&(-&r))?
@@ -429,13 +443,17 @@ impl Newton<'_, '_, '_> {
             (true, _) => change / it.previous,
             (false, _) => (change / it.previous).powi(2),
         };
-        let chord_next = !full && rate <= CHORD_RATE;
-        let Some((t, trial, phi_t)) = self.line_search(it, &delta, phi, full, chord_next) else {
+        let kind = match (full, rate <= CHORD_RATE) {
+            (true, _) => StepKind::WithinTolerance,
+            (false, true) => StepKind::ChordNext,
+            (false, false) => StepKind::NewtonNext,
+        };
+        let Some((t, trial, phi_t)) = self.line_search(it, &delta, phi, kind) else {
             return Ok(Attempt::ChordRejected);
         };
-        it.mode = if chord_next && t == 1.0 { Mode::Chord } else { Mode::Newton };
+        it.mode = if kind == StepKind::ChordNext && t == 1.0 { Mode::Chord } else { Mode::Newton };
         it.damped = t < 1.0;
-        self.take_step(it, k, trial, full, phi_t, observer)
+        self.take_step(it, k, trial, kind, phi_t, observer)
     }
 
     /// A stalled iteration `k` (merit `phi`): converged if its iterate is certified; a lean
@@ -469,10 +487,10 @@ impl Newton<'_, '_, '_> {
         it: &mut Iterate,
         delta: &DVector<f64>,
         phi: f64,
-        full: bool,
-        chord_next: bool,
+        kind: StepKind,
     ) -> Option<(f64, DVector<f64>, f64)> {
         let chord = it.mode == Mode::Chord;
+        let (full, chord_next) = (kind == StepKind::WithinTolerance, kind == StepKind::ChordNext);
         let mut t = 1.0;
         loop {
             let trial = &it.big + delta * t;
@@ -481,11 +499,12 @@ impl Newton<'_, '_, '_> {
             // iteration then uses (the same element sums, so the same residual as assembling
             // it there).
             let with_jacobian = t == 1.0 && !full && !chord_next && !it.damped;
+            let eval = if with_jacobian { Eval::WithJacobian } else { Eval::Residual };
             // the last step is taken without its residual where no record needs it
             if full && self.lean {
                 return Some((t, trial, f64::NAN));
             }
-            let r_t = self.residual(&trial, with_jacobian);
+            let r_t = self.residual(&trial, eval);
             let phi_t = self.merit(&r_t);
             if full || phi_t <= (1.0 - ARMIJO * t) * phi || t <= MIN_STEP {
                 if t == 1.0 && !full && (with_jacobian || chord_next) {
@@ -508,10 +527,11 @@ impl Newton<'_, '_, '_> {
         it: &mut Iterate,
         k: usize,
         trial: DVector<f64>,
-        full: bool,
+        kind: StepKind,
         phi_t: f64,
         observer: &mut impl FnMut(&InverseRecord, &DVector<f64>, &DVector<f64>) -> ControlFlow<()>,
     ) -> Result<Attempt, SolveError> {
+        let full = kind == StepKind::WithinTolerance;
         let dofs = self.s.dofs;
         let u_old = dofs.kkt_state(&it.big);
         it.u = dofs.kkt_state(&trial);
@@ -571,7 +591,7 @@ pub(crate) fn solve_warm(
     }
     let done = start.history.len();
     let rest = InverseParams { max_iterations: p.max_iterations.saturating_sub(done).max(1), ..p };
-    let newton = solve_from(s, &rest, frame, &start.u, true, &mut |r, u, a| {
+    let newton = solve_from(s, &rest, frame, &start.u, Scaling::Rescaled, &mut |r, u, a| {
         observer(&InverseRecord { iteration: r.iteration + done, ..*r }, u, a)
     })?;
     let mut history = start.history;

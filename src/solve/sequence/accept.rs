@@ -3,7 +3,7 @@
 //! that is over the gate (docs/decisions.md D26).
 use nalgebra::Vector3;
 
-use super::SequenceParams;
+use super::{FrameStart, SequenceParams};
 use crate::model::chart::Chart;
 use crate::model::element::midpoint_curvatures;
 use crate::model::mesh::Field;
@@ -53,19 +53,40 @@ pub(super) fn frame_fit(
     fit
 }
 
+/// Where the first solve of a frame started from: the previous frame's solution (carried into
+/// this frame's chart) or anything else (a guess, a nearby solution of the first frame).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum StartedFrom {
+    PreviousFrame,
+    Other,
+}
+
+impl StartedFrom {
+    /// Where frame `i` of a clip (counted from 0) that starts its frames as `start` says starts
+    /// from: the previous frame's solution on every frame after the first with
+    /// [`FrameStart::PreviousFrame`].
+    pub(super) fn frame(i: usize, start: FrameStart) -> Self {
+        if i > 0 && start == FrameStart::PreviousFrame {
+            StartedFrom::PreviousFrame
+        } else {
+            StartedFrom::Other
+        }
+    }
+}
+
 /// The solution a frame keeps (`first`: the solve and whether it restarted) with its fit
-/// (`check`): a solution from the previous frame's (`from_previous`) that is over the gate —
+/// (`check`): a solution from the previous frame's ([`StartedFrom::PreviousFrame`]) that is over the gate —
 /// the previous frame's branch, carried — is solved again from the frame's own data guess
 /// (`again`) and that kept (`resolved`, flagged if it is over the gate too); a failure of that
 /// solve keeps the first, flagged.
 pub(super) fn accepted(
     (sol, restarted): (InverseSolution, bool),
-    from_previous: bool,
+    from: StartedFrom,
     check: &dyn Fn(&InverseSolution) -> FrameFit,
     again: impl FnOnce() -> Option<InverseSolution>,
 ) -> (InverseSolution, bool, FrameFit) {
     let fit = check(&sol);
-    if !(from_previous && !restarted && fit.flagged) {
+    if !(from == StartedFrom::PreviousFrame && !restarted && fit.flagged) {
         return (sol, restarted, fit);
     }
     match again() {

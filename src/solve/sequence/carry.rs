@@ -5,6 +5,7 @@ use crate::model::chart::{Chart, Converted};
 use crate::model::mesh::{DofMap, Field};
 use crate::model::rotation::Angles;
 
+use crate::solve::inverse::kkt::Part;
 use crate::solve::inverse::InverseSolution;
 
 /// A state `(x, α)` of chart `from` in chart `to` (R6): positions rotated by `B_to B_fromᵀ`,
@@ -48,8 +49,8 @@ pub(super) fn carry_converted(
 /// The solution with positions and adjoints in space coordinates (R3); angles unchanged.
 pub(super) fn to_space(dofs: &DofMap, chart: &Chart, sol: &InverseSolution) -> InverseSolution {
     InverseSolution {
-        u: vector_to_space(dofs, chart, &sol.u, false),
-        adjoint: vector_to_space(dofs, chart, &sol.adjoint, true),
+        u: vector_to_space(dofs, chart, &sol.u, Part::State),
+        adjoint: vector_to_space(dofs, chart, &sol.adjoint, Part::Adjoint),
         history: sol.history.clone(),
         stop: sol.stop,
         certificate: sol.certificate,
@@ -58,16 +59,17 @@ pub(super) fn to_space(dofs: &DofMap, chart: &Chart, sol: &InverseSolution) -> I
 }
 
 /// A forward-layout vector of chart `chart` in space coordinates (R3): the position block
-/// rotated, the angle block rotated too if `both` (an adjoint), else unchanged (angles stay the
-/// chart's). What [`super::FrameSolution::solution`] holds, from the chart's state and adjoint.
-pub fn vector_to_space(dofs: &DofMap, chart: &Chart, v: &DVector<f64>, both: bool) -> DVector<f64> {
+/// rotated, the angle block rotated too for an adjoint (`part`: [`Part::Adjoint`], whose α̂ is
+/// a vector of space), unchanged for a state (angles stay the chart's). What
+/// [`super::FrameSolution::solution`] holds, from the chart's state and adjoint.
+pub fn vector_to_space(dofs: &DofMap, chart: &Chart, v: &DVector<f64>, part: Part) -> DVector<f64> {
     if chart.is_identity() {
         return v.clone();
     }
     let mut out = v.clone();
     for j in 0..dofs.nodes() {
         let (a, b) = (dofs.get(v, j, Field::X), dofs.get(v, j, Field::Alpha));
-        let (a, b) = (chart.to_space(&a), if both { chart.to_space(&b) } else { b });
+        let (a, b) = (chart.to_space(&a), if part == Part::Adjoint { chart.to_space(&b) } else { b });
         dofs.set(&mut out, j, Field::X, &a);
         dofs.set(&mut out, j, Field::Alpha, &b);
     }
