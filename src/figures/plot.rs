@@ -557,7 +557,11 @@ mod tests {
         p.y_window = Some((-1.0, 1.0));
         let (_, y) = ranges(&p).unwrap();
         assert!(y.end <= 1.0 + 2.0 * RANGE_MARGIN && y.start >= -1.0 - 2.0 * RANGE_MARGIN, "{y:?}");
-        let runs = plottable_runs(&p, &p.series[0], (Axis::new(0.0..1.0, false).0, Axis::new(0.0..1.0, false).0));
+        let runs = plottable_runs(
+            &p,
+            &p.series[0],
+            (Axis::new(0.0..1.0, Scale::Linear).0, Axis::new(0.0..1.0, Scale::Linear).0),
+        );
         assert_eq!(runs.iter().map(Vec::len).collect::<Vec<_>>(), [3, 46], "broken at the spike");
     }
 
