@@ -383,13 +383,11 @@ pub fn run_recording(case: &Case, case_file: &InputFile, entry: &PlanEntry, out:
 /// What continues a recording's run kept beside its folder.
 const NEXT_BATCH: &str = "(the next batch of this case continues it; `--force` lets a batch replace a complete run)";
 
-/// How [`run_batch`] runs a plan: on `jobs` threads (0: one per core; never more than the
-/// recordings, nor [`super::MAX_JOBS`]), each recording as `force` says ([`RecordingOptions`]).
+/// How [`run_batch`] runs a plan: on `jobs` threads (`--jobs`; 0: one per core; at most the
+/// recordings and [`super::MAX_JOBS`]), each recording with `force` ([`RecordingOptions`]).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct BatchOptions {
-    /// threads (`--jobs`; 0: one per core)
     pub jobs: usize,
-    /// `--force` ([`RecordingOptions::force`])
     pub force: bool,
 }
 
@@ -407,16 +405,14 @@ pub struct RecordingOptions {
 /// kept beside it (killed, stopped by a full disk, or stopped beside a complete run), if there
 /// is one (`true`), else fresh; `opts.force` (`--force`): always fresh.
 fn begin_recording(dir: &Path, manifest: Manifest, opts: RecordingOptions) -> Result<(RunFolder, bool), FolderError> {
-    let force = opts.force;
-    // --force: a fresh run, which replaces the folder whatever its end
-    if !force && resumable_beside(dir, &manifest) {
+    if !opts.force && resumable_beside(dir, &manifest) {
         match RunFolder::begin(dir, manifest.clone(), Mode::Resume) {
             Ok(f) => return Ok((f, true)),
             Err(FolderError::CannotResume { .. }) => {}
             Err(e) => return Err(e),
         }
     }
-    Ok((RunFolder::begin(dir, manifest, Mode::Fresh { force })?, false))
+    Ok((RunFolder::begin(dir, manifest, Mode::Fresh { force: opts.force })?, false))
 }
 
 /// A recording's run stopped by a full disk: its folder `dir` is left as it was; its converged

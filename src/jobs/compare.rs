@@ -182,15 +182,10 @@ pub fn stop_tolerance(case: &Case) -> f64 {
 /// Whether the rows include the iteration count (the same algorithm and rule in both engines,
 /// not compared at an equal count by construction).
 fn counts_compared(case: &Case) -> Iterations {
-    let compared = match &case.analysis {
-        Analysis::Static(p) => matches!(p.method, Method::FixedPoint { .. }),
-        Analysis::Dynamic(_) => false,
-        Analysis::Inverse(inv) => matches!(inv.params.method, InverseMethod::Newton { .. }),
-    };
-    if compared {
-        Iterations::Compared
-    } else {
-        Iterations::Ignored
+    match &case.analysis {
+        Analysis::Static(p) if matches!(p.method, Method::FixedPoint { .. }) => Iterations::Compared,
+        Analysis::Inverse(inv) if matches!(inv.params.method, InverseMethod::Newton { .. }) => Iterations::Compared,
+        Analysis::Static(_) | Analysis::Dynamic(_) | Analysis::Inverse(_) => Iterations::Ignored,
     }
 }
 
