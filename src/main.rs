@@ -51,9 +51,7 @@ fn main() -> ExitCode {
 fn dispatch(cli: Cli) -> Result<ExitCode> {
     match cli.command {
         Command::Run(a) => cmd_run(a),
-        Command::Compare { case, out, short, frames, force, limits } => {
-            cmd_compare(&case, out, short, frames, force, limits)
-        }
+        Command::Compare(a) => cmd_compare(a),
         Command::Sweep(a) => cmd_sweep(a),
         Command::Audit(a) => cmd_audit(a),
         Command::Batch(a) => cli::cmd_batch(a),

@@ -17,13 +17,21 @@ pub enum ReferenceError {
     NoConvergence { iterations: usize, residual: f64 },
 }
 
-fn check(name: &'static str, value: f64, positive: bool) -> Result<(), ReferenceError> {
-    let ok = value.is_finite() && (!positive || value > 0.0);
-    let requirement = if positive { "must be finite and > 0" } else { "must be finite" };
-    if ok {
+/// `value` of the parameter `name` finite and > 0, or the error saying so.
+fn positive(name: &'static str, value: f64) -> Result<(), ReferenceError> {
+    if value.is_finite() && value > 0.0 {
         Ok(())
     } else {
-        Err(ReferenceError::InvalidParameter { name, value, requirement })
+        Err(ReferenceError::InvalidParameter { name, value, requirement: "must be finite and > 0" })
+    }
+}
+
+/// `value` of the parameter `name` finite, or the error saying so.
+fn finite(name: &'static str, value: f64) -> Result<(), ReferenceError> {
+    if value.is_finite() {
+        Ok(())
+    } else {
+        Err(ReferenceError::InvalidParameter { name, value, requirement: "must be finite" })
     }
 }
 
@@ -127,15 +135,15 @@ pub fn tip_loaded_cantilever_steps(
     force_n: f64,
     steps: usize,
 ) -> Result<PlanarSolution, ReferenceError> {
-    check("length_m", rod.length_m, true)?;
-    check("bending_stiffness_nm2", rod.bending_stiffness_nm2, true)?;
+    positive("length_m", rod.length_m)?;
+    positive("bending_stiffness_nm2", rod.bending_stiffness_nm2)?;
     if let Some(v) = rod.shear_stiffness_n {
-        check("shear_stiffness_n", v, true)?;
+        positive("shear_stiffness_n", v)?;
     }
     if let Some(v) = rod.axial_stiffness_n {
-        check("axial_stiffness_n", v, true)?;
+        positive("axial_stiffness_n", v)?;
     }
-    check("force_n", force_n, false)?;
+    finite("force_n", force_n)?;
     if steps < 2 {
         return Err(ReferenceError::InvalidParameter {
             name: "steps",

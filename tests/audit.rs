@@ -6,12 +6,13 @@
 use std::path::Path;
 
 use cosserat::audit::spec::read_spec;
-use cosserat::audit::{run_audit, spec_files, AuditOptions, AuditStatus, Verdict};
+use cosserat::audit::{run_audit, spec_files, AuditOptions, AuditStatus, Depth, Verdict};
 
 #[test]
 fn quick_audit_verdicts_are_the_recorded_ones() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/paper");
-    let specs: Vec<_> = spec_files(&dir).expect("specs").iter().map(|f| read_spec(f, true).expect("spec")).collect();
+    let specs: Vec<_> =
+        spec_files(&dir).expect("specs").iter().map(|f| read_spec(f, Depth::Quick).expect("spec")).collect();
     assert!(specs.len() >= 5, "the audit covers §5.1, §5.2 (three specs) and §6");
     let out = tempfile::tempdir().expect("tempdir");
     let opts = AuditOptions {
@@ -21,7 +22,7 @@ fn quick_audit_verdicts_are_the_recorded_ones() {
         resume: false,
         engines: false,
     };
-    let report = run_audit(&specs, true, &opts, |_, _| {}).expect("audit");
+    let report = run_audit(&specs, Depth::Quick, &opts, |_, _| {}).expect("audit");
 
     let wrong: Vec<String> = report
         .claims
@@ -93,14 +94,14 @@ fn quick_audit_verdicts_are_the_recorded_ones() {
 #[test]
 fn audit_folder_is_replaced_whole_or_refused() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/paper");
-    let spec = read_spec(&dir.join("fig07_timoshenko.toml"), true).expect("spec");
+    let spec = read_spec(&dir.join("fig07_timoshenko.toml"), Depth::Quick).expect("spec");
     let out = tempfile::tempdir().expect("tempdir");
     let opts =
         AuditOptions { out: out.path().join("a"), jobs: 1, fields: Default::default(), resume: false, engines: false };
-    run_audit(std::slice::from_ref(&spec), true, &opts, |_, _| {}).expect("first audit");
+    run_audit(std::slice::from_ref(&spec), Depth::Quick, &opts, |_, _| {}).expect("first audit");
     let stale = opts.out.join("fig07_timoshenko/stale.txt");
     std::fs::write(&stale, "from an older audit").expect("write");
-    run_audit(std::slice::from_ref(&spec), true, &opts, |_, _| {}).expect("second audit");
+    run_audit(std::slice::from_ref(&spec), Depth::Quick, &opts, |_, _| {}).expect("second audit");
     assert!(!stale.exists(), "a file of the older audit survived");
 
     let foreign = out.path().join("mine");
@@ -108,7 +109,7 @@ fn audit_folder_is_replaced_whole_or_refused() {
     std::fs::write(foreign.join("thesis.tex"), "keep me").expect("write");
     let err = run_audit(
         &[spec],
-        true,
+        Depth::Quick,
         &AuditOptions { out: foreign.clone(), jobs: 1, fields: Default::default(), resume: false, engines: false },
         |_, _| {},
     )
@@ -124,7 +125,7 @@ fn audit_folder_is_replaced_whole_or_refused() {
 #[test]
 fn tradeoff_figure_lists_every_point_with_its_time_and_error() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/bench/accuracy_per_second.toml");
-    let spec = read_spec(&path, true).expect("spec");
+    let spec = read_spec(&path, Depth::Quick).expect("spec");
     let out = tempfile::tempdir().expect("tempdir");
     let opts = AuditOptions {
         out: out.path().join("aps"),
@@ -133,7 +134,7 @@ fn tradeoff_figure_lists_every_point_with_its_time_and_error() {
         resume: false,
         engines: false,
     };
-    let report = run_audit(std::slice::from_ref(&spec), true, &opts, |_, _| {}).expect("audit");
+    let report = run_audit(std::slice::from_ref(&spec), Depth::Quick, &opts, |_, _| {}).expect("audit");
     assert!(report.claims.iter().all(|c| c.verdict == Some(Verdict::Reproduced)), "{:?}", report.claims[0].ours);
     let csv = std::fs::read_to_string(opts.out.join("accuracy_per_second/accuracy_per_second.csv")).expect("csv");
     let rows: Vec<Vec<f64>> = csv
@@ -180,7 +181,7 @@ expect = "reproduced"
     );
     let path = tmp.path().join("failed.toml");
     std::fs::write(&path, spec).expect("spec");
-    let spec = read_spec(&path, true).expect("spec");
+    let spec = read_spec(&path, Depth::Quick).expect("spec");
     let opts = AuditOptions {
         out: tmp.path().join("out"),
         jobs: 1,
@@ -188,7 +189,7 @@ expect = "reproduced"
         resume: false,
         engines: false,
     };
-    let report = run_audit(&[spec], true, &opts, |_, _| {}).expect("report written");
+    let report = run_audit(&[spec], Depth::Quick, &opts, |_, _| {}).expect("report written");
     assert!(matches!(&report.status, AuditStatus::Failed(e) if e.len() == 1 && e[0].contains("eq63_curve_rel_eror")));
     assert_eq!((report.unjudged(), report.counts()), (1, [1, 0, 0, 0]));
     let md = std::fs::read_to_string(opts.out.join("REPORT.md")).expect("REPORT.md");
@@ -507,7 +508,7 @@ ours = true
     let read = |text: String| {
         let path = tmp.path().join("p.toml");
         std::fs::write(&path, text).expect("spec");
-        read_spec(&path, true)
+        read_spec(&path, Depth::Quick)
     };
     let err = read(spec("reproduced", "agrees very well", "")).expect_err("refused");
     assert!(err.to_string().contains("at best \"differs\""), "{err}");
@@ -523,7 +524,7 @@ ours = true
         resume: false,
         engines: false,
     };
-    let report = run_audit(&[spec], true, &opts, |_, _| {}).expect("audit");
+    let report = run_audit(&[spec], Depth::Quick, &opts, |_, _| {}).expect("audit");
     // the same check, which holds (fig7-5pct): partial → differs; ours → reproduced, apart
     assert_eq!(report.claims[0].verdict, Some(Verdict::Differs), "{}", report.claims[0].ours);
     assert!(report.claims[0].ours.contains("[partial check: the tip only]"), "{}", report.claims[0].ours);

@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use cosserat::audit::spec::read_spec;
-use cosserat::audit::Verdict;
+use cosserat::audit::{Depth, Verdict};
 
 /// A point of a synthetic run: its grid value, how it ended and its numbers.
 fn synthetic_point(
@@ -88,7 +88,7 @@ cause = "no stop at lambda_d = {{first_failing}}"
     );
     let path = tmp.path().join("c.toml");
     std::fs::write(&path, text).expect("spec");
-    let spec = read_spec(&path, false).expect("spec");
+    let spec = read_spec(&path, Depth::Full).expect("spec");
     let claim = &spec.claims[0];
     let judged = cosserat::audit::check::judge(&spec, claim, &synthetic_run(false));
     assert_eq!(judged.verdict, Some(Verdict::Reproduced), "{}", judged.ours);

@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use cosserat::case::Case;
-use cosserat::study::{run_study, StudyRow, StudySpec, SPLINE};
+use cosserat::study::{run_study, Depth, StudyRow, StudySpec, SPLINE};
 
 fn root() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -58,7 +58,7 @@ label = "auto"
     let spec_path = dir.path().join("spec.toml");
     std::fs::write(&spec_path, text).expect("spec");
     let spec = StudySpec::read(&spec_path).expect("spec reads");
-    run_study(&spec, &dir.path().join("out"), false, |_| {}).expect("study runs")
+    run_study(&spec, &dir.path().join("out"), Depth::Full, |_| {}).expect("study runs")
 }
 
 fn find<'a>(rows: &'a [StudyRow], method: &str, noise_m: f64) -> &'a StudyRow {

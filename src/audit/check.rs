@@ -3,7 +3,7 @@
 //! claim's declared fallbacks. Numbers are written as `numbers` says: two significant digits,
 //! counts exactly, a value beside its reference with the digits that show their difference.
 use super::cause::{fill, PointState};
-use super::convergence::{converges, met_rule};
+use super::convergence::{converges, met_rule, Claimed};
 use super::numbers::{against, input, sig2};
 use super::points::{key_of, outcome, point_label, select, values};
 pub use super::points::{CheckError, Outcome};
@@ -57,11 +57,11 @@ fn split_by<'a>(
 /// The outcome and text of `check`, one stage per kind of check.
 fn evaluate_inner(check: &Check, runs: &[RunResults]) -> Result<(Outcome, String), CheckError> {
     match check {
-        Check::Converges { run } => converges(runs, run, false),
+        Check::Converges { run } => converges(runs, run, Claimed::Converges),
         Check::DoesNotConverge { run, with } => {
-            let mut all = converges(runs, run, true)?;
+            let mut all = converges(runs, run, Claimed::DoesNotConverge)?;
             for w in with {
-                let (o, text) = converges(runs, w, true)?;
+                let (o, text) = converges(runs, w, Claimed::DoesNotConverge)?;
                 all.1.push_str(&format!("; {w}: {text}"));
                 all.0 = match (all.0, o) {
                     (Outcome::Holds, Outcome::Holds) => Outcome::Holds,
@@ -71,14 +71,16 @@ fn evaluate_inner(check: &Check, runs: &[RunResults]) -> Result<(Outcome, String
             }
             Ok(all)
         }
-        Check::Below { run, metric, limit, at, with } => threshold(runs, (run, with), metric, *limit, at, true),
-        Check::Above { run, metric, limit, at, with } => threshold(runs, (run, with), metric, *limit, at, false),
+        Check::Below { run, metric, limit, at, with } => threshold(runs, (run, with), metric, *limit, at, Side::AtMost),
+        Check::Above { run, metric, limit, at, with } => {
+            threshold(runs, (run, with), metric, *limit, at, Side::AtLeast)
+        }
         Check::Increasing { run, metric } => increasing(runs, run, metric),
         Check::RatioAbove { metric, numerator, denominator, limit } => {
-            ratio(runs, metric, numerator, denominator, *limit, true)
+            ratio(runs, metric, numerator, denominator, *limit, Side::AtLeast)
         }
         Check::RatioBelow { metric, numerator, denominator, limit } => {
-            ratio(runs, metric, numerator, denominator, *limit, false)
+            ratio(runs, metric, numerator, denominator, *limit, Side::AtMost)
         }
         Check::WithinFactor { run, metric, factor, with, also } => {
             let mut worst = within_factor(runs, run, metric, *factor, with)?;
@@ -105,15 +107,41 @@ fn evaluate_inner(check: &Check, runs: &[RunResults]) -> Result<(Outcome, String
     }
 }
 
-/// `below` (or `above`): `metric ≤ limit` (`≥`) at every selected point of `run` and every
-/// point of the runs `with`.
+/// Which side of its limit a value must lie on: `≤` (`below`, `ratio_below`) or `≥` (`above`,
+/// `ratio_above`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Side {
+    AtMost,
+    AtLeast,
+}
+
+impl Side {
+    /// Does `v` lie on this side of `limit` (the limit included)?
+    fn holds(self, v: f64, limit: f64) -> bool {
+        match self {
+            Side::AtMost => v <= limit,
+            Side::AtLeast => v >= limit,
+        }
+    }
+
+    /// `≤` or `≥`, as the claim's text writes it.
+    fn symbol(self) -> &'static str {
+        match self {
+            Side::AtMost => "≤",
+            Side::AtLeast => "≥",
+        }
+    }
+}
+
+/// `below` (or `above`, as `side` says): `metric ≤ limit` (`≥`) at every selected point of
+/// `run` and every point of the runs `with`.
 fn threshold(
     runs: &[RunResults],
     (run, with): (&str, &[String]),
     metric: &str,
     limit: f64,
     at: &Selector,
-    below: bool,
+    side: Side,
 ) -> Result<(Outcome, String), CheckError> {
     let mut pts = select(runs, run, at)?;
     let mut list = metric_list(&pts, metric, limit);
@@ -122,9 +150,9 @@ fn threshold(
         list.push_str(&format!("; {w}: {}", metric_list(&more, metric, limit)));
         pts.extend(more);
     }
-    let pass = |p: &PointResult| p.metric(metric).is_some_and(|v| if below { v <= limit } else { v >= limit });
+    let pass = |p: &PointResult| p.metric(metric).is_some_and(|v| side.holds(v, limit));
     let (ok, _) = split_by(&pts, pass);
-    let rel = if below { "≤" } else { "≥" };
+    let rel = side.symbol();
     Ok((outcome(ok.len(), pts.len()), format!("{metric} {list} (claim: {rel} {})", input(limit))))
 }
 
@@ -147,20 +175,21 @@ fn increasing(runs: &[RunResults], run: &str, metric: &str) -> Result<(Outcome, 
     Ok((outcome(rising, vals.len().saturating_sub(1)), text))
 }
 
-/// `ratio_above` (or `ratio_below`): `metric(numerator) / metric(denominator) ≥ limit` (`≤`).
+/// `ratio_above` (or `ratio_below`, as `side` says): `metric(numerator) / metric(denominator) ≥
+/// limit` (`≤`).
 fn ratio(
     runs: &[RunResults],
     metric: &str,
     numerator: &Ref,
     denominator: &Ref,
     limit: f64,
-    above: bool,
+    side: Side,
 ) -> Result<(Outcome, String), CheckError> {
     let (a, b) = (one(runs, numerator)?, one(runs, denominator)?);
     let missing = |p: &PointResult| CheckError::MissingMetric { metric: metric.to_string(), point: point_label(p) };
     let (va, vb) = (a.metric(metric).ok_or_else(|| missing(a))?, b.metric(metric).ok_or_else(|| missing(b))?);
     let ratio = va / vb;
-    let pass = if above { ratio >= limit } else { ratio <= limit };
+    let pass = side.holds(ratio, limit);
     let text = format!(
         "{metric}: {} ({}, {}) / {} ({}, {}) = {} (claim: {} {})",
         sig2(va),
@@ -170,7 +199,7 @@ fn ratio(
         denominator.run,
         point_label(b),
         against(ratio, limit),
-        if above { "≥" } else { "≤" },
+        side.symbol(),
         input(limit)
     );
     Ok((if pass { Outcome::Holds } else { Outcome::Fails }, text))

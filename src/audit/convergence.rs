@@ -62,10 +62,18 @@ fn iterations(pts: &[&PointResult]) -> String {
     }
 }
 
-/// `converges` (or, with `fails`, `does_not_converge`): the points that stop by the paper's
+/// What a convergence check claims of its points: that they stop by the paper's rule
+/// (`converges`) or that they do not (`does_not_converge`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Claimed {
+    Converges,
+    DoesNotConverge,
+}
+
+/// `converges` (or `does_not_converge`, as `claimed`): the points that stop by the paper's
 /// rule, with their iterations, and why each other did not; the outcome counts the former
 /// (the latter).
-pub fn converges(runs: &[RunResults], run: &str, fails: bool) -> Result<(Outcome, String), CheckError> {
+pub fn converges(runs: &[RunResults], run: &str, claimed: Claimed) -> Result<(Outcome, String), CheckError> {
     let pts = select(runs, run, &Selector::new())?;
     let (ok, bad): (Vec<&PointResult>, Vec<&PointResult>) = pts.iter().partition(|p| met_rule(p));
     let key = key_of(&pts);
@@ -75,7 +83,10 @@ pub fn converges(runs: &[RunResults], run: &str, fails: bool) -> Result<(Outcome
         parts.push(format!("stops by the paper's rule for {}{}", named(&ok), iterations(&ok)));
     }
     parts.extend(bad.iter().map(|p| format!("{}: {}", named(&[p]), failure(p))));
-    let good = if fails { bad.len() } else { ok.len() };
+    let good = match claimed {
+        Claimed::Converges => ok.len(),
+        Claimed::DoesNotConverge => bad.len(),
+    };
     Ok((outcome(good, pts.len()), parts.join("; ")))
 }
 
@@ -94,7 +105,9 @@ pub fn standard(check: &Check, runs: &[RunResults]) -> Option<String> {
     for name in names {
         let pts = select(runs, name, &Selector::new()).ok()?;
         let prefix = if many { format!("{name}: ") } else { String::new() };
-        let each: Vec<String> = pts.iter().map(|p| point_standard(p, pts.len() > 1)).collect();
+        // each point named by its grid values where the run has more than one
+        let label = |p: &PointResult| if pts.len() > 1 { format!("{}: ", point_label(p)) } else { String::new() };
+        let each: Vec<String> = pts.iter().map(|p| format!("{}{}", label(p), point_standard(p))).collect();
         parts.push(format!("{prefix}{}", each.join("; ")));
     }
     Some(format!("certificate ≤ {}: {}", input(OUR_TOLERANCE), parts.join("; ")))
@@ -102,13 +115,12 @@ pub fn standard(check: &Check, runs: &[RunResults]) -> Option<String> {
 
 /// A point's part of [`standard`]: `λd = 1e-6: 4.2e-7 (4200×); Newton from it x 1e-6, κ 1e-3
 /// (discretisation x 2e-4, κ 0.11)`.
-fn point_standard(p: &PointResult, labelled: bool) -> String {
-    let label = if labelled { format!("{}: ", point_label(p)) } else { String::new() };
+fn point_standard(p: &PointResult) -> String {
     if !frames(p).is_empty() {
-        return format!("{label}{}", clip_standard(frames(p)));
+        return clip_standard(frames(p));
     }
-    let Some(c) = p.value(Metric::Certificate) else { return format!("{label}no certificate") };
-    let mut text = format!("{label}{} ({}× ours)", sig2(c), sig2(c / OUR_TOLERANCE));
+    let Some(c) = p.value(Metric::Certificate) else { return "no certificate".to_string() };
+    let mut text = format!("{} ({}× ours)", sig2(c), sig2(c / OUR_TOLERANCE));
     if let (Some(x), Some(k)) = (p.metric("newton_x_dist_rel"), p.metric("newton_kappa_dist_rel")) {
         let root = if p.metric("newton_certified") == Some(1.0) {
             "the Newton solution".to_string()

@@ -20,6 +20,7 @@ pub mod spec;
 pub mod truth;
 pub mod wave;
 
+pub use crate::jobs::depth::Depth;
 use std::path::{Path, PathBuf};
 
 use rayon::prelude::*;
@@ -197,7 +198,8 @@ pub struct AuditReport {
     pub claims: Vec<ClaimResult>,
     /// figures written, relative to the audit folder
     pub figures: Vec<String>,
-    pub quick: bool,
+    /// the grids run (`--quick` or full)
+    pub depth: Depth,
     pub wall_time_s: f64,
     /// CPU time of the audit's process (user + system) [s], `None` where /proc is not there
     pub cpu_time_s: Option<f64>,
@@ -259,14 +261,6 @@ pub enum PointFields {
 }
 
 impl PointFields {
-    /// From the flags `--fields` and `--vtk` of `cosserat audit`.
-    pub fn from_flags(fields: bool, vtk: bool) -> Self {
-        match (fields, vtk) {
-            (_, true) => PointFields::Vtk,
-            (true, _) => PointFields::Compact,
-            _ => PointFields::Tables,
-        }
-    }
     pub fn as_str(&self) -> &'static str {
         match self {
             PointFields::Tables => {
@@ -356,14 +350,14 @@ fn process_cpu_time_s() -> Option<f64> {
 /// `opts.out`. `progress(done, total)` after each point.
 pub fn run_audit(
     specs: &[Spec],
-    quick: bool,
+    depth: Depth,
     opts: &AuditOptions,
     progress: impl Fn(usize, usize) + Sync,
 ) -> Result<AuditReport, AuditError> {
     let start = std::time::Instant::now();
     let cpu_start = process_cpu_time_s();
     let reused: Vec<Option<(Vec<ClaimResult>, Vec<String>)>> =
-        specs.iter().map(|s| if opts.resume { resume::load(s, quick, &opts.out) } else { None }).collect();
+        specs.iter().map(|s| if opts.resume { resume::load(s, depth, &opts.out) } else { None }).collect();
     let mut jobs = plan_jobs(specs, &reused, opts)?;
     if opts.resume {
         resume_folder(&opts.out, specs, &reused)?;
@@ -402,7 +396,7 @@ pub fn run_audit(
         }
     };
     let interrupted = crate::interrupt::requested();
-    let (claims, figures, failures) = judge_all(specs, (&results, &reruns), &opts.out, reused, quick);
+    let (claims, figures, failures) = judge_all(specs, (&results, &reruns), &opts.out, reused, depth);
     let status = if interrupted {
         AuditStatus::Interrupted
     } else if failures.is_empty() {
@@ -413,7 +407,7 @@ pub fn run_audit(
     let report = AuditReport {
         claims,
         figures,
-        quick,
+        depth,
         wall_time_s: start.elapsed().as_secs_f64(),
         cpu_time_s: process_cpu_time_s().zip(cpu_start).map(|(end, start)| end - start),
         status,
@@ -484,7 +478,7 @@ fn judge_all(
     (results, reruns): (&[Vec<RunResults>], &engines::Reruns),
     out: &Path,
     reused: Vec<Option<(Vec<ClaimResult>, Vec<String>)>>,
-    quick: bool,
+    depth: Depth,
 ) -> (Vec<ClaimResult>, Vec<String>, Vec<String>) {
     let (mut claims, mut figures, mut failures) = (Vec::new(), Vec::new(), Vec::new());
     for (((spec, runs), old), reruns) in specs.iter().zip(results).zip(reused).zip(reruns) {
@@ -512,7 +506,7 @@ fn judge_all(
             claims.push(c);
         }
         if whole && failures.is_empty() {
-            if let Err(e) = resume::store(spec, &claims[first..], &figures, quick, out) {
+            if let Err(e) = resume::store(spec, &claims[first..], &figures, depth, out) {
                 failures.push(format!("spec {}: {e}", spec.name));
             }
         }

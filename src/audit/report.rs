@@ -92,7 +92,7 @@ fn header(r: &AuditReport) -> String {
         s => format!(" — {}: {judged} of {total} claims judged", s.as_str()),
     };
     let _ = writeln!(o, "# Audit of Wang et al., Comput. Mech. 71 (2023), §5–6{state}\n");
-    let command = format!("cosserat audit{}", if r.quick { " --quick" } else { "" });
+    let command = format!("cosserat audit{}", if r.depth.is_quick() { " --quick" } else { "" });
     let [orep, odif, oref, onc] = r.our_counts();
     let counts = format!(
         "of the paper's {}: {rep} reproduced, {dif} differ, {refu} refuted, {nc} not computable here; of our {ours} own checks: {orep} hold, {} do not",

@@ -9,6 +9,7 @@ use serde::{Deserialize, Serialize};
 use super::spec::Spec;
 use super::{ClaimResult, Verdict};
 use crate::io::OutputError;
+use crate::jobs::depth::Depth;
 
 /// The record of a spec judged whole, in its folder.
 pub const JUDGED: &str = "judged.json";
@@ -41,7 +42,7 @@ pub fn store(
     spec: &Spec,
     claims: &[ClaimResult],
     figures: &[String],
-    quick: bool,
+    depth: Depth,
     out: &Path,
 ) -> Result<(), OutputError> {
     let claims = claims
@@ -62,17 +63,17 @@ pub fn store(
     let prefix = format!("{}/", spec.name);
     let figures = figures.iter().filter(|f| f.starts_with(&prefix)).cloned().collect();
     let path = out.join(&spec.name).join(JUDGED);
-    let text = serde_json::to_string_pretty(&Judged { quick, claims, figures })
+    let text = serde_json::to_string_pretty(&Judged { quick: depth.is_quick(), claims, figures })
         .map_err(|e| OutputError::Invalid { path: path.clone(), reason: e.to_string() })?;
     crate::io::files::write_atomic(&path, text.as_bytes())
 }
 
 /// The claims and figures of `spec` from the audit being resumed: `None` unless it judged
-/// every claim the spec has now, in the same mode (`quick`).
-pub fn load(spec: &Spec, quick: bool, out: &Path) -> Option<(Vec<ClaimResult>, Vec<String>)> {
+/// every claim the spec has now, at the same `depth`.
+pub fn load(spec: &Spec, depth: Depth, out: &Path) -> Option<(Vec<ClaimResult>, Vec<String>)> {
     let text = std::fs::read_to_string(out.join(&spec.name).join(JUDGED)).ok()?;
     let judged: Judged = serde_json::from_str(&text).ok()?;
-    if judged.quick != quick || judged.claims.len() != spec.claims.len() {
+    if judged.quick != depth.is_quick() || judged.claims.len() != spec.claims.len() {
         return None;
     }
     let claims = spec

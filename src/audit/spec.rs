@@ -28,6 +28,7 @@
 //! title = "Fig. 10: convergence against λd"
 //! show = { kind = "convergence", run = "ld" }
 //! ```
+use crate::jobs::depth::Depth;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
@@ -425,8 +426,8 @@ impl Spec {
     }
 }
 
-/// Read and validate a spec; `quick`: apply the runs' `quick_set` and `quick_grid`.
-pub fn read_spec(path: &Path, quick: bool) -> Result<Spec, SpecError> {
+/// Read and validate a spec; at [`Depth::Quick`], with the runs' `quick_set` and `quick_grid`.
+pub fn read_spec(path: &Path, depth: Depth) -> Result<Spec, SpecError> {
     let text = read_capped_text(path, SPEC_FILE_CAP_BYTES, "audit spec")?;
     let raw: RawSpec = toml::from_str(&text).map_err(|e| SpecError::Syntax {
         path: path.to_path_buf(),
@@ -439,7 +440,7 @@ pub fn read_spec(path: &Path, quick: bool) -> Result<Spec, SpecError> {
             false => e.to_string(),
         },
     })?;
-    let runs = raw.runs.into_iter().map(|(name, r)| read_run(path, name, r, quick)).collect::<Result<Vec<_>, _>>()?;
+    let runs = raw.runs.into_iter().map(|(name, r)| read_run(path, name, r, depth)).collect::<Result<Vec<_>, _>>()?;
     let mut claims: Vec<Claim> = Vec::new();
     for c in raw.claims {
         let claim = read_claim(path, c, &claims, &runs)?;
@@ -470,8 +471,8 @@ fn invalid(path: &Path, what: String, reason: String) -> SpecError {
 }
 
 /// The run `name` of the spec at `path`: its case file (relative to the spec) with the run's
-/// `set` (and, `quick`, `quick_set`), and its grid of known keys and finite values.
-fn read_run(path: &Path, name: String, r: RawRun, quick: bool) -> Result<RunSpec, SpecError> {
+/// `set` (and, at [`Depth::Quick`], `quick_set`), and its grid of known keys and finite values.
+fn read_run(path: &Path, name: String, r: RawRun, depth: Depth) -> Result<RunSpec, SpecError> {
     let dir = path.parent().unwrap_or(Path::new("."));
     let case_path = dir.join(&r.case);
     let boxed = |e: Box<dyn std::error::Error + Send + Sync>| SpecError::Case {
@@ -482,13 +483,13 @@ fn read_run(path: &Path, name: String, r: RawRun, quick: bool) -> Result<RunSpec
     };
     let mut case = Case::from_file(&case_path).map_err(|e| boxed(Box::new(e)))?;
     let mut set: Vec<(String, toml::Value)> = r.set.into_iter().collect();
-    if quick {
+    if depth.is_quick() {
         set.extend(r.quick_set);
     }
     if !set.is_empty() {
         case = case.with_overrides(&set).map_err(|e| boxed(Box::new(e)))?;
     }
-    let grid_table = if quick { r.quick_grid.unwrap_or(r.grid) } else { r.grid };
+    let grid_table = if depth.is_quick() { r.quick_grid.unwrap_or(r.grid) } else { r.grid };
     let known = known_keys(&case);
     let mut grid = Vec::new();
     for (key, values) in grid_table {

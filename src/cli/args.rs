@@ -38,26 +38,7 @@ pub enum Command {
     /// values ([[reference.values]]) has them checked in both engines: a second table, and
     /// reference.csv with both engines' values, errors and verdicts; a value missed in either
     /// engine is exit status 1 too.
-    Compare {
-        /// Case file (TOML)
-        case: PathBuf,
-        /// Directory for both engines' outputs [default: out/<case name>]
-        #[arg(long)]
-        out: Option<PathBuf>,
-        /// Short horizon: 200 time steps, 40 fixed-point iterations, 3 clip frames
-        #[arg(long)]
-        short: bool,
-        /// Clip cases: frames to compare, a number or `all` [default: the case's
-        /// `[compare] frames`, 10]
-        #[arg(long, value_parser = super::parse_frames)]
-        frames: Option<usize>,
-        /// Replace the output directory even if it holds files but no run.json, or a complete
-        /// run with one that fails or is interrupted
-        #[arg(long)]
-        force: bool,
-        #[command(flatten)]
-        limits: Limits,
-    },
+    Compare(CompareArgs),
     /// Run a case for every point of a parameter grid (in parallel) and summarise.
     ///
     /// Writes one folder per run (the files of `run`), `summary.csv` (one row per run: the swept
@@ -132,6 +113,29 @@ pub struct Limits {
     /// memory]
     #[arg(long, value_name = "GIB")]
     pub max_memory_gib: Option<f64>,
+}
+
+/// The options of `cosserat compare` (its help is the `Compare` command's).
+#[derive(clap::Args, Debug)]
+pub struct CompareArgs {
+    /// Case file (TOML)
+    pub case: PathBuf,
+    /// Directory for both engines' outputs [default: out/<case name>]
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Short horizon: 200 time steps, 40 fixed-point iterations, 3 clip frames
+    #[arg(long)]
+    pub short: bool,
+    /// Clip cases: frames to compare, a number or `all` [default: the case's
+    /// `[compare] frames`, 10]
+    #[arg(long, value_parser = super::parse_frames)]
+    pub frames: Option<usize>,
+    /// Replace the output directory even if it holds files but no run.json, or a complete
+    /// run with one that fails or is interrupted
+    #[arg(long)]
+    pub force: bool,
+    #[command(flatten)]
+    pub limits: Limits,
 }
 
 /// The options of `cosserat sweep` (its help is the `Sweep` command's).
@@ -234,6 +238,40 @@ pub struct RunArgs {
     /// or complete_with_warnings, either way)
     #[arg(long)]
     pub strict: bool,
+}
+
+impl RunArgs {
+    /// What a missed published value or a flagged frame does: `--strict` makes it fail.
+    pub fn strictness(&self) -> super::outcome::Strictness {
+        use super::outcome::Strictness;
+        if self.strict {
+            Strictness::Fail
+        } else {
+            Strictness::Warn
+        }
+    }
+}
+
+impl AuditArgs {
+    /// The grids to run: `--quick`'s or the full ones.
+    pub fn depth(&self) -> cosserat::audit::Depth {
+        use cosserat::audit::Depth;
+        if self.quick {
+            Depth::Quick
+        } else {
+            Depth::Full
+        }
+    }
+
+    /// What the clip points keep, from `--fields` and `--vtk`.
+    pub fn point_fields(&self) -> cosserat::audit::PointFields {
+        use cosserat::audit::PointFields;
+        match (self.fields, self.vtk) {
+            (_, true) => PointFields::Vtk,
+            (true, _) => PointFields::Compact,
+            _ => PointFields::Tables,
+        }
+    }
 }
 
 /// `--engine` as the command line spells it (the library's [`Engine`] knows no command line).

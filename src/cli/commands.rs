@@ -5,8 +5,8 @@ use std::process::ExitCode;
 
 use anyhow::{bail, Context, Result};
 
-use super::args::{AuditArgs, Limits, RunArgs, SweepArgs};
-use super::progress::{FreefemProgress, Progress};
+use super::args::{AuditArgs, CompareArgs, Limits, RunArgs, SweepArgs};
+use super::progress::{FreefemProgress, Progress, Visibility};
 use cosserat::case::Case;
 use cosserat::engine::budget::{self, default_limit_bytes, Footprint, GIB};
 use cosserat::engine::Engine;
@@ -28,7 +28,8 @@ fn check_memory(case: &Case, what: Footprint, limits: Limits) -> Result<()> {
 }
 
 pub fn cmd_run(args: RunArgs) -> Result<ExitCode> {
-    let RunArgs { case: path, engine, out, force, resume, output_format, limits, quiet, strict } = args;
+    let strictness = args.strictness();
+    let RunArgs { case: path, engine, out, force, resume, output_format, limits, quiet, .. } = args;
     let (path, engine) = (path.as_path(), Engine::from(engine));
     let mode = (if resume { Mode::Resume } else { Mode::Fresh { force } }, OutputFormat::from(output_format));
     let case = load(path)?;
@@ -42,7 +43,8 @@ pub fn cmd_run(args: RunArgs) -> Result<ExitCode> {
     let counted = engine == Engine::Freefem
         && (case.clip().is_some() || matches!(case.analysis, cosserat::case::Analysis::Dynamic(_)));
     let label = format!("{} [{engine}]", case.name);
-    let pb = Progress::new(&label, super::outcome::progress_unit(&case, engine), 0, quiet || counted);
+    let shown = Visibility::unless(quiet || counted);
+    let pb = Progress::new(&label, super::outcome::progress_unit(&case, engine), 0, shown);
     let freefem = (counted && !quiet).then(|| FreefemProgress::start(&label));
     if engine == Engine::Freefem && !quiet {
         eprintln!("{} [freefem]: running FreeFEM in a staging folder beside {}", case.name, dir.display());
@@ -54,19 +56,14 @@ pub fn cmd_run(args: RunArgs) -> Result<ExitCode> {
     for n in &end.notes {
         eprintln!("note: {n}");
     }
-    super::outcome::run_end(end, (&case, engine), path, &dir, strict)
+    super::outcome::run_end(end, (&case, engine), path, &dir, strictness)
 }
 
-pub fn cmd_compare(
-    path: &Path,
-    out: Option<PathBuf>,
-    short: bool,
-    frames: Option<usize>,
-    force: bool,
-    limits: Limits,
-) -> Result<ExitCode> {
-    use cosserat::jobs::compare::default_dir;
-    let case = load(path)?;
+pub fn cmd_compare(args: CompareArgs) -> Result<ExitCode> {
+    use cosserat::jobs::compare::{default_dir, CompareOptions, Horizon};
+    let CompareArgs { case: path, out, short, frames, force, limits } = args;
+    let opts = CompareOptions { horizon: if short { Horizon::Short } else { Horizon::Full }, frames };
+    let case = load(&path)?;
     if let Some(why) = cosserat::engine::published::unavailable(&case) {
         bail!(why);
     }
@@ -81,9 +78,9 @@ pub fn cmd_compare(
     // every 10 s says the comparison is still running.
     let counted = case.clip().is_some() || matches!(case.analysis, cosserat::case::Analysis::Dynamic(_));
     let on_terminal = std::io::IsTerminal::is_terminal(&std::io::stderr());
-    let pb = Progress::new(&format!("{} compare", case.name), "", 0, on_terminal || counted);
+    let pb = Progress::new(&format!("{} compare", case.name), "", 0, Visibility::unless(on_terminal || counted));
     let freefem = FreefemProgress::start(&format!("{} FreeFEM", case.name));
-    let result = compare_into(&case, folder.dir(), &target, short, frames);
+    let result = compare_into(&case, folder.dir(), &target, &opts);
     freefem.finish();
     pb.finish();
     let (status, message) = match &result {
@@ -102,16 +99,20 @@ pub fn cmd_compare(
     }
 }
 
-/// Both engines on `case` and their comparison, written into `dir` (the staging folder).
-fn compare_into(case: &Case, dir: &Path, target: &Path, short: bool, frames: Option<usize>) -> Result<ExitCode> {
-    use cosserat::jobs::compare::{compare_case, report_table, write_compare, CompareOptions, Horizon};
-    let opts = CompareOptions { horizon: if short { Horizon::Short } else { Horizon::Full }, frames };
+/// Both engines on `case` at `opts` and their comparison, written into `dir` (the staging folder).
+fn compare_into(
+    case: &Case,
+    dir: &Path,
+    target: &Path,
+    opts: &cosserat::jobs::compare::CompareOptions,
+) -> Result<ExitCode> {
+    use cosserat::jobs::compare::{compare_case, report_table, write_compare};
     eprintln!(
         "{}: rust engine (twice: as given and with its input perturbed by 1e-13), then FreeFEM in {}",
         case.name,
         target.join("freefem_work").display()
     );
-    let report = compare_case(case, dir, &opts).with_context(|| case_label(case))?;
+    let report = compare_case(case, dir, opts).with_context(|| case_label(case))?;
     write_compare(case, &report, dir)?;
     print!("{}", report_table(case, &report));
     println!("wrote {}", target.join("compare.csv").display());
@@ -161,7 +162,7 @@ pub fn cmd_sweep(args: SweepArgs) -> Result<ExitCode> {
     let mut manifest = run_manifest(&case, Engine::Rust)?;
     manifest.writer.command = "sweep".into();
     let folder = CommandFolder::begin(&target, manifest, Mode::Fresh { force }, &case_label(&case), SWEEP_THEN)?;
-    let pb = Progress::new(&format!("{} sweep", case.name), "points", points.len(), quiet);
+    let pb = Progress::new(&format!("{} sweep", case.name), "points", points.len(), Visibility::unless(quiet));
     let keys: Vec<String> = params.iter().map(|p| p.key.clone()).collect();
     let result = sweep_into(&case, &keys, &points, folder.dir(), jobs.unwrap_or(0), || pb.inc());
     pb.finish();
@@ -176,7 +177,7 @@ pub fn cmd_sweep(args: SweepArgs) -> Result<ExitCode> {
     let count = |s: Outcome| rows.iter().filter(|r| r.status == s).count();
     let complete = rows.iter().filter(|r| r.status.is_complete()).count();
     let (interrupted, failed) = (count(Outcome::Interrupted), rows.len() - complete);
-    let status = ended(interrupted > 0, failed > 0);
+    let status = ended(interrupted, failed);
     let message = (failed > 0).then(|| {
         format!("{failed} of {} points failed, did not converge or were interrupted (summary.csv)", rows.len())
     });
@@ -251,12 +252,13 @@ impl CommandFolder {
     }
 }
 
-/// The status of work that was `interrupted` or had parts that `failed` (complete otherwise).
-fn ended(interrupted: bool, failed: bool) -> Status {
+/// The status of work of which `interrupted` parts were stopped by a signal and `failed`
+/// parts (those stopped among them) did not complete: interrupted, failed, else complete.
+fn ended(interrupted: usize, failed: usize) -> Status {
     match (interrupted, failed) {
-        (true, _) => Status::Interrupted,
-        (false, true) => Status::Failed,
-        (false, false) => Status::Complete,
+        (1.., _) => Status::Interrupted,
+        (0, 1..) => Status::Failed,
+        (0, 0) => Status::Complete,
     }
 }
 
@@ -280,13 +282,15 @@ fn held(placed: &Placed, word: &str, then: &str) -> String {
 }
 
 pub fn cmd_audit(args: AuditArgs) -> Result<ExitCode> {
-    use cosserat::audit::{run_audit, spec::read_spec, AuditOptions, AuditStatus, PointFields};
-    let AuditArgs { specs: paths, quick, out, force, jobs, quiet, fields, vtk, resume, engines } = args;
-    let (paths, fields) = (paths.as_slice(), PointFields::from_flags(fields, vtk));
+    use cosserat::audit::{run_audit, spec::read_spec, AuditOptions, AuditStatus, Depth};
+    let (fields, depth) = (args.point_fields(), args.depth());
+    let AuditArgs { specs: paths, out, force, jobs, quiet, resume, engines, .. } = args;
+    let quick = depth == Depth::Quick;
+    let paths = paths.as_slice();
     // --resume keeps what the folder holds: no replacing it (`None`)
     let force = (!resume).then_some(force);
     let files = audit_spec_files(paths)?;
-    let specs = files.iter().map(|f| read_spec(f, quick)).collect::<Result<Vec<_>, _>>()?;
+    let specs = files.iter().map(|f| read_spec(f, depth)).collect::<Result<Vec<_>, _>>()?;
     let out = out.unwrap_or_else(|| PathBuf::from(if quick { "out/audit-quick" } else { "out/audit" }));
     // an audit folder of an older version carries the audit's marker instead of run.json
     let marker = out.join(cosserat::audit::MARKER).is_file();
@@ -296,10 +300,10 @@ pub fn cmd_audit(args: AuditArgs) -> Result<ExitCode> {
     manifest.input.settings.insert("quick".into(), f64::from(u8::from(quick)).into());
     let resume = force.is_none();
     let folder = CommandFolder::begin(&out, manifest, mode, "audit", AUDIT_THEN)?;
-    let pb = Progress::new(if quick { "audit (quick)" } else { "audit" }, "points", 0, quiet);
+    let pb = Progress::new(if quick { "audit (quick)" } else { "audit" }, "points", 0, Visibility::unless(quiet));
     let opts = AuditOptions { out: folder.dir().to_path_buf(), jobs: jobs.unwrap_or(0), fields, resume, engines };
     let points = std::sync::atomic::AtomicUsize::new(0);
-    let report = run_audit(&specs, quick, &opts, |done, total| {
+    let report = run_audit(&specs, depth, &opts, |done, total| {
         points.store(total, std::sync::atomic::Ordering::SeqCst);
         pb.set(done, total);
     });

@@ -23,7 +23,7 @@ use cosserat::jobs::slurm;
 use cosserat::jobs::MAX_JOBS;
 use cosserat::solve::Outcome;
 
-use progress::Progress;
+use progress::{Progress, Visibility};
 
 /// `cosserat batch`.
 #[derive(clap::Args, Debug)]
@@ -167,10 +167,15 @@ pub fn cmd_batch(a: BatchArgs) -> Result<ExitCode> {
     plan.begin(&real)?;
     let out = std::fs::canonicalize(&real).with_context(|| format!("output folder {}", a.out.display()))?;
     if a.slurm.submit {
-        return submit_batch(&a.slurm, a.quiet, &plan, &out, &case.name);
+        return submit_batch(&a.slurm, Visibility::unless(a.quiet), &plan, &out, &case.name);
     }
-    let pb = Progress::new(&format!("{} batch", case.name), "recordings", plan.recordings.len(), a.quiet);
-    let ran = run_batch(&plan, &out, (a.jobs.unwrap_or(0), a.force), || pb.inc())?;
+    let pb = Progress::new(
+        &format!("{} batch", case.name),
+        "recordings",
+        plan.recordings.len(),
+        Visibility::unless(a.quiet),
+    );
+    let ran = run_batch(&plan, &out, batch::BatchOptions { jobs: a.jobs.unwrap_or(0), force: a.force }, || pb.inc())?;
     pb.finish();
     let skipped = ran.iter().filter(|r| r.skipped).count();
     let rows: Vec<BatchRow> = ran.into_iter().map(|r| r.row).collect();
@@ -205,8 +210,8 @@ fn lock_batch(out: &Path, doing: &str) -> Result<(cosserat::output::folder_lock:
 
 /// `batch --slurm`: the job script of the array tasks that have a recording to run (a
 /// resubmission runs only the unfinished recordings), submitted unless `--dry-run`; with
-/// `--wait`, waited for (progress unless `quiet`) and gathered.
-fn submit_batch(a: &SlurmArgs, quiet: bool, plan: &Plan, out: &Path, name: &str) -> Result<ExitCode> {
+/// `--wait`, waited for (progress as `visibility` says) and gathered.
+fn submit_batch(a: &SlurmArgs, visibility: Visibility, plan: &Plan, out: &Path, name: &str) -> Result<ExitCode> {
     let exe = std::env::current_exe().context("cannot find the cosserat executable for the job script")?;
     let complete = batch::complete_recordings(plan, out)?;
     let skipped = complete.iter().filter(|c| **c).count();
@@ -252,7 +257,7 @@ fn submit_batch(a: &SlurmArgs, quiet: bool, plan: &Plan, out: &Path, name: &str)
         eprintln!("when it has finished: cosserat gather {}", out.display());
         return Ok(ExitCode::SUCCESS);
     }
-    let pb = Progress::new(&format!("{name} job {id}"), "array tasks", tasks.len(), quiet);
+    let pb = Progress::new(&format!("{name} job {id}"), "array tasks", tasks.len(), visibility);
     slurm::wait(&id, Duration::from_millis(500), |queued| pb.set(tasks.len() - queued.min(tasks.len()), 0))?;
     pb.finish();
     let rows = gather(out)?;
@@ -263,7 +268,7 @@ fn submit_batch(a: &SlurmArgs, quiet: bool, plan: &Plan, out: &Path, name: &str)
 const SETUP_FILE_CAP_BYTES: u64 = 64 << 10;
 
 pub fn cmd_batch_task(a: TaskArgs) -> Result<ExitCode> {
-    let pb = Progress::new(&format!("batch task {}", a.index), "recordings", 0, false);
+    let pb = Progress::new(&format!("batch task {}", a.index), "recordings", 0, Visibility::Shown);
     let ran = run_task(&a.out, a.index, |done, total| pb.set(done, total))?;
     pb.finish();
     for r in &ran {

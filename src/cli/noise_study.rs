@@ -8,11 +8,11 @@ use std::process::ExitCode;
 use anyhow::{Context, Result};
 
 use cosserat::figures::panels::render_panels_svg;
-use cosserat::figures::plot::{LinePlot, Series};
+use cosserat::figures::plot::{LinePlot, Scale, Series};
 use cosserat::io::write_atomic;
-use cosserat::study::{centreline_name, recovered_name, run_study, StudyRow, StudySpec, SPLINE};
+use cosserat::study::{centreline_name, recovered_name, run_study, Depth, StudyRow, StudySpec, SPLINE};
 
-use super::progress::Progress;
+use super::progress::{Progress, Visibility};
 
 /// `cosserat noise-study`.
 #[derive(clap::Args, Debug)]
@@ -42,11 +42,12 @@ pub fn cmd_noise_study(a: NoiseStudyArgs) -> Result<ExitCode> {
         std::fs::remove_dir_all(&a.out).with_context(|| format!("cannot remove {}", a.out.display()))?;
     }
     std::fs::create_dir_all(&a.out).with_context(|| format!("cannot create {}", a.out.display()))?;
-    let plan = spec.plan(a.quick);
+    let depth = if a.quick { Depth::Quick } else { Depth::Full };
+    let plan = spec.plan(depth);
     let total = spec.meshes.len() * plan.noise_m.len() * spec.variants.len();
-    let pb = Progress::new(&spec.title, "batches", total, a.quiet);
+    let pb = Progress::new(&spec.title, "batches", total, Visibility::unless(a.quiet));
     let rows =
-        run_study(&spec, &a.out, a.quick, |_| pb.inc()).with_context(|| format!("noise study {}", a.spec.display()))?;
+        run_study(&spec, &a.out, depth, |_| pb.inc()).with_context(|| format!("noise study {}", a.spec.display()))?;
     pb.finish();
     let svg = figure(&spec, &rows)?;
     write_atomic(&a.out.join("noise_study.svg"), svg.as_bytes())?;
@@ -155,20 +156,20 @@ fn figure(spec: &StudySpec, rows: &[StudyRow]) -> Result<String> {
         .collect();
     let mut panels = Vec::new();
     for mesh in &spec.meshes {
-        let panel = |what: &str, y_label: &str, log_y: bool| LinePlot {
+        let panel = |what: &str, y_label: &str, y_scale: Scale| LinePlot {
             title: match mesh.shape_noise_m > 0.0 {
                 true => format!("{} nodes, shape changes {} µm: {what}", mesh.nodes, mesh.shape_noise_m * 1e6),
                 false => format!("{} nodes: {what}", mesh.nodes),
             },
             x_label: "noise σ per coordinate [µm] (σ = 0: see the table)".into(),
             y_label: y_label.into(),
-            log_x: true,
-            log_y,
+            x_scale: Scale::Log,
+            y_scale,
             ..LinePlot::default()
         };
-        let mut median = panel("bending error, median frame", "relative L² error of |κ| [–]", true);
-        let mut worst = panel("bending error, worst frame", "relative L² error of |κ| [–]", true);
-        let mut frac = panel("frames reconstructed", "fraction of frames [–]", false);
+        let mut median = panel("bending error, median frame", "relative L² error of |κ| [–]", Scale::Log);
+        let mut worst = panel("bending error, worst frame", "relative L² error of |κ| [–]", Scale::Log);
+        let mut frac = panel("frames reconstructed", "fraction of frames [–]", Scale::Linear);
         for (name, label) in &shown {
             let pts: Vec<(f64, &Cell)> = cells
                 .iter()

@@ -105,6 +105,14 @@ pub fn disk_full_text(e: &(dyn std::error::Error + 'static), target: &Path, what
     )
 }
 
+/// What a missed published value or a clip's frames over the fit-quality gate do to the exit
+/// status of `run`: a warning (status 0), or, with `--strict`, an error (status 1).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Strictness {
+    Warn,
+    Fail,
+}
+
 /// How `cosserat run` ends, by the status of its folder: the summary on stdout, its published
 /// values on stderr, a warning or a missed published value (`--strict`: exit 1), the interrupt's exit status 130 with what was kept, or the error with
 /// what the folder holds.
@@ -113,12 +121,13 @@ pub fn run_end(
     (case, engine): (&Case, Engine),
     path: &Path,
     dir: &Path,
-    strict: bool,
+    strictness: Strictness,
 ) -> anyhow::Result<std::process::ExitCode> {
+    let strict = strictness == Strictness::Fail;
     match end.status {
         Status::Complete => {
             print!("{}", end.summary(&case.name, engine));
-            if published_values(&end, (case, engine), strict) > 0 && strict {
+            if published_values(&end, (case, engine), strictness) > 0 && strict {
                 return Ok(std::process::ExitCode::from(1));
             }
         }
@@ -179,7 +188,12 @@ pub fn run_end(
 
 /// The published values (`[[reference.values]]`) of a complete single run on stderr, one line
 /// each, and a line with the number missed; returns that number.
-fn published_values(end: &cosserat::jobs::job::JobEnd, (case, engine): (&Case, Engine), strict: bool) -> usize {
+fn published_values(
+    end: &cosserat::jobs::job::JobEnd,
+    (case, engine): (&Case, Engine),
+    strictness: Strictness,
+) -> usize {
+    let strict = strictness == Strictness::Fail;
     use cosserat::engine::{metrics::all_metrics, published::evaluate};
     let Some(r) = &end.single else { return 0 };
     let rows = match all_metrics(case, r) {

@@ -14,6 +14,31 @@ pub const INTERVAL_S: f64 = 10.0;
 /// Environment variable that sets another interval [s] (tests use a short one).
 pub const INTERVAL_VAR: &str = "COSSERAT_PROGRESS_INTERVAL_S";
 
+/// Whether a command shows its progress (`--quiet`: hidden).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Visibility {
+    Shown,
+    Hidden,
+}
+
+impl Visibility {
+    /// Hidden if `hidden` (`--quiet`, or progress shown another way), else shown.
+    pub fn unless(hidden: bool) -> Self {
+        if hidden {
+            Visibility::Hidden
+        } else {
+            Visibility::Shown
+        }
+    }
+}
+
+/// Which line [`State::line`] writes: one while the command runs, or its last.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Line {
+    Running,
+    Last,
+}
+
 /// The progress of one command.
 pub struct Progress {
     shown: Shown,
@@ -38,7 +63,8 @@ struct State {
 }
 
 impl State {
-    fn line(&self, last: bool) -> String {
+    fn line(&self, which: Line) -> String {
+        let last = which == Line::Last;
         let (done, total) = (self.done.load(Ordering::SeqCst), self.total.load(Ordering::SeqCst));
         let elapsed = self.start.elapsed().as_secs_f64();
         let (label, unit) = (&self.label, self.unit);
@@ -82,8 +108,8 @@ fn interval() -> Duration {
 impl Progress {
     /// Progress of `label` counted in `unit` ("frames", "points"); `total` 0 where it is not
     /// known (then only the time elapsed is shown).
-    pub fn new(label: &str, unit: &'static str, total: usize, quiet: bool) -> Progress {
-        if quiet {
+    pub fn new(label: &str, unit: &'static str, total: usize, visibility: Visibility) -> Progress {
+        if visibility == Visibility::Hidden {
             return Progress { shown: Shown::Hidden };
         }
         if std::io::stderr().is_terminal() {
@@ -123,7 +149,7 @@ impl Progress {
                 if *stopped {
                     return;
                 }
-                eprintln!("{}", s.line(false));
+                eprintln!("{}", s.line(Line::Running));
             }
         });
         Progress { shown: Shown::Lines { state, ticker: Some(ticker) } }
@@ -174,7 +200,7 @@ impl Progress {
                 if let Some(t) = ticker {
                     let _ = t.join();
                 }
-                eprintln!("{}", state.line(true));
+                eprintln!("{}", state.line(Line::Last));
             }
         }
     }
@@ -207,7 +233,7 @@ impl FreefemProgress {
                 Unit::PathSteps => "path steps",
             };
             let mut p = into.lock().unwrap_or_else(|e| e.into_inner());
-            p.get_or_insert_with(|| Progress::new(&label, unit, c.total, false)).set(c.done, c.total);
+            p.get_or_insert_with(|| Progress::new(&label, unit, c.total, Visibility::Shown)).set(c.done, c.total);
         })));
         FreefemProgress { shown }
     }
@@ -240,9 +266,13 @@ mod tests {
             stopped: Mutex::new(false),
             wake: Condvar::new(),
         };
-        let line = s.line(false);
+        let line = s.line(Line::Running);
         assert!(line.starts_with("clip: 30/120 frames (25%) after 10.0 s, 3.00 frames/s, ETA 30.0 s"), "{line}");
-        assert!(s.line(true).starts_with("clip: 30/120 frames in 10.0 s, 3.00 frames/s"), "{}", s.line(true));
+        assert!(
+            s.line(Line::Last).starts_with("clip: 30/120 frames in 10.0 s, 3.00 frames/s"),
+            "{}",
+            s.line(Line::Last)
+        );
         assert_eq!((significant(212.4), significant(0.04123)), ("212".into(), "0.0412".into()));
         assert_eq!((duration(185.0), duration(7500.0)), ("3 min 05 s".into(), "2 h 05 min".into()));
     }

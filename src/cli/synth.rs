@@ -211,7 +211,9 @@ fn write_staged<T, E>(
 where
     E: std::error::Error + Send + Sync + 'static,
 {
-    refuse_not_empty(&a.out, a.force)?;
+    if !a.force {
+        refuse_not_empty(&a.out)?;
+    }
     let mut manifest = Manifest::new("synth");
     for k in kymograms {
         manifest.input.inputs.push(input_file_as(k, "kymogram")?);
@@ -234,9 +236,9 @@ where
 }
 
 /// A corpus is written into a folder of its own: refuse one that holds anything, unless
-/// `force`.
-fn refuse_not_empty(out: &Path, force: bool) -> Result<()> {
-    if let (false, Some(names)) = (force, not_empty(out)) {
+/// `--force` (which the caller checks).
+fn refuse_not_empty(out: &Path) -> Result<()> {
+    if let Some(names) = not_empty(out) {
         anyhow::bail!(
             "synth: {} is not empty ({names}, …): a corpus is written into a folder of its own, and a batch runs every recording of it; choose a new --out, or pass --force to replace the folder whole",
             out.display()

@@ -192,6 +192,16 @@ pub struct FrameLength {
     pub corrected_m: f64,
 }
 
+/// The coordinates a recording's noise lies in: three (a 3D recording) or the two of its plane
+/// (a planar recording, `crate::clip::recording`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Noisy {
+    /// noise in all three coordinates
+    Spatial,
+    /// noise in the two coordinates of the recording's plane
+    Planar,
+}
+
 impl FrameLength {
     /// The lengths of the frame `x` (nodes in order, [m]).
     pub fn of(x: &[Vector3<f64>]) -> FrameLength {
@@ -205,18 +215,18 @@ impl FrameLength {
     pub fn of_in(x: &[Vector3<f64>], plane: Option<&Vector3<f64>>) -> FrameLength {
         match plane {
             None => FrameLength::of(x),
-            Some(n) => FrameLength::measured(x, noise_level_in(x, Some(n)), true),
+            Some(n) => FrameLength::measured(x, noise_level_in(x, Some(n)), Noisy::Planar),
         }
     }
 
     /// The lengths of the frame `x` with the noise level `noise_m` [m] per coordinate.
     pub fn with_noise(x: &[Vector3<f64>], noise_m: f64) -> FrameLength {
-        FrameLength::measured(x, noise_m, false)
+        FrameLength::measured(x, noise_m, Noisy::Spatial)
     }
 
     /// The lengths of the frame `x` with the noise level `noise_m` [m] per coordinate, in two
-    /// coordinates (`planar`) or three.
-    fn measured(x: &[Vector3<f64>], noise_m: f64, planar: bool) -> FrameLength {
+    /// or three coordinates (`noisy`).
+    fn measured(x: &[Vector3<f64>], noise_m: f64, noisy: Noisy) -> FrameLength {
         let polyline_m = polyline_length(x);
         let n = x.len().saturating_sub(1);
         let s = std::f64::consts::SQRT_2 * noise_m.max(0.0);
@@ -230,7 +240,7 @@ impl FrameLength {
             .map(|o| {
                 let m = (n - o) / k;
                 let nodes: Vec<Vector3<f64>> = (0..=m).map(|j| x[o + j * k]).collect();
-                curvature_corrected(&nodes, noise_m, planar) * n as f64 / (m * k) as f64
+                curvature_corrected(&nodes, noise_m, noisy) * n as f64 / (m * k) as f64
             })
             .collect();
         let corrected_m = estimates.iter().sum::<f64>() / estimates.len().max(1) as f64;
@@ -283,10 +293,11 @@ fn chord_step(x: &[Vector3<f64>], s: f64) -> usize {
 }
 
 /// Steps 2 and 3 of the module doc on the chords of `nodes` (the nodes kept) with noise
-/// `noise_m` [m] per coordinate, in three coordinates or two (`planar`,
+/// `noise_m` [m] per coordinate, in three coordinates or two (`noisy`,
 /// [`FrameLength::of_in`]):
 /// `Σ_j ℓ_j (θ̄_j/2)/sin(θ̄_j/2)` [m].
-fn curvature_corrected(nodes: &[Vector3<f64>], noise_m: f64, planar: bool) -> f64 {
+fn curvature_corrected(nodes: &[Vector3<f64>], noise_m: f64, noisy: Noisy) -> f64 {
+    let planar = noisy == Noisy::Planar;
     let s = std::f64::consts::SQRT_2 * noise_m;
     let chords: Vec<Vector3<f64>> = nodes.windows(2).map(|w| w[1] - w[0]).collect();
     let l: Vec<f64> = chords

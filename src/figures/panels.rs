@@ -63,18 +63,18 @@ pub(crate) fn draw_panels<DB: DrawingBackend>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::figures::plot::{Legend, Series};
+    use crate::figures::plot::{Legend, Scale, Series};
     use crate::figures::svg_text::{overlaps, texts};
 
-    fn panel(title: &str, log_x: bool, legend: Legend) -> LinePlot {
+    fn panel(title: &str, x_scale: Scale, legend: Legend) -> LinePlot {
         let x: Vec<f64> = (1..=60).map(f64::from).collect();
         LinePlot {
             title: title.into(),
             x_label: "iteration".into(),
             y_label: "relative change [–]".into(),
             series: vec![Series::new("a run", x.clone(), x.iter().map(|k| 1.0 / k).collect())],
-            log_x,
-            log_y: true,
+            x_scale,
+            y_scale: Scale::Log,
             legend,
             ..Default::default()
         }
@@ -85,7 +85,8 @@ mod tests {
     #[test]
     fn the_figure_title_runs_into_no_panel_title() {
         let title = "Fig. 5: the cantilever's tip, Cosserat rod against the modal solution of the linearised rod";
-        let panels = [panel("displacement", false, Legend::Right), panel("rotation", false, Legend::Right)];
+        let panels =
+            [panel("displacement", Scale::Linear, Legend::Right), panel("rotation", Scale::Linear, Legend::Right)];
         let svg = render_figure_svg(title, &panels, 2).unwrap();
         assert!(svg.contains(&format!("height=\"{}\"", PLOT_SIZE.1 + FIGURE_TITLE_STRIP)), "height");
         assert_eq!(overlaps(&svg), Vec::<(String, String)>::new());
@@ -103,7 +104,7 @@ mod tests {
             .map(|n| LinePlot {
                 title: n.to_string(),
                 y_label: format!("{n} [1/m]"),
-                ..panel("", false, Legend::Right)
+                ..panel("", Scale::Linear, Legend::Right)
             })
             .collect();
         let svg = render_panels_svg(&panels, 2).unwrap();
@@ -118,7 +119,7 @@ mod tests {
     /// Without a legend strip, the last tick label of the x axis stays inside the figure.
     #[test]
     fn the_last_x_tick_label_is_inside_the_figure() {
-        let svg = render_panels_svg(&[panel("no legend", true, Legend::Hidden)], 1).unwrap();
+        let svg = render_panels_svg(&[panel("no legend", Scale::Log, Legend::Hidden)], 1).unwrap();
         let last = texts(&svg).into_iter().find(|b| b.text == "100").expect("the tick 100");
         assert!(last.x.1 <= PLOT_SIZE.0 as f64, "the tick label ends at {} px", last.x.1);
     }

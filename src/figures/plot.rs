@@ -113,6 +113,21 @@ pub struct Band {
     pub label: String,
 }
 
+/// How an axis maps its values: linearly, or by their logarithm (only positive values drawn).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Scale {
+    #[default]
+    Linear,
+    Log,
+}
+
+impl Scale {
+    /// Is this a logarithmic axis?
+    pub fn is_log(self) -> bool {
+        self == Scale::Log
+    }
+}
+
 /// A 2-D line chart. Non-finite points (and non-positive values on a log
 /// axis) are skipped; lines break at skipped points.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -125,10 +140,11 @@ pub struct LinePlot {
     pub y_label: String,
     /// Curves, drawn in order with distinct colours (markers first, under the lines).
     pub series: Vec<Series>,
-    /// Logarithmic x axis.
-    pub log_x: bool,
-    /// Logarithmic y axis (padded to whole decades, so that it always has labelled ticks).
-    pub log_y: bool,
+    /// The x axis's scale.
+    pub x_scale: Scale,
+    /// The y axis's scale (a log axis is padded to whole decades, so that it always has
+    /// labelled ticks).
+    pub y_scale: Scale,
     /// Whether the legend strip is drawn.
     pub legend: Legend,
     /// Shaded x intervals.
@@ -175,14 +191,14 @@ pub(crate) fn draw_err(title: &str, e: impl std::fmt::Display) -> PlotError {
     PlotError::Draw { title: title.to_string(), detail: e.to_string() }
 }
 
-fn keep(v: f64, log: bool) -> bool {
-    v.is_finite() && (!log || v > 0.0)
+fn keep(v: f64, scale: Scale) -> bool {
+    v.is_finite() && (scale == Scale::Linear || v > 0.0)
 }
 
 /// Whether the point (x, y) of `plot` is drawn: finite, positive on a log axis, y inside the
 /// plot's window.
 fn kept(plot: &LinePlot, x: f64, y: f64) -> bool {
-    keep(x, plot.log_x) && keep(y, plot.log_y) && plot.y_window.is_none_or(|(lo, hi)| lo <= y && y <= hi)
+    keep(x, plot.x_scale) && keep(y, plot.y_scale) && plot.y_window.is_none_or(|(lo, hi)| lo <= y && y <= hi)
 }
 
 /// Validates `plot` and returns the padded (x, y) ranges.
@@ -210,15 +226,19 @@ pub(crate) fn ranges(plot: &LinePlot) -> Result<(Range<f64>, Range<f64>), PlotEr
         }
     }
     if x0 > x1 {
-        return Err(PlotError::NoPlottablePoints { title: plot.title.clone(), log_x: plot.log_x, log_y: plot.log_y });
+        return Err(PlotError::NoPlottablePoints {
+            title: plot.title.clone(),
+            log_x: plot.x_scale.is_log(),
+            log_y: plot.y_scale.is_log(),
+        });
     }
-    Ok((pad(x0, x1, plot.log_x), pad(y0, y1, plot.log_y)))
+    Ok((pad(x0, x1, plot.x_scale), pad(y0, y1, plot.y_scale)))
 }
 
 /// Adds a margin; a log axis is widened to whole decades (at least one), so that it has
 /// labelled ticks; a zero-width linear range is widened.
-fn pad(lo: f64, hi: f64, log: bool) -> Range<f64> {
-    if log {
+fn pad(lo: f64, hi: f64, scale: Scale) -> Range<f64> {
+    if scale == Scale::Log {
         let a = (lo.log10() + 1e-9).floor();
         let b = (hi.log10() - 1e-9).ceil().max(a + 1.0);
         // a hair beyond the decades, so that round-off keeps both end ticks inside
@@ -408,21 +428,21 @@ fn plottable_runs(plot: &LinePlot, s: &Series, (ax, ay): (Axis, Axis)) -> Vec<Ve
 struct Axis {
     factor: f64,
     span: f64,
-    log: bool,
+    scale: Scale,
 }
 
 impl Axis {
     /// The axis of `range` (padded) and its drawn range.
-    fn new(range: Range<f64>, log: bool) -> (Self, Range<f64>) {
-        let factor = if log { 1.0 / range.start } else { 1.0 };
-        let axis = Axis { factor, span: range.end - range.start, log };
+    fn new(range: Range<f64>, scale: Scale) -> (Self, Range<f64>) {
+        let factor = if scale == Scale::Log { 1.0 / range.start } else { 1.0 };
+        let axis = Axis { factor, span: range.end - range.start, scale };
         (axis, range.start * factor..range.end * factor)
     }
     fn to(self, v: f64) -> f64 {
         v * self.factor
     }
     fn label(self, v: f64) -> String {
-        if self.log {
+        if self.scale == Scale::Log {
             format_tick(v / self.factor)
         } else {
             axis_tick(v, self.span)
@@ -432,12 +452,13 @@ impl Axis {
 
 pub(crate) fn draw_plot<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, plot: &LinePlot) -> Result<(), PlotError> {
     let (xr, yr) = ranges(plot)?;
-    let ((ax, xr), (ay, yr)) = (Axis::new(xr, plot.log_x), Axis::new(yr, plot.log_y));
-    match (plot.log_x, plot.log_y) {
-        (false, false) => draw_with(area, plot, xr, yr, (ax, ay)),
-        (true, false) => draw_with(area, plot, xr.log_scale(), yr, (ax, ay)),
-        (false, true) => draw_with(area, plot, xr, yr.log_scale(), (ax, ay)),
-        (true, true) => draw_with(area, plot, xr.log_scale(), yr.log_scale(), (ax, ay)),
+    let ((ax, xr), (ay, yr)) = (Axis::new(xr, plot.x_scale), Axis::new(yr, plot.y_scale));
+    use Scale::{Linear, Log};
+    match (plot.x_scale, plot.y_scale) {
+        (Linear, Linear) => draw_with(area, plot, xr, yr, (ax, ay)),
+        (Log, Linear) => draw_with(area, plot, xr.log_scale(), yr, (ax, ay)),
+        (Linear, Log) => draw_with(area, plot, xr, yr.log_scale(), (ax, ay)),
+        (Log, Log) => draw_with(area, plot, xr.log_scale(), yr.log_scale(), (ax, ay)),
     }
 }
 
@@ -506,11 +527,11 @@ mod tests {
     #[test]
     fn log_axes() {
         let mut p = plot(vec![series("err", |x| 10f64.powf(-x)), series("with zero", |x| x)]);
-        p.log_y = true;
-        p.log_x = true; // x = 0 is dropped
+        p.y_scale = Scale::Log;
+        p.x_scale = Scale::Log; // x = 0 is dropped
         let svg = render_svg(&p).unwrap();
         assert!(svg.contains("err") && svg.contains("with zero"));
-        let all_negative = LinePlot { log_y: true, ..plot(vec![series("neg", |x| -1.0 - x)]) };
+        let all_negative = LinePlot { y_scale: Scale::Log, ..plot(vec![series("neg", |x| -1.0 - x)]) };
         assert!(matches!(render_svg(&all_negative), Err(PlotError::NoPlottablePoints { log_y: true, .. })));
     }
 
@@ -536,7 +557,11 @@ mod tests {
         p.y_window = Some((-1.0, 1.0));
         let (_, y) = ranges(&p).unwrap();
         assert!(y.end <= 1.0 + 2.0 * RANGE_MARGIN && y.start >= -1.0 - 2.0 * RANGE_MARGIN, "{y:?}");
-        let runs = plottable_runs(&p, &p.series[0], (Axis::new(0.0..1.0, false).0, Axis::new(0.0..1.0, false).0));
+        let runs = plottable_runs(
+            &p,
+            &p.series[0],
+            (Axis::new(0.0..1.0, Scale::Linear).0, Axis::new(0.0..1.0, Scale::Linear).0),
+        );
         assert_eq!(runs.iter().map(Vec::len).collect::<Vec<_>>(), [3, 46], "broken at the spike");
     }
 
@@ -559,7 +584,7 @@ mod tests {
         let svg = render_svg(&plot(vec![series("a", |x| x - 2.0)])).unwrap();
         assert!(smallest_text(&svg) >= 12.0, "{}", smallest_text(&svg));
         // a log axis far below 1e-15 still has its decades labelled
-        let tiny = LinePlot { log_y: true, ..plot(vec![series("tiny", |x| 1e-22 * (1.0 + x))]) };
+        let tiny = LinePlot { y_scale: Scale::Log, ..plot(vec![series("tiny", |x| 1e-22 * (1.0 + x))]) };
         let svg = render_svg(&tiny).unwrap();
         assert!(svg.contains("\n1e-22\n") && svg.contains("\n1e-21\n"), "decades missing");
     }

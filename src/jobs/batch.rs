@@ -340,7 +340,7 @@ pub fn run_recording(case: &Case, case_file: &InputFile, entry: &PlanEntry, out:
         Ok(c) => c,
         Err(e) => return failed(chain(&e)),
     };
-    let (mut folder, resume) = match begin_recording(&dir, manifest, opts.force) {
+    let (mut folder, resume) = match begin_recording(&dir, manifest, opts) {
         Ok(f) => f,
         Err(e) => return failed(chain(&e)),
     };
@@ -383,6 +383,14 @@ pub fn run_recording(case: &Case, case_file: &InputFile, entry: &PlanEntry, out:
 /// What continues a recording's run kept beside its folder.
 const NEXT_BATCH: &str = "(the next batch of this case continues it; `--force` lets a batch replace a complete run)";
 
+/// How [`run_batch`] runs a plan: on `jobs` threads (`--jobs`; 0: one per core; at most the
+/// recordings and [`super::MAX_JOBS`]), each recording with `force` ([`RecordingOptions`]).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct BatchOptions {
+    pub jobs: usize,
+    pub force: bool,
+}
+
 /// How [`run_recording`] runs a recording.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct RecordingOptions {
@@ -395,17 +403,16 @@ pub struct RecordingOptions {
 
 /// Claim the folder `dir` of a recording: continuing the run of the same case and recording
 /// kept beside it (killed, stopped by a full disk, or stopped beside a complete run), if there
-/// is one (`true`), else fresh.
-fn begin_recording(dir: &Path, manifest: Manifest, force: bool) -> Result<(RunFolder, bool), FolderError> {
-    // --force: a fresh run, which replaces the folder whatever its end
-    if !force && resumable_beside(dir, &manifest) {
+/// is one (`true`), else fresh; `opts.force` (`--force`): always fresh.
+fn begin_recording(dir: &Path, manifest: Manifest, opts: RecordingOptions) -> Result<(RunFolder, bool), FolderError> {
+    if !opts.force && resumable_beside(dir, &manifest) {
         match RunFolder::begin(dir, manifest.clone(), Mode::Resume) {
             Ok(f) => return Ok((f, true)),
             Err(FolderError::CannotResume { .. }) => {}
             Err(e) => return Err(e),
         }
     }
-    Ok((RunFolder::begin(dir, manifest, Mode::Fresh { force })?, false))
+    Ok((RunFolder::begin(dir, manifest, Mode::Fresh { force: opts.force })?, false))
 }
 
 /// A recording's run stopped by a full disk: its folder `dir` is left as it was; its converged
@@ -487,27 +494,27 @@ pub fn unfinished_tasks(plan: &Plan, complete: &[bool]) -> Vec<usize> {
     (0..plan.tasks()).filter(|&t| complete.chunks(plan.per_task).nth(t).is_some_and(|c| c.iter().any(|d| !d))).collect()
 }
 
-/// Run every recording of the plan in `out` on `jobs` threads (0: one per core; never more than
-/// the recordings, nor [`super::MAX_JOBS`]), then write
+/// Run every recording of the plan in `out` as `opts` says ([`BatchOptions`]), then write
 /// `summary.csv`; `tick` after each recording that ran to its end (not after one a stop request
 /// stopped or kept from starting). Rows in the plan's order.
-pub fn run_batch(
-    plan: &Plan,
-    out: &Path,
-    (jobs, force): (usize, bool),
-    tick: impl Fn() + Sync,
-) -> Result<Vec<Ran>, BatchError> {
+pub fn run_batch(plan: &Plan, out: &Path, opts: BatchOptions, tick: impl Fn() + Sync) -> Result<Vec<Ran>, BatchError> {
     use rayon::prelude::*;
     let (case, case_file) = plan_case(plan)?;
     let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(super::threads_for(jobs, plan.recordings.len()))
+        .num_threads(super::threads_for(opts.jobs, plan.recordings.len()))
         .build()
         .map_err(|e| BatchError::Pool(e.to_string()))?;
     let ran: Vec<Ran> = pool.install(|| {
         plan.recordings
             .par_iter()
             .map(|entry| {
-                let r = run_recording(&case, &case_file, entry, out, RecordingOptions { format: plan.format, force });
+                let r = run_recording(
+                    &case,
+                    &case_file,
+                    entry,
+                    out,
+                    RecordingOptions { format: plan.format, force: opts.force },
+                );
                 // a recording stopped (or never started) by a stop request is not done
                 if r.row.status != Some(crate::solve::Outcome::Interrupted) {
                     tick();

@@ -10,7 +10,7 @@ use crate::engine::clip::{ClipFrame, ClipOutcome, ClipRun, FrameSink};
 use crate::engine::{run_clip_into, ClipInput, EngineError};
 use crate::io::compact::OutputFormat;
 use crate::io::files::{JournalError, OutputError};
-use crate::output::clip_output::ClipWriter;
+use crate::output::clip_output::{ClipWriter, WriterOptions};
 use crate::output::journal::{journal_records, scan_journal, JournalScan};
 
 /// Solve the clip of a clip case frame by frame in the Rust engine, streaming every converged
@@ -59,17 +59,17 @@ pub fn run_clip_to(
     progress: impl FnMut(usize, usize),
 ) -> Result<ClipOutcome, EngineError> {
     let input = ClipInput::of(case)?;
-    let has_truth = input.has_truth();
+    let writer = WriterOptions { truth: input.has_truth(), journal: opts.journal, format: opts.format };
     let (scan, sink) = if opts.resume {
         // a run killed before its first frame has no journal yet: it resumes from the start
         let scan = match scan_journal(dir) {
             Err(JournalError::Missing { .. }) => JournalScan::default(),
             read => read?,
         };
-        let sink = ClipWriter::resume(dir, has_truth, &scan, opts.format)?;
+        let sink = ClipWriter::resume(dir, &scan, writer)?;
         (scan, sink)
     } else {
-        (JournalScan::default(), ClipWriter::create(dir, has_truth, opts.journal, opts.format)?)
+        (JournalScan::default(), ClipWriter::create(dir, writer)?)
     };
     // the records of the resumed frames, read again one at a time while they are summarised
     let mut records: Box<dyn Iterator<Item = _>> = match scan.frames.len() {

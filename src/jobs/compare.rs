@@ -28,7 +28,7 @@ use crate::engine::clip::solve_frames;
 use crate::engine::frames::{SolvedFrame, SolvedFrames};
 use crate::engine::input::clip_files::load_clip;
 use crate::engine::input::data::write_data;
-use crate::engine::metrics::{all_metrics, differences, ComparisonRow, Difference, Group};
+use crate::engine::metrics::{all_metrics, differences, ComparisonRow, Difference, Group, Iterations};
 use crate::engine::{load_data, EngineError};
 use crate::engine::{run_forward, run_inverse, NodalState, RunError, RunResult};
 use crate::engine::{run_freefem, run_freefem_clip, run_freefem_inverse, FreeFemFrames, RunOptions};
@@ -181,11 +181,11 @@ pub fn stop_tolerance(case: &Case) -> f64 {
 
 /// Whether the rows include the iteration count (the same algorithm and rule in both engines,
 /// not compared at an equal count by construction).
-fn counts_compared(case: &Case) -> bool {
+fn counts_compared(case: &Case) -> Iterations {
     match &case.analysis {
-        Analysis::Static(p) => matches!(p.method, Method::FixedPoint { .. }),
-        Analysis::Dynamic(_) => false,
-        Analysis::Inverse(inv) => matches!(inv.params.method, InverseMethod::Newton { .. }),
+        Analysis::Static(p) if matches!(p.method, Method::FixedPoint { .. }) => Iterations::Compared,
+        Analysis::Inverse(inv) if matches!(inv.params.method, InverseMethod::Newton { .. }) => Iterations::Compared,
+        Analysis::Static(_) | Analysis::Dynamic(_) | Analysis::Inverse(_) => Iterations::Ignored,
     }
 }
 
@@ -382,7 +382,9 @@ fn compare_clip(case: &Case, dir: &Path, opts: &CompareOptions) -> Result<Compar
     let runs = solve_clip_both(case, ClipData { positions: &clip.frames[..n], tracked }, dir)?;
     let tau = stop_tolerance(case);
     let fixed_point = is_fixed_point_inverse(case);
-    let per_frame = compare_frames(case, tau, !fixed_point, &runs);
+    // a fixed point's frames run the same count in both engines by construction
+    let counts = if fixed_point { Iterations::Ignored } else { Iterations::Compared };
+    let per_frame = compare_frames(case, tau, counts, &runs);
     let mut out = per_frame.worst;
     out.push(frames_solved_row(n, &runs));
     out.push(ComparisonRow {
@@ -447,8 +449,8 @@ struct FrameComparison {
     times: Vec<FrameTime>,
 }
 
-/// Compare the frames of `runs` (`counts`: iteration counts are compared too).
-fn compare_frames(case: &Case, tau: f64, counts: bool, runs: &ClipRuns) -> FrameComparison {
+/// Compare the frames of `runs` (their iteration counts as `counts` says).
+fn compare_frames(case: &Case, tau: f64, counts: Iterations, runs: &ClipRuns) -> FrameComparison {
     let mut worst: Vec<(ComparisonRow, usize, f64)> = Vec::new();
     let mut restarts = 0.0;
     let mut times = Vec::new();

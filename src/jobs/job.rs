@@ -14,7 +14,9 @@ use crate::engine::clip::{ClipFrame, ClipRun};
 use crate::engine::{Engine, RunResult};
 use crate::io::compact::OutputFormat;
 use crate::jobs::clip_run::ClipOptions;
-use crate::output::run_folder::{input_file_as, FolderError, InputFile, Manifest, Mode, Placed, RunFolder, Status};
+use crate::output::run_folder::{
+    input_file_as, Beside, FolderError, InputFile, Manifest, Mode, Placed, RunFolder, Status,
+};
 
 /// How a run ended.
 #[derive(Debug)]
@@ -219,8 +221,8 @@ pub fn run_into_observed(
         return Ok(stopped_by_full_disk(folder, end, out));
     }
     // a clip keeps its converged frames for --resume; a single run's run.json alone is nothing
-    let keep = end.frames.is_some_and(|(n, _)| n > 0);
-    match folder.finish_keeping(end.status, end.message.clone(), keep)? {
+    let beside = if end.frames.is_some_and(|(n, _)| n > 0) { Beside::Kept } else { Beside::Removed };
+    match folder.finish_keeping(end.status, end.message.clone(), beside)? {
         Placed::InPlace(target) => {
             // the manifest lists every file but itself
             end.files = Manifest::read(&target)?.map(|m| m.files.len() + 1).unwrap_or(0);

@@ -9,6 +9,7 @@ pub mod batch_task;
 pub mod clip_run;
 pub mod compare;
 pub mod compare_published;
+pub mod depth;
 pub mod job;
 pub mod slurm;
 pub mod solved;

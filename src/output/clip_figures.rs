@@ -7,7 +7,7 @@ use crate::engine::clip::{ClipRun, KymographColumn};
 use crate::figures::decimate::{min_max, MAX_LINE_POINTS};
 use crate::figures::heatmap::{render_marked_heatmaps_svg, ColourScale, ColumnMarks, Heatmap};
 use crate::figures::panels::render_panels_svg;
-use crate::figures::plot::{LinePlot, Series};
+use crate::figures::plot::{LinePlot, Scale, Series};
 use crate::io::files::{write_plot, OutputError};
 use crate::solve::sequence::FrameReport;
 
@@ -25,8 +25,8 @@ impl FrameAxis {
         let (x, y) = min_max(&self.0, &y, MAX_LINE_POINTS);
         Series::new(label, x, y)
     }
-    fn plot(title: String, y_label: &str, series: Vec<Series>, log_y: bool) -> LinePlot {
-        LinePlot { title, x_label: "t [s]".into(), y_label: y_label.into(), series, log_y, ..Default::default() }
+    fn plot(title: String, y_label: &str, series: Vec<Series>, y_scale: Scale) -> LinePlot {
+        LinePlot { title, x_label: "t [s]".into(), y_label: y_label.into(), series, y_scale, ..Default::default() }
     }
 }
 
@@ -98,7 +98,7 @@ pub fn write_truth_plot(case: &Case, run: &ClipRun, path: &Path) -> Result<(), O
                 s("bending k1^2+k2^2, rel. L2", c.iter().map(|v| v.bending_rel_l2).collect()),
                 s("max angle(d3, true d3) [rad]", c.iter().map(|v| v.max_tangent_angle_rad).collect()),
             ],
-            true,
+            Scale::Log,
         ),
         plot(
             "roll of the frame about d3".into(),
@@ -107,7 +107,7 @@ pub fn write_truth_plot(case: &Case, run: &ClipRun, path: &Path) -> Result<(), O
                 s("true roll psi of the bending plane", t.roll_rad.clone()),
                 s("recovered d1 vs true d1 (offset)", c.iter().map(|v| v.roll_offset_rad).collect()),
             ],
-            false,
+            Scale::Linear,
         ),
         plot(
             "twist κ3".into(),
@@ -117,13 +117,13 @@ pub fn write_truth_plot(case: &Case, run: &ClipRun, path: &Path) -> Result<(), O
                 s("recovered (mean over inner nodes)", c.iter().map(|v| v.twist_mean_per_m * 1e-3).collect()),
                 s("rms error", c.iter().map(|v| v.twist_rms_error_per_m * 1e-3).collect()),
             ],
-            false,
+            Scale::Linear,
         ),
         plot(
             "angle chart: min |cos beta| over the nodes".into(),
             "|cos beta|",
             vec![s("rebased chart", run.reports.iter().map(|r| r.conditioning.min_cos_beta).collect())],
-            false,
+            Scale::Linear,
         ),
     ];
     let lines = path.with_file_name("truth_errors.svg");
@@ -172,7 +172,7 @@ pub fn write_clip_plot(
             format!("{}: iterations per frame", case.name),
             "iterations",
             vec![s("iterations", reports.iter().map(|r| r.convergence.iterations as f64).collect())],
-            false,
+            Scale::Linear,
         ),
         plot(
             "fit per frame".into(),
@@ -182,13 +182,13 @@ pub fn write_clip_plot(
                 s("|x' - d3| [m^1/2]", reports.iter().map(|r| r.misfit.tangent_misfit).collect()),
                 s("last relative change", reports.iter().map(|r| r.convergence.last_change).collect()),
             ],
-            true,
+            Scale::Log,
         ),
         plot(
             "angle chart: min |cos beta| over the nodes".into(),
             "|cos beta|",
             vec![s("min |cos beta|", reports.iter().map(|r| r.conditioning.min_cos_beta).collect())],
-            false,
+            Scale::Linear,
         ),
         plot(
             "objective (41)".into(),
@@ -197,7 +197,7 @@ pub fn write_clip_plot(
                 s("tracking", reports.iter().map(|r| r.misfit.objective.tracking).collect()),
                 s("total", reports.iter().map(|r| r.misfit.objective.total()).collect()),
             ],
-            true,
+            Scale::Log,
         ),
         plot(
             "roughness of the curvature (sign alternation of its differences)".into(),
@@ -206,7 +206,7 @@ pub fn write_clip_plot(
                 s("recovered κ2", roughness.iter().map(|r| r.0).collect()),
                 s("data", roughness.iter().map(|r| r.1).collect()),
             ],
-            false,
+            Scale::Linear,
         ),
     ];
     write_plot(path, render_panels_svg(&panels, 2))

@@ -130,10 +130,22 @@ pub const CLIP_FIELD_COLUMNS: [&str; 30] = [
     "omega3_rad_per_s",
 ];
 
+/// What a [`ClipWriter`] writes besides a clip's own files, and in which format.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct WriterOptions {
+    /// `truth.csv` too (a clip with a ground truth)
+    pub truth: bool,
+    /// the resume journal too (`super::journal`)
+    pub journal: bool,
+    /// how the per-node fields are written (`crate::io::compact`)
+    pub format: OutputFormat,
+}
+
 impl ClipWriter {
-    /// Create the streamed files of `format` in `dir` (headers written); `truth`: also
-    /// `truth.csv`; `journal`: also the resume journal (`super::journal`).
-    pub fn create(dir: &Path, truth: bool, journal: bool, format: OutputFormat) -> Result<Self, OutputError> {
+    /// Create the streamed files of `opts.format` in `dir` (headers written), and `truth.csv`
+    /// and the resume journal as `opts` says.
+    pub fn create(dir: &Path, opts: WriterOptions) -> Result<Self, OutputError> {
+        let WriterOptions { truth, journal, format } = opts;
         let err = |path: PathBuf| move |source| OutputError::Io { path: path.clone(), source };
         let compact = format == OutputFormat::Compact;
         // the folder itself too: a sweep's or an audit's point has none before its first file
@@ -163,10 +175,11 @@ impl ClipWriter {
 
     /// Reopen the streamed files of an earlier run in `dir` after the frames of `scan` (its
     /// journal's complete lines): every CSV cut back to its length after the last of them, the
-    /// VTK files of later frames removed, the journal continued. `format` must be the earlier
-    /// run's.
-    pub fn resume(dir: &Path, truth: bool, scan: &JournalScan, format: OutputFormat) -> Result<Self, OutputError> {
-        let Some(o) = scan.last else { return Self::create(dir, truth, true, format) };
+    /// VTK files of later frames removed, the journal continued (whatever `opts.journal`
+    /// says). `opts.format` must be the earlier run's.
+    pub fn resume(dir: &Path, scan: &JournalScan, opts: WriterOptions) -> Result<Self, OutputError> {
+        let Some(o) = scan.last else { return Self::create(dir, WriterOptions { journal: true, ..opts }) };
+        let WriterOptions { truth, format, .. } = opts;
         let [fields, curvature] = row_files(format);
         if !dir.join(fields).is_file() {
             return Err(OutputError::Invalid {
@@ -260,7 +273,7 @@ impl ClipWriter {
         let d = nodes.directors();
         let [fields, curvature] = row_files(self.format());
         // each file's rows of the frame are built in one buffer and written at once
-        let compact = self.compact.is_some();
+        let format = self.format();
         let mut block = Vec::with_capacity(nodes.s.len() * 28 * 18);
         let mut v = Vec::with_capacity(28);
         for i in 0..nodes.s.len() {
@@ -275,12 +288,12 @@ impl ClipWriter {
             v.extend(torque[i].iter());
             v.extend(data[i].iter());
             v.extend(omega[i].iter());
-            push_row(&mut block, compact, &[r.frame, i], &v);
+            push_row(&mut block, format, &[r.frame, i], &v);
         }
         self.fields.write_all(&block).and_then(|_| self.fields.flush()).map_err(err(fields))?;
         block.clear();
         for row in elements.kappa.iter().zip(&elements.resultants).map(element_row) {
-            push_row(&mut block, compact, &[r.frame], &row);
+            push_row(&mut block, format, &[r.frame], &row);
         }
         self.curvature.write_all(&block).and_then(|_| self.curvature.flush()).map_err(err(curvature))?;
         if let Some(frames) = &mut self.compact {
@@ -392,11 +405,11 @@ pub fn remove_raw(dir: &Path) -> Result<(), OutputError> {
     Ok(())
 }
 
-/// Append one row of a per-node or per-element file to `out`: raw little-endian `values` in
-/// the compact format, else the CSV line `index,…,value,…` (values `{:.10e}`,
+/// Append one row of a per-node or per-element file of `format` to `out`: raw little-endian
+/// `values` in the compact format, else the CSV line `index,…,value,…` (values `{:.10e}`,
 /// [`crate::io::number::push_exp`]).
-fn push_row(out: &mut Vec<u8>, compact: bool, index: &[usize], values: &[f64]) {
-    if compact {
+fn push_row(out: &mut Vec<u8>, format: OutputFormat, index: &[usize], values: &[f64]) {
+    if format == OutputFormat::Compact {
         out.extend(values.iter().flat_map(|x| x.to_le_bytes()));
         return;
     }

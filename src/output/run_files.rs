@@ -6,7 +6,7 @@ use crate::case::Case;
 use crate::engine::metrics::Metrics;
 use crate::engine::{InverseOutput, RunResult};
 use crate::figures::panels::render_panels_svg;
-use crate::figures::plot::{LinePlot, Mark, Series};
+use crate::figures::plot::{LinePlot, Mark, Scale, Series};
 use crate::io::compact::CURVATURE_COLUMNS;
 use crate::io::files::{csv_text, csv_text_int, write_atomic, write_plot, OutputError};
 use crate::model::resultants::Resultants;
@@ -285,13 +285,13 @@ fn inverse_panels(case: &Case, r: &RunResult, inv: &InverseOutput) -> Vec<LinePl
     // the data as markers under the inverse solution (solid), in the same colour
     let data =
         |label: String, x: Vec<f64>, y: Vec<f64>, c: usize| series(label, x, y).marked(Mark::Markers).coloured(c);
-    let plot = |title: String, xl: &str, yl: &str, s: Vec<Series>, log: bool| LinePlot {
+    let plot = |title: String, xl: &str, yl: &str, s: Vec<Series>, scale: Scale| LinePlot {
         title,
         x_label: xl.into(),
         y_label: yl.into(),
         series: s,
-        log_x: log,
-        log_y: log,
+        x_scale: scale,
+        y_scale: scale,
         ..Default::default()
     };
     // one length unit per figure: mm for a rod shorter than 10 cm (the worm's scale), else m
@@ -337,24 +337,24 @@ fn inverse_panels(case: &Case, r: &RunResult, inv: &InverseOutput) -> Vec<LinePl
             &s_label,
             &format!("position [{unit}]"),
             pos,
-            false,
+            Scale::Linear,
         ),
-        plot("curvature (eq. 28), data vs inverse".into(), &s_label, &format!("κ [1/{unit}]"), curv, false),
+        plot("curvature (eq. 28), data vs inverse".into(), &s_label, &format!("κ [1/{unit}]"), curv, Scale::Linear),
         plot(
             "recovered force f = x̂/λf (eq. 54), global frame".into(),
             &s_label,
             &format!("f [N/{unit}]"),
             ctrl(&f, "f", 1.0 / to),
-            false,
+            Scale::Linear,
         ),
         plot(
             "recovered torque l = α̂/λl (eq. 54), global frame".into(),
             &s_label,
             &format!("l [N {unit}/{unit}]"),
             ctrl(&l, "l", 1.0),
-            false,
+            Scale::Linear,
         ),
-        plot("convergence history".into(), "iteration", "change, error [–]; ‖x' − d3‖ [m^½]", hist, true),
+        plot("convergence history".into(), "iteration", "change, error [–]; ‖x' − d3‖ [m^½]", hist, Scale::Log),
     ]
 }
 
@@ -367,8 +367,8 @@ pub fn write_convergence_plot(runs: &[(&String, &RunResult)], path: &Path) -> Re
         x_label: "iteration".into(),
         y_label: yl.into(),
         series,
-        log_x: true,
-        log_y: true,
+        x_scale: Scale::Log,
+        y_scale: Scale::Log,
         ..Default::default()
     };
     let mut xerr = Vec::new();

@@ -179,21 +179,21 @@ impl RunFolder {
     /// (and not `--force`), that folder left as it was and this run's kept beside it
     /// ([`Placed::Beside`]), where `--resume` finds it.
     pub fn finish(self, status: Status, message: Option<String>) -> Result<Placed, FolderError> {
-        self.finish_keeping(status, message, true)
+        self.finish_keeping(status, message, Beside::Kept)
     }
 
-    /// [`RunFolder::finish`]; `keep`: whether a run that is not put in place (it would have
+    /// [`RunFolder::finish`]; `beside`: whether a run that is not put in place (it would have
     /// replaced a complete run) is kept beside it, or removed (it holds nothing to continue:
     /// a single run's `run.json` alone).
     pub fn finish_keeping(
         mut self,
         status: Status,
         message: Option<String>,
-        keep: bool,
+        beside: Beside,
     ) -> Result<Placed, FolderError> {
         let previous = Manifest::read(&self.target).ok().flatten().map(|m| m.status);
         if !status.is_complete() && !self.force && previous.is_some_and(Status::is_complete) {
-            if !keep {
+            if beside == Beside::Removed {
                 std::fs::remove_dir_all(&self.staging).map_err(io_err(&self.staging))?;
                 return Ok(Placed::Beside { target: self.target.clone(), kept: None });
             }
@@ -204,6 +204,16 @@ impl RunFolder {
         put_in_place(&self.staging, &self.target)?;
         Ok(Placed::InPlace(self.target.clone()))
     }
+}
+
+/// What [`RunFolder::finish_keeping`] does with a run that is not put in place because the
+/// output folder holds a complete one: keeps it beside that folder, or removes it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Beside {
+    /// kept in its staging folder, where `--resume` (or the next batch) continues it
+    Kept,
+    /// removed: it holds nothing to continue
+    Removed,
 }
 
 /// Where [`RunFolder::finish`] left a run.

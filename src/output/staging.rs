@@ -117,20 +117,21 @@ pub(super) fn remove_temporaries(dir: &Path) -> Result<(), FolderError> {
 /// Copy the folder `from` into the new folder `to` (files and subfolders; `run.json` at the
 /// top excepted: the run writes its own).
 pub(super) fn copy_run(from: &Path, to: &Path) -> Result<(), FolderError> {
-    fn copy(from: &Path, to: &Path, top: bool) -> Result<(), FolderError> {
+    // `skipped`: the name of a file not copied (the top folder's `run.json`)
+    fn copy(from: &Path, to: &Path, skipped: Option<&str>) -> Result<(), FolderError> {
         std::fs::create_dir(to).map_err(io_err(to))?;
         for entry in std::fs::read_dir(from).map_err(io_err(from))? {
             let entry = entry.map_err(io_err(from))?;
             let (src, dst) = (entry.path(), to.join(entry.file_name()));
             if entry.file_type().map_err(io_err(&src))?.is_dir() {
-                copy(&src, &dst, false)?;
-            } else if !(top && entry.file_name() == MANIFEST) {
+                copy(&src, &dst, None)?;
+            } else if skipped.is_none_or(|s| entry.file_name() != s) {
                 std::fs::copy(&src, &dst).map_err(io_err(&dst))?;
             }
         }
         Ok(())
     }
-    copy(from, to, true).inspect_err(|_| {
+    copy(from, to, Some(MANIFEST)).inspect_err(|_| {
         let _ = std::fs::remove_dir_all(to);
     })
 }

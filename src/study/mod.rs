@@ -12,6 +12,7 @@
 pub mod score;
 mod spec;
 
+pub use crate::jobs::depth::Depth;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -22,7 +23,7 @@ use crate::engine::input::corpus::{recording_path, write_corpus, CorpusParams};
 use crate::engine::input::tracker::{write_tracker_corpus, Losses, TrackerParams};
 use crate::engine::input::truth_file::{read_truth, truth_sidecar};
 use crate::io::{write_atomic, InputError, OutputError};
-use crate::jobs::batch::{run_batch, Plan};
+use crate::jobs::batch::{run_batch, BatchOptions, Plan};
 use score::{
     bending_error, centreline_bending, median_and_worst, read_curvature, read_positions, recovered_nodal,
     spline_bending, truth_bending, truth_bending_nodal, ScoreError,
@@ -79,8 +80,8 @@ pub struct StudyRow {
 }
 
 /// Run the study of `spec` (read from `spec_path`) into `out`, calling `tick` after each batch.
-pub fn run_study(spec: &StudySpec, out: &Path, quick: bool, tick: impl Fn(&str)) -> Result<Vec<StudyRow>, StudyError> {
-    let plan = spec.plan(quick);
+pub fn run_study(spec: &StudySpec, out: &Path, depth: Depth, tick: impl Fn(&str)) -> Result<Vec<StudyRow>, StudyError> {
+    let plan = spec.plan(depth);
     let mut rows = Vec::new();
     for mesh in &spec.meshes {
         for &noise_m in &plan.noise_m {
@@ -124,7 +125,7 @@ pub fn run_study(spec: &StudySpec, out: &Path, quick: bool, tick: impl Fn(&str))
                 let runs = out.join("runs").join(&tag).join(&variant.name);
                 let plan = Plan::new(&case, &recordings, 1);
                 plan.begin(&runs)?;
-                let ran = run_batch(&plan, &runs, (0, false), || {})?;
+                let ran = run_batch(&plan, &runs, BatchOptions::default(), || {})?;
                 for (r, recording) in ran.iter().zip(&recordings) {
                     let dir = runs.join(&r.row.folder);
                     let scored = score_run(mesh, noise_m, variant, recording, &dir, spec.skip_elements)?;

@@ -150,9 +150,9 @@ impl StudySpec {
         Ok(spec)
     }
 
-    /// The noise levels, recordings and frames of a full or a quick run.
-    pub fn plan(&self, quick: bool) -> Plan {
-        if quick {
+    /// The noise levels, recordings and frames of a run at `depth`.
+    pub fn plan(&self, depth: crate::jobs::depth::Depth) -> Plan {
+        if depth.is_quick() {
             Plan { noise_m: self.quick.noise_m.clone(), recordings: self.quick.recordings, frames: self.quick.frames }
         } else {
             Plan { noise_m: self.noise_m.clone(), recordings: self.recordings, frames: self.frames }

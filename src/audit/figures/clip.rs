@@ -4,7 +4,7 @@ use std::collections::BTreeMap;
 
 use nalgebra::Vector3;
 
-use super::{frame_interval_s, label, line, pretty_key, run, Svg};
+use super::{frame_interval_s, label, line, pretty_key, run, Axes, Svg};
 use crate::audit::spec::{Selector, Spec};
 use crate::audit::{PointResult, RunResults};
 use crate::case::Case;
@@ -148,7 +148,7 @@ pub(super) fn objectives(
         if series.is_empty() || !positive {
             continue;
         }
-        panels.push(line(name.to_string(), "t [s]", y_label, series, (false, true)));
+        panels.push(line(name.to_string(), "t [s]", y_label, series, Axes::LOG_Y));
     }
     (!panels.is_empty()).then(|| render_figure_svg(title, &panels, 2))
 }
@@ -176,7 +176,7 @@ pub(super) fn omega(spec: &Spec, title: &str, names: &[String], runs: &[RunResul
             "t [s]",
             "max |ω| over the body [rad/s]",
             series,
-            (false, true),
+            Axes::LOG_Y,
         );
         render_figure_svg(title, &[panel], 1)
     })
@@ -252,5 +252,6 @@ fn profiles(all: &RunResults, frames: &[usize]) -> Option<LinePlot> {
     let y_label = if key == "lambda_d" { "∠(d3, ∂s x) per element [°]" } else { "κ3 [1/mm]" };
     let what = if key == "lambda_d" { "the detachment of d3 from the centreline's chord" } else { "the twist κ3" };
     let t = format!("{what} along the body at frame {}, for each {}", frame_no?, pretty_key(&key));
-    (!series.is_empty()).then(|| line(t, "arc length s [mm] (0 = head)", y_label, series, (false, key == "lambda_d")))
+    let axes = if key == "lambda_d" { Axes::LOG_Y } else { Axes::LINEAR };
+    (!series.is_empty()).then(|| line(t, "arc length s [mm] (0 = head)", y_label, series, axes))
 }

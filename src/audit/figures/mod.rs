@@ -10,7 +10,7 @@ use super::{PointResult, RunResults};
 use crate::case::Case;
 use crate::engine::metrics::Metric;
 use crate::figures::panels::render_figure_svg;
-use crate::figures::plot::{render_svg, Legend, LinePlot, Mark, Series};
+use crate::figures::plot::{render_svg, Legend, LinePlot, Mark, Scale, Series};
 use crate::io::files::write_plot;
 use crate::io::OutputError;
 use crate::solve::inverse::InverseMethod;
@@ -67,14 +67,30 @@ fn first_at<'a>(runs: &'a [RunResults], name: &str, at: &Selector) -> Option<&'a
     run(runs, name)?.select(at).find(|p| p.outcome.single.is_some() || p.outcome.clip.is_some())
 }
 
-fn line(title: String, x_label: &str, y_label: &str, series: Vec<Series>, log: (bool, bool)) -> LinePlot {
+/// The scales of a line plot's two axes.
+#[derive(Debug, Clone, Copy)]
+struct Axes {
+    x: Scale,
+    y: Scale,
+}
+
+impl Axes {
+    /// both axes linear
+    const LINEAR: Axes = Axes { x: Scale::Linear, y: Scale::Linear };
+    /// a linear x axis, a logarithmic y axis
+    const LOG_Y: Axes = Axes { x: Scale::Linear, y: Scale::Log };
+    /// both axes logarithmic
+    const LOG_LOG: Axes = Axes { x: Scale::Log, y: Scale::Log };
+}
+
+fn line(title: String, x_label: &str, y_label: &str, series: Vec<Series>, axes: Axes) -> LinePlot {
     LinePlot {
         title,
         x_label: x_label.into(),
         y_label: y_label.into(),
         series,
-        log_x: log.0,
-        log_y: log.1,
+        x_scale: axes.x,
+        y_scale: axes.y,
         ..Default::default()
     }
 }
@@ -180,7 +196,7 @@ fn tradeoff(title: &str, r: &RunResults, metric: &str) -> Option<Svg> {
         pts.iter().map(|p| p.0).collect(),
         pts.iter().map(|p| p.1).collect(),
     )];
-    Some(render_svg(&line(title.to_string(), "solve wall time [s]", metric, series, (true, true))))
+    Some(render_svg(&line(title.to_string(), "solve wall time [s]", metric, series, Axes::LOG_LOG)))
 }
 
 /// Figs. 9–11, 13: log-log histories of every point, one panel per measure. Each curve is
@@ -222,7 +238,7 @@ fn convergence(title: &str, r: &RunResults, rule: Option<f64>) -> Option<Svg> {
             .coloured(7)
         });
         series.extend(rule_line.clone());
-        let mut panel = line(y.to_string(), "iteration", y, series, (true, true));
+        let mut panel = line(y.to_string(), "iteration", y, series, Axes::LOG_LOG);
         // a run without a grid: one curve, described by the figure's title (and the rule's line)
         if single && rule_line.is_none() {
             panel.legend = Legend::Hidden;

@@ -2,7 +2,7 @@
 //! recovered centreline and curvature (Figs. 8, 12, 14) and the controls (Fig. 15).
 use nalgebra::Vector3;
 
-use super::{line, Svg};
+use super::{line, Axes, Svg};
 use crate::audit::measures::modal_tip_history;
 use crate::audit::PointResult;
 use crate::case::{Case, Reference};
@@ -26,7 +26,7 @@ pub(super) fn recovered(title: &str, p: &PointResult) -> Option<Svg> {
         let rec = r.nodes.x.iter().map(|x| x[c] * 1e3).collect();
         pos.push(Series::new(format!("{} recovered", comp[c]), s_mm.clone(), rec).coloured(c));
     }
-    let mut panels = vec![line("position".into(), "s [mm]", "x [mm]", pos, (false, false))];
+    let mut panels = vec![line("position".into(), "s [mm]", "x [mm]", pos, Axes::LINEAR)];
     if inv.angles_known {
         let (kd, kr) = (inv.data.element_curvature(), r.nodes.element_curvature());
         let sm: Vec<f64> = kd.iter().map(|(s, _)| s * 1e3).collect();
@@ -37,7 +37,7 @@ pub(super) fn recovered(title: &str, p: &PointResult) -> Option<Svg> {
             let rec = kr.iter().map(|(_, v)| v[c] * 1e-3).collect();
             k.push(Series::new(format!("κ{} recovered", c + 1), sm.clone(), rec).coloured(c));
         }
-        panels.push(line("curvature κ = A ∂sα (eq. 28)".into(), "s [mm]", "κ [1/mm]", k, (false, false)));
+        panels.push(line("curvature κ = A ∂sα (eq. 28)".into(), "s [mm]", "κ [1/mm]", k, Axes::LINEAR));
     }
     Some(render_figure_svg(title, &panels, 2))
 }
@@ -96,16 +96,16 @@ pub(super) fn controls(title: &str, case: &Case, p: &PointResult) -> Option<Svg>
         series
     };
     let global = "global frame e1, e2, e3";
-    let mut force = line(format!("force, {global}"), "s [mm]", "f [N/mm]", curves(0, 0..n), (false, false));
+    let mut force = line(format!("force, {global}"), "s [mm]", "f [N/mm]", curves(0, 0..n), Axes::LINEAR);
     force.bands = bands.clone();
-    let mut torque = line(format!("torque, {global}"), "s [mm]", "l [N mm/mm]", curves(1, 0..n), (false, false));
+    let mut torque = line(format!("torque, {global}"), "s [mm]", "l [N mm/mm]", curves(1, 0..n), Axes::LINEAR);
     torque.bands = bands;
     let inner = INNER_SKIP_ELEMENTS..n - INNER_SKIP_ELEMENTS;
     let zoom = |which: usize, what: &str, unit: &str| {
         let t = format!(
             "{what} without the {INNER_SKIP_ELEMENTS} end elements, within {DESIGN_WINDOW}× the design's largest"
         );
-        let mut panel = line(t, "s [mm]", unit, curves(which, inner.clone()), (false, false));
+        let mut panel = line(t, "s [mm]", unit, curves(which, inner.clone()), Axes::LINEAR);
         // the clamp's boundary layer reaches past the end elements: the window keeps the
         // design's scale readable (the upper panels draw every value)
         let scale = if which == 0 { 1e-3 } else { 1.0 };
@@ -136,7 +136,7 @@ pub(super) fn tip_history(title: &str, case: &Case, p: &PointResult) -> Option<S
             let y = m.iter().map(|v| v.position_m[c] * 1e3).collect();
             series.push(Series::new(format!("{name} tip, modal"), t.clone(), y).marked(Mark::Dashed));
         }
-        panels.push(line(format!("displacement {name}"), "t [s]", &format!("{name} [mm]"), series, (false, false)));
+        panels.push(line(format!("displacement {name}"), "t [s]", &format!("{name} [mm]"), series, Axes::LINEAR));
     }
     let mut rotation = Vec::new();
     for (c, name) in ["α", "β", "γ"].iter().enumerate() {
@@ -149,7 +149,7 @@ pub(super) fn tip_history(title: &str, case: &Case, p: &PointResult) -> Option<S
             rotation.push(Series::new(format!("{name}, modal"), t.clone(), y).marked(Mark::Dashed).coloured(c));
         }
     }
-    panels.push(line("rotation: the tip's angles".into(), "t [s]", "angle [rad]", rotation, (false, false)));
+    panels.push(line("rotation: the tip's angles".into(), "t [s]", "angle [rad]", rotation, Axes::LINEAR));
     Some(render_figure_svg(title, &panels, 2))
 }
 
@@ -200,6 +200,6 @@ pub(super) fn deflection(title: &str, pts: &[(&Case, &PointResult)]) -> Option<S
         s.colour = Some(0);
     }
     (!series.is_empty()).then(|| {
-        render_figure_svg(title, &[line("deflection y(s)".into(), "s [mm]", "y [mm]", series, (false, false))], 1)
+        render_figure_svg(title, &[line("deflection y(s)".into(), "s [mm]", "y [mm]", series, Axes::LINEAR)], 1)
     })
 }

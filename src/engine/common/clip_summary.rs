@@ -98,14 +98,24 @@ pub(crate) struct Summary {
 }
 
 impl Summary {
-    /// The summary of a run of a clip of `frames` frames (`truth`: with a ground truth).
-    pub(crate) fn new(truth: bool, frames: usize) -> Self {
+    /// The summary of a run of a clip of `frames` frames without a ground truth.
+    pub(crate) fn new(frames: usize) -> Self {
+        Summary::of(frames, None)
+    }
+
+    /// The summary of a run of a clip of `frames` frames with a ground truth to score against
+    /// (a synthetic recording's sidecar).
+    pub(crate) fn with_truth(frames: usize) -> Self {
+        Summary::of(frames, Some(TruthRun::default()))
+    }
+
+    fn of(frames: usize, truth: Option<TruthRun>) -> Self {
         Summary {
             run: ClipRun {
                 reports: Vec::new(),
                 roughness: Vec::new(),
                 kymograph: Kymograph::new(frames),
-                truth: truth.then(TruthRun::default),
+                truth,
                 wall_time_s: 0.0,
                 source: String::new(),
                 weights: None,

@@ -275,10 +275,18 @@ pub struct Difference {
 /// state, D27): compared only when both runs have them.
 pub const RUST_ONLY_METRICS: [Metric; 2] = [Metric::TangentSmallestEigenvalue, Metric::Stable];
 
+/// Whether [`differences`] compares the runs' iteration counts: where both engines run the same
+/// algorithm to the same rule (not where they run an equal count by construction).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Iterations {
+    Compared,
+    Ignored,
+}
+
 /// The quantities two runs of the same case are compared on: node-wise displacement, angles
 /// and (inverse) adjoints, the tip history of a dynamic run, the physical metrics, the recovery
-/// errors and, with `iterations`, the iteration counts.
-pub fn differences(a: &RunResult, b: &RunResult, iterations: bool) -> Vec<Difference> {
+/// errors and, as `iterations` says, the iteration counts.
+pub fn differences(a: &RunResult, b: &RunResult, iterations: Iterations) -> Vec<Difference> {
     let mut rows = Vec::new();
     let amax = |v: &[Vector3<f64>]| v.iter().fold(0.0_f64, |m, v| m.max(v.amax()));
     let disp_scale = amax(&a.nodes.displacement()).max(amax(&a.tip.iter().map(|t| t.position_m).collect::<Vec<_>>()));
@@ -352,7 +360,7 @@ pub fn differences(a: &RunResult, b: &RunResult, iterations: bool) -> Vec<Differ
             None,
         ));
     }
-    if iterations {
+    if iterations == Iterations::Compared {
         let (x, y) = (a.stats.iterations as f64, b.stats.iterations as f64);
         rows.push(Difference::scalar("iterations", Group::Iterations, Some(x), Some(y), None));
     }

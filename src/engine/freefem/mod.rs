@@ -389,12 +389,12 @@ pub(super) fn execute(
     let status = loop {
         if let Some(status) = child.try_wait().map_err(io(&script))? {
             if let Some(w) = watch.as_mut() {
-                w.poll(true);
+                w.read();
             }
             break status;
         }
         if let Some(w) = watch.as_mut() {
-            w.poll(false);
+            w.poll();
         }
         if crate::interrupt::requested() {
             let _ = child.kill();

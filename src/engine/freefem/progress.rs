@@ -73,12 +73,15 @@ impl Watch {
         Some(watch)
     }
 
-    /// Reads the count if [`POLL`] has passed since the last read (or `now`) and tells the
-    /// observer a new one.
-    pub(super) fn poll(&mut self, now: bool) {
-        if !now && self.polled.elapsed() < POLL {
-            return;
+    /// Reads the count ([`Watch::read`]) if [`POLL`] has passed since the last read.
+    pub(super) fn poll(&mut self) {
+        if self.polled.elapsed() >= POLL {
+            self.read();
         }
+    }
+
+    /// Reads the count now and tells the observer a new one.
+    pub(super) fn read(&mut self) {
         self.polled = Instant::now();
         // a missing file (not yet written) counts nothing
         let rows = std::fs::read(&self.file).map(|b| b.iter().filter(|&&c| c == b'\n').count()).unwrap_or(0);

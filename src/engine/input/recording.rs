@@ -168,7 +168,7 @@ impl Table {
             }
             out.push(pts);
         }
-        let info = recording_info(first, self.unit, self.planar, &out);
+        let info = info_of(first, self.unit, if self.planar { Some(PLANE_AXIS) } else { constant_axis(&out) });
         Ok(Recorded { frames: out, info })
     }
 }
@@ -333,7 +333,7 @@ fn npy_recorded(path: &Path, spec: &ReadSpec) -> Result<Recorded, InputError> {
     while let Some(pts) = reader.next_frame()? {
         out.push(pts);
     }
-    let info = recording_info(0, reader.unit(), reader.planar(), &out);
+    let info = info_of(0, reader.unit(), if reader.planar() { Some(PLANE_AXIS) } else { constant_axis(&out) });
     Ok(Recorded { frames: out, info })
 }
 
@@ -467,21 +467,19 @@ pub fn memory_recorded(
         .enumerate()
         .map(|(f, v)| frame_positions(name, f, (v, dims), spec.missing, metres))
         .collect::<Result<Vec<_>, _>>()?;
-    let info = recording_info(0, unit, dims == 2, &out);
+    let info = info_of(0, unit, if dims == 2 { Some(PLANE_AXIS) } else { constant_axis(&out) });
     Ok(Recorded { frames: out, info })
 }
 
-/// What a recording says about itself: its first frame number, its unit and its plane (z = 0
-/// for two coordinates, else an axis along which every position is the same).
-fn recording_info(first_frame: usize, unit: LengthUnit, planar: bool, frames: &[Vec<Vector3<f64>>]) -> RecordingInfo {
-    info_of(first_frame, unit, planar, if planar { None } else { constant_axis(frames) })
-}
+/// The axis normal to the plane z = 0 that a recording of two coordinates is placed in.
+pub(crate) const PLANE_AXIS: usize = 2;
 
-/// [`recording_info`] with the constant axis of the frames (`crate::clip::recording::ConstantAxes`)
-/// found as they were read.
-pub(crate) fn info_of(first_frame: usize, unit: LengthUnit, planar: bool, axis: Option<usize>) -> RecordingInfo {
-    let plane_normal = if planar { Some(Vector3::z()) } else { axis.map(|k| Vector3::ith(k, 1.0)) };
-    RecordingInfo { first_frame, unit, plane_normal }
+/// What a recording says about itself: its first frame number, its unit and its plane, normal
+/// to `axis`, the axis along which every position is the same, if there is one:
+/// [`PLANE_AXIS`] for a file of two coordinates, else found in its frames ([`constant_axis`],
+/// or `crate::clip::recording::ConstantAxes` as they are read).
+pub(crate) fn info_of(first_frame: usize, unit: LengthUnit, axis: Option<usize>) -> RecordingInfo {
+    RecordingInfo { first_frame, unit, plane_normal: axis.map(|k| Vector3::ith(k, 1.0)) }
 }
 
 #[cfg(test)]

@@ -18,7 +18,7 @@ use std::path::{Path, PathBuf};
 use nalgebra::{Matrix3, Vector3};
 
 use super::clip_files::{clip_source, read_spec, recording_source, ClipFileError};
-use super::recording::{info_of, NpyFrames, ReadSpec};
+use super::recording::{info_of, NpyFrames, ReadSpec, PLANE_AXIS};
 use super::truth_file::truth_sidecar;
 use crate::case::{Case, ClipKind, RodLength, WeightsRule};
 use crate::clip::length::{BodyLength, FrameLength};
@@ -55,8 +55,7 @@ fn survey(path: &Path, spec: &ReadSpec) -> Result<Option<Survey>, InputError> {
         length0_m.get_or_insert_with(|| polyline_length(&x));
     }
     let length0_m = length0_m.filter(|&l| l > 0.0);
-    let planar = reader.planar();
-    let info = info_of(0, reader.unit(), planar, if planar { None } else { axes.axis() });
+    let info = info_of(0, reader.unit(), if reader.planar() { Some(PLANE_AXIS) } else { axes.axis() });
     Ok(length0_m.map(|length0_m| Survey { frames, nodes, info, length0_m }))
 }
 

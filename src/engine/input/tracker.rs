@@ -152,7 +152,8 @@ pub fn write_tracker_corpus(
     let mut entries = Vec::with_capacity(p.count);
     for k in 0..p.count {
         let which = k % kymograms.len();
-        let entry = write_recording(dir, &rows[which], &kymograms[which], format!("worm_{k:0width$}"), k, p, &mut rng)?;
+        let played = Played { rows: &rows[which], file: &kymograms[which] };
+        let entry = write_recording(dir, played, format!("worm_{k:0width$}"), k, p, &mut rng)?;
         entries.push(entry);
     }
     let listing = serde_json::json!({ "params": p, "recordings": entries });
@@ -171,16 +172,23 @@ pub fn onto_plate(heading: f64) -> Matrix3<f64> {
     (rz * rx).into_inner()
 }
 
-/// Recording `k` (module doc).
+/// The kymogram a recording plays: its rows and the file they were read from.
+#[derive(Clone, Copy)]
+struct Played<'a> {
+    rows: &'a [Vec<f64>],
+    file: &'a Path,
+}
+
+/// Recording `k` (module doc), named `name`, playing `kymogram`.
 fn write_recording(
     dir: &Path,
-    rows: &[Vec<f64>],
-    kymogram: &Path,
+    kymogram: Played,
     name: String,
     k: usize,
     p: &TrackerParams,
     rng: &mut SplitMix64,
 ) -> Result<TrackerEntry, CorpusError> {
+    let rows = kymogram.rows;
     let length_m = p.lengths_m[k % p.lengths_m.len()];
     // the kymogram at the tracker's rate: (frames − 1) Δt of the kymogram's time
     let played = (((p.frames - 1) as f64 * p.dt_s * KYMOGRAM_FPS).round() as usize + 1).clamp(2, rows.len());
@@ -243,7 +251,7 @@ fn write_recording(
     Ok(TrackerEntry {
         name,
         length_m,
-        kymogram: kymogram.display().to_string(),
+        kymogram: kymogram.file.display().to_string(),
         rows: [first_row, first_row + played],
         heading_rad: heading,
         lost_frames: lost.iter().map(|&f| (p.first_frame + f, how(f).unwrap_or(""))).collect(),

@@ -27,7 +27,7 @@ pub enum Footprint {
 #[error(
     "{case}: {what} would need about {:.3e} GiB of memory (estimated from {basis}), above {}",
     .bytes / GIB,
-    limit_text(*.limit, *.address_space, key)
+    limit_text(*.limit, *.limit_source, key)
 )]
 pub struct BudgetError {
     /// the case file (or the case's name)
@@ -37,13 +37,22 @@ pub struct BudgetError {
     pub limit: f64,
     pub basis: String,
     pub key: &'static str,
-    /// the limit is the process's address-space limit (`ulimit -v`), below the one asked for
-    pub address_space: bool,
+    /// which limit the estimate exceeds
+    pub limit_source: LimitSource,
+}
+
+/// Which limit a [`BudgetError`]'s estimate exceeds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LimitSource {
+    /// the one asked for (`--max-memory-gib`, or its default)
+    Asked,
+    /// the process's address-space limit (`ulimit -v`), below the one asked for
+    AddressSpace,
 }
 
 /// The limit of a [`BudgetError`] and how to raise it.
-fn limit_text(limit: f64, address_space: bool, key: &str) -> String {
-    if address_space {
+fn limit_text(limit: f64, source: LimitSource, key: &str) -> String {
+    if source == LimitSource::AddressSpace {
         format!(
             "the process's address-space limit of {:.1} MiB (ulimit -v); reduce {key} or raise that limit",
             limit / (1024.0 * 1024.0)
@@ -168,9 +177,9 @@ pub fn estimate(case: &Case, what: Footprint) -> (f64, String, &'static str) {
 /// address-space limit where that is lower (an allocation beyond it would fail mid-run).
 pub fn check(case: &Case, what: Footprint, limit_bytes: f64) -> Result<(), BudgetError> {
     let (bytes, basis, key) = estimate(case, what);
-    let (limit_bytes, address_space) = match address_space_limit() {
-        Some(a) if a < limit_bytes => (a, true),
-        _ => (limit_bytes, false),
+    let (limit_bytes, limit_source) = match address_space_limit() {
+        Some(a) if a < limit_bytes => (a, LimitSource::AddressSpace),
+        _ => (limit_bytes, LimitSource::Asked),
     };
     if bytes > limit_bytes {
         let what = match what {
@@ -178,7 +187,7 @@ pub fn check(case: &Case, what: Footprint, limit_bytes: f64) -> Result<(), Budge
             Footprint::Modes { .. } => "the modal analysis",
         };
         let case = case.origin.source.as_ref().map(|p| p.display().to_string()).unwrap_or_else(|| case.name.clone());
-        return Err(BudgetError { case, what, bytes, limit: limit_bytes, basis, key, address_space });
+        return Err(BudgetError { case, what, bytes, limit: limit_bytes, basis, key, limit_source });
     }
     Ok(())
 }

@@ -190,7 +190,7 @@ pub fn run_clip_resumed<S: FrameSink>(
         dt_s,
     };
     let start = Instant::now();
-    let mut summary = Summary::new(has_truth, total);
+    let mut summary = if has_truth { Summary::with_truth(total) } else { Summary::new(total) };
     let resumed = resume_summary(&deriver, &mut arrivals, resume, sp.frame_offset, &mut summary)?;
     // room for about 0.1 s of frames: the output thread falls behind while a streamed clip's
     // generator shares its core (the first 0.25 s of worm_roll_3d), and catches up after
