@@ -356,9 +356,15 @@ def run_case(
     """
     text, path = _case_source(case)
     folder = None if out is None else os.fspath(out)
-    result = _native.run_case(
-        text, path, _overrides(overrides), engine, progress, cancel, folder, bool(force), output_format
-    )
+    settings = {
+        "engine": engine,
+        "progress": progress,
+        "cancel": cancel,
+        "out": folder,
+        "force": bool(force),
+        "output_format": output_format,
+    }
+    result = _native.run_case(text, path, _overrides(overrides), settings)
     if "frames" in result:
         _add_weights(result, None, None)
     return result
@@ -405,7 +411,8 @@ def compare(
         if frames < 1:
             raise ValueError(f"frames = {frames}: at least 1 frame (or \"all\")")
     text, path = _case_source(case)
-    return _native.compare(text, path, _overrides(overrides), bool(short), frames, cancel)
+    settings = {"short": bool(short), "frames": frames, "cancel": cancel}
+    return _native.compare(text, path, _overrides(overrides), settings)
 
 
 def synth(
@@ -434,10 +441,18 @@ def synth(
     """
     out = []
     with tempfile.TemporaryDirectory(prefix="cosserat-synth-") as tmp:
-        entries = _native.write_corpus(
-            tmp, os.fspath(kymogram), int(count), int(frames), int(nodes), float(length_m),
-            float(frame_interval_s), float(noise_m), int(seed), float(max_roll_rad), float(max_twist_per_m),
-        )
+        settings = {
+            "count": int(count),
+            "frames": int(frames),
+            "nodes": int(nodes),
+            "length_m": float(length_m),
+            "frame_interval_s": float(frame_interval_s),
+            "noise_m": float(noise_m),
+            "seed": int(seed),
+            "max_roll_rad": float(max_roll_rad),
+            "max_twist_per_m": float(max_twist_per_m),
+        }
+        entries = _native.write_corpus(tmp, os.fspath(kymogram), settings)
         for e in entries:
             x = np.load(os.path.join(tmp, e["name"] + ".npy"))
             t = np.load(os.path.join(tmp, e["name"] + ".truth.npy"))

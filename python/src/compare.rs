@@ -43,19 +43,30 @@ fn interrupted(e: &CompareError) -> bool {
     }
 }
 
+/// The keywords of `cosserat.compare` after the case, as the package's wrapper passes them (a
+/// dict with every key).
+#[derive(FromPyObject)]
+#[pyo3(from_item_all)]
+pub struct CompareSettings<'py> {
+    /// the short horizon (`--short`)
+    short: bool,
+    /// a clip's frames to compare (`--frames`; `usize::MAX`: all)
+    frames: Option<usize>,
+    cancel: Option<Bound<'py, Cancel>>,
+}
+
 /// Compare the case of the file `case_path` (or of `case_text`) with `overrides` in both
-/// engines; see `cosserat.compare`. FreeFEM works in a temporary folder, removed afterwards.
+/// engines as `settings` say; see `cosserat.compare`. FreeFEM works in a temporary folder,
+/// removed afterwards.
 #[pyfunction]
-#[pyo3(signature = (case_text, case_path, overrides, short=false, frames=None, cancel=None))]
 pub fn compare<'py>(
     py: Python<'py>,
     case_text: Option<&str>,
     case_path: &str,
     overrides: Vec<(String, Bound<'py, PyAny>)>,
-    short: bool,
-    frames: Option<usize>,
-    cancel: Option<Bound<'py, Cancel>>,
+    settings: CompareSettings<'py>,
 ) -> PyResult<Vec<Bound<'py, PyDict>>> {
+    let CompareSettings { short, frames, cancel } = settings;
     let o = crate::case::overrides(&overrides)?;
     let case = py.detach(|| load_case(case_text, case_path, &o))?;
     if let Some(why) = cosserat::engine::published::unavailable(&case) {

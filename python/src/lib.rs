@@ -79,25 +79,37 @@ pub(crate) fn result_dict<'py>(py: Python<'py>, case: &Case, r: &RunResult, d: &
     Ok(())
 }
 
-/// Run the case of the file `case_path` (or of `case_text`) with `overrides` in `engine`
-/// (`"rust"` or `"freefem"`); see `cosserat.run_case`. A clip case runs as [`clip::run_clip`];
-/// with `out`, into that folder ([`folder::run_into_folder`]).
+/// The keywords of `cosserat.run_case` after the case, as the package's wrapper passes them
+/// (a dict with every key).
+#[derive(FromPyObject)]
+#[pyo3(from_item_all)]
+struct RunSettings<'py> {
+    /// `"rust"` or `"freefem"`
+    engine: String,
+    /// called as `progress(done, total)`
+    progress: Option<Bound<'py, PyAny>>,
+    cancel: Option<Bound<'py, Cancel>>,
+    /// the output folder, if the run writes one
+    out: Option<String>,
+    /// `--force` for `out`
+    force: bool,
+    /// `"csv"` or `"compact"`, for `out`
+    output_format: String,
+}
+
+/// Run the case of the file `case_path` (or of `case_text`) with `overrides` as `settings`
+/// say, in their engine (`"rust"` or `"freefem"`); see `cosserat.run_case`. A clip case runs
+/// as [`clip::run_clip`]; with `out`, into that folder ([`folder::run_into_folder`]).
 #[pyfunction]
-#[pyo3(signature = (case_text, case_path, overrides, engine="rust", progress=None, cancel=None, out=None, force=false, output_format="csv"))]
-#[allow(clippy::too_many_arguments)]
 fn run_case<'py>(
     py: Python<'py>,
     case_text: Option<&str>,
     case_path: &str,
     overrides: Vec<(String, Bound<'py, PyAny>)>,
-    engine: &str,
-    progress: Option<Bound<'py, PyAny>>,
-    cancel: Option<Bound<'py, Cancel>>,
-    out: Option<&str>,
-    force: bool,
-    output_format: &str,
+    settings: RunSettings<'py>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let engine = match engine {
+    let RunSettings { engine, progress, cancel, out, force, output_format } = settings;
+    let engine = match engine.as_str() {
         "rust" => Engine::Rust,
         "freefem" => Engine::Freefem,
         other => {
@@ -109,8 +121,8 @@ fn run_case<'py>(
     if let Some(why) = cosserat::jobs::solved::unsupported(&case, engine) {
         return Err(BindError::Unsupported(why).into());
     }
-    if let Some(out) = out {
-        let opts = folder::FolderOptions { out, force, format: output_format };
+    if let Some(out) = out.as_deref() {
+        let opts = folder::FolderOptions { out, force, format: &output_format };
         return folder::run_into_folder(py, &case, engine, opts, progress, cancel.as_ref());
     }
     if case.clip().is_some() {
@@ -197,25 +209,48 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     Ok(())
 }
 
-/// Write a corpus of synthetic recordings into `dir` (as `cosserat synth`); see `cosserat.synth`.
+/// The keywords of `cosserat.synth` but the kymogram, as the package's wrapper passes them (a
+/// dict with every key; units as `cosserat.synth` documents them).
+#[derive(FromPyObject)]
+#[pyo3(from_item_all)]
+struct CorpusSettings {
+    count: usize,
+    frames: usize,
+    nodes: usize,
+    /// [m]
+    length_m: f64,
+    /// [s]
+    frame_interval_s: f64,
+    /// [m]
+    noise_m: f64,
+    seed: u64,
+    /// [rad]
+    max_roll_rad: f64,
+    /// [rad/m]
+    max_twist_per_m: f64,
+}
+
+/// Write a corpus of synthetic recordings of `settings` into `dir` from the kymogram
+/// `kymogram` (as `cosserat synth`); see `cosserat.synth`.
 #[pyfunction]
-#[pyo3(signature = (dir, kymogram, count, frames, nodes, length_m, frame_interval_s, noise_m, seed, max_roll_rad, max_twist_per_m))]
-#[allow(clippy::too_many_arguments)]
 fn write_corpus<'py>(
     py: Python<'py>,
     dir: &str,
     kymogram: &str,
-    count: usize,
-    frames: usize,
-    nodes: usize,
-    length_m: f64,
-    frame_interval_s: f64,
-    noise_m: f64,
-    seed: u64,
-    max_roll_rad: f64,
-    max_twist_per_m: f64,
+    settings: CorpusSettings,
 ) -> PyResult<Bound<'py, PyAny>> {
     use cosserat::engine::input::corpus::{write_corpus as write, CorpusParams};
+    let CorpusSettings {
+        count,
+        frames,
+        nodes,
+        length_m,
+        frame_interval_s,
+        noise_m,
+        seed,
+        max_roll_rad,
+        max_twist_per_m,
+    } = settings;
     let params = CorpusParams {
         count,
         frames,
