@@ -1,4 +1,4 @@
-//! Judging a claim: the check of its spec on the runs' points gives an [`Outcome`] (holds,
+//! Judging a claim: the check of its spec on the runs' points gives a [`Holding`] (holds,
 //! holds in part, fails) and our numbers as text; the verdict follows from the outcome and the
 //! claim's declared fallbacks. Numbers are written as `numbers` says: two significant digits,
 //! counts exactly, a value beside its reference with the digits that show their difference.
@@ -6,7 +6,7 @@ use super::cause::{fill, PointState};
 use super::convergence::{converges, met_rule, Claimed};
 use super::numbers::{against, input, sig2};
 use super::points::{key_of, outcome, point_label, select, values};
-pub use super::points::{CheckError, Outcome};
+pub use super::points::{CheckError, Holding};
 use super::spec::{Check, Claim, Ref, Selector, Spec};
 use super::{ClaimResult, PointResult, RunResults, Verdict};
 use crate::jobs::sweep::NOT_STARTED;
@@ -40,10 +40,10 @@ fn one<'a>(runs: &'a [RunResults], r: &Ref) -> Result<&'a PointResult, CheckErro
 }
 
 /// Evaluate a check: its outcome and our numbers.
-pub fn evaluate(check: &Check, runs: &[RunResults]) -> (Outcome, String) {
+pub fn evaluate(check: &Check, runs: &[RunResults]) -> (Holding, String) {
     match evaluate_inner(check, runs) {
         Ok(r) => r,
-        Err(e) => (Outcome::Fails, format!("not evaluated: {e}")),
+        Err(e) => (Holding::Fails, format!("not evaluated: {e}")),
     }
 }
 
@@ -55,7 +55,7 @@ fn split_by<'a>(
 }
 
 /// The outcome and text of `check`, one stage per kind of check.
-fn evaluate_inner(check: &Check, runs: &[RunResults]) -> Result<(Outcome, String), CheckError> {
+fn evaluate_inner(check: &Check, runs: &[RunResults]) -> Result<(Holding, String), CheckError> {
     match check {
         Check::Converges { run } => converges(runs, run, Claimed::Converges),
         Check::DoesNotConverge { run, with } => {
@@ -64,9 +64,9 @@ fn evaluate_inner(check: &Check, runs: &[RunResults]) -> Result<(Outcome, String
                 let (o, text) = converges(runs, w, Claimed::DoesNotConverge)?;
                 all.1.push_str(&format!("; {w}: {text}"));
                 all.0 = match (all.0, o) {
-                    (Outcome::Holds, Outcome::Holds) => Outcome::Holds,
-                    (Outcome::Fails, Outcome::Fails) => Outcome::Fails,
-                    _ => Outcome::Partly,
+                    (Holding::Holds, Holding::Holds) => Holding::Holds,
+                    (Holding::Fails, Holding::Fails) => Holding::Fails,
+                    _ => Holding::Partly,
                 };
             }
             Ok(all)
@@ -88,9 +88,9 @@ fn evaluate_inner(check: &Check, runs: &[RunResults]) -> Result<(Outcome, String
                 let (o, text) = within_factor(runs, run, m, *factor, with)?;
                 worst.1.push_str(&format!("; {text}"));
                 worst.0 = match (worst.0, o) {
-                    (Outcome::Fails, _) | (_, Outcome::Fails) => Outcome::Fails,
-                    (Outcome::Partly, _) | (_, Outcome::Partly) => Outcome::Partly,
-                    _ => Outcome::Holds,
+                    (Holding::Fails, _) | (_, Holding::Fails) => Holding::Fails,
+                    (Holding::Partly, _) | (_, Holding::Partly) => Holding::Partly,
+                    _ => Holding::Holds,
                 };
             }
             Ok(worst)
@@ -142,7 +142,7 @@ fn threshold(
     limit: f64,
     at: &Selector,
     side: Side,
-) -> Result<(Outcome, String), CheckError> {
+) -> Result<(Holding, String), CheckError> {
     let mut pts = select(runs, run, at)?;
     let mut list = metric_list(&pts, metric, limit);
     for w in with {
@@ -157,7 +157,7 @@ fn threshold(
 }
 
 /// `increasing`: `metric` rises along the run's single grid key.
-fn increasing(runs: &[RunResults], run: &str, metric: &str) -> Result<(Outcome, String), CheckError> {
+fn increasing(runs: &[RunResults], run: &str, metric: &str) -> Result<(Holding, String), CheckError> {
     let pts = select(runs, run, &Selector::new())?;
     let mut sorted = pts.clone();
     sorted.sort_by(|a, b| {
@@ -184,7 +184,7 @@ fn ratio(
     denominator: &Ref,
     limit: f64,
     side: Side,
-) -> Result<(Outcome, String), CheckError> {
+) -> Result<(Holding, String), CheckError> {
     let (a, b) = (one(runs, numerator)?, one(runs, denominator)?);
     let missing = |p: &PointResult| CheckError::MissingMetric { metric: metric.to_string(), point: point_label(p) };
     let (va, vb) = (a.metric(metric).ok_or_else(|| missing(a))?, b.metric(metric).ok_or_else(|| missing(b))?);
@@ -202,7 +202,7 @@ fn ratio(
         side.symbol(),
         input(limit)
     );
-    Ok((if pass { Outcome::Holds } else { Outcome::Fails }, text))
+    Ok((if pass { Holding::Holds } else { Holding::Fails }, text))
 }
 
 /// `within_factor`: `max / min` of the magnitudes of `metric` over the points of `run` and of
@@ -213,7 +213,7 @@ fn within_factor(
     metric: &str,
     factor: f64,
     with: &[String],
-) -> Result<(Outcome, String), CheckError> {
+) -> Result<(Holding, String), CheckError> {
     let empty = Selector::new();
     let mut pts = select(runs, run, &empty)?;
     // (run, point) names for a check across runs
@@ -244,11 +244,11 @@ fn within_factor(
     );
     // every value 0 (a term whose weight is 0): the same everywhere
     let o = if hi <= lo * factor || hi == 0.0 {
-        Outcome::Holds
+        Holding::Holds
     } else if best > 1 {
-        Outcome::Partly
+        Holding::Partly
     } else {
-        Outcome::Fails
+        Holding::Fails
     };
     Ok((o, text))
 }
@@ -261,7 +261,7 @@ fn magnitude(
     value: f64,
     orders: f64,
     at: &Selector,
-) -> Result<(Outcome, String), CheckError> {
+) -> Result<(Holding, String), CheckError> {
     let pts = select(runs, run, at)?;
     let apart = |p: &PointResult| p.metric(metric).map(|v| (v.abs() / value).log10().abs());
     let (ok, _) = split_by(&pts, |p| apart(p).is_some_and(|o| o <= orders));
@@ -312,7 +312,7 @@ fn same_histories(
     history: &str,
     reference: &Selector,
     limit: f64,
-) -> Result<(Outcome, String), CheckError> {
+) -> Result<(Holding, String), CheckError> {
     let (base, hb, spreads) = history_spreads(runs, run, history, reference)?;
     let same_length = |n: usize| same_length(n, hb.len());
     let good = spreads.iter().filter(|(_, s)| s.is_some_and(|(s, n)| s <= limit && same_length(n))).count();
@@ -423,7 +423,7 @@ pub fn judge(spec: &Spec, claim: &Claim, runs: &[RunResults]) -> ClaimResult {
     let (o, mut ours) = evaluate(&claim.check, runs);
     // the cause explains a failure: none for a check that holds
     let cause = match (o, &claim.caveats.cause) {
-        (Outcome::Holds, _) | (_, None) => None,
+        (Holding::Holds, _) | (_, None) => None,
         (_, Some(text)) => Some(fill(text, &point_states(&claim.check, runs))),
     };
     if let Some(s) = &claim.caveats.substitute {
@@ -439,10 +439,10 @@ pub fn judge(spec: &Spec, claim: &Claim, runs: &[RunResults]) -> ClaimResult {
     // A claim on data we do not have is "not computable here" when its check holds on the
     // substitute; when it does not hold there either, the substitute's outcome decides.
     let verdict = match (o, claim.caveats.not_computable.is_some()) {
-        (Outcome::Holds, true) => Verdict::NotComputable,
-        (Outcome::Holds, false) => Verdict::Reproduced,
-        (Outcome::Partly, _) => claim.fallback.if_partly,
-        (Outcome::Fails, _) => claim.fallback.if_fails,
+        (Holding::Holds, true) => Verdict::NotComputable,
+        (Holding::Holds, false) => Verdict::Reproduced,
+        (Holding::Partly, _) => claim.fallback.if_partly,
+        (Holding::Fails, _) => claim.fallback.if_fails,
     };
     // a check weaker than the paper's words cannot reproduce it
     let verdict = match (verdict, &claim.caveats.partial) {

@@ -10,7 +10,7 @@
 //!   ([`super::newton_distance`]) set against the discretisation error the point reports
 //!   (`x_err_rel`, `kappa_err_rel` against the exact data). A clip says it per frame.
 use super::numbers::{input, sig2};
-use super::points::{failure, key_of, outcome, point_label, select, values, CheckError, Outcome};
+use super::points::{failure, key_of, outcome, point_label, select, values, CheckError, Holding};
 use super::spec::{Check, Selector};
 use super::{PointResult, RunResults};
 use crate::engine::metrics::Metric;
@@ -73,7 +73,7 @@ pub enum Claimed {
 /// `converges` (or `does_not_converge`, as `claimed`): the points that stop by the paper's
 /// rule, with their iterations, and why each other did not; the outcome counts the former
 /// (the latter).
-pub fn converges(runs: &[RunResults], run: &str, claimed: Claimed) -> Result<(Outcome, String), CheckError> {
+pub fn converges(runs: &[RunResults], run: &str, claimed: Claimed) -> Result<(Holding, String), CheckError> {
     let pts = select(runs, run, &Selector::new())?;
     let (ok, bad): (Vec<&PointResult>, Vec<&PointResult>) = pts.iter().partition(|p| met_rule(p));
     let key = key_of(&pts);

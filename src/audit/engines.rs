@@ -16,7 +16,7 @@ use std::path::{Path, PathBuf};
 
 use rayon::prelude::*;
 
-use super::check::{evaluate, scheme_deviations, stopped, Outcome};
+use super::check::{evaluate, scheme_deviations, stopped, Holding};
 use super::measures::derived_metrics;
 use super::spec::{Claim, Spec};
 use super::{ClaimResult, PointResult, RunResults, Verdict};
@@ -90,7 +90,7 @@ pub fn plan<'a>(specs: &'a [Spec], results: &[Vec<RunResults>], out: &Path) -> V
     for (i, (spec, runs)) in specs.iter().zip(results).enumerate() {
         for claim in &spec.claims {
             let Some(q) = reading(spec, claim) else { continue };
-            if runs.iter().all(|r| r.points.is_empty()) || evaluate(&claim.check, runs).0 == Outcome::Holds {
+            if runs.iter().all(|r| r.points.is_empty()) || evaluate(&claim.check, runs).0 == Holding::Holds {
                 continue;
             }
             for name in claim.check.runs() {
@@ -169,7 +169,7 @@ pub fn apply(spec: &Spec, claim: &Claim, c: &mut ClaimResult, reruns: &[(Variant
         }
         let (o, text) = evaluate(&claim.check, runs);
         // a check that could not be evaluated there refutes nothing
-        all_fail &= o != Outcome::Holds && !text.starts_with("not evaluated");
+        all_fail &= o != Holding::Holds && !text.starts_with("not evaluated");
         texts.push(format!("{}: {}", variant.label(), text));
     }
     c.engines = Some(format!("rerun in {}", texts.join("; ")));

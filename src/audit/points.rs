@@ -7,9 +7,9 @@ use super::{PointResult, RunResults};
 use crate::engine::metrics::Metric;
 use crate::solve;
 
-/// How far a check holds.
+/// How far a check holds (not an outcome of a run: that is `solve::Outcome`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Outcome {
+pub enum Holding {
     Holds,
     /// holds on some points of the grid only
     Partly,
@@ -87,12 +87,12 @@ pub fn select<'a>(runs: &'a [RunResults], run: &str, at: &Selector) -> Result<Ve
 }
 
 /// The outcome of a check that holds at `good` of `total` points.
-pub fn outcome(good: usize, total: usize) -> Outcome {
+pub fn outcome(good: usize, total: usize) -> Holding {
     if good == total {
-        Outcome::Holds
+        Holding::Holds
     } else if good > 0 {
-        Outcome::Partly
+        Holding::Partly
     } else {
-        Outcome::Fails
+        Holding::Fails
     }
 }

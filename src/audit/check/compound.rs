@@ -7,33 +7,33 @@
 use super::super::numbers::{input, sig2};
 use super::super::spec::{Check, Selector};
 use super::super::{PointResult, RunResults};
-use super::{evaluate, CheckError, Outcome};
+use super::{evaluate, CheckError, Holding};
 
 /// Two outcomes of one sentence together: holds when both hold, fails when both fail,
 /// partly otherwise.
-pub fn both(a: Outcome, b: Outcome) -> Outcome {
+pub fn both(a: Holding, b: Holding) -> Holding {
     match (a, b) {
-        (Outcome::Holds, Outcome::Holds) => Outcome::Holds,
-        (Outcome::Fails, Outcome::Fails) => Outcome::Fails,
-        _ => Outcome::Partly,
+        (Holding::Holds, Holding::Holds) => Holding::Holds,
+        (Holding::Fails, Holding::Fails) => Holding::Fails,
+        _ => Holding::Partly,
     }
 }
 
 /// `all`: each check's outcome and text, numbered; holds when every check holds, fails when
 /// every check fails, partly otherwise.
-pub fn all(checks: &[Check], runs: &[RunResults]) -> (Outcome, String) {
-    let results: Vec<(Outcome, String)> = checks.iter().map(|c| evaluate(c, runs)).collect();
-    let outcome = if results.iter().all(|r| r.0 == Outcome::Holds) {
-        Outcome::Holds
-    } else if results.iter().all(|r| r.0 == Outcome::Fails) {
-        Outcome::Fails
+pub fn all(checks: &[Check], runs: &[RunResults]) -> (Holding, String) {
+    let results: Vec<(Holding, String)> = checks.iter().map(|c| evaluate(c, runs)).collect();
+    let outcome = if results.iter().all(|r| r.0 == Holding::Holds) {
+        Holding::Holds
+    } else if results.iter().all(|r| r.0 == Holding::Fails) {
+        Holding::Fails
     } else {
-        Outcome::Partly
+        Holding::Partly
     };
-    let word = |o: Outcome| match o {
-        Outcome::Holds => "holds",
-        Outcome::Partly => "holds in part",
-        Outcome::Fails => "fails",
+    let word = |o: Holding| match o {
+        Holding::Holds => "holds",
+        Holding::Partly => "holds in part",
+        Holding::Fails => "fails",
     };
     let text: Vec<String> =
         results.iter().enumerate().map(|(i, (o, t))| format!("({}) {t} [{}]", i + 1, word(*o))).collect();
@@ -48,7 +48,7 @@ pub fn varies(
     with: &[String],
     metrics: &[String],
     factor: f64,
-) -> Result<(Outcome, String), CheckError> {
+) -> Result<(Holding, String), CheckError> {
     let mut pts: Vec<&PointResult> = Vec::new();
     for name in std::iter::once(run).chain(with.iter().map(String::as_str)) {
         let r = runs.iter().find(|r| r.name == name).ok_or_else(|| CheckError::NoRun { run: name.to_string() })?;
@@ -76,5 +76,5 @@ pub fn varies(
         parts.push(format!("{metric} {}", if spread.is_finite() { sig2(spread) } else { "∞".into() }));
     }
     let text = format!("max/min over {} points: {} (claim: some > {})", pts.len(), parts.join(", "), input(factor));
-    Ok((if varied { Outcome::Holds } else { Outcome::Fails }, text))
+    Ok((if varied { Holding::Holds } else { Holding::Fails }, text))
 }

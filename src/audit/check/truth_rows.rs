@@ -5,7 +5,7 @@ use super::super::numbers::{input, sig2};
 use super::super::spec::{Check, Selector};
 use super::super::RunResults;
 use super::compound::both;
-use super::{evaluate, CheckError, Outcome};
+use super::{evaluate, CheckError, Holding};
 
 /// `with_truth`: the outcome and text of `check`, with the errors against the truth of every
 /// point of the runs `runs` (`truth_bending_err_rel_mean`, `truth_twist_err_rel`); with
@@ -16,7 +16,7 @@ pub fn with_truth(
     runs: &[RunResults],
     names: &[String],
     (bending_below, twist_below): (Option<f64>, Option<f64>),
-) -> Result<(Outcome, String), CheckError> {
+) -> Result<(Holding, String), CheckError> {
     let (inner, mut text) = evaluate(check, runs);
     let (mut good, mut total) = (0usize, 0usize);
     let mut parts = Vec::new();
@@ -44,9 +44,9 @@ pub fn with_truth(
         .collect();
     text.push_str(&format!(" (claim: {})", limits.join(", ")));
     let truth = match good {
-        g if g == total => Outcome::Holds,
-        0 => Outcome::Fails,
-        _ => Outcome::Partly,
+        g if g == total => Holding::Holds,
+        0 => Holding::Fails,
+        _ => Holding::Partly,
     };
     Ok((both(inner, truth), text))
 }
