@@ -15,13 +15,7 @@ fn quick_audit_verdicts_are_the_recorded_ones() {
         spec_files(&dir).expect("specs").iter().map(|f| read_spec(f, Depth::Quick).expect("spec")).collect();
     assert!(specs.len() >= 5, "the audit covers §5.1, §5.2 (three specs) and §6");
     let out = tempfile::tempdir().expect("tempdir");
-    let opts = AuditOptions {
-        out: out.path().join("audit"),
-        jobs: 0,
-        fields: Default::default(),
-        resume: false,
-        engines: false,
-    };
+    let opts = AuditOptions::new(out.path().join("audit"));
     let report = run_audit(&specs, Depth::Quick, &opts, |_, _| {}).expect("audit");
 
     let wrong: Vec<String> = report
@@ -96,8 +90,7 @@ fn audit_folder_is_replaced_whole_or_refused() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/paper");
     let spec = read_spec(&dir.join("fig07_timoshenko.toml"), Depth::Quick).expect("spec");
     let out = tempfile::tempdir().expect("tempdir");
-    let opts =
-        AuditOptions { out: out.path().join("a"), jobs: 1, fields: Default::default(), resume: false, engines: false };
+    let opts = AuditOptions { jobs: 1, ..AuditOptions::new(out.path().join("a")) };
     run_audit(std::slice::from_ref(&spec), Depth::Quick, &opts, |_, _| {}).expect("first audit");
     let stale = opts.out.join("fig07_timoshenko/stale.txt");
     std::fs::write(&stale, "from an older audit").expect("write");
@@ -107,14 +100,10 @@ fn audit_folder_is_replaced_whole_or_refused() {
     let foreign = out.path().join("mine");
     std::fs::create_dir_all(&foreign).expect("mkdir");
     std::fs::write(foreign.join("thesis.tex"), "keep me").expect("write");
-    let err = run_audit(
-        &[spec],
-        Depth::Quick,
-        &AuditOptions { out: foreign.clone(), jobs: 1, fields: Default::default(), resume: false, engines: false },
-        |_, _| {},
-    )
-    .err()
-    .expect("a foreign folder is refused");
+    let err =
+        run_audit(&[spec], Depth::Quick, &AuditOptions { jobs: 1, ..AuditOptions::new(foreign.clone()) }, |_, _| {})
+            .err()
+            .expect("a foreign folder is refused");
     assert!(err.to_string().contains("not an audit folder"), "{err}");
     assert!(foreign.join("thesis.tex").is_file());
 }
@@ -127,13 +116,7 @@ fn tradeoff_figure_lists_every_point_with_its_time_and_error() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/bench/accuracy_per_second.toml");
     let spec = read_spec(&path, Depth::Quick).expect("spec");
     let out = tempfile::tempdir().expect("tempdir");
-    let opts = AuditOptions {
-        out: out.path().join("aps"),
-        jobs: 1,
-        fields: Default::default(),
-        resume: false,
-        engines: false,
-    };
+    let opts = AuditOptions { jobs: 1, ..AuditOptions::new(out.path().join("aps")) };
     let report = run_audit(std::slice::from_ref(&spec), Depth::Quick, &opts, |_, _| {}).expect("audit");
     assert!(report.claims.iter().all(|c| c.verdict == Some(Verdict::Reproduced)), "{:?}", report.claims[0].ours);
     let csv = std::fs::read_to_string(opts.out.join("accuracy_per_second/accuracy_per_second.csv")).expect("csv");
@@ -182,13 +165,7 @@ expect = "reproduced"
     let path = tmp.path().join("failed.toml");
     std::fs::write(&path, spec).expect("spec");
     let spec = read_spec(&path, Depth::Quick).expect("spec");
-    let opts = AuditOptions {
-        out: tmp.path().join("out"),
-        jobs: 1,
-        fields: Default::default(),
-        resume: false,
-        engines: false,
-    };
+    let opts = AuditOptions { jobs: 1, ..AuditOptions::new(tmp.path().join("out")) };
     let report = run_audit(&[spec], Depth::Quick, &opts, |_, _| {}).expect("report written");
     assert!(matches!(&report.status, AuditStatus::Failed(e) if e.len() == 1 && e[0].contains("eq63_curve_rel_eror")));
     assert_eq!((report.unjudged(), report.counts()), (1, [1, 0, 0, 0]));
@@ -517,13 +494,7 @@ ours = true
     let err = read(spec("refuted", "agrees very well", "")).expect_err("refused");
     assert!(err.to_string().contains("both engines"), "{err}");
     let spec = read(spec("differs", "agrees very well", "")).expect("spec");
-    let opts = AuditOptions {
-        out: tmp.path().join("out"),
-        jobs: 1,
-        fields: Default::default(),
-        resume: false,
-        engines: false,
-    };
+    let opts = AuditOptions { jobs: 1, ..AuditOptions::new(tmp.path().join("out")) };
     let report = run_audit(&[spec], Depth::Quick, &opts, |_, _| {}).expect("audit");
     // the same check, which holds (fig7-5pct): partial → differs; ours → reproduced, apart
     assert_eq!(report.claims[0].verdict, Some(Verdict::Differs), "{}", report.claims[0].ours);

@@ -246,6 +246,14 @@ pub struct AuditOptions {
     pub engines: bool,
 }
 
+impl AuditOptions {
+    /// An audit into `out`: one run per core, the default point fields, not resumed, the
+    /// Rust engine only.
+    pub fn new(out: PathBuf) -> Self {
+        AuditOptions { out, jobs: 0, fields: PointFields::default(), resume: false, engines: false }
+    }
+}
+
 /// What a clip point of the audit keeps in its folder. Its claims and the audit's figures
 /// read the series the audit records in memory ([`measures::ClipSeries`]), not these files.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
